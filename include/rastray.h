@@ -1,0 +1,196 @@
+/* rastray — ray casting and rasterization as one algorithm.
+ *
+ * One public header. Objects are opaque handles created and released in pairs;
+ * every call returns an rr_error and leaves a one-line message in its device
+ * (rr_device_message). There is no global mutable state: two devices never
+ * share anything. Option structs are filled with defaults by their _init()
+ * function so fields can be added later without breaking callers. */
+#ifndef RASTRAY_H
+#define RASTRAY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define RR_VERSION "0.1.0"
+#define RR_MISS 0xFFFFFFFFu /* primitive id of a sample that hits nothing */
+#define RR_MAX_SIZE 16384   /* largest image side accepted */
+
+typedef enum rr_error {
+  RR_OK = 0,
+  RR_ERROR_ARGUMENT,    /* a bad value passed by the caller */
+  RR_ERROR_IO,          /* a file could not be opened, read or written */
+  RR_ERROR_PARSE,       /* a file was read but its content is not understood */
+  RR_ERROR_EMPTY,       /* a scene with nothing to render */
+  RR_ERROR_MEMORY,      /* an allocation failed */
+  RR_ERROR_UNSUPPORTED  /* a valid request this build or method cannot do */
+} rr_error;
+
+typedef struct rr_device rr_device; /* owns error state; one per thread of control */
+typedef struct rr_scene rr_scene;   /* triangles, attributes, materials, BVH */
+typedef struct rr_frame rr_frame;   /* a visibility buffer plus its statistics */
+
+/* Creates a device; returns NULL only when out of memory. */
+rr_device *rr_device_new(void);
+/* Releases a device; its scenes and frames must be released first. */
+void rr_device_release(rr_device *dev);
+/* The code of the device's last failed call (RR_OK after a success). */
+rr_error rr_device_error(const rr_device *dev);
+/* A one-line message about the device's last failed call ("" after a success). */
+const char *rr_device_message(const rr_device *dev);
+
+/* ---- scenes -------------------------------------------------------------- */
+
+/* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...)
+ * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]",
+ * "grid:PATH:N" (N×N copies of a mesh on the XZ plane). */
+rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out);
+/* Creates an empty scene to be filled with rr_scene_add_mesh. */
+rr_error rr_scene_new(rr_device *dev, rr_scene **out);
+/* Appends an indexed triangle mesh (xyz positions, 3 indices per triangle, RGB
+ * base colour). Degenerate and non-finite triangles are skipped and counted. */
+rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
+                           const uint32_t *indices, size_t ntriangles, const float rgb[3]);
+/* Builds what rendering needs (the BVH); called implicitly by rr_scene_load. */
+rr_error rr_scene_commit(rr_scene *scene);
+/* Releases a scene. */
+void rr_scene_release(rr_scene *scene);
+
+typedef struct rr_scene_info {
+  uint64_t triangles;    /* triangles kept */
+  uint64_t skipped;      /* degenerate or non-finite triangles dropped at load */
+  uint32_t materials;    /* materials */
+  float bounds_min[3], bounds_max[3];
+  /* BVH (zero before it is built) */
+  uint64_t bvh_nodes, bvh_leaves;
+  uint32_t bvh_depth;
+  double bvh_sah_cost;
+  double bvh_build_ms;
+  uint64_t bvh_bytes;
+} rr_scene_info;
+
+/* Fills what is known about a scene. */
+rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
+
+/* ---- cameras ------------------------------------------------------------- */
+
+typedef enum rr_camera_type {
+  RR_CAMERA_PERSPECTIVE = 0
+} rr_camera_type;
+
+typedef struct rr_camera {
+  rr_camera_type type;
+  float eye[3], target[3], up[3];
+  float fov_deg; /* vertical field of view */
+} rr_camera;
+
+/* Fills a camera with defaults: perspective, eye (0,0,3) looking at the origin, y up, 45°. */
+void rr_camera_init(rr_camera *cam);
+/* Places eye and target so that the scene's bounds fill the view of cam->fov_deg. */
+rr_error rr_camera_frame(rr_device *dev, const rr_scene *scene, int width, int height,
+                         rr_camera *cam);
+/* Checks a camera (finite values, eye != target, up not parallel to the view). */
+rr_error rr_camera_check(rr_device *dev, const rr_camera *cam);
+
+/* ---- visibility ---------------------------------------------------------- */
+
+typedef enum rr_method {
+  RR_METHOD_RC = 0,   /* every sample × every triangle (Durand's loop) */
+  RR_METHOD_3DR_BB,   /* every triangle × the samples of its screen bounding box */
+  RR_METHOD_COUNT
+} rr_method;
+
+/* The method named `name` ("rc", "3dr-bb", ...); -1 when unknown. */
+int rr_method_from_name(const char *name);
+/* The name of a method ("rc", ...), NULL when out of range. */
+const char *rr_method_name(int method);
+
+typedef struct rr_render_options {
+  rr_method method;
+  int width, height;  /* image size in samples (one per pixel) */
+  int threads;        /* 0: all cores */
+  int cull_backfaces; /* nonzero: triangles seen from behind are invisible */
+} rr_render_options;
+
+/* Fills options with defaults: 3dr-bb, 1024x768, all cores, no culling. */
+void rr_render_options_init(rr_render_options *opt);
+
+typedef struct rr_stats {
+  uint64_t setups;     /* S: triangle setups computed */
+  uint64_t edge_evals; /* E: one triangle's three edge functions at one sample or bin corner */
+  uint64_t nodes;      /* N: BVH nodes visited */
+  double frame_ms;     /* wall time of the visibility pass */
+  int threads;         /* threads the pass ran on */
+} rr_stats;
+
+/* Computes primary visibility of a scene from a camera into a new frame. */
+rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                   const rr_render_options *opt, rr_frame **out);
+/* Releases a frame. */
+void rr_frame_release(rr_frame *frame);
+/* The statistics of the pass that made the frame. */
+rr_error rr_frame_get_stats(const rr_frame *frame, rr_stats *stats);
+/* Width and height of the frame's visibility buffer. */
+rr_error rr_frame_get_size(const rr_frame *frame, int *width, int *height);
+/* Read-only views of the visibility buffer, row 0 at the top: primitive id
+ * (RR_MISS on a miss), ray parameter t along the unnormalised camera ray
+ * (+inf on a miss) and barycentrics λ1, λ2 of the hit. */
+const uint32_t *rr_frame_ids(const rr_frame *frame);
+const float *rr_frame_t(const rr_frame *frame);
+const float *rr_frame_bary1(const rr_frame *frame);
+const float *rr_frame_bary2(const rr_frame *frame);
+
+/* ---- shading and images -------------------------------------------------- */
+
+typedef enum rr_shade_mode {
+  RR_SHADE_LAMBERT = 0, /* headlight over the material's base colour */
+  RR_SHADE_ID,          /* a stable hashed colour per triangle */
+  RR_SHADE_NORMAL,      /* shading normal mapped to colour */
+  RR_SHADE_DEPTH,       /* eye distance, near bright, far dark */
+  RR_SHADE_COUNT
+} rr_shade_mode;
+
+/* The shade mode named `name`; -1 when unknown. */
+int rr_shade_from_name(const char *name);
+
+typedef enum rr_aov {
+  RR_AOV_DEPTH = 0, /* 1 float: eye-to-hit distance, +inf on a miss */
+  RR_AOV_ID,        /* 1 uint32: primitive id, RR_MISS on a miss */
+  RR_AOV_NORMAL,    /* 3 floats: unit shading normal, 0 on a miss */
+  RR_AOV_BARY,      /* 2 floats: λ1, λ2, 0 on a miss */
+  RR_AOV_COUNT
+} rr_aov;
+
+/* The AOV named `name` ("depth", "id", "normal", "bary"); -1 when unknown. */
+int rr_aov_from_name(const char *name);
+
+typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
+
+/* An image owned by the caller or by rastray (rr_image_free). */
+typedef struct rr_image {
+  int width, height, channels;
+  rr_pixel_type type;
+  void *data; /* row-major, row 0 at the top, channels interleaved */
+} rr_image;
+
+/* Shades a frame into a new float RGB image, display-encoded in [0, 1]. */
+rr_error rr_shade(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                  const rr_frame *frame, rr_shade_mode mode, rr_image *out);
+/* Extracts an AOV of a frame into a new image. */
+rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                      const rr_frame *frame, rr_aov aov, rr_image *out);
+/* Frees the pixels of an image made by rastray. */
+void rr_image_free(rr_image *img);
+/* Writes an image; the format follows the extension (.png, .pfm, .exr, .npy).
+ * The file is written under a temporary name and renamed, so a failure leaves nothing. */
+rr_error rr_image_write(rr_device *dev, const rr_image *img, const char *path);
+/* Reads an image written by rr_image_write (.png, .pfm, .exr, .npy). */
+rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,246 @@
+/* rastray internal header: the data of each pipeline stage and the one sample test.
+ *
+ * Data flows one way: scene → BVH → camera → visibility → shading → image. */
+#ifndef RR_INTERNAL_H
+#define RR_INTERNAL_H
+
+#include "rastray.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+/* ---- device and errors --------------------------------------------------- */
+
+struct rr_device {
+  rr_error error;
+  char message[512];
+};
+
+/* Records a failure in dev (when not NULL) and returns its code. */
+rr_error rr_fail(rr_device *dev, rr_error code, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+/* Records success. */
+rr_error rr_ok(rr_device *dev);
+
+/* ---- small vector algebra ------------------------------------------------ */
+
+typedef struct { float x, y, z; } vec3;
+
+static inline vec3 v3(float x, float y, float z) { vec3 r = {x, y, z}; return r; }
+static inline vec3 v3_add(vec3 a, vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline vec3 v3_sub(vec3 a, vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline vec3 v3_scale(vec3 a, float s) { return v3(a.x * s, a.y * s, a.z * s); }
+static inline vec3 v3_neg(vec3 a) { return v3(-a.x, -a.y, -a.z); }
+static inline float v3_dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline vec3 v3_cross(vec3 a, vec3 b) {
+  return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline float v3_len(vec3 a) { return sqrtf(v3_dot(a, a)); }
+static inline vec3 v3_norm(vec3 a) { float l = v3_len(a); return l > 0 ? v3_scale(a, 1.0f / l) : a; }
+static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
+static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
+static inline float v3_get(vec3 a, int axis) { return axis == 0 ? a.x : axis == 1 ? a.y : a.z; }
+static inline vec3 v3_load(const float *p) { return v3(p[0], p[1], p[2]); }
+
+/* ---- scene --------------------------------------------------------------- */
+
+typedef struct rr_texture {
+  int width, height; /* 0 when the file could not be read */
+  uint8_t *rgb;      /* 3 bytes per texel, row 0 at the top */
+} rr_texture;
+
+typedef struct rr_material {
+  float color[3];
+  char *texture_path; /* NULL when the material names no texture */
+  rr_texture texture;
+} rr_material;
+
+/* Triangles in structure-of-arrays form: component c of vertex k of triangle i is
+ * p[k][c][i]. Normals and UVs are per triangle corner and may be NULL. */
+struct rr_scene {
+  rr_device *dev;
+  uint32_t ntris, cap;
+  float *p[3][3];
+  float *n[3][3];  /* optional vertex normals */
+  float *uv[3][2]; /* optional texture coordinates */
+  uint32_t *material;
+  rr_material *materials;
+  uint32_t nmaterials;
+  uint64_t skipped;
+  vec3 bmin, bmax;
+  struct rr_bvh *bvh; /* built by rr_scene_commit */
+};
+
+static inline vec3 scene_vertex(const rr_scene *s, int k, uint32_t i) {
+  return v3(s->p[k][0][i], s->p[k][1][i], s->p[k][2][i]);
+}
+
+/* Grows the scene to hold `more` triangles; with_normals/with_uvs allocate those arrays. */
+rr_error scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_uvs);
+/* Appends one triangle (positions, optional corner normals/uvs); drops and counts
+ * degenerate or non-finite ones. Returns true when kept. */
+bool scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv)[2], uint32_t mat);
+/* Adds a material and returns its index (UINT32_MAX when out of memory). */
+uint32_t scene_add_material(rr_scene *s, const float color[3], const char *texture_path);
+/* Recomputes bounds. */
+void scene_update_bounds(rr_scene *s);
+
+/* Loaders: assimp files and the built-in scenes. */
+rr_error scene_load_file(rr_scene *s, const char *path);
+/* Returns RR_OK when `name` named a built-in scene (and fills s), RR_ERROR_UNSUPPORTED
+ * when it is not a built-in name; other codes are real failures. */
+rr_error scene_load_builtin(rr_scene *s, const char *name);
+/* Loads the textures named by the materials (missing files leave textures empty). */
+void scene_load_textures(rr_scene *s, const char *base_dir);
+
+/* ---- BVH --------------------------------------------------------------------- */
+
+struct rr_bvh;
+/* Frees the scene's BVH (if any). */
+void scene_free_bvh(rr_scene *s);
+/* Adds the BVH's figures to a scene's info. */
+void bvh_fill_info(const rr_scene *s, rr_scene_info *info);
+
+/* ---- camera -------------------------------------------------------------- */
+
+/* A camera resolved for an image: an orthonormal basis and, for planar cameras,
+ * the ray direction of sample (sx, sy) as d0 + sx·dx + sy·dy, where the sample of
+ * pixel (x, y) is (x + 0.5, y + 0.5) and row 0 is at the top. */
+typedef struct camera {
+  rr_camera_type type;
+  int width, height;
+  vec3 eye, right, up, fwd;
+  vec3 d0, dx, dy;
+  float tan_half_h, tan_half_w;
+} camera;
+
+/* Resolves a public camera for an image size. */
+rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *out);
+/* The (unnormalised) ray direction of sample (sx, sy). */
+static inline vec3 camera_dir(const camera *c, float sx, float sy) {
+  return v3_add(c->d0, v3_add(v3_scale(c->dx, sx), v3_scale(c->dy, sy)));
+}
+/* Projects a point given relative to the eye to sample coordinates; false when it
+ * is not strictly in front of the eye. */
+bool camera_project(const camera *c, vec3 p, float *sx, float *sy);
+
+/* ---- triangle setup and the one sample test ----------------------------- */
+
+/* A triangle set up for an eye and a planar camera (paper eqs. 1–3). Edge i's 3D
+ * edge function at sample (sx, sy) is V_i = a[i] + sx·b[i] + sy·c[i]; all values are
+ * sign-normalised so that the inside is positive whichever face is seen. */
+typedef struct tri_setup {
+  float a[3], b[3], c[3];
+  float vol;    /* |V|, the scaled volume of the tetrahedron eye–triangle */
+  uint32_t tie; /* bit i: a sample exactly on edge i belongs to this triangle */
+} tri_setup;
+
+enum { SETUP_CULLED = 0, SETUP_FRONT = 1, SETUP_BACK = 2 };
+
+/* Sets up triangle `i` of `s` for camera `c` (eye at origin). Returns SETUP_FRONT,
+ * SETUP_BACK, or SETUP_CULLED when the triangle cannot be seen (its plane holds the
+ * eye, or it is a back face and cull_backfaces is set). */
+int tri_setup_planar(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces,
+                     tri_setup *out);
+
+/* The three edge functions of a set-up triangle at a sample. The evaluation order
+ * is fixed (no FMA contraction: the build uses -ffp-contract=off) so every method
+ * computes the same bits for the same (triangle, sample). */
+static inline void tri_edges(const tri_setup *t, float sx, float sy, float e[3]) {
+  for (int i = 0; i < 3; i++) e[i] = t->a[i] + sx * t->b[i] + sy * t->c[i];
+}
+
+/* The one sample test (paper eq. 2 with the top-left rule of sect. 4.2).
+ * e: sign-normalised edge values at the sample; tie: bit i set when the sample
+ * belongs to this triangle if it lies exactly on edge i; vol: |V|.
+ * On a hit returns true with t = V / ΣV_i and λ_i = V_i / ΣV_i. */
+static inline bool sample_test(const float e[3], uint32_t tie, float vol,
+                               float *t, float *l1, float *l2) {
+  bool in0 = e[0] > 0.0f || (e[0] == 0.0f && (tie & 1u));
+  bool in1 = e[1] > 0.0f || (e[1] == 0.0f && (tie & 2u));
+  bool in2 = e[2] > 0.0f || (e[2] == 0.0f && (tie & 4u));
+  if (!(in0 & in1 & in2)) return false;
+  float sum = e[0] + e[1] + e[2];
+  if (!(sum > 0.0f)) return false; /* all three on their edges: a degenerate sliver */
+  float inv = 1.0f / sum;
+  *t = vol * inv;
+  *l1 = e[1] * inv;
+  *l2 = e[2] * inv;
+  return true;
+}
+
+/* ---- visibility buffer and frames --------------------------------------- */
+
+typedef struct visbuf {
+  int width, height;
+  uint32_t *id;
+  float *t, *l1, *l2;
+} visbuf;
+
+/* The depth test shared by every method: nearer wins; on equal t the lower id wins,
+ * so the result does not depend on the order in which triangles are visited. */
+static inline bool depth_wins(float t, uint32_t id, float best_t, uint32_t best_id) {
+  return t < best_t || (t == best_t && id < best_id);
+}
+
+/* Tests one set-up triangle at one sample and keeps it when it is nearer. */
+static inline bool shade_sample(const tri_setup *ts, uint32_t id, float sx, float sy,
+                                visbuf *vb, size_t k) {
+  float e[3], t, l1, l2;
+  tri_edges(ts, sx, sy, e);
+  if (!sample_test(e, ts->tie, ts->vol, &t, &l1, &l2)) return false;
+  if (!depth_wins(t, id, vb->t[k], vb->id[k])) return false;
+  vb->t[k] = t;
+  vb->id[k] = id;
+  vb->l1[k] = l1;
+  vb->l2[k] = l2;
+  return true;
+}
+
+struct rr_frame {
+  visbuf vb;
+  rr_stats stats;
+  rr_method method;
+};
+
+/* A pass of a method: fills vb (cleared to misses) and adds to stats. */
+typedef struct render_ctx {
+  const rr_scene *scene;
+  const camera *cam;
+  const rr_render_options *opt;
+  int threads;
+  visbuf *vb;
+  rr_stats *stats;
+} render_ctx;
+
+typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
+
+rr_error vis_rc(rr_device *dev, render_ctx *ctx);
+/* The inclusive pixel rectangle a triangle's samples may lie in; false when none. */
+bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int rect[4]);
+/* Tests every sample of an inclusive rectangle against one set-up triangle and
+ * returns the number of edge-function evaluations. */
+uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], visbuf *vb);
+rr_error vis_3dr_bb(rr_device *dev, render_ctx *ctx);
+
+/* ---- threads --------------------------------------------------------------- */
+
+/* Runs fn(job, thread, arg) for job = 0..njobs-1, dealt out dynamically to
+ * `threads` threads (the caller's thread is one of them). */
+typedef void (*parallel_fn)(int job, int thread, void *arg);
+void parallel_for(int njobs, int threads, parallel_fn fn, void *arg);
+/* Number of cores available. */
+int cpu_count(void);
+/* Milliseconds on a monotonic clock. */
+double now_ms(void);
+
+/* ---- images ---------------------------------------------------------------- */
+
+/* Writers and readers by extension, in image_io.c. */
+rr_error image_write_file(rr_device *dev, const rr_image *img, const char *path);
+rr_error image_read_file(rr_device *dev, const char *path, rr_image *out);
+
+#endif

@@ -1,0 +1,193 @@
+/* Scene storage: triangles in structure-of-arrays form, materials, bounds. */
+#include "rr.h"
+
+#include <string.h>
+
+rr_error rr_scene_new(rr_device *dev, rr_scene **out) {
+  if (!out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_scene_new: out is NULL");
+  *out = NULL;
+  rr_scene *s = calloc(1, sizeof *s);
+  if (!s) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory creating a scene");
+  s->dev = dev;
+  s->bmin = v3(INFINITY, INFINITY, INFINITY);
+  s->bmax = v3(-INFINITY, -INFINITY, -INFINITY);
+  *out = s;
+  return rr_ok(dev);
+}
+
+void rr_scene_release(rr_scene *s) {
+  if (!s) return;
+  for (int k = 0; k < 3; k++) {
+    for (int c = 0; c < 3; c++) free(s->p[k][c]), free(s->n[k][c]);
+    for (int c = 0; c < 2; c++) free(s->uv[k][c]);
+  }
+  free(s->material);
+  for (uint32_t m = 0; m < s->nmaterials; m++) {
+    free(s->materials[m].texture_path);
+    free(s->materials[m].texture.rgb);
+  }
+  free(s->materials);
+  scene_free_bvh(s);
+  free(s);
+}
+
+static bool grow(float **arr, uint32_t cap) {
+  float *p = realloc(*arr, (size_t)cap * sizeof **arr);
+  if (!p) return false;
+  *arr = p;
+  return true;
+}
+
+rr_error scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_uvs) {
+  uint64_t need = (uint64_t)s->ntris + more;
+  if (need > UINT32_MAX - 1)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "scene too large: %llu triangles", (unsigned long long)need);
+  /* Attribute arrays appear when the first mesh that has them arrives; earlier
+   * triangles get zeros so the arrays stay aligned with the positions. */
+  bool add_n = with_normals && !s->n[0][0], add_uv = with_uvs && !s->uv[0][0];
+  uint32_t cap = s->cap;
+  if (need > cap) {
+    cap = cap ? cap : 1024;
+    while (cap < need) cap = cap > UINT32_MAX / 2 ? UINT32_MAX - 1 : cap * 2;
+  }
+  if (cap == s->cap && !add_n && !add_uv) return RR_OK;
+  bool ok = true;
+  for (int k = 0; k < 3; k++) {
+    for (int c = 0; c < 3; c++) {
+      ok = ok && grow(&s->p[k][c], cap);
+      if (s->n[k][c] || add_n) {
+        bool fresh = !s->n[k][c];
+        ok = ok && grow(&s->n[k][c], cap);
+        if (ok && fresh) memset(s->n[k][c], 0, (size_t)s->ntris * sizeof(float));
+      }
+    }
+    for (int c = 0; c < 2; c++) {
+      if (s->uv[k][c] || add_uv) {
+        bool fresh = !s->uv[k][c];
+        ok = ok && grow(&s->uv[k][c], cap);
+        if (ok && fresh) memset(s->uv[k][c], 0, (size_t)s->ntris * sizeof(float));
+      }
+    }
+  }
+  uint32_t *m = ok ? realloc(s->material, (size_t)cap * sizeof *m) : NULL;
+  if (!m) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for %llu triangles", (unsigned long long)need);
+  s->material = m;
+  s->cap = cap;
+  return RR_OK;
+}
+
+static bool finite3(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+bool scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv)[2], uint32_t mat) {
+  /* A triangle with a non-finite coordinate or no area can never be hit
+   * consistently; it is dropped and counted, not fatal. */
+  vec3 cr = v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]));
+  if (!finite3(p[0]) || !finite3(p[1]) || !finite3(p[2]) || !finite3(cr) ||
+      (cr.x == 0 && cr.y == 0 && cr.z == 0)) {
+    s->skipped++;
+    return false;
+  }
+  if (s->ntris >= s->cap && scene_reserve(s, 1, n != NULL, uv != NULL) != RR_OK) return false;
+  if ((n && !s->n[0][0]) || (uv && !s->uv[0][0]))
+    if (scene_reserve(s, 0, n != NULL, uv != NULL) != RR_OK) return false;
+  uint32_t i = s->ntris++;
+  for (int k = 0; k < 3; k++) {
+    s->p[k][0][i] = p[k].x, s->p[k][1][i] = p[k].y, s->p[k][2][i] = p[k].z;
+    if (s->n[0][0]) {
+      vec3 nk = n ? n[k] : v3(0, 0, 0);
+      s->n[k][0][i] = nk.x, s->n[k][1][i] = nk.y, s->n[k][2][i] = nk.z;
+    }
+    if (s->uv[0][0]) {
+      s->uv[k][0][i] = uv ? uv[k][0] : 0;
+      s->uv[k][1][i] = uv ? uv[k][1] : 0;
+    }
+    s->bmin = v3_min(s->bmin, p[k]);
+    s->bmax = v3_max(s->bmax, p[k]);
+  }
+  s->material[i] = mat;
+  return true;
+}
+
+uint32_t scene_add_material(rr_scene *s, const float color[3], const char *texture_path) {
+  rr_material *m = realloc(s->materials, (s->nmaterials + 1) * sizeof *m);
+  if (!m) return UINT32_MAX;
+  s->materials = m;
+  rr_material *mat = &m[s->nmaterials];
+  memset(mat, 0, sizeof *mat);
+  memcpy(mat->color, color, sizeof mat->color);
+  if (texture_path && *texture_path) {
+    mat->texture_path = malloc(strlen(texture_path) + 1);
+    if (!mat->texture_path) return UINT32_MAX;
+    strcpy(mat->texture_path, texture_path);
+  }
+  return s->nmaterials++;
+}
+
+void scene_update_bounds(rr_scene *s) {
+  vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+  for (uint32_t i = 0; i < s->ntris; i++)
+    for (int k = 0; k < 3; k++) {
+      vec3 p = scene_vertex(s, k, i);
+      lo = v3_min(lo, p);
+      hi = v3_max(hi, p);
+    }
+  s->bmin = lo;
+  s->bmax = hi;
+}
+
+rr_error rr_scene_add_mesh(rr_scene *s, const float *pos, size_t nvert, const uint32_t *idx,
+                           size_t ntri, const float rgb[3]) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if ((!pos && nvert) || (!idx && ntri))
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh: NULL positions or indices");
+  if (ntri > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh: too many triangles");
+  float grey[3] = {0.8f, 0.8f, 0.8f};
+  uint32_t mat = scene_add_material(s, rgb ? rgb : grey, NULL);
+  if (mat == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
+  rr_error e = scene_reserve(s, (uint32_t)ntri, false, false);
+  if (e) return e;
+  for (size_t t = 0; t < ntri; t++) {
+    vec3 p[3];
+    for (int k = 0; k < 3; k++) {
+      uint32_t v = idx[3 * t + k];
+      if (v >= nvert)
+        return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh: index %u of triangle %zu out of range (%zu vertices)",
+                       v, t, nvert);
+      p[k] = v3_load(pos + 3 * (size_t)v);
+    }
+    scene_push(s, p, NULL, NULL, mat);
+  }
+  return rr_ok(s->dev);
+}
+
+rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out) {
+  if (!out || !path) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_scene_load: NULL argument");
+  *out = NULL;
+  rr_scene *s;
+  rr_error e = rr_scene_new(dev, &s);
+  if (e) return e;
+  e = scene_load_builtin(s, path);
+  if (e == RR_ERROR_UNSUPPORTED) e = scene_load_file(s, path);
+  if (!e && s->ntris == 0)
+    e = rr_fail(dev, RR_ERROR_EMPTY, "scene '%s' has no triangles%s", path,
+                s->skipped ? " (all were degenerate or non-finite)" : "");
+  if (!e) e = rr_scene_commit(s);
+  if (e) {
+    rr_scene_release(s);
+    return e;
+  }
+  *out = s;
+  return rr_ok(dev);
+}
+
+rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
+  if (!s || !info) return RR_ERROR_ARGUMENT;
+  memset(info, 0, sizeof *info);
+  info->triangles = s->ntris;
+  info->skipped = s->skipped;
+  info->materials = s->nmaterials;
+  info->bounds_min[0] = s->bmin.x, info->bounds_min[1] = s->bmin.y, info->bounds_min[2] = s->bmin.z;
+  info->bounds_max[0] = s->bmax.x, info->bounds_max[1] = s->bmax.y, info->bounds_max[2] = s->bmax.z;
+  bvh_fill_info(s, info);
+  return RR_OK;
+}

@@ -1,0 +1,176 @@
+/* Deferred shading: reads only the visibility buffer (id, t, λ1, λ2) and the
+ * scene, so it never knows which method made the frame. */
+#include "rr.h"
+
+#include <string.h>
+
+typedef struct hit {
+  bool valid;
+  uint32_t id;
+  vec3 dir;    /* unit ray direction */
+  float dist;  /* eye-to-hit distance */
+  vec3 normal; /* unit shading normal facing the eye */
+  float l0, l1, l2;
+} hit;
+
+static vec3 geometric_normal(const rr_scene *s, uint32_t i) {
+  vec3 p0 = scene_vertex(s, 0, i);
+  return v3_norm(v3_cross(v3_sub(scene_vertex(s, 1, i), p0), v3_sub(scene_vertex(s, 2, i), p0)));
+}
+
+static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, int y) {
+  hit h = {0};
+  size_t k = (size_t)y * vb->width + x;
+  h.id = vb->id[k];
+  if (h.id == RR_MISS || h.id >= s->ntris) return h;
+  h.valid = true;
+  vec3 d = camera_dir(c, (float)x + 0.5f, (float)y + 0.5f);
+  float len = v3_len(d);
+  h.dir = v3_scale(d, 1.0f / len);
+  h.dist = vb->t[k] * len;
+  h.l1 = vb->l1[k], h.l2 = vb->l2[k], h.l0 = 1.0f - h.l1 - h.l2;
+  vec3 n = geometric_normal(s, h.id);
+  if (s->n[0][0]) {
+    vec3 sn = v3(0, 0, 0);
+    float w[3] = {h.l0, h.l1, h.l2};
+    for (int v = 0; v < 3; v++)
+      sn = v3_add(sn, v3_scale(v3(s->n[v][0][h.id], s->n[v][1][h.id], s->n[v][2][h.id]), w[v]));
+    if (v3_dot(sn, sn) > 1e-12f) {
+      sn = v3_norm(sn);
+      /* keep interpolated normals on the geometric normal's side */
+      n = v3_dot(sn, n) < 0 ? v3_neg(sn) : sn;
+    }
+  }
+  h.normal = v3_dot(n, h.dir) > 0 ? v3_neg(n) : n;
+  return h;
+}
+
+static void texel(const rr_texture *t, float u, float v, float rgb[3]) {
+  /* Wrap, bilinear; v points up in the file's convention, rows run down. */
+  u -= floorf(u), v -= floorf(v);
+  float fx = u * t->width - 0.5f, fy = (1.0f - v) * t->height - 0.5f;
+  int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
+  float ax = fx - x0, ay = fy - y0;
+  for (int c = 0; c < 3; c++) rgb[c] = 0;
+  for (int j = 0; j < 2; j++)
+    for (int i = 0; i < 2; i++) {
+      int xx = ((x0 + i) % t->width + t->width) % t->width, yy = ((y0 + j) % t->height + t->height) % t->height;
+      float w = (i ? ax : 1 - ax) * (j ? ay : 1 - ay);
+      const uint8_t *p = t->rgb + 3 * ((size_t)yy * t->width + xx);
+      for (int c = 0; c < 3; c++) rgb[c] += w * p[c] / 255.0f;
+    }
+  /* textures are sRGB-encoded; shading works in linear light */
+  for (int c = 0; c < 3; c++) rgb[c] = powf(rgb[c], 2.2f);
+}
+
+static void base_color(const rr_scene *s, const hit *h, float rgb[3]) {
+  const rr_material *m = s->nmaterials ? &s->materials[s->material[h->id] % s->nmaterials] : NULL;
+  rgb[0] = rgb[1] = rgb[2] = 0.8f;
+  if (!m) return;
+  memcpy(rgb, m->color, sizeof m->color);
+  if (m->texture.width > 0 && s->uv[0][0]) {
+    uint32_t i = h->id;
+    float u = h->l0 * s->uv[0][0][i] + h->l1 * s->uv[1][0][i] + h->l2 * s->uv[2][0][i];
+    float v = h->l0 * s->uv[0][1][i] + h->l1 * s->uv[1][1][i] + h->l2 * s->uv[2][1][i];
+    float t[3];
+    texel(&m->texture, u, v, t);
+    for (int c = 0; c < 3; c++) rgb[c] *= t[c];
+  }
+}
+
+static uint32_t hash32(uint32_t x) {
+  x ^= x >> 16, x *= 0x7feb352dU, x ^= x >> 15, x *= 0x846ca68bU, x ^= x >> 16;
+  return x;
+}
+
+static float to_display(float linear) { return powf(fminf(fmaxf(linear, 0.0f), 1.0f), 1.0f / 2.2f); }
+
+static rr_error image_alloc(rr_device *dev, rr_image *img, int w, int h, int ch, rr_pixel_type type) {
+  size_t size = type == RR_PIXEL_U8 ? 1 : 4;
+  img->width = w, img->height = h, img->channels = ch, img->type = type;
+  img->data = calloc((size_t)w * h * ch, size);
+  return img->data ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d image", w, h);
+}
+
+rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                  rr_shade_mode mode, rr_image *out) {
+  if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
+  if ((int)mode < 0 || mode >= RR_SHADE_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shade mode %d", (int)mode);
+  camera c;
+  const visbuf *vb = &f->vb;
+  rr_error e = camera_setup(dev, cam, vb->width, vb->height, &c);
+  if (e) return e;
+  e = image_alloc(dev, out, vb->width, vb->height, 3, RR_PIXEL_F32);
+  if (e) return e;
+  float dmin = INFINITY, dmax = 0;
+  if (mode == RR_SHADE_DEPTH)
+    for (int y = 0; y < vb->height; y++)
+      for (int x = 0; x < vb->width; x++) {
+        hit h = hit_at(s, &c, vb, x, y);
+        if (h.valid) dmin = fminf(dmin, h.dist), dmax = fmaxf(dmax, h.dist);
+      }
+  float *px = out->data;
+  for (int y = 0; y < vb->height; y++)
+    for (int x = 0; x < vb->width; x++) {
+      float *o = px + 3 * ((size_t)y * vb->width + x);
+      hit h = hit_at(s, &c, vb, x, y);
+      if (!h.valid) {
+        /* a quiet vertical gradient behind the scene */
+        float g = 0.16f + 0.10f * (1.0f - (float)y / vb->height);
+        o[0] = g * 0.9f, o[1] = g, o[2] = g * 1.15f;
+        continue;
+      }
+      switch (mode) {
+      case RR_SHADE_LAMBERT: {
+        float rgb[3];
+        base_color(s, &h, rgb);
+        float lit = 0.12f + 0.88f * fmaxf(0.0f, -v3_dot(h.normal, h.dir));
+        for (int ch = 0; ch < 3; ch++) o[ch] = to_display(rgb[ch] * lit);
+        break;
+      }
+      case RR_SHADE_ID: {
+        uint32_t hsh = hash32(h.id + 1);
+        for (int ch = 0; ch < 3; ch++) o[ch] = 0.2f + 0.8f * (float)((hsh >> (8 * ch)) & 255) / 255.0f;
+        break;
+      }
+      case RR_SHADE_NORMAL:
+        o[0] = 0.5f + 0.5f * h.normal.x, o[1] = 0.5f + 0.5f * h.normal.y, o[2] = 0.5f + 0.5f * h.normal.z;
+        break;
+      case RR_SHADE_DEPTH: {
+        float g = dmax > dmin ? 1.0f - 0.85f * (h.dist - dmin) / (dmax - dmin) : 1.0f;
+        o[0] = o[1] = o[2] = g;
+        break;
+      }
+      default:
+        break;
+      }
+    }
+  return rr_ok(dev);
+}
+
+rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_aov aov,
+                      rr_image *out) {
+  if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_frame_aov: NULL argument");
+  const visbuf *vb = &f->vb;
+  camera c;
+  rr_error e = camera_setup(dev, cam, vb->width, vb->height, &c);
+  if (e) return e;
+  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2};
+  if ((int)aov < 0 || aov >= RR_AOV_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AOV %d", (int)aov);
+  e = image_alloc(dev, out, vb->width, vb->height, channels[aov], aov == RR_AOV_ID ? RR_PIXEL_U32 : RR_PIXEL_F32);
+  if (e) return e;
+  for (int y = 0; y < vb->height; y++)
+    for (int x = 0; x < vb->width; x++) {
+      size_t k = (size_t)y * vb->width + x;
+      if (aov == RR_AOV_ID) {
+        ((uint32_t *)out->data)[k] = vb->id[k];
+        continue;
+      }
+      float *o = (float *)out->data + channels[aov] * k;
+      hit h = hit_at(s, &c, vb, x, y);
+      if (aov == RR_AOV_DEPTH) o[0] = h.valid ? h.dist : INFINITY;
+      else if (aov == RR_AOV_NORMAL && h.valid) o[0] = h.normal.x, o[1] = h.normal.y, o[2] = h.normal.z;
+      else if (aov == RR_AOV_BARY && h.valid) o[0] = h.l1, o[1] = h.l2;
+    }
+  return rr_ok(dev);
+}

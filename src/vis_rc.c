@@ -1,0 +1,44 @@
+/* rc: Durand's loop, every sample × every triangle. The reference method; it
+ * calls the same sample test as every other method, in the other loop order. */
+#include "rr.h"
+
+typedef struct {
+  render_ctx *ctx;
+  const tri_setup *setup;
+  const uint32_t *ids;
+  uint32_t n;
+  uint64_t evals[256];
+} rc_job;
+
+static void rc_row(int y, int thread, void *arg) {
+  rc_job *job = arg;
+  visbuf *vb = job->ctx->vb;
+  float sy = (float)y + 0.5f;
+  for (int x = 0; x < vb->width; x++) {
+    size_t k = (size_t)y * vb->width + x;
+    float sx = (float)x + 0.5f;
+    for (uint32_t j = 0; j < job->n; j++) shade_sample(&job->setup[j], job->ids[j], sx, sy, vb, k);
+  }
+  job->evals[thread] += (uint64_t)vb->width * job->n;
+}
+
+rr_error vis_rc(rr_device *dev, render_ctx *ctx) {
+  const rr_scene *s = ctx->scene;
+  /* One setup per triangle for the eye, reused by every ray (the paper's
+   * "at the cost of additional per-triangle storage"). */
+  tri_setup *setup = malloc((size_t)s->ntris * sizeof *setup + 1);
+  uint32_t *ids = malloc((size_t)s->ntris * sizeof *ids + 1);
+  if (!setup || !ids) {
+    free(setup), free(ids);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %u triangle setups", s->ntris);
+  }
+  uint32_t n = 0;
+  for (uint32_t i = 0; i < s->ntris; i++)
+    if (tri_setup_planar(s, i, ctx->cam, ctx->opt->cull_backfaces, &setup[n]) != SETUP_CULLED) ids[n++] = i;
+  ctx->stats->setups += s->ntris;
+  rc_job job = {.ctx = ctx, .setup = setup, .ids = ids, .n = n};
+  parallel_for(ctx->vb->height, ctx->threads, rc_row, &job);
+  for (int t = 0; t < 256; t++) ctx->stats->edge_evals += job.evals[t];
+  free(setup), free(ids);
+  return RR_OK;
+}

@@ -1,0 +1,308 @@
+/* rastray: the command-line tool. Everything it does goes through rastray.h.
+ * Exit codes: 0 success, 1 bad input (files, scenes), 2 bad usage (flags, values). */
+#include "rastray.h"
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+enum { EXIT_INPUT = 1, EXIT_USAGE = 2 };
+
+static void die(int code, const char *fmt, ...) __attribute__((noreturn, format(printf, 2, 3)));
+static void die(int code, const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  fputs("rastray: ", stderr);
+  vfprintf(stderr, fmt, ap);
+  fputc('\n', stderr);
+  va_end(ap);
+  exit(code);
+}
+
+static const char usage[] =
+    "usage: rastray render [SCENE] [options]     render SCENE (a mesh file or built-in name; default demo)\n"
+    "       rastray info SCENE                   print the scene's triangles and BVH figures\n"
+    "       rastray --help | --version\n"
+    "\n"
+    "scenes: a file assimp reads (.obj .ply .gltf .glb .dae .3ds ...), or demo, plane[:N],\n"
+    "        sphere[:N], box[:N], rooms[:N], grid:PATH:N (N×N copies of a mesh)\n"
+    "\n"
+    "options:\n"
+    "  --method NAME       visibility method: rc, 3dr-bb (default 3dr-bb)\n"
+    "  --size WxH          image size (default 1024x768, at most 16384 a side)\n"
+    "  --camera NAME       perspective\n"
+    "  --eye X,Y,Z --target X,Y,Z --up X,Y,Z --fov DEG\n"
+    "                      camera; without --eye/--target the scene is framed automatically\n"
+    "  --shade MODE        lambert (default), id, normal, depth\n"
+    "  -o PATH             colour image: .png, .exr or .pfm (default rastray.png unless --aov is given)\n"
+    "  --aov NAME=PATH     write an AOV (depth, id, normal, bary) as .npy, .pfm or .exr; repeatable\n"
+    "  --threads N         threads (default: all cores)\n"
+    "  --repeat N          run the visibility pass N times, report the median time\n"
+    "  --stats             print key=value statistics to stderr\n"
+    "  --stats-json PATH   write the statistics as one JSON object\n"
+    "  --cull-backfaces    triangles seen from behind are invisible\n";
+
+static long parse_int(const char *flag, const char *s, long lo, long hi) {
+  char *end;
+  double v = s ? strtod(s, &end) : 0;
+  if (!s || !*s || *end || !isfinite(v) || v != floor(v))
+    die(EXIT_USAGE, "bad value '%s' for %s (expected an integer)", s ? s : "", flag);
+  if (v < lo || v > hi) die(EXIT_USAGE, "bad value '%s' for %s (expected %ld..%ld)", s, flag, lo, hi);
+  return (long)v;
+}
+
+static float parse_float(const char *flag, const char *s) {
+  char *end;
+  double v = s ? strtod(s, &end) : 0;
+  if (!s || !*s || *end || !isfinite(v) || fabs(v) > 1e30)
+    die(EXIT_USAGE, "bad value '%s' for %s (expected a finite number)", s ? s : "", flag);
+  return (float)v;
+}
+
+static void parse_vec(const char *flag, const char *s, float out[3]) {
+  char buf[256];
+  if (!s || strlen(s) >= sizeof buf) die(EXIT_USAGE, "bad vector '%s' for %s (expected X,Y,Z)", s ? s : "", flag);
+  strcpy(buf, s);
+  char *save = NULL, *tok = strtok_r(buf, ",", &save);
+  int n = 0;
+  for (; tok && n < 3; tok = strtok_r(NULL, ",", &save)) {
+    char *end;
+    double v = strtod(tok, &end);
+    if (!*tok || *end || !isfinite(v) || fabs(v) > 1e30) break;
+    out[n++] = (float)v;
+  }
+  if (n != 3 || tok || s[strlen(s) - 1] == ',' || s[0] == ',')
+    die(EXIT_USAGE, "bad vector '%s' for %s (expected X,Y,Z with finite numbers)", s, flag);
+}
+
+static void parse_size(const char *s, int *w, int *h) {
+  char buf[64];
+  if (!s || strlen(s) >= sizeof buf) die(EXIT_USAGE, "bad size '%s' (expected WxH, e.g. 1024x768)", s ? s : "");
+  strcpy(buf, s);
+  char *x = strchr(buf, 'x');
+  if (!x) die(EXIT_USAGE, "bad size '%s' (expected WxH, e.g. 1024x768)", s);
+  *x = 0;
+  char *end;
+  long a = strtol(buf, &end, 10);
+  bool bad = !*buf || *end;
+  long b = strtol(x + 1, &end, 10);
+  bad = bad || !x[1] || *end;
+  if (bad) die(EXIT_USAGE, "bad size '%s' (expected WxH, e.g. 1024x768)", s);
+  if (a < 1 || b < 1 || a > RR_MAX_SIZE || b > RR_MAX_SIZE)
+    die(EXIT_USAGE, "bad size '%s' (each side must be 1..%d)", s, RR_MAX_SIZE);
+  *w = (int)a, *h = (int)b;
+}
+
+typedef struct {
+  rr_aov aov;
+  const char *path;
+} aov_out;
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static double now_ms(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+static rr_scene *load_scene(rr_device *dev, const char *name) {
+  rr_scene *scene;
+  if (rr_scene_load(dev, name, &scene) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+  return scene;
+}
+
+static void write_image(rr_device *dev, rr_image *img, const char *path) {
+  rr_error e = rr_image_write(dev, img, path);
+  rr_image_free(img);
+  if (e) die(e == RR_ERROR_ARGUMENT ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
+}
+
+static int cmd_info(rr_device *dev, int argc, char **argv) {
+  if (argc != 1) die(EXIT_USAGE, "info takes one scene (see --help)");
+  rr_scene *scene = load_scene(dev, argv[0]);
+  rr_scene_info in;
+  rr_scene_get_info(scene, &in);
+  printf("scene        %s\n", argv[0]);
+  printf("triangles    %llu (%llu degenerate or non-finite skipped)\n", (unsigned long long)in.triangles,
+         (unsigned long long)in.skipped);
+  printf("materials    %u\n", in.materials);
+  printf("bounds       (%g, %g, %g) .. (%g, %g, %g)\n", in.bounds_min[0], in.bounds_min[1], in.bounds_min[2],
+         in.bounds_max[0], in.bounds_max[1], in.bounds_max[2]);
+  printf("bvh nodes    %llu\n", (unsigned long long)in.bvh_nodes);
+  printf("bvh leaves   %llu\n", (unsigned long long)in.bvh_leaves);
+  printf("bvh depth    %u\n", in.bvh_depth);
+  printf("bvh sah cost %.3f\n", in.bvh_sah_cost);
+  printf("bvh build    %.1f ms\n", in.bvh_build_ms);
+  printf("bvh memory   %.2f MiB\n", in.bvh_bytes / 1048576.0);
+  rr_scene_release(scene);
+  return 0;
+}
+
+static const char *arg_value(int *i, int argc, char **argv) {
+  if (*i + 1 >= argc) die(EXIT_USAGE, "%s needs a value (see --help)", argv[*i]);
+  return argv[++*i];
+}
+
+static int cmd_render(rr_device *dev, int argc, char **argv) {
+  double t_start = now_ms();
+  rr_render_options opt;
+  rr_render_options_init(&opt);
+  rr_camera cam;
+  rr_camera_init(&cam);
+  const char *scene_name = NULL, *out = NULL, *json = NULL;
+  bool have_eye = false, have_target = false, stats = false;
+  int shade = RR_SHADE_LAMBERT, repeat = 1, naov = 0;
+  aov_out aovs[16];
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i];
+    if (strcmp(a, "--method") == 0) {
+      const char *v = arg_value(&i, argc, argv);
+      int m = rr_method_from_name(v);
+      if (m < 0) die(EXIT_USAGE, "unknown method '%s' (see --help)", v);
+      opt.method = (rr_method)m;
+    } else if (strcmp(a, "--size") == 0) {
+      parse_size(arg_value(&i, argc, argv), &opt.width, &opt.height);
+    } else if (strcmp(a, "--camera") == 0) {
+      const char *v = arg_value(&i, argc, argv);
+      if (strcmp(v, "perspective") != 0) die(EXIT_USAGE, "unknown camera '%s' (expected perspective)", v);
+      cam.type = RR_CAMERA_PERSPECTIVE;
+    } else if (strcmp(a, "--eye") == 0) {
+      parse_vec(a, arg_value(&i, argc, argv), cam.eye), have_eye = true;
+    } else if (strcmp(a, "--target") == 0) {
+      parse_vec(a, arg_value(&i, argc, argv), cam.target), have_target = true;
+    } else if (strcmp(a, "--up") == 0) {
+      parse_vec(a, arg_value(&i, argc, argv), cam.up);
+    } else if (strcmp(a, "--fov") == 0) {
+      const char *v = arg_value(&i, argc, argv);
+      cam.fov_deg = parse_float(a, v);
+      if (!(cam.fov_deg > 0 && cam.fov_deg < 180)) die(EXIT_USAGE, "bad value '%s' for --fov (expected 0 < fov < 180)", v);
+    } else if (strcmp(a, "--shade") == 0) {
+      const char *v = arg_value(&i, argc, argv);
+      shade = rr_shade_from_name(v);
+      if (shade < 0) die(EXIT_USAGE, "unknown shade mode '%s' (expected lambert, id, normal or depth)", v);
+    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
+      out = arg_value(&i, argc, argv);
+    } else if (strcmp(a, "--aov") == 0) {
+      const char *v = arg_value(&i, argc, argv);
+      const char *eq = strchr(v, '=');
+      char name[32];
+      if (!eq || eq == v || !eq[1] || (size_t)(eq - v) >= sizeof name)
+        die(EXIT_USAGE, "bad --aov '%s' (expected NAME=PATH)", v);
+      memcpy(name, v, eq - v), name[eq - v] = 0;
+      int k = rr_aov_from_name(name);
+      if (k < 0) die(EXIT_USAGE, "unknown AOV '%s' (expected depth, id, normal or bary)", name);
+      if (naov == 16) die(EXIT_USAGE, "too many --aov (at most 16)");
+      aovs[naov++] = (aov_out){(rr_aov)k, eq + 1};
+    } else if (strcmp(a, "--threads") == 0) {
+      opt.threads = (int)parse_int(a, arg_value(&i, argc, argv), 1, 256);
+    } else if (strcmp(a, "--repeat") == 0) {
+      repeat = (int)parse_int(a, arg_value(&i, argc, argv), 1, 1000);
+    } else if (strcmp(a, "--stats") == 0) {
+      stats = true;
+    } else if (strcmp(a, "--stats-json") == 0) {
+      json = arg_value(&i, argc, argv);
+    } else if (strcmp(a, "--cull-backfaces") == 0) {
+      opt.cull_backfaces = 1;
+    } else if (a[0] == '-' && a[1]) {
+      die(EXIT_USAGE, "unknown option '%s' (see --help)", a);
+    } else if (!scene_name) {
+      scene_name = a;
+    } else {
+      die(EXIT_USAGE, "more than one scene given ('%s' and '%s')", scene_name, a);
+    }
+  }
+  if (have_eye != have_target) die(EXIT_USAGE, "--eye and --target go together");
+  if (!scene_name) scene_name = "demo";
+  if (!out && naov == 0) out = "rastray.png";
+
+  rr_scene *scene = load_scene(dev, scene_name);
+  if (!have_eye && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK)
+    die(EXIT_INPUT, "%s", rr_device_message(dev));
+  if (rr_camera_check(dev, &cam) != RR_OK) die(EXIT_USAGE, "%s", rr_device_message(dev));
+
+  double *times = malloc(sizeof(double) * repeat);
+  rr_frame *frame = NULL;
+  for (int r = 0; r < repeat; r++) {
+    rr_frame_release(frame);
+    if (rr_render(dev, scene, &cam, &opt, &frame) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+    rr_stats st;
+    rr_frame_get_stats(frame, &st);
+    times[r] = st.frame_ms;
+  }
+  qsort(times, repeat, sizeof *times, cmp_double);
+  double frame_ms = repeat % 2 ? times[repeat / 2] : 0.5 * (times[repeat / 2 - 1] + times[repeat / 2]);
+  free(times);
+
+  if (out) {
+    rr_image img;
+    if (rr_shade(dev, scene, &cam, frame, (rr_shade_mode)shade, &img) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+    write_image(dev, &img, out);
+  }
+  for (int k = 0; k < naov; k++) {
+    rr_image img;
+    if (rr_frame_aov(dev, scene, &cam, frame, aovs[k].aov, &img) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+    write_image(dev, &img, aovs[k].path);
+  }
+
+  rr_stats st;
+  rr_frame_get_stats(frame, &st);
+  rr_scene_info info;
+  rr_scene_get_info(scene, &info);
+  double total_ms = now_ms() - t_start;
+  const char *method = rr_method_name(opt.method);
+  int threads = st.threads;
+  if (stats)
+    fprintf(stderr,
+            "method=%s camera=perspective triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f total_ms=%.1f "
+            "setups=%llu edge_evals=%llu nodes=%llu\n",
+            method, (unsigned long long)info.triangles, opt.width, opt.height, threads, frame_ms, total_ms,
+            (unsigned long long)st.setups, (unsigned long long)st.edge_evals, (unsigned long long)st.nodes);
+  if (json) {
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp", json);
+    FILE *f = fopen(tmp, "w");
+    if (!f) die(EXIT_INPUT, "cannot write '%s'", json);
+    fprintf(f,
+            "{\"scene\": \"%s\", \"method\": \"%s\", \"camera\": \"perspective\", \"triangles\": %llu, "
+            "\"skipped\": %llu, \"width\": %d, \"height\": %d, \"threads\": %d, \"repeat\": %d, "
+            "\"frame_ms\": %.3f, \"total_ms\": %.3f, \"setups\": %llu, \"edge_evals\": %llu, \"nodes\": %llu}\n",
+            scene_name, method, (unsigned long long)info.triangles, (unsigned long long)info.skipped, opt.width,
+            opt.height, threads, repeat, frame_ms, total_ms, (unsigned long long)st.setups,
+            (unsigned long long)st.edge_evals, (unsigned long long)st.nodes);
+    if (fclose(f) != 0 || rename(tmp, json) != 0) {
+      remove(tmp);
+      die(EXIT_INPUT, "cannot write '%s'", json);
+    }
+  }
+  if (out && !stats) fprintf(stderr, "wrote %s (%dx%d, %s, %.1f ms)\n", out, opt.width, opt.height, method, frame_ms);
+  rr_frame_release(frame);
+  rr_scene_release(scene);
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
+    fputs(usage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? EXIT_USAGE : 0;
+  }
+  if (strcmp(argv[1], "--version") == 0) {
+    printf("rastray %s\n", RR_VERSION);
+    return 0;
+  }
+  rr_device *dev = rr_device_new();
+  if (!dev) die(EXIT_INPUT, "out of memory");
+  int rc;
+  if (strcmp(argv[1], "render") == 0) rc = cmd_render(dev, argc - 2, argv + 2);
+  else if (strcmp(argv[1], "info") == 0) rc = cmd_info(dev, argc - 2, argv + 2);
+  else die(EXIT_USAGE, "unknown command '%s' (expected render or info; see --help)", argv[1]);
+  rr_device_release(dev);
+  return rc;
+}
