@@ -98,8 +98,16 @@ rr_error rr_camera_check(rr_device *dev, const rr_camera *cam);
 /* ---- visibility ---------------------------------------------------------- */
 
 typedef enum rr_method {
-  RR_METHOD_RC = 0,   /* every sample × every triangle (Durand's loop) */
-  RR_METHOD_3DR_BB,   /* every triangle × the samples of its screen bounding box */
+  RR_METHOD_RC = 0,   /* every sample × every triangle (Durand's loop); tiny scenes only */
+  RR_METHOD_RC_BVH,   /* one ray per sample through the BVH */
+  RR_METHOD_RC_PACKET,/* coherent packets of rays through the BVH */
+  RR_METHOD_2DR_BB,   /* projection, clipping, 2D edge functions over bounding boxes, z-buffer */
+  RR_METHOD_2DR_BIN,  /* 2dr-bb with hierarchical binning and early-z */
+  RR_METHOD_3DR_BB,   /* 3D edge functions over each triangle's screen bounding box */
+  RR_METHOD_3DR_BIN,  /* 3dr-bb with hierarchical binning and early-z */
+  RR_METHOD_3DR_FC,   /* 256² frusta, BVH frustum culling, binning at leaves */
+  RR_METHOD_3DR_FS,   /* occlusion culling and frustum splitting down to 8², no binning */
+  RR_METHOD_3DR_FULL, /* 3dr-fs followed by binning and early-z */
   RR_METHOD_COUNT
 } rr_method;
 

@@ -33,12 +33,22 @@ rr_error rr_ok(rr_device *dev) {
 
 /* ---- names ---------------------------------------------------------------- */
 
+/* Every method is one traversal configuration; a NULL entry is a method this
+ * build does not have yet. */
 static const struct {
   const char *name;
   vis_method_fn fn;
 } methods[RR_METHOD_COUNT] = {
     [RR_METHOD_RC] = {"rc", vis_rc},
+    [RR_METHOD_RC_BVH] = {"rc-bvh", NULL},
+    [RR_METHOD_RC_PACKET] = {"rc-packet", NULL},
+    [RR_METHOD_2DR_BB] = {"2dr-bb", NULL},
+    [RR_METHOD_2DR_BIN] = {"2dr-bin", NULL},
     [RR_METHOD_3DR_BB] = {"3dr-bb", vis_3dr_bb},
+    [RR_METHOD_3DR_BIN] = {"3dr-bin", NULL},
+    [RR_METHOD_3DR_FC] = {"3dr-fc", NULL},
+    [RR_METHOD_3DR_FS] = {"3dr-fs", NULL},
+    [RR_METHOD_3DR_FULL] = {"3dr-full", NULL},
 };
 
 int rr_method_from_name(const char *name) {
@@ -100,6 +110,8 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown method %d", (int)opt->method);
   if (opt->threads < 0 || opt->threads > 256)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad thread count %d (0 for all cores, at most 256)", opt->threads);
+  if (!methods[opt->method].fn)
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED, "method '%s' is not available in this build", methods[opt->method].name);
   camera c;
   rr_error e = camera_setup(dev, cam, opt->width, opt->height, &c);
   if (e) return e;
