@@ -1,0 +1,527 @@
+/* Built-in scenes generated in code: exact test meshes (plane, sphere, box), a grid
+ * of copies of a mesh file, a many-layered benchmark (rooms) and the default demo.
+ *
+ * Closed meshes compute each vertex position once and index it, so a vertex shared
+ * by several triangles has bitwise identical coordinates in all of them: the shared
+ * sample test then leaves no cracks and counts no pixel twice along shared edges. */
+#include "rr.h"
+
+#include <string.h>
+
+static const double PI = 3.14159265358979323846;
+
+/* ---- name parsing -------------------------------------------------------------- */
+
+/* When `name` is `key` or `key:ARG`, returns ARG ("" for the bare key); else NULL. */
+static const char *builtin_arg(const char *name, const char *key) {
+  size_t n = strlen(key);
+  if (strncmp(name, key, n) != 0) return NULL;
+  if (name[n] == 0) return "";
+  return name[n] == ':' ? name + n + 1 : NULL;
+}
+
+/* Parses a decimal count in [lo, hi]: digits only, no sign or spaces. */
+static bool parse_count(const char *text, long lo, long hi, long *out) {
+  if (!*text || strlen(text) > 9) return false;
+  long v = 0;
+  for (const char *c = text; *c; c++) {
+    if (*c < '0' || *c > '9') return false;
+    v = v * 10 + (*c - '0');
+  }
+  if (v < lo || v > hi) return false;
+  *out = v;
+  return true;
+}
+
+/* The size argument of `name` (its default when absent), or an argument error. */
+static rr_error size_arg(rr_scene *s, const char *name, const char *arg, long def, long lo,
+                         long hi, long *out) {
+  if (!*arg && !strchr(name, ':')) {
+    *out = def;
+    return RR_OK;
+  }
+  if (parse_count(arg, lo, hi, out)) return RR_OK;
+  return rr_fail(s->dev, RR_ERROR_ARGUMENT, "bad size '%s' in '%s' (expected %ld..%ld)", arg, name,
+                 lo, hi);
+}
+
+/* ---- small helpers --------------------------------------------------------------- */
+
+static rr_error add_material(rr_scene *s, float r, float g, float b, uint32_t *out) {
+  float rgb[3] = {r, g, b};
+  *out = scene_add_material(s, rgb, NULL);
+  if (*out == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
+  return RR_OK;
+}
+
+/* Reserves room first so that scene_push can only refuse degenerate triangles. */
+static rr_error reserve(rr_scene *s, uint64_t more, bool with_normals) {
+  if (more > UINT32_MAX - 1 - (uint64_t)s->ntris)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "scene too large: %llu more triangles",
+                   (unsigned long long)more);
+  return scene_reserve(s, (uint32_t)more, with_normals, false);
+}
+
+/* Pushes triangle (a, b, c) of an indexed vertex array; nrm may be NULL. */
+static void push_idx(rr_scene *s, const vec3 *pos, const vec3 *nrm, uint32_t a, uint32_t b,
+                     uint32_t c, uint32_t mat) {
+  vec3 p[3] = {pos[a], pos[b], pos[c]};
+  if (nrm) {
+    vec3 n[3] = {nrm[a], nrm[b], nrm[c]};
+    scene_push(s, p, n, NULL, mat);
+  } else {
+    scene_push(s, p, NULL, NULL, mat);
+  }
+}
+
+/* Pushes quad a-b-c-d as (a, b, c) and (a, c, d) with one flat normal (may be NULL). */
+static void push_quad(rr_scene *s, vec3 a, vec3 b, vec3 c, vec3 d, const vec3 *flat,
+                      uint32_t mat) {
+  vec3 t0[3] = {a, b, c}, t1[3] = {a, c, d};
+  vec3 n[3];
+  if (flat) n[0] = n[1] = n[2] = *flat;
+  scene_push(s, t0, flat ? n : NULL, NULL, mat);
+  scene_push(s, t1, flat ? n : NULL, NULL, mat);
+}
+
+/* ---- plane ------------------------------------------------------------------------ */
+
+/* n×n unit cells on y = 0 with integer corners, centred on the origin (for odd n the
+ * extra column/row is on the + side so corners stay integers). Each cell is split
+ * along its (x0,z0)-(x1,z1) diagonal; both halves are counter-clockwise from +y. */
+static rr_error gen_plane(rr_scene *s, int n) {
+  uint32_t mat;
+  rr_error e = add_material(s, 0.8f, 0.8f, 0.8f, &mat);
+  if (!e) e = reserve(s, 2 * (uint64_t)n * n, false);
+  if (e) return e;
+  int lo = -(n / 2);
+  for (int j = 0; j < n; j++)
+    for (int i = 0; i < n; i++) {
+      float x0 = (float)(lo + i), x1 = (float)(lo + i + 1);
+      float z0 = (float)(lo + j), z1 = (float)(lo + j + 1);
+      push_quad(s, v3(x0, 0, z0), v3(x0, 0, z1), v3(x1, 0, z1), v3(x1, 0, z0), NULL, mat);
+    }
+  return RR_OK;
+}
+
+/* ---- UV sphere ------------------------------------------------------------------- */
+
+/* A closed UV sphere: `seg` segments in longitude, seg/2 rings, single pole vertices.
+ * Vertex 0 is the north pole, then rings 1..rings-1 of `seg` vertices each from the
+ * top, then the south pole. Longitude turns counter-clockwise seen from +y, so
+ * (upper j, lower j+1, upper j+1)-style triangles face outward. Corner normals are
+ * the unit directions. */
+static rr_error gen_sphere(rr_scene *s, int seg, vec3 centre, float radius, uint32_t mat) {
+  int rings = seg / 2;
+  size_t nv = 2 + (size_t)(rings - 1) * seg;
+  vec3 *dir = malloc(nv * sizeof *dir), *pos = malloc(nv * sizeof *pos);
+  rr_error e = dir && pos ? reserve(s, 2 * (uint64_t)seg * (rings - 1), true)
+                          : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory generating a sphere");
+  if (e) {
+    free(dir), free(pos);
+    return e;
+  }
+  dir[0] = v3(0, 1, 0);
+  dir[nv - 1] = v3(0, -1, 0);
+  for (int r = 1; r < rings; r++) {
+    double th = PI * r / rings;
+    for (int j = 0; j < seg; j++) {
+      double ph = 2 * PI * j / seg;
+      dir[1 + (size_t)(r - 1) * seg + j] =
+          v3((float)(sin(th) * cos(ph)), (float)cos(th), (float)(-sin(th) * sin(ph)));
+    }
+  }
+  for (size_t k = 0; k < nv; k++) pos[k] = v3_add(centre, v3_scale(dir[k], radius));
+
+  uint32_t south = (uint32_t)(nv - 1);
+  for (int j = 0; j < seg; j++) {
+    uint32_t j1 = (uint32_t)((j + 1) % seg);
+    push_idx(s, pos, dir, 0, 1 + j, 1 + j1, mat); /* north cap */
+    for (int r = 1; r + 1 < rings; r++) {
+      uint32_t up = 1 + (uint32_t)(r - 1) * seg, lo = up + seg;
+      push_idx(s, pos, dir, up + j, lo + j, lo + j1, mat);
+      push_idx(s, pos, dir, up + j, lo + j1, up + j1, mat);
+    }
+    uint32_t last = 1 + (uint32_t)(rings - 2) * seg;
+    push_idx(s, pos, dir, south, last + j1, last + j, mat); /* south cap */
+  }
+  free(dir), free(pos);
+  return RR_OK;
+}
+
+/* ---- box --------------------------------------------------------------------------- */
+
+/* The cube [-1,1]^3, each face n×n cells. Every face takes its coordinates from one
+ * table g[t] = (2t - n)/n, so vertices along the cube's edges and corners come out
+ * bitwise identical on the faces that share them (g[0] = -1 and g[n] = 1 exactly). */
+static rr_error gen_box(rr_scene *s, int n) {
+  uint32_t mat;
+  float *g = malloc(((size_t)n + 1) * sizeof *g);
+  rr_error e = g ? add_material(s, 0.8f, 0.8f, 0.8f, &mat)
+                 : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory generating a box");
+  if (!e) e = reserve(s, 12 * (uint64_t)n * n, true);
+  if (e) {
+    free(g);
+    return e;
+  }
+  for (int t = 0; t <= n; t++) g[t] = (float)(2 * t - n) / (float)n;
+  for (int a = 0; a < 3; a++) {
+    int u = (a + 1) % 3, v = (a + 2) % 3; /* e_u × e_v = e_a */
+    for (int side = -1; side <= 1; side += 2) {
+      float nrm[3] = {0, 0, 0};
+      nrm[a] = (float)side;
+      vec3 flat = v3(nrm[0], nrm[1], nrm[2]);
+      for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+          vec3 q[4]; /* (i,j), (i+1,j), (i+1,j+1), (i,j+1): counter-clockwise about +e_a */
+          for (int k = 0; k < 4; k++) {
+            float c[3];
+            c[a] = (float)side;
+            c[u] = g[i + (k == 1 || k == 2)];
+            c[v] = g[j + (k >= 2)];
+            q[k] = v3(c[0], c[1], c[2]);
+          }
+          if (side > 0) push_quad(s, q[0], q[1], q[2], q[3], &flat, mat);
+          else push_quad(s, q[0], q[3], q[2], q[1], &flat, mat);
+        }
+    }
+  }
+  free(g);
+  return RR_OK;
+}
+
+/* ---- torus ------------------------------------------------------------------------- */
+
+/* A torus around the vertical axis through `centre`: major radius R, tube radius r,
+ * nu segments around the axis and nv around the tube, smooth normals. */
+static rr_error gen_torus(rr_scene *s, int nu, int nv, float R, float r, vec3 centre,
+                          uint32_t mat) {
+  size_t count = (size_t)nu * nv;
+  vec3 *pos = malloc(count * sizeof *pos), *nrm = malloc(count * sizeof *nrm);
+  rr_error e = pos && nrm ? reserve(s, 2 * (uint64_t)count, true)
+                          : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory generating a torus");
+  if (e) {
+    free(pos), free(nrm);
+    return e;
+  }
+  for (int i = 0; i < nu; i++) {
+    double u = 2 * PI * i / nu;
+    for (int j = 0; j < nv; j++) {
+      double w = 2 * PI * j / nv;
+      double cu = cos(u), su = -sin(u), cw = cos(w), sw = sin(w);
+      nrm[(size_t)i * nv + j] = v3((float)(cw * cu), (float)sw, (float)(cw * su));
+      pos[(size_t)i * nv + j] =
+          v3_add(centre, v3((float)((R + r * cw) * cu), (float)(r * sw), (float)((R + r * cw) * su)));
+    }
+  }
+  for (int i = 0; i < nu; i++)
+    for (int j = 0; j < nv; j++) {
+      uint32_t a = (uint32_t)(i * nv + j), b = (uint32_t)(((i + 1) % nu) * nv + j);
+      uint32_t c = (uint32_t)(((i + 1) % nu) * nv + (j + 1) % nv), d = (uint32_t)(i * nv + (j + 1) % nv);
+      /* a→b turns about the axis, b→c climbs the tube: a-b-c-d faces outward. */
+      push_idx(s, pos, nrm, a, b, c, mat);
+      push_idx(s, pos, nrm, a, c, d, mat);
+    }
+  free(pos), free(nrm);
+  return RR_OK;
+}
+
+/* ---- grid of copies ----------------------------------------------------------------- */
+
+/* grid:PATH:N — N×N copies of a mesh file on the XZ plane, copy k = j·N + i moved by
+ * (i·1.25·sx, 0, j·1.25·sz). The copies are written straight into the arrays rather
+ * than through scene_push: a translated sliver could round to zero area and be
+ * dropped, which would break the rule that copy k's triangle m has id k·T + m. */
+static rr_error load_grid(rr_scene *s, const char *name) {
+  const char *rest = name + strlen("grid:");
+  const char *colon = strrchr(rest, ':'); /* PATH may itself contain ':' */
+  if (!colon || colon == rest)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "bad grid name '%s' (expected grid:PATH:N)", name);
+  long n;
+  if (!parse_count(colon + 1, 1, 1000, &n))
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "bad grid count '%s' in '%s' (expected 1..1000)",
+                   colon + 1, name);
+  size_t len = (size_t)(colon - rest);
+  char *path = malloc(len + 1);
+  if (!path) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory reading '%s'", name);
+  memcpy(path, rest, len);
+  path[len] = 0;
+  uint32_t t0 = s->ntris;
+  uint64_t skipped0 = s->skipped;
+  rr_error e = scene_load_file(s, path);
+  free(path);
+  if (e) return e;
+
+  uint32_t T = s->ntris - t0;
+  uint64_t copies = (uint64_t)n * (uint64_t)n, total = copies * T;
+  if (T == 0 || n == 1) return RR_OK;
+  if (total > UINT32_MAX - 1 - (uint64_t)t0)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "grid '%s' would hold %llu triangles (at most %u)", name,
+                   (unsigned long long)total, UINT32_MAX - 1 - t0);
+
+  float xlo = INFINITY, xhi = -INFINITY, zlo = INFINITY, zhi = -INFINITY;
+  for (int k = 0; k < 3; k++)
+    for (uint32_t m = t0; m < s->ntris; m++) {
+      xlo = fminf(xlo, s->p[k][0][m]), xhi = fmaxf(xhi, s->p[k][0][m]);
+      zlo = fminf(zlo, s->p[k][2][m]), zhi = fmaxf(zhi, s->p[k][2][m]);
+    }
+  float sx = xhi - xlo, sz = zhi - zlo;
+  if (!isfinite((float)(n - 1) * 1.25f * sx) || !isfinite((float)(n - 1) * 1.25f * sz))
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "grid '%s': the mesh is too large to replicate", name);
+
+  e = scene_reserve(s, (uint32_t)(total - T), false, false);
+  if (e) return e;
+  for (uint64_t copy = 1; copy < copies; copy++) {
+    float ox = (float)(copy % n) * 1.25f * sx, oz = (float)(copy / n) * 1.25f * sz;
+    size_t dst = t0 + copy * T;
+    for (int k = 0; k < 3; k++) {
+      for (uint32_t m = 0; m < T; m++) {
+        s->p[k][0][dst + m] = s->p[k][0][t0 + m] + ox;
+        s->p[k][1][dst + m] = s->p[k][1][t0 + m];
+        s->p[k][2][dst + m] = s->p[k][2][t0 + m] + oz;
+      }
+      for (int c = 0; c < 3; c++)
+        if (s->n[k][c]) memcpy(s->n[k][c] + dst, s->n[k][c] + t0, T * sizeof(float));
+      for (int c = 0; c < 2; c++)
+        if (s->uv[k][c]) memcpy(s->uv[k][c] + dst, s->uv[k][c] + t0, T * sizeof(float));
+    }
+    memcpy(s->material + dst, s->material + t0, T * sizeof(uint32_t));
+  }
+  s->ntris = (uint32_t)(t0 + total);
+  /* Count the file's dropped triangles once per copy, as loading it N² times would. */
+  s->skipped += (s->skipped - skipped0) * (copies - 1);
+  scene_update_bounds(s);
+  return RR_OK;
+}
+
+/* ---- rooms -------------------------------------------------------------------------- */
+
+/* A small deterministic generator (LCG) so the benchmark scene never changes. */
+static float rng_next(uint32_t *state) {
+  *state = *state * 1664525u + 1013904223u;
+  return (float)(*state >> 8) / 16777216.0f;
+}
+
+enum { ROOM_SIZE = 8 };
+static const float ROOM_H = 3.0f, ROOM_INSET = 0.1f, DOOR_W = 1.2f, DOOR_H = 2.2f;
+
+/* A vertical wall from floor point a to b (y = 0..ROOM_H) with a door in its middle;
+ * its front faces (b - a) × y, the room's inside when walls go round counter-clockwise
+ * seen from +y. */
+static void push_wall(rr_scene *s, vec3 a, vec3 b, uint32_t mat) {
+  vec3 d = v3_sub(b, a);
+  float len = v3_len(d);
+  vec3 u = v3_scale(d, 1.0f / len), up = v3(0, ROOM_H, 0), door = v3(0, DOOR_H, 0);
+  vec3 l = v3_add(a, v3_scale(u, 0.5f * (len - DOOR_W))); /* door jambs */
+  vec3 r = v3_add(a, v3_scale(u, 0.5f * (len + DOOR_W)));
+  push_quad(s, a, l, v3_add(l, up), v3_add(a, up), NULL, mat);
+  push_quad(s, r, b, v3_add(b, up), v3_add(r, up), NULL, mat);
+  push_quad(s, v3_add(l, door), v3_add(r, door), v3_add(r, up), v3_add(l, up), NULL, mat);
+}
+
+/* A prism column of `sides` sides standing from the floor to the ceiling. It has no
+ * caps: they would lie in the floor and ceiling planes and fight with them. */
+static void push_column(rr_scene *s, float cx, float cz, float radius, int sides, uint32_t mat) {
+  vec3 bot[12], top[12];
+  for (int k = 0; k < sides; k++) {
+    double ph = 2 * PI * k / sides; /* counter-clockwise seen from +y */
+    bot[k] = v3(cx + radius * (float)cos(ph), 0, cz - radius * (float)sin(ph));
+    top[k] = v3(bot[k].x, ROOM_H, bot[k].z);
+  }
+  for (int k = 0; k < sides; k++) {
+    int k1 = (k + 1) % sides;
+    push_quad(s, bot[k], bot[k1], top[k1], top[k], NULL, mat); /* faces outward */
+  }
+}
+
+/* rooms:N — N×N rooms of ROOM_SIZE units, each with floor, ceiling, four walls with a
+ * door in the middle of each (so the rooms open into each other), and three prism
+ * columns. Walls of neighbouring rooms stand a little apart, so a view across the
+ * array crosses many large overlapping layers. */
+static rr_error gen_rooms(rr_scene *s, int n) {
+  uint32_t floor_m, wall_m, ceil_m, col_m[3];
+  rr_error e = add_material(s, 0.55f, 0.45f, 0.35f, &floor_m);
+  if (!e) e = add_material(s, 0.85f, 0.82f, 0.75f, &wall_m);
+  if (!e) e = add_material(s, 0.95f, 0.95f, 0.95f, &ceil_m);
+  if (!e) e = add_material(s, 0.75f, 0.30f, 0.25f, &col_m[0]);
+  if (!e) e = add_material(s, 0.25f, 0.45f, 0.75f, &col_m[1]);
+  if (!e) e = add_material(s, 0.30f, 0.65f, 0.35f, &col_m[2]);
+  /* per room: 4 floor/ceiling + 24 wall + 3 columns of at most 2·12 */
+  if (!e) e = reserve(s, (uint64_t)n * n * (4 + 24 + 3 * 24), false);
+  if (e) return e;
+  uint32_t rng = 12345u;
+  for (int rj = 0; rj < n; rj++)
+    for (int ri = 0; ri < n; ri++) {
+      float x0 = (float)(ri * ROOM_SIZE) + ROOM_INSET, x1 = (float)((ri + 1) * ROOM_SIZE) - ROOM_INSET;
+      float z0 = (float)(rj * ROOM_SIZE) + ROOM_INSET, z1 = (float)((rj + 1) * ROOM_SIZE) - ROOM_INSET;
+      vec3 c00 = v3(x0, 0, z0), c10 = v3(x1, 0, z0), c11 = v3(x1, 0, z1), c01 = v3(x0, 0, z1);
+      vec3 up = v3(0, ROOM_H, 0);
+      push_quad(s, c00, c01, c11, c10, NULL, floor_m); /* faces +y */
+      push_quad(s, v3_add(c00, up), v3_add(c10, up), v3_add(c11, up), v3_add(c01, up), NULL,
+                ceil_m); /* faces -y */
+      push_wall(s, c00, c10, wall_m);
+      push_wall(s, c10, c11, wall_m);
+      push_wall(s, c11, c01, wall_m);
+      push_wall(s, c01, c00, wall_m);
+      /* Columns near three of the four quadrant centres, clear of the door paths. */
+      int skip = (int)(rng_next(&rng) * 4.0f);
+      for (int q = 0; q < 4; q++) {
+        if (q == skip) continue;
+        float cx = 0.5f * (x0 + x1) + ((q & 1) ? 2.0f : -2.0f) + rng_next(&rng) - 0.5f;
+        float cz = 0.5f * (z0 + z1) + ((q & 2) ? 2.0f : -2.0f) + rng_next(&rng) - 0.5f;
+        float radius = 0.3f + 0.3f * rng_next(&rng);
+        int sides = 8 + (int)(rng_next(&rng) * 5.0f); /* 8..12 */
+        push_column(s, cx, cz, radius, sides, col_m[(q + ri + rj) % 3]);
+      }
+    }
+  return RR_OK;
+}
+
+/* ---- demo ----------------------------------------------------------------------------- */
+
+typedef struct corner_key {
+  float x, y, z;
+  uint32_t tri, k;
+} corner_key;
+
+static int corner_cmp(const void *pa, const void *pb) {
+  const corner_key *a = pa, *b = pb;
+  if (a->x != b->x) return a->x < b->x ? -1 : 1;
+  if (a->y != b->y) return a->y < b->y ? -1 : 1;
+  if (a->z != b->z) return a->z < b->z ? -1 : 1;
+  return 0;
+}
+
+/* Smooth corner normals for triangles [t0, t1): each corner averages the
+ * area-weighted normals of the triangles meeting at the same position whose faces
+ * turn by less than 60° from its own, so creases (the teapot's rim) stay sharp. */
+static rr_error smooth_normals(rr_scene *s, uint32_t t0, uint32_t t1) {
+  size_t nt = t1 - t0, nc = 3 * nt;
+  rr_error e = scene_reserve(s, 0, true, false);
+  if (e) return e;
+  corner_key *c = malloc(nc * sizeof *c);
+  vec3 *fn = malloc(nt * sizeof *fn);
+  if (!c || !fn) {
+    free(c), free(fn);
+    return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory smoothing normals");
+  }
+  for (size_t t = 0; t < nt; t++) {
+    uint32_t i = t0 + (uint32_t)t;
+    vec3 p0 = scene_vertex(s, 0, i), p1 = scene_vertex(s, 1, i), p2 = scene_vertex(s, 2, i);
+    fn[t] = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
+    for (uint32_t k = 0; k < 3; k++) {
+      vec3 p = scene_vertex(s, (int)k, i);
+      c[3 * t + k] = (corner_key){p.x, p.y, p.z, (uint32_t)t, k};
+    }
+  }
+  qsort(c, nc, sizeof *c, corner_cmp);
+  const float crease = 0.5f; /* cos 60° */
+  for (size_t g0 = 0, g1; g0 < nc; g0 = g1) {
+    for (g1 = g0 + 1; g1 < nc && corner_cmp(&c[g0], &c[g1]) == 0; g1++) {
+    }
+    for (size_t a = g0; a < g1; a++) {
+      vec3 own = v3_norm(fn[c[a].tri]), sum = v3(0, 0, 0);
+      for (size_t b = g0; b < g1; b++)
+        if (v3_dot(own, v3_norm(fn[c[b].tri])) >= crease) sum = v3_add(sum, fn[c[b].tri]);
+      vec3 nrm = v3_len(sum) > 0 ? v3_norm(sum) : own;
+      uint32_t i = t0 + c[a].tri, k = c[a].k;
+      s->n[k][0][i] = nrm.x, s->n[k][1][i] = nrm.y, s->n[k][2][i] = nrm.z;
+    }
+  }
+  free(c), free(fn);
+  return RR_OK;
+}
+
+/* Loads a mesh file into s, gives it smooth normals, scales it uniformly by `size`
+ * divided by its largest extent, turns it by `yaw` degrees about +y and stands the
+ * bottom centre of its bounds at (x, 0, z). Returns the first material it added. */
+static rr_error place_file(rr_scene *s, const char *path, float size, float yaw, float x,
+                           float z, uint32_t *first_mat) {
+  uint32_t t0 = s->ntris;
+  *first_mat = s->nmaterials;
+  rr_error e = scene_load_file(s, path);
+  if (!e && s->ntris == t0) e = rr_fail(s->dev, RR_ERROR_EMPTY, "demo mesh '%s' has no triangles", path);
+  if (!e) e = smooth_normals(s, t0, s->ntris);
+  if (e) return e;
+  float cy = cosf(yaw * (float)(PI / 180)), sy = sinf(yaw * (float)(PI / 180));
+  vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+  for (uint32_t i = t0; i < s->ntris; i++)
+    for (int k = 0; k < 3; k++) {
+      vec3 p = scene_vertex(s, k, i);
+      lo = v3_min(lo, p), hi = v3_max(hi, p);
+    }
+  vec3 ext = v3_sub(hi, lo);
+  float scale = size / fmaxf(ext.x, fmaxf(ext.y, ext.z));
+  vec3 mid = v3(0.5f * (lo.x + hi.x), lo.y, 0.5f * (lo.z + hi.z));
+  for (uint32_t i = t0; i < s->ntris; i++)
+    for (int k = 0; k < 3; k++) {
+      vec3 p = v3_scale(v3_sub(scene_vertex(s, k, i), mid), scale);
+      s->p[k][0][i] = cy * p.x + sy * p.z + x;
+      s->p[k][1][i] = p.y;
+      s->p[k][2][i] = -sy * p.x + cy * p.z + z;
+      float nx = s->n[k][0][i], nz = s->n[k][2][i];
+      s->n[k][0][i] = cy * nx + sy * nz;
+      s->n[k][2][i] = -sy * nx + cy * nz;
+    }
+  return RR_OK;
+}
+
+/* The default scene: teapot, Spot the cow, two spheres and a torus on a floor. The
+ * floor stays within about twice the group's size because auto-framing fits the
+ * whole bounding box. */
+static rr_error gen_demo(rr_scene *s) {
+  uint32_t floor_m, blue_m, gold_m, green_m, teapot_m, spot_m;
+  rr_error e = add_material(s, 0.82f, 0.82f, 0.80f, &floor_m);
+  if (!e) e = add_material(s, 0.20f, 0.45f, 0.85f, &blue_m);
+  if (!e) e = add_material(s, 0.95f, 0.70f, 0.18f, &gold_m);
+  if (!e) e = add_material(s, 0.30f, 0.72f, 0.42f, &green_m);
+  if (!e) e = reserve(s, 2, true);
+  if (e) return e;
+  vec3 up = v3(0, 1, 0);
+  const float fy = -0.01f; /* just below the objects resting on y = 0 */
+  push_quad(s, v3(-5.0f, fy, -3.0f), v3(-5.0f, fy, 3.0f), v3(5.0f, fy, 3.0f), v3(5.0f, fy, -3.0f),
+            &up, floor_m);
+
+  e = place_file(s, RR_DATA_DIR "/teapot.obj", 3.2f, -20.0f, -0.6f, -0.3f, &teapot_m);
+  if (e) return e;
+  for (uint32_t m = teapot_m; m < s->nmaterials; m++) { /* the file has no colour of its own */
+    s->materials[m].color[0] = 0.86f, s->materials[m].color[1] = 0.30f, s->materials[m].color[2] = 0.24f;
+  }
+  e = place_file(s, RR_DATA_DIR "/spot.obj", 1.9f, 145.0f, 2.6f, 0.3f, &spot_m);
+  if (!e) e = gen_sphere(s, 48, v3(-3.3f, 0.6f, 0.9f), 0.6f, blue_m);
+  if (!e) e = gen_sphere(s, 32, v3(0.9f, 0.35f, 1.6f), 0.35f, gold_m);
+  if (!e) e = gen_torus(s, 48, 24, 0.5f, 0.17f, v3(-1.6f, 0.17f, 1.7f), green_m);
+  if (e) return e;
+  scene_update_bounds(s);
+  return RR_OK;
+}
+
+/* ---- entry point ------------------------------------------------------------------- */
+
+rr_error scene_load_builtin(rr_scene *s, const char *name) {
+  const char *arg;
+  long n;
+  rr_error e;
+  if (strcmp(name, "demo") == 0) {
+    e = gen_demo(s);
+  } else if ((arg = builtin_arg(name, "plane"))) {
+    e = size_arg(s, name, arg, 64, 1, 4096, &n);
+    if (!e) e = gen_plane(s, (int)n);
+  } else if ((arg = builtin_arg(name, "sphere"))) {
+    uint32_t mat;
+    e = size_arg(s, name, arg, 32, 4, 4096, &n);
+    if (!e) e = add_material(s, 0.8f, 0.8f, 0.8f, &mat);
+    if (!e) e = gen_sphere(s, (int)n, v3(0, 0, 0), 1.0f, mat);
+  } else if ((arg = builtin_arg(name, "box"))) {
+    e = size_arg(s, name, arg, 8, 1, 1024, &n);
+    if (!e) e = gen_box(s, (int)n);
+  } else if ((arg = builtin_arg(name, "rooms"))) {
+    e = size_arg(s, name, arg, 4, 1, 100, &n);
+    if (!e) e = gen_rooms(s, (int)n);
+  } else if (strncmp(name, "grid:", 5) == 0) {
+    e = load_grid(s, name);
+  } else {
+    return RR_ERROR_UNSUPPORTED; /* not a built-in name: the caller reads it as a file */
+  }
+  return e ? e : rr_ok(s->dev);
+}
