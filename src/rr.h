@@ -98,7 +98,22 @@ void scene_load_textures(rr_scene *s, const char *base_dir);
 
 /* ---- BVH --------------------------------------------------------------------- */
 
-struct rr_bvh;
+/* 32-byte node with its own bounds. A leaf (count > 0) holds triangles
+ * bvh->prims[first .. first + count); an inner node's children are nodes[first]
+ * and nodes[first + 1]. The root is node 0. */
+typedef struct bvh_node {
+  float lo[3], hi[3];
+  uint32_t first, count;
+} bvh_node;
+
+typedef struct rr_bvh {
+  bvh_node *nodes;
+  uint32_t nnodes, nleaves, depth;
+  uint32_t *prims; /* triangle ids in leaf order */
+  double sah_cost, build_ms;
+  uint64_t bytes;
+} rr_bvh;
+
 /* Frees the scene's BVH (if any). */
 void scene_free_bvh(rr_scene *s);
 /* Adds the BVH's figures to a scene's info. */
@@ -214,7 +229,25 @@ typedef struct render_ctx {
   int threads;
   visbuf *vb;
   rr_stats *stats;
+  float *heat_e, *heat_n; /* optional per-pixel E and N charges */
 } render_ctx;
+
+/* The oracles of the continuum's traversal (paper Fig. 8), as settings. */
+typedef struct oracles {
+  int frustum_size;  /* side of the initial frusta; 0: whole image (tiles on several threads) */
+  bool leaves;       /* generateSamples at BVH leaves (false: at the root, plain rasterization) */
+  bool cull_outside; /* isOutside: frustum culling of BVH nodes */
+  bool cull_occluded;/* isOccluded: hierarchical z-buffer test of BVH nodes */
+  int split_min;     /* splitFrustum down to this side (0: never split) */
+  float split_ratio; /* split when a node's projected area is below ratio × the frustum's */
+  bool binning;      /* rasterize hierarchically in bins rather than every sample of the bounds */
+  bool early_z;      /* reject bins hidden behind the stored depths */
+  int bin_size;      /* top bin side */
+  int bin_min;       /* bins this small are tested sample by sample */
+} oracles;
+
+/* The continuum's one traversal with the given oracles (src/traverse.c). */
+rr_error vis_traverse(rr_device *dev, render_ctx *ctx, const oracles *o);
 
 typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
 

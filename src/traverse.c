@@ -1,0 +1,383 @@
+/* The continuum (paper sect. 4.4, Fig. 8): one traversal of frusta F through BVH
+ * nodes N, steered by oracles. Every configuration calls the same sample test, so
+ * every configuration yields the same visibility buffer; only the order and number
+ * of (sample, triangle) pairs visited change.
+ *
+ *   traverse(F, N):
+ *     if isOutside(F, N) or isOccluded(F, N): return
+ *     if splitFrustum(F, N): traverse(F_i, N) for each quadrant F_i; return
+ *     if generateSamples(F, N): rasterize N's triangles into F (binning or not); return
+ *     traverse(F, child) for N's children, front to back
+ *
+ * Depth here is the ray parameter t along d(x, y) = d0 + x dx + y dy; for the
+ * perspective camera d·fwd = 1, so t is also the distance along fwd. Culling
+ * decisions keep a relative safety margin so they never remove a winning triangle. */
+#include "rr.h"
+
+#include <string.h>
+
+#define HIZ 8               /* hierarchical z-buffer tile size: frusta split down to it */
+#define DEPTH_MARGIN 1e-3f  /* relative slack of every depth comparison used for culling */
+
+typedef struct tile_rect { int x0, y0, x1, y1; } tile_rect; /* samples [x0, x1) × [y0, y1) */
+
+typedef struct trav {
+  const rr_scene *s;
+  const camera *c;
+  const oracles *o;
+  visbuf *vb;
+  bool cull_back;
+  float *hiz;        /* per HIZ×HIZ tile: the farthest t stored (recomputed when dirty) */
+  uint8_t *dirty;
+  int tiles_x;
+  float *heat_e, *heat_n; /* optional per-pixel E and N charges */
+  rr_stats st;
+} trav;
+
+/* ---- per-pixel statistics ------------------------------------------------ */
+
+static void charge(float *heat, int width, tile_rect r, float amount) {
+  if (!heat) return;
+  float each = amount / (float)((r.x1 - r.x0) * (r.y1 - r.y0));
+  for (int y = r.y0; y < r.y1; y++)
+    for (int x = r.x0; x < r.x1; x++) heat[(size_t)y * width + x] += each;
+}
+
+/* ---- hierarchical z ---------------------------------------------------- */
+
+static float hiz_tile(trav *t, int tx, int ty) {
+  int k = ty * t->tiles_x + tx;
+  if (t->dirty[k]) {
+    const visbuf *vb = t->vb;
+    int x1 = (tx + 1) * HIZ < vb->width ? (tx + 1) * HIZ : vb->width;
+    int y1 = (ty + 1) * HIZ < vb->height ? (ty + 1) * HIZ : vb->height;
+    float m = 0;
+    for (int y = ty * HIZ; y < y1; y++)
+      for (int x = tx * HIZ; x < x1; x++) m = fmaxf(m, vb->t[(size_t)y * vb->width + x]);
+    t->hiz[k] = m;
+    t->dirty[k] = 0;
+  }
+  return t->hiz[k];
+}
+
+/* The farthest depth stored in a rectangle (aligned to HIZ tiles, or inside one). */
+static float hiz_max(trav *t, tile_rect r) {
+  float m = 0;
+  for (int ty = r.y0 / HIZ; ty <= (r.y1 - 1) / HIZ; ty++)
+    for (int tx = r.x0 / HIZ; tx <= (r.x1 - 1) / HIZ; tx++) {
+      m = fmaxf(m, hiz_tile(t, tx, ty));
+      if (m == INFINITY) return m;
+    }
+  return m;
+}
+
+static void mark_dirty(trav *t, tile_rect r) {
+  for (int ty = r.y0 / HIZ; ty <= (r.y1 - 1) / HIZ; ty++)
+    for (int tx = r.x0 / HIZ; tx <= (r.x1 - 1) / HIZ; tx++) t->dirty[ty * t->tiles_x + tx] = 1;
+}
+
+/* ---- rasterizing one triangle into a frustum ---------------------------- */
+
+typedef struct tri_job {
+  tri_setup ts;
+  uint32_t id;
+  float zmin;      /* nearest depth of the triangle (0 when it reaches the eye plane) */
+  float slack[3];  /* how far below zero a rounded corner value may fall for an inside sample */
+  int bb[4];       /* inclusive screen bounds */
+} tri_job;
+
+/* Tests every sample of r; the one kernel every generateSamples path ends in. */
+static void raster_samples(trav *t, const tri_job *j, tile_rect r) {
+  int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
+  t->st.edge_evals += raster_rect(&j->ts, j->id, rect, t->vb);
+  charge(t->heat_e, t->vb->width, r, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
+  mark_dirty(t, r);
+}
+
+/* Hierarchical binning: a bin is rejected when one edge function is negative at
+ * all four corner samples (the edges are linear in the sample position for planar
+ * cameras) or when early-z shows it is hidden; otherwise it is refined by 4 in each
+ * direction down to single samples. Accepted samples still go through the sample
+ * test, which keeps the result bit-identical. */
+static void bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
+  for (int by = r.y0 - r.y0 % size; by < r.y1; by += size)
+    for (int bx = r.x0 - r.x0 % size; bx < r.x1; bx += size) {
+      tile_rect b = {bx > r.x0 ? bx : r.x0, by > r.y0 ? by : r.y0, bx + size < r.x1 ? bx + size : r.x1,
+                     by + size < r.y1 ? by + size : r.y1};
+      if (size <= t->o->bin_min || (b.x1 - b.x0) * (b.y1 - b.y0) <= 4) {
+        raster_samples(t, j, b);
+        continue;
+      }
+      float xs[2] = {b.x0 + 0.5f, b.x1 - 0.5f}, ys[2] = {b.y0 + 0.5f, b.y1 - 0.5f};
+      bool out = false;
+      for (int e = 0; e < 3 && !out; e++) {
+        bool all_out = true;
+        for (int k = 0; k < 4 && all_out; k++)
+          all_out = j->ts.a[e] + xs[k & 1] * j->ts.b[e] + ys[k >> 1] * j->ts.c[e] < -j->slack[e];
+        out = all_out;
+      }
+      t->st.edge_evals += 4;
+      if (t->heat_e) {
+        int w = t->vb->width;
+        t->heat_e[(size_t)b.y0 * w + b.x0] += 1, t->heat_e[(size_t)b.y0 * w + b.x1 - 1] += 1;
+        t->heat_e[(size_t)(b.y1 - 1) * w + b.x0] += 1, t->heat_e[(size_t)(b.y1 - 1) * w + b.x1 - 1] += 1;
+      }
+      if (out) continue;
+      if (t->o->early_z && j->zmin > 0 && j->zmin * (1 - DEPTH_MARGIN) > hiz_max(t, b)) continue;
+      bin_raster(t, j, b, size / 4 > 1 ? size / 4 : 1);
+    }
+}
+
+/* Triangle setup for a frustum: false when the triangle cannot cover a sample. */
+static bool prepare(const trav *t, uint32_t id, tri_job *j) {
+  if (tri_setup_planar(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED) return false;
+  if (!tri_screen_bounds(t->s, id, t->c, j->bb)) return false;
+  j->id = id;
+  if (!t->o->binning) return true;
+  float zmin = INFINITY;
+  for (int k = 0; k < 3; k++) zmin = fminf(zmin, v3_dot(v3_sub(scene_vertex(t->s, k, id), t->c->eye), t->c->fwd));
+  j->zmin = zmin > 0 ? zmin : 0;
+  float W = (float)t->vb->width + 1, H = (float)t->vb->height + 1;
+  for (int e = 0; e < 3; e++)
+    j->slack[e] = 1e-5f * (fabsf(j->ts.a[e]) + W * fabsf(j->ts.b[e]) + H * fabsf(j->ts.c[e]));
+  return true;
+}
+
+/* Rasterizes a prepared triangle into the samples of f it may cover. */
+static void draw(trav *t, const tri_job *j, tile_rect f) {
+  tile_rect r = {j->bb[0] > f.x0 ? j->bb[0] : f.x0, j->bb[1] > f.y0 ? j->bb[1] : f.y0,
+                 j->bb[2] + 1 < f.x1 ? j->bb[2] + 1 : f.x1, j->bb[3] + 1 < f.y1 ? j->bb[3] + 1 : f.y1};
+  if (r.x0 >= r.x1 || r.y0 >= r.y1) return;
+  if (t->o->binning) bin_raster(t, j, r, t->o->bin_size);
+  else raster_samples(t, j, r);
+}
+
+static void rasterize(trav *t, uint32_t id, tile_rect f) {
+  tri_job j;
+  t->st.setups++;
+  if (prepare(t, id, &j)) draw(t, &j, f);
+}
+
+/* ---- frusta against boxes ---------------------------------------------- */
+
+typedef struct frustum {
+  tile_rect r;
+  vec3 plane[4]; /* inward normals of the side planes through the eye */
+  vec3 centre;   /* direction of the centre ray */
+} frustum;
+
+static frustum make_frustum(const camera *c, tile_rect r) {
+  frustum f = {.r = r};
+  /* Half a pixel beyond the outer sample centres: conservative for every sample. */
+  float x0 = (float)r.x0, x1 = (float)r.x1, y0 = (float)r.y0, y1 = (float)r.y1;
+  vec3 d00 = camera_dir(c, x0, y0), d10 = camera_dir(c, x1, y0), d11 = camera_dir(c, x1, y1),
+       d01 = camera_dir(c, x0, y1);
+  f.centre = camera_dir(c, 0.5f * (x0 + x1), 0.5f * (y0 + y1));
+  vec3 n[4] = {v3_cross(d00, d10), v3_cross(d10, d11), v3_cross(d11, d01), v3_cross(d01, d00)};
+  for (int i = 0; i < 4; i++) f.plane[i] = v3_dot(n[i], f.centre) < 0 ? v3_neg(n[i]) : n[i];
+  return f;
+}
+
+/* Largest value of n·(p − eye) over the corners of a box. */
+static float box_max_dot(const bvh_node *b, vec3 eye, vec3 n, float *mag) {
+  float m = 0, s = 0;
+  const float nn[3] = {n.x, n.y, n.z}, e[3] = {eye.x, eye.y, eye.z};
+  for (int a = 0; a < 3; a++) {
+    float lo = nn[a] * (b->lo[a] - e[a]), hi = nn[a] * (b->hi[a] - e[a]);
+    m += fmaxf(lo, hi);
+    s += fabsf(lo) + fabsf(hi);
+  }
+  *mag = s;
+  return m;
+}
+
+static float box_zmin(const bvh_node *b, const camera *c) {
+  float m = 0;
+  const float f[3] = {c->fwd.x, c->fwd.y, c->fwd.z}, e[3] = {c->eye.x, c->eye.y, c->eye.z};
+  for (int a = 0; a < 3; a++) m += fminf(f[a] * (b->lo[a] - e[a]), f[a] * (b->hi[a] - e[a]));
+  return m;
+}
+
+/* isOutside: the box lies wholly outside one side plane, or behind the eye. */
+static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
+  float mag;
+  if (box_max_dot(b, c->eye, c->fwd, &mag) <= -1e-6f * mag) return true;
+  for (int i = 0; i < 4; i++)
+    if (box_max_dot(b, c->eye, f->plane[i], &mag) < -1e-5f * mag) return true;
+  return false;
+}
+
+/* Does the centre ray of f meet the box (slab test with slack)? */
+static bool centre_hits(const frustum *f, const bvh_node *b, vec3 eye) {
+  float t0 = 0, t1 = INFINITY;
+  const float o[3] = {eye.x, eye.y, eye.z}, d[3] = {f->centre.x, f->centre.y, f->centre.z};
+  for (int a = 0; a < 3; a++) {
+    float pad = 1e-4f * (b->hi[a] - b->lo[a]);
+    if (d[a] == 0) {
+      if (o[a] < b->lo[a] - pad || o[a] > b->hi[a] + pad) return false;
+      continue;
+    }
+    float inv = 1.0f / d[a], ta = (b->lo[a] - pad - o[a]) * inv, tb = (b->hi[a] + pad - o[a]) * inv;
+    t0 = fmaxf(t0, fminf(ta, tb));
+    t1 = fminf(t1, fmaxf(ta, tb));
+  }
+  return t0 <= t1;
+}
+
+/* splitFrustum: the centre ray misses the node, or the node looks small in F. */
+static bool should_split(const trav *t, const frustum *f, const bvh_node *b) {
+  const oracles *o = t->o;
+  int w = f->r.x1 - f->r.x0, h = f->r.y1 - f->r.y0;
+  if (!o->split_min || (w <= o->split_min && h <= o->split_min)) return false;
+  if (!centre_hits(f, b, t->c->eye)) return true;
+  float z = box_zmin(b, t->c);
+  if (!(z > 0)) return false;
+  vec3 ext = v3(b->hi[0] - b->lo[0], b->hi[1] - b->lo[1], b->hi[2] - b->lo[2]);
+  float px = v3_len(ext) / (z * 2.0f * t->c->tan_half_h / (float)t->vb->height); /* box size in pixels */
+  return px * px < o->split_ratio * (float)w * (float)h;
+}
+
+static void traverse(trav *t, const frustum *f, uint32_t node);
+
+static void split(trav *t, const frustum *f, uint32_t node) {
+  const tile_rect r = f->r;
+  /* Quadrants aligned to the hierarchical z tiles. */
+  int mx = r.x1 - r.x0 > t->o->split_min ? (r.x0 + (r.x1 - r.x0) / 2 + HIZ - 1) / HIZ * HIZ : r.x1;
+  int my = r.y1 - r.y0 > t->o->split_min ? (r.y0 + (r.y1 - r.y0) / 2 + HIZ - 1) / HIZ * HIZ : r.y1;
+  if (mx >= r.x1) mx = r.x1;
+  if (my >= r.y1) my = r.y1;
+  tile_rect q[4] = {{r.x0, r.y0, mx, my}, {mx, r.y0, r.x1, my}, {r.x0, my, mx, r.y1}, {mx, my, r.x1, r.y1}};
+  for (int i = 0; i < 4; i++) {
+    if (q[i].x0 >= q[i].x1 || q[i].y0 >= q[i].y1) continue;
+    frustum sub = make_frustum(t->c, q[i]);
+    traverse(t, &sub, node);
+  }
+}
+
+static void generate(trav *t, const frustum *f, uint32_t node) {
+  const rr_bvh *bvh = t->s->bvh;
+  const bvh_node *n = &bvh->nodes[node];
+  if (n->count) {
+    for (uint32_t k = 0; k < n->count; k++) rasterize(t, bvh->prims[n->first + k], f->r);
+    return;
+  }
+  generate(t, f, n->first);
+  generate(t, f, n->first + 1);
+}
+
+static void traverse(trav *t, const frustum *f, uint32_t node) {
+  const rr_bvh *bvh = t->s->bvh;
+  const bvh_node *n = &bvh->nodes[node];
+  const oracles *o = t->o;
+  t->st.nodes++;
+  charge(t->heat_n, t->vb->width, f->r, 1.0f);
+  if (o->cull_outside && is_outside(f, n, t->c)) return;
+  if (o->cull_occluded) {
+    float z = box_zmin(n, t->c);
+    if (z > 0 && z * (1 - DEPTH_MARGIN) > hiz_max(t, f->r)) return;
+  }
+  if (should_split(t, f, n)) {
+    split(t, f, node);
+    return;
+  }
+  if (n->count) {
+    generate(t, f, node);
+    return;
+  }
+  /* Children front to back: nearer box first along the view direction. */
+  uint32_t a = n->first, b = n->first + 1;
+  if (box_zmin(&bvh->nodes[b], t->c) < box_zmin(&bvh->nodes[a], t->c)) a = b, b = n->first;
+  traverse(t, f, a);
+  traverse(t, f, b);
+}
+
+/* ---- driving it ------------------------------------------------------------ */
+
+typedef struct trav_job {
+  render_ctx *ctx;
+  const oracles *o;
+  int tile, tiles_x;
+  float *hiz;
+  uint8_t *dirty;
+  rr_stats st[256];
+  const tri_job *pre; /* root-only on several tiles: every triangle set up once */
+  uint32_t npre;
+} trav_job;
+
+static void run_tile(int job, int thread, void *arg) {
+  trav_job *tj = arg;
+  render_ctx *ctx = tj->ctx;
+  const visbuf *vb = ctx->vb;
+  int tx = job % tj->tiles_x, ty = job / tj->tiles_x;
+  tile_rect r = {tx * tj->tile, ty * tj->tile, (tx + 1) * tj->tile, (ty + 1) * tj->tile};
+  if (r.x1 > vb->width) r.x1 = vb->width;
+  if (r.y1 > vb->height) r.y1 = vb->height;
+  trav t = {.s = ctx->scene,
+            .c = ctx->cam,
+            .o = tj->o,
+            .vb = ctx->vb,
+            .cull_back = ctx->opt->cull_backfaces != 0,
+            .hiz = tj->hiz,
+            .dirty = tj->dirty,
+            .tiles_x = (vb->width + HIZ - 1) / HIZ,
+            .heat_e = ctx->heat_e,
+            .heat_n = ctx->heat_n};
+  frustum f = make_frustum(ctx->cam, r);
+  if (tj->o->leaves) {
+    traverse(&t, &f, 0);
+  } else if (tj->pre) {
+    for (uint32_t i = 0; i < tj->npre; i++) draw(&t, &tj->pre[i], r);
+  } else {
+    /* generateSamples at the root: plain rasterization of every triangle in order */
+    for (uint32_t i = 0; i < ctx->scene->ntris; i++) rasterize(&t, i, r);
+  }
+  rr_stats *s = &tj->st[thread];
+  s->setups += t.st.setups, s->edge_evals += t.st.edge_evals, s->nodes += t.st.nodes;
+}
+
+rr_error vis_traverse(rr_device *dev, render_ctx *ctx, const oracles *o) {
+  const visbuf *vb = ctx->vb;
+  if (!ctx->scene->bvh && o->leaves)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "this method needs the scene's BVH (call rr_scene_commit)");
+  /* Initial frusta: the whole image on one thread (the paper's set-up), else
+   * tiles dealt out to the threads; frustum_size forces a tile size. */
+  int tile = o->frustum_size;
+  if (tile <= 0) tile = ctx->threads > 1 ? 128 : (vb->width > vb->height ? vb->width : vb->height);
+  tile = (tile + HIZ - 1) / HIZ * HIZ;
+  trav_job *tj = calloc(1, sizeof *tj);
+  int tiles_x = (vb->width + HIZ - 1) / HIZ, tiles_y = (vb->height + HIZ - 1) / HIZ;
+  if (tj) {
+    tj->hiz = malloc((size_t)tiles_x * tiles_y * sizeof *tj->hiz);
+    tj->dirty = malloc((size_t)tiles_x * tiles_y);
+  }
+  if (!tj || !tj->hiz || !tj->dirty) {
+    if (tj) free(tj->hiz), free(tj->dirty);
+    free(tj);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the hierarchical z-buffer");
+  }
+  for (int k = 0; k < tiles_x * tiles_y; k++) tj->hiz[k] = INFINITY, tj->dirty[k] = 0;
+  tj->ctx = ctx, tj->o = o, tj->tile = tile, tj->tiles_x = (vb->width + tile - 1) / tile;
+  int njobs = tj->tiles_x * ((vb->height + tile - 1) / tile);
+  tri_job *pre = NULL;
+  if (!o->leaves && njobs > 1) {
+    /* Rasterization from the root on several tiles: set every triangle up once and
+     * let each tile take those whose bounds reach it. */
+    pre = malloc((size_t)ctx->scene->ntris * sizeof *pre + 1);
+    if (!pre) {
+      free(tj->hiz), free(tj->dirty), free(tj);
+      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %u triangle setups", ctx->scene->ntris);
+    }
+    trav t = {.s = ctx->scene, .c = ctx->cam, .o = o, .vb = ctx->vb, .cull_back = ctx->opt->cull_backfaces != 0};
+    for (uint32_t i = 0; i < ctx->scene->ntris; i++) tj->npre += prepare(&t, i, &pre[tj->npre]);
+    ctx->stats->setups += ctx->scene->ntris;
+    tj->pre = pre;
+  }
+  parallel_for(njobs, ctx->threads, run_tile, tj);
+  for (int i = 0; i < 256; i++) {
+    ctx->stats->setups += tj->st[i].setups;
+    ctx->stats->edge_evals += tj->st[i].edge_evals;
+    ctx->stats->nodes += tj->st[i].nodes;
+  }
+  free(pre), free(tj->hiz), free(tj->dirty), free(tj);
+  return RR_OK;
+}
