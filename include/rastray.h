@@ -121,6 +121,13 @@ typedef struct rr_render_options {
   int width, height;  /* image size in samples (one per pixel) */
   int threads;        /* 0: all cores */
   int cull_backfaces; /* nonzero: triangles seen from behind are invisible */
+  int heat;           /* nonzero: also record E and N charged to each pixel (AOVs evals, nodes) */
+  const char *oracles;/* "key=value,..." overrides of a 3dr method's traversal oracles, or NULL:
+                         frustum=N (initial frustum side, 0 = whole image), leaves=0|1
+                         (generate samples at BVH leaves or at the root), outside=0|1 (frustum
+                         culling), occluded=0|1 (occlusion culling), split=N (split frusta down
+                         to N, 0 = never), split-ratio=F, binning=0|1, early-z=0|1, bin=N (top
+                         bin side), bin-min=N (bins tested sample by sample) */
 } rr_render_options;
 
 /* Fills options with defaults: 3dr-bb, 1024x768, all cores, no culling. */
@@ -158,6 +165,8 @@ typedef enum rr_shade_mode {
   RR_SHADE_ID,          /* a stable hashed colour per triangle */
   RR_SHADE_NORMAL,      /* shading normal mapped to colour */
   RR_SHADE_DEPTH,       /* eye distance, near bright, far dark */
+  RR_SHADE_HEAT_EVALS,  /* edge evaluations per pixel as a heat map with a legend */
+  RR_SHADE_HEAT_NODES,  /* BVH nodes visited per pixel as a heat map with a legend */
   RR_SHADE_COUNT
 } rr_shade_mode;
 
@@ -169,10 +178,12 @@ typedef enum rr_aov {
   RR_AOV_ID,        /* 1 uint32: primitive id, RR_MISS on a miss */
   RR_AOV_NORMAL,    /* 3 floats: unit shading normal, 0 on a miss */
   RR_AOV_BARY,      /* 2 floats: λ1, λ2, 0 on a miss */
+  RR_AOV_EVALS,     /* 1 float: edge evaluations charged to the pixel (needs options.heat) */
+  RR_AOV_NODES,     /* 1 float: BVH nodes visited charged to the pixel (needs options.heat) */
   RR_AOV_COUNT
 } rr_aov;
 
-/* The AOV named `name` ("depth", "id", "normal", "bary"); -1 when unknown. */
+/* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes"); -1 when unknown. */
 int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;

@@ -33,23 +33,66 @@ rr_error rr_ok(rr_device *dev) {
 
 /* ---- names ---------------------------------------------------------------- */
 
-/* Every method is one traversal configuration; a NULL entry is a method this
- * build does not have yet. */
+/* The 3D rasterization methods are configurations of one traversal (paper
+ * sect. 5); the others have loops of their own around the same sample test.
+ * A method without either is one this build does not have yet. */
 static const struct {
   const char *name;
   vis_method_fn fn;
+  oracles o;
 } methods[RR_METHOD_COUNT] = {
-    [RR_METHOD_RC] = {"rc", vis_rc},
-    [RR_METHOD_RC_BVH] = {"rc-bvh", NULL},
-    [RR_METHOD_RC_PACKET] = {"rc-packet", NULL},
-    [RR_METHOD_2DR_BB] = {"2dr-bb", NULL},
-    [RR_METHOD_2DR_BIN] = {"2dr-bin", NULL},
-    [RR_METHOD_3DR_BB] = {"3dr-bb", vis_3dr_bb},
-    [RR_METHOD_3DR_BIN] = {"3dr-bin", NULL},
-    [RR_METHOD_3DR_FC] = {"3dr-fc", NULL},
-    [RR_METHOD_3DR_FS] = {"3dr-fs", NULL},
-    [RR_METHOD_3DR_FULL] = {"3dr-full", NULL},
+    [RR_METHOD_RC] = {"rc", vis_rc, {0}},
+    [RR_METHOD_RC_BVH] = {"rc-bvh", NULL, {0}},
+    [RR_METHOD_RC_PACKET] = {"rc-packet", NULL, {0}},
+    [RR_METHOD_2DR_BB] = {"2dr-bb", NULL, {0}},
+    [RR_METHOD_2DR_BIN] = {"2dr-bin", NULL, {0}},
+    [RR_METHOD_3DR_BB] = {"3dr-bb", vis_traverse, {.bin_size = 64, .bin_min = 4}},
+    [RR_METHOD_3DR_BIN] = {"3dr-bin", vis_traverse, {.binning = 1, .early_z = 1, .bin_size = 64, .bin_min = 4}},
+    [RR_METHOD_3DR_FC] = {"3dr-fc", vis_traverse,
+                          {.frustum_size = 256, .leaves = 1, .cull_outside = 1, .binning = 1, .early_z = 1,
+                           .bin_size = 64, .bin_min = 4}},
+    [RR_METHOD_3DR_FS] = {"3dr-fs", vis_traverse,
+                          {.leaves = 1, .cull_outside = 1, .cull_occluded = 1, .split_min = 8, .split_ratio = 0.25f,
+                           .bin_size = 64, .bin_min = 4}},
+    [RR_METHOD_3DR_FULL] = {"3dr-full", vis_traverse,
+                            {.leaves = 1, .cull_outside = 1, .cull_occluded = 1, .split_min = 8, .split_ratio = 0.25f,
+                             .binning = 1, .early_z = 1, .bin_size = 64, .bin_min = 4}},
 };
+
+/* Applies "key=value,..." to a method's oracles. */
+static rr_error parse_oracles(rr_device *dev, const char *spec, oracles *o) {
+  char buf[512];
+  if (strlen(spec) >= sizeof buf) return rr_fail(dev, RR_ERROR_ARGUMENT, "oracle settings too long");
+  strcpy(buf, spec);
+  char *save = NULL;
+  for (char *kv = strtok_r(buf, ",", &save); kv; kv = strtok_r(NULL, ",", &save)) {
+    char *eq = strchr(kv, '=');
+    if (!eq || eq == kv || !eq[1]) return rr_fail(dev, RR_ERROR_ARGUMENT, "bad oracle setting '%s' (expected key=value)", kv);
+    *eq = 0;
+    char *end;
+    double v = strtod(eq + 1, &end);
+    if (*end || !isfinite(v) || v < 0 || v > 65536)
+      return rr_fail(dev, RR_ERROR_ARGUMENT, "bad value '%s' for oracle '%s'", eq + 1, kv);
+    int iv = (int)v;
+    bool flag = v != 0;
+    if (strcmp(kv, "frustum") == 0) o->frustum_size = iv;
+    else if (strcmp(kv, "leaves") == 0) o->leaves = flag;
+    else if (strcmp(kv, "outside") == 0) o->cull_outside = flag;
+    else if (strcmp(kv, "occluded") == 0) o->cull_occluded = flag;
+    else if (strcmp(kv, "split") == 0) o->split_min = iv;
+    else if (strcmp(kv, "split-ratio") == 0) o->split_ratio = (float)v;
+    else if (strcmp(kv, "binning") == 0) o->binning = flag;
+    else if (strcmp(kv, "early-z") == 0) o->early_z = flag;
+    else if (strcmp(kv, "bin") == 0 && iv >= 1) o->bin_size = iv;
+    else if (strcmp(kv, "bin-min") == 0 && iv >= 1) o->bin_min = iv;
+    else
+      return rr_fail(dev, RR_ERROR_ARGUMENT,
+                     "unknown oracle '%s' (expected frustum, leaves, outside, occluded, split, split-ratio, binning, "
+                     "early-z, bin or bin-min)", kv);
+  }
+  if (o->split_min && o->split_min < 8) o->split_min = 8; /* frusta split down to the z tiles */
+  return RR_OK;
+}
 
 int rr_method_from_name(const char *name) {
   for (int m = 0; name && m < RR_METHOD_COUNT; m++)
@@ -66,12 +109,12 @@ static int name_index(const char *const *names, int n, const char *name) {
 }
 
 int rr_shade_from_name(const char *name) {
-  static const char *const names[RR_SHADE_COUNT] = {"lambert", "id", "normal", "depth"};
+  static const char *const names[RR_SHADE_COUNT] = {"lambert", "id", "normal", "depth", "heat-evals", "heat-nodes"};
   return name_index(names, RR_SHADE_COUNT, name);
 }
 
 int rr_aov_from_name(const char *name) {
-  static const char *const names[RR_AOV_COUNT] = {"depth", "id", "normal", "bary"};
+  static const char *const names[RR_AOV_COUNT] = {"depth", "id", "normal", "bary", "evals", "nodes"};
   return name_index(names, RR_AOV_COUNT, name);
 }
 
@@ -110,6 +153,13 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown method %d", (int)opt->method);
   if (opt->threads < 0 || opt->threads > 256)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad thread count %d (0 for all cores, at most 256)", opt->threads);
+  oracles o = methods[opt->method].o;
+  if (opt->oracles && *opt->oracles) {
+    if (methods[opt->method].fn != vis_traverse)
+      return rr_fail(dev, RR_ERROR_ARGUMENT, "oracles apply to the 3dr methods, not to '%s'", methods[opt->method].name);
+    rr_error e = parse_oracles(dev, opt->oracles, &o);
+    if (e) return e;
+  }
   if (!methods[opt->method].fn)
     return rr_fail(dev, RR_ERROR_UNSUPPORTED, "method '%s' is not available in this build", methods[opt->method].name);
   camera c;
@@ -121,12 +171,20 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d visibility buffer", opt->width, opt->height);
   }
   f->method = opt->method;
+  size_t npix = (size_t)opt->width * opt->height;
+  if (opt->heat && (!(f->heat_e = calloc(npix, sizeof(float))) || !(f->heat_n = calloc(npix, sizeof(float))))) {
+    rr_frame_release(f);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the per-pixel statistics");
+  }
   render_ctx ctx = {.scene = scene,
                     .cam = &c,
                     .opt = opt,
                     .threads = opt->threads ? opt->threads : cpu_count(),
                     .vb = &f->vb,
-                    .stats = &f->stats};
+                    .stats = &f->stats,
+                    .heat_e = f->heat_e,
+                    .heat_n = f->heat_n,
+                    .oracles = &o};
   f->stats.threads = ctx.threads;
   double t0 = now_ms();
   e = methods[opt->method].fn(dev, &ctx);
@@ -142,6 +200,7 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
 void rr_frame_release(rr_frame *f) {
   if (!f) return;
   visbuf_free(&f->vb);
+  free(f->heat_e), free(f->heat_n);
   free(f);
 }
 

@@ -217,6 +217,7 @@ static inline bool shade_sample(const tri_setup *ts, uint32_t id, float sx, floa
 
 struct rr_frame {
   visbuf vb;
+  float *heat_e, *heat_n; /* per-pixel E and N, when options.heat was set */
   rr_stats stats;
   rr_method method;
 };
@@ -230,6 +231,7 @@ typedef struct render_ctx {
   visbuf *vb;
   rr_stats *stats;
   float *heat_e, *heat_n; /* optional per-pixel E and N charges */
+  const struct oracles *oracles; /* the traversal's settings, for the 3dr methods */
 } render_ctx;
 
 /* The oracles of the continuum's traversal (paper Fig. 8), as settings. */
@@ -246,8 +248,8 @@ typedef struct oracles {
   int bin_min;       /* bins this small are tested sample by sample */
 } oracles;
 
-/* The continuum's one traversal with the given oracles (src/traverse.c). */
-rr_error vis_traverse(rr_device *dev, render_ctx *ctx, const oracles *o);
+/* The continuum's one traversal, steered by ctx->oracles (src/traverse.c). */
+rr_error vis_traverse(rr_device *dev, render_ctx *ctx);
 
 typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
 
@@ -257,7 +259,6 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int rect[
 /* Tests every sample of an inclusive rectangle against one set-up triangle and
  * returns the number of edge-function evaluations. */
 uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], visbuf *vb);
-rr_error vis_3dr_bb(rr_device *dev, render_ctx *ctx);
 
 /* ---- threads --------------------------------------------------------------- */
 

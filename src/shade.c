@@ -2,7 +2,14 @@
  * scene, so it never knows which method made the frame. */
 #include "rr.h"
 
+#include <stdio.h>
 #include <string.h>
+
+/* stb_easy_font is header-only with static functions; only some are used. */
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#include <stb_easy_font.h>
+#pragma GCC diagnostic pop
 
 typedef struct hit {
   bool valid;
@@ -92,6 +99,63 @@ static rr_error image_alloc(rr_device *dev, rr_image *img, int w, int h, int ch,
   return img->data ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d image", w, h);
 }
 
+/* A perceptually ordered ramp: dark blue, cyan, green, yellow, red, white. */
+static void heat_color(float v, float *o) {
+  static const float stops[6][3] = {{0.05f, 0.05f, 0.35f}, {0.0f, 0.6f, 0.9f}, {0.1f, 0.8f, 0.2f},
+                                    {1.0f, 0.9f, 0.1f},    {0.9f, 0.1f, 0.05f}, {1.0f, 1.0f, 1.0f}};
+  v = fminf(fmaxf(v, 0.0f), 1.0f) * 5.0f;
+  int i = v >= 5.0f ? 4 : (int)v;
+  float f = v - (float)i;
+  for (int c = 0; c < 3; c++) o[c] = stops[i][c] * (1 - f) + stops[i + 1][c] * f;
+}
+
+/* Draws text with stb_easy_font's quads, scaled by `scale`, into an RGB float image. */
+static void draw_text(rr_image *img, float x, float y, float scale, const char *text) {
+  static char buf[64 * 1024];
+  char t[128];
+  snprintf(t, sizeof t, "%s", text);
+  int quads = stb_easy_font_print(0, 0, t, NULL, buf, sizeof buf);
+  float *px = img->data;
+  for (int q = 0; q < quads; q++) {
+    const float *v0 = (const float *)(buf + q * 64), *v2 = (const float *)(buf + q * 64 + 32);
+    int x0 = (int)(x + v0[0] * scale), y0 = (int)(y + v0[1] * scale);
+    int x1 = (int)(x + v2[0] * scale), y1 = (int)(y + v2[1] * scale);
+    for (int yy = y0 < 0 ? 0 : y0; yy < y1 && yy < img->height; yy++)
+      for (int xx = x0 < 0 ? 0 : x0; xx < x1 && xx < img->width; xx++) {
+        float *o = px + 3 * ((size_t)yy * img->width + xx);
+        o[0] = o[1] = o[2] = 1.0f;
+      }
+  }
+}
+
+/* Per-pixel counts as a heat map on a log scale up to the largest value, with a
+ * legend: the ramp along the bottom, its range and the mean. */
+static void shade_heat(const float *heat, rr_image *img, const char *what) {
+  size_t n = (size_t)img->width * img->height;
+  float top = 0;
+  double sum = 0;
+  for (size_t k = 0; k < n; k++) top = fmaxf(top, heat[k]), sum += heat[k];
+  float *px = img->data, norm = top > 0 ? 1.0f / log1pf(top) : 0;
+  for (size_t k = 0; k < n; k++) heat_color(log1pf(heat[k]) * norm, px + 3 * k);
+  int bar = img->height / 40 > 5 ? img->height / 40 : 5;
+  float scale = bar / 7.0f > 1 ? bar / 7.0f : 1, line = 11 * scale;
+  int y0 = img->height - bar - 3, ytext = (int)(y0 - line - 2);
+  if (ytext < 0 || img->width < 64) return;
+  int x0 = img->width * 3 / 5, x1 = img->width - 8;
+  for (int y = ytext - 2; y < img->height; y++)
+    for (int x = 0; x < img->width; x++) {
+      float *o = px + 3 * ((size_t)y * img->width + x);
+      o[0] = o[1] = o[2] = 0.0f;
+      if (y >= y0 && y < y0 + bar && x >= x0 && x < x1) heat_color((float)(x - x0) / (x1 - x0 - 1), o);
+    }
+  char label[128];
+  snprintf(label, sizeof label, "%s per pixel (log), mean %.1f", what, sum / n);
+  draw_text(img, 4, (float)ytext, scale, label);
+  draw_text(img, (float)x0 - 8 * scale, (float)y0 - 2 * scale, scale, "0");
+  snprintf(label, sizeof label, "%.0f", top);
+  draw_text(img, (float)x1 - stb_easy_font_width(label) * scale, (float)ytext, scale, label);
+}
+
 rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
                   rr_shade_mode mode, rr_image *out) {
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
@@ -100,8 +164,16 @@ rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const
   const visbuf *vb = &f->vb;
   rr_error e = camera_setup(dev, cam, vb->width, vb->height, &c);
   if (e) return e;
+  bool heat = mode == RR_SHADE_HEAT_EVALS || mode == RR_SHADE_HEAT_NODES;
+  const float *counts = mode == RR_SHADE_HEAT_EVALS ? f->heat_e : f->heat_n;
+  if (heat && !counts)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "heat maps need per-pixel statistics (render with options.heat set)");
   e = image_alloc(dev, out, vb->width, vb->height, 3, RR_PIXEL_F32);
   if (e) return e;
+  if (heat) {
+    shade_heat(counts, out, mode == RR_SHADE_HEAT_EVALS ? "edge evaluations" : "BVH nodes");
+    return rr_ok(dev);
+  }
   float dmin = INFINITY, dmax = 0;
   if (mode == RR_SHADE_DEPTH)
     for (int y = 0; y < vb->height; y++)
@@ -155,8 +227,16 @@ rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, c
   camera c;
   rr_error e = camera_setup(dev, cam, vb->width, vb->height, &c);
   if (e) return e;
-  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2};
+  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1};
   if ((int)aov < 0 || aov >= RR_AOV_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AOV %d", (int)aov);
+  if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
+    const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
+    if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
+    e = image_alloc(dev, out, vb->width, vb->height, 1, RR_PIXEL_F32);
+    if (e) return e;
+    memcpy(out->data, counts, (size_t)vb->width * vb->height * sizeof(float));
+    return rr_ok(dev);
+  }
   e = image_alloc(dev, out, vb->width, vb->height, channels[aov], aov == RR_AOV_ID ? RR_PIXEL_U32 : RR_PIXEL_F32);
   if (e) return e;
   for (int y = 0; y < vb->height; y++)

@@ -335,7 +335,8 @@ static void run_tile(int job, int thread, void *arg) {
   s->setups += t.st.setups, s->edge_evals += t.st.edge_evals, s->nodes += t.st.nodes;
 }
 
-rr_error vis_traverse(rr_device *dev, render_ctx *ctx, const oracles *o) {
+rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
+  const oracles *o = ctx->oracles;
   const visbuf *vb = ctx->vb;
   if (!ctx->scene->bvh && o->leaves)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "this method needs the scene's BVH (call rr_scene_commit)");

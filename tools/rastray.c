@@ -32,14 +32,18 @@ static const char usage[] =
     "        sphere[:N], box[:N], rooms[:N], grid:PATH:N (N×N copies of a mesh)\n"
     "\n"
     "options:\n"
-    "  --method NAME       visibility method: rc, 3dr-bb (default 3dr-bb)\n"
+    "  --method NAME       visibility method (default 3dr-bb): rc, rc-bvh, rc-packet, 2dr-bb,\n"
+    "                      2dr-bin, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full\n"
+    "  --oracles K=V,...   override a 3dr method's traversal: frustum=N leaves=0|1 outside=0|1\n"
+    "                      occluded=0|1 split=N split-ratio=F binning=0|1 early-z=0|1 bin=N bin-min=N\n"
     "  --size WxH          image size (default 1024x768, at most 16384 a side)\n"
     "  --camera NAME       perspective\n"
     "  --eye X,Y,Z --target X,Y,Z --up X,Y,Z --fov DEG\n"
     "                      camera; without --eye/--target the scene is framed automatically\n"
-    "  --shade MODE        lambert (default), id, normal, depth\n"
+    "  --shade MODE        lambert (default), id, normal, depth, heat-evals, heat-nodes\n"
     "  -o PATH             colour image: .png, .exr or .pfm (default rastray.png unless --aov is given)\n"
-    "  --aov NAME=PATH     write an AOV (depth, id, normal, bary) as .npy, .pfm or .exr; repeatable\n"
+    "  --aov NAME=PATH     write an AOV (depth, id, normal, bary, evals, nodes) as .npy, .pfm or\n"
+    "                      .exr; repeatable\n"
     "  --threads N         threads (default: all cores)\n"
     "  --repeat N          run the visibility pass N times, report the median time\n"
     "  --stats             print key=value statistics to stderr\n"
@@ -187,7 +191,8 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
     } else if (strcmp(a, "--shade") == 0) {
       const char *v = arg_value(&i, argc, argv);
       shade = rr_shade_from_name(v);
-      if (shade < 0) die(EXIT_USAGE, "unknown shade mode '%s' (expected lambert, id, normal or depth)", v);
+      if (shade < 0)
+        die(EXIT_USAGE, "unknown shade mode '%s' (expected lambert, id, normal, depth, heat-evals or heat-nodes)", v);
     } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
       out = arg_value(&i, argc, argv);
     } else if (strcmp(a, "--aov") == 0) {
@@ -198,7 +203,8 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
         die(EXIT_USAGE, "bad --aov '%s' (expected NAME=PATH)", v);
       memcpy(name, v, eq - v), name[eq - v] = 0;
       int k = rr_aov_from_name(name);
-      if (k < 0) die(EXIT_USAGE, "unknown AOV '%s' (expected depth, id, normal or bary)", name);
+      if (k < 0) die(EXIT_USAGE, "unknown AOV '%s' (expected depth, id, normal, bary, evals or nodes)", name);
+      if (k == RR_AOV_EVALS || k == RR_AOV_NODES) opt.heat = 1;
       if (naov == 16) die(EXIT_USAGE, "too many --aov (at most 16)");
       aovs[naov++] = (aov_out){(rr_aov)k, eq + 1};
     } else if (strcmp(a, "--threads") == 0) {
@@ -209,6 +215,8 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
       stats = true;
     } else if (strcmp(a, "--stats-json") == 0) {
       json = arg_value(&i, argc, argv);
+    } else if (strcmp(a, "--oracles") == 0) {
+      opt.oracles = arg_value(&i, argc, argv);
     } else if (strcmp(a, "--cull-backfaces") == 0) {
       opt.cull_backfaces = 1;
     } else if (a[0] == '-' && a[1]) {
@@ -222,6 +230,7 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   if (have_eye != have_target) die(EXIT_USAGE, "--eye and --target go together");
   if (!scene_name) scene_name = "demo";
   if (!out && naov == 0) out = "rastray.png";
+  if (shade == RR_SHADE_HEAT_EVALS || shade == RR_SHADE_HEAT_NODES) opt.heat = 1;
 
   rr_scene *scene = load_scene(dev, scene_name);
   if (!have_eye && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK)
@@ -232,7 +241,8 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   rr_frame *frame = NULL;
   for (int r = 0; r < repeat; r++) {
     rr_frame_release(frame);
-    if (rr_render(dev, scene, &cam, &opt, &frame) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+    rr_error e = rr_render(dev, scene, &cam, &opt, &frame);
+    if (e) die(e == RR_ERROR_ARGUMENT || e == RR_ERROR_UNSUPPORTED ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
     rr_stats st;
     rr_frame_get_stats(frame, &st);
     times[r] = st.frame_ms;
