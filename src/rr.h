@@ -250,6 +250,10 @@ typedef struct oracles {
 
 /* The continuum's one traversal, steered by ctx->oracles (src/traverse.c). */
 rr_error vis_traverse(rr_device *dev, render_ctx *ctx);
+/* isOutside: may the box be culled from the frustum of samples [x0, x1) × [y0, y1)? */
+bool oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bvh_node *box);
+/* isOccluded: may the box be culled when the farthest depth stored in a frustum is `farthest`? */
+bool oracle_occluded(const camera *c, const bvh_node *box, float farthest);
 
 typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
 

@@ -199,7 +199,11 @@ static float box_zmin(const bvh_node *b, const camera *c) {
 }
 
 /* isOutside: the box lies wholly outside one side plane, or behind the eye. */
+static bool centre_hits(const frustum *f, const bvh_node *b, vec3 eye);
+
 static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
+  /* A frustum of one sample is its ray: the classic ray-box test. */
+  if (f->r.x1 - f->r.x0 == 1 && f->r.y1 - f->r.y0 == 1) return !centre_hits(f, b, c->eye);
   float mag;
   if (box_max_dot(b, c->eye, c->fwd, &mag) <= -1e-6f * mag) return true;
   for (int i = 0; i < 4; i++)
@@ -237,6 +241,17 @@ static bool should_split(const trav *t, const frustum *f, const bvh_node *b) {
   return px * px < o->split_ratio * (float)w * (float)h;
 }
 
+bool oracle_occluded(const camera *c, const bvh_node *b, float farthest) {
+  float z = box_zmin(b, c);
+  return z > 0 && z * (1 - DEPTH_MARGIN) > farthest;
+}
+
+bool oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bvh_node *b) {
+  tile_rect r = {x0, y0, x1, y1};
+  frustum f = make_frustum(c, r);
+  return is_outside(&f, b, c);
+}
+
 static void traverse(trav *t, const frustum *f, uint32_t node);
 
 static void split(trav *t, const frustum *f, uint32_t node) {
@@ -272,10 +287,7 @@ static void traverse(trav *t, const frustum *f, uint32_t node) {
   t->st.nodes++;
   charge(t->heat_n, t->vb->width, f->r, 1.0f);
   if (o->cull_outside && is_outside(f, n, t->c)) return;
-  if (o->cull_occluded) {
-    float z = box_zmin(n, t->c);
-    if (z > 0 && z * (1 - DEPTH_MARGIN) > hiz_max(t, f->r)) return;
-  }
+  if (o->cull_occluded && oracle_occluded(t->c, n, hiz_max(t, f->r))) return;
   if (should_split(t, f, n)) {
     split(t, f, node);
     return;
@@ -296,7 +308,7 @@ static void traverse(trav *t, const frustum *f, uint32_t node) {
 typedef struct trav_job {
   render_ctx *ctx;
   const oracles *o;
-  int tile, tiles_x;
+  int tile, tiles_x, frustum;
   float *hiz;
   uint8_t *dirty;
   rr_stats st[256];
@@ -304,6 +316,7 @@ typedef struct trav_job {
   uint32_t npre;
 } trav_job;
 
+/* One job: a tile of the image, itself cut into the initial frusta. */
 static void run_tile(int job, int thread, void *arg) {
   trav_job *tj = arg;
   render_ctx *ctx = tj->ctx;
@@ -322,14 +335,20 @@ static void run_tile(int job, int thread, void *arg) {
             .tiles_x = (vb->width + HIZ - 1) / HIZ,
             .heat_e = ctx->heat_e,
             .heat_n = ctx->heat_n};
-  frustum f = make_frustum(ctx->cam, r);
-  if (tj->o->leaves) {
-    traverse(&t, &f, 0);
-  } else if (tj->pre) {
-    for (uint32_t i = 0; i < tj->npre; i++) draw(&t, &tj->pre[i], r);
-  } else {
+  if (!tj->o->leaves) {
     /* generateSamples at the root: plain rasterization of every triangle in order */
-    for (uint32_t i = 0; i < ctx->scene->ntris; i++) rasterize(&t, i, r);
+    if (tj->pre)
+      for (uint32_t i = 0; i < tj->npre; i++) draw(&t, &tj->pre[i], r);
+    else
+      for (uint32_t i = 0; i < ctx->scene->ntris; i++) rasterize(&t, i, r);
+  } else {
+    int fs = tj->frustum < tj->tile ? tj->frustum : tj->tile;
+    for (int y = r.y0; y < r.y1; y += fs)
+      for (int x = r.x0; x < r.x1; x += fs) {
+        tile_rect q = {x, y, x + fs < r.x1 ? x + fs : r.x1, y + fs < r.y1 ? y + fs : r.y1};
+        frustum f = make_frustum(ctx->cam, q);
+        traverse(&t, &f, 0);
+      }
   }
   rr_stats *s = &tj->st[thread];
   s->setups += t.st.setups, s->edge_evals += t.st.edge_evals, s->nodes += t.st.nodes;
@@ -342,8 +361,11 @@ rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
     return rr_fail(dev, RR_ERROR_ARGUMENT, "this method needs the scene's BVH (call rr_scene_commit)");
   /* Initial frusta: the whole image on one thread (the paper's set-up), else
    * tiles dealt out to the threads; frustum_size forces a tile size. */
-  int tile = o->frustum_size;
-  if (tile <= 0) tile = ctx->threads > 1 ? 128 : (vb->width > vb->height ? vb->width : vb->height);
+  int whole = vb->width > vb->height ? vb->width : vb->height;
+  int frustum = o->frustum_size > 0 ? o->frustum_size : whole;
+  /* Jobs are tiles aligned to the z tiles, so no z tile has two writers; a job
+   * holds one initial frustum, or several small ones. */
+  int tile = ctx->threads > 1 ? (frustum < 128 ? 128 : frustum) : (frustum < whole ? frustum : whole);
   tile = (tile + HIZ - 1) / HIZ * HIZ;
   trav_job *tj = calloc(1, sizeof *tj);
   int tiles_x = (vb->width + HIZ - 1) / HIZ, tiles_y = (vb->height + HIZ - 1) / HIZ;
@@ -357,7 +379,7 @@ rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the hierarchical z-buffer");
   }
   for (int k = 0; k < tiles_x * tiles_y; k++) tj->hiz[k] = INFINITY, tj->dirty[k] = 0;
-  tj->ctx = ctx, tj->o = o, tj->tile = tile, tj->tiles_x = (vb->width + tile - 1) / tile;
+  tj->ctx = ctx, tj->o = o, tj->tile = tile, tj->frustum = frustum, tj->tiles_x = (vb->width + tile - 1) / tile;
   int njobs = tj->tiles_x * ((vb->height + tile - 1) / tile);
   tri_job *pre = NULL;
   if (!o->leaves && njobs > 1) {
