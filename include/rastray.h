@@ -54,8 +54,21 @@ rr_error rr_scene_new(rr_device *dev, rr_scene **out);
  * base colour). Degenerate and non-finite triangles are skipped and counted. */
 rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
                            const uint32_t *indices, size_t ntriangles, const float rgb[3]);
-/* Builds what rendering needs (the BVH); called implicitly by rr_scene_load. */
+/* Builds what rendering needs (the BVH); called implicitly by rr_scene_load.
+ * Uses the device's build options (rr_device_set_build_options). */
 rr_error rr_scene_commit(rr_scene *scene);
+
+typedef struct rr_build_options {
+  int threads;   /* threads building the BVH; 0: all cores. The tree does not depend on it. */
+  int bins;      /* SAH bins per axis, 2..64 (default 32) */
+  int leaf_size; /* most triangles in a leaf, 1..64 (default 4) */
+} rr_build_options;
+
+/* Fills build options with defaults: all cores, 32 bins, leaves of at most 4 triangles. */
+void rr_build_options_init(rr_build_options *opt);
+/* Sets the options that later commits of this device's scenes use (like Embree's
+ * device "threads=N"); rr_scene_load commits, so set them before loading. */
+rr_error rr_device_set_build_options(rr_device *dev, const rr_build_options *opt);
 /* Releases a scene. */
 void rr_scene_release(rr_scene *scene);
 
@@ -75,17 +88,52 @@ typedef struct rr_scene_info {
 /* Fills what is known about a scene. */
 rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
 
+/* ---- ray queries --------------------------------------------------------- */
+
+/* An arbitrary ray: points org + t·dir for tmin <= t <= tmax (dir need not be unit). */
+typedef struct rr_ray {
+  float org[3], dir[3];
+  float tmin, tmax;
+} rr_ray;
+
+typedef struct rr_hit {
+  uint32_t prim; /* triangle id, RR_MISS when nothing is hit */
+  float t;       /* ray parameter of the hit (+inf on a miss) */
+  float l1, l2;  /* barycentrics of the hit: weights of the triangle's vertices 1 and 2 */
+} rr_hit;
+
+/* Closest hit of a ray through the committed scene's BVH, with the one sample test
+ * of every method (ties in t go to the lower id; a ray through a shared edge hits
+ * exactly one triangle). Needs a committed scene. */
+rr_error rr_intersect(const rr_scene *scene, const rr_ray *ray, rr_hit *hit);
+/* Whether the ray hits any triangle with tmin <= t <= tmax (*occluded = 0 or 1). */
+rr_error rr_occluded(const rr_scene *scene, const rr_ray *ray, int *occluded);
+
 /* ---- cameras ------------------------------------------------------------- */
 
+/* With u = 2(x+0.5)/W - 1, v = 1 - 2(y+0.5)/H and the camera basis right, up, fwd: */
 typedef enum rr_camera_type {
-  RR_CAMERA_PERSPECTIVE = 0
+  RR_CAMERA_PERSPECTIVE = 0, /* pinhole; fov_deg is the vertical field of view */
+  RR_CAMERA_ORTHOGRAPHIC,    /* rays along fwd from eye + u·(h·aspect/2)·right + v·(h/2)·up, h = ortho_height */
+  RR_CAMERA_PARABOLIC,       /* hemisphere around fwd: d = u·right + v·up + (1 - u² - v²)/2·fwd, u²+v² <= 1 */
+  RR_CAMERA_LATLONG,         /* 360°×180° panorama: φ = 2π(x+0.5)/W - π, θ = π(y+0.5)/H */
+  RR_CAMERA_FISHEYE,         /* equidistant: r = √(u²+v²) <= 1, angle from fwd = r·fov_deg/2 (fov up to 360) */
+  RR_CAMERA_CUBE,            /* six 90° faces in a horizontal cross (image 4F × 3F) */
+  RR_CAMERA_COUNT
 } rr_camera_type;
 
 typedef struct rr_camera {
   rr_camera_type type;
   float eye[3], target[3], up[3];
-  float fov_deg; /* vertical field of view */
+  float fov_deg;      /* vertical field of view (perspective), full angle (fisheye) */
+  float ortho_height; /* orthographic view height; 0: 2·|target - eye|·tan(fov/2) */
 } rr_camera;
+
+/* The camera type named `name` ("perspective", "orthographic", "parabolic", "latlong",
+ * "fisheye", "cube"); -1 when unknown. */
+int rr_camera_from_name(const char *name);
+/* The name of a camera type, NULL when out of range. */
+const char *rr_camera_name(int type);
 
 /* Fills a camera with defaults: perspective, eye (0,0,3) looking at the origin, y up, 45°. */
 void rr_camera_init(rr_camera *cam);

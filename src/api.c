@@ -42,10 +42,10 @@ static const struct {
   oracles o;
 } methods[RR_METHOD_COUNT] = {
     [RR_METHOD_RC] = {"rc", vis_rc, {0}},
-    [RR_METHOD_RC_BVH] = {"rc-bvh", NULL, {0}},
-    [RR_METHOD_RC_PACKET] = {"rc-packet", NULL, {0}},
-    [RR_METHOD_2DR_BB] = {"2dr-bb", NULL, {0}},
-    [RR_METHOD_2DR_BIN] = {"2dr-bin", NULL, {0}},
+    [RR_METHOD_RC_BVH] = {"rc-bvh", vis_rc_bvh, {0}},
+    [RR_METHOD_RC_PACKET] = {"rc-packet", vis_rc_packet, {0}},
+    [RR_METHOD_2DR_BB] = {"2dr-bb", vis_2dr_bb, {0}},
+    [RR_METHOD_2DR_BIN] = {"2dr-bin", vis_2dr_bin, {0}},
     [RR_METHOD_3DR_BB] = {"3dr-bb", vis_traverse, {.bin_size = 64, .bin_min = 4}},
     [RR_METHOD_3DR_BIN] = {"3dr-bin", vis_traverse, {.binning = 1, .early_z = 1, .bin_size = 64, .bin_min = 4}},
     [RR_METHOD_3DR_FC] = {"3dr-fc", vis_traverse,
@@ -162,20 +162,24 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   }
   if (!methods[opt->method].fn)
     return rr_fail(dev, RR_ERROR_UNSUPPORTED, "method '%s' is not available in this build", methods[opt->method].name);
+  if ((opt->method == RR_METHOD_2DR_BB || opt->method == RR_METHOD_2DR_BIN) && cam->type != RR_CAMERA_PERSPECTIVE &&
+      cam->type != RR_CAMERA_ORTHOGRAPHIC)
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED,
+                   "method '%s' projects onto a plane and cannot render a %s camera; the 3D methods can (rc, rc-bvh, "
+                   "rc-packet, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full)",
+                   methods[opt->method].name, rr_camera_name(cam->type));
   camera c;
   rr_error e = camera_setup(dev, cam, opt->width, opt->height, &c);
   if (e) return e;
   rr_frame *f = calloc(1, sizeof *f);
-  if (!f || !visbuf_alloc(&f->vb, opt->width, opt->height)) {
-    free(f);
+  size_t npix = (size_t)opt->width * opt->height;
+  if (!f || !visbuf_alloc(&f->vb, opt->width, opt->height) ||
+      (opt->heat && (!(f->heat_e = calloc(npix, sizeof(float))) || !(f->heat_n = calloc(npix, sizeof(float)))))) {
+    rr_frame_release(f);
+    camera_release(&c);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d visibility buffer", opt->width, opt->height);
   }
   f->method = opt->method;
-  size_t npix = (size_t)opt->width * opt->height;
-  if (opt->heat && (!(f->heat_e = calloc(npix, sizeof(float))) || !(f->heat_n = calloc(npix, sizeof(float))))) {
-    rr_frame_release(f);
-    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the per-pixel statistics");
-  }
   render_ctx ctx = {.scene = scene,
                     .cam = &c,
                     .opt = opt,
@@ -189,6 +193,7 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   double t0 = now_ms();
   e = methods[opt->method].fn(dev, &ctx);
   f->stats.frame_ms = now_ms() - t0;
+  camera_release(&c);
   if (e) {
     rr_frame_release(f);
     return e;

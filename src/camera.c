@@ -1,6 +1,8 @@
 /* Cameras: the ray direction of every sample, and bounds for rasterization. */
 #include "rr.h"
 
+#include <string.h>
+
 void rr_camera_init(rr_camera *cam) {
   if (!cam) return;
   *cam = (rr_camera){.type = RR_CAMERA_PERSPECTIVE,
@@ -10,15 +12,33 @@ void rr_camera_init(rr_camera *cam) {
                      .fov_deg = 45};
 }
 
+static const char *const camera_names[RR_CAMERA_COUNT] = {"perspective", "orthographic", "parabolic",
+                                                          "latlong",     "fisheye",      "cube"};
+
+int rr_camera_from_name(const char *name) {
+  for (int i = 0; name && i < RR_CAMERA_COUNT; i++)
+    if (strcmp(camera_names[i], name) == 0) return i;
+  return -1;
+}
+
+const char *rr_camera_name(int type) { return type >= 0 && type < RR_CAMERA_COUNT ? camera_names[type] : NULL; }
+
 static bool finite_v(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
 rr_error rr_camera_check(rr_device *dev, const rr_camera *c) {
   if (!c) return rr_fail(dev, RR_ERROR_ARGUMENT, "camera is NULL");
-  if (c->type != RR_CAMERA_PERSPECTIVE) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown camera type %d", (int)c->type);
+  if ((int)c->type < 0 || c->type >= RR_CAMERA_COUNT)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown camera type %d", (int)c->type);
   if (!finite_v(c->eye) || !finite_v(c->target) || !finite_v(c->up))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "camera vectors must be finite");
-  if (!(c->fov_deg > 0 && c->fov_deg < 180))
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad field of view %g (expected 0 < fov < 180 degrees)", c->fov_deg);
+  float fov_max = c->type == RR_CAMERA_FISHEYE ? 360 : 180;
+  bool fov_used = c->type == RR_CAMERA_PERSPECTIVE || c->type == RR_CAMERA_FISHEYE ||
+                  (c->type == RR_CAMERA_ORTHOGRAPHIC && c->ortho_height == 0);
+  if (fov_used && !(c->fov_deg > 0 && (c->fov_deg < fov_max || (fov_max == 360 && c->fov_deg == 360))))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad field of view %g (expected 0 < fov < %g degrees)", c->fov_deg,
+                   fov_max);
+  if (!(c->ortho_height >= 0) || !isfinite(c->ortho_height))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad orthographic height %g (expected > 0)", c->ortho_height);
   vec3 f = v3_sub(v3_load(c->target), v3_load(c->eye));
   if (f.x == 0 && f.y == 0 && f.z == 0)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "eye equals target (%g,%g,%g)", c->eye[0], c->eye[1], c->eye[2]);
@@ -30,11 +50,56 @@ rr_error rr_camera_check(rr_device *dev, const rr_camera *c) {
   return rr_ok(dev);
 }
 
+/* The direction of pixel (x, y) of a curved camera; zero where it has no ray. */
+static vec3 curved_dir(const camera *c, const rr_camera *in, int x, int y) {
+  double W = c->width, H = c->height, sx = x + 0.5, sy = y + 0.5;
+  double u = 2 * sx / W - 1, v = 1 - 2 * sy / H;
+  vec3 r = c->right, up = c->up, f = c->fwd;
+  switch (c->type) {
+  case RR_CAMERA_PARABOLIC: {
+    double rr = u * u + v * v;
+    if (rr > 1) return v3(0, 0, 0);
+    return v3_add(v3_add(v3_scale(r, (float)u), v3_scale(up, (float)v)), v3_scale(f, (float)(0.5 - 0.5 * rr)));
+  }
+  case RR_CAMERA_LATLONG: {
+    double phi = 2 * M_PI * sx / W - M_PI, theta = M_PI * sy / H;
+    return v3_add(v3_scale(v3_add(v3_scale(r, (float)sin(phi)), v3_scale(f, (float)cos(phi))), (float)sin(theta)),
+                  v3_scale(up, (float)cos(theta)));
+  }
+  case RR_CAMERA_FISHEYE: {
+    double rad = sqrt(u * u + v * v);
+    if (rad > 1) return v3(0, 0, 0);
+    double a = rad * in->fov_deg * M_PI / 360, psi = atan2(v, u);
+    return v3_add(v3_scale(v3_add(v3_scale(r, (float)cos(psi)), v3_scale(up, (float)sin(psi))), (float)sin(a)),
+                  v3_scale(f, (float)cos(a)));
+  }
+  case RR_CAMERA_CUBE: {
+    /* horizontal cross: row 0 top face, row 1 left/front/right/back, row 2 bottom */
+    int F = c->face, col = x / F, row = y / F;
+    if (col > 3 || row > 2 || (row != 1 && col != 1)) return v3(0, 0, 0);
+    float a = (float)(2 * (x - col * F + 0.5) / F - 1), b = (float)(1 - 2 * (y - row * F + 0.5) / F);
+    vec3 ff = f, fr = r, fu = up;
+    if (row == 0) ff = up, fu = v3_neg(f);
+    else if (row == 2) ff = v3_neg(up), fu = f;
+    else if (col == 0) ff = v3_neg(r), fr = f;
+    else if (col == 2) ff = r, fr = v3_neg(f);
+    else if (col == 3) ff = v3_neg(f), fr = v3_neg(r);
+    return v3_add(ff, v3_add(v3_scale(fr, a), v3_scale(fu, b)));
+  }
+  default:
+    return v3(0, 0, 0);
+  }
+}
+
 rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
+  memset(c, 0, sizeof *c);
   rr_error e = rr_camera_check(dev, in);
   if (e) return e;
   if (width < 1 || height < 1 || width > RR_MAX_SIZE || height > RR_MAX_SIZE)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad image size %dx%d (1..%d per side)", width, height, RR_MAX_SIZE);
+  if (in->type == RR_CAMERA_CUBE && (width != height / 3 * 4 || height % 3))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "a cube camera needs a 4:3 image of six square faces (e.g. 1024x768), not %dx%d",
+                   width, height);
   c->type = in->type;
   c->width = width;
   c->height = height;
@@ -44,19 +109,101 @@ rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height
   c->up = v3_cross(c->right, c->fwd);
   c->tan_half_h = tanf(in->fov_deg * (float)M_PI / 360.0f);
   c->tan_half_w = c->tan_half_h * (float)width / (float)height;
-  /* d(sx, sy) = fwd + (2 sx / W - 1) tw right + (1 - 2 sy / H) th up */
-  c->d0 = v3_add(c->fwd, v3_sub(v3_scale(c->up, c->tan_half_h), v3_scale(c->right, c->tan_half_w)));
-  c->dx = v3_scale(c->right, 2.0f * c->tan_half_w / (float)width);
-  c->dy = v3_scale(c->up, -2.0f * c->tan_half_h / (float)height);
+  c->planar = in->type == RR_CAMERA_PERSPECTIVE || in->type == RR_CAMERA_ORTHOGRAPHIC;
+  c->dir_len_max = 1;
+  if (in->type == RR_CAMERA_PERSPECTIVE) {
+    /* d(sx, sy) = fwd + (2 sx / W - 1) tw right + (1 - 2 sy / H) th up */
+    c->d0 = v3_add(c->fwd, v3_sub(v3_scale(c->up, c->tan_half_h), v3_scale(c->right, c->tan_half_w)));
+    c->dx = v3_scale(c->right, 2.0f * c->tan_half_w / (float)width);
+    c->dy = v3_scale(c->up, -2.0f * c->tan_half_h / (float)height);
+    return rr_ok(dev);
+  }
+  if (in->type == RR_CAMERA_ORTHOGRAPHIC) {
+    float h = in->ortho_height > 0 ? in->ortho_height
+                                   : 2 * v3_len(v3_sub(v3_load(in->target), c->eye)) * c->tan_half_h;
+    float w = h * (float)width / (float)height;
+    c->o0 = v3_sub(v3_scale(c->up, h / 2), v3_scale(c->right, w / 2));
+    c->ox = v3_scale(c->right, w / (float)width);
+    c->oy = v3_scale(c->up, -h / (float)height);
+    c->d0 = c->fwd;
+    c->tan_half_h = h / 2, c->tan_half_w = w / 2; /* half extents of the view */
+    return rr_ok(dev);
+  }
+  /* Curved: one direction per sample, computed once, and the largest angle between
+   * directions of samples one pixel apart (the map's Lipschitz constant). */
+  c->dirs = malloc((size_t)width * height * sizeof *c->dirs);
+  if (!c->dirs) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
+  c->face = height / 3;
+  for (int y = 0; y < height; y++)
+    for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, in, x, y);
+  switch (in->type) {
+  case RR_CAMERA_PARABOLIC: /* conformal, angle = 2 atan(r): at most 2 radians per unit of u */
+    c->lipschitz = 2.0f * 2.0f / (float)(width < height ? width : height);
+    break;
+  case RR_CAMERA_LATLONG: /* ds² = dθ² + sin²θ dφ² <= dθ² + dφ² */
+    c->lipschitz = fmaxf(2.0f * (float)M_PI / (float)width, (float)M_PI / (float)height);
+    break;
+  case RR_CAMERA_FISHEYE: /* angle = r·fov/2; the tangential rate sin(a)/r is smaller */
+    c->lipschitz = in->fov_deg * (float)M_PI / 360.0f * 2.0f / (float)(width < height ? width : height);
+    break;
+  default: /* cube: a 90° face, atan' <= 1 on its [-1, 1] image plane */
+    c->lipschitz = 2.0f / (float)c->face;
+    c->dir_len_max = sqrtf(3.0f);
+    break;
+  }
+  c->lipschitz *= 1.001f;
   return rr_ok(dev);
+}
+
+void camera_release(camera *c) {
+  free(c->dirs);
+  c->dirs = NULL;
+}
+
+bool camera_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
+  float sx = (float)x + 0.5f, sy = (float)y + 0.5f;
+  *origin = c->eye;
+  switch (c->type) {
+  case RR_CAMERA_PERSPECTIVE:
+    *dir = camera_dir(c, sx, sy);
+    return true;
+  case RR_CAMERA_ORTHOGRAPHIC:
+    *origin = v3_add(c->eye, v3_add(c->o0, v3_add(v3_scale(c->ox, sx), v3_scale(c->oy, sy))));
+    *dir = c->fwd;
+    return true;
+  default:
+    *dir = c->dirs[(size_t)y * c->width + x];
+    return dir->x != 0 || dir->y != 0 || dir->z != 0;
+  }
 }
 
 bool camera_project(const camera *c, vec3 p, float *sx, float *sy) {
   float z = v3_dot(p, c->fwd);
-  if (!(z > 0)) return false;
+  if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
+    if (!(z > 0)) return false;
+    *sx = (v3_dot(p, c->right) / c->tan_half_w + 1.0f) * 0.5f * (float)c->width;
+    *sy = (1.0f - v3_dot(p, c->up) / c->tan_half_h) * 0.5f * (float)c->height;
+    return true;
+  }
+  if (c->type != RR_CAMERA_PERSPECTIVE || !(z > 0)) return false;
   float u = v3_dot(p, c->right) / (z * c->tan_half_w), v = v3_dot(p, c->up) / (z * c->tan_half_h);
   *sx = (u + 1.0f) * 0.5f * (float)c->width;
   *sy = (1.0f - v) * 0.5f * (float)c->height;
+  return true;
+}
+
+bool camera_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle) {
+  if (c->planar) return false;
+  if (c->type == RR_CAMERA_CUBE && (x0 / c->face != (x1 - 1) / c->face || y0 / c->face != (y1 - 1) / c->face))
+    return false; /* the cross is discontinuous between faces */
+  /* The centre sample's direction and the Lipschitz bound over the half-diagonal
+   * (plus half a pixel: every sample lies within that distance of the centre). */
+  int cx = (x0 + x1 - 1) / 2, cy = (y0 + y1 - 1) / 2;
+  vec3 d = c->dirs[(size_t)cy * c->width + cx];
+  if (d.x == 0 && d.y == 0 && d.z == 0) return false;
+  float hx = (float)(x1 - x0) * 0.5f + 0.5f, hy = (float)(y1 - y0) * 0.5f + 0.5f;
+  *axis = v3_norm(d);
+  *angle = c->lipschitz * sqrtf(hx * hx + hy * hy) + 1e-5f;
   return true;
 }
 

@@ -19,6 +19,14 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int r[4])
       x0 = fminf(x0, sx), x1 = fmaxf(x1, sx), y0 = fminf(y0, sy), y1 = fmaxf(y1, sy);
     }
   }
+  if (!c->planar) {
+    /* Curved views have no straight-edged projection: the whole image (the
+     * traversal's binning and frusta narrow it down). Hemispheres see nothing
+     * wholly behind the eye plane. */
+    if (behind == 3 && c->type == RR_CAMERA_PARABOLIC) return false;
+    r[0] = 0, r[1] = 0, r[2] = c->width - 1, r[3] = c->height - 1;
+    return true;
+  }
   if (behind == 3) return false; /* every camera ray has d·fwd > 0: unreachable */
   if (projected == 3) {
     /* Sample (x + 0.5) lies in [x0, x1] for x in [ceil(x0 - 0.5), floor(x1 - 0.5)]. */
@@ -33,12 +41,23 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int r[4])
   return true;
 }
 
-/* Tests every sample of rectangle r against one triangle; returns the evaluations. */
-uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int r[4], visbuf *vb) {
+/* The sample loop, written once and specialised for planar and curved cameras. */
+static inline void raster_loop(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb,
+                               const bool planar) {
   for (int y = r[1]; y <= r[3]; y++) {
     float sy = (float)y + 0.5f;
     size_t row = (size_t)y * vb->width;
-    for (int x = r[0]; x <= r[2]; x++) shade_sample(ts, id, (float)x + 0.5f, sy, vb, row + x);
+    for (int x = r[0]; x <= r[2]; x++) {
+      float sx = (float)x + 0.5f;
+      vec3 w = planar ? v3(1.0f, sx, sy) : c->dirs[row + x];
+      shade_sample_w(ts, id, w, sx, sy, vb, row + x);
+    }
   }
+}
+
+/* Tests every sample of rectangle r against one triangle; returns the evaluations. */
+uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb) {
+  if (c->planar) raster_loop(ts, id, r, c, vb, true);
+  else raster_loop(ts, id, r, c, vb, false);
   return (uint64_t)(r[2] - r[0] + 1) * (uint64_t)(r[3] - r[1] + 1);
 }

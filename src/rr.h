@@ -17,6 +17,7 @@
 struct rr_device {
   rr_error error;
   char message[512];
+  rr_build_options build; /* used by rr_scene_commit; zeros mean defaults */
 };
 
 /* Records a failure in dev (when not NULL) and returns its code. */
@@ -112,7 +113,30 @@ typedef struct rr_bvh {
   uint32_t *prims; /* triangle ids in leaf order */
   double sah_cost, build_ms;
   uint64_t bytes;
+  void *node_mem;  /* the allocation behind nodes (sibling pairs share a cache line) */
+  uint32_t nprims; /* triangles the tree was built over (== scene->ntris when current) */
+  int bins, leaf_size;
 } rr_bvh;
+
+enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK = 128 };
+
+/* Builds a binned-SAH BVH over the scene's triangles (src/bvh.c); the tree is the
+ * same for any opt->threads. An empty scene gets NULL. */
+rr_error bvh_build(rr_scene *s, const rr_build_options *opt, rr_bvh **out);
+/* The scene's BVH when it is current, else NULL with a message in dev (an empty
+ * scene also gives NULL, with *empty set: every ray misses). */
+const rr_bvh *bvh_of(rr_device *dev, const rr_scene *s, bool *empty);
+typedef struct camera camera;
+/* A pseudo-camera for one arbitrary ray: eye = origin, d0 = direction and dx, dy
+ * two fixed directions perpendicular to it, so tri_setup_planar() sets a triangle
+ * up for the ray, and its edge functions at sample (0, 0) are the ray's. The tie
+ * bits (top-left rule) then come from the derivatives along dx, then dy: a ray
+ * through a shared edge or vertex hits exactly one triangle. */
+void ray_camera(const float org[3], const float dir[3], camera *out);
+/* The one sample test for an arbitrary ray set up by ray_camera(): true on a hit
+ * with t in [tmin, tmax] (t along the unnormalised direction). */
+bool ray_tri_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull_backfaces, float tmin, float tmax,
+                 float *t, float *l1, float *l2);
 
 /* Frees the scene's BVH (if any). */
 void scene_free_bvh(rr_scene *s);
@@ -121,56 +145,93 @@ void bvh_fill_info(const rr_scene *s, rr_scene_info *info);
 
 /* ---- camera -------------------------------------------------------------- */
 
-/* A camera resolved for an image: an orthonormal basis and, for planar cameras,
- * the ray direction of sample (sx, sy) as d0 + sx·dx + sy·dy, where the sample of
- * pixel (x, y) is (x + 0.5, y + 0.5) and row 0 is at the top. */
+/* A camera resolved for an image. Sample (sx, sy) of pixel (x, y) is
+ * (x + 0.5, y + 0.5), row 0 at the top. Planar cameras (perspective, orthographic)
+ * have edge functions linear in (sx, sy): a perspective ray leaves the eye along
+ * d0 + sx·dx + sy·dy; an orthographic ray leaves eye + o0 + sx·ox + sy·oy along fwd.
+ * Curved cameras (parabolic, lat-long, fisheye, cube) keep one direction per
+ * sample in `dirs` (zero where the image has no ray), and bound the directions of
+ * a rectangle of samples by a cone whose half-angle grows by `lipschitz` radians
+ * per pixel of distance. */
 typedef struct camera {
   rr_camera_type type;
   int width, height;
+  bool planar;
   vec3 eye, right, up, fwd;
   vec3 d0, dx, dy;
+  vec3 o0, ox, oy;
   float tan_half_h, tan_half_w;
+  vec3 *dirs;
+  float lipschitz;
+  float dir_len_max; /* longest |d| of the camera's rays */
+  int face;          /* cube: side of a face in pixels */
 } camera;
 
-/* Resolves a public camera for an image size. */
+/* Resolves a public camera for an image size; camera_release frees it. */
 rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *out);
-/* The (unnormalised) ray direction of sample (sx, sy). */
+void camera_release(camera *c);
+/* The ray of sample (sx, sy) of a planar perspective camera (unnormalised). */
 static inline vec3 camera_dir(const camera *c, float sx, float sy) {
   return v3_add(c->d0, v3_add(v3_scale(c->dx, sx), v3_scale(c->dy, sy)));
 }
-/* Projects a point given relative to the eye to sample coordinates; false when it
- * is not strictly in front of the eye. */
+/* The ray of pixel (x, y) for any camera: origin and (unnormalised) direction;
+ * false when the pixel has no ray (outside a hemisphere's disk, a cube's cross). */
+bool camera_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir);
+/* What a triangle's edge functions are evaluated against at pixel (x, y):
+ * (1, sx, sy) for planar cameras, the ray direction for curved ones. */
+static inline vec3 camera_w(const camera *c, int x, int y) {
+  return c->planar ? v3(1.0f, (float)x + 0.5f, (float)y + 0.5f) : c->dirs[(size_t)y * c->width + x];
+}
+/* Projects a point given relative to the eye to sample coordinates (planar
+ * cameras); false when it is not strictly in front of the image plane. */
 bool camera_project(const camera *c, vec3 p, float *sx, float *sy);
+/* A cone (unit axis, half-angle) holding the directions of the samples
+ * [x0, x1) × [y0, y1) of a curved camera; false when none is known. */
+bool camera_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle);
 
 /* ---- triangle setup and the one sample test ----------------------------- */
 
-/* A triangle set up for an eye and a planar camera (paper eqs. 1–3). Edge i's 3D
- * edge function at sample (sx, sy) is V_i = a[i] + sx·b[i] + sy·c[i]; all values are
- * sign-normalised so that the inside is positive whichever face is seen. */
+/* A triangle set up for a camera (paper eqs. 1–3 and appendix). Its edge functions
+ * at a sample are V_i = a[i]·w.x + b[i]·w.y + c[i]·w.z for the camera's w
+ * (camera_w): for planar cameras that is a + sx·b + sy·c (eq. 3), for curved ones
+ * (a, b, c) is the edge normal n_i and V_i = n_i·d. The volume at the sample is
+ * vol + sx·vol_x + sy·vol_y (constant but for orthographic views, whose ray origin
+ * moves). Everything is sign-normalised so that the inside is positive whichever
+ * face is seen. */
 typedef struct tri_setup {
   float a[3], b[3], c[3];
-  float vol;    /* |V|, the scaled volume of the tetrahedron eye–triangle */
+  float vol, vol_x, vol_y;
   uint32_t tie; /* bit i: a sample exactly on edge i belongs to this triangle */
 } tri_setup;
 
 enum { SETUP_CULLED = 0, SETUP_FRONT = 1, SETUP_BACK = 2 };
 
-/* Sets up triangle `i` of `s` for camera `c` (eye at origin). Returns SETUP_FRONT,
- * SETUP_BACK, or SETUP_CULLED when the triangle cannot be seen (its plane holds the
- * eye, or it is a back face and cull_backfaces is set). */
-int tri_setup_planar(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces,
-                     tri_setup *out);
+/* Sets up triangle `i` of `s` for camera `c`. Returns SETUP_FRONT, SETUP_BACK, or
+ * SETUP_CULLED when the triangle cannot be seen (edge-on, or a back face and
+ * cull_backfaces is set). */
+int tri_setup_camera(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces, tri_setup *out);
+#define tri_setup_planar tri_setup_camera
 
-/* The three edge functions of a set-up triangle at a sample. The evaluation order
- * is fixed (no FMA contraction: the build uses -ffp-contract=off) so every method
- * computes the same bits for the same (triangle, sample). */
+/* The three edge functions of a set-up triangle for evaluation vector w. The
+ * order of operations is fixed (the build uses -ffp-contract=off: a fused
+ * multiply-add would change the bits) so every method computes the same values
+ * for the same (triangle, sample). */
+static inline void tri_edges_w(const tri_setup *t, vec3 w, float e[3]) {
+  for (int i = 0; i < 3; i++) e[i] = t->a[i] * w.x + t->b[i] * w.y + t->c[i] * w.z;
+}
+/* The same for a planar camera's sample (sx, sy): w = (1, sx, sy), same bits. */
 static inline void tri_edges(const tri_setup *t, float sx, float sy, float e[3]) {
-  for (int i = 0; i < 3; i++) e[i] = t->a[i] + sx * t->b[i] + sy * t->c[i];
+  tri_edges_w(t, v3(1.0f, sx, sy), e);
+}
+/* The volume term at sample (sx, sy). */
+static inline float tri_vol(const tri_setup *t, float sx, float sy) {
+  return t->vol + sx * t->vol_x + sy * t->vol_y;
 }
 
 /* The one sample test (paper eq. 2 with the top-left rule of sect. 4.2).
  * e: sign-normalised edge values at the sample; tie: bit i set when the sample
- * belongs to this triangle if it lies exactly on edge i; vol: |V|.
+ * belongs to this triangle if it lies exactly on edge i; vol: the sign-normalised
+ * volume at the sample (positive when the hit lies ahead of the ray origin).
  * On a hit returns true with t = V / ΣV_i and λ_i = V_i / ΣV_i. */
 static inline bool sample_test(const float e[3], uint32_t tie, float vol,
                                float *t, float *l1, float *l2) {
@@ -179,7 +240,8 @@ static inline bool sample_test(const float e[3], uint32_t tie, float vol,
   bool in2 = e[2] > 0.0f || (e[2] == 0.0f && (tie & 4u));
   if (!(in0 & in1 & in2)) return false;
   float sum = e[0] + e[1] + e[2];
-  if (!(sum > 0.0f)) return false; /* all three on their edges: a degenerate sliver */
+  /* sum == 0: all three on their edges (a degenerate sliver) or a pixel with no ray */
+  if (!(sum > 0.0f) || !(vol > 0.0f)) return false;
   float inv = 1.0f / sum;
   *t = vol * inv;
   *l1 = e[1] * inv;
@@ -201,18 +263,24 @@ static inline bool depth_wins(float t, uint32_t id, float best_t, uint32_t best_
   return t < best_t || (t == best_t && id < best_id);
 }
 
-/* Tests one set-up triangle at one sample and keeps it when it is nearer. */
-static inline bool shade_sample(const tri_setup *ts, uint32_t id, float sx, float sy,
-                                visbuf *vb, size_t k) {
+/* Tests one set-up triangle at pixel k, whose sample is (sx, sy) with evaluation
+ * vector w, and keeps it when it is nearer. */
+static inline bool shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, float sy, visbuf *vb,
+                                  size_t k) {
   float e[3], t, l1, l2;
-  tri_edges(ts, sx, sy, e);
-  if (!sample_test(e, ts->tie, ts->vol, &t, &l1, &l2)) return false;
+  tri_edges_w(ts, w, e);
+  if (!sample_test(e, ts->tie, tri_vol(ts, sx, sy), &t, &l1, &l2)) return false;
   if (!depth_wins(t, id, vb->t[k], vb->id[k])) return false;
   vb->t[k] = t;
   vb->id[k] = id;
   vb->l1[k] = l1;
   vb->l2[k] = l2;
   return true;
+}
+
+/* The same for a planar camera's sample (sx, sy). */
+static inline bool shade_sample(const tri_setup *ts, uint32_t id, float sx, float sy, visbuf *vb, size_t k) {
+  return shade_sample_w(ts, id, v3(1.0f, sx, sy), sx, sy, vb, k);
 }
 
 struct rr_frame {
@@ -258,11 +326,23 @@ bool oracle_occluded(const camera *c, const bvh_node *box, float farthest);
 typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
 
 rr_error vis_rc(rr_device *dev, render_ctx *ctx);
+/* rc-bvh and rc-packet: single rays and 8x8 ray packets through the BVH (src/vis_rc_bvh.c). */
+rr_error vis_rc_bvh(rr_device *dev, render_ctx *ctx);
+rr_error vis_rc_packet(rr_device *dev, render_ctx *ctx);
+/* 2dr-bb and 2dr-bin: projection, clipping, fixed-point 2D edge functions (src/raster2d.c). */
+rr_error vis_2dr_bb(rr_device *dev, render_ctx *ctx);
+rr_error vis_2dr_bin(rr_device *dev, render_ctx *ctx);
+/* Test hook: runs the 2D pipeline (binning when `bin`) over every triangle but, instead
+ * of the z test, counts in front[k] / back[k] every triangle that claims sample k. */
+rr_error raster2d_claims(const rr_scene *s, const camera *c, bool bin, int threads, uint8_t *front, uint8_t *back);
+/* Test hook: where the 2D pipeline's vertex stage puts world point p on the screen;
+ * false when p is behind its near plane. */
+bool raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, double *sy);
 /* The inclusive pixel rectangle a triangle's samples may lie in; false when none. */
 bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int rect[4]);
 /* Tests every sample of an inclusive rectangle against one set-up triangle and
  * returns the number of edge-function evaluations. */
-uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], visbuf *vb);
+uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb);
 
 /* ---- threads --------------------------------------------------------------- */
 

@@ -1,4 +1,4 @@
-/* Triangle setup for an eye (paper sect. 3.2, eqs. 1–3).
+/* Triangle setup for a camera (paper sect. 3.2, eqs. 1–3, and the appendix).
  *
  * Consistency (sect. 4.2) needs the two triangles of a shared edge to compute
  * exactly opposite edge functions. The edge normal is therefore computed from the
@@ -13,6 +13,14 @@ static bool lex_less(vec3 a, vec3 b) {
   return a.z < b.z;
 }
 
+/* m = d × (a − b) for the edge a → b, with the same canonical order. */
+static vec3 edge_normal_dir(vec3 d, vec3 a, vec3 b) {
+  bool swap = lex_less(b, a);
+  vec3 l = swap ? b : a, h = swap ? a : b;
+  vec3 m = v3_cross(d, v3_sub(l, h));
+  return swap ? v3_neg(m) : m;
+}
+
 /* n = b × a for the edge a → b of a triangle seen from the origin, computed in the
  * stable form h × (l − h) for the canonical order (l, h). */
 static vec3 edge_normal(vec3 a, vec3 b) {
@@ -22,28 +30,56 @@ static vec3 edge_normal(vec3 a, vec3 b) {
   return swap ? v3_neg(m) : m;
 }
 
-int tri_setup_planar(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces,
-                     tri_setup *out) {
+/* Exactly one of n and -n is positive in the lexicographic order of
+ * (g1, g2, g3); the tie rule asks it of the edge's derivatives, so the two
+ * triangles of a shared edge never both own, nor both refuse, its samples. */
+static bool lex_positive(float g1, float g2, float g3) {
+  return g1 > 0 || (g1 == 0 && (g2 > 0 || (g2 == 0 && g3 > 0)));
+}
+
+int tri_setup_camera(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces, tri_setup *out) {
   vec3 q[3];
   for (int k = 0; k < 3; k++) q[k] = v3_sub(scene_vertex(s, k, i), c->eye);
   /* Edge i runs from q[i+1] to q[i+2]: n_i = q[i+2] × q[i+1] (paper eq. 1). */
   vec3 n[3];
   for (int e = 0; e < 3; e++) n[e] = edge_normal(q[(e + 1) % 3], q[(e + 2) % 3]);
-  float vol = v3_dot(q[0], n[0]);
-  if (!(vol != 0) || !isfinite(vol)) return SETUP_CULLED; /* the eye lies in its plane */
-  int face = vol > 0 ? SETUP_FRONT : SETUP_BACK;
+  float vol = v3_dot(q[0], n[0]), vol_x = 0, vol_y = 0, orient = vol;
+  vec3 m[3];
+  if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
+    /* The eye at infinity (paper appendix): the ray origin o = o0 + sx·ox + sy·oy moves
+     * and d = fwd is fixed, so V_i = d·n_i + o·m_i with m_i = d × (q[i+1] - q[i+2]),
+     * and the volume V(o) = V - o·Σn_i; the face is the sign of d·Σn_i. */
+    vec3 sum = v3_add(v3_add(n[0], n[1]), n[2]);
+    for (int e = 0; e < 3; e++) m[e] = edge_normal_dir(c->fwd, q[(e + 1) % 3], q[(e + 2) % 3]);
+    vol = vol - v3_dot(c->o0, sum);
+    vol_x = -v3_dot(c->ox, sum);
+    vol_y = -v3_dot(c->oy, sum);
+    orient = v3_dot(c->fwd, sum);
+  }
+  if (!(orient != 0) || !isfinite(vol)) return SETUP_CULLED; /* seen edge-on */
+  int face = orient > 0 ? SETUP_FRONT : SETUP_BACK;
   if (face == SETUP_BACK && cull_backfaces) return SETUP_CULLED;
   float sign = face == SETUP_FRONT ? 1.0f : -1.0f;
-  out->vol = vol * sign;
+  out->vol = vol * sign, out->vol_x = vol_x * sign, out->vol_y = vol_y * sign;
   out->tie = 0;
   for (int e = 0; e < 3; e++) {
     vec3 ne = v3_scale(n[e], sign);
-    out->a[e] = v3_dot(ne, c->d0);
-    out->b[e] = v3_dot(ne, c->dx);
-    out->c[e] = v3_dot(ne, c->dy);
-    /* Top-left rule: a sample on the edge belongs to the triangle whose inside
-     * lies to its right (V_i,x > 0), or below for a horizontal edge (V_i,y > 0). */
-    if (out->b[e] > 0 || (out->b[e] == 0 && out->c[e] > 0)) out->tie |= 1u << e;
+    float g1, g2;
+    if (c->type == RR_CAMERA_PERSPECTIVE) {
+      out->a[e] = v3_dot(ne, c->d0), out->b[e] = v3_dot(ne, c->dx), out->c[e] = v3_dot(ne, c->dy);
+      g1 = out->b[e], g2 = out->c[e];
+    } else if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
+      vec3 me = v3_scale(m[e], sign);
+      out->a[e] = v3_dot(ne, c->fwd) + v3_dot(me, c->o0);
+      out->b[e] = v3_dot(me, c->ox), out->c[e] = v3_dot(me, c->oy);
+      g1 = out->b[e], g2 = out->c[e];
+    } else {
+      out->a[e] = ne.x, out->b[e] = ne.y, out->c[e] = ne.z;
+      g1 = v3_dot(ne, c->right), g2 = -v3_dot(ne, c->up);
+    }
+    /* Top-left rule: a sample on the edge belongs to the triangle whose inside lies
+     * to its right (V_i,x > 0), or below for a horizontal edge (V_i,y > 0). */
+    if (lex_positive(g1, g2, v3_dot(ne, c->fwd))) out->tie |= 1u << e;
   }
   return face;
 }

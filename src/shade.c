@@ -31,7 +31,11 @@ static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, i
   h.id = vb->id[k];
   if (h.id == RR_MISS || h.id >= s->ntris) return h;
   h.valid = true;
-  vec3 d = camera_dir(c, (float)x + 0.5f, (float)y + 0.5f);
+  vec3 o, d;
+  if (!camera_ray(c, x, y, &o, &d)) {
+    h.valid = false;
+    return h;
+  }
   float len = v3_len(d);
   h.dir = v3_scale(d, 1.0f / len);
   h.dist = vb->t[k] * len;
@@ -156,14 +160,11 @@ static void shade_heat(const float *heat, rr_image *img, const char *what) {
   draw_text(img, (float)x1 - stb_easy_font_width(label) * scale, (float)ytext, scale, label);
 }
 
-rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
-                  rr_shade_mode mode, rr_image *out) {
-  if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
-  if ((int)mode < 0 || mode >= RR_SHADE_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shade mode %d", (int)mode);
-  camera c;
+static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp, const rr_frame *f,
+                            rr_shade_mode mode, rr_image *out) {
+  const camera c = *cp;
   const visbuf *vb = &f->vb;
-  rr_error e = camera_setup(dev, cam, vb->width, vb->height, &c);
-  if (e) return e;
+  rr_error e;
   bool heat = mode == RR_SHADE_HEAT_EVALS || mode == RR_SHADE_HEAT_NODES;
   const float *counts = mode == RR_SHADE_HEAT_EVALS ? f->heat_e : f->heat_n;
   if (heat && !counts)
@@ -220,13 +221,11 @@ rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const
   return rr_ok(dev);
 }
 
-rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_aov aov,
-                      rr_image *out) {
-  if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_frame_aov: NULL argument");
+static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cp, const rr_frame *f, rr_aov aov,
+                          rr_image *out) {
+  const camera c = *cp;
   const visbuf *vb = &f->vb;
-  camera c;
-  rr_error e = camera_setup(dev, cam, vb->width, vb->height, &c);
-  if (e) return e;
+  rr_error e;
   static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1};
   if ((int)aov < 0 || aov >= RR_AOV_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AOV %d", (int)aov);
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
@@ -253,4 +252,26 @@ rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, c
       else if (aov == RR_AOV_BARY && h.valid) o[0] = h.l1, o[1] = h.l2;
     }
   return rr_ok(dev);
+}
+
+/* The public entry points resolve the camera for the frame's size around the work. */
+rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_shade_mode mode,
+                  rr_image *out) {
+  if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
+  if ((int)mode < 0 || mode >= RR_SHADE_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shade mode %d", (int)mode);
+  camera c;
+  rr_error e = camera_setup(dev, cam, f->vb.width, f->vb.height, &c);
+  if (!e) e = shade_frame(dev, s, &c, f, mode, out);
+  camera_release(&c);
+  return e;
+}
+
+rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_aov aov,
+                      rr_image *out) {
+  if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_frame_aov: NULL argument");
+  camera c;
+  rr_error e = camera_setup(dev, cam, f->vb.width, f->vb.height, &c);
+  if (!e) e = frame_aov(dev, s, &c, f, aov, out);
+  camera_release(&c);
+  return e;
 }

@@ -82,14 +82,15 @@ typedef struct tri_job {
   tri_setup ts;
   uint32_t id;
   float zmin;      /* nearest depth of the triangle (0 when it reaches the eye plane) */
-  float slack[3];  /* how far below zero a rounded corner value may fall for an inside sample */
+  float slack[3];  /* planar: how far below zero a rounded corner value may fall for an inside sample;
+                      curved: the length of the edge normal */
   int bb[4];       /* inclusive screen bounds */
 } tri_job;
 
 /* Tests every sample of r; the one kernel every generateSamples path ends in. */
 static void raster_samples(trav *t, const tri_job *j, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
-  t->st.edge_evals += raster_rect(&j->ts, j->id, rect, t->vb);
+  t->st.edge_evals += raster_rect(&j->ts, j->id, rect, t->c, t->vb);
   charge(t->heat_e, t->vb->width, r, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
   mark_dirty(t, r);
 }
@@ -108,19 +109,35 @@ static void bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
         raster_samples(t, j, b);
         continue;
       }
-      float xs[2] = {b.x0 + 0.5f, b.x1 - 0.5f}, ys[2] = {b.y0 + 0.5f, b.y1 - 0.5f};
       bool out = false;
-      for (int e = 0; e < 3 && !out; e++) {
-        bool all_out = true;
-        for (int k = 0; k < 4 && all_out; k++)
-          all_out = j->ts.a[e] + xs[k & 1] * j->ts.b[e] + ys[k >> 1] * j->ts.c[e] < -j->slack[e];
-        out = all_out;
-      }
-      t->st.edge_evals += 4;
-      if (t->heat_e) {
-        int w = t->vb->width;
-        t->heat_e[(size_t)b.y0 * w + b.x0] += 1, t->heat_e[(size_t)b.y0 * w + b.x1 - 1] += 1;
-        t->heat_e[(size_t)(b.y1 - 1) * w + b.x0] += 1, t->heat_e[(size_t)(b.y1 - 1) * w + b.x1 - 1] += 1;
+      if (t->c->planar) {
+        float xs[2] = {b.x0 + 0.5f, b.x1 - 0.5f}, ys[2] = {b.y0 + 0.5f, b.y1 - 0.5f};
+        for (int e = 0; e < 3 && !out; e++) {
+          bool all_out = true;
+          for (int k = 0; k < 4 && all_out; k++)
+            all_out = j->ts.a[e] + xs[k & 1] * j->ts.b[e] + ys[k >> 1] * j->ts.c[e] < -j->slack[e];
+          out = all_out;
+        }
+        t->st.edge_evals += 4;
+        if (t->heat_e) {
+          int w = t->vb->width;
+          t->heat_e[(size_t)b.y0 * w + b.x0] += 1, t->heat_e[(size_t)b.y0 * w + b.x1 - 1] += 1;
+          t->heat_e[(size_t)(b.y1 - 1) * w + b.x0] += 1, t->heat_e[(size_t)(b.y1 - 1) * w + b.x1 - 1] += 1;
+        }
+      } else {
+        /* Curved views bend edges into arcs, so corners prove nothing. Bound the bin's
+         * rays by a cone instead: edge e rejects the bin when its plane leaves the
+         * whole cone on the outside, n·axis < -|n| sin(angle) (paper sect. 4.1 does
+         * the same for the parabolic map by shifting the corners). */
+        vec3 axis;
+        float angle;
+        if (camera_rect_cone(t->c, b.x0, b.y0, b.x1, b.y1, &axis, &angle) && angle < 1.5f) {
+          float lim = sinf(angle) + 1e-5f;
+          for (int e = 0; e < 3 && !out; e++)
+            out = j->ts.a[e] * axis.x + j->ts.b[e] * axis.y + j->ts.c[e] * axis.z < -j->slack[e] * lim;
+          t->st.edge_evals += 1;
+          if (t->heat_e) t->heat_e[(size_t)((b.y0 + b.y1) / 2) * t->vb->width + (b.x0 + b.x1) / 2] += 1;
+        }
       }
       if (out) continue;
       if (t->o->early_z && j->zmin > 0 && j->zmin * (1 - DEPTH_MARGIN) > hiz_max(t, b)) continue;
@@ -134,12 +151,24 @@ static bool prepare(const trav *t, uint32_t id, tri_job *j) {
   if (!tri_screen_bounds(t->s, id, t->c, j->bb)) return false;
   j->id = id;
   if (!t->o->binning) return true;
-  float zmin = INFINITY;
-  for (int k = 0; k < 3; k++) zmin = fminf(zmin, v3_dot(v3_sub(scene_vertex(t->s, k, id), t->c->eye), t->c->fwd));
-  j->zmin = zmin > 0 ? zmin : 0;
-  float W = (float)t->vb->width + 1, H = (float)t->vb->height + 1;
-  for (int e = 0; e < 3; e++)
-    j->slack[e] = 1e-5f * (fabsf(j->ts.a[e]) + W * fabsf(j->ts.b[e]) + H * fabsf(j->ts.c[e]));
+  const camera *c = t->c;
+  if (c->planar) {
+    float zmin = INFINITY;
+    for (int k = 0; k < 3; k++) zmin = fminf(zmin, v3_dot(v3_sub(scene_vertex(t->s, k, id), c->eye), c->fwd));
+    j->zmin = zmin > 0 ? zmin : 0;
+    float W = (float)t->vb->width + 1, H = (float)t->vb->height + 1;
+    for (int e = 0; e < 3; e++)
+      j->slack[e] = 1e-5f * (fabsf(j->ts.a[e]) + W * fabsf(j->ts.b[e]) + H * fabsf(j->ts.c[e]));
+  } else {
+    /* the distance to the triangle's plane bounds every hit's distance from below */
+    vec3 q0 = v3_sub(scene_vertex(t->s, 0, id), c->eye), q1 = v3_sub(scene_vertex(t->s, 1, id), c->eye),
+         q2 = v3_sub(scene_vertex(t->s, 2, id), c->eye);
+    vec3 nrm = v3_cross(v3_sub(q1, q0), v3_sub(q2, q0));
+    float dist = fabsf(v3_dot(q0, nrm)) / v3_len(nrm);
+    j->zmin = dist > 0 && isfinite(dist) ? dist / c->dir_len_max : 0;
+    for (int e = 0; e < 3; e++)
+      j->slack[e] = sqrtf(j->ts.a[e] * j->ts.a[e] + j->ts.b[e] * j->ts.b[e] + j->ts.c[e] * j->ts.c[e]);
+  }
   return true;
 }
 
@@ -162,28 +191,52 @@ static void rasterize(trav *t, uint32_t id, tile_rect f) {
 
 typedef struct frustum {
   tile_rect r;
-  vec3 plane[4]; /* inward normals of the side planes through the eye */
-  vec3 centre;   /* direction of the centre ray */
+  int nplanes;       /* planar cameras: inward side planes n·p + off >= 0 */
+  vec3 plane[4];
+  float off[4];
+  bool has_cone;     /* curved cameras: a cone of the frustum's directions */
+  vec3 axis;
+  float angle;
+  bool has_ray;      /* the centre sample's ray */
+  vec3 origin, dir;
 } frustum;
 
 static frustum make_frustum(const camera *c, tile_rect r) {
   frustum f = {.r = r};
-  /* Half a pixel beyond the outer sample centres: conservative for every sample. */
-  float x0 = (float)r.x0, x1 = (float)r.x1, y0 = (float)r.y0, y1 = (float)r.y1;
-  vec3 d00 = camera_dir(c, x0, y0), d10 = camera_dir(c, x1, y0), d11 = camera_dir(c, x1, y1),
-       d01 = camera_dir(c, x0, y1);
-  f.centre = camera_dir(c, 0.5f * (x0 + x1), 0.5f * (y0 + y1));
-  vec3 n[4] = {v3_cross(d00, d10), v3_cross(d10, d11), v3_cross(d11, d01), v3_cross(d01, d00)};
-  for (int i = 0; i < 4; i++) f.plane[i] = v3_dot(n[i], f.centre) < 0 ? v3_neg(n[i]) : n[i];
+  f.has_ray = camera_ray(c, (r.x0 + r.x1 - 1) / 2, (r.y0 + r.y1 - 1) / 2, &f.origin, &f.dir);
+  if (c->type == RR_CAMERA_PERSPECTIVE) {
+    /* Planes through the eye and the outer pixel edges: half a pixel beyond the
+     * outer sample centres, conservative for every sample. */
+    float x0 = (float)r.x0, x1 = (float)r.x1, y0 = (float)r.y0, y1 = (float)r.y1;
+    vec3 d00 = camera_dir(c, x0, y0), d10 = camera_dir(c, x1, y0), d11 = camera_dir(c, x1, y1),
+         d01 = camera_dir(c, x0, y1), centre = camera_dir(c, 0.5f * (x0 + x1), 0.5f * (y0 + y1));
+    vec3 n[4] = {v3_cross(d00, d10), v3_cross(d10, d11), v3_cross(d11, d01), v3_cross(d01, d00)};
+    f.nplanes = 4;
+    for (int i = 0; i < 4; i++) {
+      f.plane[i] = v3_dot(n[i], centre) < 0 ? v3_neg(n[i]) : n[i];
+      f.off[i] = -v3_dot(f.plane[i], c->eye);
+    }
+  } else if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
+    /* Parallel rays: a box-shaped prism along fwd over the rectangle's origins. */
+    vec3 lo = v3_add(c->eye, v3_add(c->o0, v3_add(v3_scale(c->ox, (float)r.x0), v3_scale(c->oy, (float)r.y0))));
+    vec3 hi = v3_add(c->eye, v3_add(c->o0, v3_add(v3_scale(c->ox, (float)r.x1), v3_scale(c->oy, (float)r.y1))));
+    f.nplanes = 4;
+    f.plane[0] = c->right, f.off[0] = -v3_dot(c->right, lo);
+    f.plane[1] = v3_neg(c->right), f.off[1] = v3_dot(c->right, hi);
+    f.plane[2] = c->up, f.off[2] = -v3_dot(c->up, hi);
+    f.plane[3] = v3_neg(c->up), f.off[3] = v3_dot(c->up, lo);
+  } else {
+    f.has_cone = camera_rect_cone(c, r.x0, r.y0, r.x1, r.y1, &f.axis, &f.angle);
+  }
   return f;
 }
 
-/* Largest value of n·(p − eye) over the corners of a box. */
-static float box_max_dot(const bvh_node *b, vec3 eye, vec3 n, float *mag) {
-  float m = 0, s = 0;
-  const float nn[3] = {n.x, n.y, n.z}, e[3] = {eye.x, eye.y, eye.z};
+/* Largest value of n·p + off over the corners of a box, and a magnitude for slack. */
+static float box_max_plane(const bvh_node *b, vec3 n, float off, float *mag) {
+  float m = off, s = fabsf(off);
+  const float nn[3] = {n.x, n.y, n.z};
   for (int a = 0; a < 3; a++) {
-    float lo = nn[a] * (b->lo[a] - e[a]), hi = nn[a] * (b->hi[a] - e[a]);
+    float lo = nn[a] * b->lo[a], hi = nn[a] * b->hi[a];
     m += fmaxf(lo, hi);
     s += fabsf(lo) + fabsf(hi);
   }
@@ -191,32 +244,31 @@ static float box_max_dot(const bvh_node *b, vec3 eye, vec3 n, float *mag) {
   return m;
 }
 
-static float box_zmin(const bvh_node *b, const camera *c) {
+/* A lower bound of the ray parameter t of any hit inside the box, in the units of
+ * the stored depths: the distance along fwd for planar cameras (d·fwd = 1), the
+ * distance from the eye over the longest ray direction for curved ones. */
+static float box_tmin(const bvh_node *b, const camera *c) {
+  const float e[3] = {c->eye.x, c->eye.y, c->eye.z};
   float m = 0;
-  const float f[3] = {c->fwd.x, c->fwd.y, c->fwd.z}, e[3] = {c->eye.x, c->eye.y, c->eye.z};
-  for (int a = 0; a < 3; a++) m += fminf(f[a] * (b->lo[a] - e[a]), f[a] * (b->hi[a] - e[a]));
-  return m;
-}
-
-/* isOutside: the box lies wholly outside one side plane, or behind the eye. */
-static bool centre_hits(const frustum *f, const bvh_node *b, vec3 eye);
-
-static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
-  /* A frustum of one sample is its ray: the classic ray-box test. */
-  if (f->r.x1 - f->r.x0 == 1 && f->r.y1 - f->r.y0 == 1) return !centre_hits(f, b, c->eye);
-  float mag;
-  if (box_max_dot(b, c->eye, c->fwd, &mag) <= -1e-6f * mag) return true;
-  for (int i = 0; i < 4; i++)
-    if (box_max_dot(b, c->eye, f->plane[i], &mag) < -1e-5f * mag) return true;
-  return false;
-}
-
-/* Does the centre ray of f meet the box (slab test with slack)? */
-static bool centre_hits(const frustum *f, const bvh_node *b, vec3 eye) {
-  float t0 = 0, t1 = INFINITY;
-  const float o[3] = {eye.x, eye.y, eye.z}, d[3] = {f->centre.x, f->centre.y, f->centre.z};
+  if (c->planar) {
+    const float f[3] = {c->fwd.x, c->fwd.y, c->fwd.z};
+    for (int a = 0; a < 3; a++) m += fminf(f[a] * (b->lo[a] - e[a]), f[a] * (b->hi[a] - e[a]));
+    return m;
+  }
   for (int a = 0; a < 3; a++) {
-    float pad = 1e-4f * (b->hi[a] - b->lo[a]);
+    float d = fmaxf(fmaxf(b->lo[a] - e[a], e[a] - b->hi[a]), 0.0f);
+    m += d * d;
+  }
+  return sqrtf(m) / c->dir_len_max;
+}
+
+/* The ray of the centre sample meets the box (slab test with slack)? */
+static bool centre_hits(const frustum *f, const bvh_node *b) {
+  if (!f->has_ray) return false;
+  float t0 = 0, t1 = INFINITY;
+  const float o[3] = {f->origin.x, f->origin.y, f->origin.z}, d[3] = {f->dir.x, f->dir.y, f->dir.z};
+  for (int a = 0; a < 3; a++) {
+    float pad = 1e-4f * (b->hi[a] - b->lo[a]) + 1e-6f * fabsf(o[a]);
     if (d[a] == 0) {
       if (o[a] < b->lo[a] - pad || o[a] > b->hi[a] + pad) return false;
       continue;
@@ -225,7 +277,29 @@ static bool centre_hits(const frustum *f, const bvh_node *b, vec3 eye) {
     t0 = fmaxf(t0, fminf(ta, tb));
     t1 = fminf(t1, fmaxf(ta, tb));
   }
-  return t0 <= t1;
+  return t0 <= t1 * 1.0001f;
+}
+
+/* isOutside: the box lies wholly outside one side plane, behind the image plane,
+ * or outside the cone of directions. */
+static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
+  /* A frustum of one sample is its ray: the classic ray-box test. */
+  if (f->r.x1 - f->r.x0 == 1 && f->r.y1 - f->r.y0 == 1) return !centre_hits(f, b);
+  float mag;
+  if (f->nplanes) {
+    if (box_max_plane(b, c->fwd, -v3_dot(c->fwd, c->eye), &mag) <= -1e-6f * mag) return true;
+    for (int i = 0; i < f->nplanes; i++)
+      if (box_max_plane(b, f->plane[i], f->off[i], &mag) < -1e-5f * mag) return true;
+    return false;
+  }
+  if (!f->has_cone) return false;
+  /* the box's bounding sphere against the cone */
+  vec3 lo = v3_load(b->lo), hi = v3_load(b->hi);
+  vec3 v = v3_sub(v3_scale(v3_add(lo, hi), 0.5f), c->eye);
+  float rad = 0.5f * v3_len(v3_sub(hi, lo)) * 1.0001f, dist = v3_len(v);
+  if (dist <= rad || !(dist > 0)) return false;
+  float beta = asinf(rad / dist), phi = acosf(fmaxf(-1.0f, fminf(1.0f, v3_dot(v, f->axis) / dist)));
+  return phi > f->angle + beta + 1e-4f;
 }
 
 /* splitFrustum: the centre ray misses the node, or the node looks small in F. */
@@ -233,16 +307,21 @@ static bool should_split(const trav *t, const frustum *f, const bvh_node *b) {
   const oracles *o = t->o;
   int w = f->r.x1 - f->r.x0, h = f->r.y1 - f->r.y0;
   if (!o->split_min || (w <= o->split_min && h <= o->split_min)) return false;
-  if (!centre_hits(f, b, t->c->eye)) return true;
-  float z = box_zmin(b, t->c);
-  if (!(z > 0)) return false;
-  vec3 ext = v3(b->hi[0] - b->lo[0], b->hi[1] - b->lo[1], b->hi[2] - b->lo[2]);
-  float px = v3_len(ext) / (z * 2.0f * t->c->tan_half_h / (float)t->vb->height); /* box size in pixels */
-  return px * px < o->split_ratio * (float)w * (float)h;
+  if (!centre_hits(f, b)) return true;
+  const camera *c = t->c;
+  float diag = v3_len(v3(b->hi[0] - b->lo[0], b->hi[1] - b->lo[1], b->hi[2] - b->lo[2])), px;
+  if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
+    px = diag / (2.0f * c->tan_half_h / (float)c->height);
+  } else {
+    float z = box_tmin(b, c);
+    if (!(z > 0)) return false;
+    px = c->planar ? diag / (z * 2.0f * c->tan_half_h / (float)c->height) : diag / (z * c->lipschitz);
+  }
+  return px * px < o->split_ratio * (float)w * (float)h; /* box size in pixels, squared */
 }
 
 bool oracle_occluded(const camera *c, const bvh_node *b, float farthest) {
-  float z = box_zmin(b, c);
+  float z = box_tmin(b, c);
   return z > 0 && z * (1 - DEPTH_MARGIN) > farthest;
 }
 
@@ -298,7 +377,7 @@ static void traverse(trav *t, const frustum *f, uint32_t node) {
   }
   /* Children front to back: nearer box first along the view direction. */
   uint32_t a = n->first, b = n->first + 1;
-  if (box_zmin(&bvh->nodes[b], t->c) < box_zmin(&bvh->nodes[a], t->c)) a = b, b = n->first;
+  if (box_tmin(&bvh->nodes[b], t->c) < box_tmin(&bvh->nodes[a], t->c)) a = b, b = n->first;
   traverse(t, f, a);
   traverse(t, f, b);
 }

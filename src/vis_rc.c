@@ -17,8 +17,11 @@ static void rc_row(int y, int thread, void *arg) {
   for (int x = 0; x < vb->width; x++) {
     size_t k = (size_t)y * vb->width + x;
     float sx = (float)x + 0.5f;
-    for (uint32_t j = 0; j < job->n; j++) shade_sample(&job->setup[j], job->ids[j], sx, sy, vb, k);
+    vec3 w = camera_w(job->ctx->cam, x, y);
+    for (uint32_t j = 0; j < job->n; j++) shade_sample_w(&job->setup[j], job->ids[j], w, sx, sy, vb, k);
   }
+  if (job->ctx->heat_e)
+    for (int x = 0; x < vb->width; x++) job->ctx->heat_e[(size_t)y * vb->width + x] += (float)job->n;
   job->evals[thread] += (uint64_t)vb->width * job->n;
 }
 

@@ -37,7 +37,9 @@ static const char usage[] =
     "  --oracles K=V,...   override a 3dr method's traversal: frustum=N leaves=0|1 outside=0|1\n"
     "                      occluded=0|1 split=N split-ratio=F binning=0|1 early-z=0|1 bin=N bin-min=N\n"
     "  --size WxH          image size (default 1024x768, at most 16384 a side)\n"
-    "  --camera NAME       perspective\n"
+    "  --camera NAME       perspective (default), orthographic, parabolic, latlong, fisheye, cube\n"
+    "  --ortho-height H    orthographic view height (default 2·|target-eye|·tan(fov/2))\n"
+    "  --cube-faces DIR    cube camera: also write the six faces as DIR/front.png, right, back, ...\n"
     "  --eye X,Y,Z --target X,Y,Z --up X,Y,Z --fov DEG\n"
     "                      camera; without --eye/--target the scene is framed automatically\n"
     "  --shade MODE        lambert (default), id, normal, depth, heat-evals, heat-nodes\n"
@@ -129,6 +131,28 @@ static void write_image(rr_device *dev, rr_image *img, const char *path) {
   if (e) die(e == RR_ERROR_ARGUMENT ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
 }
 
+/* Cuts the six faces out of a cube camera's cross and writes DIR/<face>.png. */
+static void write_cube_faces(rr_device *dev, const rr_image *cross, const char *dir) {
+  static const struct {
+    const char *name;
+    int col, row;
+  } faces[6] = {{"front", 1, 1}, {"right", 2, 1}, {"back", 3, 1}, {"left", 0, 1}, {"top", 1, 0}, {"bottom", 1, 2}};
+  int n = cross->height / 3;
+  for (int f = 0; f < 6; f++) {
+    rr_image img = {n, n, 3, RR_PIXEL_F32, malloc((size_t)n * n * 3 * sizeof(float))};
+    if (!img.data) die(EXIT_INPUT, "out of memory");
+    for (int y = 0; y < n; y++)
+      memcpy((float *)img.data + (size_t)y * n * 3,
+             (const float *)cross->data + ((size_t)(faces[f].row * n + y) * cross->width + faces[f].col * n) * 3,
+             (size_t)n * 3 * sizeof(float));
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s.png", dir, faces[f].name);
+    rr_error e = rr_image_write(dev, &img, path);
+    free(img.data);
+    if (e) die(EXIT_INPUT, "%s", rr_device_message(dev));
+  }
+}
+
 static int cmd_info(rr_device *dev, int argc, char **argv) {
   if (argc != 1) die(EXIT_USAGE, "info takes one scene (see --help)");
   rr_scene *scene = load_scene(dev, argv[0]);
@@ -161,7 +185,7 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   rr_render_options_init(&opt);
   rr_camera cam;
   rr_camera_init(&cam);
-  const char *scene_name = NULL, *out = NULL, *json = NULL;
+  const char *scene_name = NULL, *out = NULL, *json = NULL, *cube_dir = NULL;
   bool have_eye = false, have_target = false, stats = false;
   int shade = RR_SHADE_LAMBERT, repeat = 1, naov = 0;
   aov_out aovs[16];
@@ -176,8 +200,16 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
       parse_size(arg_value(&i, argc, argv), &opt.width, &opt.height);
     } else if (strcmp(a, "--camera") == 0) {
       const char *v = arg_value(&i, argc, argv);
-      if (strcmp(v, "perspective") != 0) die(EXIT_USAGE, "unknown camera '%s' (expected perspective)", v);
-      cam.type = RR_CAMERA_PERSPECTIVE;
+      int type = rr_camera_from_name(v);
+      if (type < 0)
+        die(EXIT_USAGE, "unknown camera '%s' (expected perspective, orthographic, parabolic, latlong, fisheye or cube)", v);
+      cam.type = (rr_camera_type)type;
+    } else if (strcmp(a, "--ortho-height") == 0) {
+      const char *v = arg_value(&i, argc, argv);
+      cam.ortho_height = parse_float(a, v);
+      if (!(cam.ortho_height > 0)) die(EXIT_USAGE, "bad value '%s' for --ortho-height (expected > 0)", v);
+    } else if (strcmp(a, "--cube-faces") == 0) {
+      cube_dir = arg_value(&i, argc, argv);
     } else if (strcmp(a, "--eye") == 0) {
       parse_vec(a, arg_value(&i, argc, argv), cam.eye), have_eye = true;
     } else if (strcmp(a, "--target") == 0) {
@@ -187,7 +219,7 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
     } else if (strcmp(a, "--fov") == 0) {
       const char *v = arg_value(&i, argc, argv);
       cam.fov_deg = parse_float(a, v);
-      if (!(cam.fov_deg > 0 && cam.fov_deg < 180)) die(EXIT_USAGE, "bad value '%s' for --fov (expected 0 < fov < 180)", v);
+      if (!(cam.fov_deg > 0 && cam.fov_deg <= 360)) die(EXIT_USAGE, "bad value '%s' for --fov (expected 0 < fov < 180, or up to 360 for fisheye)", v);
     } else if (strcmp(a, "--shade") == 0) {
       const char *v = arg_value(&i, argc, argv);
       shade = rr_shade_from_name(v);
@@ -236,6 +268,7 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   if (!have_eye && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK)
     die(EXIT_INPUT, "%s", rr_device_message(dev));
   if (rr_camera_check(dev, &cam) != RR_OK) die(EXIT_USAGE, "%s", rr_device_message(dev));
+  if (cube_dir && cam.type != RR_CAMERA_CUBE) die(EXIT_USAGE, "--cube-faces needs --camera cube");
 
   double *times = malloc(sizeof(double) * repeat);
   rr_frame *frame = NULL;
@@ -251,10 +284,12 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   double frame_ms = repeat % 2 ? times[repeat / 2] : 0.5 * (times[repeat / 2 - 1] + times[repeat / 2]);
   free(times);
 
-  if (out) {
+  if (out || cube_dir) {
     rr_image img;
     if (rr_shade(dev, scene, &cam, frame, (rr_shade_mode)shade, &img) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
-    write_image(dev, &img, out);
+    if (cube_dir) write_cube_faces(dev, &img, cube_dir);
+    if (out) write_image(dev, &img, out);
+    else rr_image_free(&img);
   }
   for (int k = 0; k < naov; k++) {
     rr_image img;
@@ -271,9 +306,9 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   int threads = st.threads;
   if (stats)
     fprintf(stderr,
-            "method=%s camera=perspective triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f total_ms=%.1f "
+            "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f total_ms=%.1f "
             "setups=%llu edge_evals=%llu nodes=%llu\n",
-            method, (unsigned long long)info.triangles, opt.width, opt.height, threads, frame_ms, total_ms,
+            method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, threads, frame_ms, total_ms,
             (unsigned long long)st.setups, (unsigned long long)st.edge_evals, (unsigned long long)st.nodes);
   if (json) {
     char tmp[4096];
@@ -281,10 +316,10 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
     FILE *f = fopen(tmp, "w");
     if (!f) die(EXIT_INPUT, "cannot write '%s'", json);
     fprintf(f,
-            "{\"scene\": \"%s\", \"method\": \"%s\", \"camera\": \"perspective\", \"triangles\": %llu, "
+            "{\"scene\": \"%s\", \"method\": \"%s\", \"camera\": \"%s\", \"triangles\": %llu, "
             "\"skipped\": %llu, \"width\": %d, \"height\": %d, \"threads\": %d, \"repeat\": %d, "
             "\"frame_ms\": %.3f, \"total_ms\": %.3f, \"setups\": %llu, \"edge_evals\": %llu, \"nodes\": %llu}\n",
-            scene_name, method, (unsigned long long)info.triangles, (unsigned long long)info.skipped, opt.width,
+            scene_name, method, rr_camera_name(cam.type), (unsigned long long)info.triangles, (unsigned long long)info.skipped, opt.width,
             opt.height, threads, repeat, frame_ms, total_ms, (unsigned long long)st.setups,
             (unsigned long long)st.edge_evals, (unsigned long long)st.nodes);
     if (fclose(f) != 0 || rename(tmp, json) != 0) {
