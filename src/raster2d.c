@@ -1,0 +1,665 @@
+/* 2dr-bb and 2dr-bin: the classic 2D pipeline that 3D rasterization is measured
+ * against (paper sect. 3.1; slides "Graphics Pipeline & Rasterization II").
+ *
+ *   vertex stage  world → eye (view matrix) → clip (projection matrix), in double
+ *   clipping      near plane and a guard band, in homogeneous space
+ *   setup         vertices snapped to 8 sub-pixel bits; Pineda edge functions in
+ *                 exact 64-bit integers with the top-left fill rule
+ *   raster        2dr-bb: every sample of the bounding box; 2dr-bin: 64² tiles,
+ *                 16² and 4² blocks rejected or accepted whole by their corner
+ *                 samples, early-z against per-block farthest depths
+ *   sample        coverage from the integer edge values; depth and barycentrics
+ *                 perspective-correct from the planes of 1/w, t/w and λ/w given by
+ *                 the inverse of the matrix of homogeneous vertices (Olano & Greer,
+ *                 the slides' interpolation matrix)
+ *
+ * The edge values are exact integers, so evaluating them directly (at a tile corner)
+ * or incrementally (along a row) gives the same numbers: 2dr-bin produces the same
+ * visibility buffer as 2dr-bb bit for bit, and a sample on an edge shared by two
+ * triangles is claimed by exactly one of them. */
+#include "rr.h"
+
+#include <string.h>
+
+#define SUBPIX_BITS 8
+#define SUBPIX (1 << SUBPIX_BITS)
+/* Guard band: clip only where the projection leaves ±GUARD_PX pixels around the
+ * screen centre. With screens up to 16384 pixels, snapped coordinates stay below
+ * 2^24, edge coefficients below 2^25 and edge values below 2^51: int64 is exact. */
+#define GUARD_PX 32768.0
+#define MAX_POLY 9 /* a triangle clipped by 5 planes has at most 8 vertices */
+#define MAX_SUB (MAX_POLY - 2)
+#define BATCH 16384 /* triangles set up before they are rasterized */
+#define CHUNK 2048  /* triangles per setup job */
+/* Kernels are specialised by constant flags; the compiler must inline them to do so. */
+#define KERNEL static inline __attribute__((always_inline))
+
+/* ---- vertex stage ---------------------------------------------------------- */
+
+/* The fixed state of the pipeline for one camera and scene. */
+typedef struct pipe2d {
+  double clip[4][4]; /* world → homogeneous clip coordinates: projection × view */
+  double depth[4];   /* world → t, the ray parameter along the camera's unnormalised ray */
+  double kx, ky;     /* guard band in clip units: |x| ≤ kx·w, |y| ≤ ky·w */
+  double hw, hh;     /* half the image size: the viewport transform */
+  int width, height;
+  bool cull;
+} pipe2d;
+
+static void mat4_mul(double r[4][4], const double a[4][4], const double b[4][4]) {
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++) {
+      double s = 0;
+      for (int k = 0; k < 4; k++) s += a[i][k] * b[k][j];
+      r[i][j] = s;
+    }
+}
+
+/* The near plane: tiny against the scene, since 3D rasterization has none; only
+ * geometry closer to the eye than 1e-9 of the scene's diagonal is lost. Depth and
+ * barycentrics do not depend on it (they come from the unclipped triangle). */
+static double near_distance(const rr_scene *s) {
+  double d = v3_len(v3_sub(s->bmax, s->bmin));
+  return d > 0 && isfinite(d) ? 1e-9 * d : 1e-30;
+}
+
+/* Inverse of the 3×3 matrix with columns a, b, c (false when singular). */
+static bool inverse3(const double a[3], const double b[3], const double c[3], double inv[3][3]) {
+  const double *col[3] = {a, b, c};
+  for (int i = 0; i < 3; i++) {
+    const double *u = col[(i + 1) % 3], *v = col[(i + 2) % 3];
+    inv[i][0] = u[1] * v[2] - u[2] * v[1], inv[i][1] = u[2] * v[0] - u[0] * v[2], inv[i][2] = u[0] * v[1] - u[1] * v[0];
+  }
+  double det = a[0] * inv[0][0] + a[1] * inv[0][1] + a[2] * inv[0][2];
+  if (!(det != 0) || !isfinite(det)) return false;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) inv[i][j] /= det;
+  return true;
+}
+
+/* View matrix: world → eye space, x along right, y along up, z along fwd. The
+ * projection inverts the camera's own rays: a point q = w·(d0 + sx·dx + sy·dy) has
+ * homogeneous screen coordinates (sx·w, sy·w, w) = [dx dy d0]⁻¹·q, so every point of
+ * the ray of sample (sx, sy) lands on (sx, sy) exactly, and w is the ray parameter
+ * t. For this orthonormal pinhole it is the usual frustum matrix (x_e/tan_w, y_e/tan_h,
+ * w = z_e). Clip space is OpenGL's for x and y (x/w, y/w in [-1, 1] on screen, y up);
+ * the near plane is z_c = w − near ≥ 0. */
+static bool pipe_setup(pipe2d *pp, const rr_scene *s, const camera *c, bool cull) {
+  /* Only a pinhole projects through a matrix here. An orthographic camera would
+   * invert [ox oy fwd] the same way and keep w_c = 1; curved cameras have no
+   * projection matrix at all. */
+  if (c->type != RR_CAMERA_PERSPECTIVE) return false;
+  vec3 axis[3] = {c->right, c->up, c->fwd};
+  double view[4][4] = {{0}}, proj[4][4] = {{0}};
+  for (int r = 0; r < 3; r++) {
+    double a[3] = {axis[r].x, axis[r].y, axis[r].z};
+    view[r][0] = a[0], view[r][1] = a[1], view[r][2] = a[2];
+    view[r][3] = -(a[0] * c->eye.x + a[1] * c->eye.y + a[2] * c->eye.z);
+  }
+  view[3][3] = 1;
+  /* The camera's dx, dy, d0 in eye space, and the inverse: rows sx·w, sy·w, w. */
+  vec3 d[3] = {c->dx, c->dy, c->d0};
+  double de[3][3], inv[3][3];
+  for (int k = 0; k < 3; k++)
+    for (int r = 0; r < 3; r++) de[k][r] = (double)d[k].x * axis[r].x + (double)d[k].y * axis[r].y + (double)d[k].z * axis[r].z;
+  if (!inverse3(de[0], de[1], de[2], inv)) return false;
+  double hw = 0.5 * c->width, hh = 0.5 * c->height, near = near_distance(s);
+  for (int j = 0; j < 3; j++) {
+    proj[0][j] = inv[0][j] / hw - inv[2][j]; /* x_c = sx·w/hw − w */
+    proj[1][j] = inv[2][j] - inv[1][j] / hh; /* y_c = w − sy·w/hh */
+    proj[2][j] = inv[2][j];                  /* z_c = w − near */
+    proj[3][j] = inv[2][j];                  /* w_c = w = t */
+  }
+  proj[2][3] = -near;
+  mat4_mul(pp->clip, proj, view);
+  /* t, the ray parameter along d = camera_dir(...), is w. */
+  for (int k = 0; k < 4; k++) pp->depth[k] = pp->clip[3][k];
+  pp->width = c->width, pp->height = c->height;
+  pp->hw = hw, pp->hh = hh;
+  pp->kx = GUARD_PX / hw, pp->ky = GUARD_PX / hh;
+  pp->cull = cull;
+  return true;
+}
+
+/* A vertex in clip space and its depth t, which clipping interpolates too. */
+enum { CX, CY, CZ, CW, CT, NCOMP };
+typedef struct cvert {
+  double v[NCOMP];
+} cvert;
+
+static void vertex_stage(const pipe2d *pp, vec3 p, cvert *out) {
+  double h[4] = {p.x, p.y, p.z, 1.0};
+  for (int r = 0; r < 4; r++)
+    out->v[r] = pp->clip[r][0] * h[0] + pp->clip[r][1] * h[1] + pp->clip[r][2] * h[2] + pp->clip[r][3];
+  out->v[CT] = pp->depth[0] * h[0] + pp->depth[1] * h[1] + pp->depth[2] * h[2] + pp->depth[3];
+}
+
+/* ---- clipping -------------------------------------------------------------- */
+
+/* Planes as signed distances, inside when ≥ 0: near, the guard band (clipped), and
+ * the screen's sides (only to reject triangles that are wholly off screen). */
+enum { P_NEAR, P_GUARD_L, P_GUARD_R, P_GUARD_T, P_GUARD_B, P_LEFT, P_RIGHT, P_TOP, P_BOTTOM, NPLANES };
+#define CLIP_PLANES 5
+
+static double plane_dist(const pipe2d *pp, int plane, const double *v) {
+  switch (plane) {
+  case P_NEAR: return v[CZ];
+  case P_GUARD_L: return pp->kx * v[CW] + v[CX];
+  case P_GUARD_R: return pp->kx * v[CW] - v[CX];
+  case P_GUARD_T: return pp->ky * v[CW] - v[CY];
+  case P_GUARD_B: return pp->ky * v[CW] + v[CY];
+  case P_LEFT: return v[CW] + v[CX];
+  case P_RIGHT: return v[CW] - v[CX];
+  case P_TOP: return v[CW] - v[CY];
+  default: return v[CW] + v[CY];
+  }
+}
+
+static unsigned outcode(const pipe2d *pp, const cvert *v) {
+  double x = v->v[CX], y = v->v[CY], w = v->v[CW], gx = pp->kx * w, gy = pp->ky * w;
+  return (unsigned)(v->v[CZ] < 0) << P_NEAR | (unsigned)(gx + x < 0) << P_GUARD_L |
+         (unsigned)(gx - x < 0) << P_GUARD_R | (unsigned)(gy - y < 0) << P_GUARD_T |
+         (unsigned)(gy + y < 0) << P_GUARD_B | (unsigned)(w + x < 0) << P_LEFT | (unsigned)(w - x < 0) << P_RIGHT |
+         (unsigned)(w - y < 0) << P_TOP | (unsigned)(w + y < 0) << P_BOTTOM;
+}
+
+/* Sutherland–Hodgman against one plane. A new vertex is interpolated from the
+ * edge's inside end towards its outside end, whichever way the polygon runs the
+ * edge, so the two triangles of a shared edge make bit-identical vertices. */
+static int clip_plane(const pipe2d *pp, int plane, const cvert *in, int n, cvert *out) {
+  int m = 0;
+  for (int k = 0; k < n; k++) {
+    const cvert *a = &in[k], *b = &in[(k + 1) % n];
+    double da = plane_dist(pp, plane, a->v), db = plane_dist(pp, plane, b->v);
+    if (da >= 0) out[m++] = *a;
+    if ((da >= 0) != (db >= 0)) {
+      const cvert *i = da >= 0 ? a : b, *o = da >= 0 ? b : a;
+      double di = da >= 0 ? da : db, dout = da >= 0 ? db : da;
+      double s = di / (di - dout);
+      for (int c = 0; c < NCOMP; c++) out[m].v[c] = i->v[c] + s * (o->v[c] - i->v[c]);
+      m++;
+    }
+  }
+  return m;
+}
+
+/* ---- triangle setup -------------------------------------------------------- */
+
+/* A (sub-)triangle ready for rasterization. Coverage: edge i (opposite vertex i) is
+ * E_i(X, Y) = a[i]·X + b[i]·Y + c[i] at fixed-point sample position (X, Y), positive
+ * inside whichever way the triangle faces; c is biased by −1 on edges that do not
+ * own their samples, so a sample is covered when E_0, E_1, E_2 ≥ 0. Interpolation:
+ * planes (value at the sample of pixel (rect[0], rect[1]), d/dx, d/dy) of 1/w, t/w,
+ * λ1/w and λ2/w of the original triangle. */
+typedef struct tri2d {
+  int64_t c[3];
+  int32_t a[3], b[3];
+  float pw[3], pt[3], p1[3], p2[3];
+  float tmin, tmax; /* depth range of the (sub-)triangle: interpolated depths are clamped to it */
+  int16_t rect[4];  /* inclusive sample rectangle on screen */
+  uint32_t id;
+  bool back;        /* seen from behind */
+} tri2d;
+
+/* The original triangle's interpolation planes at the screen origin: with the
+ * homogeneous screen positions (X, Y, W) = (sx·w, sy·w, w) of its vertices as the
+ * columns of M, M⁻¹·(sx, sy, 1) = (λ0, λ1, λ2)/w at every sample. Row i of M⁻¹ is
+ * the cross product of the other two columns over det M. No division by w: the
+ * planes stay exact for vertices behind the eye or at the near plane. */
+typedef struct planes {
+  double w[3], t[3], l1[3], l2[3];
+} planes;
+
+static bool interpolation_planes(const pipe2d *pp, const cvert v[3], planes *pl) {
+  double col[3][3];
+  for (int k = 0; k < 3; k++) {
+    col[k][0] = (v[k].v[CX] + v[k].v[CW]) * pp->hw;
+    col[k][1] = (v[k].v[CW] - v[k].v[CY]) * pp->hh;
+    col[k][2] = v[k].v[CW];
+  }
+  double r[3][3];
+  for (int i = 0; i < 3; i++) {
+    const double *a = col[(i + 1) % 3], *b = col[(i + 2) % 3];
+    r[i][0] = a[1] * b[2] - a[2] * b[1], r[i][1] = a[2] * b[0] - a[0] * b[2], r[i][2] = a[0] * b[1] - a[1] * b[0];
+  }
+  double det = col[0][0] * r[0][0] + col[0][1] * r[0][1] + col[0][2] * r[0][2];
+  if (!(det != 0) || !isfinite(det)) return false; /* the triangle's plane holds the eye */
+  /* M⁻¹ has rows r_i/det with columns (coefficient of sx, of sy, constant). */
+  for (int j = 0; j < 3; j++) {
+    double r0 = r[0][j] / det, r1 = r[1][j] / det, r2 = r[2][j] / det;
+    pl->w[j] = r0 + r1 + r2;
+    pl->t[j] = v[0].v[CT] * r0 + v[1].v[CT] * r1 + v[2].v[CT] * r2;
+    pl->l1[j] = r1, pl->l2[j] = r2;
+  }
+  return true;
+}
+
+/* A plane re-referenced to the sample (x + 0.5, y + 0.5), where float keeps the
+ * most precision for the triangle's own samples. */
+static void plane_at(const double p[3], int x, int y, float out[3]) {
+  out[0] = (float)(p[2] + p[0] * (x + 0.5) + p[1] * (y + 0.5));
+  out[1] = (float)p[0], out[2] = (float)p[1];
+}
+
+static int64_t floor_div(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+/* Viewport transform and snapping to 8 sub-pixel bits (round half away from zero). */
+static void snap(const pipe2d *pp, const cvert *c, int64_t *x, int64_t *y) {
+  double iw = 1.0 / c->v[CW];
+  double sx = (c->v[CX] * iw * pp->hw + pp->hw) * SUBPIX, sy = (pp->hh - c->v[CY] * iw * pp->hh) * SUBPIX;
+  *x = (int64_t)(sx >= 0 ? sx + 0.5 : sx - 0.5);
+  *y = (int64_t)(sy >= 0 ? sy + 0.5 : sy - 0.5);
+}
+
+/* Sets up one (sub-)triangle of snapped vertices; false when it covers no sample
+ * (degenerate after snapping, culled, or between sample centres). */
+static bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], const double depth[3],
+                      const planes *pl, uint32_t id, tri2d *t) {
+  /* Twice the signed area, y down: negative for a triangle that is counter-clockwise
+   * as the viewer sees it, the front face (as tri_setup_planar decides it). */
+  int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+  if (area == 0) return false;
+  t->back = area > 0;
+  if (t->back && pp->cull) return false;
+  /* The samples (x + 0.5, y + 0.5) inside the snapped vertices' bounds. */
+  int64_t x0 = X[0], x1 = X[0], y0 = Y[0], y1 = Y[0];
+  for (int k = 1; k < 3; k++) {
+    x0 = X[k] < x0 ? X[k] : x0, x1 = X[k] > x1 ? X[k] : x1;
+    y0 = Y[k] < y0 ? Y[k] : y0, y1 = Y[k] > y1 ? Y[k] : y1;
+  }
+  x0 = -floor_div(SUBPIX / 2 - x0, SUBPIX), y0 = -floor_div(SUBPIX / 2 - y0, SUBPIX);
+  x1 = floor_div(x1 - SUBPIX / 2, SUBPIX), y1 = floor_div(y1 - SUBPIX / 2, SUBPIX);
+  if (x0 < 0) x0 = 0;
+  if (y0 < 0) y0 = 0;
+  if (x1 > pp->width - 1) x1 = pp->width - 1;
+  if (y1 > pp->height - 1) y1 = pp->height - 1;
+  if (x0 > x1 || y0 > y1) return false;
+  t->rect[0] = (int16_t)x0, t->rect[1] = (int16_t)y0, t->rect[2] = (int16_t)x1, t->rect[3] = (int16_t)y1;
+  int64_t sign = area > 0 ? 1 : -1;
+  for (int i = 0; i < 3; i++) {
+    int p = (i + 1) % 3, q = (i + 2) % 3;
+    int64_t a = -(Y[q] - Y[p]) * sign, b = (X[q] - X[p]) * sign;
+    t->a[i] = (int32_t)a, t->b[i] = (int32_t)b;
+    t->c[i] = -(a * X[p] + b * Y[p]);
+    /* Top-left rule: a sample on the edge belongs to the triangle whose inside
+     * lies to its right (a > 0), or below for a horizontal edge (b > 0). */
+    if (!(a > 0 || (a == 0 && b > 0))) t->c[i] -= 1;
+  }
+  plane_at(pl->w, (int)x0, (int)y0, t->pw);
+  plane_at(pl->t, (int)x0, (int)y0, t->pt);
+  plane_at(pl->l1, (int)x0, (int)y0, t->p1);
+  plane_at(pl->l2, (int)x0, (int)y0, t->p2);
+  /* Depth is linear on the triangle, so its range is that of the vertices. The
+   * clamp also makes early-z exact: no sample of the triangle is nearer than tmin. */
+  t->tmin = (float)fmin(depth[0], fmin(depth[1], depth[2]));
+  t->tmax = (float)fmax(depth[0], fmax(depth[1], depth[2]));
+  t->id = id;
+  return true;
+}
+
+/* Vertex stage, clipping and setup of scene triangle i; appends up to MAX_SUB
+ * set-up triangles to out and returns their number. *setups counts the triangles
+ * that reached setup. */
+static int setup_scene_tri(const pipe2d *pp, const rr_scene *s, uint32_t i, tri2d *out, uint64_t *setups) {
+  cvert poly[2][MAX_POLY];
+  unsigned all = ~0u, any = 0;
+  for (int k = 0; k < 3; k++) {
+    vertex_stage(pp, scene_vertex(s, k, i), &poly[0][k]);
+    unsigned code = outcode(pp, &poly[0][k]);
+    all &= code, any |= code;
+  }
+  if (all) return 0; /* wholly beyond one plane: off screen or behind the near plane */
+  planes pl;
+  if (!interpolation_planes(pp, poly[0], &pl)) return 0;
+  int n = 3, cur = 0;
+  for (int p = 0; p < CLIP_PLANES && n >= 3; p++) {
+    if (!(any & (1u << p))) continue;
+    n = clip_plane(pp, p, poly[cur], n, poly[cur ^ 1]);
+    cur ^= 1;
+  }
+  int64_t X[MAX_POLY], Y[MAX_POLY];
+  for (int k = 0; k < n; k++) snap(pp, &poly[cur][k], &X[k], &Y[k]);
+  /* A fan over the clipped polygon; its inner edges are shared by consecutive
+   * triangles and the fill rule gives each of their samples to one of them. */
+  int m = 0;
+  for (int k = 1; k + 1 < n; k++) {
+    int64_t tx[3] = {X[0], X[k], X[k + 1]}, ty[3] = {Y[0], Y[k], Y[k + 1]};
+    double depth[3] = {poly[cur][0].v[CT], poly[cur][k].v[CT], poly[cur][k + 1].v[CT]};
+    ++*setups;
+    if (setup_tri(pp, tx, ty, depth, &pl, i, &out[m])) m++;
+  }
+  return m;
+}
+
+/* ---- the per-sample kernel --------------------------------------------------- */
+
+/* Where samples go: the visibility buffer (depth test), or, for the watertightness
+ * tests, a count of every triangle that claims each sample. */
+typedef struct target {
+  visbuf *vb;
+  uint8_t *front, *back;
+} target;
+
+/* Shades covered sample k at (dx, dy) pixels from the triangle's reference sample;
+ * qr, tr, r1, r2: the planes' values at the start of the row. count: claims mode. */
+KERNEL bool shade2d(const tri2d *t, float dx, float qr, float tr, float r1, float r2, const target *tg, size_t k,
+                    const bool count) {
+  if (count) {
+    uint8_t *claims = t->back ? tg->back : tg->front;
+    claims[k]++;
+    return true;
+  }
+  float w = 1.0f / (qr + dx * t->pw[1]);
+  float depth = (tr + dx * t->pt[1]) * w;
+  depth = depth < t->tmin ? t->tmin : depth > t->tmax ? t->tmax : depth;
+  visbuf *vb = tg->vb;
+  if (!depth_wins(depth, t->id, vb->t[k], vb->id[k])) return false;
+  vb->t[k] = depth;
+  vb->id[k] = t->id;
+  vb->l1[k] = (r1 + dx * t->p1[1]) * w;
+  vb->l2[k] = (r2 + dx * t->p2[1]) * w;
+  return true;
+}
+
+/* Samples x0..x1 of row y, stepping the edge values in integers. test: check
+ * coverage (off inside an accepted block). Returns true when a sample was written. */
+KERNEL bool raster_row(const tri2d *t, int x0, int x1, int y, const target *tg, const bool test, const bool count) {
+  int64_t px = (int64_t)x0 * SUBPIX + SUBPIX / 2, py = (int64_t)y * SUBPIX + SUBPIX / 2;
+  int64_t e0 = t->a[0] * px + t->b[0] * py + t->c[0];
+  int64_t e1 = t->a[1] * px + t->b[1] * py + t->c[1];
+  int64_t e2 = t->a[2] * px + t->b[2] * py + t->c[2];
+  int64_t s0 = (int64_t)t->a[0] * SUBPIX, s1 = (int64_t)t->a[1] * SUBPIX, s2 = (int64_t)t->a[2] * SUBPIX;
+  /* Planes evaluated directly at each sample (not stepped), so every traversal
+   * computes the same bits for the same sample. */
+  float dy = (float)(y - t->rect[1]);
+  float qr = t->pw[0] + dy * t->pw[2], tr = t->pt[0] + dy * t->pt[2];
+  float r1 = t->p1[0] + dy * t->p1[2], r2 = t->p2[0] + dy * t->p2[2];
+  size_t k = (size_t)y * (size_t)tg->vb->width + (size_t)x0;
+  bool wrote = false;
+  for (int x = x0; x <= x1; x++, k++, e0 += s0, e1 += s1, e2 += s2)
+    if (!test || (e0 | e1 | e2) >= 0)
+      wrote |= shade2d(t, (float)(x - t->rect[0]), qr, tr, r1, r2, tg, k, count);
+  return wrote;
+}
+
+/* ---- 2dr-bb ------------------------------------------------------------------ */
+
+KERNEL uint64_t raster_bb(const tri2d *t, int y0, int y1, const target *tg, const bool count) {
+  for (int y = y0; y <= y1; y++) raster_row(t, t->rect[0], t->rect[2], y, tg, true, count);
+  return (uint64_t)(t->rect[2] - t->rect[0] + 1) * (uint64_t)(y1 - y0 + 1);
+}
+
+/* ---- 2dr-bin: hierarchical binning and early-z --------------------------------- */
+
+/* Block sizes by level: 4², 16², 64² samples (a level-2 block is a tile). */
+#define LEVELS 3
+static inline int block_size(int level) { return 4 << (2 * level); }
+
+/* Farthest stored depth per block, at each level. Level 0 is exact after every
+ * write; levels 1 and 2 are recomputed from their children when marked dirty. A
+ * block with a miss has +inf. */
+typedef struct hiz {
+  int w[LEVELS], h[LEVELS];
+  float *zmax[LEVELS];
+  uint8_t *dirty[LEVELS];
+} hiz;
+
+static void hiz_free(hiz *h) {
+  for (int l = 0; l < LEVELS; l++) free(h->zmax[l]), free(h->dirty[l]);
+}
+
+static bool hiz_alloc(hiz *h, int width, int height) {
+  memset(h, 0, sizeof *h);
+  bool ok = true;
+  for (int l = 0; l < LEVELS; l++) {
+    int s = block_size(l);
+    h->w[l] = (width + s - 1) / s, h->h[l] = (height + s - 1) / s;
+    size_t n = (size_t)h->w[l] * h->h[l];
+    h->zmax[l] = malloc(n * sizeof(float));
+    h->dirty[l] = calloc(n, 1);
+    if (!h->zmax[l] || !h->dirty[l]) ok = false;
+    else
+      for (size_t k = 0; k < n; k++) h->zmax[l][k] = INFINITY;
+  }
+  if (!ok) hiz_free(h);
+  return ok;
+}
+
+static float hiz_get(hiz *h, int l, int i, int j) {
+  size_t k = (size_t)j * h->w[l] + i;
+  if (l > 0 && h->dirty[l][k]) {
+    float m = -INFINITY;
+    for (int cj = 4 * j; cj < 4 * j + 4 && cj < h->h[l - 1]; cj++)
+      for (int ci = 4 * i; ci < 4 * i + 4 && ci < h->w[l - 1]; ci++) {
+        float z = hiz_get(h, l - 1, ci, cj);
+        m = z > m ? z : m;
+      }
+    h->zmax[l][k] = m;
+    h->dirty[l][k] = 0;
+  }
+  return h->zmax[l][k];
+}
+
+/* Recomputes the level-0 blocks over samples [x0, x1] × [y0, y1]. */
+static void hiz_update(hiz *h, const visbuf *vb, int x0, int y0, int x1, int y1) {
+  for (int j = y0 >> 2; j <= y1 >> 2; j++)
+    for (int i = x0 >> 2; i <= x1 >> 2; i++) {
+      float m = -INFINITY;
+      int ye = 4 * j + 4 < vb->height ? 4 * j + 4 : vb->height, xe = 4 * i + 4 < vb->width ? 4 * i + 4 : vb->width;
+      for (int y = 4 * j; y < ye; y++)
+        for (int x = 4 * i; x < xe; x++) {
+          float z = vb->t[(size_t)y * vb->width + x];
+          m = z > m ? z : m;
+        }
+      size_t k = (size_t)j * h->w[0] + i;
+      if (m < h->zmax[0][k]) {
+        h->zmax[0][k] = m;
+        h->dirty[1][(size_t)(j >> 2) * h->w[1] + (i >> 2)] = 1;
+        h->dirty[2][(size_t)(j >> 4) * h->w[2] + (i >> 4)] = 1;
+      }
+    }
+}
+
+typedef struct bin_ctx {
+  const target *tg;
+  hiz *hz; /* NULL in claims mode */
+  uint64_t evals;
+} bin_ctx;
+
+/* One block of `level` with top-left sample (bx, by): skipped when the triangle is
+ * behind everything stored there, rejected when one edge is negative at all of its
+ * corner samples, accepted when every edge is non-negative at all of them, else
+ * split (or tested sample by sample at level 0). Linear functions take their
+ * extremes over a rectangle of samples at its corners, and the integer values make
+ * these tests exact. */
+static void bin_block_z(const tri2d *t, int level, int bx, int by, bin_ctx *bc);
+static void bin_block_claims(const tri2d *t, int level, int bx, int by, bin_ctx *bc);
+
+KERNEL void bin_block(const tri2d *t, int level, int bx, int by, bin_ctx *bc, const bool count) {
+  const visbuf *vb = bc->tg->vb;
+  int s = block_size(level);
+  if (!count && t->tmin > hiz_get(bc->hz, level, bx / s, by / s)) return;
+  int ex = bx + s - 1 < vb->width - 1 ? bx + s - 1 : vb->width - 1;
+  int ey = by + s - 1 < vb->height - 1 ? by + s - 1 : vb->height - 1;
+  int64_t px = (int64_t)bx * SUBPIX + SUBPIX / 2, py = (int64_t)by * SUBPIX + SUBPIX / 2;
+  int64_t dx = (int64_t)(ex - bx) * SUBPIX, dy = (int64_t)(ey - by) * SUBPIX;
+  bool accept = true;
+  for (int i = 0; i < 3; i++) {
+    int64_t e = t->a[i] * px + t->b[i] * py + t->c[i];
+    int64_t ax = t->a[i] * dx, by_ = t->b[i] * dy;
+    int64_t hi = e + (ax > 0 ? ax : 0) + (by_ > 0 ? by_ : 0), lo = e + (ax < 0 ? ax : 0) + (by_ < 0 ? by_ : 0);
+    if (hi < 0) {
+      bc->evals += 4;
+      return;
+    }
+    accept &= lo >= 0;
+  }
+  bc->evals += 4; /* counted as the four corners, as 3dr-bin counts a bin */
+  int x0 = bx, y0 = by, x1 = ex, y1 = ey;
+  bool wrote = false;
+  if (accept) {
+    for (int y = y0; y <= y1; y++) wrote |= raster_row(t, x0, x1, y, bc->tg, false, count);
+  } else if (level == 0) {
+    x0 = x0 > t->rect[0] ? x0 : t->rect[0], x1 = x1 < t->rect[2] ? x1 : t->rect[2];
+    y0 = y0 > t->rect[1] ? y0 : t->rect[1], y1 = y1 < t->rect[3] ? y1 : t->rect[3];
+    for (int y = y0; y <= y1; y++) wrote |= raster_row(t, x0, x1, y, bc->tg, true, count);
+  } else {
+    /* children that meet the triangle's rectangle */
+    int c = block_size(level - 1);
+    int cx0 = t->rect[0] > bx ? bx + (t->rect[0] - bx) / c * c : bx;
+    int cy0 = t->rect[1] > by ? by + (t->rect[1] - by) / c * c : by;
+    int cx1 = t->rect[2] < ex ? t->rect[2] : ex, cy1 = t->rect[3] < ey ? t->rect[3] : ey;
+    for (int cy = cy0; cy <= cy1; cy += c)
+      for (int cx = cx0; cx <= cx1; cx += c) {
+        if (count) bin_block_claims(t, level - 1, cx, cy, bc);
+        else bin_block_z(t, level - 1, cx, cy, bc);
+      }
+    return;
+  }
+  bc->evals += (uint64_t)(x1 - x0 + 1) * (uint64_t)(y1 - y0 + 1);
+  if (!count && wrote) hiz_update(bc->hz, vb, x0, y0, x1, y1);
+}
+
+static void bin_block_z(const tri2d *t, int level, int bx, int by, bin_ctx *bc) {
+  bin_block(t, level, bx, by, bc, false);
+}
+
+static void bin_block_claims(const tri2d *t, int level, int bx, int by, bin_ctx *bc) {
+  bin_block(t, level, bx, by, bc, true);
+}
+
+/* The blocks of rows y0..y1 (a tile-aligned band) that meet a triangle's rectangle.
+ * The hierarchy starts at the smallest block that holds the whole rectangle: a
+ * larger one could not reject more samples, nor cull more by depth (a block's
+ * farthest depth is at most its parent's). */
+KERNEL void raster_bin(const tri2d *t, int y0, int y1, bin_ctx *bc, const bool count) {
+  int ry0 = y0 > t->rect[1] ? y0 : t->rect[1], ry1 = y1 < t->rect[3] ? y1 : t->rect[3];
+  int level = 0;
+  while (level < LEVELS - 1 &&
+         (t->rect[0] / block_size(level) != t->rect[2] / block_size(level) || ry0 / block_size(level) != ry1 / block_size(level)))
+    level++;
+  const int s = block_size(level);
+  for (int by = ry0 / s * s; by <= ry1; by += s)
+    for (int bx = t->rect[0] / s * s; bx <= t->rect[2]; bx += s) bin_block(t, level, bx, by, bc, count);
+}
+
+/* ---- the pass: batches of setups, then bands of rows ------------------------- */
+
+typedef struct job2d {
+  const rr_scene *scene;
+  const pipe2d *pp;
+  bool bin;
+  target tg;
+  hiz *hz;
+  uint32_t first, count; /* the triangles of the current batch */
+  tri2d *tris;           /* setup job j writes from tris[j * CHUNK * MAX_SUB] */
+  uint32_t ntris[BATCH / CHUNK];
+  int band_rows;
+  uint64_t setups[256], evals[256];
+} job2d;
+
+static void setup_job(int j, int thread, void *arg) {
+  job2d *job = arg;
+  uint32_t i0 = job->first + (uint32_t)j * CHUNK, i1 = i0 + CHUNK;
+  if (i1 > job->first + job->count) i1 = job->first + job->count;
+  tri2d *out = job->tris + (size_t)j * CHUNK * MAX_SUB;
+  uint32_t n = 0;
+  uint64_t setups = 0;
+  for (uint32_t i = i0; i < i1; i++) n += setup_scene_tri(job->pp, job->scene, i, out + n, &setups);
+  job->ntris[j] = n;
+  job->setups[thread] += setups;
+}
+
+KERNEL void band_loop(job2d *job, int y0, int y1, int thread, const bool bin, const bool count) {
+  bin_ctx bc = {.tg = &job->tg, .hz = job->hz};
+  uint64_t evals = 0;
+  int nchunks = (int)((job->count + CHUNK - 1) / CHUNK);
+  for (int j = 0; j < nchunks; j++) {
+    const tri2d *tris = job->tris + (size_t)j * CHUNK * MAX_SUB;
+    for (uint32_t k = 0; k < job->ntris[j]; k++) {
+      const tri2d *t = &tris[k];
+      if (t->rect[3] < y0 || t->rect[1] > y1) continue;
+      if (bin) raster_bin(t, y0, y1, &bc, count);
+      else evals += raster_bb(t, y0 > t->rect[1] ? y0 : t->rect[1], y1 < t->rect[3] ? y1 : t->rect[3], &job->tg, count);
+    }
+  }
+  job->evals[thread] += evals + bc.evals;
+}
+
+/* One band of rows: its own samples and blocks, so no sample has two writers. */
+static void band_job(int band, int thread, void *arg) {
+  job2d *job = arg;
+  int y0 = band * job->band_rows, y1 = y0 + job->band_rows - 1;
+  if (y1 > job->tg.vb->height - 1) y1 = job->tg.vb->height - 1;
+  bool count = job->tg.front != NULL;
+  if (job->bin) {
+    if (count) band_loop(job, y0, y1, thread, true, true);
+    else band_loop(job, y0, y1, thread, true, false);
+  } else {
+    if (count) band_loop(job, y0, y1, thread, false, true);
+    else band_loop(job, y0, y1, thread, false, false);
+  }
+}
+
+static rr_error run2d(rr_device *dev, const rr_scene *s, const camera *c, bool cull, bool bin, int threads,
+                      target tg, rr_stats *stats) {
+  pipe2d pp;
+  if (!pipe_setup(&pp, s, c, cull))
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED, "2D rasterization needs a perspective camera");
+  job2d *job = calloc(1, sizeof *job);
+  tri2d *tris = malloc((size_t)BATCH * MAX_SUB * sizeof *tris);
+  hiz hz;
+  memset(&hz, 0, sizeof hz);
+  bool need_hiz = bin && !tg.front;
+  if (!job || !tris || (need_hiz && !hiz_alloc(&hz, c->width, c->height))) {
+    free(job), free(tris);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for 2D rasterization");
+  }
+  *job = (job2d){.scene = s, .pp = &pp, .bin = bin, .tg = tg, .hz = need_hiz ? &hz : NULL, .tris = tris};
+  /* Bands are whole tiles; one band when one thread. */
+  const int tile = block_size(LEVELS - 1);
+  int bands = threads > 1 ? 4 * threads : 1;
+  job->band_rows = (c->height + bands - 1) / bands;
+  job->band_rows = (job->band_rows + tile - 1) / tile * tile;
+  bands = (c->height + job->band_rows - 1) / job->band_rows;
+  for (uint32_t first = 0; first < s->ntris; first += BATCH) {
+    job->first = first;
+    job->count = s->ntris - first < BATCH ? s->ntris - first : BATCH;
+    parallel_for((int)((job->count + CHUNK - 1) / CHUNK), threads, setup_job, job);
+    parallel_for(bands, threads, band_job, job);
+  }
+  for (int t = 0; t < 256; t++) stats->setups += job->setups[t], stats->edge_evals += job->evals[t];
+  if (need_hiz) hiz_free(&hz);
+  free(tris), free(job);
+  return RR_OK;
+}
+
+rr_error vis_2dr_bb(rr_device *dev, render_ctx *ctx) {
+  target tg = {.vb = ctx->vb};
+  return run2d(dev, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, false, ctx->threads, tg, ctx->stats);
+}
+
+rr_error vis_2dr_bin(rr_device *dev, render_ctx *ctx) {
+  target tg = {.vb = ctx->vb};
+  return run2d(dev, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, true, ctx->threads, tg, ctx->stats);
+}
+
+rr_error raster2d_claims(const rr_scene *s, const camera *c, bool bin, int threads, uint8_t *front, uint8_t *back) {
+  size_t n = (size_t)c->width * c->height;
+  memset(front, 0, n), memset(back, 0, n);
+  visbuf vb = {.width = c->width, .height = c->height};
+  target tg = {.vb = &vb, .front = front, .back = back};
+  rr_stats st = {0};
+  return run2d(NULL, s, c, false, bin, threads < 1 ? 1 : threads, tg, &st);
+}
+
+bool raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, double *sy) {
+  pipe2d pp;
+  if (!pipe_setup(&pp, s, c, false)) return false;
+  cvert v;
+  vertex_stage(&pp, p, &v);
+  if (v.v[CZ] < 0) return false;
+  *sx = v.v[CX] / v.v[CW] * pp.hw + pp.hw;
+  *sy = pp.hh - v.v[CY] / v.v[CW] * pp.hh;
+  return true;
+}
