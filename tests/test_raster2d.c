@@ -1,0 +1,403 @@
+/* The 2D pipeline (2dr-bb, 2dr-bin): its projection maps the camera's pixel
+ * centres; its fill rule claims every sample of a closed or tessellated surface
+ * exactly once, through clipping and for both traversals; 2dr-bin equals 2dr-bb bit
+ * for bit on any thread count; and it agrees with 3D rasterization (3dr-bb) where
+ * snapping allows: near and across the eye plane, behind it, on huge triangles,
+ * inside closed meshes, and on real meshes. */
+#include "rr.h"
+#include "testutil.h"
+
+#include <string.h>
+
+static rr_device *dev;
+
+static rr_camera pub_camera(vec3 eye, vec3 target, vec3 up, float fov) {
+  rr_camera rc;
+  rr_camera_init(&rc);
+  memcpy(rc.eye, &eye, 12), memcpy(rc.target, &target, 12), memcpy(rc.up, &up, 12);
+  rc.fov_deg = fov;
+  return rc;
+}
+
+static camera make_cam(vec3 eye, vec3 target, vec3 up, float fov, int w, int h) {
+  rr_camera rc = pub_camera(eye, target, up, fov);
+  camera c;
+  rr_error e = camera_setup(dev, &rc, w, h, &c);
+  CHECK(e == RR_OK, "camera: %s", rr_device_message(dev));
+  return c;
+}
+
+static rr_frame *render(const rr_scene *s, const rr_camera *cam, rr_method m, int threads, int w, int h, int cull) {
+  rr_render_options opt;
+  rr_render_options_init(&opt);
+  opt.method = m, opt.width = w, opt.height = h, opt.threads = threads, opt.cull_backfaces = cull;
+  rr_frame *f = NULL;
+  rr_error e = rr_render(dev, s, cam, &opt, &f);
+  CHECK(e == RR_OK, "render %s: %s", rr_method_name(m), rr_device_message(dev));
+  return f;
+}
+
+static rr_scene *load(const char *name) {
+  rr_scene *s = NULL;
+  if (rr_scene_load(dev, name, &s) != RR_OK) {
+    CHECK(0, "load %s: %s", name, rr_device_message(dev));
+    return NULL;
+  }
+  return s;
+}
+
+/* ---- projection ------------------------------------------------------------------ */
+
+/* A point anywhere on the ray of sample (sx, sy) must project back to (sx, sy), up
+ * to the rounding of the test point itself: a few float ulps across the ray, which
+ * the image plane magnifies to |d|²/(d·fwd)/|dx| · 2^-23 pixels. The eye sits at the origin so that adding it
+ * rounds nothing. */
+static void check_projection(const rr_scene *s) {
+  double worst = 0, worst_px = 0;
+  for (int v = 0; v < 50; v++) {
+    vec3 eye = v3(0, 0, 0), target = v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1));
+    int w = 64 + (int)(test_rand() % 1000), h = 64 + (int)(test_rand() % 1000);
+    camera c = make_cam(eye, target, v3(test_randf(-1, 1), 1, test_randf(-1, 1)), test_randf(10, 150), w, h);
+    for (int k = 0; k < 20; k++) {
+      int x = (int)(test_rand() % (unsigned)w), y = (int)(test_rand() % (unsigned)h);
+      vec3 d = camera_dir(&c, x + 0.5f, y + 0.5f);
+      vec3 p = v3_add(c.eye, v3_scale(d, test_randf(0.1f, 20)));
+      double sx, sy;
+      bool ok = raster2d_project(s, &c, p, &sx, &sy);
+      CHECK(ok, "a point in front of the eye is behind the near plane");
+      if (!ok) continue;
+      double err = fmax(fabs(sx - (x + 0.5)), fabs(sy - (y + 0.5)));
+      double ulp_px = v3_dot(d, d) / v3_dot(d, c.fwd) / fmin(v3_len(c.dx), v3_len(c.dy)) * 0x1p-23;
+      worst = fmax(worst, err / ulp_px), worst_px = fmax(worst_px, err);
+    }
+  }
+  printf("projection: worst distance from the pixel centre %.2e pixels, %.2f float ulps of the ray\n", worst_px,
+         worst);
+  CHECK(worst < 4, "points on a pixel's ray land %.2f ulps of the ray from its centre", worst);
+}
+
+/* ---- fill rule: every claim counted ---------------------------------------------- */
+
+/* mode 0: every sample claimed exactly once; mode 1 (the plane y = 0): samples whose
+ * hit lies inside the plane by more than 1/64 pixel claimed exactly once, none
+ * twice; mode 2 (closed mesh from outside): as many front as back claims, none twice. */
+static void check_claims(const rr_scene *s, const camera *c, int mode, const char *what) {
+  size_t n = (size_t)c->width * c->height;
+  uint8_t *front = malloc(n), *back = malloc(n);
+  for (int run = 0; run < 3; run++) {
+    bool bin = run > 0;
+    int threads = run == 2 ? 3 : 1;
+    rr_error e = raster2d_claims(s, c, bin, threads, front, back);
+    CHECK(e == RR_OK, "claims: %s", rr_device_message(dev));
+    int holes = 0, doubles = 0, unequal = 0;
+    for (size_t k = 0; k < n; k++) {
+      int total = front[k] + back[k];
+      if (mode == 0) {
+        holes += total == 0, doubles += total > 1;
+      } else if (mode == 1) {
+        doubles += total > 1;
+        int x = (int)(k % c->width), y = (int)(k / c->width);
+        vec3 d = camera_dir(c, x + 0.5f, y + 0.5f);
+        double t = -(double)c->eye.y / d.y;
+        double hx = c->eye.x + t * d.x, hz = c->eye.z + t * d.z;
+        double half = 0.5 * sqrt((double)s->ntris / 2);
+        double margin = t * fmax(v3_len(c->dx), v3_len(c->dy)) * v3_len(d) / fabs(d.y) / 64;
+        if (t > 0 && fabs(hx) < half - margin && fabs(hz) < half - margin) holes += total == 0;
+      } else {
+        doubles += front[k] > 1 || back[k] > 1;
+        unequal += front[k] != back[k];
+      }
+    }
+    CHECK(holes == 0 && doubles == 0 && unequal == 0,
+          "%s (%s, %d threads): %d holes, %d double claims, %d rays entering and leaving unequally", what,
+          bin ? "2dr-bin" : "2dr-bb", threads, holes, doubles, unequal);
+  }
+  free(front), free(back);
+}
+
+static void check_fill_rule(void) {
+  rr_scene *plane = load("plane:64"), *sphere = load("sphere:48"), *box = load("box:8");
+  if (!plane || !sphere || !box) return;
+  /* Straight down on the plane with pixel centres exactly on the vertices, then on
+   * the edges, then random oblique views. */
+  camera c = make_cam(v3(-0.5f, 32, -0.5f), v3(-0.5f, 0, -0.5f), v3(0, 0, -1), 90, 64, 64);
+  check_claims(plane, &c, 0, "plane, pixel centres on vertices");
+  c = make_cam(v3(0, 32, -0.5f), v3(0, 0, -0.5f), v3(0, 0, -1), 90, 64, 64);
+  check_claims(plane, &c, 1, "plane, pixel centres on edges");
+  for (int v = 0; v < 6; v++) {
+    vec3 eye = v3(test_randf(-20, 20), test_randf(2, 30), test_randf(-20, 20));
+    vec3 target = v3(test_randf(-10, 10), 0, test_randf(-10, 10));
+    c = make_cam(eye, target, v3(0, 1, 0), test_randf(30, 100), 96, 72);
+    check_claims(plane, &c, 1, "plane, random view");
+  }
+  /* Low over the plane: triangles cross the eye plane and the guard band. */
+  for (int v = 0; v < 4; v++) {
+    vec3 eye = v3(test_randf(-5, 5), test_randf(0.05f, 0.5f), test_randf(-5, 5));
+    vec3 target = v3(test_randf(-10, 10), test_randf(-1, 0.2f), test_randf(-10, 10));
+    c = make_cam(eye, target, v3(0, 1, 0), test_randf(60, 120), 96, 72);
+    check_claims(plane, &c, 1, "plane, low view across the eye plane");
+  }
+  /* Inside the closed box and sphere: every sample claimed exactly once, although
+   * the walls beside the eye are clipped at the near plane and the guard band. */
+  c = make_cam(v3(-0.015625f, 0.015625f, 0), v3(-0.015625f, 0.015625f, -1), v3(0, 1, 0), 90, 64, 64);
+  check_claims(box, &c, 0, "inside box, centres on vertices");
+  for (int v = 0; v < 6; v++) {
+    const rr_scene *s = v & 1 ? sphere : box;
+    vec3 eye = v3(test_randf(-0.4f, 0.4f), test_randf(-0.4f, 0.4f), test_randf(-0.4f, 0.4f));
+    vec3 target = v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1));
+    c = make_cam(eye, target, v3(test_randf(-1, 1), 1, test_randf(-1, 1)), test_randf(40, 150), 80, 60);
+    check_claims(s, &c, 0, v & 1 ? "inside sphere" : "inside box");
+  }
+  for (int v = 0; v < 6; v++) {
+    const rr_scene *s = v & 1 ? sphere : box;
+    vec3 eye = v3_scale(v3_norm(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1))), test_randf(2, 5));
+    c = make_cam(eye, v3(0, 0, 0), v3(0, 1, 0), test_randf(30, 70), 80, 60);
+    check_claims(s, &c, 2, v & 1 ? "sphere from outside" : "box from outside");
+  }
+  rr_scene_release(plane), rr_scene_release(sphere), rr_scene_release(box);
+}
+
+/* ---- agreement with 2dr-bb (bitwise) and 3dr-bb (within snapping) ----------------- */
+
+static int bitwise_diff(const rr_frame *a, const rr_frame *b) {
+  size_t n = (size_t)a->vb.width * a->vb.height;
+  int d = 0;
+  for (size_t k = 0; k < n; k++)
+    d += a->vb.id[k] != b->vb.id[k] || memcmp(&a->vb.t[k], &b->vb.t[k], 4) || memcmp(&a->vb.l1[k], &b->vb.l1[k], 4) ||
+         memcmp(&a->vb.l2[k], &b->vb.l2[k], 4);
+  return d;
+}
+
+/* The ray parameter of the hit of ray eye + t·d with triangle i's plane, in double. */
+static double exact_t(const rr_scene *s, uint32_t i, vec3 eye, vec3 d) {
+  double p[3][3], e1[3], e2[3];
+  for (int k = 0; k < 3; k++) {
+    vec3 v = scene_vertex(s, k, i);
+    p[k][0] = (double)v.x - eye.x, p[k][1] = (double)v.y - eye.y, p[k][2] = (double)v.z - eye.z;
+  }
+  for (int c = 0; c < 3; c++) e1[c] = p[1][c] - p[0][c], e2[c] = p[2][c] - p[0][c];
+  double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+  return (n[0] * p[0][0] + n[1] * p[0][1] + n[2] * p[0][2]) / (n[0] * d.x + n[1] * d.y + n[2] * d.z);
+}
+
+typedef struct {
+  double same_id, same_hit, depth_ok, bary_ok; /* shares; depth and λ where both hit the same id */
+  int hits;
+  int depth_bad;      /* 2dr depths off the exact hit by more than 1e-4, or off the triangle's range */
+  int depth_diff;     /* common hits whose depths differ by more than 1e-4 */
+  int depth_3dr_off;  /* ... of which 3dr-bb's depth is the one off the exact hit */
+  double worst_2dr, worst_3dr; /* largest relative depth errors against the exact hit */
+} agreement;
+
+/* a: 2dr, b: 3dr-bb. Depths are also compared with the exact hit of each id. */
+static agreement compare(const rr_scene *s, const camera *c, const rr_frame *a, const rr_frame *b) {
+  size_t n = (size_t)a->vb.width * a->vb.height, same_id = 0, same_hit = 0, both = 0, depth_ok = 0, bary_ok = 0;
+  agreement g = {0};
+  for (size_t k = 0; k < n; k++) {
+    uint32_t ia = a->vb.id[k], ib = b->vb.id[k];
+    same_id += ia == ib;
+    same_hit += (ia == RR_MISS) == (ib == RR_MISS);
+    if (ia == RR_MISS) continue;
+    g.hits++;
+    int x = (int)(k % a->vb.width), y = (int)(k / a->vb.width);
+    vec3 d = camera_dir(c, x + 0.5f, y + 0.5f);
+    double ta = a->vb.t[k], ea = exact_t(s, ia, c->eye, d), err_a = fabs(ta - ea) / ea;
+    /* Where snapping alone puts the sample on the triangle (the ids differ), the
+     * plane's depth is clamped to the triangle's: check the range only. */
+    double lo = INFINITY, hi = -INFINITY;
+    for (int q = 0; q < 3; q++) {
+      vec3 p = v3_sub(scene_vertex(s, q, ia), c->eye);
+      double z = ((double)p.x * c->fwd.x + (double)p.y * c->fwd.y + (double)p.z * c->fwd.z) / v3_dot(c->fwd, c->d0);
+      lo = fmin(lo, z), hi = fmax(hi, z);
+    }
+    g.depth_bad += !(ta >= lo * (1 - 1e-5) && ta <= hi * (1 + 1e-5));
+    if (ia != ib) continue;
+    g.depth_bad += !(err_a <= 1e-4);
+    g.worst_2dr = fmax(g.worst_2dr, err_a);
+    both++;
+    double tb = b->vb.t[k], err_b = fabs(tb - ea) / ea;
+    g.worst_3dr = fmax(g.worst_3dr, err_b);
+    if (fabs(ta - tb) <= 1e-4 * fmax(ta, tb)) depth_ok++;
+    else g.depth_diff++, g.depth_3dr_off += err_a <= 1e-4 && err_b > err_a;
+    bary_ok += fabsf(a->vb.l1[k] - b->vb.l1[k]) <= 1e-2f && fabsf(a->vb.l2[k] - b->vb.l2[k]) <= 1e-2f;
+  }
+  g.same_id = (double)same_id / n, g.same_hit = (double)same_hit / n;
+  g.depth_ok = both ? (double)depth_ok / both : 1, g.bary_ok = both ? (double)bary_ok / both : 1;
+  return g;
+}
+
+/* Renders one view with 2dr-bb (1 and 3 threads), 2dr-bin (1 and 2 threads) and
+ * 3dr-bb; 2dr-bin must equal 2dr-bb bit for bit, and 2dr-bb must agree with 3dr-bb
+ * on ids and hits at least as often as asked. Where the ids agree the depths must
+ * agree within 1e-4, except where 3dr-bb's float depth is itself that far off the
+ * exact hit; and every 2dr depth must be within 1e-4 of the exact hit there, and
+ * within the triangle's depth range everywhere. */
+static agreement check_view(const rr_scene *s, const rr_camera *cam, int w, int h, int cull, const char *what,
+                            double min_id, double min_hit) {
+  agreement g = {0};
+  camera c;
+  if (camera_setup(dev, cam, w, h, &c) != RR_OK) {
+    CHECK(0, "%s: camera: %s", what, rr_device_message(dev));
+    return g;
+  }
+  rr_frame *bb = render(s, cam, RR_METHOD_2DR_BB, 1, w, h, cull);
+  rr_frame *bb3 = render(s, cam, RR_METHOD_2DR_BB, 3, w, h, cull);
+  rr_frame *bin = render(s, cam, RR_METHOD_2DR_BIN, 1, w, h, cull);
+  rr_frame *bin2 = render(s, cam, RR_METHOD_2DR_BIN, 2, w, h, cull);
+  rr_frame *ref = render(s, cam, RR_METHOD_3DR_BB, 1, w, h, cull);
+  if (bb && bb3 && bin && bin2 && ref) {
+    int d1 = bitwise_diff(bb, bin), d2 = bitwise_diff(bb, bb3), d3 = bitwise_diff(bb, bin2);
+    CHECK(d1 == 0 && d2 == 0 && d3 == 0,
+          "%s: 2dr-bin differs from 2dr-bb at %d samples, 3 threads at %d, 2dr-bin on 2 threads at %d", what, d1, d2,
+          d3);
+    CHECK(bin->stats.setups == bb->stats.setups, "%s: both traversals set up the same triangles", what);
+    g = compare(s, &c, bb, ref);
+    printf("%s: %d hits; vs 3dr-bb: id %.4f%%, hit/miss %.4f%%, depth %.4f%% (%d off by 3dr-bb's rounding), "
+           "bary %.4f%%; worst depth error 2dr %.1e, 3dr %.1e; E bb %llu bin %llu\n",
+           what, g.hits, 100 * g.same_id, 100 * g.same_hit, 100 * g.depth_ok, g.depth_3dr_off, 100 * g.bary_ok,
+           g.worst_2dr, g.worst_3dr, (unsigned long long)bb->stats.edge_evals,
+           (unsigned long long)bin->stats.edge_evals);
+    CHECK(g.same_id >= min_id, "%s: ids agree with 3dr-bb on %.4f%% of samples", what, 100 * g.same_id);
+    CHECK(g.same_hit >= min_hit, "%s: hit/miss agrees with 3dr-bb on %.4f%% of samples", what, 100 * g.same_hit);
+    CHECK(g.depth_diff == g.depth_3dr_off, "%s: %d depths differ from 3dr-bb's by more than 1e-4 where 3dr-bb is right",
+          what, g.depth_diff - g.depth_3dr_off);
+    CHECK(g.depth_bad == 0, "%s: %d 2dr depths are off the exact hit by more than 1e-4 (worst %.2e)", what,
+          g.depth_bad, g.worst_2dr);
+  }
+  rr_frame_release(bb), rr_frame_release(bb3), rr_frame_release(bin), rr_frame_release(bin2), rr_frame_release(ref);
+  return g;
+}
+
+static rr_scene *mesh_scene(const float *pos, size_t nv, const uint32_t *idx, size_t nt) {
+  rr_scene *s = NULL;
+  CHECK(rr_scene_new(dev, &s) == RR_OK, "new scene");
+  CHECK(rr_scene_add_mesh(s, pos, nv, idx, nt, NULL) == RR_OK, "add mesh: %s", rr_device_message(dev));
+  CHECK(rr_scene_commit(s) == RR_OK, "commit: %s", rr_device_message(dev));
+  return s;
+}
+
+/* Random triangles around the eye: crossing the eye plane, near it, behind it. */
+static rr_scene *soup_scene(int n, float radius, float size) {
+  float *pos = malloc((size_t)n * 9 * sizeof *pos);
+  uint32_t *idx = malloc((size_t)n * 3 * sizeof *idx);
+  for (int i = 0; i < n; i++) {
+    vec3 c = v3(test_randf(-radius, radius), test_randf(-radius, radius), test_randf(-radius, radius));
+    for (int k = 0; k < 3; k++) {
+      pos[9 * i + 3 * k + 0] = c.x + test_randf(-size, size);
+      pos[9 * i + 3 * k + 1] = c.y + test_randf(-size, size);
+      pos[9 * i + 3 * k + 2] = c.z + test_randf(-size, size);
+      idx[3 * i + k] = (uint32_t)(3 * i + k);
+    }
+  }
+  rr_scene *s = mesh_scene(pos, (size_t)n * 3, idx, (size_t)n);
+  free(pos), free(idx);
+  return s;
+}
+
+static void check_clipping(void) {
+  /* A ground quad 100 units wide under an eye 1 unit above it: it runs behind the
+   * eye and to the horizon; with a box standing on it. */
+  {
+    const float pos[] = {-50, 0, -50, 50, 0, -50, 50, 0, 50, -50, 0, 50,
+                         -1, 0, -3, 1, 0, -3, 1, 2, -3, -1, 2, -3};
+    const uint32_t idx[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7};
+    rr_scene *s = mesh_scene(pos, 8, idx, 4);
+    for (int v = 0; v < 6; v++) {
+      rr_camera cam = pub_camera(v3(test_randf(-2, 2), test_randf(0.2f, 1.5f), test_randf(-1, 3)),
+                                 v3(test_randf(-5, 5), test_randf(-1, 1), test_randf(-10, -3)), v3(0, 1, 0),
+                                 test_randf(40, 120));
+      check_view(s, &cam, 128, 96, v & 1, "ground across the eye plane", 0.998, 0.998);
+    }
+    rr_scene_release(s);
+  }
+  /* Random triangles all around the eye, many crossing the near and eye planes. */
+  {
+    rr_scene *s = soup_scene(300, 3, 1.5f);
+    for (int v = 0; v < 6; v++) {
+      rr_camera cam = pub_camera(v3(test_randf(-0.5f, 0.5f), test_randf(-0.5f, 0.5f), test_randf(-0.5f, 0.5f)),
+                                 v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)), v3(0, 1, 0),
+                                 test_randf(40, 120));
+      check_view(s, &cam, 128, 96, v & 1, "triangles around the eye", 0.995, 0.998);
+    }
+    rr_scene_release(s);
+  }
+  /* Triangles wholly behind the eye: nothing is drawn. */
+  {
+    const float pos[] = {-1, -1, 1, 1, -1, 1, 0, 1, 1, -100, -100, 0.5f, 100, -100, 0.5f, 0, 100, 200};
+    const uint32_t idx[] = {0, 1, 2, 3, 4, 5};
+    rr_scene *s = mesh_scene(pos, 6, idx, 2);
+    rr_camera cam = pub_camera(v3(0, 0, 0), v3(0, 0, -1), v3(0, 1, 0), 90);
+    agreement g = check_view(s, &cam, 64, 64, 0, "triangles behind the eye", 1, 1);
+    CHECK(g.hits == 0, "%d samples hit a triangle behind the eye", g.hits);
+    rr_scene_release(s);
+  }
+  /* Huge triangles, vertices a million units away, around a small one. */
+  {
+    const float pos[] = {-1e6f, -1e6f, -1e6f, 1e6f, -1e6f, -2e6f, 0, 1e6f, 1e6f,
+                         -3e6f, -1, 1e6f, 3e6f, -1, 1e6f, 0, -1, -3e6f,
+                         -0.5f, -0.5f, -2, 0.5f, -0.5f, -2, 0, 0.5f, -2};
+    const uint32_t idx[] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+    rr_scene *s = mesh_scene(pos, 9, idx, 3);
+    for (int v = 0; v < 6; v++) {
+      rr_camera cam = pub_camera(v3(test_randf(-0.5f, 0.5f), test_randf(-0.5f, 0.5f), test_randf(-0.5f, 0.5f)),
+                                 v3(test_randf(-1, 1), test_randf(-1, 1), -2), v3(0, 1, 0), test_randf(30, 150));
+      check_view(s, &cam, 128, 96, 0, "huge triangles", 0.998, 0.998);
+    }
+    rr_scene_release(s);
+  }
+  /* Inside closed meshes. */
+  const char *closed[] = {"sphere:48", "box:8"};
+  for (int m = 0; m < 2; m++) {
+    rr_scene *s = load(closed[m]);
+    if (!s) continue;
+    for (int v = 0; v < 3; v++) {
+      rr_camera cam = pub_camera(v3(test_randf(-0.4f, 0.4f), test_randf(-0.4f, 0.4f), test_randf(-0.4f, 0.4f)),
+                                 v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)), v3(0, 1, 0),
+                                 test_randf(40, 150));
+      check_view(s, &cam, 128, 96, 0, closed[m], 0.995, 1);
+    }
+    rr_scene_release(s);
+  }
+}
+
+/* Real meshes at several views, one of them from inside the bounds. */
+static void check_models(void) {
+  const char *meshes[] = {"stanford-bunny.obj", "ogre.obj", "nefertiti.obj", "suzanne.obj", "spot.obj"};
+  for (int m = 0; m < 5; m++) {
+    const char *path = test_model(meshes[m]);
+    if (!path) continue;
+    rr_scene *s = load(path);
+    if (!s) continue;
+    vec3 c = v3_scale(v3_add(s->bmin, s->bmax), 0.5f);
+    float r = 0.5f * v3_len(v3_sub(s->bmax, s->bmin));
+    for (int v = 0; v < 3; v++) {
+      rr_camera cam;
+      rr_camera_init(&cam);
+      cam.fov_deg = 50;
+      if (v == 0) {
+        rr_camera_frame(dev, s, 512, 512, &cam);
+      } else {
+        vec3 dir = v3_norm(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)));
+        vec3 eye = v3_add(c, v3_scale(dir, r * (v == 2 ? 0.3f : test_randf(1.5f, 3))));
+        vec3 target = v3_add(c, v3_scale(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)), 0.2f * r));
+        cam = pub_camera(eye, target, v3(0, 1, 0), test_randf(40, 90));
+      }
+      char what[256];
+      snprintf(what, sizeof what, "%s view %d", meshes[m], v);
+      check_view(s, &cam, 512, 512, v == 1, what, 0.999, 0.9999);
+    }
+    rr_scene_release(s);
+  }
+}
+
+int main(void) {
+  dev = rr_device_new();
+  rr_scene *sphere = load("sphere:24");
+  if (sphere) check_projection(sphere);
+  rr_scene_release(sphere);
+  check_fill_rule();
+  check_clipping();
+  check_models();
+  rr_device_release(dev);
+  return test_done();
+}
