@@ -1,11 +1,723 @@
-/* Bounding volume hierarchy: not built yet (the ray-casting issue adds it). */
+/* Bounding volume hierarchy: a binary BVH built with the binned surface area
+ * heuristic over triangle bounds (paper sect. 4.4: the spatial index every
+ * traversal of the continuum shares).
+ *
+ * Determinism: a node's split depends only on the triangle references of its
+ * range, in their order. Binning merges per-chunk bins with min/max and integer
+ * counts (exact, so the merge order does not matter); big ranges are partitioned
+ * stably by fixed-size chunks whatever the thread count; small ranges in place by
+ * one thread. Which path a node takes depends on its size only, and nodes are
+ * numbered in a fixed order, so the tree is the same for any number of threads.
+ *
+ * Layout: the root is node 0, every split allocates its two children as a pair
+ * at an odd index; the array starts 32 bytes past a 64-byte boundary so a pair
+ * shares one cache line. The top of the tree (ranges too big for one task) comes
+ * first, then each task's subtree in depth-first order. */
 #include "rr.h"
+
+#include <emmintrin.h>
+#include <string.h>
+
+enum {
+  BVH_MAX_BINS = 64,
+  BVH_TASK_MAX = 4096,  /* ranges at most this big are built whole by one thread */
+  BVH_PAR_MIN = 32768,  /* ranges at least this big bin and partition by chunks */
+  BVH_CHUNK = 8192,     /* references per chunk (a constant: part of the result) */
+  BVH_SAH_DEPTH = 48,   /* below this depth split at the median: bounds the depth */
+};
+
+/* SAH costs of a traversal step and a triangle test (relative). */
+#define BVH_COST_NODE 1.0
+#define BVH_COST_TRI 1.0
+
+/* A triangle reference: its bounds; the id sits in a lane that is masked off. */
+typedef struct {
+  float lo[3];
+  uint32_t id;
+  float hi[3];
+  uint32_t pad;
+} pref;
+
+typedef struct {
+  __m128 lo, hi;
+} box4;
+
+static inline box4 box_empty(void) {
+  box4 b = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
+  return b;
+}
+
+static inline __m128 xyz_mask(void) { return _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1)); }
+
+static inline void ref_load(const pref *r, __m128 *lo, __m128 *hi) {
+  __m128 m = xyz_mask();
+  *lo = _mm_and_ps(_mm_load_ps(r->lo), m);
+  *hi = _mm_and_ps(_mm_load_ps(r->hi), m);
+}
+
+static inline void box_grow(box4 *b, __m128 lo, __m128 hi) {
+  b->lo = _mm_min_ps(b->lo, lo);
+  b->hi = _mm_max_ps(b->hi, hi);
+}
+
+static inline void box_merge(box4 *b, box4 o) { box_grow(b, o.lo, o.hi); }
+
+/* Half the surface area, in double so that huge extents do not overflow. */
+static double half_area(box4 b) {
+  float lo[4], hi[4];
+  _mm_storeu_ps(lo, b.lo), _mm_storeu_ps(hi, b.hi);
+  if (!(lo[0] <= hi[0])) return 0;
+  double x = (double)hi[0] - lo[0], y = (double)hi[1] - lo[1], z = (double)hi[2] - lo[2];
+  return x * y + y * z + z * x;
+}
+
+/* Maps centroids to bins: bin = clamp((c - cmin) * scale, 0, nb - 1), per axis. */
+typedef struct {
+  __m128 cmin, scale, top;
+  int nb;
+  bool ok[3]; /* axis has extent */
+} binmap;
+
+static binmap binmap_make(box4 cbox, int nb) {
+  binmap m;
+  float lo[4], hi[4], sc[4] = {0, 0, 0, 0};
+  _mm_storeu_ps(lo, cbox.lo), _mm_storeu_ps(hi, cbox.hi);
+  for (int a = 0; a < 3; a++) {
+    float ext = hi[a] - lo[a];
+    float s = (float)nb / ext;
+    m.ok[a] = ext > 0 && isfinite(ext) && isfinite(s);
+    sc[a] = m.ok[a] ? s : 0;
+  }
+  m.cmin = _mm_and_ps(cbox.lo, xyz_mask());
+  m.scale = _mm_loadu_ps(sc);
+  m.top = _mm_set1_ps((float)(nb - 1));
+  m.nb = nb;
+  return m;
+}
+
+static inline __m128 centroid(__m128 lo, __m128 hi) { return _mm_mul_ps(_mm_add_ps(lo, hi), _mm_set1_ps(0.5f)); }
+
+/* Bin indices of a centroid on the three axes (NaN lands in bin 0). */
+static inline __m128i bin_of(const binmap *m, __m128 c) {
+  __m128 f = _mm_mul_ps(_mm_sub_ps(c, m->cmin), m->scale);
+  f = _mm_min_ps(_mm_max_ps(f, _mm_setzero_ps()), m->top);
+  return _mm_cvttps_epi32(f);
+}
+
+typedef struct {
+  box4 box[3][BVH_MAX_BINS];
+  uint32_t n[3][BVH_MAX_BINS];
+} bins;
+
+static void bins_clear(bins *b, int nb) {
+  for (int a = 0; a < 3; a++)
+    for (int i = 0; i < nb; i++) b->box[a][i] = box_empty(), b->n[a][i] = 0;
+}
+
+static void bin_range(const pref *r, uint32_t n, const binmap *m, bins *b) {
+  bins_clear(b, m->nb);
+  for (uint32_t i = 0; i < n; i++) {
+    __m128 lo, hi;
+    ref_load(&r[i], &lo, &hi);
+    int idx[4];
+    _mm_storeu_si128((__m128i *)idx, bin_of(m, centroid(lo, hi)));
+    for (int a = 0; a < 3; a++) {
+      box_grow(&b->box[a][idx[a]], lo, hi);
+      b->n[a][idx[a]]++;
+    }
+  }
+}
+
+static void bins_merge(bins *into, const bins *b, int nb) {
+  for (int a = 0; a < 3; a++)
+    for (int i = 0; i < nb; i++) box_merge(&into->box[a][i], b->box[a][i]), into->n[a][i] += b->n[a][i];
+}
+
+/* A range of references waiting to become a subtree rooted at `node`. */
+typedef struct {
+  uint32_t start, count, node, depth;
+  box4 box, cbox;
+} task;
+
+/* How a range is split: on `axis`, bins < pos go left; `mid` is the size of
+ * the left part; leaf when mid == 0. */
+typedef struct {
+  uint32_t mid;
+  task l, r;
+} split;
+
+typedef struct {
+  pref *refs, *scratch;
+  int bins, leaf_size, threads;
+} builder;
+
+/* Chooses the cheapest binned SAH split; returns false when every centroid falls
+ * into one bin on every axis. *cost is the SAH cost of the split (unnormalised). */
+static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, double *cost) {
+  bool found = false;
+  int nb = m->nb;
+  for (int a = 0; a < 3; a++) {
+    if (!m->ok[a]) continue;
+    double rcost[BVH_MAX_BINS];
+    box4 acc = box_empty();
+    uint32_t cnt = 0;
+    for (int i = nb - 1; i > 0; i--) {
+      if (b->n[a][i]) box_merge(&acc, b->box[a][i]);
+      cnt += b->n[a][i];
+      rcost[i] = half_area(acc) * cnt;
+    }
+    acc = box_empty(), cnt = 0;
+    for (int i = 1; i < nb; i++) {
+      if (b->n[a][i - 1]) box_merge(&acc, b->box[a][i - 1]);
+      cnt += b->n[a][i - 1];
+      uint32_t right = 0;
+      for (int j = i; j < nb && !right; j++) right = b->n[a][j];
+      if (!cnt || !right) continue;
+      double c = half_area(acc) * cnt + rcost[i];
+      if (!found || c < *cost) found = true, *cost = c, *axis = a, *pos = i;
+    }
+  }
+  return found;
+}
+
+static inline int ref_bin(const pref *r, const binmap *m, int axis) {
+  __m128 lo, hi;
+  ref_load(r, &lo, &hi);
+  int idx[4];
+  _mm_storeu_si128((__m128i *)idx, bin_of(m, centroid(lo, hi)));
+  return idx[axis];
+}
+
+/* Bounds and centroid bounds of a range. */
+static void range_bounds(const pref *r, uint32_t n, box4 *box, box4 *cbox) {
+  *box = box_empty(), *cbox = box_empty();
+  for (uint32_t i = 0; i < n; i++) {
+    __m128 lo, hi;
+    ref_load(&r[i], &lo, &hi);
+    box_grow(box, lo, hi);
+    __m128 c = centroid(lo, hi);
+    box_grow(cbox, c, c);
+  }
+}
+
+/* In-place partition of a small range (one thread): left = bin < pos. */
+static uint32_t partition_small(pref *r, uint32_t n, const binmap *m, int axis, int pos, box4 cb[2]) {
+  cb[0] = box_empty(), cb[1] = box_empty();
+  uint32_t i = 0, j = n;
+  while (i < j) {
+    __m128 lo, hi;
+    ref_load(&r[i], &lo, &hi);
+    __m128 c = centroid(lo, hi);
+    int idx[4];
+    _mm_storeu_si128((__m128i *)idx, bin_of(m, c));
+    if (idx[axis] < pos) {
+      box_grow(&cb[0], c, c);
+      i++;
+    } else {
+      box_grow(&cb[1], c, c);
+      pref t = r[i];
+      r[i] = r[--j];
+      r[j] = t;
+    }
+  }
+  return i;
+}
+
+/* ---- chunked work on big ranges (parallel, result independent of threads) -- */
+
+typedef struct {
+  builder *bd;
+  const task *t;
+  const binmap *m;
+  int axis, pos;
+  bins *chunk_bins;   /* one per chunk */
+  uint32_t *nleft;    /* per chunk */
+  uint32_t *offset;   /* per chunk: where its left / right parts go */
+  box4 *ccb;          /* per chunk: centroid bounds left, right */
+} chunk_job;
+
+static void chunk_bin(int c, int thread, void *arg) {
+  (void)thread;
+  chunk_job *j = arg;
+  uint32_t s = (uint32_t)c * BVH_CHUNK, n = j->t->count - s < BVH_CHUNK ? j->t->count - s : BVH_CHUNK;
+  bin_range(j->bd->refs + j->t->start + s, n, j->m, &j->chunk_bins[c]);
+}
+
+static void chunk_count(int c, int thread, void *arg) {
+  (void)thread;
+  chunk_job *j = arg;
+  uint32_t s = (uint32_t)c * BVH_CHUNK, n = j->t->count - s < BVH_CHUNK ? j->t->count - s : BVH_CHUNK;
+  const pref *r = j->bd->refs + j->t->start + s;
+  uint32_t k = 0;
+  for (uint32_t i = 0; i < n; i++) k += ref_bin(&r[i], j->m, j->axis) < j->pos;
+  j->nleft[c] = k;
+}
+
+static void chunk_scatter(int c, int thread, void *arg) {
+  (void)thread;
+  chunk_job *j = arg;
+  int nchunks = (int)((j->t->count + BVH_CHUNK - 1) / BVH_CHUNK);
+  uint32_t s = (uint32_t)c * BVH_CHUNK, n = j->t->count - s < BVH_CHUNK ? j->t->count - s : BVH_CHUNK;
+  const pref *r = j->bd->refs + j->t->start + s;
+  pref *out = j->bd->scratch + j->t->start;
+  uint32_t li = j->offset[c], ri = j->offset[nchunks + c];
+  box4 cb[2] = {box_empty(), box_empty()};
+  for (uint32_t i = 0; i < n; i++) {
+    __m128 lo, hi;
+    ref_load(&r[i], &lo, &hi);
+    __m128 cen = centroid(lo, hi);
+    int idx[4];
+    _mm_storeu_si128((__m128i *)idx, bin_of(j->m, cen));
+    int side = idx[j->axis] >= j->pos;
+    box_grow(&cb[side], cen, cen);
+    out[side ? ri++ : li++] = r[i];
+  }
+  j->ccb[2 * c] = cb[0], j->ccb[2 * c + 1] = cb[1];
+}
+
+static void chunk_copy(int c, int thread, void *arg) {
+  (void)thread;
+  chunk_job *j = arg;
+  uint32_t s = (uint32_t)c * BVH_CHUNK, n = j->t->count - s < BVH_CHUNK ? j->t->count - s : BVH_CHUNK;
+  memcpy(j->bd->refs + j->t->start + s, j->bd->scratch + j->t->start + s, n * sizeof(pref));
+}
+
+/* ---- splitting one range ---------------------------------------------------- */
+
+static int bins_for(const builder *bd, uint32_t count) {
+  /* Few references gain nothing from many bins but pay for the sweep. */
+  int nb = count < (uint32_t)bd->bins ? (int)count + 4 : bd->bins;
+  return nb > bd->bins ? bd->bins : nb;
+}
+
+static void median_split(builder *bd, const task *t, split *sp) {
+  sp->mid = t->count / 2;
+  range_bounds(bd->refs + t->start, sp->mid, &sp->l.box, &sp->l.cbox);
+  range_bounds(bd->refs + t->start + sp->mid, t->count - sp->mid, &sp->r.box, &sp->r.cbox);
+}
+
+/* Decides how to split t (or not) and partitions its references; `threads` only
+ * says how many threads may help with a big range. */
+static void split_task(builder *bd, const task *t, int threads, split *sp) {
+  sp->mid = 0;
+  if (t->count <= 1) return;
+  bool big = t->count >= BVH_PAR_MIN;
+  if (t->depth >= BVH_SAH_DEPTH) {
+    if (t->count > (uint32_t)bd->leaf_size) median_split(bd, t, sp);
+    goto children;
+  }
+  int nb = bins_for(bd, t->count);
+  binmap m = binmap_make(t->cbox, nb);
+  bins bins_local, *b = &bins_local;
+  int nchunks = big ? (int)((t->count + BVH_CHUNK - 1) / BVH_CHUNK) : 1;
+  chunk_job job = {.bd = bd, .t = t, .m = &m};
+  if (big) {
+    job.chunk_bins = malloc(sizeof(bins) * nchunks);
+    parallel_for(nchunks, threads, chunk_bin, &job);
+    bins_clear(b, nb);
+    for (int c = 0; c < nchunks; c++) bins_merge(b, &job.chunk_bins[c], nb);
+    free(job.chunk_bins);
+  } else {
+    bin_range(bd->refs + t->start, t->count, &m, b);
+  }
+  int axis = 0, pos = 0;
+  double cost = 0;
+  bool found = best_split(b, &m, &axis, &pos, &cost);
+  double area = half_area(t->box);
+  /* Leaf when small enough and no split is cheaper (costs scaled by the area). */
+  if (t->count <= (uint32_t)bd->leaf_size &&
+      (!found || BVH_COST_TRI * t->count * area <= BVH_COST_NODE * area + BVH_COST_TRI * cost)) {
+    return;
+  }
+  if (!found) {
+    median_split(bd, t, sp);
+    goto children;
+  }
+  sp->l.box = box_empty(), sp->r.box = box_empty();
+  for (int i = 0; i < nb; i++)
+    if (b->n[axis][i]) box_merge(i < pos ? &sp->l.box : &sp->r.box, b->box[axis][i]);
+  if (big) {
+    job.axis = axis, job.pos = pos;
+    job.nleft = malloc(sizeof(uint32_t) * nchunks);
+    job.offset = malloc(sizeof(uint32_t) * 2 * nchunks);
+    job.ccb = malloc(sizeof(box4) * 2 * nchunks);
+    parallel_for(nchunks, threads, chunk_count, &job);
+    uint32_t nl = 0;
+    for (int c = 0; c < nchunks; c++) job.offset[c] = nl, nl += job.nleft[c];
+    uint32_t nr = nl;
+    for (int c = 0; c < nchunks; c++) {
+      job.offset[nchunks + c] = nr;
+      nr += (c == nchunks - 1 ? t->count - (uint32_t)c * BVH_CHUNK : BVH_CHUNK) - job.nleft[c];
+    }
+    parallel_for(nchunks, threads, chunk_scatter, &job);
+    parallel_for(nchunks, threads, chunk_copy, &job);
+    sp->l.cbox = box_empty(), sp->r.cbox = box_empty();
+    for (int c = 0; c < nchunks; c++) box_merge(&sp->l.cbox, job.ccb[2 * c]), box_merge(&sp->r.cbox, job.ccb[2 * c + 1]);
+    sp->mid = nl;
+    free(job.nleft), free(job.offset), free(job.ccb);
+  } else {
+    box4 cb[2];
+    sp->mid = partition_small(bd->refs + t->start, t->count, &m, axis, pos, cb);
+    sp->l.cbox = cb[0], sp->r.cbox = cb[1];
+  }
+children:
+  if (!sp->mid) return;
+  sp->l.start = t->start, sp->l.count = sp->mid;
+  sp->r.start = t->start + sp->mid, sp->r.count = t->count - sp->mid;
+  sp->l.depth = sp->r.depth = t->depth + 1;
+}
+
+static void store_box(bvh_node *n, box4 b) {
+  float lo[4], hi[4];
+  _mm_storeu_ps(lo, b.lo), _mm_storeu_ps(hi, b.hi);
+  memcpy(n->lo, lo, 12), memcpy(n->hi, hi, 12);
+}
+
+/* ---- growable arrays ---------------------------------------------------------- */
+
+typedef struct {
+  bvh_node *v;
+  uint32_t n, cap;
+  bool oom;
+} node_vec;
+
+static uint32_t node_pair(node_vec *nv) {
+  if (nv->n + 2 > nv->cap) {
+    uint32_t cap = nv->cap ? nv->cap * 2 : 64;
+    bvh_node *p = realloc(nv->v, (size_t)cap * sizeof *p);
+    if (!p) {
+      nv->oom = true;
+      return UINT32_MAX;
+    }
+    nv->v = p, nv->cap = cap;
+  }
+  nv->n += 2;
+  return nv->n - 2;
+}
+
+typedef struct {
+  task *v;
+  uint32_t n, cap;
+  bool oom;
+} task_vec;
+
+static void task_push(task_vec *tv, task t) {
+  if (tv->n == tv->cap) {
+    uint32_t cap = tv->cap ? tv->cap * 2 : 64;
+    task *p = realloc(tv->v, (size_t)cap * sizeof *p);
+    if (!p) {
+      tv->oom = true;
+      return;
+    }
+    tv->v = p, tv->cap = cap;
+  }
+  tv->v[tv->n++] = t;
+}
+
+/* ---- subtrees: one thread builds a whole small range ------------------------ */
+
+typedef struct {
+  builder *bd;
+  bvh_node *top;   /* the task roots live here */
+  task *tasks;
+  node_vec *local; /* per task: its nodes below the root; inner `first` local */
+  uint32_t *leaves, *depth;
+} sub_job;
+
+static void build_subtree(int ti, int thread, void *arg) {
+  (void)thread;
+  sub_job *j = arg;
+  node_vec *nv = &j->local[ti];
+  task stack[2 * 128];
+  int sp = 0;
+  stack[sp++] = j->tasks[ti];
+  uint32_t leaves = 0, depth = 0;
+  /* The root's node is in the top array; its descendants' nodes are local and
+   * are told apart by the high bit until relocation. */
+  while (sp) {
+    task t = stack[--sp];
+    bvh_node *n = (t.node & 0x80000000u) ? &nv->v[t.node & 0x7FFFFFFFu] : &j->top[t.node];
+    split s;
+    split_task(j->bd, &t, 1, &s);
+    store_box(n, t.box);
+    if (!s.mid) {
+      n->first = t.start, n->count = t.count;
+      leaves++;
+      depth = t.depth > depth ? t.depth : depth;
+      continue;
+    }
+    uint32_t p = node_pair(nv);
+    if (p == UINT32_MAX) return;
+    n = (t.node & 0x80000000u) ? &nv->v[t.node & 0x7FFFFFFFu] : &j->top[t.node]; /* realloc may move it */
+    n->first = p, n->count = 0;
+    s.l.node = p | 0x80000000u, s.r.node = (p + 1) | 0x80000000u;
+    stack[sp++] = s.r; /* left first: depth-first order */
+    stack[sp++] = s.l;
+  }
+  j->leaves[ti] = leaves, j->depth[ti] = depth;
+}
+
+/* ---- the top of the tree: big ranges, split one level at a time ------------ */
+
+typedef struct {
+  builder *bd;
+  task *t;
+  split *s;
+} level_job;
+
+static void split_one(int i, int thread, void *arg) {
+  (void)thread;
+  level_job *j = arg;
+  split_task(j->bd, &j->t[i], 1, &j->s[i]);
+}
+
+/* ---- prim bounds ---------------------------------------------------------------- */
+
+typedef struct {
+  const rr_scene *s;
+  pref *refs;
+  box4 *cb; /* per chunk: bounds, centroid bounds */
+} ref_job;
+
+static void make_refs(int c, int thread, void *arg) {
+  (void)thread;
+  ref_job *j = arg;
+  const rr_scene *s = j->s;
+  uint32_t a = (uint32_t)c * BVH_CHUNK, e = s->ntris - a < BVH_CHUNK ? s->ntris : a + BVH_CHUNK;
+  box4 b = box_empty(), cb = box_empty();
+  for (uint32_t i = a; i < e; i++) {
+    pref *r = &j->refs[i];
+    for (int x = 0; x < 3; x++) {
+      float v0 = s->p[0][x][i], v1 = s->p[1][x][i], v2 = s->p[2][x][i];
+      r->lo[x] = fminf(v0, fminf(v1, v2));
+      r->hi[x] = fmaxf(v0, fmaxf(v1, v2));
+    }
+    r->id = i, r->pad = 0;
+    __m128 lo, hi;
+    ref_load(r, &lo, &hi);
+    box_grow(&b, lo, hi);
+    __m128 cen = centroid(lo, hi);
+    box_grow(&cb, cen, cen);
+  }
+  j->cb[2 * c] = b, j->cb[2 * c + 1] = cb;
+}
+
+static void bvh_free(struct rr_bvh *b) {
+  if (!b) return;
+  free(b->node_mem), free(b->prims);
+  free(b);
+}
+
+void scene_free_bvh(rr_scene *s) {
+  if (!s) return;
+  bvh_free(s->bvh);
+  s->bvh = NULL;
+}
+
+void rr_build_options_init(rr_build_options *opt) {
+  if (!opt) return;
+  *opt = (rr_build_options){.threads = 0, .bins = BVH_DEFAULT_BINS, .leaf_size = BVH_DEFAULT_LEAF};
+}
+
+rr_error rr_device_set_build_options(rr_device *dev, const rr_build_options *opt) {
+  if (!dev || !opt) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_device_set_build_options: NULL argument");
+  if (opt->threads < 0 || opt->threads > 256)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad build thread count %d (0 for all cores, at most 256)", opt->threads);
+  if (opt->bins != 0 && (opt->bins < 2 || opt->bins > BVH_MAX_BINS))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad SAH bin count %d (2..%d)", opt->bins, BVH_MAX_BINS);
+  if (opt->leaf_size != 0 && (opt->leaf_size < 1 || opt->leaf_size > BVH_MAX_LEAF))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad leaf size %d (1..%d)", opt->leaf_size, BVH_MAX_LEAF);
+  dev->build = *opt;
+  return rr_ok(dev);
+}
+
+/* Fills a built tree's totals: SAH cost (relative to the root's area). */
+static double sah_cost(const struct rr_bvh *b) {
+  double sum = 0;
+  for (uint32_t i = 0; i < b->nnodes; i++) {
+    const bvh_node *n = &b->nodes[i];
+    double x = (double)n->hi[0] - n->lo[0], y = (double)n->hi[1] - n->lo[1], z = (double)n->hi[2] - n->lo[2];
+    double a = x * y + y * z + z * x;
+    sum += n->count ? BVH_COST_TRI * n->count * a : BVH_COST_NODE * a;
+  }
+  const bvh_node *r = &b->nodes[0];
+  double x = (double)r->hi[0] - r->lo[0], y = (double)r->hi[1] - r->lo[1], z = (double)r->hi[2] - r->lo[2];
+  double ra = x * y + y * z + z * x;
+  return ra > 0 ? sum / ra : 0;
+}
+
+rr_error bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out) {
+  *out = NULL;
+  double t0 = now_ms();
+  builder bd = {.bins = opt->bins ? opt->bins : BVH_DEFAULT_BINS,
+                .leaf_size = opt->leaf_size ? opt->leaf_size : BVH_DEFAULT_LEAF,
+                .threads = opt->threads ? opt->threads : cpu_count()};
+  struct rr_bvh *b = calloc(1, sizeof *b);
+  if (!b) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for the BVH");
+  b->nprims = s->ntris;
+  b->bins = bd.bins, b->leaf_size = bd.leaf_size;
+  if (s->ntris == 0) { /* an empty scene has no tree: every ray misses */
+    free(b);
+    return RR_OK;
+  }
+  uint32_t n = s->ntris;
+  bd.refs = aligned_alloc(64, ((size_t)n * sizeof(pref) + 63) & ~(size_t)63);
+  bd.scratch = aligned_alloc(64, ((size_t)n * sizeof(pref) + 63) & ~(size_t)63);
+  int nchunks = (int)((n + BVH_CHUNK - 1) / BVH_CHUNK);
+  box4 *cb = malloc(sizeof(box4) * 2 * nchunks);
+  task_vec frontier = {0}, next = {0}, small = {0};
+  node_vec top = {0}, *local = NULL;
+  uint32_t *leaves = NULL, *depths = NULL;
+  split *splits = NULL;
+  rr_error err = RR_OK;
+  if (!bd.refs || !bd.scratch || !cb) goto oom;
+
+  ref_job rj = {s, bd.refs, cb};
+  parallel_for(nchunks, bd.threads, make_refs, &rj);
+  task root = {.start = 0, .count = n, .node = 0, .depth = 0, .box = cb[0], .cbox = cb[1]};
+  for (int c = 1; c < nchunks; c++) box_merge(&root.box, cb[2 * c]), box_merge(&root.cbox, cb[2 * c + 1]);
+  /* The root sits alone before the pairs, so pairs start at odd indices. */
+  top.v = malloc(64 * sizeof *top.v), top.cap = 64, top.n = 1;
+  if (!top.v) goto oom;
+  uint32_t top_leaves = 0, top_depth = 0;
+  if (root.count > BVH_TASK_MAX) task_push(&frontier, root);
+  else task_push(&small, root);
+
+  while (frontier.n) {
+    splits = realloc(splits, sizeof *splits * frontier.n);
+    if (!splits) goto oom;
+    /* Big ranges one at a time with all threads inside; the rest one per thread. */
+    level_job lj = {&bd, frontier.v, splits};
+    int nmid = 0;
+    for (uint32_t i = 0; i < frontier.n; i++) {
+      if (frontier.v[i].count >= BVH_PAR_MIN) split_task(&bd, &frontier.v[i], bd.threads, &splits[i]);
+      else nmid++;
+    }
+    if (nmid) {
+      /* Ranges below BVH_PAR_MIN, in parallel; a range is split the same way
+       * whichever thread does it. */
+      task *mt = malloc(sizeof *mt * nmid);
+      split *ms = malloc(sizeof *ms * nmid);
+      if (!mt || !ms) {
+        free(mt), free(ms);
+        goto oom;
+      }
+      int k = 0;
+      for (uint32_t i = 0; i < frontier.n; i++)
+        if (frontier.v[i].count < BVH_PAR_MIN) mt[k++] = frontier.v[i];
+      lj.t = mt, lj.s = ms;
+      parallel_for(nmid, bd.threads, split_one, &lj);
+      k = 0;
+      for (uint32_t i = 0; i < frontier.n; i++)
+        if (frontier.v[i].count < BVH_PAR_MIN) splits[i] = ms[k++];
+      free(mt), free(ms);
+    }
+    next.n = 0;
+    for (uint32_t i = 0; i < frontier.n; i++) {
+      task *t = &frontier.v[i];
+      split *sp = &splits[i];
+      store_box(&top.v[t->node], t->box);
+      if (!sp->mid) { /* cannot happen for ranges this big, but stay correct */
+        top.v[t->node].first = t->start, top.v[t->node].count = t->count;
+        top_leaves++;
+        top_depth = t->depth > top_depth ? t->depth : top_depth;
+        continue;
+      }
+      uint32_t p = node_pair(&top);
+      if (p == UINT32_MAX) goto oom;
+      top.v[t->node].first = p, top.v[t->node].count = 0;
+      sp->l.node = p, sp->r.node = p + 1;
+      task_push(sp->l.count > BVH_TASK_MAX ? &next : &small, sp->l);
+      task_push(sp->r.count > BVH_TASK_MAX ? &next : &small, sp->r);
+    }
+    if (next.oom || small.oom) goto oom;
+    task_vec tmp = frontier;
+    frontier = next, next = tmp;
+  }
+
+  /* Small ranges: one subtree per task, in parallel. */
+  local = calloc(small.n, sizeof *local);
+  leaves = calloc(small.n, sizeof *leaves);
+  depths = calloc(small.n, sizeof *depths);
+  if (!local || !leaves || !depths) goto oom;
+  sub_job sj = {&bd, top.v, small.v, local, leaves, depths};
+  parallel_for((int)small.n, bd.threads, build_subtree, &sj);
+
+  /* Assemble: the top, then each task's nodes with their child indices moved. */
+  uint64_t total = top.n;
+  for (uint32_t i = 0; i < small.n; i++) {
+    if (local[i].oom) goto oom;
+    total += local[i].n;
+  }
+  if (total > UINT32_MAX / 2) goto oom;
+  b->node_mem = aligned_alloc(64, ((size_t)(total + 2) * sizeof(bvh_node) + 63) & ~(size_t)63);
+  b->prims = malloc((size_t)n * sizeof *b->prims);
+  if (!b->node_mem || !b->prims) goto oom;
+  b->nodes = (bvh_node *)b->node_mem + 1;
+  memcpy(b->nodes, top.v, top.n * sizeof *top.v);
+  uint32_t off = top.n;
+  b->nleaves = top_leaves, b->depth = top_depth;
+  for (uint32_t i = 0; i < small.n; i++) {
+    bvh_node *root_node = &b->nodes[small.v[i].node];
+    if (!root_node->count) root_node->first += off;
+    bvh_node *dst = b->nodes + off;
+    for (uint32_t k = 0; k < local[i].n; k++) {
+      dst[k] = local[i].v[k];
+      if (!dst[k].count) dst[k].first += off;
+    }
+    off += local[i].n;
+    b->nleaves += leaves[i];
+    b->depth = depths[i] > b->depth ? depths[i] : b->depth;
+  }
+  b->nnodes = (uint32_t)total;
+  for (uint32_t i = 0; i < n; i++) b->prims[i] = bd.refs[i].id;
+  b->sah_cost = sah_cost(b);
+  b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims;
+  b->build_ms = now_ms() - t0;
+  *out = b;
+  b = NULL;
+  goto done;
+oom:
+  err = rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory building the BVH of %u triangles", n);
+done:
+  for (uint32_t i = 0; local && i < small.n; i++) free(local[i].v);
+  free(local), free(leaves), free(depths), free(splits);
+  free(frontier.v), free(next.v), free(small.v), free(top.v);
+  free(bd.refs), free(bd.scratch), free(cb);
+  bvh_free(b);
+  return err;
+}
 
 rr_error rr_scene_commit(rr_scene *s) {
   if (!s) return RR_ERROR_ARGUMENT;
+  rr_build_options opt;
+  rr_build_options_init(&opt);
+  if (s->dev) opt = s->dev->build;
+  struct rr_bvh *b;
+  rr_error e = bvh_build(s, &opt, &b);
+  if (e) return e;
+  scene_free_bvh(s);
+  s->bvh = b;
   return rr_ok(s->dev);
 }
 
-void scene_free_bvh(rr_scene *s) { (void)s; }
+const rr_bvh *bvh_of(rr_device *dev, const rr_scene *s, bool *empty) {
+  *empty = s->ntris == 0;
+  if (*empty) return NULL;
+  if (!s->bvh || s->bvh->nprims != s->ntris) {
+    rr_fail(dev, RR_ERROR_ARGUMENT, "the scene has no current BVH (call rr_scene_commit after adding meshes)");
+    return NULL;
+  }
+  return s->bvh;
+}
 
-void bvh_fill_info(const rr_scene *s, rr_scene_info *info) { (void)s, (void)info; }
+void bvh_fill_info(const rr_scene *s, rr_scene_info *info) {
+  const struct rr_bvh *b = s->bvh;
+  if (!b) return;
+  info->bvh_nodes = b->nnodes;
+  info->bvh_leaves = b->nleaves;
+  info->bvh_depth = b->depth;
+  info->bvh_sah_cost = b->sah_cost;
+  info->bvh_build_ms = b->build_ms;
+  info->bvh_bytes = b->bytes;
+}

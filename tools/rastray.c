@@ -264,6 +264,10 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   if (!out && naov == 0) out = "rastray.png";
   if (shade == RR_SHADE_HEAT_EVALS || shade == RR_SHADE_HEAT_NODES) opt.heat = 1;
 
+  rr_build_options build; /* the BVH is built on the render's threads too */
+  rr_build_options_init(&build);
+  build.threads = opt.threads;
+  rr_device_set_build_options(dev, &build);
   rr_scene *scene = load_scene(dev, scene_name);
   if (!have_eye && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK)
     die(EXIT_INPUT, "%s", rr_device_message(dev));

@@ -1,0 +1,593 @@
+/* Ray casting through the BVH: rc-bvh (one ray per sample), rc-packet (8x8
+ * packets of primary rays) and the public queries rr_intersect / rr_occluded.
+ *
+ * Leaves run the project's one sample test, so these methods produce the same
+ * bits as rc and 3dr-bb: a primary ray tests a triangle with tri_setup_planar()
+ * for the camera (computed once per frame, on first use, and kept in leaf order)
+ * and shade_sample() at its sample (x + 0.5, y + 0.5). Traversal only decides
+ * which (sample, triangle) pairs are visited, so it must never skip the winner:
+ * - box tests are conservative: the slab interval is widened by RAY_MARGIN
+ *   relative to t on both ends, and a slab the ray runs inside of exactly
+ *   (0 · inf = NaN) is ignored rather than taken as a miss;
+ * - a box is pruned only when its widened entry t is strictly greater than the
+ *   best t found, because an equal t with a lower id still wins (depth_wins).
+ * The margin covers the rounding of the box test and the difference between a
+ * triangle's computed t (V / ΣV_i, with rounding) and the exact entry distance of
+ * its box; a triangle whose plane passes within rounding of the eye can compute a
+ * t arbitrarily far from its box (its samples are numerical noise in every
+ * method) and is the one case the margin does not bound. */
+#include "rr.h"
+
+#include <emmintrin.h>
+#include <string.h>
+
+#define RAY_MARGIN 0x1p-10f /* relative widening of box intervals (about 1e-3) */
+
+/* ---- per-frame triangle setups and exact pruning bounds ------------------------ */
+
+/* Every triangle is set up once per frame (S = triangles), in leaf order, with a
+ * lower bound `tlo` of the t that sample_test() can compute for it at any sample
+ * of the image; a node's tlo is the least of its triangles'. A primary ray prunes
+ * a node only when the node's tlo is greater than its best t, which is exact:
+ * box entry distances are not, because a triangle seen at a grazing angle can
+ * compute a t well in front of its own box (measured: 2.4% at sin = 0.004 on the
+ * ogre), and rc / 3dr-bb keep such hits. Box tests then only cull rays that miss. */
+typedef struct {
+  const rr_scene *s;
+  const rr_bvh *b;
+  const camera *cam;
+  bool cull;
+  tri_setup *ts;  /* by position in b->prims */
+  uint8_t *live;  /* 0: culled for this camera */
+  float *tlo;     /* by node */
+} frame_setups;
+
+/* Upper bound of max over the samples of the image where edge values e_i >= -u_i
+ * of Σ(e_i + u_i), for the exact edge functions E_i = a + sx·b + sy·c of ts. */
+static double sum_bound(const tri_setup *ts, const double u[3], double w, double h) {
+  /* The region {E_i >= -u_i} is the triangle of the three lines E_i = -u_i when
+   * each line's opposite vertex satisfies its constraint with room to spare; its
+   * maximum is at a vertex. Otherwise bound over the image rectangle. */
+  double best = -INFINITY;
+  bool bounded = true;
+  for (int k = 0; k < 3 && bounded; k++) {
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    double bi = ts->b[i], ci = ts->c[i], bj = ts->b[j], cj = ts->c[j];
+    double ri = -u[i] - ts->a[i], rj = -u[j] - ts->a[j];
+    double det = bi * cj - bj * ci, scale = fabs(bi * cj) + fabs(bj * ci);
+    if (!(fabs(det) > 1e-9 * scale)) {
+      bounded = false;
+      break;
+    }
+    double sx = (ri * cj - rj * ci) / det, sy = (bi * rj - bj * ri) / det;
+    double ek = ts->a[k] + sx * ts->b[k] + sy * ts->c[k];
+    double mag = fabs(ts->a[k]) + fabs(sx * ts->b[k]) + fabs(sy * ts->c[k]);
+    if (!isfinite(ek) || !(ek + u[k] > 1e-9 * mag)) {
+      bounded = false;
+      break;
+    }
+    double sum = ek + u[k]; /* Σ(E + u) at the vertex: the other two are 0 there */
+    best = sum > best ? sum : best;
+  }
+  if (bounded) return best * (1 + 1e-6);
+  double A = 0, B = 0, C = 0;
+  for (int i = 0; i < 3; i++) A += (double)ts->a[i] + u[i], B += ts->b[i], C += ts->c[i];
+  double m = A + fmax(0.5 * B, (w - 0.5) * B) + fmax(0.5 * C, (h - 0.5) * C);
+  return m + 1e-6 * (fabs(A) + fabs(w * B) + fabs(h * C));
+}
+
+/* The least t sample_test() can return for ts at a sample of a w × h image. The
+ * float error of tri_edges() is below 4u·(|a| + |sx·b| + |sy·c|) (u = 2^-24); a
+ * passing sample has e_i >= 0, so the computed sum is at most (1+u)^2 Σ(E_i + u_i)
+ * and t = vol·(1/sum) at least vol·(1-u)^2 / that. */
+static float t_lower_bound(const tri_setup *ts, int w, int h) {
+  const double u = 0x1p-24;
+  double ub[3];
+  for (int i = 0; i < 3; i++) ub[i] = 4 * u * (fabs(ts->a[i]) + w * fabs(ts->b[i]) + h * fabs(ts->c[i]));
+  double smax = sum_bound(ts, ub, w, h);
+  if (!(smax > 0)) return INFINITY; /* no sample can pass */
+  double t = (double)ts->vol * (1 - u) * (1 - u) / (smax * (1 + u) * (1 + u)) * (1 - 1e-6);
+  float f = (float)t;
+  return (double)f > t ? nextafterf(f, 0) : f;
+}
+
+typedef struct {
+  frame_setups *fs;
+  int chunk;
+} setup_job;
+
+enum { SETUP_CHUNK = 4096 };
+
+/* Sets up the triangles of the leaves among nodes [job·chunk, (job+1)·chunk). */
+static void setup_leaves(int job, int thread, void *arg) {
+  (void)thread;
+  frame_setups *fs = ((setup_job *)arg)->fs;
+  const rr_bvh *b = fs->b;
+  uint32_t n0 = (uint32_t)job * SETUP_CHUNK, n1 = n0 + SETUP_CHUNK < b->nnodes ? n0 + SETUP_CHUNK : b->nnodes;
+  for (uint32_t k = n0; k < n1; k++) {
+    const bvh_node *n = &b->nodes[k];
+    if (!n->count) continue;
+    float tlo = INFINITY;
+    for (uint32_t i = n->first; i < n->first + n->count; i++) {
+      fs->live[i] = tri_setup_planar(fs->s, b->prims[i], fs->cam, fs->cull, &fs->ts[i]) != SETUP_CULLED;
+      if (!fs->live[i]) continue;
+      float t = t_lower_bound(&fs->ts[i], fs->cam->width, fs->cam->height);
+      tlo = t < tlo ? t : tlo;
+    }
+    fs->tlo[k] = tlo;
+  }
+}
+
+static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *ctx, const rr_bvh *b) {
+  *fs = (frame_setups){.s = ctx->scene, .b = b, .cam = ctx->cam, .cull = ctx->opt->cull_backfaces != 0};
+  size_t n = b->nprims;
+  fs->ts = malloc(n * sizeof *fs->ts + 1);
+  fs->live = malloc(n + 1);
+  fs->tlo = malloc((size_t)b->nnodes * sizeof *fs->tlo + 1);
+  if (!fs->ts || !fs->live || !fs->tlo) {
+    free(fs->ts), free(fs->live), free(fs->tlo);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %zu triangle setups", n);
+  }
+  setup_job sj = {fs, SETUP_CHUNK};
+  parallel_for((int)((b->nnodes + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, &sj);
+  /* Children come after their parent in the array: one backward pass. */
+  for (uint32_t k = b->nnodes; k-- > 0;) {
+    const bvh_node *nd = &b->nodes[k];
+    if (nd->count) continue;
+    float l = fs->tlo[nd->first], r = fs->tlo[nd->first + 1];
+    fs->tlo[k] = l < r ? l : r;
+  }
+  ctx->stats->setups += n;
+  return RR_OK;
+}
+
+static void setups_free(frame_setups *fs) { free(fs->ts), free(fs->live), free(fs->tlo); }
+
+/* ---- one ray ------------------------------------------------------------------ */
+
+/* A ray prepared for slab tests: the near plane of axis a is node float near[a]
+ * (0..2: lo, 3..5: hi), the far plane far[a]. */
+typedef struct {
+  float o[3], inv[3];
+  int nr[3], fr[3];
+} ray_q;
+
+static inline void ray_q_init(ray_q *q, vec3 o, vec3 d) {
+  float dv[3] = {d.x, d.y, d.z}, ov[3] = {o.x, o.y, o.z};
+  for (int a = 0; a < 3; a++) {
+    q->o[a] = ov[a];
+    q->inv[a] = 1.0f / dv[a]; /* ±inf for a zero component, by its sign */
+    bool neg = q->inv[a] < 0;
+    q->nr[a] = neg ? 3 + a : a;
+    q->fr[a] = neg ? a : 3 + a;
+  }
+}
+
+/* Conservative ray-box test: true when the box may hold a point of the ray with
+ * t in [tmin, tmax]; *tnear is the widened entry t. NaN slabs (the ray runs in a
+ * box face) are ignored by the operand order of the comparisons. */
+static inline bool box_test(const bvh_node *n, const ray_q *q, float tmin, float tmax, float *tnear) {
+  const float *f = (const float *)n; /* lo[0..2], hi[0..2] */
+  float t0 = -INFINITY, t1 = INFINITY;
+  for (int a = 0; a < 3; a++) {
+    float tn = (f[q->nr[a]] - q->o[a]) * q->inv[a];
+    float tf = (f[q->fr[a]] - q->o[a]) * q->inv[a];
+    t0 = tn > t0 ? tn : t0;
+    t1 = tf < t1 ? tf : t1;
+  }
+  t0 -= fabsf(t0) * RAY_MARGIN;
+  t1 += fabsf(t1) * RAY_MARGIN;
+  *tnear = t0;
+  return t0 <= t1 && t0 <= tmax && t1 >= tmin;
+}
+
+enum { MODE_PRIMARY, MODE_CLOSEST, MODE_ANY };
+
+typedef struct {
+  ray_q q;
+  float tmin;
+  float t, l1, l2; /* best hit so far; t starts at tmax */
+  uint32_t id;
+  /* primary rays: the sample and the frame's setups */
+  float sx, sy;
+  const frame_setups *fs;
+  /* arbitrary rays: the ray's pseudo-camera */
+  const rr_scene *s;
+  const camera *rcam;
+  uint64_t setups, evals, nodes;
+} ray_state;
+
+/* Tests a leaf's triangles; true when an any-hit query is answered. */
+static inline bool leaf_test(const rr_bvh *b, const bvh_node *n, ray_state *r, const int mode) {
+  for (uint32_t i = n->first, end = n->first + n->count; i < end; i++) {
+    uint32_t id = b->prims[i];
+    if (mode == MODE_PRIMARY) {
+      if (!r->fs->live[i]) continue;
+      r->evals++;
+      visbuf one = {1, 1, &r->id, &r->t, &r->l1, &r->l2};
+      shade_sample(&r->fs->ts[i], id, r->sx, r->sy, &one, 0);
+    } else {
+      float t, l1, l2;
+      r->setups++, r->evals++;
+      if (!ray_tri_hit(r->s, id, r->rcam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
+      if (mode == MODE_ANY) return true;
+      if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
+    }
+  }
+  return false;
+}
+
+/* May node k hold the ray's winner? *tn: its widened box entry (the order key);
+ * *key: what a later pop compares with the best t (primary rays: the node's exact
+ * bound, other rays: the box entry). */
+static inline bool node_test(const rr_bvh *b, uint32_t k, const ray_state *r, float *tn, float *key, const int mode) {
+  if (mode == MODE_PRIMARY) {
+    *key = r->fs->tlo[k];
+    return !(*key > r->t) && box_test(&b->nodes[k], &r->q, r->tmin, INFINITY, tn);
+  }
+  bool hit = box_test(&b->nodes[k], &r->q, r->tmin, r->t, tn);
+  *key = *tn;
+  return hit;
+}
+
+/* Front-to-back traversal of one ray: the nearer child first, the farther one
+ * stacked and dropped on pop when the best t is already nearer than its key. */
+static inline bool trace1(const rr_bvh *b, ray_state *r, const int mode) {
+  struct {
+    uint32_t node;
+    float key;
+  } stack[BVH_STACK];
+  int sp = 0;
+  const bvh_node *nodes = b->nodes;
+  float tn0, tn1, k0, k1;
+  r->nodes++;
+  if (!node_test(b, 0, r, &tn0, &k0, mode)) return false;
+  uint32_t cur = 0;
+  for (;;) {
+    const bvh_node *n = &nodes[cur];
+    if (n->count) {
+      if (leaf_test(b, n, r, mode) && mode == MODE_ANY) return true;
+    } else {
+      bool h0 = node_test(b, n->first, r, &tn0, &k0, mode);
+      bool h1 = node_test(b, n->first + 1, r, &tn1, &k1, mode);
+      r->nodes += 2;
+      if (h0 && h1) {
+        uint32_t nearer = n->first, farther = n->first + 1;
+        if (tn1 < tn0) nearer = n->first + 1, farther = n->first, k1 = k0;
+        stack[sp].node = farther, stack[sp].key = k1, sp++;
+        cur = nearer;
+        continue;
+      }
+      if (h0 | h1) {
+        cur = n->first + (h0 ? 0 : 1);
+        continue;
+      }
+    }
+    for (;;) {
+      if (!sp) return false;
+      sp--;
+      if (!(stack[sp].key > r->t)) break; /* equal t may still win on id */
+    }
+    cur = stack[sp].node;
+  }
+}
+
+/* ---- arbitrary rays -------------------------------------------------------------- */
+
+void ray_camera(const float org[3], const float dir[3], camera *out) {
+  memset(out, 0, sizeof *out);
+  vec3 d = v3_load(dir);
+  out->eye = v3_load(org);
+  out->d0 = d;
+  /* dx: perpendicular to d in the plane of its two largest components; dy = d × dx. */
+  float ax = fabsf(d.x), ay = fabsf(d.y), az = fabsf(d.z);
+  vec3 u = ax <= ay && ax <= az ? v3(0, d.z, -d.y) : ay <= az ? v3(-d.z, 0, d.x) : v3(d.y, -d.x, 0);
+  out->dx = u;
+  out->dy = v3_cross(d, u);
+  out->fwd = d;
+}
+
+bool ray_tri_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull, float tmin, float tmax, float *t,
+                 float *l1, float *l2) {
+  tri_setup ts;
+  if (tri_setup_planar(s, i, ray, cull, &ts) == SETUP_CULLED) return false;
+  float e[3];
+  tri_edges(&ts, 0.0f, 0.0f, e); /* = a[i]: the edge functions along the ray itself */
+  if (!sample_test(e, ts.tie, ts.vol, t, l1, l2)) return false;
+  return *t >= tmin && *t <= tmax;
+}
+
+static rr_error ray_begin(const rr_scene *s, const rr_ray *ray, const rr_bvh **b, bool *empty) {
+  if (!s || !ray) return RR_ERROR_ARGUMENT;
+  for (int a = 0; a < 3; a++)
+    if (!isfinite(ray->org[a]) || !isfinite(ray->dir[a]))
+      return rr_fail(s->dev, RR_ERROR_ARGUMENT, "ray with a non-finite origin or direction");
+  if (ray->dir[0] == 0 && ray->dir[1] == 0 && ray->dir[2] == 0)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "ray with a zero direction");
+  if (isnan(ray->tmin) || isnan(ray->tmax)) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "ray with a NaN range");
+  *b = bvh_of(s->dev, s, empty);
+  return *b || *empty ? RR_OK : s->dev ? s->dev->error : RR_ERROR_ARGUMENT;
+}
+
+static void ray_state_init(ray_state *r, const rr_scene *s, const rr_ray *ray, const camera *rc) {
+  memset(r, 0, sizeof *r);
+  ray_q_init(&r->q, rc->eye, rc->d0);
+  r->tmin = ray->tmin, r->t = ray->tmax, r->id = RR_MISS;
+  r->s = s, r->rcam = rc;
+}
+
+rr_error rr_intersect(const rr_scene *s, const rr_ray *ray, rr_hit *hit) {
+  if (!hit) return s ? rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_intersect: hit is NULL") : RR_ERROR_ARGUMENT;
+  *hit = (rr_hit){RR_MISS, INFINITY, 0, 0};
+  const rr_bvh *b = NULL;
+  bool empty = false;
+  rr_error e = ray_begin(s, ray, &b, &empty);
+  if (e || empty) return e;
+  camera rc;
+  ray_camera(ray->org, ray->dir, &rc);
+  ray_state r;
+  ray_state_init(&r, s, ray, &rc);
+  trace1(b, &r, MODE_CLOSEST);
+  if (r.id != RR_MISS) *hit = (rr_hit){r.id, r.t, r.l1, r.l2};
+  return RR_OK;
+}
+
+rr_error rr_occluded(const rr_scene *s, const rr_ray *ray, int *occluded) {
+  if (!occluded) return s ? rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_occluded: result is NULL") : RR_ERROR_ARGUMENT;
+  *occluded = 0;
+  const rr_bvh *b = NULL;
+  bool empty = false;
+  rr_error e = ray_begin(s, ray, &b, &empty);
+  if (e || empty) return e;
+  camera rc;
+  ray_camera(ray->org, ray->dir, &rc);
+  ray_state r;
+  ray_state_init(&r, s, ray, &rc);
+  *occluded = trace1(b, &r, MODE_ANY);
+  return RR_OK;
+}
+
+/* ---- primary rays: tiles of the image dealt to threads ---------------------------- */
+
+enum { TILE = 32, PK = 8, PN = PK * PK };
+
+typedef struct {
+  uint64_t evals, nodes;
+  char pad[48]; /* one cache line per thread */
+} thread_stats;
+
+typedef struct {
+  render_ctx *ctx;
+  const rr_bvh *b;
+  frame_setups fs;
+  int tiles_x;
+  thread_stats st[256];
+} frame_job;
+
+static void rc_bvh_tile(int job, int thread, void *arg) {
+  frame_job *j = arg;
+  const camera *c = j->ctx->cam;
+  visbuf *vb = j->ctx->vb;
+  int x0 = job % j->tiles_x * TILE, y0 = job / j->tiles_x * TILE;
+  int x1 = x0 + TILE < vb->width ? x0 + TILE : vb->width, y1 = y0 + TILE < vb->height ? y0 + TILE : vb->height;
+  ray_state r;
+  memset(&r, 0, sizeof r);
+  r.fs = &j->fs;
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++) {
+      r.sx = (float)x + 0.5f, r.sy = (float)y + 0.5f;
+      ray_q_init(&r.q, c->eye, camera_dir(c, r.sx, r.sy));
+      r.tmin = 0, r.t = INFINITY, r.id = RR_MISS, r.l1 = r.l2 = 0;
+      trace1(j->b, &r, MODE_PRIMARY);
+      size_t k = (size_t)y * vb->width + x;
+      vb->id[k] = r.id, vb->t[k] = r.t, vb->l1[k] = r.l1, vb->l2[k] = r.l2;
+    }
+  thread_stats *st = &j->st[thread];
+  st->evals += r.evals, st->nodes += r.nodes;
+}
+
+/* ---- packets of 8x8 primary rays ---------------------------------------------- */
+
+/* A packet: the rays' inverse directions and near-plane masks (lanes of 4), their
+ * best hits, and which lanes are samples of the image. `uniform` when every ray
+ * has the same direction signs, so near and far planes are the same for all. */
+typedef struct {
+  __m128 inv[3][PN / 4], neg[3][PN / 4];
+  float o[3];
+  bool uniform;
+  int nr[3], fr[3]; /* near / far plane of each axis when uniform */
+  float t[PN], l1[PN], l2[PN];
+  uint32_t id[PN];
+  int x0, y0;
+  uint64_t valid;
+} packet;
+
+static inline __m128 select_ps(__m128 m, __m128 a, __m128 b) { return _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b)); }
+
+/* The lanes of `mask` whose rays meet the box and whose best t is not below the
+ * node's bound tlo; *tnear is the smallest widened entry t among them. The same
+ * arithmetic as box_test. */
+static inline uint64_t packet_box(const packet *p, const bvh_node *n, float tlo, uint64_t mask, float *tnear,
+                                  const bool uniform) {
+  const float *f = (const float *)n;
+  const __m128 margin = _mm_set1_ps(RAY_MARGIN), abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
+  __m128 lo[3], hi[3];
+  for (int a = 0; a < 3; a++) {
+    if (uniform) {
+      lo[a] = _mm_set1_ps(f[p->nr[a]] - p->o[a]);
+      hi[a] = _mm_set1_ps(f[p->fr[a]] - p->o[a]);
+    } else {
+      lo[a] = _mm_set1_ps(f[a] - p->o[a]);
+      hi[a] = _mm_set1_ps(f[3 + a] - p->o[a]);
+    }
+  }
+  __m128 tmin_all = _mm_set1_ps(INFINITY);
+  uint64_t hit = 0;
+  for (int g = 0; g < PN / 4; g++) {
+    if (!((mask >> (4 * g)) & 15)) continue;
+    __m128 t0 = _mm_set1_ps(-INFINITY), t1 = _mm_set1_ps(INFINITY);
+    for (int a = 0; a < 3; a++) {
+      __m128 ta = _mm_mul_ps(lo[a], p->inv[a][g]), tb = _mm_mul_ps(hi[a], p->inv[a][g]);
+      __m128 tn = uniform ? ta : select_ps(p->neg[a][g], tb, ta);
+      __m128 tf = uniform ? tb : select_ps(p->neg[a][g], ta, tb);
+      t0 = _mm_max_ps(tn, t0); /* a NaN tn yields t0: ignored */
+      t1 = _mm_min_ps(tf, t1);
+    }
+    t0 = _mm_sub_ps(t0, _mm_mul_ps(_mm_and_ps(t0, abs_mask), margin));
+    t1 = _mm_add_ps(t1, _mm_mul_ps(_mm_and_ps(t1, abs_mask), margin));
+    __m128 best = _mm_loadu_ps(&p->t[4 * g]);
+    __m128 ok = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(t0, t1), _mm_cmple_ps(_mm_set1_ps(tlo), best)),
+                           _mm_cmpge_ps(t1, _mm_setzero_ps()));
+    uint64_t bits = (uint64_t)_mm_movemask_ps(ok) & ((mask >> (4 * g)) & 15);
+    if (!bits) continue;
+    hit |= bits << (4 * g);
+    __m128 lane_on = _mm_castsi128_ps(
+        _mm_set_epi32(-(int)((bits >> 3) & 1), -(int)((bits >> 2) & 1), -(int)((bits >> 1) & 1), -(int)(bits & 1)));
+    tmin_all = _mm_min_ps(tmin_all, select_ps(lane_on, t0, _mm_set1_ps(INFINITY)));
+  }
+  float tm[4];
+  _mm_storeu_ps(tm, tmin_all);
+  *tnear = fminf(fminf(tm[0], tm[1]), fminf(tm[2], tm[3]));
+  return hit;
+}
+
+static inline void packet_leaf(frame_job *j, packet *p, const bvh_node *n, uint64_t mask, ray_state *acc) {
+  const rr_bvh *b = j->b;
+  visbuf pvb = {PK, PK, p->id, p->t, p->l1, p->l2};
+  int cnt = __builtin_popcountll(mask);
+  for (uint32_t i = n->first, end = n->first + n->count; i < end; i++) {
+    if (!j->fs.live[i]) continue;
+    const tri_setup *ts = &j->fs.ts[i];
+    uint32_t id = b->prims[i];
+    acc->evals += cnt;
+    for (uint64_t m = mask; m; m &= m - 1) {
+      int k = __builtin_ctzll(m);
+      shade_sample(ts, id, (float)(p->x0 + (k & 7)) + 0.5f, (float)(p->y0 + (k >> 3)) + 0.5f, &pvb, k);
+    }
+  }
+}
+
+static inline void packet_trace(frame_job *j, packet *p, ray_state *acc, const bool uniform) {
+  const bvh_node *nodes = j->b->nodes;
+  struct {
+    uint32_t node;
+    uint64_t mask;
+  } stack[BVH_STACK];
+  int sp = 0;
+  float tn0, tn1;
+  acc->nodes++;
+  const float *tlo = j->fs.tlo;
+  uint64_t mask = packet_box(p, &nodes[0], tlo[0], p->valid, &tn0, uniform);
+  uint32_t cur = 0;
+  while (mask) {
+    const bvh_node *n = &nodes[cur];
+    if (n->count) {
+      packet_leaf(j, p, n, mask, acc);
+    } else {
+      const bvh_node *c = &nodes[n->first];
+      uint64_t m0 = packet_box(p, &c[0], tlo[n->first], mask, &tn0, uniform);
+      uint64_t m1 = packet_box(p, &c[1], tlo[n->first + 1], mask, &tn1, uniform);
+      acc->nodes += 2;
+      if (m0 && m1) {
+        bool swap = tn1 < tn0;
+        stack[sp].node = n->first + !swap, stack[sp].mask = swap ? m0 : m1, sp++;
+        cur = n->first + swap, mask = swap ? m1 : m0;
+        continue;
+      }
+      if (m0 | m1) {
+        cur = n->first + (m0 ? 0 : 1), mask = m0 | m1;
+        continue;
+      }
+    }
+    /* Pop, narrowing the stacked lanes to those whose best t still allows the box. */
+    mask = 0;
+    while (sp && !mask) {
+      sp--;
+      cur = stack[sp].node;
+      acc->nodes++;
+      mask = packet_box(p, &nodes[cur], tlo[cur], stack[sp].mask, &tn0, uniform);
+    }
+  }
+}
+
+static void rc_packet_tile(int job, int thread, void *arg) {
+  frame_job *j = arg;
+  const camera *c = j->ctx->cam;
+  visbuf *vb = j->ctx->vb;
+  int tx0 = job % j->tiles_x * TILE, ty0 = job / j->tiles_x * TILE;
+  ray_state acc;
+  memset(&acc, 0, sizeof acc);
+  packet pk, *p = &pk;
+  for (int py = ty0; py < ty0 + TILE && py < vb->height; py += PK)
+    for (int px = tx0; px < tx0 + TILE && px < vb->width; px += PK) {
+      p->x0 = px, p->y0 = py, p->valid = 0;
+      p->o[0] = c->eye.x, p->o[1] = c->eye.y, p->o[2] = c->eye.z;
+      int negs[3] = {0, 0, 0};
+      float inv[3][PN], neg[3][PN];
+      for (int k = 0; k < PN; k++) {
+        int x = px + (k & 7), y = py + (k >> 3);
+        p->t[k] = INFINITY, p->id[k] = RR_MISS, p->l1[k] = p->l2[k] = 0;
+        vec3 d = camera_dir(c, (float)x + 0.5f, (float)y + 0.5f);
+        float dv[3] = {d.x, d.y, d.z};
+        bool in = x < vb->width && y < vb->height;
+        if (in) p->valid |= 1ull << k;
+        for (int a = 0; a < 3; a++) {
+          inv[a][k] = 1.0f / dv[a];
+          bool ng = inv[a][k] < 0;
+          uint32_t m = ng ? 0xFFFFFFFFu : 0;
+          memcpy(&neg[a][k], &m, 4);
+          negs[a] += in && ng;
+        }
+      }
+      int nvalid = __builtin_popcountll(p->valid);
+      p->uniform = true;
+      for (int a = 0; a < 3; a++) {
+        bool all_neg = negs[a] == nvalid, none = negs[a] == 0;
+        p->uniform = p->uniform && (all_neg || none);
+        p->nr[a] = all_neg ? 3 + a : a, p->fr[a] = all_neg ? a : 3 + a;
+        for (int g = 0; g < PN / 4; g++) {
+          p->inv[a][g] = _mm_loadu_ps(&inv[a][4 * g]);
+          p->neg[a][g] = _mm_loadu_ps(&neg[a][4 * g]);
+        }
+      }
+      if (p->uniform) packet_trace(j, p, &acc, true);
+      else packet_trace(j, p, &acc, false);
+      for (int k = 0; k < PN; k++) {
+        if (!((p->valid >> k) & 1)) continue;
+        size_t i = (size_t)(py + (k >> 3)) * vb->width + px + (k & 7);
+        vb->id[i] = p->id[k], vb->t[i] = p->t[k], vb->l1[i] = p->l1[k], vb->l2[i] = p->l2[k];
+      }
+    }
+  thread_stats *st = &j->st[thread];
+  st->evals += acc.evals, st->nodes += acc.nodes;
+}
+
+static rr_error run_frame(rr_device *dev, render_ctx *ctx, parallel_fn tile_fn) {
+  bool empty;
+  const rr_bvh *b = bvh_of(dev, ctx->scene, &empty);
+  if (empty) return RR_OK; /* the visibility buffer is already all misses */
+  if (!b) return dev ? dev->error : RR_ERROR_ARGUMENT;
+  frame_job *j = calloc(1, sizeof *j);
+  if (!j) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory");
+  j->ctx = ctx, j->b = b;
+  rr_error e = setups_init(dev, &j->fs, ctx, b);
+  if (e) {
+    free(j);
+    return e;
+  }
+  const visbuf *vb = ctx->vb;
+  j->tiles_x = (vb->width + TILE - 1) / TILE;
+  int tiles = j->tiles_x * ((vb->height + TILE - 1) / TILE);
+  parallel_for(tiles, ctx->threads, tile_fn, j);
+  for (int t = 0; t < 256; t++) {
+    ctx->stats->edge_evals += j->st[t].evals;
+    ctx->stats->nodes += j->st[t].nodes;
+  }
+  setups_free(&j->fs);
+  free(j);
+  return RR_OK;
+}
+
+rr_error vis_rc_bvh(rr_device *dev, render_ctx *ctx) { return run_frame(dev, ctx, rc_bvh_tile); }
+
+rr_error vis_rc_packet(rr_device *dev, render_ctx *ctx) { return run_frame(dev, ctx, rc_packet_tile); }
