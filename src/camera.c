@@ -152,12 +152,36 @@ rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height
     break;
   }
   c->lipschitz *= 1.001f;
+  /* Cones of coarse cells, for the screen bounds of triangles in curved views. */
+  c->cells_x = (width + CAMERA_CELL - 1) / CAMERA_CELL, c->cells_y = (height + CAMERA_CELL - 1) / CAMERA_CELL;
+  c->cells = malloc((size_t)c->cells_x * c->cells_y * 4 * sizeof *c->cells);
+  if (!c->cells) {
+    camera_release(c);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
+  }
+  for (int cy = 0; cy < c->cells_y; cy++)
+    for (int cx = 0; cx < c->cells_x; cx++) {
+      float *cell = c->cells + 4 * ((size_t)cy * c->cells_x + cx);
+      int x1 = (cx + 1) * CAMERA_CELL < width ? (cx + 1) * CAMERA_CELL : width;
+      int y1 = (cy + 1) * CAMERA_CELL < height ? (cy + 1) * CAMERA_CELL : height;
+      vec3 axis = v3(0, 0, 0);
+      float angle;
+      bool ok = camera_rect_cone(c, cx * CAMERA_CELL, cy * CAMERA_CELL, x1, y1, &axis, &angle) && angle < 1.5f;
+      bool any = false; /* a cell without rays is no triangle's */
+      for (int y = cy * CAMERA_CELL; y < y1 && !any; y++)
+        for (int x = cx * CAMERA_CELL; x < x1 && !any; x++) {
+          vec3 d = c->dirs[(size_t)y * width + x];
+          any = d.x != 0 || d.y != 0 || d.z != 0;
+        }
+      cell[0] = axis.x, cell[1] = axis.y, cell[2] = axis.z;
+      cell[3] = !any ? -1.0f : ok ? angle : 2.0f;
+    }
   return rr_ok(dev);
 }
 
 void camera_release(camera *c) {
-  free(c->dirs);
-  c->dirs = NULL;
+  free(c->dirs), free(c->cells);
+  c->dirs = NULL, c->cells = NULL;
 }
 
 bool camera_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
@@ -200,8 +224,19 @@ bool camera_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axi
    * (plus half a pixel: every sample lies within that distance of the centre). */
   int cx = (x0 + x1 - 1) / 2, cy = (y0 + y1 - 1) / 2;
   vec3 d = c->dirs[(size_t)cy * c->width + cx];
-  if (d.x == 0 && d.y == 0 && d.z == 0) return false;
   float hx = (float)(x1 - x0) * 0.5f + 0.5f, hy = (float)(y1 - y0) * 0.5f + 0.5f;
+  if (d.x == 0 && d.y == 0 && d.z == 0) {
+    /* No ray at the centre (the rim of a disk, the gaps of a cross): start from a
+     * corner that has one, with the whole diagonal as radius. */
+    const int px[4] = {x0, x1 - 1, x0, x1 - 1}, py[4] = {y0, y0, y1 - 1, y1 - 1};
+    int k = 0;
+    for (; k < 4; k++) {
+      d = c->dirs[(size_t)py[k] * c->width + px[k]];
+      if (d.x != 0 || d.y != 0 || d.z != 0) break;
+    }
+    if (k == 4) return false;
+    hx *= 2, hy *= 2;
+  }
   *axis = v3_norm(d);
   *angle = c->lipschitz * sqrtf(hx * hx + hy * hy) + 1e-5f;
   return true;

@@ -7,7 +7,60 @@
 /* Samples a set-up triangle may cover, as an inclusive pixel rectangle. Returns
  * false when it covers none. Projected bounds get a one-pixel margin so rounding
  * in the edge functions can never put a hit outside the box. */
-bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int r[4]) {
+/* Curved views: the cells whose cone no edge plane leaves wholly outside. */
+/* Curved views: does a cone of directions (unit axis, half-angle) miss the
+ * triangle's directions? Two conservative tests: the triangle's bounding cap
+ * (tight for small triangles), and the four planes through the eye a hit must lie
+ * inside of: V_i >= 0 for the three edges and ΣV_i > 0 (t > 0). */
+bool cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float angle) {
+  if (tc->cap_angle >= 0 && acosf(fminf(1.0f, v3_dot(axis, tc->cap_axis))) > angle + tc->cap_angle + 1e-5f)
+    return true;
+  float lim = sinf(angle) + 1e-5f, sum = 0;
+  for (int e = 0; e < 3; e++) {
+    float v = ts->a[e] * axis.x + ts->b[e] * axis.y + ts->c[e] * axis.z;
+    if (v < -tc->len[e] * lim) return true;
+    sum += v;
+  }
+  return sum < -tc->len[3] * lim;
+}
+
+void tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, tri_cone *tc) {
+  for (int e = 0; e < 3; e++) tc->len[e] = sqrtf(ts->a[e] * ts->a[e] + ts->b[e] * ts->b[e] + ts->c[e] * ts->c[e]);
+  float sx = ts->a[0] + ts->a[1] + ts->a[2], sy = ts->b[0] + ts->b[1] + ts->b[2], sz = ts->c[0] + ts->c[1] + ts->c[2];
+  /* the sum is evaluated edge by edge: allow for the rounding of each term too */
+  tc->len[3] = sqrtf(sx * sx + sy * sy + sz * sz) + 1e-6f * (tc->len[0] + tc->len[1] + tc->len[2]);
+  /* A cap around the mean vertex direction holds the spherical triangle when its
+   * radius is under 90° (caps that small are spherically convex). */
+  vec3 u[3], m = v3(0, 0, 0);
+  for (int k = 0; k < 3; k++) u[k] = v3_norm(v3_sub(scene_vertex(s, k, i), c->eye)), m = v3_add(m, u[k]);
+  tc->cap_angle = -1;
+  if (v3_len(m) > 1e-3f) {
+    tc->cap_axis = v3_norm(m);
+    float r = 0;
+    for (int k = 0; k < 3; k++) r = fmaxf(r, acosf(fminf(1.0f, v3_dot(u[k], tc->cap_axis))));
+    if (r < 1.5f) tc->cap_angle = r * 1.0001f + 1e-5f;
+  }
+}
+
+static bool curved_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int r[4]) {
+  tri_cone tc;
+  tri_cone_setup(s, i, c, ts, &tc);
+  int x0 = c->cells_x, y0 = c->cells_y, x1 = -1, y1 = -1;
+  for (int cy = 0; cy < c->cells_y; cy++)
+    for (int cx = 0; cx < c->cells_x; cx++) {
+      const float *cell = c->cells + 4 * ((size_t)cy * c->cells_x + cx);
+      if (cell[3] < 0) continue; /* no rays */
+      if (cell[3] < 1.5f && cone_excludes(&tc, ts, v3(cell[0], cell[1], cell[2]), cell[3])) continue;
+      x0 = cx < x0 ? cx : x0, x1 = cx > x1 ? cx : x1, y0 = cy < y0 ? cy : y0, y1 = cy > y1 ? cy : y1;
+    }
+  if (x1 < 0) return false;
+  r[0] = x0 * CAMERA_CELL, r[1] = y0 * CAMERA_CELL;
+  r[2] = (x1 + 1) * CAMERA_CELL - 1 < c->width - 1 ? (x1 + 1) * CAMERA_CELL - 1 : c->width - 1;
+  r[3] = (y1 + 1) * CAMERA_CELL - 1 < c->height - 1 ? (y1 + 1) * CAMERA_CELL - 1 : c->height - 1;
+  return true;
+}
+
+bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int r[4]) {
   float x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   int behind = 0, projected = 0;
   for (int k = 0; k < 3; k++) {
@@ -20,12 +73,10 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int r[4])
     }
   }
   if (!c->planar) {
-    /* Curved views have no straight-edged projection: the whole image (the
-     * traversal's binning and frusta narrow it down). Hemispheres see nothing
+    /* Curved views have no straight-edged projection; hemispheres see nothing
      * wholly behind the eye plane. */
     if (behind == 3 && c->type == RR_CAMERA_PARABOLIC) return false;
-    r[0] = 0, r[1] = 0, r[2] = c->width - 1, r[3] = c->height - 1;
-    return true;
+    return curved_bounds(s, i, c, ts, r);
   }
   if (behind == 3) return false; /* every camera ray has d·fwd > 0: unreachable */
   if (projected == 3) {

@@ -116,7 +116,13 @@ typedef struct rr_bvh {
   void *node_mem;  /* the allocation behind nodes (sibling pairs share a cache line) */
   uint32_t nprims; /* triangles the tree was built over (== scene->ntris when current) */
   int bins, leaf_size;
+  struct bvh_pair *pairs; /* the children's bounds of each sibling pair, for SIMD tests */
 } rr_bvh;
+
+/* Sibling pair nodes[2p + 1], nodes[2p + 2] as lanes (lo0, lo1, hi0, hi1) per axis. */
+typedef struct bvh_pair {
+  float x[4], y[4], z[4], pad[4];
+} bvh_pair;
 
 enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK = 128 };
 
@@ -165,7 +171,11 @@ typedef struct camera {
   float lipschitz;
   float dir_len_max; /* longest |d| of the camera's rays */
   int face;          /* cube: side of a face in pixels */
+  int cells_x, cells_y; /* curved: cones of CAMERA_CELL² cells of samples, 4 floats each: */
+  float *cells;         /* unit axis and half-angle; no bound when >= 1.5, no rays when < 0 */
 } camera;
+
+#define CAMERA_CELL 32
 
 /* Resolves a public camera for an image size; camera_release frees it. */
 rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *out);
@@ -338,10 +348,21 @@ rr_error raster2d_claims(const rr_scene *s, const camera *c, bool bin, int threa
 /* Test hook: where the 2D pipeline's vertex stage puts world point p on the screen;
  * false when p is behind its near plane. */
 bool raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, double *sy);
-/* The inclusive pixel rectangle a triangle's samples may lie in; false when none. */
-bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int rect[4]);
+/* The inclusive pixel rectangle a set-up triangle's samples may lie in; false when
+ * none. For curved cameras it is the bounding box of the cells whose cone of
+ * directions no edge plane excludes. */
+bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int rect[4]);
 /* Tests every sample of an inclusive rectangle against one set-up triangle and
  * returns the number of edge-function evaluations. */
+/* Curved cameras: what bounds a triangle's directions from the eye. */
+typedef struct tri_cone {
+  float len[4];      /* lengths of the three edge normals and of their sum */
+  vec3 cap_axis;     /* a cap holding the triangle's directions, */
+  float cap_angle;   /* or a negative angle when none under 90° does */
+} tri_cone;
+void tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, tri_cone *tc);
+/* May a triangle be excluded from a cone of directions (unit axis, half-angle)? */
+bool cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float angle);
 uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb);
 
 /* ---- threads --------------------------------------------------------------- */

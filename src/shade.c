@@ -12,7 +12,7 @@
 #pragma GCC diagnostic pop
 
 typedef struct hit {
-  bool valid;
+  bool valid, has_ray;
   uint32_t id;
   vec3 dir;    /* unit ray direction */
   float dist;  /* eye-to-hit distance */
@@ -28,11 +28,12 @@ static vec3 geometric_normal(const rr_scene *s, uint32_t i) {
 static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, int y) {
   hit h = {0};
   size_t k = (size_t)y * vb->width + x;
+  vec3 o, d;
+  h.has_ray = camera_ray(c, x, y, &o, &d);
   h.id = vb->id[k];
   if (h.id == RR_MISS || h.id >= s->ntris) return h;
   h.valid = true;
-  vec3 o, d;
-  if (!camera_ray(c, x, y, &o, &d)) {
+  if (!h.has_ray) {
     h.valid = false;
     return h;
   }
@@ -187,6 +188,7 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp,
     for (int x = 0; x < vb->width; x++) {
       float *o = px + 3 * ((size_t)y * vb->width + x);
       hit h = hit_at(s, &c, vb, x, y);
+      if (!h.has_ray) continue; /* black where the camera has no ray */
       if (!h.valid) {
         /* a quiet vertical gradient behind the scene */
         float g = 0.16f + 0.10f * (1.0f - (float)y / vb->height);

@@ -82,8 +82,8 @@ typedef struct tri_job {
   tri_setup ts;
   uint32_t id;
   float zmin;      /* nearest depth of the triangle (0 when it reaches the eye plane) */
-  float slack[3];  /* planar: how far below zero a rounded corner value may fall for an inside sample;
-                      curved: the length of the edge normal */
+  float slack[3];  /* planar: how far below zero a rounded corner value may fall for an inside sample */
+  tri_cone cone;   /* curved: what bounds the triangle's directions */
   int bb[4];       /* inclusive screen bounds */
 } tri_job;
 
@@ -132,9 +132,7 @@ static void bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
         vec3 axis;
         float angle;
         if (camera_rect_cone(t->c, b.x0, b.y0, b.x1, b.y1, &axis, &angle) && angle < 1.5f) {
-          float lim = sinf(angle) + 1e-5f;
-          for (int e = 0; e < 3 && !out; e++)
-            out = j->ts.a[e] * axis.x + j->ts.b[e] * axis.y + j->ts.c[e] * axis.z < -j->slack[e] * lim;
+          out = cone_excludes(&j->cone, &j->ts, axis, angle);
           t->st.edge_evals += 1;
           if (t->heat_e) t->heat_e[(size_t)((b.y0 + b.y1) / 2) * t->vb->width + (b.x0 + b.x1) / 2] += 1;
         }
@@ -148,7 +146,7 @@ static void bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
 /* Triangle setup for a frustum: false when the triangle cannot cover a sample. */
 static bool prepare(const trav *t, uint32_t id, tri_job *j) {
   if (tri_setup_planar(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED) return false;
-  if (!tri_screen_bounds(t->s, id, t->c, j->bb)) return false;
+  if (!tri_screen_bounds(t->s, id, t->c, &j->ts, j->bb)) return false;
   j->id = id;
   if (!t->o->binning) return true;
   const camera *c = t->c;
@@ -166,8 +164,7 @@ static bool prepare(const trav *t, uint32_t id, tri_job *j) {
     vec3 nrm = v3_cross(v3_sub(q1, q0), v3_sub(q2, q0));
     float dist = fabsf(v3_dot(q0, nrm)) / v3_len(nrm);
     j->zmin = dist > 0 && isfinite(dist) ? dist / c->dir_len_max : 0;
-    for (int e = 0; e < 3; e++)
-      j->slack[e] = sqrtf(j->ts.a[e] * j->ts.a[e] + j->ts.b[e] * j->ts.b[e] + j->ts.c[e] * j->ts.c[e]);
+    tri_cone_setup(t->s, id, c, &j->ts, &j->cone);
   }
   return true;
 }

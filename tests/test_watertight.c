@@ -22,7 +22,7 @@ static void count_claims(const rr_scene *s, const camera *c, bool use_bounds, ui
     int face = tri_setup_planar(s, i, c, false, &ts);
     if (face == SETUP_CULLED) continue;
     int r[4] = {0, 0, c->width - 1, c->height - 1};
-    if (use_bounds && !tri_screen_bounds(s, i, c, r)) continue;
+    if (use_bounds && !tri_screen_bounds(s, i, c, &ts, r)) continue;
     for (int y = r[1]; y <= r[3]; y++)
       for (int x = r[0]; x <= r[2]; x++) {
         float e[3], t, l1, l2;
