@@ -225,8 +225,9 @@ static bool interpolation_planes(const pipe2d *pp, const cvert v[3], planes *pl)
   double det = col[0][0] * r[0][0] + col[0][1] * r[0][1] + col[0][2] * r[0][2];
   if (!(det != 0) || !isfinite(det)) return false; /* the triangle's plane holds the eye */
   /* M⁻¹ has rows r_i/det with columns (coefficient of sx, of sy, constant). */
+  double inv = 1.0 / det;
   for (int j = 0; j < 3; j++) {
-    double r0 = r[0][j] / det, r1 = r[1][j] / det, r2 = r[2][j] / det;
+    double r0 = r[0][j] * inv, r1 = r[1][j] * inv, r2 = r[2][j] * inv;
     pl->w[j] = r0 + r1 + r2;
     pl->t[j] = v[0].v[CT] * r0 + v[1].v[CT] * r1 + v[2].v[CT] * r2;
     pl->l1[j] = r1, pl->l2[j] = r2;
@@ -291,8 +292,9 @@ static bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], 
   plane_at(pl->l2, (int)x0, (int)y0, t->p2);
   /* Depth is linear on the triangle, so its range is that of the vertices. The
    * clamp also makes early-z exact: no sample of the triangle is nearer than tmin. */
-  t->tmin = (float)fmin(depth[0], fmin(depth[1], depth[2]));
-  t->tmax = (float)fmax(depth[0], fmax(depth[1], depth[2]));
+  double lo = depth[0] < depth[1] ? depth[0] : depth[1], hi = depth[0] > depth[1] ? depth[0] : depth[1];
+  t->tmin = (float)(lo < depth[2] ? lo : depth[2]);
+  t->tmax = (float)(hi > depth[2] ? hi : depth[2]);
   t->id = id;
   return true;
 }
@@ -374,11 +376,22 @@ KERNEL bool raster_row(const tri2d *t, int x0, int x1, int y, const target *tg, 
   float dy = (float)(y - t->rect[1]);
   float qr = t->pw[0] + dy * t->pw[2], tr = t->pt[0] + dy * t->pt[2];
   float r1 = t->p1[0] + dy * t->p1[2], r2 = t->p2[0] + dy * t->p2[2];
-  size_t k = (size_t)y * (size_t)tg->vb->width + (size_t)x0;
+  size_t row = (size_t)y * (size_t)tg->vb->width;
   bool wrote = false;
-  for (int x = x0; x <= x1; x++, k++, e0 += s0, e1 += s1, e2 += s2)
-    if (!test || (e0 | e1 | e2) >= 0)
-      wrote |= shade2d(t, (float)(x - t->rect[0]), qr, tr, r1, r2, tg, k, count);
+  /* Coverage of up to 64 samples as a bit mask first, without branches, then the
+   * covered samples: a coverage branch per sample would mispredict half the time. */
+  for (int xs = x0; xs <= x1; xs += 64) {
+    int n = x1 - xs + 1 < 64 ? x1 - xs + 1 : 64;
+    uint64_t mask = n == 64 ? ~0ull : (1ull << n) - 1;
+    if (test) {
+      mask = 0;
+      for (int i = 0; i < n; i++, e0 += s0, e1 += s1, e2 += s2) mask |= (uint64_t)((e0 | e1 | e2) >= 0) << i;
+    }
+    for (; mask; mask &= mask - 1) {
+      int x = xs + __builtin_ctzll(mask);
+      wrote |= shade2d(t, (float)(x - t->rect[0]), qr, tr, r1, r2, tg, row + (size_t)x, count);
+    }
+  }
   return wrote;
 }
 
@@ -393,7 +406,8 @@ KERNEL uint64_t raster_bb(const tri2d *t, int y0, int y1, const target *tg, cons
 
 /* Block sizes by level: 4², 16², 64² samples (a level-2 block is a tile). */
 #define LEVELS 3
-static inline int block_size(int level) { return 4 << (2 * level); }
+static inline int block_shift(int level) { return 2 + 2 * level; }
+static inline int block_size(int level) { return 1 << block_shift(level); }
 
 /* Farthest stored depth per block, at each level. Level 0 is exact after every
  * write; levels 1 and 2 are recomputed from their children when marked dirty. A
@@ -478,7 +492,7 @@ static void bin_block_claims(const tri2d *t, int level, int bx, int by, bin_ctx 
 KERNEL void bin_block(const tri2d *t, int level, int bx, int by, bin_ctx *bc, const bool count) {
   const visbuf *vb = bc->tg->vb;
   int s = block_size(level);
-  if (!count && t->tmin > hiz_get(bc->hz, level, bx / s, by / s)) return;
+  if (!count && t->tmin > hiz_get(bc->hz, level, bx >> block_shift(level), by >> block_shift(level))) return;
   int ex = bx + s - 1 < vb->width - 1 ? bx + s - 1 : vb->width - 1;
   int ey = by + s - 1 < vb->height - 1 ? by + s - 1 : vb->height - 1;
   int64_t px = (int64_t)bx * SUBPIX + SUBPIX / 2, py = (int64_t)by * SUBPIX + SUBPIX / 2;
@@ -505,9 +519,8 @@ KERNEL void bin_block(const tri2d *t, int level, int bx, int by, bin_ctx *bc, co
     for (int y = y0; y <= y1; y++) wrote |= raster_row(t, x0, x1, y, bc->tg, true, count);
   } else {
     /* children that meet the triangle's rectangle */
-    int c = block_size(level - 1);
-    int cx0 = t->rect[0] > bx ? bx + (t->rect[0] - bx) / c * c : bx;
-    int cy0 = t->rect[1] > by ? by + (t->rect[1] - by) / c * c : by;
+    int c = block_size(level - 1), m = ~(c - 1);
+    int cx0 = t->rect[0] > bx ? t->rect[0] & m : bx, cy0 = t->rect[1] > by ? t->rect[1] & m : by;
     int cx1 = t->rect[2] < ex ? t->rect[2] : ex, cy1 = t->rect[3] < ey ? t->rect[3] : ey;
     for (int cy = cy0; cy <= cy1; cy += c)
       for (int cx = cx0; cx <= cx1; cx += c) {
@@ -529,18 +542,18 @@ static void bin_block_claims(const tri2d *t, int level, int bx, int by, bin_ctx 
 }
 
 /* The blocks of rows y0..y1 (a tile-aligned band) that meet a triangle's rectangle.
- * The hierarchy starts at the smallest block that holds the whole rectangle: a
- * larger one could not reject more samples, nor cull more by depth (a block's
- * farthest depth is at most its parent's). */
+ * The hierarchy starts at the smallest blocks at least half as large as the
+ * rectangle (it meets at most 3×3 of them): larger ones could not reject more
+ * samples, nor cull more by depth (a block's farthest depth is at most its
+ * parent's), and would only add tests. */
 KERNEL void raster_bin(const tri2d *t, int y0, int y1, bin_ctx *bc, const bool count) {
   int ry0 = y0 > t->rect[1] ? y0 : t->rect[1], ry1 = y1 < t->rect[3] ? y1 : t->rect[3];
+  int extent = t->rect[2] - t->rect[0] > ry1 - ry0 ? t->rect[2] - t->rect[0] : ry1 - ry0;
   int level = 0;
-  while (level < LEVELS - 1 &&
-         (t->rect[0] / block_size(level) != t->rect[2] / block_size(level) || ry0 / block_size(level) != ry1 / block_size(level)))
-    level++;
-  const int s = block_size(level);
-  for (int by = ry0 / s * s; by <= ry1; by += s)
-    for (int bx = t->rect[0] / s * s; bx <= t->rect[2]; bx += s) bin_block(t, level, bx, by, bc, count);
+  while (level < LEVELS - 1 && extent >= 2 * block_size(level)) level++;
+  const int s = block_size(level), m = ~(s - 1);
+  for (int by = ry0 & m; by <= ry1; by += s)
+    for (int bx = t->rect[0] & m; bx <= t->rect[2]; bx += s) bin_block(t, level, bx, by, bc, count);
 }
 
 /* ---- the pass: batches of setups, then bands of rows ------------------------- */
