@@ -5,8 +5,7 @@
 #include "rr.h"
 
 /* Samples a set-up triangle may cover, as an inclusive pixel rectangle. Returns
- * false when it covers none. Projected bounds get a one-pixel margin so rounding
- * in the edge functions can never put a hit outside the box. */
+ * false when it covers none. */
 /* Curved views: the cells whose cone no edge plane leaves wholly outside. */
 /* Curved views: does a cone of directions (unit axis, half-angle) miss the
  * triangle's directions? Two conservative tests: the triangle's bounding cap
@@ -81,7 +80,10 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri
   if (behind == 3) return false; /* every camera ray has d·fwd > 0: unreachable */
   if (projected == 3) {
     /* Sample (x + 0.5) lies in [x0, x1] for x in [ceil(x0 - 0.5), floor(x1 - 0.5)]. */
-    float m = 1.0f;
+    /* The margin covers the rounding of the projection and of the edge functions,
+     * a few ulps of the larger coordinate; a whole pixel would double the area of
+     * the small triangles of real meshes. */
+    float m = 1.0f / 64 + 1e-5f * fmaxf(fmaxf(fabsf(x0), fabsf(x1)), fmaxf(fabsf(y0), fabsf(y1)));
     float lx = fmaxf(ceilf(x0 - 0.5f - m), 0.0f), hx = fminf(floorf(x1 - 0.5f + m), (float)(c->width - 1));
     float ly = fmaxf(ceilf(y0 - 0.5f - m), 0.0f), hy = fminf(floorf(y1 - 0.5f + m), (float)(c->height - 1));
     if (lx > hx || ly > hy) return false;
