@@ -504,7 +504,7 @@ static void make_refs(int c, int thread, void *arg) {
 
 static void bvh_free(struct rr_bvh *b) {
   if (!b) return;
-  free(b->node_mem), free(b->prims);
+  free(b->node_mem), free(b->prims), free(b->pairs);
   free(b);
 }
 
@@ -671,8 +671,20 @@ rr_error bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out
   }
   b->nnodes = (uint32_t)total;
   for (uint32_t i = 0; i < n; i++) b->prims[i] = bd.refs[i].id;
+  /* Sibling pairs again with their bounds laid out for a two-box SIMD test. */
+  uint32_t npairs = (b->nnodes - 1) / 2;
+  b->pairs = aligned_alloc(64, ((size_t)npairs * sizeof(bvh_pair) + 64) & ~(size_t)63);
+  if (!b->pairs) goto oom;
+  for (uint32_t p = 0; p < npairs; p++) {
+    const bvh_node *c0 = &b->nodes[2 * p + 1], *c1 = &b->nodes[2 * p + 2];
+    bvh_pair *q = &b->pairs[p];
+    float *ax[3] = {q->x, q->y, q->z};
+    for (int a = 0; a < 3; a++) ax[a][0] = c0->lo[a], ax[a][1] = c1->lo[a], ax[a][2] = c0->hi[a], ax[a][3] = c1->hi[a];
+    q->first[0] = c0->first, q->first[1] = c1->first, q->count[0] = c0->count, q->count[1] = c1->count;
+  }
   b->sah_cost = sah_cost(b);
-  b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims;
+  b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
+             (uint64_t)npairs * sizeof(bvh_pair);
   b->build_ms = now_ms() - t0;
   *out = b;
   b = NULL;

@@ -119,9 +119,11 @@ typedef struct rr_bvh {
   struct bvh_pair *pairs; /* the children's bounds of each sibling pair, for SIMD tests */
 } rr_bvh;
 
-/* Sibling pair nodes[2p + 1], nodes[2p + 2] as lanes (lo0, lo1, hi0, hi1) per axis. */
+/* Sibling pair nodes[2p + 1], nodes[2p + 2] again (a copy for fast single-ray
+ * traversal): bounds as lanes (lo0, lo1, hi0, hi1) per axis, and their first/count. */
 typedef struct bvh_pair {
-  float x[4], y[4], z[4], pad[4];
+  float x[4], y[4], z[4];
+  uint32_t first[2], count[2];
 } bvh_pair;
 
 enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK = 128 };

@@ -22,6 +22,8 @@
 #include <string.h>
 
 #define RAY_MARGIN 0x1p-10f /* relative widening of box intervals (about 1e-3) */
+/* The kernels take constant mode flags: forcing them inline specialises each use. */
+#define KERNEL static inline __attribute__((always_inline))
 
 /* ---- per-frame triangle setups and exact pruning bounds ------------------------ */
 
@@ -150,9 +152,11 @@ static void setups_free(frame_setups *fs) { free(fs->ts), free(fs->live), free(f
 typedef struct {
   float o[3], inv[3];
   int nr[3], fr[3];
+  __m128 vo[3], vinv[3]; /* the same, broadcast, for pair tests */
+  bool neg[3];
 } ray_q;
 
-static inline void ray_q_init(ray_q *q, vec3 o, vec3 d) {
+KERNEL void ray_q_init(ray_q *q, vec3 o, vec3 d) {
   float dv[3] = {d.x, d.y, d.z}, ov[3] = {o.x, o.y, o.z};
   for (int a = 0; a < 3; a++) {
     q->o[a] = ov[a];
@@ -160,13 +164,39 @@ static inline void ray_q_init(ray_q *q, vec3 o, vec3 d) {
     bool neg = q->inv[a] < 0;
     q->nr[a] = neg ? 3 + a : a;
     q->fr[a] = neg ? a : 3 + a;
+    q->neg[a] = neg;
+    q->vo[a] = _mm_set1_ps(ov[a]);
+    q->vinv[a] = _mm_set1_ps(q->inv[a]);
   }
+}
+
+/* box_test() for both children of a pair at once: lanes (near0, near1, far0, far1)
+ * per axis, the same operations in the same order, so the same bits. Returns the
+ * hit bits (1: first child, 2: second) for t in [tmin, tmax], entries in tn[2]. */
+KERNEL int pair_test(const bvh_pair *p, const ray_q *q, float tmin, float tmax, float tn[2]) {
+  const float *ax[3] = {p->x, p->y, p->z};
+  __m128 t0 = _mm_set1_ps(-INFINITY), t1 = _mm_set1_ps(INFINITY);
+  for (int a = 0; a < 3; a++) {
+    __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(ax[a]), q->vo[a]), q->vinv[a]);
+    if (q->neg[a]) t = _mm_shuffle_ps(t, t, _MM_SHUFFLE(1, 0, 3, 2)); /* hi planes are the near ones */
+    t0 = _mm_max_ps(t, t0); /* a NaN lane yields t0: ignored, as in box_test */
+    t1 = _mm_min_ps(t, t1);
+  }
+  /* Lanes 0, 1 of t0 hold the entries, lanes 2, 3 of t1 the exits. */
+  const __m128 margin = _mm_set1_ps(RAY_MARGIN), abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
+  __m128 far = _mm_movehl_ps(t1, t1);
+  t0 = _mm_sub_ps(t0, _mm_mul_ps(_mm_and_ps(t0, abs_mask), margin));
+  far = _mm_add_ps(far, _mm_mul_ps(_mm_and_ps(far, abs_mask), margin));
+  __m128 ok = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(t0, far), _mm_cmple_ps(t0, _mm_set1_ps(tmax))),
+                         _mm_cmpge_ps(far, _mm_set1_ps(tmin)));
+  _mm_storel_pi((__m64 *)tn, t0);
+  return _mm_movemask_ps(ok) & 3;
 }
 
 /* Conservative ray-box test: true when the box may hold a point of the ray with
  * t in [tmin, tmax]; *tnear is the widened entry t. NaN slabs (the ray runs in a
  * box face) are ignored by the operand order of the comparisons. */
-static inline bool box_test(const bvh_node *n, const ray_q *q, float tmin, float tmax, float *tnear) {
+KERNEL bool box_test(const bvh_node *n, const ray_q *q, float tmin, float tmax, float *tnear) {
   const float *f = (const float *)n; /* lo[0..2], hi[0..2] */
   float t0 = -INFINITY, t1 = INFINITY;
   for (int a = 0; a < 3; a++) {
@@ -198,7 +228,7 @@ typedef struct {
 } ray_state;
 
 /* Tests a leaf's triangles; true when an any-hit query is answered. */
-static inline bool leaf_test(const rr_bvh *b, const bvh_node *n, ray_state *r, const int mode) {
+KERNEL bool leaf_test(const rr_bvh *b, const bvh_node *n, ray_state *r, const int mode) {
   for (uint32_t i = n->first, end = n->first + n->count; i < end; i++) {
     uint32_t id = b->prims[i];
     if (mode == MODE_PRIMARY) {
@@ -220,7 +250,7 @@ static inline bool leaf_test(const rr_bvh *b, const bvh_node *n, ray_state *r, c
 /* May node k hold the ray's winner? *tn: its widened box entry (the order key);
  * *key: what a later pop compares with the best t (primary rays: the node's exact
  * bound, other rays: the box entry). */
-static inline bool node_test(const rr_bvh *b, uint32_t k, const ray_state *r, float *tn, float *key, const int mode) {
+KERNEL bool node_test(const rr_bvh *b, uint32_t k, const ray_state *r, float *tn, float *key, const int mode) {
   if (mode == MODE_PRIMARY) {
     *key = r->fs->tlo[k];
     return !(*key > r->t) && box_test(&b->nodes[k], &r->q, r->tmin, INFINITY, tn);
@@ -230,36 +260,48 @@ static inline bool node_test(const rr_bvh *b, uint32_t k, const ray_state *r, fl
   return hit;
 }
 
-/* Front-to-back traversal of one ray: the nearer child first, the farther one
- * stacked and dropped on pop when the best t is already nearer than its key. */
-static inline bool trace1(const rr_bvh *b, ray_state *r, const int mode) {
+/* Front-to-back traversal of one ray over the sibling pairs: the nearer child
+ * first, the farther one stacked and dropped on pop when the best t is already
+ * nearer than its key (primary rays: the node's exact bound, other rays: the box
+ * entry). A node is carried as (index, first, count). */
+KERNEL bool trace1(const rr_bvh *b, ray_state *r, const int mode) {
   struct {
-    uint32_t node;
+    uint32_t node, first, count;
     float key;
   } stack[BVH_STACK];
   int sp = 0;
-  const bvh_node *nodes = b->nodes;
-  float tn0, tn1, k0, k1;
+  float tn0, k0;
   r->nodes++;
   if (!node_test(b, 0, r, &tn0, &k0, mode)) return false;
-  uint32_t cur = 0;
+  uint32_t cur = 0, first = b->nodes[0].first, count = b->nodes[0].count;
   for (;;) {
-    const bvh_node *n = &nodes[cur];
-    if (n->count) {
-      if (leaf_test(b, n, r, mode) && mode == MODE_ANY) return true;
+    if (count) {
+      bvh_node leaf = {.first = first, .count = count};
+      if (leaf_test(b, &leaf, r, mode) && mode == MODE_ANY) return true;
     } else {
-      bool h0 = node_test(b, n->first, r, &tn0, &k0, mode);
-      bool h1 = node_test(b, n->first + 1, r, &tn1, &k1, mode);
+      uint32_t p = (first - 1) / 2;
+      const bvh_pair *pr = &b->pairs[p];
+      float tn[2], k[2];
+      int hits;
+      if (mode == MODE_PRIMARY) {
+        k[0] = r->fs->tlo[first], k[1] = r->fs->tlo[first + 1];
+        hits = pair_test(pr, &r->q, r->tmin, INFINITY, tn);
+        hits &= (k[0] > r->t ? 0 : 1) | (k[1] > r->t ? 0 : 2);
+      } else {
+        hits = pair_test(pr, &r->q, r->tmin, r->t, tn);
+        k[0] = tn[0], k[1] = tn[1];
+      }
       r->nodes += 2;
-      if (h0 && h1) {
-        uint32_t nearer = n->first, farther = n->first + 1;
-        if (tn1 < tn0) nearer = n->first + 1, farther = n->first, k1 = k0;
-        stack[sp].node = farther, stack[sp].key = k1, sp++;
-        cur = nearer;
+      if (hits == 3) {
+        int nr = tn[1] < tn[0], fr = !nr;
+        stack[sp].node = first + fr, stack[sp].first = pr->first[fr], stack[sp].count = pr->count[fr];
+        stack[sp].key = k[fr], sp++;
+        cur = first + nr, count = pr->count[nr], first = pr->first[nr];
         continue;
       }
-      if (h0 | h1) {
-        cur = n->first + (h0 ? 0 : 1);
+      if (hits) {
+        int c = hits >> 1;
+        cur = first + c, count = pr->count[c], first = pr->first[c];
         continue;
       }
     }
@@ -268,8 +310,9 @@ static inline bool trace1(const rr_bvh *b, ray_state *r, const int mode) {
       sp--;
       if (!(stack[sp].key > r->t)) break; /* equal t may still win on id */
     }
-    cur = stack[sp].node;
+    cur = stack[sp].node, first = stack[sp].first, count = stack[sp].count;
   }
+  (void)cur;
 }
 
 /* ---- arbitrary rays -------------------------------------------------------------- */
@@ -407,7 +450,7 @@ static inline __m128 select_ps(__m128 m, __m128 a, __m128 b) { return _mm_or_ps(
 /* The lanes of `mask` whose rays meet the box and whose best t is not below the
  * node's bound tlo; *tnear is the smallest widened entry t among them. The same
  * arithmetic as box_test. */
-static inline uint64_t packet_box(const packet *p, const bvh_node *n, float tlo, uint64_t mask, float *tnear,
+KERNEL uint64_t packet_box(const packet *p, const bvh_node *n, float tlo, uint64_t mask, float *tnear,
                                   const bool uniform) {
   const float *f = (const float *)n;
   const __m128 margin = _mm_set1_ps(RAY_MARGIN), abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
@@ -451,7 +494,7 @@ static inline uint64_t packet_box(const packet *p, const bvh_node *n, float tlo,
   return hit;
 }
 
-static inline void packet_leaf(frame_job *j, packet *p, const bvh_node *n, uint64_t mask, ray_state *acc) {
+KERNEL void packet_leaf(frame_job *j, packet *p, const bvh_node *n, uint64_t mask, ray_state *acc) {
   const rr_bvh *b = j->b;
   visbuf pvb = {PK, PK, p->id, p->t, p->l1, p->l2};
   int cnt = __builtin_popcountll(mask);
@@ -467,7 +510,7 @@ static inline void packet_leaf(frame_job *j, packet *p, const bvh_node *n, uint6
   }
 }
 
-static inline void packet_trace(frame_job *j, packet *p, ray_state *acc, const bool uniform) {
+KERNEL void packet_trace(frame_job *j, packet *p, ray_state *acc, const bool uniform) {
   const bvh_node *nodes = j->b->nodes;
   struct {
     uint32_t node;

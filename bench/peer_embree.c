@@ -1,0 +1,137 @@
+/* Embree 3 peer: see peer_embree.h. */
+#include "peer_embree.h"
+
+#include <embree3/rtcore.h>
+#include <stdio.h>
+#include <string.h>
+
+struct peer_embree {
+  RTCDevice dev;
+  RTCScene scene;
+};
+
+static void embree_error(void *user, enum RTCError code, const char *msg) {
+  (void)user;
+  fprintf(stderr, "embree: error %d: %s\n", (int)code, msg);
+}
+
+peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double *build_ms) {
+  char cfg[64];
+  snprintf(cfg, sizeof cfg, "threads=%d", threads);
+  peer_embree *e = calloc(1, sizeof *e);
+  if (!e) return NULL;
+  e->dev = rtcNewDevice(cfg);
+  if (!e->dev) {
+    fprintf(stderr, "embree: cannot create a device (%s)\n", cfg);
+    free(e);
+    return NULL;
+  }
+  rtcSetDeviceErrorFunction(e->dev, embree_error, NULL);
+  /* One vertex per triangle corner, so triangle i has Embree primID i. */
+  RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+  float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                     (size_t)s->ntris * 3);
+  unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                         s->ntris);
+  if (!v || !ix) {
+    rtcReleaseGeometry(g);
+    peer_embree_release(e);
+    return NULL;
+  }
+  for (uint32_t i = 0; i < s->ntris; i++)
+    for (int k = 0; k < 3; k++) {
+      for (int c = 0; c < 3; c++) v[(3 * (size_t)i + k) * 3 + c] = s->p[k][c][i];
+      ix[3 * (size_t)i + k] = 3 * i + k;
+    }
+  rtcCommitGeometry(g);
+  e->scene = rtcNewScene(e->dev);
+  rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_NONE);
+  rtcSetSceneBuildQuality(e->scene, quality >= 2 ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
+  rtcAttachGeometry(e->scene, g);
+  rtcReleaseGeometry(g);
+  double t0 = now_ms();
+  rtcCommitScene(e->scene);
+  *build_ms = now_ms() - t0;
+  return e;
+}
+
+void peer_embree_release(peer_embree *e) {
+  if (!e) return;
+  if (e->scene) rtcReleaseScene(e->scene);
+  if (e->dev) rtcReleaseDevice(e->dev);
+  free(e);
+}
+
+enum { EMB_TILE = 32 };
+
+typedef struct {
+  peer_embree *e;
+  const camera *c;
+  int width, tiles_x;
+  uint32_t *ids;
+  float *t;
+} cast_job;
+
+static void cast1_tile(int job, int thread, void *arg) {
+  (void)thread;
+  cast_job *j = arg;
+  const camera *c = j->c;
+  int x0 = job % j->tiles_x * EMB_TILE, y0 = job / j->tiles_x * EMB_TILE;
+  struct RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  for (int y = y0; y < y0 + EMB_TILE && y < c->height; y++)
+    for (int x = x0; x < x0 + EMB_TILE && x < c->width; x++) {
+      vec3 d = camera_dir(c, (float)x + 0.5f, (float)y + 0.5f);
+      struct RTCRayHit rh;
+      rh.ray.org_x = c->eye.x, rh.ray.org_y = c->eye.y, rh.ray.org_z = c->eye.z;
+      rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+      rh.ray.tnear = 0, rh.ray.tfar = INFINITY, rh.ray.time = 0, rh.ray.mask = 0xFFFFFFFFu, rh.ray.id = 0,
+      rh.ray.flags = 0;
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID, rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(j->e->scene, &ctx, &rh);
+      size_t k = (size_t)y * c->width + x;
+      bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      j->ids[k] = hit ? rh.hit.primID : RR_MISS;
+      j->t[k] = hit ? rh.ray.tfar : INFINITY;
+    }
+}
+
+static void cast8_tile(int job, int thread, void *arg) {
+  (void)thread;
+  cast_job *j = arg;
+  const camera *c = j->c;
+  int x0 = job % j->tiles_x * EMB_TILE, y0 = job / j->tiles_x * EMB_TILE;
+  struct RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTC_ALIGN(32) struct RTCRayHit8 rh;
+  RTC_ALIGN(32) int valid[8];
+  for (int py = y0; py < y0 + EMB_TILE && py < c->height; py += 2)
+    for (int px = x0; px < x0 + EMB_TILE && px < c->width; px += 4) {
+      for (int l = 0; l < 8; l++) {
+        int x = px + (l & 3), y = py + (l >> 2);
+        valid[l] = x < c->width && y < c->height ? -1 : 0;
+        vec3 d = camera_dir(c, (float)x + 0.5f, (float)y + 0.5f);
+        rh.ray.org_x[l] = c->eye.x, rh.ray.org_y[l] = c->eye.y, rh.ray.org_z[l] = c->eye.z;
+        rh.ray.dir_x[l] = d.x, rh.ray.dir_y[l] = d.y, rh.ray.dir_z[l] = d.z;
+        rh.ray.tnear[l] = 0, rh.ray.tfar[l] = INFINITY, rh.ray.time[l] = 0, rh.ray.mask[l] = 0xFFFFFFFFu;
+        rh.ray.id[l] = 0, rh.ray.flags[l] = 0;
+        rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID, rh.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcIntersect8(valid, j->e->scene, &ctx, &rh);
+      for (int l = 0; l < 8; l++) {
+        if (!valid[l]) continue;
+        size_t k = (size_t)(py + (l >> 2)) * c->width + px + (l & 3);
+        bool hit = rh.hit.geomID[l] != RTC_INVALID_GEOMETRY_ID;
+        j->ids[k] = hit ? rh.hit.primID[l] : RR_MISS;
+        j->t[k] = hit ? rh.ray.tfar[l] : INFINITY;
+      }
+    }
+}
+
+double peer_embree_cast(peer_embree *e, const camera *c, int width, int threads, uint32_t *ids, float *t) {
+  cast_job j = {e, c, width, (c->width + EMB_TILE - 1) / EMB_TILE, ids, t};
+  int tiles = j.tiles_x * ((c->height + EMB_TILE - 1) / EMB_TILE);
+  double t0 = now_ms();
+  parallel_for(tiles, threads, width == 8 ? cast8_tile : cast1_tile, &j);
+  return now_ms() - t0;
+}

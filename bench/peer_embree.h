@@ -1,0 +1,20 @@
+/* Embree 3 as a peer of the ray-casting methods (bench only): the same triangles,
+ * the same rays (origin = eye, direction = camera_dir of each sample), the same
+ * thread pool (parallel_for). Compiled when the build finds Embree 3. */
+#ifndef RR_PEER_EMBREE_H
+#define RR_PEER_EMBREE_H
+#include "rr.h"
+
+typedef struct peer_embree peer_embree;
+
+/* Builds an Embree scene of s's triangles (RTC_SCENE_FLAG_NONE; quality 1 = MEDIUM,
+ * 2 = HIGH) on a device with "threads=N". *build_ms: the time of rtcCommitScene.
+ * NULL (and a message on stderr) on failure. */
+peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double *build_ms);
+void peer_embree_release(peer_embree *e);
+/* Casts one primary ray per pixel of camera c: width = 1 uses rtcIntersect1,
+ * width = 8 rtcIntersect8 on 2x4-pixel packets; tiles dealt to `threads` threads.
+ * Writes ids (RR_MISS on a miss) and t (+inf on a miss) in rastray's layout and
+ * returns the wall time in milliseconds. */
+double peer_embree_cast(peer_embree *e, const camera *c, int width, int threads, uint32_t *ids, float *t);
+#endif
