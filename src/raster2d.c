@@ -78,17 +78,18 @@ static bool inverse3(const double a[3], const double b[3], const double c[3], do
 }
 
 /* View matrix: world → eye space, x along right, y along up, z along fwd. The
- * projection inverts the camera's own rays: a point q = w·(d0 + sx·dx + sy·dy) has
- * homogeneous screen coordinates (sx·w, sy·w, w) = [dx dy d0]⁻¹·q, so every point of
- * the ray of sample (sx, sy) lands on (sx, sy) exactly, and w is the ray parameter
- * t. For this orthonormal pinhole it is the usual frustum matrix (x_e/tan_w, y_e/tan_h,
- * w = z_e). Clip space is OpenGL's for x and y (x/w, y/w in [-1, 1] on screen, y up);
- * the near plane is z_c = w − near ≥ 0. */
+ * projection inverts the camera's own rays, so every point of the ray of sample
+ * (sx, sy) lands on (sx, sy) exactly:
+ *   pinhole:      q = w·(d0 + sx·dx + sy·dy), so (sx·w, sy·w, w) = [dx dy d0]⁻¹·q and
+ *                 the ray parameter t is w (for this orthonormal camera it is the
+ *                 usual frustum matrix: x_e/tan_w, y_e/tan_h, w = z_e);
+ *   orthographic: q = o0 + sx·ox + sy·oy + t·fwd, so (sx, sy, t) = [ox oy fwd]⁻¹·(q − o0)
+ *                 and w = 1.
+ * Clip space is OpenGL's for x and y (x/w, y/w in [-1, 1] on screen, y up); the near
+ * plane is z_c = t − near ≥ 0. */
 static bool pipe_setup(pipe2d *pp, const rr_scene *s, const camera *c, bool cull) {
-  /* Only a pinhole projects through a matrix here. An orthographic camera would
-   * invert [ox oy fwd] the same way and keep w_c = 1; curved cameras have no
-   * projection matrix at all. */
-  if (c->type != RR_CAMERA_PERSPECTIVE) return false;
+  bool ortho = c->type == RR_CAMERA_ORTHOGRAPHIC;
+  if (c->type != RR_CAMERA_PERSPECTIVE && !ortho) return false; /* curved views have no projection */
   vec3 axis[3] = {c->right, c->up, c->fwd};
   double view[4][4] = {{0}}, proj[4][4] = {{0}};
   for (int r = 0; r < 3; r++) {
@@ -97,23 +98,30 @@ static bool pipe_setup(pipe2d *pp, const rr_scene *s, const camera *c, bool cull
     view[r][3] = -(a[0] * c->eye.x + a[1] * c->eye.y + a[2] * c->eye.z);
   }
   view[3][3] = 1;
-  /* The camera's dx, dy, d0 in eye space, and the inverse: rows sx·w, sy·w, w. */
-  vec3 d[3] = {c->dx, c->dy, c->d0};
-  double de[3][3], inv[3][3];
-  for (int k = 0; k < 3; k++)
-    for (int r = 0; r < 3; r++) de[k][r] = (double)d[k].x * axis[r].x + (double)d[k].y * axis[r].y + (double)d[k].z * axis[r].z;
+  /* The camera's sample parameterization in eye space, and its inverse. */
+  vec3 d[4] = {ortho ? c->ox : c->dx, ortho ? c->oy : c->dy, c->d0, ortho ? c->o0 : v3(0, 0, 0)};
+  double de[4][3], inv[3][3];
+  for (int k = 0; k < 4; k++)
+    for (int r = 0; r < 3; r++)
+      de[k][r] = (double)d[k].x * axis[r].x + (double)d[k].y * axis[r].y + (double)d[k].z * axis[r].z;
   if (!inverse3(de[0], de[1], de[2], inv)) return false;
+  /* Rows over eye space (x, y, z, 1): X = sx·w, Y = sy·w, W = w, T = t. */
+  double X[4], Y[4], W[4] = {0, 0, 0, 1}, T[4];
+  for (int j = 0; j < 3; j++) X[j] = inv[0][j], Y[j] = inv[1][j], T[j] = inv[2][j];
+  X[3] = -(inv[0][0] * de[3][0] + inv[0][1] * de[3][1] + inv[0][2] * de[3][2]);
+  Y[3] = -(inv[1][0] * de[3][0] + inv[1][1] * de[3][1] + inv[1][2] * de[3][2]);
+  T[3] = -(inv[2][0] * de[3][0] + inv[2][1] * de[3][1] + inv[2][2] * de[3][2]);
+  if (!ortho) memcpy(W, T, sizeof W);
   double hw = 0.5 * c->width, hh = 0.5 * c->height, near = near_distance(s);
-  for (int j = 0; j < 3; j++) {
-    proj[0][j] = inv[0][j] / hw - inv[2][j]; /* x_c = sx·w/hw − w */
-    proj[1][j] = inv[2][j] - inv[1][j] / hh; /* y_c = w − sy·w/hh */
-    proj[2][j] = inv[2][j];                  /* z_c = w − near */
-    proj[3][j] = inv[2][j];                  /* w_c = w = t */
+  for (int j = 0; j < 4; j++) {
+    proj[0][j] = X[j] / hw - W[j]; /* x_c = sx·w/hw − w */
+    proj[1][j] = W[j] - Y[j] / hh; /* y_c = w − sy·w/hh */
+    proj[2][j] = T[j];             /* z_c = t − near */
+    proj[3][j] = W[j];             /* w_c = w */
   }
-  proj[2][3] = -near;
+  proj[2][3] -= near;
   mat4_mul(pp->clip, proj, view);
-  /* t, the ray parameter along d = camera_dir(...), is w. */
-  for (int k = 0; k < 4; k++) pp->depth[k] = pp->clip[3][k];
+  for (int j = 0; j < 4; j++) pp->depth[j] = T[0] * view[0][j] + T[1] * view[1][j] + T[2] * view[2][j] + T[3] * view[3][j];
   pp->width = c->width, pp->height = c->height;
   pp->hw = hw, pp->hh = hh;
   pp->kx = GUARD_PX / hw, pp->ky = GUARD_PX / hh;
@@ -618,7 +626,7 @@ static rr_error run2d(rr_device *dev, const rr_scene *s, const camera *c, bool c
                       target tg, rr_stats *stats) {
   pipe2d pp;
   if (!pipe_setup(&pp, s, c, cull))
-    return rr_fail(dev, RR_ERROR_UNSUPPORTED, "2D rasterization needs a perspective camera");
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED, "2D rasterization needs a planar camera (perspective or orthographic)");
   job2d *job = calloc(1, sizeof *job);
   tri2d *tris = malloc((size_t)BATCH * MAX_SUB * sizeof *tris);
   hiz hz;

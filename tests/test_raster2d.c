@@ -74,6 +74,28 @@ static void check_projection(const rr_scene *s) {
   printf("projection: worst distance from the pixel centre %.2e pixels, %.2f float ulps of the ray\n", worst_px,
          worst);
   CHECK(worst < 4, "points on a pixel's ray land %.2f ulps of the ray from its centre", worst);
+  /* Orthographic: points along the ray of a sample, from its origin on the image plane. */
+  worst_px = 0;
+  for (int v = 0; v < 20; v++) {
+    rr_camera rc = pub_camera(v3(test_randf(-2, 2), test_randf(-2, 2), test_randf(-2, 2)), v3(0, 0, 0), v3(0, 1, 0), 45);
+    rc.type = RR_CAMERA_ORTHOGRAPHIC, rc.ortho_height = test_randf(0.5f, 4);
+    int w = 64 + (int)(test_rand() % 500), h = 64 + (int)(test_rand() % 500);
+    camera c;
+    if (camera_setup(dev, &rc, w, h, &c) != RR_OK) continue;
+    for (int k = 0; k < 20; k++) {
+      int x = (int)(test_rand() % (unsigned)w), y = (int)(test_rand() % (unsigned)h);
+      vec3 o, d;
+      camera_ray(&c, x, y, &o, &d);
+      double sx, sy;
+      if (!raster2d_project(s, &c, v3_add(o, v3_scale(d, test_randf(0.1f, 4))), &sx, &sy)) {
+        CHECK(0, "orthographic: a point in front of the image plane is behind the near plane");
+        continue;
+      }
+      worst_px = fmax(worst_px, fmax(fabs(sx - (x + 0.5)), fabs(sy - (y + 0.5))));
+    }
+  }
+  printf("orthographic projection: worst distance from the pixel centre %.2e pixels\n", worst_px);
+  CHECK(worst_px < 1e-3, "orthographic: points on a pixel's ray land %.2e pixels from its centre", worst_px);
 }
 
 /* ---- fill rule: every claim counted ---------------------------------------------- */
@@ -96,13 +118,20 @@ static void check_claims(const rr_scene *s, const camera *c, int mode, const cha
         holes += total == 0, doubles += total > 1;
       } else if (mode == 1) {
         doubles += total > 1;
+        /* where the ray meets the plane, and the size of a pixel there */
         int x = (int)(k % c->width), y = (int)(k / c->width);
-        vec3 d = camera_dir(c, x + 0.5f, y + 0.5f);
-        double t = -(double)c->eye.y / d.y;
-        double hx = c->eye.x + t * d.x, hz = c->eye.z + t * d.z;
-        double half = 0.5 * sqrt((double)s->ntris / 2);
-        double margin = t * fmax(v3_len(c->dx), v3_len(c->dy)) * v3_len(d) / fabs(d.y) / 64;
-        if (t > 0 && fabs(hx) < half - margin && fabs(hz) < half - margin) holes += total == 0;
+        double hit[3][3], t = 0;
+        for (int j = 0; j < 3; j++) {
+          vec3 o, d;
+          camera_ray(c, x + (j == 1), y + (j == 2), &o, &d);
+          double tj = -(double)o.y / d.y;
+          hit[j][0] = o.x + tj * d.x, hit[j][2] = o.z + tj * d.z;
+          if (j == 0) t = tj;
+        }
+        double pixel = fmax(hypot(hit[1][0] - hit[0][0], hit[1][2] - hit[0][2]),
+                            hypot(hit[2][0] - hit[0][0], hit[2][2] - hit[0][2]));
+        double half = 0.5 * sqrt((double)s->ntris / 2), margin = pixel / 64;
+        if (t > 0 && fabs(hit[0][0]) < half - margin && fabs(hit[0][2]) < half - margin) holes += total == 0;
       } else {
         doubles += front[k] > 1 || back[k] > 1;
         unequal += front[k] != back[k];
@@ -124,6 +153,20 @@ static void check_fill_rule(void) {
   check_claims(plane, &c, 0, "plane, pixel centres on vertices");
   c = make_cam(v3(0, 32, -0.5f), v3(0, 0, -0.5f), v3(0, 0, -1), 90, 64, 64);
   check_claims(plane, &c, 1, "plane, pixel centres on edges");
+  {
+    /* Orthographic, one pixel per cell: centres on vertices, then random views. */
+    rr_camera rc = pub_camera(v3(-0.5f, 10, -0.5f), v3(-0.5f, 0, -0.5f), v3(0, 0, -1), 45);
+    rc.type = RR_CAMERA_ORTHOGRAPHIC, rc.ortho_height = 64;
+    CHECK(camera_setup(dev, &rc, 64, 64, &c) == RR_OK, "orthographic camera");
+    check_claims(plane, &c, 0, "plane, orthographic, pixel centres on vertices");
+    for (int v = 0; v < 3; v++) {
+      rc = pub_camera(v3(test_randf(-20, 20), test_randf(2, 30), test_randf(-20, 20)),
+                      v3(test_randf(-10, 10), 0, test_randf(-10, 10)), v3(0, 1, 0), 45);
+      rc.type = RR_CAMERA_ORTHOGRAPHIC, rc.ortho_height = test_randf(5, 60);
+      CHECK(camera_setup(dev, &rc, 96, 72, &c) == RR_OK, "orthographic camera");
+      check_claims(plane, &c, 1, "plane, orthographic, random view");
+    }
+  }
   for (int v = 0; v < 6; v++) {
     vec3 eye = v3(test_randf(-20, 20), test_randf(2, 30), test_randf(-20, 20));
     vec3 target = v3(test_randf(-10, 10), 0, test_randf(-10, 10));
@@ -168,16 +211,30 @@ static int bitwise_diff(const rr_frame *a, const rr_frame *b) {
   return d;
 }
 
-/* The ray parameter of the hit of ray eye + t·d with triangle i's plane, in double. */
-static double exact_t(const rr_scene *s, uint32_t i, vec3 eye, vec3 d) {
+/* The ray of pixel (x, y) of a planar camera, from its parameterization in double
+ * (camera_ray rounds origin and direction to float). */
+static void exact_ray(const camera *c, int x, int y, double o[3], double d[3]) {
+  double sx = x + 0.5, sy = y + 0.5;
+  bool ortho = c->type == RR_CAMERA_ORTHOGRAPHIC;
+  vec3 a = ortho ? c->ox : c->dx, b = ortho ? c->oy : c->dy, z = ortho ? c->o0 : c->d0;
+  double u[3] = {z.x + sx * a.x + sy * b.x, z.y + sx * a.y + sy * b.y, z.z + sx * a.z + sy * b.z};
+  double e[3] = {c->eye.x, c->eye.y, c->eye.z}, f[3] = {c->fwd.x, c->fwd.y, c->fwd.z};
+  for (int k = 0; k < 3; k++) {
+    o[k] = ortho ? e[k] + u[k] : e[k];
+    d[k] = ortho ? f[k] : u[k];
+  }
+}
+
+/* The ray parameter of the hit of ray o + t·d with triangle i's plane, in double. */
+static double exact_t(const rr_scene *s, uint32_t i, const double o[3], const double d[3]) {
   double p[3][3], e1[3], e2[3];
   for (int k = 0; k < 3; k++) {
     vec3 v = scene_vertex(s, k, i);
-    p[k][0] = (double)v.x - eye.x, p[k][1] = (double)v.y - eye.y, p[k][2] = (double)v.z - eye.z;
+    p[k][0] = v.x - o[0], p[k][1] = v.y - o[1], p[k][2] = v.z - o[2];
   }
   for (int c = 0; c < 3; c++) e1[c] = p[1][c] - p[0][c], e2[c] = p[2][c] - p[0][c];
   double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-  return (n[0] * p[0][0] + n[1] * p[0][1] + n[2] * p[0][2]) / (n[0] * d.x + n[1] * d.y + n[2] * d.z);
+  return (n[0] * p[0][0] + n[1] * p[0][1] + n[2] * p[0][2]) / (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
 }
 
 typedef struct {
@@ -200,24 +257,28 @@ static agreement compare(const rr_scene *s, const camera *c, const rr_frame *a, 
     if (ia == RR_MISS) continue;
     g.hits++;
     int x = (int)(k % a->vb.width), y = (int)(k / a->vb.width);
-    vec3 d = camera_dir(c, x + 0.5f, y + 0.5f);
-    double ta = a->vb.t[k], ea = exact_t(s, ia, c->eye, d), err_a = fabs(ta - ea) / ea;
+    double o[3], d[3];
+    exact_ray(c, x, y, o, d);
+    /* Relative errors, but not below a floor: an orthographic image plane through the
+     * scene has depths near zero, where only absolute precision means anything. */
+    double floor_t = 1e-3 * v3_len(v3_sub(s->bmax, s->bmin));
+    double ta = a->vb.t[k], ea = exact_t(s, ia, o, d), err_a = fabs(ta - ea) / fmax(ea, floor_t);
     /* Where snapping alone puts the sample on the triangle (the ids differ), the
      * plane's depth is clamped to the triangle's: check the range only. */
-    double lo = INFINITY, hi = -INFINITY;
+    double lo = INFINITY, hi = -INFINITY, fd = c->fwd.x * d[0] + c->fwd.y * d[1] + c->fwd.z * d[2];
     for (int q = 0; q < 3; q++) {
-      vec3 p = v3_sub(scene_vertex(s, q, ia), c->eye);
-      double z = ((double)p.x * c->fwd.x + (double)p.y * c->fwd.y + (double)p.z * c->fwd.z) / v3_dot(c->fwd, c->d0);
+      vec3 v = scene_vertex(s, q, ia);
+      double z = ((v.x - o[0]) * c->fwd.x + (v.y - o[1]) * c->fwd.y + (v.z - o[2]) * c->fwd.z) / fd;
       lo = fmin(lo, z), hi = fmax(hi, z);
     }
-    g.depth_bad += !(ta >= lo * (1 - 1e-5) && ta <= hi * (1 + 1e-5));
+    g.depth_bad += !(ta >= lo - 1e-5 * fabs(lo) && ta <= hi + 1e-5 * fabs(hi));
     if (ia != ib) continue;
     g.depth_bad += !(err_a <= 1e-4);
     g.worst_2dr = fmax(g.worst_2dr, err_a);
     both++;
-    double tb = b->vb.t[k], err_b = fabs(tb - ea) / ea;
+    double tb = b->vb.t[k], err_b = fabs(tb - ea) / fmax(ea, floor_t);
     g.worst_3dr = fmax(g.worst_3dr, err_b);
-    if (fabs(ta - tb) <= 1e-4 * fmax(ta, tb)) depth_ok++;
+    if (fabs(ta - tb) <= 1e-4 * fmax(fmax(ta, tb), floor_t)) depth_ok++;
     else g.depth_diff++, g.depth_3dr_off += err_a <= 1e-4 && err_b > err_a;
     bary_ok += fabsf(a->vb.l1[k] - b->vb.l1[k]) <= 1e-2f && fabsf(a->vb.l2[k] - b->vb.l2[k]) <= 1e-2f;
   }
@@ -229,8 +290,9 @@ static agreement compare(const rr_scene *s, const camera *c, const rr_frame *a, 
 /* Renders one view with 2dr-bb (1 and 3 threads), 2dr-bin (1 and 2 threads) and
  * 3dr-bb; 2dr-bin must equal 2dr-bb bit for bit, and 2dr-bb must agree with 3dr-bb
  * on ids and hits at least as often as asked. Where the ids agree the depths must
- * agree within 1e-4, except where 3dr-bb's float depth is itself that far off the
- * exact hit; and every 2dr depth must be within 1e-4 of the exact hit there, and
+ * agree within 1e-4 (relative, or of 1e-3 of the scene's size near the image
+ * plane), except where 3dr-bb's float depth is itself that far off the exact hit;
+ * and every 2dr depth must be within 1e-4 of the exact hit there, and
  * within the triangle's depth range everywhere. */
 static agreement check_view(const rr_scene *s, const rr_camera *cam, int w, int h, int cull, const char *what,
                             double min_id, double min_hit) {
@@ -385,6 +447,15 @@ static void check_models(void) {
       char what[256];
       snprintf(what, sizeof what, "%s view %d", meshes[m], v);
       check_view(s, &cam, 512, 512, v == 1, what, 0.999, 0.9999);
+    }
+    /* Orthographic, from outside and with the image plane through the mesh. */
+    for (int v = 0; v < 2; v++) {
+      vec3 dir = v3_norm(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)));
+      rr_camera cam = pub_camera(v3_add(c, v3_scale(dir, r * (v ? 0.2f : 2))), c, v3(0, 1, 0), 45);
+      cam.type = RR_CAMERA_ORTHOGRAPHIC, cam.ortho_height = 2.2f * r;
+      char what[256];
+      snprintf(what, sizeof what, "%s orthographic view %d", meshes[m], v);
+      check_view(s, &cam, 512, 512, 0, what, 0.999, 0.9999);
     }
     rr_scene_release(s);
   }
