@@ -348,7 +348,14 @@ static int setup_scene_tri(const pipe2d *pp, const rr_scene *s, uint32_t i, tri2
 typedef struct target {
   visbuf *vb;
   uint8_t *front, *back;
+  float *heat; /* optional: edge evaluations charged to each sample (heat maps) */
 } target;
+
+/* Charges one evaluation to every sample of a rectangle; off the hot path. */
+static void charge(float *heat, int width, int x0, int y0, int x1, int y1) {
+  for (int y = y0; y <= y1; y++)
+    for (int x = x0; x <= x1; x++) heat[(size_t)y * width + x] += 1;
+}
 
 /* Shades covered sample k at (dx, dy) pixels from the triangle's reference sample;
  * qr, tr, r1, r2: the planes' values at the start of the row. count: claims mode. */
@@ -506,17 +513,22 @@ KERNEL void bin_block(const tri2d *t, int level, int bx, int by, bin_ctx *bc, co
   int64_t px = (int64_t)bx * SUBPIX + SUBPIX / 2, py = (int64_t)by * SUBPIX + SUBPIX / 2;
   int64_t dx = (int64_t)(ex - bx) * SUBPIX, dy = (int64_t)(ey - by) * SUBPIX;
   bool accept = true;
+  int64_t hi = 0;
   for (int i = 0; i < 3; i++) {
     int64_t e = t->a[i] * px + t->b[i] * py + t->c[i];
     int64_t ax = t->a[i] * dx, by_ = t->b[i] * dy;
-    int64_t hi = e + (ax > 0 ? ax : 0) + (by_ > 0 ? by_ : 0), lo = e + (ax < 0 ? ax : 0) + (by_ < 0 ? by_ : 0);
-    if (hi < 0) {
-      bc->evals += 4;
-      return;
-    }
+    int64_t lo = e + (ax < 0 ? ax : 0) + (by_ < 0 ? by_ : 0);
+    hi = e + (ax > 0 ? ax : 0) + (by_ > 0 ? by_ : 0);
+    if (hi < 0) break;
     accept &= lo >= 0;
   }
   bc->evals += 4; /* counted as the four corners, as 3dr-bin counts a bin */
+  if (bc->tg->heat) {
+    float *h = bc->tg->heat;
+    int w = vb->width;
+    h[(size_t)by * w + bx] += 1, h[(size_t)by * w + ex] += 1, h[(size_t)ey * w + bx] += 1, h[(size_t)ey * w + ex] += 1;
+  }
+  if (hi < 0) return;
   int x0 = bx, y0 = by, x1 = ex, y1 = ey;
   bool wrote = false;
   if (accept) {
@@ -538,6 +550,7 @@ KERNEL void bin_block(const tri2d *t, int level, int bx, int by, bin_ctx *bc, co
     return;
   }
   bc->evals += (uint64_t)(x1 - x0 + 1) * (uint64_t)(y1 - y0 + 1);
+  if (bc->tg->heat) charge(bc->tg->heat, vb->width, x0, y0, x1, y1);
   if (!count && wrote) hiz_update(bc->hz, vb, x0, y0, x1, y1);
 }
 
@@ -600,8 +613,13 @@ KERNEL void band_loop(job2d *job, int y0, int y1, int thread, const bool bin, co
     for (uint32_t k = 0; k < job->ntris[j]; k++) {
       const tri2d *t = &tris[k];
       if (t->rect[3] < y0 || t->rect[1] > y1) continue;
-      if (bin) raster_bin(t, y0, y1, &bc, count);
-      else evals += raster_bb(t, y0 > t->rect[1] ? y0 : t->rect[1], y1 < t->rect[3] ? y1 : t->rect[3], &job->tg, count);
+      if (bin) {
+        raster_bin(t, y0, y1, &bc, count);
+        continue;
+      }
+      int ry0 = y0 > t->rect[1] ? y0 : t->rect[1], ry1 = y1 < t->rect[3] ? y1 : t->rect[3];
+      evals += raster_bb(t, ry0, ry1, &job->tg, count);
+      if (job->tg.heat) charge(job->tg.heat, job->tg.vb->width, t->rect[0], ry0, t->rect[2], ry1);
     }
   }
   job->evals[thread] += evals + bc.evals;
@@ -656,12 +674,12 @@ static rr_error run2d(rr_device *dev, const rr_scene *s, const camera *c, bool c
 }
 
 rr_error vis_2dr_bb(rr_device *dev, render_ctx *ctx) {
-  target tg = {.vb = ctx->vb};
+  target tg = {.vb = ctx->vb, .heat = ctx->heat_e};
   return run2d(dev, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, false, ctx->threads, tg, ctx->stats);
 }
 
 rr_error vis_2dr_bin(rr_device *dev, render_ctx *ctx) {
-  target tg = {.vb = ctx->vb};
+  target tg = {.vb = ctx->vb, .heat = ctx->heat_e};
   return run2d(dev, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, true, ctx->threads, tg, ctx->stats);
 }
 
