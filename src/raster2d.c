@@ -260,10 +260,9 @@ static void snap(const pipe2d *pp, const cvert *c, int64_t *x, int64_t *y) {
   *y = (int64_t)(sy >= 0 ? sy + 0.5 : sy - 0.5);
 }
 
-/* Sets up one (sub-)triangle of snapped vertices; false when it covers no sample
- * (degenerate after snapping, culled, or between sample centres). */
-static bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], const double depth[3],
-                      const planes *pl, uint32_t id, tri2d *t) {
+/* Sets up the coverage of one (sub-)triangle of snapped vertices; false when it
+ * covers no sample (degenerate after snapping, culled, or between sample centres). */
+static bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], tri2d *t) {
   /* Twice the signed area, y down: negative for a triangle that is counter-clockwise
    * as the viewer sees it, the front face (as tri_setup_planar decides it). */
   int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
@@ -294,17 +293,21 @@ static bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], 
      * lies to its right (a > 0), or below for a horizontal edge (b > 0). */
     if (!(a > 0 || (a == 0 && b > 0))) t->c[i] -= 1;
   }
-  plane_at(pl->w, (int)x0, (int)y0, t->pw);
-  plane_at(pl->t, (int)x0, (int)y0, t->pt);
-  plane_at(pl->l1, (int)x0, (int)y0, t->p1);
-  plane_at(pl->l2, (int)x0, (int)y0, t->p2);
+  return true;
+}
+
+/* Sets up the interpolation of a (sub-)triangle that covers samples. */
+static void setup_interp(tri2d *t, const planes *pl, const double depth[3], uint32_t id) {
+  plane_at(pl->w, t->rect[0], t->rect[1], t->pw);
+  plane_at(pl->t, t->rect[0], t->rect[1], t->pt);
+  plane_at(pl->l1, t->rect[0], t->rect[1], t->p1);
+  plane_at(pl->l2, t->rect[0], t->rect[1], t->p2);
   /* Depth is linear on the triangle, so its range is that of the vertices. The
    * clamp also makes early-z exact: no sample of the triangle is nearer than tmin. */
   double lo = depth[0] < depth[1] ? depth[0] : depth[1], hi = depth[0] > depth[1] ? depth[0] : depth[1];
   t->tmin = (float)(lo < depth[2] ? lo : depth[2]);
   t->tmax = (float)(hi > depth[2] ? hi : depth[2]);
   t->id = id;
-  return true;
 }
 
 /* Vertex stage, clipping and setup of scene triangle i; appends up to MAX_SUB
@@ -319,8 +322,13 @@ static int setup_scene_tri(const pipe2d *pp, const rr_scene *s, uint32_t i, tri2
     all &= code, any |= code;
   }
   if (all) return 0; /* wholly beyond one plane: off screen or behind the near plane */
+  /* The interpolation planes come from the unclipped triangle, and only once a
+   * part of it covers a sample (most triangles of a large scene cover none). */
+  const cvert *orig = poly[0];
+  cvert saved[3];
+  if (any & ((1u << CLIP_PLANES) - 1)) memcpy(saved, poly[0], sizeof saved), orig = saved;
   planes pl;
-  if (!interpolation_planes(pp, poly[0], &pl)) return 0;
+  bool have_planes = false;
   int n = 3, cur = 0;
   for (int p = 0; p < CLIP_PLANES && n >= 3; p++) {
     if (!(any & (1u << p))) continue;
@@ -334,9 +342,11 @@ static int setup_scene_tri(const pipe2d *pp, const rr_scene *s, uint32_t i, tri2
   int m = 0;
   for (int k = 1; k + 1 < n; k++) {
     int64_t tx[3] = {X[0], X[k], X[k + 1]}, ty[3] = {Y[0], Y[k], Y[k + 1]};
-    double depth[3] = {poly[cur][0].v[CT], poly[cur][k].v[CT], poly[cur][k + 1].v[CT]};
     ++*setups;
-    if (setup_tri(pp, tx, ty, depth, &pl, i, &out[m])) m++;
+    if (!setup_tri(pp, tx, ty, &out[m])) continue;
+    if (!have_planes && !(have_planes = interpolation_planes(pp, orig, &pl))) return 0;
+    double depth[3] = {poly[cur][0].v[CT], poly[cur][k].v[CT], poly[cur][k + 1].v[CT]};
+    setup_interp(&out[m++], &pl, depth, i);
   }
   return m;
 }
