@@ -62,11 +62,19 @@ static inline void box_grow(box4 *b, __m128 lo, __m128 hi) {
 
 static inline void box_merge(box4 *b, box4 o) { box_grow(b, o.lo, o.hi); }
 
-/* Half the surface area, in double so that huge extents do not overflow. */
-static double half_area(box4 b) {
-  float lo[4], hi[4];
-  _mm_storeu_ps(lo, b.lo), _mm_storeu_ps(hi, b.hi);
-  if (!(lo[0] <= hi[0])) return 0;
+/* Half the surface area: in float lanes, and again in double when that overflows
+ * (boxes wider than about 1e19). An empty box has none. */
+static inline double half_area(box4 b) {
+  __m128 e = _mm_sub_ps(b.hi, b.lo);
+  __m128 p = _mm_mul_ps(e, _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1)));
+  float v[4], lo[4];
+  _mm_storeu_ps(v, p);
+  float a = v[0] + v[1] + v[2];
+  if (isfinite(a) && a >= 0) return a;
+  _mm_storeu_ps(lo, b.lo), _mm_storeu_ps(v, e);
+  if (!(v[0] >= 0)) return 0; /* empty (or NaN) */
+  float hi[4];
+  _mm_storeu_ps(hi, b.hi);
   double x = (double)hi[0] - lo[0], y = (double)hi[1] - lo[1], z = (double)hi[2] - lo[2];
   return x * y + y * z + z * x;
 }
@@ -159,21 +167,22 @@ static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, doub
   for (int a = 0; a < 3; a++) {
     if (!m->ok[a]) continue;
     double rcost[BVH_MAX_BINS];
+    uint32_t rcnt[BVH_MAX_BINS];
     box4 acc = box_empty();
     uint32_t cnt = 0;
     for (int i = nb - 1; i > 0; i--) {
-      if (b->n[a][i]) box_merge(&acc, b->box[a][i]);
-      cnt += b->n[a][i];
-      rcost[i] = half_area(acc) * cnt;
+      if (b->n[a][i]) box_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = half_area(acc) * cnt;
+      else rcost[i] = i + 1 < nb ? rcost[i + 1] : 0;
+      rcnt[i] = cnt;
     }
     acc = box_empty(), cnt = 0;
+    double lcost = 0;
     for (int i = 1; i < nb; i++) {
-      if (b->n[a][i - 1]) box_merge(&acc, b->box[a][i - 1]);
-      cnt += b->n[a][i - 1];
-      uint32_t right = 0;
-      for (int j = i; j < nb && !right; j++) right = b->n[a][j];
-      if (!cnt || !right) continue;
-      double c = half_area(acc) * cnt + rcost[i];
+      if (b->n[a][i - 1]) box_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1], lcost = half_area(acc) * cnt;
+      /* Only splits at a bin boundary with triangles on both sides, and the first
+       * of equal candidates (a run of empty bins gives equal costs). */
+      if (!cnt || !rcnt[i] || !b->n[a][i]) continue;
+      double c = lcost + rcost[i];
       if (!found || c < *cost) found = true, *cost = c, *axis = a, *pos = i;
     }
   }
@@ -286,8 +295,8 @@ static void chunk_copy(int c, int thread, void *arg) {
 
 static int bins_for(const builder *bd, uint32_t count) {
   /* Few references gain nothing from many bins but pay for the sweep. */
-  int nb = count < (uint32_t)bd->bins ? (int)count + 4 : bd->bins;
-  return nb > bd->bins ? bd->bins : nb;
+  int nb = count < (uint32_t)bd->bins ? (int)count : bd->bins;
+  return nb < 4 ? (bd->bins < 4 ? bd->bins : 4) : nb;
 }
 
 static void median_split(builder *bd, const task *t, split *sp) {
@@ -502,9 +511,66 @@ static void make_refs(int c, int thread, void *arg) {
   j->cb[2 * c] = b, j->cb[2 * c + 1] = cb;
 }
 
+/* ---- the 4-wide copy ------------------------------------------------------------ */
+
+static double node_area(const bvh_node *n) {
+  double x = (double)n->hi[0] - n->lo[0], y = (double)n->hi[1] - n->lo[1], z = (double)n->hi[2] - n->lo[2];
+  return x * y + y * z + z * x;
+}
+
+/* Makes wide node w from binary node k: k's children, then the inner slot with
+ * the largest area opened into its two children until four slots are used. */
+static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
+  uint32_t slot[4], n = 0;
+  const bvh_node *nk = &b->nodes[k];
+  if (nk->count) slot[n++] = k; /* a leaf root */
+  else slot[n++] = nk->first, slot[n++] = nk->first + 1;
+  while (n < 4) {
+    int open = -1;
+    double best = -1;
+    for (uint32_t i = 0; i < n; i++) {
+      const bvh_node *c = &b->nodes[slot[i]];
+      if (!c->count && node_area(c) > best) best = node_area(c), open = (int)i;
+    }
+    if (open < 0) break;
+    uint32_t first = b->nodes[slot[open]].first;
+    for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1];
+    slot[open] = first, slot[open + 1] = first + 1, n++;
+  }
+  bvh_wide *wn = &b->wide[w];
+  for (int i = 0; i < 4; i++) {
+    b->wide_node[4 * w + i] = i < (int)n ? slot[i] : UINT32_MAX;
+    for (int a = 0; a < 3; a++) {
+      wn->lo[a][i] = i < (int)n ? b->nodes[slot[i]].lo[a] : INFINITY;
+      wn->hi[a][i] = i < (int)n ? b->nodes[slot[i]].hi[a] : -INFINITY;
+    }
+    wn->ref[i] = i < (int)n ? 0 : UINT32_MAX, wn->count[i] = 0;
+    if (i >= (int)n) continue;
+    const bvh_node *c = &b->nodes[slot[i]];
+    if (c->count) {
+      wn->ref[i] = c->first, wn->count[i] = c->count;
+    } else {
+      wn->ref[i] = (*next)++;
+      collapse_node(b, wn->ref[i], slot[i], next);
+    }
+  }
+}
+
+static bool collapse_wide(rr_bvh *b) {
+  /* At most one wide node per inner binary node (plus a leaf root). */
+  uint32_t cap = (b->nnodes - 1) / 2 + 1;
+  b->wide = aligned_alloc(64, (size_t)cap * sizeof(bvh_wide));
+  b->wide_node = malloc((size_t)cap * 4 * sizeof(uint32_t));
+  if (!b->wide || !b->wide_node) return false;
+  uint32_t next = 1;
+  collapse_node(b, 0, 0, &next);
+  b->nwide = next;
+  return true;
+}
+
 static void bvh_free(struct rr_bvh *b) {
   if (!b) return;
-  free(b->node_mem), free(b->prims), free(b->pairs);
+  free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node);
   free(b);
 }
 
@@ -671,20 +737,10 @@ rr_error bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out
   }
   b->nnodes = (uint32_t)total;
   for (uint32_t i = 0; i < n; i++) b->prims[i] = bd.refs[i].id;
-  /* Sibling pairs again with their bounds laid out for a two-box SIMD test. */
-  uint32_t npairs = (b->nnodes - 1) / 2;
-  b->pairs = aligned_alloc(64, ((size_t)npairs * sizeof(bvh_pair) + 64) & ~(size_t)63);
-  if (!b->pairs) goto oom;
-  for (uint32_t p = 0; p < npairs; p++) {
-    const bvh_node *c0 = &b->nodes[2 * p + 1], *c1 = &b->nodes[2 * p + 2];
-    bvh_pair *q = &b->pairs[p];
-    float *ax[3] = {q->x, q->y, q->z};
-    for (int a = 0; a < 3; a++) ax[a][0] = c0->lo[a], ax[a][1] = c1->lo[a], ax[a][2] = c0->hi[a], ax[a][3] = c1->hi[a];
-    q->first[0] = c0->first, q->first[1] = c1->first, q->count[0] = c0->count, q->count[1] = c1->count;
-  }
+  if (!collapse_wide(b)) goto oom;
   b->sah_cost = sah_cost(b);
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
-             (uint64_t)npairs * sizeof(bvh_pair);
+             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t));
   b->build_ms = now_ms() - t0;
   *out = b;
   b = NULL;

@@ -116,15 +116,18 @@ typedef struct rr_bvh {
   void *node_mem;  /* the allocation behind nodes (sibling pairs share a cache line) */
   uint32_t nprims; /* triangles the tree was built over (== scene->ntris when current) */
   int bins, leaf_size;
-  struct bvh_pair *pairs; /* the children's bounds of each sibling pair, for SIMD tests */
+  struct bvh_wide *wide; /* the same tree collapsed to 4 children per node, for single rays */
+  uint32_t *wide_node;   /* per wide node, per slot: the node of `nodes` it is (UINT32_MAX: empty) */
+  uint32_t nwide;
 } rr_bvh;
 
-/* Sibling pair nodes[2p + 1], nodes[2p + 2] again (a copy for fast single-ray
- * traversal): bounds as lanes (lo0, lo1, hi0, hi1) per axis, and their first/count. */
-typedef struct bvh_pair {
-  float x[4], y[4], z[4];
-  uint32_t first[2], count[2];
-} bvh_pair;
+/* A 4-wide node: up to four of the binary tree's nodes side by side, bounds as
+ * lanes per axis (an empty slot has an empty box). A slot with count > 0 is a leaf
+ * holding prims [ref, ref + count); with count 0 it is wide node `ref`. Root: 0. */
+typedef struct bvh_wide {
+  float lo[3][4], hi[3][4];
+  uint32_t ref[4], count[4];
+} bvh_wide;
 
 enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK = 128 };
 
@@ -341,6 +344,9 @@ rr_error vis_rc(rr_device *dev, render_ctx *ctx);
 /* rc-bvh and rc-packet: single rays and 8x8 ray packets through the BVH (src/vis_rc_bvh.c). */
 rr_error vis_rc_bvh(rr_device *dev, render_ctx *ctx);
 rr_error vis_rc_packet(rr_device *dev, render_ctx *ctx);
+/* The least t that sample_test() can return for a set-up triangle at any sample of
+ * a w × h image (planar cameras): the exact pruning bound of rc-bvh and rc-packet. */
+float tri_t_lower_bound(const tri_setup *ts, int w, int h);
 /* 2dr-bb and 2dr-bin: projection, clipping, fixed-point 2D edge functions (src/raster2d.c). */
 rr_error vis_2dr_bb(rr_device *dev, render_ctx *ctx);
 rr_error vis_2dr_bin(rr_device *dev, render_ctx *ctx);

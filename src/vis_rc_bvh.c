@@ -19,6 +19,7 @@
 #include "rr.h"
 
 #include <emmintrin.h>
+#include <stddef.h>
 #include <string.h>
 
 #define RAY_MARGIN 0x1p-10f /* relative widening of box intervals (about 1e-3) */
@@ -34,61 +35,68 @@
  * box entry distances are not, because a triangle seen at a grazing angle can
  * compute a t well in front of its own box (measured: 2.4% at sin = 0.004 on the
  * ogre), and rc / 3dr-bb keep such hits. Box tests then only cull rays that miss. */
+/* A triangle's setup with its id (RR_MISS when culled for this camera): the one
+ * stream of memory a leaf reads. */
+typedef struct {
+  tri_setup ts;
+  uint32_t id;
+} leaf_tri;
+
 typedef struct {
   const rr_scene *s;
   const rr_bvh *b;
   const camera *cam;
   bool cull;
-  tri_setup *ts;  /* by position in b->prims */
-  uint8_t *live;  /* 0: culled for this camera */
+  leaf_tri *ts;   /* by position in b->prims */
   float *tlo;     /* by node */
+  float *tlo4;    /* by wide node and slot (+inf for an empty slot) */
 } frame_setups;
 
-/* Upper bound of max over the samples of the image where edge values e_i >= -u_i
- * of Σ(e_i + u_i), for the exact edge functions E_i = a + sx·b + sy·c of ts. */
-static double sum_bound(const tri_setup *ts, const double u[3], double w, double h) {
-  /* The region {E_i >= -u_i} is the triangle of the three lines E_i = -u_i when
-   * each line's opposite vertex satisfies its constraint with room to spare; its
-   * maximum is at a vertex. Otherwise bound over the image rectangle. */
-  double best = -INFINITY;
-  bool bounded = true;
-  for (int k = 0; k < 3 && bounded; k++) {
-    int i = (k + 1) % 3, j = (k + 2) % 3;
-    double bi = ts->b[i], ci = ts->c[i], bj = ts->b[j], cj = ts->c[j];
-    double ri = -u[i] - ts->a[i], rj = -u[j] - ts->a[j];
-    double det = bi * cj - bj * ci, scale = fabs(bi * cj) + fabs(bj * ci);
-    if (!(fabs(det) > 1e-9 * scale)) {
-      bounded = false;
-      break;
-    }
-    double sx = (ri * cj - rj * ci) / det, sy = (bi * rj - bj * ri) / det;
-    double ek = ts->a[k] + sx * ts->b[k] + sy * ts->c[k];
-    double mag = fabs(ts->a[k]) + fabs(sx * ts->b[k]) + fabs(sy * ts->c[k]);
-    if (!isfinite(ek) || !(ek + u[k] > 1e-9 * mag)) {
-      bounded = false;
-      break;
-    }
-    double sum = ek + u[k]; /* Σ(E + u) at the vertex: the other two are 0 there */
-    best = sum > best ? sum : best;
+/* The least t sample_test() can return for ts at a sample of a w × h image.
+ *
+ * The float error of tri_edges() is below u_i = 4u·(|a| + |sx·b| + |sy·c|)
+ * (u = 2^-24, bounded over the image); a passing sample has every computed
+ * e_i >= 0, so it lies in P = {E_i >= -u_i} for the exact edge functions E_i of
+ * the setup values, the computed sum is at most (1+u)^2 Σ(E_i + u_i) and
+ * t = vol·(1/sum) at least vol·(1-u)^2 / that. Σ(E_i + u_i) is affine, so its
+ * maximum over P is at a vertex of P; at the vertex where E_i + u_i and
+ * E_j + u_j vanish it equals det[a' b c] / (b_i·c_j - b_j·c_i) (Cramer; a' = a + u),
+ * and P is that bounded triangle when all three values are positive. Otherwise
+ * the maximum over the image rectangle bounds it. Double arithmetic carries a
+ * relative slack far above its own rounding. */
+float tri_t_lower_bound(const tri_setup *ts, int w, int h) {
+  const double u = 0x1p-24, slack = 1e-12;
+  double a[3], b[3], c[3];
+  for (int i = 0; i < 3; i++) {
+    b[i] = ts->b[i], c[i] = ts->c[i];
+    a[i] = ts->a[i] + 4 * u * (fabs(ts->a[i]) + w * fabs(b[i]) + h * fabs(c[i]));
   }
-  if (bounded) return best * (1 + 1e-6);
-  double A = 0, B = 0, C = 0;
-  for (int i = 0; i < 3; i++) A += (double)ts->a[i] + u[i], B += ts->b[i], C += ts->c[i];
-  double m = A + fmax(0.5 * B, (w - 0.5) * B) + fmax(0.5 * C, (h - 0.5) * C);
-  return m + 1e-6 * (fabs(A) + fabs(w * B) + fabs(h * C));
-}
-
-/* The least t sample_test() can return for ts at a sample of a w × h image. The
- * float error of tri_edges() is below 4u·(|a| + |sx·b| + |sy·c|) (u = 2^-24); a
- * passing sample has e_i >= 0, so the computed sum is at most (1+u)^2 Σ(E_i + u_i)
- * and t = vol·(1/sum) at least vol·(1-u)^2 / that. */
-static float t_lower_bound(const tri_setup *ts, int w, int h) {
-  const double u = 0x1p-24;
-  double ub[3];
-  for (int i = 0; i < 3; i++) ub[i] = 4 * u * (fabs(ts->a[i]) + w * fabs(ts->b[i]) + h * fabs(ts->c[i]));
-  double smax = sum_bound(ts, ub, w, h);
+  double smax = -INFINITY;
+  double m[3], mag_m[3];
+  for (int k = 0; k < 3; k++) {
+    int i = (k + 1) % 3, j = (k + 2) % 3;
+    m[k] = b[i] * c[j] - b[j] * c[i], mag_m[k] = fabs(b[i] * c[j]) + fabs(b[j] * c[i]);
+  }
+  double det = a[0] * m[0] + a[1] * m[1] + a[2] * m[2];
+  double mag_d = fabs(a[0]) * mag_m[0] + fabs(a[1]) * mag_m[1] + fabs(a[2]) * mag_m[2];
+  /* Bounded when det and the three minors share a sign (either: it depends on how
+   * the triangle's projection turns on screen), each clear of the slack. */
+  double sg = det < 0 ? -1 : 1;
+  bool bounded = sg * det > slack * mag_d;
+  for (int k = 0; k < 3 && bounded; k++) {
+    bounded = sg * m[k] > slack * mag_m[k];
+    if (bounded) {
+      double v = (sg * det + slack * mag_d) / (sg * m[k] - slack * mag_m[k]);
+      smax = v > smax ? v : smax;
+    }
+  }
+  if (!bounded) {
+    double A = a[0] + a[1] + a[2], B = b[0] + b[1] + b[2], C = c[0] + c[1] + c[2];
+    smax = A + fmax(0.5 * B, (w - 0.5) * B) + fmax(0.5 * C, (h - 0.5) * C);
+    smax += slack * (fabs(A) + w * fabs(B) + h * fabs(C));
+  }
   if (!(smax > 0)) return INFINITY; /* no sample can pass */
-  double t = (double)ts->vol * (1 - u) * (1 - u) / (smax * (1 + u) * (1 + u)) * (1 - 1e-6);
+  double t = (double)ts->vol * (1 - u) * (1 - u) / (smax * (1 + u) * (1 + u)) * (1 - 1e-9);
   float f = (float)t;
   return (double)f > t ? nextafterf(f, 0) : f;
 }
@@ -111,9 +119,10 @@ static void setup_leaves(int job, int thread, void *arg) {
     if (!n->count) continue;
     float tlo = INFINITY;
     for (uint32_t i = n->first; i < n->first + n->count; i++) {
-      fs->live[i] = tri_setup_planar(fs->s, b->prims[i], fs->cam, fs->cull, &fs->ts[i]) != SETUP_CULLED;
-      if (!fs->live[i]) continue;
-      float t = t_lower_bound(&fs->ts[i], fs->cam->width, fs->cam->height);
+      bool live = tri_setup_planar(fs->s, b->prims[i], fs->cam, fs->cull, &fs->ts[i].ts) != SETUP_CULLED;
+      fs->ts[i].id = live ? b->prims[i] : RR_MISS;
+      if (!live) continue;
+      float t = tri_t_lower_bound(&fs->ts[i].ts, fs->cam->width, fs->cam->height);
       tlo = t < tlo ? t : tlo;
     }
     fs->tlo[k] = tlo;
@@ -124,10 +133,10 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
   *fs = (frame_setups){.s = ctx->scene, .b = b, .cam = ctx->cam, .cull = ctx->opt->cull_backfaces != 0};
   size_t n = b->nprims;
   fs->ts = malloc(n * sizeof *fs->ts + 1);
-  fs->live = malloc(n + 1);
   fs->tlo = malloc((size_t)b->nnodes * sizeof *fs->tlo + 1);
-  if (!fs->ts || !fs->live || !fs->tlo) {
-    free(fs->ts), free(fs->live), free(fs->tlo);
+  fs->tlo4 = aligned_alloc(16, (size_t)b->nwide * 4 * sizeof *fs->tlo4);
+  if (!fs->ts || !fs->tlo || !fs->tlo4) {
+    free(fs->ts), free(fs->tlo), free(fs->tlo4);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %zu triangle setups", n);
   }
   setup_job sj = {fs, SETUP_CHUNK};
@@ -139,11 +148,13 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
     float l = fs->tlo[nd->first], r = fs->tlo[nd->first + 1];
     fs->tlo[k] = l < r ? l : r;
   }
+  for (size_t k = 0; k < 4 * (size_t)b->nwide; k++)
+    fs->tlo4[k] = b->wide_node[k] == UINT32_MAX ? INFINITY : fs->tlo[b->wide_node[k]];
   ctx->stats->setups += n;
   return RR_OK;
 }
 
-static void setups_free(frame_setups *fs) { free(fs->ts), free(fs->live), free(fs->tlo); }
+static void setups_free(frame_setups *fs) { free(fs->ts), free(fs->tlo), free(fs->tlo4); }
 
 /* ---- one ray ------------------------------------------------------------------ */
 
@@ -152,8 +163,8 @@ static void setups_free(frame_setups *fs) { free(fs->ts), free(fs->live), free(f
 typedef struct {
   float o[3], inv[3];
   int nr[3], fr[3];
-  __m128 vo[3], vinv[3]; /* the same, broadcast, for pair tests */
-  bool neg[3];
+  __m128 vo[3], vinv[3]; /* the same, broadcast, for 4-wide tests */
+  int wn[3], wf[3];      /* byte offsets of the near / far lanes in a bvh_wide */
 } ray_q;
 
 KERNEL void ray_q_init(ray_q *q, vec3 o, vec3 d) {
@@ -164,51 +175,32 @@ KERNEL void ray_q_init(ray_q *q, vec3 o, vec3 d) {
     bool neg = q->inv[a] < 0;
     q->nr[a] = neg ? 3 + a : a;
     q->fr[a] = neg ? a : 3 + a;
-    q->neg[a] = neg;
+    q->wn[a] = (int)(neg ? offsetof(bvh_wide, hi[a]) : offsetof(bvh_wide, lo[a]));
+    q->wf[a] = (int)(neg ? offsetof(bvh_wide, lo[a]) : offsetof(bvh_wide, hi[a]));
     q->vo[a] = _mm_set1_ps(ov[a]);
     q->vinv[a] = _mm_set1_ps(q->inv[a]);
   }
 }
 
-/* box_test() for both children of a pair at once: lanes (near0, near1, far0, far1)
- * per axis, the same operations in the same order, so the same bits. Returns the
- * hit bits (1: first child, 2: second) for t in [tmin, tmax], entries in tn[2]. */
-KERNEL int pair_test(const bvh_pair *p, const ray_q *q, float tmin, float tmax, float tn[2]) {
-  const float *ax[3] = {p->x, p->y, p->z};
+/* box_test() for the four slots of a wide node at once (same operations, same
+ * order). Returns the slots whose box the ray meets with exit >= tmin and whose
+ * `key` (per slot) is not above `best`; the widened entries go to tn. */
+KERNEL int wide_test(const bvh_wide *w, const ray_q *q, float tmin, __m128 key, float best, __m128 *tn) {
+  const char *base = (const char *)w;
   __m128 t0 = _mm_set1_ps(-INFINITY), t1 = _mm_set1_ps(INFINITY);
   for (int a = 0; a < 3; a++) {
-    __m128 t = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(ax[a]), q->vo[a]), q->vinv[a]);
-    if (q->neg[a]) t = _mm_shuffle_ps(t, t, _MM_SHUFFLE(1, 0, 3, 2)); /* hi planes are the near ones */
-    t0 = _mm_max_ps(t, t0); /* a NaN lane yields t0: ignored, as in box_test */
-    t1 = _mm_min_ps(t, t1);
+    __m128 tnear = _mm_mul_ps(_mm_sub_ps(_mm_load_ps((const float *)(base + q->wn[a])), q->vo[a]), q->vinv[a]);
+    __m128 tfar = _mm_mul_ps(_mm_sub_ps(_mm_load_ps((const float *)(base + q->wf[a])), q->vo[a]), q->vinv[a]);
+    t0 = _mm_max_ps(tnear, t0); /* a NaN lane yields t0: ignored, as in box_test */
+    t1 = _mm_min_ps(tfar, t1);
   }
-  /* Lanes 0, 1 of t0 hold the entries, lanes 2, 3 of t1 the exits. */
   const __m128 margin = _mm_set1_ps(RAY_MARGIN), abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
-  __m128 far = _mm_movehl_ps(t1, t1);
   t0 = _mm_sub_ps(t0, _mm_mul_ps(_mm_and_ps(t0, abs_mask), margin));
-  far = _mm_add_ps(far, _mm_mul_ps(_mm_and_ps(far, abs_mask), margin));
-  __m128 ok = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(t0, far), _mm_cmple_ps(t0, _mm_set1_ps(tmax))),
-                         _mm_cmpge_ps(far, _mm_set1_ps(tmin)));
-  _mm_storel_pi((__m64 *)tn, t0);
-  return _mm_movemask_ps(ok) & 3;
-}
-
-/* Conservative ray-box test: true when the box may hold a point of the ray with
- * t in [tmin, tmax]; *tnear is the widened entry t. NaN slabs (the ray runs in a
- * box face) are ignored by the operand order of the comparisons. */
-KERNEL bool box_test(const bvh_node *n, const ray_q *q, float tmin, float tmax, float *tnear) {
-  const float *f = (const float *)n; /* lo[0..2], hi[0..2] */
-  float t0 = -INFINITY, t1 = INFINITY;
-  for (int a = 0; a < 3; a++) {
-    float tn = (f[q->nr[a]] - q->o[a]) * q->inv[a];
-    float tf = (f[q->fr[a]] - q->o[a]) * q->inv[a];
-    t0 = tn > t0 ? tn : t0;
-    t1 = tf < t1 ? tf : t1;
-  }
-  t0 -= fabsf(t0) * RAY_MARGIN;
-  t1 += fabsf(t1) * RAY_MARGIN;
-  *tnear = t0;
-  return t0 <= t1 && t0 <= tmax && t1 >= tmin;
+  t1 = _mm_add_ps(t1, _mm_mul_ps(_mm_and_ps(t1, abs_mask), margin));
+  __m128 ok = _mm_and_ps(_mm_cmple_ps(t0, t1), _mm_cmpge_ps(t1, _mm_set1_ps(tmin)));
+  ok = _mm_and_ps(ok, _mm_cmple_ps(key, _mm_set1_ps(best)));
+  *tn = t0;
+  return _mm_movemask_ps(ok);
 }
 
 enum { MODE_PRIMARY, MODE_CLOSEST, MODE_ANY };
@@ -230,13 +222,14 @@ typedef struct {
 /* Tests a leaf's triangles; true when an any-hit query is answered. */
 KERNEL bool leaf_test(const rr_bvh *b, const bvh_node *n, ray_state *r, const int mode) {
   for (uint32_t i = n->first, end = n->first + n->count; i < end; i++) {
-    uint32_t id = b->prims[i];
     if (mode == MODE_PRIMARY) {
-      if (!r->fs->live[i]) continue;
+      const leaf_tri *lt = &r->fs->ts[i];
+      if (lt->id == RR_MISS) continue;
       r->evals++;
       visbuf one = {1, 1, &r->id, &r->t, &r->l1, &r->l2};
-      shade_sample(&r->fs->ts[i], id, r->sx, r->sy, &one, 0);
+      shade_sample(&lt->ts, lt->id, r->sx, r->sy, &one, 0);
     } else {
+      uint32_t id = b->prims[i];
       float t, l1, l2;
       r->setups++, r->evals++;
       if (!ray_tri_hit(r->s, id, r->rcam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
@@ -247,61 +240,52 @@ KERNEL bool leaf_test(const rr_bvh *b, const bvh_node *n, ray_state *r, const in
   return false;
 }
 
-/* May node k hold the ray's winner? *tn: its widened box entry (the order key);
- * *key: what a later pop compares with the best t (primary rays: the node's exact
+/* Front-to-back traversal of one ray over the 4-wide tree: the hit slots in
+ * order of entry, the nearest visited and the others stacked, each dropped on pop
+ * when the best t is already nearer than its key (primary rays: the node's exact
  * bound, other rays: the box entry). */
-KERNEL bool node_test(const rr_bvh *b, uint32_t k, const ray_state *r, float *tn, float *key, const int mode) {
-  if (mode == MODE_PRIMARY) {
-    *key = r->fs->tlo[k];
-    return !(*key > r->t) && box_test(&b->nodes[k], &r->q, r->tmin, INFINITY, tn);
-  }
-  bool hit = box_test(&b->nodes[k], &r->q, r->tmin, r->t, tn);
-  *key = *tn;
-  return hit;
-}
-
-/* Front-to-back traversal of one ray over the sibling pairs: the nearer child
- * first, the farther one stacked and dropped on pop when the best t is already
- * nearer than its key (primary rays: the node's exact bound, other rays: the box
- * entry). A node is carried as (index, first, count). */
 KERNEL bool trace1(const rr_bvh *b, ray_state *r, const int mode) {
   struct {
-    uint32_t node, first, count;
+    uint32_t ref, count;
     float key;
-  } stack[BVH_STACK];
+  } stack[3 * BVH_STACK];
   int sp = 0;
-  float tn0, k0;
-  r->nodes++;
-  if (!node_test(b, 0, r, &tn0, &k0, mode)) return false;
-  uint32_t cur = 0, first = b->nodes[0].first, count = b->nodes[0].count;
+  uint32_t ref = 0, count = 0; /* wide node 0 */
   for (;;) {
     if (count) {
-      bvh_node leaf = {.first = first, .count = count};
+      bvh_node leaf = {.first = ref, .count = count};
       if (leaf_test(b, &leaf, r, mode) && mode == MODE_ANY) return true;
     } else {
-      uint32_t p = (first - 1) / 2;
-      const bvh_pair *pr = &b->pairs[p];
-      float tn[2], k[2];
+      const bvh_wide *w = &b->wide[ref];
+      __m128 tnv, keyv;
       int hits;
       if (mode == MODE_PRIMARY) {
-        k[0] = r->fs->tlo[first], k[1] = r->fs->tlo[first + 1];
-        hits = pair_test(pr, &r->q, r->tmin, INFINITY, tn);
-        hits &= (k[0] > r->t ? 0 : 1) | (k[1] > r->t ? 0 : 2);
+        keyv = _mm_load_ps(&r->fs->tlo4[4 * (size_t)ref]);
+        hits = wide_test(w, &r->q, r->tmin, keyv, r->t, &tnv);
       } else {
-        hits = pair_test(pr, &r->q, r->tmin, r->t, tn);
-        k[0] = tn[0], k[1] = tn[1];
+        hits = wide_test(w, &r->q, r->tmin, _mm_setzero_ps(), INFINITY, &tnv);
+        /* the key is the entry itself */
+        __m128 ok = _mm_cmple_ps(tnv, _mm_set1_ps(r->t));
+        hits &= _mm_movemask_ps(ok);
+        keyv = tnv;
       }
-      r->nodes += 2;
-      if (hits == 3) {
-        int nr = tn[1] < tn[0], fr = !nr;
-        stack[sp].node = first + fr, stack[sp].first = pr->first[fr], stack[sp].count = pr->count[fr];
-        stack[sp].key = k[fr], sp++;
-        cur = first + nr, count = pr->count[nr], first = pr->first[nr];
-        continue;
-      }
+      for (int i = 0; i < 4; i++) r->nodes += w->ref[i] != UINT32_MAX;
       if (hits) {
-        int c = hits >> 1;
-        cur = first + c, count = pr->count[c], first = pr->first[c];
+        float tn[4], key[4];
+        _mm_storeu_ps(tn, tnv), _mm_storeu_ps(key, keyv);
+        int order[4], n = 0;
+        for (int i = 0; i < 4; i++) {
+          if (!(hits >> i & 1)) continue;
+          int j = n++;
+          for (; j > 0 && tn[order[j - 1]] < tn[i]; j--) order[j] = order[j - 1]; /* farthest first */
+          order[j] = i;
+        }
+        for (int j = 0; j < n - 1; j++) {
+          int i = order[j];
+          stack[sp].ref = w->ref[i], stack[sp].count = w->count[i], stack[sp].key = key[i], sp++;
+        }
+        int i = order[n - 1];
+        ref = w->ref[i], count = w->count[i];
         continue;
       }
     }
@@ -310,9 +294,8 @@ KERNEL bool trace1(const rr_bvh *b, ray_state *r, const int mode) {
       sp--;
       if (!(stack[sp].key > r->t)) break; /* equal t may still win on id */
     }
-    cur = stack[sp].node, first = stack[sp].first, count = stack[sp].count;
+    ref = stack[sp].ref, count = stack[sp].count;
   }
-  (void)cur;
 }
 
 /* ---- arbitrary rays -------------------------------------------------------------- */
@@ -416,14 +399,19 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
   ray_state r;
   memset(&r, 0, sizeof r);
   r.fs = &j->fs;
-  for (int y = y0; y < y1; y++)
-    for (int x = x0; x < x1; x++) {
+  /* 4x4 blocks in the tile: neighbouring rays run one after the other and find
+   * the nodes and setups their neighbour just loaded still in cache. */
+  for (int by = y0; by < y1; by += 4)
+    for (int bx = x0; bx < x1; bx += 4)
+      for (int k = 0; k < 16; k++) {
+      int x = bx + (k & 3), y = by + (k >> 2);
+      if (x >= x1 || y >= y1) continue;
       r.sx = (float)x + 0.5f, r.sy = (float)y + 0.5f;
       ray_q_init(&r.q, c->eye, camera_dir(c, r.sx, r.sy));
       r.tmin = 0, r.t = INFINITY, r.id = RR_MISS, r.l1 = r.l2 = 0;
       trace1(j->b, &r, MODE_PRIMARY);
-      size_t k = (size_t)y * vb->width + x;
-      vb->id[k] = r.id, vb->t[k] = r.t, vb->l1[k] = r.l1, vb->l2[k] = r.l2;
+      size_t i = (size_t)y * vb->width + x;
+      vb->id[i] = r.id, vb->t[i] = r.t, vb->l1[i] = r.l1, vb->l2[i] = r.l2;
     }
   thread_stats *st = &j->st[thread];
   st->evals += r.evals, st->nodes += r.nodes;
@@ -495,13 +483,12 @@ KERNEL uint64_t packet_box(const packet *p, const bvh_node *n, float tlo, uint64
 }
 
 KERNEL void packet_leaf(frame_job *j, packet *p, const bvh_node *n, uint64_t mask, ray_state *acc) {
-  const rr_bvh *b = j->b;
   visbuf pvb = {PK, PK, p->id, p->t, p->l1, p->l2};
   int cnt = __builtin_popcountll(mask);
   for (uint32_t i = n->first, end = n->first + n->count; i < end; i++) {
-    if (!j->fs.live[i]) continue;
-    const tri_setup *ts = &j->fs.ts[i];
-    uint32_t id = b->prims[i];
+    if (j->fs.ts[i].id == RR_MISS) continue;
+    const tri_setup *ts = &j->fs.ts[i].ts;
+    uint32_t id = j->fs.ts[i].id;
     acc->evals += cnt;
     for (uint64_t m = mask; m; m &= m - 1) {
       int k = __builtin_ctzll(m);

@@ -69,18 +69,28 @@ static bool check_tree(const rr_scene *s, const char *name) {
           CHECK(0, "%s: node %u does not enclose its child %u", name, k, n->first + c);
         }
       }
-      const bvh_pair *p = &b->pairs[(n->first - 1) / 2];
-      for (int c = 0; c < 2 && !bad; c++) {
-        const bvh_node *ch = &b->nodes[n->first + c];
-        if (p->x[c] != ch->lo[0] || p->y[c] != ch->lo[1] || p->z[c] != ch->lo[2] || p->x[2 + c] != ch->hi[0] ||
-            p->y[2 + c] != ch->hi[1] || p->z[2 + c] != ch->hi[2] || p->first[c] != ch->first ||
-            p->count[c] != ch->count) {
-          bad = 1;
-          CHECK(0, "%s: the pair copy of node %u differs", name, n->first + c);
-        }
-      }
     }
   }
+  /* The 4-wide copy: every binary node but the root in exactly one slot, with its
+   * bounds and contents. */
+  uint32_t *slots = calloc(b->nnodes, sizeof *slots);
+  for (uint32_t w = 0; w < b->nwide && !bad; w++)
+    for (int i = 0; i < 4; i++) {
+      uint32_t k = b->wide_node[4 * w + i];
+      const bvh_wide *wn = &b->wide[w];
+      if (k == UINT32_MAX) {
+        if (wn->ref[i] != UINT32_MAX || wn->lo[0][i] <= wn->hi[0][i]) bad = 1;
+        continue;
+      }
+      const bvh_node *n = &b->nodes[k];
+      slots[k]++;
+      for (int a = 0; a < 3; a++) bad |= wn->lo[a][i] != n->lo[a] || wn->hi[a][i] != n->hi[a];
+      bad |= wn->count[i] != n->count || (n->count && wn->ref[i] != n->first) || (!n->count && wn->ref[i] >= b->nwide);
+    }
+  uint32_t wrong = 0;
+  for (uint32_t k = 0; k < b->nnodes; k++) wrong += slots[k] > 1 || (slots[k] == 0 && b->nodes[k].count);
+  CHECK(!bad && wrong == 0, "%s: the 4-wide copy is wrong (%u nodes misplaced)", name, wrong);
+  free(slots);
   uint32_t missing = 0;
   for (uint32_t t = 0; t < s->ntris && !bad; t++) missing += !seen[t];
   CHECK(!bad && missing == 0, "%s: %u triangles in no leaf", name, missing);

@@ -85,8 +85,66 @@ static void check_scene(rr_device *dev, const char *path, const char *name, int 
   rr_scene_release(s);
 }
 
+/* The pruning bound itself: at every sample where a triangle passes the sample
+ * test, its t is at least tri_t_lower_bound(); grazing views stress it most. */
+static void check_bound(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h, const char *name) {
+  camera c;
+  if (camera_setup(dev, cam, w, h, &c) != RR_OK) return;
+  long checked = 0, broken = 0;
+  uint32_t step = s->ntris > 20000 ? s->ntris / 20000 : 1;
+  for (uint32_t i = 0; i < s->ntris; i += step) {
+    tri_setup ts;
+    if (tri_setup_planar(s, i, &c, false, &ts) == SETUP_CULLED) continue;
+    float lo = tri_t_lower_bound(&ts, w, h);
+    for (int y = 0; y < h; y++)
+      for (int x = 0; x < w; x++) {
+        float e[3], t, l1, l2;
+        tri_edges(&ts, (float)x + 0.5f, (float)y + 0.5f, e);
+        if (!sample_test(e, ts.tie, ts.vol, &t, &l1, &l2)) continue;
+        checked++;
+        if (t < lo && broken++ < 5) fprintf(stderr, "%s: triangle %u at (%d, %d): t %.9g below its bound %.9g\n", name, i, x, y, t, lo);
+      }
+  }
+  printf("%s: %ld hits at or above the pruning bound\n", name, checked);
+  CHECK(broken == 0, "%s: %ld of %ld hits below the pruning bound", name, broken, checked);
+  camera_release(&c);
+}
+
+static void bound_views(rr_device *dev) {
+  const char *scenes[] = {"plane:16", "sphere:24", "box:4"};
+  for (int k = 0; k < 3; k++) {
+    rr_scene *s;
+    if (rr_scene_load(dev, scenes[k], &s) != RR_OK) continue;
+    for (int v = 0; v < 6; v++) {
+      rr_camera cam;
+      rr_camera_init(&cam);
+      /* Eyes just above (or in) the plane y = 0 and random views. */
+      float hgt = v < 3 ? (v == 0 ? 1e-6f : v == 1 ? 1e-3f : 0.05f) : test_randf(-3, 3);
+      cam.eye[0] = test_randf(-9, 9), cam.eye[1] = hgt, cam.eye[2] = test_randf(-9, 9);
+      cam.target[0] = test_randf(-2, 2), cam.target[1] = 0, cam.target[2] = test_randf(-2, 2);
+      cam.fov_deg = test_randf(30, 100);
+      char name[64];
+      snprintf(name, sizeof name, "%s bound view %d", scenes[k], v);
+      check_bound(dev, s, &cam, 64, 48, name);
+      check_view(dev, s, name, v, &cam, RR_METHOD_3DR_BB, 64, 48, 0);
+    }
+    rr_scene_release(s);
+  }
+  const char *p = test_model("stanford-bunny.obj");
+  rr_scene *s;
+  if (p && rr_scene_load(dev, p, &s) == RR_OK) {
+    for (int v = 0; v < 3; v++) {
+      rr_camera cam;
+      random_view(s, &cam, v == 0 ? 0.2f : 1.0f, v == 0 ? 0.8f : 2.0f);
+      check_bound(dev, s, &cam, 64, 48, "bunny bound");
+    }
+    rr_scene_release(s);
+  }
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
+  bound_views(dev);
   check_scene(dev, "demo", "demo", 3, 3);
   check_scene(dev, "sphere:24", "sphere:24", 3, 3);
   check_scene(dev, "plane:64", "plane:64", 2, 4);
