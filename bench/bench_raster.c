@@ -3,6 +3,8 @@
  * scene, camera, resolution and threads, in the same run), the ratio of each to
  * llvmpipe, and how often their triangle ids agree with llvmpipe's and 3dr-bb's.
  *
+ * Methods are timed in interleaved rounds (median per method).
+ *
  * usage: bench_raster [--size N|WxH] [--threads N] [--reps N] [--cull] [SCENE...]
  * SCENE: a built-in name, a path, or a file of the shared model directory
  * (default: stanford-bunny.obj ogre.obj nefertiti.obj grid:teapot.obj:19). */
@@ -11,6 +13,7 @@
 #include "peer_osmesa.h"
 #endif
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,6 +69,7 @@ int main(int argc, char **argv) {
   }
   if (w < 1 || h < 1 || threads < 1 || threads > 256 || reps < 1) usage();
   if (reps < 5) reps = 5; /* a median of at least five */
+  if (reps > 64) reps = 64;
   if (nscenes == 0) {
     static const char *defaults[] = {"stanford-bunny.obj", "ogre.obj", "nefertiti.obj", "grid:teapot.obj:19"};
     for (int i = 0; i < 4; i++) scenes[nscenes++] = defaults[i];
@@ -94,12 +98,41 @@ int main(int argc, char **argv) {
     bench_camera(dev, s, w, h, &cam);
     printf("\n%s: %llu triangles (loaded in %.0f ms)\n", scenes[si], (unsigned long long)info.triangles, load_ms);
     printf("  %-9s %10s %14s %14s\n", "method", "frame ms", "S", "E");
-    rr_frame *frames[NMETHODS];
+    rr_frame *frames[NMETHODS] = {0};
+    rr_render_options opt[NMETHODS];
     for (int m = 0; m < NMETHODS; m++) {
-      rr_render_options opt;
-      rr_render_options_init(&opt);
-      opt.method = methods[m], opt.width = w, opt.height = h, opt.threads = threads, opt.cull_backfaces = cull;
-      r->ms[m] = bench_render(dev, s, &cam, &opt, reps, &frames[m]);
+      rr_render_options_init(&opt[m]);
+      opt[m].method = methods[m], opt[m].width = w, opt[m].height = h;
+      opt[m].threads = threads, opt[m].cull_backfaces = cull;
+    }
+    bool have_gl = false;
+#ifdef RR_HAVE_OSMESA
+    have_gl = gl && osmesa_load(gl, s) == 0;
+#endif
+    /* Rounds over all methods, so that a change of load on the machine hits them
+     * alike; round 0 warms the caches (and llvmpipe's shader compiler) and is not
+     * counted. */
+    double t[NMETHODS + 1][64];
+    for (int rep = 0; rep <= reps; rep++) {
+      for (int m = 0; m < NMETHODS; m++) {
+        rr_frame_release(frames[m]);
+        if (rr_render(dev, s, &cam, &opt[m], &frames[m]) != RR_OK) {
+          fprintf(stderr, "bench_raster: %s\n", rr_device_message(dev));
+          return 1;
+        }
+        rr_stats st;
+        rr_frame_get_stats(frames[m], &st);
+        if (rep) t[m][rep - 1] = st.frame_ms;
+      }
+#ifdef RR_HAVE_OSMESA
+      if (have_gl) {
+        double ms = osmesa_render(gl, &cam, cull, 1);
+        if (rep) t[NMETHODS][rep - 1] = ms;
+      }
+#endif
+    }
+    for (int m = 0; m < NMETHODS; m++) {
+      r->ms[m] = bench_median(t[m], reps);
       rr_stats st;
       rr_frame_get_stats(frames[m], &st);
       printf("  %-9s %10.2f %14llu %14llu\n", rr_method_name(methods[m]), r->ms[m], (unsigned long long)st.setups,
@@ -108,8 +141,8 @@ int main(int argc, char **argv) {
     const uint32_t *ref = rr_frame_ids(frames[NMETHODS - 1]), *glids = NULL;
     r->ms[NMETHODS] = -1;
 #ifdef RR_HAVE_OSMESA
-    if (gl && osmesa_load(gl, s) == 0) {
-      r->ms[NMETHODS] = osmesa_render(gl, &cam, cull, reps);
+    if (have_gl) {
+      r->ms[NMETHODS] = bench_median(t[NMETHODS], reps);
       glids = osmesa_ids(gl);
       printf("  %-9s %10.2f\n", "llvmpipe", r->ms[NMETHODS]);
     }
