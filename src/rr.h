@@ -345,8 +345,8 @@ rr_error vis_rc(rr_device *dev, render_ctx *ctx);
 rr_error vis_rc_bvh(rr_device *dev, render_ctx *ctx);
 rr_error vis_rc_packet(rr_device *dev, render_ctx *ctx);
 /* The least t that sample_test() can return for a set-up triangle at any sample of
- * a w × h image (planar cameras): the exact pruning bound of rc-bvh and rc-packet. */
-float tri_t_lower_bound(const tri_setup *ts, int w, int h);
+ * camera c: the exact pruning bound of rc-bvh and rc-packet. */
+float tri_t_lower_bound(const tri_setup *ts, const camera *c);
 /* 2dr-bb and 2dr-bin: projection, clipping, fixed-point 2D edge functions (src/raster2d.c). */
 rr_error vis_2dr_bb(rr_device *dev, render_ctx *ctx);
 rr_error vis_2dr_bin(rr_device *dev, render_ctx *ctx);

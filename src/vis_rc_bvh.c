@@ -52,51 +52,71 @@ typedef struct {
   float *tlo4;    /* by wide node and slot (+inf for an empty slot) */
 } frame_setups;
 
-/* The least t sample_test() can return for ts at a sample of a w × h image.
+/* The least t that sample_test() can return for ts at any sample of camera c.
  *
- * The float error of tri_edges() is below u_i = 4u·(|a| + |sx·b| + |sy·c|)
- * (u = 2^-24, bounded over the image); a passing sample has every computed
- * e_i >= 0, so it lies in P = {E_i >= -u_i} for the exact edge functions E_i of
- * the setup values, the computed sum is at most (1+u)^2 Σ(E_i + u_i) and
- * t = vol·(1/sum) at least vol·(1-u)^2 / that. Σ(E_i + u_i) is affine, so its
- * maximum over P is at a vertex of P; at the vertex where E_i + u_i and
- * E_j + u_j vanish it equals det[a' b c] / (b_i·c_j - b_j·c_i) (Cramer; a' = a + u),
- * and P is that bounded triangle when all three values are positive. Otherwise
- * the maximum over the image rectangle bounds it. Double arithmetic carries a
- * relative slack far above its own rounding. */
-float tri_t_lower_bound(const tri_setup *ts, int w, int h) {
+ * Planar cameras evaluate e_i = a + sx·b + sy·c in float, with an error below
+ * u_i = 4u·(|a| + |sx·b| + |sy·c|) (u = 2^-24, bounded over the image); a passing
+ * sample has every computed e_i >= 0, so it lies in P = {E_i >= -u_i} for the
+ * exact edge functions E_i of the setup values, and the computed sum is at most
+ * (1+u)^2 Σ(E_i + u_i). That sum is affine, so its maximum over P is at a vertex
+ * of P; at the vertex where E_i + u_i and E_j + u_j vanish it equals
+ * det[a' b c] / (b_i·c_j - b_j·c_i) (Cramer; a' = a + u), and P is that bounded
+ * triangle when the three values are positive; otherwise the maximum over the
+ * image rectangle bounds it. Curved cameras evaluate e_i = n_i·d with |d| at most
+ * the camera's longest ray, so the sum is at most |Σn_i|·|d| plus the error. The
+ * volume (constant but for orthographic views) is bounded below over the image
+ * the same way, and t = vol·(1/sum) is at least vol·(1-u)^2 / max sum. Double
+ * arithmetic carries a relative slack far above its own rounding. */
+float tri_t_lower_bound(const tri_setup *ts, const camera *cam) {
   const double u = 0x1p-24, slack = 1e-12;
-  double a[3], b[3], c[3];
-  for (int i = 0; i < 3; i++) {
-    b[i] = ts->b[i], c[i] = ts->c[i];
-    a[i] = ts->a[i] + 4 * u * (fabs(ts->a[i]) + w * fabs(b[i]) + h * fabs(c[i]));
-  }
+  int w = cam->width, h = cam->height;
   double smax = -INFINITY;
-  double m[3], mag_m[3];
-  for (int k = 0; k < 3; k++) {
-    int i = (k + 1) % 3, j = (k + 2) % 3;
-    m[k] = b[i] * c[j] - b[j] * c[i], mag_m[k] = fabs(b[i] * c[j]) + fabs(b[j] * c[i]);
-  }
-  double det = a[0] * m[0] + a[1] * m[1] + a[2] * m[2];
-  double mag_d = fabs(a[0]) * mag_m[0] + fabs(a[1]) * mag_m[1] + fabs(a[2]) * mag_m[2];
-  /* Bounded when det and the three minors share a sign (either: it depends on how
-   * the triangle's projection turns on screen), each clear of the slack. */
-  double sg = det < 0 ? -1 : 1;
-  bool bounded = sg * det > slack * mag_d;
-  for (int k = 0; k < 3 && bounded; k++) {
-    bounded = sg * m[k] > slack * mag_m[k];
-    if (bounded) {
-      double v = (sg * det + slack * mag_d) / (sg * m[k] - slack * mag_m[k]);
-      smax = v > smax ? v : smax;
+  if (cam->planar) {
+    double a[3], b[3], c[3];
+    for (int i = 0; i < 3; i++) {
+      b[i] = ts->b[i], c[i] = ts->c[i];
+      a[i] = ts->a[i] + 4 * u * (fabs(ts->a[i]) + w * fabs(b[i]) + h * fabs(c[i]));
     }
-  }
-  if (!bounded) {
-    double A = a[0] + a[1] + a[2], B = b[0] + b[1] + b[2], C = c[0] + c[1] + c[2];
-    smax = A + fmax(0.5 * B, (w - 0.5) * B) + fmax(0.5 * C, (h - 0.5) * C);
-    smax += slack * (fabs(A) + w * fabs(B) + h * fabs(C));
+    double m[3], mag_m[3];
+    for (int k = 0; k < 3; k++) {
+      int i = (k + 1) % 3, j = (k + 2) % 3;
+      m[k] = b[i] * c[j] - b[j] * c[i], mag_m[k] = fabs(b[i] * c[j]) + fabs(b[j] * c[i]);
+    }
+    double det = a[0] * m[0] + a[1] * m[1] + a[2] * m[2];
+    double mag_d = fabs(a[0]) * mag_m[0] + fabs(a[1]) * mag_m[1] + fabs(a[2]) * mag_m[2];
+    /* Bounded when det and the three minors share a sign (either: it depends on
+     * how the triangle's projection turns on screen), each clear of the slack. */
+    double sg = det < 0 ? -1 : 1;
+    bool bounded = sg * det > slack * mag_d;
+    for (int k = 0; k < 3 && bounded; k++) {
+      bounded = sg * m[k] > slack * mag_m[k];
+      if (bounded) {
+        double v = (sg * det + slack * mag_d) / (sg * m[k] - slack * mag_m[k]);
+        smax = v > smax ? v : smax;
+      }
+    }
+    if (!bounded) {
+      double A = a[0] + a[1] + a[2], B = b[0] + b[1] + b[2], C = c[0] + c[1] + c[2];
+      smax = A + fmax(0.5 * B, (w - 0.5) * B) + fmax(0.5 * C, (h - 0.5) * C);
+      smax += slack * (fabs(A) + w * fabs(B) + h * fabs(C));
+    }
+  } else {
+    double dmax = (double)cam->dir_len_max * (1 + 1e-6), nx = 0, ny = 0, nz = 0, err = 0;
+    for (int i = 0; i < 3; i++) {
+      nx += ts->a[i], ny += ts->b[i], nz += ts->c[i];
+      err += 4 * u * (fabs(ts->a[i]) + fabs(ts->b[i]) + fabs(ts->c[i]));
+    }
+    smax = (sqrt(nx * nx + ny * ny + nz * nz) + err) * dmax * (1 + slack);
   }
   if (!(smax > 0)) return INFINITY; /* no sample can pass */
-  double t = (double)ts->vol * (1 - u) * (1 - u) / (smax * (1 + u) * (1 + u)) * (1 - 1e-9);
+  double vmin = ts->vol; /* exact when vol_x = vol_y = 0: vol + 0 + 0 */
+  if (ts->vol_x != 0 || ts->vol_y != 0) {
+    double v0 = ts->vol, vx = ts->vol_x, vy = ts->vol_y;
+    vmin = v0 + fmin(0.5 * vx, (w - 0.5) * vx) + fmin(0.5 * vy, (h - 0.5) * vy);
+    vmin -= 4 * u * (fabs(v0) + w * fabs(vx) + h * fabs(vy)) + slack * fabs(v0);
+  }
+  if (!(vmin > 0)) return 0;
+  double t = vmin * (1 - u) * (1 - u) / (smax * (1 + u) * (1 + u)) * (1 - 1e-9);
   float f = (float)t;
   return (double)f > t ? nextafterf(f, 0) : f;
 }
@@ -122,7 +142,7 @@ static void setup_leaves(int job, int thread, void *arg) {
       bool live = tri_setup_planar(fs->s, b->prims[i], fs->cam, fs->cull, &fs->ts[i].ts) != SETUP_CULLED;
       fs->ts[i].id = live ? b->prims[i] : RR_MISS;
       if (!live) continue;
-      float t = tri_t_lower_bound(&fs->ts[i].ts, fs->cam->width, fs->cam->height);
+      float t = tri_t_lower_bound(&fs->ts[i].ts, fs->cam);
       tlo = t < tlo ? t : tlo;
     }
     fs->tlo[k] = tlo;
@@ -210,8 +230,9 @@ typedef struct {
   float tmin;
   float t, l1, l2; /* best hit so far; t starts at tmax */
   uint32_t id;
-  /* primary rays: the sample and the frame's setups */
+  /* primary rays: the sample, its evaluation vector and the frame's setups */
   float sx, sy;
+  vec3 w;
   const frame_setups *fs;
   /* arbitrary rays: the ray's pseudo-camera */
   const rr_scene *s;
@@ -227,7 +248,7 @@ KERNEL bool leaf_test(const rr_bvh *b, const bvh_node *n, ray_state *r, const in
       if (lt->id == RR_MISS) continue;
       r->evals++;
       visbuf one = {1, 1, &r->id, &r->t, &r->l1, &r->l2};
-      shade_sample(&lt->ts, lt->id, r->sx, r->sy, &one, 0);
+      shade_sample_w(&lt->ts, lt->id, r->w, r->sx, r->sy, &one, 0);
     } else {
       uint32_t id = b->prims[i];
       float t, l1, l2;
@@ -407,9 +428,13 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
       int x = bx + (k & 3), y = by + (k >> 2);
       if (x >= x1 || y >= y1) continue;
       r.sx = (float)x + 0.5f, r.sy = (float)y + 0.5f;
-      ray_q_init(&r.q, c->eye, camera_dir(c, r.sx, r.sy));
-      r.tmin = 0, r.t = INFINITY, r.id = RR_MISS, r.l1 = r.l2 = 0;
-      trace1(j->b, &r, MODE_PRIMARY);
+      r.t = INFINITY, r.id = RR_MISS, r.l1 = r.l2 = 0;
+      vec3 o, d;
+      if (camera_ray(c, x, y, &o, &d)) { /* else a pixel without a ray: a miss */
+        ray_q_init(&r.q, o, d);
+        r.w = camera_w(c, x, y), r.tmin = 0;
+        trace1(j->b, &r, MODE_PRIMARY);
+      }
       size_t i = (size_t)y * vb->width + x;
       vb->id[i] = r.id, vb->t[i] = r.t, vb->l1[i] = r.l1, vb->l2[i] = r.l2;
     }
@@ -492,7 +517,8 @@ KERNEL void packet_leaf(frame_job *j, packet *p, const bvh_node *n, uint64_t mas
     acc->evals += cnt;
     for (uint64_t m = mask; m; m &= m - 1) {
       int k = __builtin_ctzll(m);
-      shade_sample(ts, id, (float)(p->x0 + (k & 7)) + 0.5f, (float)(p->y0 + (k >> 3)) + 0.5f, &pvb, k);
+      int x = p->x0 + (k & 7), y = p->y0 + (k >> 3);
+      shade_sample_w(ts, id, camera_w(j->ctx->cam, x, y), (float)x + 0.5f, (float)y + 0.5f, &pvb, k);
     }
   }
 }
@@ -557,9 +583,9 @@ static void rc_packet_tile(int job, int thread, void *arg) {
       for (int k = 0; k < PN; k++) {
         int x = px + (k & 7), y = py + (k >> 3);
         p->t[k] = INFINITY, p->id[k] = RR_MISS, p->l1[k] = p->l2[k] = 0;
-        vec3 d = camera_dir(c, (float)x + 0.5f, (float)y + 0.5f);
+        vec3 o, d = v3(1, 1, 1);
+        bool in = x < vb->width && y < vb->height && camera_ray(c, x, y, &o, &d);
         float dv[3] = {d.x, d.y, d.z};
-        bool in = x < vb->width && y < vb->height;
         if (in) p->valid |= 1ull << k;
         for (int a = 0; a < 3; a++) {
           inv[a][k] = 1.0f / dv[a];
@@ -593,6 +619,8 @@ static void rc_packet_tile(int job, int thread, void *arg) {
 }
 
 static rr_error run_frame(rr_device *dev, render_ctx *ctx, parallel_fn tile_fn) {
+  /* Packets share the eye as origin; orthographic rays do not: one ray each. */
+  if (tile_fn == rc_packet_tile && ctx->cam->type == RR_CAMERA_ORTHOGRAPHIC) tile_fn = rc_bvh_tile;
   bool empty;
   const rr_bvh *b = bvh_of(dev, ctx->scene, &empty);
   if (empty) return RR_OK; /* the visibility buffer is already all misses */

@@ -95,7 +95,7 @@ static void check_bound(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   for (uint32_t i = 0; i < s->ntris; i += step) {
     tri_setup ts;
     if (tri_setup_planar(s, i, &c, false, &ts) == SETUP_CULLED) continue;
-    float lo = tri_t_lower_bound(&ts, w, h);
+    float lo = tri_t_lower_bound(&ts, &c);
     for (int y = 0; y < h; y++)
       for (int x = 0; x < w; x++) {
         float e[3], t, l1, l2;
