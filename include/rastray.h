@@ -185,6 +185,8 @@ typedef struct rr_stats {
   uint64_t setups;     /* S: triangle setups computed */
   uint64_t edge_evals; /* E: one triangle's three edge functions at one sample or bin corner */
   uint64_t nodes;      /* N: BVH nodes visited */
+  uint64_t bins;       /* bins that passed binning's coverage test and were refined */
+  uint64_t bins_empty; /* of those, bins where the triangle covered no sample */
   double frame_ms;     /* wall time of the visibility pass */
   int threads;         /* threads the pass ran on */
 } rr_stats;

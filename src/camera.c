@@ -166,15 +166,9 @@ rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height
       int y1 = (cy + 1) * CAMERA_CELL < height ? (cy + 1) * CAMERA_CELL : height;
       vec3 axis = v3(0, 0, 0);
       float angle;
-      bool ok = camera_rect_cone(c, cx * CAMERA_CELL, cy * CAMERA_CELL, x1, y1, &axis, &angle) && angle < 1.5f;
-      bool any = false; /* a cell without rays is no triangle's */
-      for (int y = cy * CAMERA_CELL; y < y1 && !any; y++)
-        for (int x = cx * CAMERA_CELL; x < x1 && !any; x++) {
-          vec3 d = c->dirs[(size_t)y * width + x];
-          any = d.x != 0 || d.y != 0 || d.z != 0;
-        }
+      int cone = camera_rect_cone(c, cx * CAMERA_CELL, cy * CAMERA_CELL, x1, y1, &axis, &angle);
       cell[0] = axis.x, cell[1] = axis.y, cell[2] = axis.z;
-      cell[3] = !any ? -1.0f : ok ? angle : 2.0f;
+      cell[3] = cone < 0 ? -1.0f : cone > 0 && angle < 1.5f ? angle : 2.0f; /* no rays, a cone, no bound */
     }
   return rr_ok(dev);
 }
@@ -216,30 +210,30 @@ bool camera_project(const camera *c, vec3 p, float *sx, float *sy) {
   return true;
 }
 
-bool camera_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle) {
-  if (c->planar) return false;
+int camera_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle) {
+  if (c->planar) return 0;
   if (c->type == RR_CAMERA_CUBE && (x0 / c->face != (x1 - 1) / c->face || y0 / c->face != (y1 - 1) / c->face))
-    return false; /* the cross is discontinuous between faces */
+    return 0; /* the cross is discontinuous between faces */
   /* The centre sample's direction and the Lipschitz bound over the half-diagonal
    * (plus half a pixel: every sample lies within that distance of the centre). */
   int cx = (x0 + x1 - 1) / 2, cy = (y0 + y1 - 1) / 2;
   vec3 d = c->dirs[(size_t)cy * c->width + cx];
   float hx = (float)(x1 - x0) * 0.5f + 0.5f, hy = (float)(y1 - y0) * 0.5f + 0.5f;
   if (d.x == 0 && d.y == 0 && d.z == 0) {
-    /* No ray at the centre (the rim of a disk, the gaps of a cross): start from a
-     * corner that has one, with the whole diagonal as radius. */
-    const int px[4] = {x0, x1 - 1, x0, x1 - 1}, py[4] = {y0, y0, y1 - 1, y1 - 1};
-    int k = 0;
-    for (; k < 4; k++) {
-      d = c->dirs[(size_t)py[k] * c->width + px[k]];
-      if (d.x != 0 || d.y != 0 || d.z != 0) break;
-    }
-    if (k == 4) return false;
+    /* No ray at the centre (the rim of a disk, the gaps of a cross): start from
+     * any sample that has one, with the whole diagonal as radius. */
+    bool found = false;
+    for (int y = y0; y < y1 && !found; y++)
+      for (int x = x0; x < x1 && !found; x++) {
+        d = c->dirs[(size_t)y * c->width + x];
+        found = d.x != 0 || d.y != 0 || d.z != 0;
+      }
+    if (!found) return -1;
     hx *= 2, hy *= 2;
   }
   *axis = v3_norm(d);
   *angle = c->lipschitz * sqrtf(hx * hx + hy * hy) + 1e-5f;
-  return true;
+  return 1;
 }
 
 rr_error rr_camera_frame(rr_device *dev, const rr_scene *s, int width, int height, rr_camera *cam) {

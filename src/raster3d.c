@@ -95,22 +95,25 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri
 }
 
 /* The sample loop, written once and specialised for planar and curved cameras. */
-static inline void raster_loop(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb,
-                               const bool planar) {
+static inline uint64_t raster_loop(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb,
+                                   const bool planar) {
+  uint64_t covered = 0;
   for (int y = r[1]; y <= r[3]; y++) {
     float sy = (float)y + 0.5f;
     size_t row = (size_t)y * vb->width;
     for (int x = r[0]; x <= r[2]; x++) {
       float sx = (float)x + 0.5f;
       vec3 w = planar ? v3(1.0f, sx, sy) : c->dirs[row + x];
-      shade_sample_w(ts, id, w, sx, sy, vb, row + x);
+      covered += shade_sample_w(ts, id, w, sx, sy, vb, row + x) != 0;
     }
   }
+  return covered;
 }
 
 /* Tests every sample of rectangle r against one triangle; returns the evaluations. */
-uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb) {
-  if (c->planar) raster_loop(ts, id, r, c, vb, true);
-  else raster_loop(ts, id, r, c, vb, false);
+uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb,
+                     uint64_t *covered) {
+  uint64_t n = c->planar ? raster_loop(ts, id, r, c, vb, true) : raster_loop(ts, id, r, c, vb, false);
+  if (covered) *covered += n;
   return (uint64_t)(r[2] - r[0] + 1) * (uint64_t)(r[3] - r[1] + 1);
 }

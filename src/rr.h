@@ -201,8 +201,9 @@ static inline vec3 camera_w(const camera *c, int x, int y) {
  * cameras); false when it is not strictly in front of the image plane. */
 bool camera_project(const camera *c, vec3 p, float *sx, float *sy);
 /* A cone (unit axis, half-angle) holding the directions of the samples
- * [x0, x1) × [y0, y1) of a curved camera; false when none is known. */
-bool camera_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle);
+ * [x0, x1) × [y0, y1) of a curved camera: 1 when found, 0 when none is known,
+ * -1 when none of the samples has a ray. */
+int camera_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle);
 
 /* ---- triangle setup and the one sample test ----------------------------- */
 
@@ -279,22 +280,23 @@ static inline bool depth_wins(float t, uint32_t id, float best_t, uint32_t best_
 }
 
 /* Tests one set-up triangle at pixel k, whose sample is (sx, sy) with evaluation
- * vector w, and keeps it when it is nearer. */
-static inline bool shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, float sy, visbuf *vb,
-                                  size_t k) {
+ * vector w, and keeps it when it is nearer. Returns 0 when the triangle does not
+ * cover the sample, 1 when it covers it behind what is stored, 2 when it is kept. */
+static inline int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, float sy, visbuf *vb,
+                                 size_t k) {
   float e[3], t, l1, l2;
   tri_edges_w(ts, w, e);
-  if (!sample_test(e, ts->tie, tri_vol(ts, sx, sy), &t, &l1, &l2)) return false;
-  if (!depth_wins(t, id, vb->t[k], vb->id[k])) return false;
+  if (!sample_test(e, ts->tie, tri_vol(ts, sx, sy), &t, &l1, &l2)) return 0;
+  if (!depth_wins(t, id, vb->t[k], vb->id[k])) return 1;
   vb->t[k] = t;
   vb->id[k] = id;
   vb->l1[k] = l1;
   vb->l2[k] = l2;
-  return true;
+  return 2;
 }
 
 /* The same for a planar camera's sample (sx, sy). */
-static inline bool shade_sample(const tri_setup *ts, uint32_t id, float sx, float sy, visbuf *vb, size_t k) {
+static inline int shade_sample(const tri_setup *ts, uint32_t id, float sx, float sy, visbuf *vb, size_t k) {
   return shade_sample_w(ts, id, v3(1.0f, sx, sy), sx, sy, vb, k);
 }
 
@@ -361,7 +363,8 @@ bool raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, do
  * directions no edge plane excludes. */
 bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int rect[4]);
 /* Tests every sample of an inclusive rectangle against one set-up triangle and
- * returns the number of edge-function evaluations. */
+ * returns the number of edge-function evaluations; adds the samples the
+ * triangle covers to *covered. */
 /* Curved cameras: what bounds a triangle's directions from the eye. */
 typedef struct tri_cone {
   float len[4];      /* lengths of the three edge normals and of their sum */
@@ -371,7 +374,8 @@ typedef struct tri_cone {
 void tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, tri_cone *tc);
 /* May a triangle be excluded from a cone of directions (unit axis, half-angle)? */
 bool cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float angle);
-uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb);
+uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb,
+                     uint64_t *covered);
 
 /* ---- threads --------------------------------------------------------------- */
 

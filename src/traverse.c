@@ -87,12 +87,15 @@ typedef struct tri_job {
   int bb[4];       /* inclusive screen bounds */
 } tri_job;
 
-/* Tests every sample of r; the one kernel every generateSamples path ends in. */
-static void raster_samples(trav *t, const tri_job *j, tile_rect r) {
+/* Tests every sample of r; the one kernel every generateSamples path ends in.
+ * Returns the samples the triangle covers. */
+static uint64_t raster_samples(trav *t, const tri_job *j, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
-  t->st.edge_evals += raster_rect(&j->ts, j->id, rect, t->c, t->vb);
+  uint64_t covered = 0;
+  t->st.edge_evals += raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered);
   charge(t->heat_e, t->vb->width, r, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
   mark_dirty(t, r);
+  return covered;
 }
 
 /* Hierarchical binning: a bin is rejected when one edge function is negative at
@@ -100,13 +103,14 @@ static void raster_samples(trav *t, const tri_job *j, tile_rect r) {
  * cameras) or when early-z shows it is hidden; otherwise it is refined by 4 in each
  * direction down to single samples. Accepted samples still go through the sample
  * test, which keeps the result bit-identical. */
-static void bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
+static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
+  uint64_t covered = 0;
   for (int by = r.y0 - r.y0 % size; by < r.y1; by += size)
     for (int bx = r.x0 - r.x0 % size; bx < r.x1; bx += size) {
       tile_rect b = {bx > r.x0 ? bx : r.x0, by > r.y0 ? by : r.y0, bx + size < r.x1 ? bx + size : r.x1,
                      by + size < r.y1 ? by + size : r.y1};
       if (size <= t->o->bin_min || (b.x1 - b.x0) * (b.y1 - b.y0) <= 4) {
-        raster_samples(t, j, b);
+        covered += raster_samples(t, j, b);
         continue;
       }
       bool out = false;
@@ -131,7 +135,9 @@ static void bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
          * the same for the parabolic map by shifting the corners). */
         vec3 axis;
         float angle;
-        if (camera_rect_cone(t->c, b.x0, b.y0, b.x1, b.y1, &axis, &angle) && angle < 1.5f) {
+        int cone = camera_rect_cone(t->c, b.x0, b.y0, b.x1, b.y1, &axis, &angle);
+        if (cone < 0) continue; /* no rays here: nothing to refine */
+        if (cone > 0 && angle < 1.5f) {
           out = cone_excludes(&j->cone, &j->ts, axis, angle);
           t->st.edge_evals += 1;
           if (t->heat_e) t->heat_e[(size_t)((b.y0 + b.y1) / 2) * t->vb->width + (b.x0 + b.x1) / 2] += 1;
@@ -139,8 +145,13 @@ static void bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
       }
       if (out) continue;
       if (t->o->early_z && j->zmin > 0 && j->zmin * (1 - DEPTH_MARGIN) > hiz_max(t, b)) continue;
-      bin_raster(t, j, b, size / 4 > 1 ? size / 4 : 1);
+      /* refined: count the bins that turn out to hold none of the triangle */
+      uint64_t in = bin_raster(t, j, b, size / 4 > 1 ? size / 4 : 1);
+      t->st.bins++;
+      t->st.bins_empty += in == 0;
+      covered += in;
     }
+  return covered;
 }
 
 /* Triangle setup for a frustum: false when the triangle cannot cover a sample. */
@@ -191,7 +202,7 @@ typedef struct frustum {
   int nplanes;       /* planar cameras: inward side planes n·p + off >= 0 */
   vec3 plane[4];
   float off[4];
-  bool has_cone;     /* curved cameras: a cone of the frustum's directions */
+  int has_cone;      /* curved cameras: 1 with a cone of the frustum's directions, -1 without rays */
   vec3 axis;
   float angle;
   bool has_ray;      /* the centre sample's ray */
@@ -289,7 +300,7 @@ static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
       if (box_max_plane(b, f->plane[i], f->off[i], &mag) < -1e-5f * mag) return true;
     return false;
   }
-  if (!f->has_cone) return false;
+  if (f->has_cone <= 0) return f->has_cone < 0;
   /* the box's bounding sphere against the cone */
   vec3 lo = v3_load(b->lo), hi = v3_load(b->hi);
   vec3 v = v3_sub(v3_scale(v3_add(lo, hi), 0.5f), c->eye);
@@ -428,6 +439,7 @@ static void run_tile(int job, int thread, void *arg) {
   }
   rr_stats *s = &tj->st[thread];
   s->setups += t.st.setups, s->edge_evals += t.st.edge_evals, s->nodes += t.st.nodes;
+  s->bins += t.st.bins, s->bins_empty += t.st.bins_empty;
 }
 
 rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
@@ -476,6 +488,8 @@ rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
     ctx->stats->setups += tj->st[i].setups;
     ctx->stats->edge_evals += tj->st[i].edge_evals;
     ctx->stats->nodes += tj->st[i].nodes;
+    ctx->stats->bins += tj->st[i].bins;
+    ctx->stats->bins_empty += tj->st[i].bins_empty;
   }
   free(pre), free(tj->hiz), free(tj->dirty), free(tj);
   return RR_OK;

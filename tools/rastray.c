@@ -311,9 +311,10 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   if (stats)
     fprintf(stderr,
             "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f total_ms=%.1f "
-            "setups=%llu edge_evals=%llu nodes=%llu\n",
+            "setups=%llu edge_evals=%llu nodes=%llu bins=%llu bins_empty=%llu\n",
             method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, threads, frame_ms, total_ms,
-            (unsigned long long)st.setups, (unsigned long long)st.edge_evals, (unsigned long long)st.nodes);
+            (unsigned long long)st.setups, (unsigned long long)st.edge_evals, (unsigned long long)st.nodes,
+            (unsigned long long)st.bins, (unsigned long long)st.bins_empty);
   if (json) {
     char tmp[4096];
     snprintf(tmp, sizeof tmp, "%s.tmp", json);
@@ -322,10 +323,12 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
     fprintf(f,
             "{\"scene\": \"%s\", \"method\": \"%s\", \"camera\": \"%s\", \"triangles\": %llu, "
             "\"skipped\": %llu, \"width\": %d, \"height\": %d, \"threads\": %d, \"repeat\": %d, "
-            "\"frame_ms\": %.3f, \"total_ms\": %.3f, \"setups\": %llu, \"edge_evals\": %llu, \"nodes\": %llu}\n",
+            "\"frame_ms\": %.3f, \"total_ms\": %.3f, \"setups\": %llu, \"edge_evals\": %llu, \"nodes\": %llu, "
+            "\"bins\": %llu, \"bins_empty\": %llu}\n",
             scene_name, method, rr_camera_name(cam.type), (unsigned long long)info.triangles, (unsigned long long)info.skipped, opt.width,
             opt.height, threads, repeat, frame_ms, total_ms, (unsigned long long)st.setups,
-            (unsigned long long)st.edge_evals, (unsigned long long)st.nodes);
+            (unsigned long long)st.edge_evals, (unsigned long long)st.nodes, (unsigned long long)st.bins,
+            (unsigned long long)st.bins_empty);
     if (fclose(f) != 0 || rename(tmp, json) != 0) {
       remove(tmp);
       die(EXIT_INPUT, "cannot write '%s'", json);
