@@ -170,6 +170,7 @@ typedef struct rr_render_options {
   int threads;        /* 0: all cores */
   int cull_backfaces; /* nonzero: triangles seen from behind are invisible */
   int heat;           /* nonzero: also record E and N charged to each pixel (AOVs evals, nodes) */
+  int scalar;         /* nonzero: no SIMD kernels (for comparison; results are the same bits) */
   const char *oracles;/* "key=value,..." overrides of a 3dr method's traversal oracles, or NULL:
                          frustum=N (initial frustum side, 0 = whole image), leaves=0|1
                          (generate samples at BVH leaves or at the root), outside=0|1 (frustum

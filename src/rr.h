@@ -347,8 +347,9 @@ rr_error vis_rc(rr_device *dev, render_ctx *ctx);
 rr_error vis_rc_bvh(rr_device *dev, render_ctx *ctx);
 rr_error vis_rc_packet(rr_device *dev, render_ctx *ctx);
 /* The least t that sample_test() can return for a set-up triangle at any sample of
- * camera c: the exact pruning bound of rc-bvh and rc-packet. */
-float tri_t_lower_bound(const tri_setup *ts, const camera *c);
+ * camera c, and (planar cameras) a rectangle x0, y0, x1, y1 of sample coordinates
+ * holding every sample where it can pass: the exact culling of rc-bvh, rc-packet. */
+float tri_bounds(const tri_setup *ts, const camera *c, float rect[4]);
 /* 2dr-bb and 2dr-bin: projection, clipping, fixed-point 2D edge functions (src/raster2d.c). */
 rr_error vis_2dr_bb(rr_device *dev, render_ctx *ctx);
 rr_error vis_2dr_bin(rr_device *dev, render_ctx *ctx);
@@ -364,7 +365,7 @@ bool raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, do
 bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int rect[4]);
 /* Tests every sample of an inclusive rectangle against one set-up triangle and
  * returns the number of edge-function evaluations; adds the samples the
- * triangle covers to *covered. */
+ * triangle covers to *covered. simd: use AVX2 where the processor has it. */
 /* Curved cameras: what bounds a triangle's directions from the eye. */
 typedef struct tri_cone {
   float len[4];      /* lengths of the three edge normals and of their sum */
@@ -375,7 +376,7 @@ void tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri_se
 /* May a triangle be excluded from a cone of directions (unit axis, half-angle)? */
 bool cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float angle);
 uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb,
-                     uint64_t *covered);
+                     uint64_t *covered, bool simd);
 
 /* ---- threads --------------------------------------------------------------- */
 

@@ -26,7 +26,7 @@ typedef struct trav {
   const camera *c;
   const oracles *o;
   visbuf *vb;
-  bool cull_back;
+  bool cull_back, simd;
   float *hiz;        /* per HIZ×HIZ tile: the farthest t stored (recomputed when dirty) */
   uint8_t *dirty;
   int tiles_x;
@@ -92,7 +92,7 @@ typedef struct tri_job {
 static uint64_t raster_samples(trav *t, const tri_job *j, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
-  t->st.edge_evals += raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered);
+  t->st.edge_evals += raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd);
   charge(t->heat_e, t->vb->width, r, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
   mark_dirty(t, r);
   return covered;
@@ -417,6 +417,7 @@ static void run_tile(int job, int thread, void *arg) {
             .o = tj->o,
             .vb = ctx->vb,
             .cull_back = ctx->opt->cull_backfaces != 0,
+            .simd = !ctx->opt->scalar,
             .hiz = tj->hiz,
             .dirty = tj->dirty,
             .tiles_x = (vb->width + HIZ - 1) / HIZ,

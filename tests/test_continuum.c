@@ -10,10 +10,13 @@
 static const rr_method all3d[] = {RR_METHOD_RC_BVH,  RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
                                   RR_METHOD_3DR_FC,  RR_METHOD_3DR_FS,    RR_METHOD_3DR_FULL};
 
+static int scalar; /* nonzero: render without SIMD kernels */
+
 static rr_frame *render(rr_device *dev, const rr_scene *s, const rr_camera *cam, rr_method m, int threads, int w,
                         int h, int cull, const char *oracles, int heat) {
   rr_render_options opt;
   rr_render_options_init(&opt);
+  opt.scalar = scalar;
   opt.method = m, opt.width = w, opt.height = h, opt.threads = threads, opt.cull_backfaces = cull;
   opt.oracles = oracles, opt.heat = heat;
   rr_frame *f = NULL;
@@ -66,6 +69,16 @@ static void check_scene(rr_device *dev, const char *name, int views, int w, int 
             v % 2 == 0 ? "inside" : "outside", threads, rr_method_name(all3d[m]), d);
       rr_frame_release(f);
     }
+    /* the scalar kernels give the same bits as the SIMD ones */
+    scalar = 1;
+    for (int k = 0; k < 2; k++) {
+      rr_frame *f = render(dev, s, &cam, k ? RR_METHOD_3DR_FULL : RR_METHOD_3DR_BB, threads, w, h, cull, NULL, 0);
+      if (!f) continue;
+      int d = differ(ref, f);
+      CHECK(d == 0, "%s view %d: scalar %s differs from rc at %d samples", name, v, k ? "3dr-full" : "3dr-bb", d);
+      rr_frame_release(f);
+    }
+    scalar = 0;
     /* points between the named methods */
     const char *mixes[] = {"frustum=1,leaves=1,outside=1", "frustum=32,leaves=1,outside=1,occluded=1,binning=1",
                            "leaves=1,split=16,split-ratio=2,binning=1,bin=16,bin-min=1", "binning=1,early-z=0,bin=8"};
