@@ -156,10 +156,11 @@ typedef enum rr_method {
   RR_METHOD_3DR_FC,   /* 256² frusta, BVH frustum culling, binning at leaves */
   RR_METHOD_3DR_FS,   /* occlusion culling and frustum splitting down to 8², no binning */
   RR_METHOD_3DR_FULL, /* 3dr-fs followed by binning and early-z */
-  RR_METHOD_COUNT
+  RR_METHOD_COUNT,
+  RR_METHOD_AUTO = 99 /* the fastest for the scene and camera, found by short trials */
 } rr_method;
 
-/* The method named `name` ("rc", "3dr-bb", ...); -1 when unknown. */
+/* The method named `name` ("rc", "3dr-bb", ..., "auto"); -1 when unknown. */
 int rr_method_from_name(const char *name);
 /* The name of a method ("rc", ...), NULL when out of range. */
 const char *rr_method_name(int method);
@@ -190,6 +191,8 @@ typedef struct rr_stats {
   uint64_t bins_empty; /* of those, bins where the triangle covered no sample */
   double frame_ms;     /* wall time of the visibility pass */
   int threads;         /* threads the pass ran on */
+  int method;          /* the method that ran (what auto chose) */
+  char why[160];       /* for auto: why it chose that method */
 } rr_stats;
 
 /* Computes primary visibility of a scene from a camera into a new frame. */

@@ -95,12 +95,15 @@ static rr_error parse_oracles(rr_device *dev, const char *spec, oracles *o) {
 }
 
 int rr_method_from_name(const char *name) {
+  if (name && strcmp(name, "auto") == 0) return RR_METHOD_AUTO;
   for (int m = 0; name && m < RR_METHOD_COUNT; m++)
     if (strcmp(methods[m].name, name) == 0) return m;
   return -1;
 }
 
-const char *rr_method_name(int m) { return m >= 0 && m < RR_METHOD_COUNT ? methods[m].name : NULL; }
+const char *rr_method_name(int m) {
+  return m == RR_METHOD_AUTO ? "auto" : m >= 0 && m < RR_METHOD_COUNT ? methods[m].name : NULL;
+}
 
 static int name_index(const char *const *names, int n, const char *name) {
   for (int i = 0; name && i < n; i++)
@@ -145,10 +148,53 @@ static bool visbuf_alloc(visbuf *vb, int w, int h) {
   return true;
 }
 
+/* auto: every candidate renders the view once at half the resolution in each
+ * direction, and the fastest renders the frame. A trial costs about a quarter of a
+ * frame per candidate; a cost model from S, E and N would be cheaper but has to
+ * know this machine's costs, which the trial measures directly. */
+static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                            const rr_render_options *opt, rr_frame **out) {
+  static const rr_method planar[] = {RR_METHOD_RC_PACKET, RR_METHOD_2DR_BB, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
+                                     RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL};
+  static const rr_method curved[] = {RR_METHOD_RC_PACKET, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL};
+  if (opt->oracles && *opt->oracles)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "oracles apply to the 3dr methods: choose one instead of auto");
+  bool flat = cam->type == RR_CAMERA_PERSPECTIVE || cam->type == RR_CAMERA_ORTHOGRAPHIC;
+  const rr_method *cand = flat ? planar : curved;
+  int n = flat ? 6 : 4, best = -1;
+  double best_ms = INFINITY;
+  char trial[160] = "";
+  rr_render_options t = *opt;
+  t.width = opt->width > 1 ? opt->width / 2 : 1, t.height = opt->height > 1 ? opt->height / 2 : 1;
+  if (cam->type == RR_CAMERA_CUBE) t.width = t.height / 3 * 4, t.height = t.height / 3 * 3;
+  if (t.height < 3) t = *opt;
+  t.heat = 0, t.oracles = NULL;
+  for (int i = 0; i < n; i++) {
+    t.method = cand[i];
+    rr_frame *f;
+    rr_error e = rr_render(dev, scene, cam, &t, &f);
+    if (e == RR_ERROR_UNSUPPORTED) continue;
+    if (e) return e;
+    size_t len = strlen(trial);
+    snprintf(trial + len, sizeof trial - len, "%s%s %.1f", len ? ", " : "", methods[cand[i]].name, f->stats.frame_ms);
+    if (f->stats.frame_ms < best_ms) best_ms = f->stats.frame_ms, best = cand[i];
+    rr_frame_release(f);
+  }
+  if (best < 0) return rr_fail(dev, RR_ERROR_UNSUPPORTED, "no method can render this camera");
+  t = *opt;
+  t.method = (rr_method)best;
+  rr_error e = rr_render(dev, scene, cam, &t, out);
+  if (!e)
+    snprintf((*out)->stats.why, sizeof (*out)->stats.why, "fastest in a %dx%d trial (ms: %s)", opt->width / 2,
+             opt->height / 2, trial);
+  return e;
+}
+
 rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                    const rr_render_options *opt, rr_frame **out) {
   if (!scene || !cam || !opt || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_render: NULL argument");
   *out = NULL;
+  if (opt->method == RR_METHOD_AUTO) return render_auto(dev, scene, cam, opt, out);
   if ((int)opt->method < 0 || opt->method >= RR_METHOD_COUNT)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown method %d", (int)opt->method);
   if (opt->threads < 0 || opt->threads > 256)
@@ -190,6 +236,7 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                     .heat_n = f->heat_n,
                     .oracles = &o};
   f->stats.threads = ctx.threads;
+  f->stats.method = opt->method;
   double t0 = now_ms();
   e = methods[opt->method].fn(dev, &ctx);
   f->stats.frame_ms = now_ms() - t0;

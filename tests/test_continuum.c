@@ -69,6 +69,14 @@ static void check_scene(rr_device *dev, const char *name, int views, int w, int 
             v % 2 == 0 ? "inside" : "outside", threads, rr_method_name(all3d[m]), d);
       rr_frame_release(f);
     }
+    /* auto picks one of the methods, says why, and so gives the same picture */
+    rr_frame *fa = render(dev, s, &cam, RR_METHOD_AUTO, threads, w, h, cull, NULL, 0);
+    if (fa) {
+      CHECK(fa->stats.method >= 0 && fa->stats.method < RR_METHOD_COUNT && fa->stats.why[0], "auto chose %d (%s)",
+            fa->stats.method, fa->stats.why);
+      CHECK(differ(ref, fa) == 0, "%s view %d: auto (%s) differs from rc", name, v, rr_method_name(fa->stats.method));
+      rr_frame_release(fa);
+    }
     /* the scalar kernels give the same bits as the SIMD ones */
     scalar = 1;
     for (int k = 0; k < 2; k++) {

@@ -32,8 +32,8 @@ static const char usage[] =
     "        sphere[:N], box[:N], rooms[:N], grid:PATH:N (N×N copies of a mesh)\n"
     "\n"
     "options:\n"
-    "  --method NAME       visibility method (default 3dr-bb): rc, rc-bvh, rc-packet, 2dr-bb,\n"
-    "                      2dr-bin, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full\n"
+    "  --method NAME       visibility method: auto (default: the fastest in a short trial), rc,\n"
+    "                      rc-bvh, rc-packet, 2dr-bb, 2dr-bin, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full\n"
     "  --oracles K=V,...   override a 3dr method's traversal: frustum=N leaves=0|1 outside=0|1\n"
     "                      occluded=0|1 split=N split-ratio=F binning=0|1 early-z=0|1 bin=N bin-min=N\n"
     "  --size WxH          image size (default 1024x768, at most 16384 a side)\n"
@@ -183,6 +183,7 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   double t_start = now_ms();
   rr_render_options opt;
   rr_render_options_init(&opt);
+  opt.method = RR_METHOD_AUTO;
   rr_camera cam;
   rr_camera_init(&cam);
   const char *scene_name = NULL, *out = NULL, *json = NULL, *cube_dir = NULL;
@@ -306,7 +307,7 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   rr_scene_info info;
   rr_scene_get_info(scene, &info);
   double total_ms = now_ms() - t_start;
-  const char *method = rr_method_name(opt.method);
+  const char *method = rr_method_name(st.method);
   int threads = st.threads;
   if (stats)
     fprintf(stderr,
@@ -315,6 +316,7 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
             method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, threads, frame_ms, total_ms,
             (unsigned long long)st.setups, (unsigned long long)st.edge_evals, (unsigned long long)st.nodes,
             (unsigned long long)st.bins, (unsigned long long)st.bins_empty);
+  if (stats && st.why[0]) fprintf(stderr, "auto chose %s: %s\n", method, st.why);
   if (json) {
     char tmp[4096];
     snprintf(tmp, sizeof tmp, "%s.tmp", json);
@@ -324,11 +326,11 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
             "{\"scene\": \"%s\", \"method\": \"%s\", \"camera\": \"%s\", \"triangles\": %llu, "
             "\"skipped\": %llu, \"width\": %d, \"height\": %d, \"threads\": %d, \"repeat\": %d, "
             "\"frame_ms\": %.3f, \"total_ms\": %.3f, \"setups\": %llu, \"edge_evals\": %llu, \"nodes\": %llu, "
-            "\"bins\": %llu, \"bins_empty\": %llu}\n",
+            "\"bins\": %llu, \"bins_empty\": %llu, \"auto\": \"%s\"}\n",
             scene_name, method, rr_camera_name(cam.type), (unsigned long long)info.triangles, (unsigned long long)info.skipped, opt.width,
             opt.height, threads, repeat, frame_ms, total_ms, (unsigned long long)st.setups,
             (unsigned long long)st.edge_evals, (unsigned long long)st.nodes, (unsigned long long)st.bins,
-            (unsigned long long)st.bins_empty);
+            (unsigned long long)st.bins_empty, st.why);
     if (fclose(f) != 0 || rename(tmp, json) != 0) {
       remove(tmp);
       die(EXIT_INPUT, "cannot write '%s'", json);
