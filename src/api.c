@@ -149,19 +149,21 @@ static bool visbuf_alloc(visbuf *vb, int w, int h) {
 }
 
 /* auto: every candidate renders the view once at half the resolution in each
- * direction, and the fastest renders the frame. A trial costs about a quarter of a
+ * direction, and the fastest renders the frame. The candidates are the exact
+ * methods (bit-identical to ray casting); the 2D pipeline's snapped vertices are
+ * for comparison, not a default. A trial costs about a quarter of a
  * frame per candidate; a cost model from S, E and N would be cheaper but has to
  * know this machine's costs, which the trial measures directly. */
 static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                             const rr_render_options *opt, rr_frame **out) {
-  static const rr_method planar[] = {RR_METHOD_RC_PACKET, RR_METHOD_2DR_BB, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
-                                     RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL};
+  static const rr_method planar[] = {RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC,
+                                     RR_METHOD_3DR_FULL};
   static const rr_method curved[] = {RR_METHOD_RC_PACKET, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL};
   if (opt->oracles && *opt->oracles)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "oracles apply to the 3dr methods: choose one instead of auto");
   bool flat = cam->type == RR_CAMERA_PERSPECTIVE || cam->type == RR_CAMERA_ORTHOGRAPHIC;
   const rr_method *cand = flat ? planar : curved;
-  int n = flat ? 6 : 4, best = -1;
+  int n = flat ? 5 : 4, best = -1;
   double best_ms = INFINITY;
   char trial[160] = "";
   rr_render_options t = *opt;

@@ -32,7 +32,7 @@ static const char usage[] =
     "        sphere[:N], box[:N], rooms[:N], grid:PATH:N (N×N copies of a mesh)\n"
     "\n"
     "options:\n"
-    "  --method NAME       visibility method: auto (default: the fastest in a short trial), rc,\n"
+    "  --method NAME       visibility method: auto (default: the fastest exact one in a trial), rc,\n"
     "                      rc-bvh, rc-packet, 2dr-bb, 2dr-bin, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full\n"
     "  --oracles K=V,...   override a 3dr method's traversal: frustum=N leaves=0|1 outside=0|1\n"
     "                      occluded=0|1 split=N split-ratio=F binning=0|1 early-z=0|1 bin=N bin-min=N\n"
