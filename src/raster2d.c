@@ -42,6 +42,8 @@ typedef struct pipe2d {
   double depth[4];   /* world → t, the ray parameter along the camera's unnormalised ray */
   double kx, ky;     /* guard band in clip units: |x| ≤ kx·w, |y| ≤ ky·w */
   double hw, hh;     /* half the image size: the viewport transform */
+  double near;       /* z_c = t − near */
+  bool depth_is_w;   /* pinhole: t = w_c, so the vertex stage skips the depth row */
   int width, height;
   bool cull;
 } pipe2d;
@@ -122,6 +124,8 @@ static bool pipe_setup(pipe2d *pp, const rr_scene *s, const camera *c, bool cull
   proj[2][3] -= near;
   mat4_mul(pp->clip, proj, view);
   for (int j = 0; j < 4; j++) pp->depth[j] = T[0] * view[0][j] + T[1] * view[1][j] + T[2] * view[2][j] + T[3] * view[3][j];
+  pp->near = near;
+  pp->depth_is_w = !ortho;
   pp->width = c->width, pp->height = c->height;
   pp->hw = hw, pp->hh = hh;
   pp->kx = GUARD_PX / hw, pp->ky = GUARD_PX / hh;
@@ -135,11 +139,14 @@ typedef struct cvert {
   double v[NCOMP];
 } cvert;
 
-static void vertex_stage(const pipe2d *pp, vec3 p, cvert *out) {
-  double h[4] = {p.x, p.y, p.z, 1.0};
-  for (int r = 0; r < 4; r++)
-    out->v[r] = pp->clip[r][0] * h[0] + pp->clip[r][1] * h[1] + pp->clip[r][2] * h[2] + pp->clip[r][3];
-  out->v[CT] = pp->depth[0] * h[0] + pp->depth[1] * h[1] + pp->depth[2] * h[2] + pp->depth[3];
+static inline void vertex_stage(const pipe2d *pp, vec3 p, cvert *out) {
+  double x = p.x, y = p.y, z = p.z;
+  const double(*m)[4] = pp->clip;
+  out->v[CX] = m[0][0] * x + m[0][1] * y + m[0][2] * z + m[0][3];
+  out->v[CY] = m[1][0] * x + m[1][1] * y + m[1][2] * z + m[1][3];
+  out->v[CW] = m[3][0] * x + m[3][1] * y + m[3][2] * z + m[3][3];
+  out->v[CT] = pp->depth_is_w ? out->v[CW] : pp->depth[0] * x + pp->depth[1] * y + pp->depth[2] * z + pp->depth[3];
+  out->v[CZ] = out->v[CT] - pp->near; /* the clip matrix's z row, without recomputing t */
 }
 
 /* ---- clipping -------------------------------------------------------------- */
