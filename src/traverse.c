@@ -53,7 +53,7 @@ static float hiz_tile(trav *t, int tx, int ty) {
     int y1 = (ty + 1) * HIZ < vb->height ? (ty + 1) * HIZ : vb->height;
     float m = 0;
     for (int y = ty * HIZ; y < y1; y++)
-      for (int x = tx * HIZ; x < x1; x++) m = fmaxf(m, vb->t[(size_t)y * vb->width + x]);
+      for (int x = tx * HIZ; x < x1; x++) m = maxf(m, vb->t[(size_t)y * vb->width + x]);
     t->hiz[k] = m;
     t->dirty[k] = 0;
   }
@@ -65,7 +65,7 @@ static float hiz_max(trav *t, tile_rect r) {
   float m = 0;
   for (int ty = r.y0 / HIZ; ty <= (r.y1 - 1) / HIZ; ty++)
     for (int tx = r.x0 / HIZ; tx <= (r.x1 - 1) / HIZ; tx++) {
-      m = fmaxf(m, hiz_tile(t, tx, ty));
+      m = maxf(m, hiz_tile(t, tx, ty));
       if (m == INFINITY) return m;
     }
   return m;
@@ -163,7 +163,7 @@ static bool prepare(const trav *t, uint32_t id, tri_job *j) {
   const camera *c = t->c;
   if (c->planar) {
     float zmin = INFINITY;
-    for (int k = 0; k < 3; k++) zmin = fminf(zmin, v3_dot(v3_sub(scene_vertex(t->s, k, id), c->eye), c->fwd));
+    for (int k = 0; k < 3; k++) zmin = minf(zmin, v3_dot(v3_sub(scene_vertex(t->s, k, id), c->eye), c->fwd));
     j->zmin = zmin > 0 ? zmin : 0;
     float W = (float)t->vb->width + 1, H = (float)t->vb->height + 1;
     for (int e = 0; e < 3; e++)
@@ -245,7 +245,7 @@ static float box_max_plane(const bvh_node *b, vec3 n, float off, float *mag) {
   const float nn[3] = {n.x, n.y, n.z};
   for (int a = 0; a < 3; a++) {
     float lo = nn[a] * b->lo[a], hi = nn[a] * b->hi[a];
-    m += fmaxf(lo, hi);
+    m += maxf(lo, hi);
     s += fabsf(lo) + fabsf(hi);
   }
   *mag = s;
@@ -260,11 +260,11 @@ static float box_tmin(const bvh_node *b, const camera *c) {
   float m = 0;
   if (c->planar) {
     const float f[3] = {c->fwd.x, c->fwd.y, c->fwd.z};
-    for (int a = 0; a < 3; a++) m += fminf(f[a] * (b->lo[a] - e[a]), f[a] * (b->hi[a] - e[a]));
+    for (int a = 0; a < 3; a++) m += minf(f[a] * (b->lo[a] - e[a]), f[a] * (b->hi[a] - e[a]));
     return m;
   }
   for (int a = 0; a < 3; a++) {
-    float d = fmaxf(fmaxf(b->lo[a] - e[a], e[a] - b->hi[a]), 0.0f);
+    float d = maxf(maxf(b->lo[a] - e[a], e[a] - b->hi[a]), 0.0f);
     m += d * d;
   }
   return sqrtf(m) / c->dir_len_max;
@@ -282,8 +282,8 @@ static bool centre_hits(const frustum *f, const bvh_node *b) {
       continue;
     }
     float inv = 1.0f / d[a], ta = (b->lo[a] - pad - o[a]) * inv, tb = (b->hi[a] + pad - o[a]) * inv;
-    t0 = fmaxf(t0, fminf(ta, tb));
-    t1 = fminf(t1, fmaxf(ta, tb));
+    t0 = maxf(t0, minf(ta, tb));
+    t1 = minf(t1, maxf(ta, tb));
   }
   return t0 <= t1 * 1.0001f;
 }
@@ -306,7 +306,7 @@ static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
   vec3 v = v3_sub(v3_scale(v3_add(lo, hi), 0.5f), c->eye);
   float rad = 0.5f * v3_len(v3_sub(hi, lo)) * 1.0001f, dist = v3_len(v);
   if (dist <= rad || !(dist > 0)) return false;
-  float beta = asinf(rad / dist), phi = acosf(fmaxf(-1.0f, fminf(1.0f, v3_dot(v, f->axis) / dist)));
+  float beta = asinf(rad / dist), phi = acosf(maxf(-1.0f, minf(1.0f, v3_dot(v, f->axis) / dist)));
   return phi > f->angle + beta + 1e-4f;
 }
 
