@@ -18,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { MAX_SCENES = 16, ROWS = RR_METHOD_COUNT + 3 };
+enum { MAX_SCENES = 16, ROW_EMBREE1 = RR_METHOD_COUNT, ROW_EMBREE8, ROW_LLVMPIPE, ROW_AUTO, ROWS };
 
 typedef struct {
   bool done;
@@ -28,7 +28,7 @@ typedef struct {
 
 static const char *row_name(int r) {
   if (r < RR_METHOD_COUNT) return rr_method_name(r);
-  static const char *peers[] = {"embree rtcIntersect1", "embree rtcIntersect8", "llvmpipe (OSMesa)"};
+  static const char *peers[] = {"embree rtcIntersect1", "embree rtcIntersect8", "llvmpipe (OSMesa)", "auto"};
   return peers[r - RR_METHOD_COUNT];
 }
 
@@ -74,12 +74,15 @@ int main(int argc, char **argv) {
   }
   static cell table[ROWS][MAX_SCENES];
   uint64_t tris[MAX_SCENES];
+  double build_rr[MAX_SCENES] = {0}, build_embree[MAX_SCENES] = {0};
+  int auto_pick[MAX_SCENES];
   rr_device *dev = rr_device_new();
   for (int sc = 0; sc < nscenes; sc++) {
     rr_scene *s = bench_load(dev, scenes[sc], NULL);
     rr_scene_info in;
     rr_scene_get_info(s, &in);
     tris[sc] = in.triangles;
+    build_rr[sc] = in.bvh_build_ms;
     rr_camera cam;
     scene_camera(dev, scenes[sc], s, size, &cam);
     fprintf(stderr, "%s: %llu triangles\n", scenes[sc], (unsigned long long)in.triangles);
@@ -96,10 +99,25 @@ int main(int argc, char **argv) {
       rr_frame_release(f);
       fprintf(stderr, "  %-10s %9.1f ms\n", rr_method_name(m), c->ms);
     }
+    {
+      /* auto: its trial is not timed, only the frame of the method it picked */
+      rr_render_options opt;
+      rr_render_options_init(&opt);
+      opt.method = RR_METHOD_AUTO, opt.width = size, opt.height = size, opt.threads = threads, opt.cull_backfaces = 1;
+      rr_frame *f;
+      cell *c = &table[ROW_AUTO][sc];
+      c->ms = bench_render(dev, s, &cam, &opt, reps, &f);
+      rr_frame_get_stats(f, &c->st);
+      c->done = true;
+      auto_pick[sc] = c->st.method;
+      rr_frame_release(f);
+      fprintf(stderr, "  auto       %9.1f ms (%s: %s)\n", c->ms, rr_method_name(auto_pick[sc]), c->st.why);
+    }
 #ifdef RR_HAVE_EMBREE
     {
       double build;
       peer_embree *e = peer_embree_new(s, threads, 2, &build);
+      build_embree[sc] = build;
       camera c;
       if (e && camera_setup(dev, &cam, size, size, &c) == RR_OK) {
         uint32_t *ids = malloc((size_t)size * size * sizeof *ids);
@@ -162,6 +180,7 @@ int main(int argc, char **argv) {
         continue;
       }
       fprintf(md, " %.1f ms", c->ms);
+      if (r == ROW_AUTO) fprintf(md, " (%s)", rr_method_name(auto_pick[sc]));
       if (r < RR_METHOD_COUNT) {
         char S[32], E[32], N[32];
         fmt_count(S, sizeof S, c->st.setups), fmt_count(E, sizeof E, c->st.edge_evals),
@@ -176,6 +195,34 @@ int main(int argc, char **argv) {
     }
     fprintf(md, "\n");
   }
+  /* The targets of the speed issue, as ratios in this one run. */
+  fprintf(md, "| BVH build, rastray / Embree (HIGH) |");
+  for (int sc = 0; sc < nscenes; sc++)
+    fprintf(md, build_embree[sc] > 0 ? " %.1f / %.1f ms = %.2f× |" : " %.1f ms |", build_rr[sc], build_embree[sc],
+            build_embree[sc] > 0 ? build_rr[sc] / build_embree[sc] : 0);
+  fprintf(md, "\n| fastest exact method / Embree's best |");
+  for (int sc = 0; sc < nscenes; sc++) {
+    int best = -1;
+    for (int m = 0; m < RR_METHOD_COUNT; m++)
+      if (table[m][sc].done && m != RR_METHOD_2DR_BB && m != RR_METHOD_2DR_BIN &&
+          (best < 0 || table[m][sc].ms < table[best][sc].ms))
+        best = m;
+    double emb = 0;
+    for (int r = ROW_EMBREE1; r <= ROW_EMBREE8; r++)
+      if (table[r][sc].done && (emb == 0 || table[r][sc].ms < emb)) emb = table[r][sc].ms;
+    if (best >= 0 && emb > 0) fprintf(md, " %s %.2f× |", rr_method_name(best), table[best][sc].ms / emb);
+    else fprintf(md, " – |");
+  }
+  fprintf(md, "\n| slowest 3dr method / llvmpipe |");
+  for (int sc = 0; sc < nscenes; sc++) {
+    int worst = -1;
+    for (int m = RR_METHOD_3DR_BB; m <= RR_METHOD_3DR_FULL; m++)
+      if (table[m][sc].done && (worst < 0 || table[m][sc].ms > table[worst][sc].ms)) worst = m;
+    const cell *lp = &table[ROW_LLVMPIPE][sc];
+    if (worst >= 0 && lp->done) fprintf(md, " %s %.2f× |", rr_method_name(worst), table[worst][sc].ms / lp->ms);
+    else fprintf(md, " – |");
+  }
+  fprintf(md, "\n");
   fclose(md), fclose(csv);
   fprintf(stderr, "wrote %s.md and %s.csv\n", out, out);
   rr_device_release(dev);
