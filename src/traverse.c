@@ -163,17 +163,22 @@ static bool prepare(const trav *t, uint32_t id, tri_job *j) {
   const camera *c = t->c;
   if (c->planar) {
     float zmin = INFINITY;
-    for (int k = 0; k < 3; k++) zmin = minf(zmin, v3_dot(v3_sub(scene_vertex(t->s, k, id), c->eye), c->fwd));
+    unsigned inf = scene_inf(t->s, id); /* a point at infinity: +inf ahead, -inf behind */
+    for (int k = 0; k < 3; k++) {
+      float z = v3_dot(scene_q(t->s, k, id, c->eye), c->fwd);
+      zmin = minf(zmin, inf >> k & 1u ? (z >= 0 ? INFINITY : -INFINITY) : z);
+    }
     j->zmin = zmin > 0 ? zmin : 0;
     float W = (float)t->vb->width + 1, H = (float)t->vb->height + 1;
     for (int e = 0; e < 3; e++)
       j->slack[e] = 1e-5f * (fabsf(j->ts.a[e]) + W * fabsf(j->ts.b[e]) + H * fabsf(j->ts.c[e]));
   } else {
     /* the distance to the triangle's plane bounds every hit's distance from below */
-    vec3 q0 = v3_sub(scene_vertex(t->s, 0, id), c->eye), q1 = v3_sub(scene_vertex(t->s, 1, id), c->eye),
-         q2 = v3_sub(scene_vertex(t->s, 2, id), c->eye);
-    vec3 nrm = v3_cross(v3_sub(q1, q0), v3_sub(q2, q0));
-    float dist = fabsf(v3_dot(q0, nrm)) / v3_len(nrm);
+    unsigned inf = scene_inf(t->s, id);
+    int f = !(inf & 1u) ? 0 : !(inf & 2u) ? 1 : 2; /* a finite corner */
+    vec3 q0 = scene_q(t->s, 0, id, c->eye), q1 = scene_q(t->s, 1, id, c->eye), q2 = scene_q(t->s, 2, id, c->eye);
+    vec3 nrm = inf ? scene_tri_normal(t->s, id) : v3_cross(v3_sub(q1, q0), v3_sub(q2, q0));
+    float dist = fabsf(v3_dot(f == 0 ? q0 : f == 1 ? q1 : q2, nrm)) / v3_len(nrm);
     j->zmin = dist > 0 && isfinite(dist) ? dist / c->dir_len_max : 0;
     tri_cone_setup(t->s, id, c, &j->ts, &j->cone);
   }
@@ -399,9 +404,26 @@ typedef struct trav_job {
   float *hiz;
   uint8_t *dirty;
   rr_stats st[256];
-  const tri_job *pre; /* root-only on several tiles: every triangle set up once */
-  uint32_t npre;
+  const tri_job *pre; /* root-only on several tiles: every triangle set up once, */
+  const uint32_t *start, *list; /* and tile k's triangles list[start[k] .. start[k+1]) */
 } trav_job;
+
+#define SETUP_CHUNK 16384
+
+typedef struct setup_job {
+  trav t;
+  tri_job *pre;
+  uint32_t n;
+} setup_job;
+
+/* Sets up a chunk of triangles; those that cover nothing get bb[0] = -1. */
+static void setup_chunk(int chunk, int thread, void *arg) {
+  (void)thread;
+  setup_job *sj = arg;
+  uint32_t end = (uint32_t)(chunk + 1) * SETUP_CHUNK < sj->n ? (uint32_t)(chunk + 1) * SETUP_CHUNK : sj->n;
+  for (uint32_t i = (uint32_t)chunk * SETUP_CHUNK; i < end; i++)
+    if (!prepare(&sj->t, i, &sj->pre[i])) sj->pre[i].bb[0] = -1;
+}
 
 /* One job: a tile of the image, itself cut into the initial frusta. */
 static void run_tile(int job, int thread, void *arg) {
@@ -426,7 +448,7 @@ static void run_tile(int job, int thread, void *arg) {
   if (!tj->o->leaves) {
     /* generateSamples at the root: plain rasterization of every triangle in order */
     if (tj->pre)
-      for (uint32_t i = 0; i < tj->npre; i++) draw(&t, &tj->pre[i], r);
+      for (uint32_t k = tj->start[job]; k < tj->start[job + 1]; k++) draw(&t, &tj->pre[tj->list[k]], r);
     else
       for (uint32_t i = 0; i < ctx->scene->ntris; i++) rasterize(&t, i, r);
   } else {
@@ -471,18 +493,49 @@ rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
   tj->ctx = ctx, tj->o = o, tj->tile = tile, tj->frustum = frustum, tj->tiles_x = (vb->width + tile - 1) / tile;
   int njobs = tj->tiles_x * ((vb->height + tile - 1) / tile);
   tri_job *pre = NULL;
+  uint32_t *start = NULL, *list = NULL;
   if (!o->leaves && njobs > 1) {
-    /* Rasterization from the root on several tiles: set every triangle up once and
-     * let each tile take those whose bounds reach it. */
-    pre = malloc((size_t)ctx->scene->ntris * sizeof *pre + 1);
-    if (!pre) {
-      free(tj->hiz), free(tj->dirty), free(tj);
-      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %u triangle setups", ctx->scene->ntris);
+    /* Rasterization from the root on several tiles (sort-middle): set every triangle
+     * up once, in parallel, then give each tile the list of triangles whose bounds
+     * reach it, in scene order. */
+    uint32_t n = ctx->scene->ntris;
+    pre = malloc((size_t)n * sizeof *pre + 1);
+    start = calloc((size_t)njobs + 1, sizeof *start);
+    if (!pre || !start) {
+      free(pre), free(start), free(tj->hiz), free(tj->dirty), free(tj);
+      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %u triangle setups", n);
     }
-    trav t = {.s = ctx->scene, .c = ctx->cam, .o = o, .vb = ctx->vb, .cull_back = ctx->opt->cull_backfaces != 0};
-    for (uint32_t i = 0; i < ctx->scene->ntris; i++) tj->npre += prepare(&t, i, &pre[tj->npre]);
-    ctx->stats->setups += ctx->scene->ntris;
-    tj->pre = pre;
+    setup_job sj = {.t = {.s = ctx->scene, .c = ctx->cam, .o = o, .vb = ctx->vb,
+                          .cull_back = ctx->opt->cull_backfaces != 0},
+                    .pre = pre,
+                    .n = n};
+    parallel_for((int)((n + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_chunk, &sj);
+    ctx->stats->setups += n;
+    uint64_t total = 0;
+    for (int pass = 0; pass < 2; pass++) {
+      if (pass == 1) {
+        for (int k = 0; k < njobs; k++) start[k + 1] += start[k];
+        total = start[njobs];
+        list = malloc(total * sizeof *list + 1);
+        if (!list) {
+          free(pre), free(start), free(tj->hiz), free(tj->dirty), free(tj);
+          return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %llu tile entries", (unsigned long long)total);
+        }
+      }
+      for (uint32_t i = 0; i < n; i++) {
+        const int *bb = pre[i].bb;
+        if (bb[0] < 0) continue;
+        for (int ty = bb[1] / tile; ty <= bb[3] / tile; ty++)
+          for (int tx = bb[0] / tile; tx <= bb[2] / tile; tx++) {
+            int k = ty * tj->tiles_x + tx;
+            if (pass == 0) start[k + 1]++;
+            else list[start[k]++] = i;
+          }
+      }
+    }
+    for (int k = njobs; k > 0; k--) start[k] = start[k - 1]; /* the fill advanced each start to the next's */
+    start[0] = 0;
+    tj->pre = pre, tj->start = start, tj->list = list;
   }
   parallel_for(njobs, ctx->threads, run_tile, tj);
   for (int i = 0; i < 256; i++) {
@@ -492,6 +545,6 @@ rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
     ctx->stats->bins += tj->st[i].bins;
     ctx->stats->bins_empty += tj->st[i].bins_empty;
   }
-  free(pre), free(tj->hiz), free(tj->dirty), free(tj);
+  free(pre), free(start), free(list), free(tj->hiz), free(tj->dirty), free(tj);
   return RR_OK;
 }
