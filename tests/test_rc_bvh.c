@@ -85,8 +85,9 @@ static void check_scene(rr_device *dev, const char *path, const char *name, int 
   rr_scene_release(s);
 }
 
-/* The pruning bound itself: at every sample where a triangle passes the sample
- * test, its t is at least tri_t_lower_bound(); grazing views stress it most. */
+/* The culling bounds themselves: at every sample where a triangle passes the
+ * sample test, its t is at least the bound of tri_bounds() and the sample lies in
+ * its rectangle; grazing views stress them most. */
 static void check_bound(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h, const char *name) {
   camera c;
   if (camera_setup(dev, cam, w, h, &c) != RR_OK) return;
@@ -95,13 +96,16 @@ static void check_bound(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   for (uint32_t i = 0; i < s->ntris; i += step) {
     tri_setup ts;
     if (tri_setup_planar(s, i, &c, false, &ts) == SETUP_CULLED) continue;
-    float lo = tri_t_lower_bound(&ts, &c);
+    float rect[4], lo = tri_bounds(&ts, &c, rect);
     for (int y = 0; y < h; y++)
       for (int x = 0; x < w; x++) {
         float e[3], t, l1, l2;
         tri_edges(&ts, (float)x + 0.5f, (float)y + 0.5f, e);
         if (!sample_test(e, ts.tie, ts.vol, &t, &l1, &l2)) continue;
         checked++;
+        float sx = (float)x + 0.5f, sy = (float)y + 0.5f;
+        bool in = rect[0] <= sx && sx <= rect[2] && rect[1] <= sy && sy <= rect[3];
+        if (!in && broken++ < 5) fprintf(stderr, "%s: triangle %u passes at (%d, %d) outside its rectangle\n", name, i, x, y);
         if (t < lo && broken++ < 5) fprintf(stderr, "%s: triangle %u at (%d, %d): t %.9g below its bound %.9g\n", name, i, x, y, t, lo);
       }
   }
