@@ -465,12 +465,44 @@ static void check_models(void) {
   }
 }
 
+/* The per-pixel evaluation charges (heat maps) add up to E, and S and E do not
+ * depend on the thread count. */
+static void check_stats(void) {
+  rr_scene *s = load("demo");
+  if (!s) return;
+  rr_camera cam;
+  rr_camera_init(&cam);
+  rr_camera_frame(dev, s, 160, 120, &cam);
+  for (int m = 0; m < 2; m++) {
+    rr_render_options opt;
+    rr_render_options_init(&opt);
+    opt.method = m ? RR_METHOD_2DR_BIN : RR_METHOD_2DR_BB, opt.width = 160, opt.height = 120, opt.heat = 1;
+    rr_frame *f[2] = {NULL, NULL};
+    for (int k = 0; k < 2; k++) {
+      opt.threads = k + 1;
+      CHECK(rr_render(dev, s, &cam, &opt, &f[k]) == RR_OK, "render: %s", rr_device_message(dev));
+    }
+    if (f[0] && f[1]) {
+      double sum = 0;
+      for (int k = 0; k < 160 * 120; k++) sum += f[0]->heat_e[k];
+      CHECK(f[0]->stats.setups > 0 && f[0]->stats.edge_evals > 0, "S and E are positive");
+      CHECK(sum == (double)f[0]->stats.edge_evals, "%s: per-pixel E adds to %.0f, total %llu",
+            rr_method_name(opt.method), sum, (unsigned long long)f[0]->stats.edge_evals);
+      CHECK(f[0]->stats.setups == f[1]->stats.setups && f[0]->stats.edge_evals == f[1]->stats.edge_evals,
+            "%s: stats differ between 1 and 2 threads", rr_method_name(opt.method));
+    }
+    rr_frame_release(f[0]), rr_frame_release(f[1]);
+  }
+  rr_scene_release(s);
+}
+
 int main(void) {
   dev = rr_device_new();
   rr_scene *sphere = load("sphere:24");
   if (sphere) check_projection(sphere);
   rr_scene_release(sphere);
   check_fill_rule();
+  check_stats();
   check_clipping();
   check_models();
   rr_device_release(dev);
