@@ -46,7 +46,8 @@ const char *rr_device_message(const rr_device *dev);
 
 /* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...)
  * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]",
- * "grid:PATH:N" (N×N copies of a mesh on the XZ plane). */
+ * "grid:PATH:N" (N×N copies of a mesh on the XZ plane), "ground" (an infinite
+ * plane with vertices at infinity, and objects on it). */
 rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out);
 /* Creates an empty scene to be filled with rr_scene_add_mesh. */
 rr_error rr_scene_new(rr_device *dev, rr_scene **out);
@@ -54,6 +55,9 @@ rr_error rr_scene_new(rr_device *dev, rr_scene **out);
  * base colour). Degenerate and non-finite triangles are skipped and counted. */
 rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
                            const uint32_t *indices, size_t ntriangles, const float rgb[3]);
+/* The same with homogeneous xyzw vertices: w != 0 is divided out, w = 0 is a point at infinity in direction xyz (3D methods only). */
+rr_error rr_scene_add_mesh4(rr_scene *scene, const float *xyzw, size_t nvertices, const uint32_t *indices,
+                            size_t ntriangles, const float rgb[3]);
 /* Builds what rendering needs (the BVH); called implicitly by rr_scene_load.
  * Uses the device's build options (rr_device_set_build_options). */
 rr_error rr_scene_commit(rr_scene *scene);

@@ -660,6 +660,10 @@ static void band_job(int band, int thread, void *arg) {
 static rr_error run2d(rr_device *dev, const rr_scene *s, const camera *c, bool cull, bool bin, int threads,
                       target tg, rr_stats *stats) {
   pipe2d pp;
+  if (s->inf)
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED,
+                   "2D rasterization does not take vertices at infinity (w = 0); use a 3D method "
+                   "(rc, rc-bvh, rc-packet, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full)");
   if (!pipe_setup(&pp, s, c, cull))
     return rr_fail(dev, RR_ERROR_UNSUPPORTED, "2D rasterization needs a planar camera (perspective or orthographic)");
   job2d *job = calloc(1, sizeof *job);

@@ -10,7 +10,7 @@
 /* Curved views: does a cone of directions (unit axis, half-angle) miss the
  * triangle's directions? Two conservative tests: the triangle's bounding cap
  * (tight for small triangles), and the four planes through the eye a hit must lie
- * inside of: V_i >= 0 for the three edges and ΣV_i > 0 (t > 0). */
+ * inside of: V_i >= 0 for the three edges and Σw_iV_i > 0 (t > 0). */
 bool cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float angle) {
   if (tc->cap_angle >= 0 && acosf(fminf(1.0f, v3_dot(axis, tc->cap_axis))) > angle + tc->cap_angle + 1e-5f)
     return true;
@@ -18,20 +18,23 @@ bool cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float ang
   for (int e = 0; e < 3; e++) {
     float v = ts->a[e] * axis.x + ts->b[e] * axis.y + ts->c[e] * axis.z;
     if (v < -tc->len[e] * lim) return true;
-    sum += v;
+    sum += v * ts->w[e];
   }
   return sum < -tc->len[3] * lim;
 }
 
 void tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, tri_cone *tc) {
   for (int e = 0; e < 3; e++) tc->len[e] = sqrtf(ts->a[e] * ts->a[e] + ts->b[e] * ts->b[e] + ts->c[e] * ts->c[e]);
-  float sx = ts->a[0] + ts->a[1] + ts->a[2], sy = ts->b[0] + ts->b[1] + ts->b[2], sz = ts->c[0] + ts->c[1] + ts->c[2];
+  const float *w = ts->w; /* the sum that must be positive is Σ w_i V_i */
+  float sx = ts->a[0] * w[0] + ts->a[1] * w[1] + ts->a[2] * w[2];
+  float sy = ts->b[0] * w[0] + ts->b[1] * w[1] + ts->b[2] * w[2];
+  float sz = ts->c[0] * w[0] + ts->c[1] * w[1] + ts->c[2] * w[2];
   /* the sum is evaluated edge by edge: allow for the rounding of each term too */
   tc->len[3] = sqrtf(sx * sx + sy * sy + sz * sz) + 1e-6f * (tc->len[0] + tc->len[1] + tc->len[2]);
   /* A cap around the mean vertex direction holds the spherical triangle when its
    * radius is under 90° (caps that small are spherically convex). */
   vec3 u[3], m = v3(0, 0, 0);
-  for (int k = 0; k < 3; k++) u[k] = v3_norm(v3_sub(scene_vertex(s, k, i), c->eye)), m = v3_add(m, u[k]);
+  for (int k = 0; k < 3; k++) u[k] = v3_norm(scene_q(s, k, i, c->eye)), m = v3_add(m, u[k]);
   tc->cap_angle = -1;
   if (v3_len(m) > 1e-3f) {
     tc->cap_axis = v3_norm(m);
@@ -62,8 +65,13 @@ static bool curved_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
 bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int r[4]) {
   float x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   int behind = 0, projected = 0;
+  /* A point at infinity projects to its vanishing point when its direction points
+   * ahead; the projection of the segment from a point to it is then the segment
+   * to the vanishing point, so the hull of the three still bounds the triangle.
+   * An orthographic view sees such a triangle unbounded: whole screen. */
+  bool ortho_inf = c->type == RR_CAMERA_ORTHOGRAPHIC && scene_inf(s, i);
   for (int k = 0; k < 3; k++) {
-    vec3 q = v3_sub(scene_vertex(s, k, i), c->eye);
+    vec3 q = scene_q(s, k, i, c->eye);
     float sx, sy;
     if (!(v3_dot(q, c->fwd) > 0)) behind++;
     else if (camera_project(c, q, &sx, &sy) && isfinite(sx) && isfinite(sy)) {
@@ -78,7 +86,7 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri
     return curved_bounds(s, i, c, ts, r);
   }
   if (behind == 3) return false; /* every camera ray has d·fwd > 0: unreachable */
-  if (projected == 3) {
+  if (projected == 3 && !ortho_inf) {
     /* Sample (x + 0.5) lies in [x0, x1] for x in [ceil(x0 - 0.5), floor(x1 - 0.5)]. */
     /* The margin covers the rounding of the projection and of the edge functions,
      * a few ulps of the larger coordinate; a whole pixel would double the area of
@@ -123,6 +131,7 @@ __attribute__((target("avx2"))) static uint64_t raster_loop_avx2(const tri_setup
     a[e] = _mm256_set1_ps(ts->a[e]), b[e] = _mm256_set1_ps(ts->b[e]), c[e] = _mm256_set1_ps(ts->c[e]);
     tie[e] = _mm256_castsi256_ps(_mm256_set1_epi32(ts->tie & (1u << e) ? -1 : 0));
   }
+  const __m256 w0 = _mm256_set1_ps(ts->w[0]), w1 = _mm256_set1_ps(ts->w[1]), w2 = _mm256_set1_ps(ts->w[2]);
   const __m256 vol = _mm256_set1_ps(ts->vol), vol_x = _mm256_set1_ps(ts->vol_x), vol_y = _mm256_set1_ps(ts->vol_y);
   const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), bias = _mm256_set1_epi32((int)0x80000000);
@@ -143,7 +152,8 @@ __attribute__((target("avx2"))) static uint64_t raster_loop_avx2(const tri_setup
         in = _mm256_and_ps(in, _mm256_or_ps(pos, on));
       }
       if (!_mm256_movemask_ps(in)) continue;
-      __m256 sum = _mm256_add_ps(_mm256_add_ps(ev[0], ev[1]), ev[2]);
+      __m256 sum = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ev[0], w0), _mm256_mul_ps(ev[1], w1)),
+                                 _mm256_mul_ps(ev[2], w2));
       __m256 v = _mm256_add_ps(_mm256_add_ps(vol, _mm256_mul_ps(sx, vol_x)), _mm256_mul_ps(sy, vol_y));
       in = _mm256_and_ps(in, _mm256_and_ps(_mm256_cmp_ps(sum, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, zero, _CMP_GT_OQ)));
       int hit = _mm256_movemask_ps(in);

@@ -74,7 +74,10 @@ struct rr_scene {
   rr_material *materials;
   uint32_t nmaterials;
   uint64_t skipped;
-  vec3 bmin, bmax;
+  /* Homogeneous input: bit k of inf[i] set when corner k of triangle i is a point at
+   * infinity (w = 0), whose p then holds its direction; NULL when there is none. */
+  uint8_t *inf;
+  vec3 bmin, bmax; /* of the finite corners */
   struct rr_bvh *bvh; /* built by rr_scene_commit */
 };
 
@@ -82,11 +85,25 @@ static inline vec3 scene_vertex(const rr_scene *s, int k, uint32_t i) {
   return v3(s->p[k][0][i], s->p[k][1][i], s->p[k][2][i]);
 }
 
+/* Which corners of triangle i lie at infinity (bit k: corner k); 0 for most. */
+static inline unsigned scene_inf(const rr_scene *s, uint32_t i) { return s->inf ? s->inf[i] : 0u; }
+/* Corner k of triangle i seen from `eye`: p - eye for a finite corner, the
+ * direction itself for a point at infinity (where every ray from eye meets it). */
+static inline vec3 scene_q(const rr_scene *s, int k, uint32_t i, vec3 eye) {
+  vec3 p = scene_vertex(s, k, i);
+  return scene_inf(s, i) >> k & 1u ? p : v3_sub(p, eye);
+}
+/* The (unnormalised) normal of triangle i's plane, for finite and infinite corners. */
+vec3 scene_tri_normal(const rr_scene *s, uint32_t i);
+
 /* Grows the scene to hold `more` triangles; with_normals/with_uvs allocate those arrays. */
 rr_error scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_uvs);
 /* Appends one triangle (positions, optional corner normals/uvs); drops and counts
  * degenerate or non-finite ones. Returns true when kept. */
 bool scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv)[2], uint32_t mat);
+/* The same with corners at infinity (bit k of inf: p[k] is a direction); a triangle
+ * with all three at infinity is dropped and counted. */
+bool scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, const float (*uv)[2], uint32_t mat);
 /* Adds a material and returns its index (UINT32_MAX when out of memory). */
 uint32_t scene_add_material(rr_scene *s, const float color[3], const char *texture_path);
 /* Recomputes bounds. */
@@ -221,6 +238,7 @@ typedef struct tri_setup {
   float a[3], b[3], c[3];
   float vol, vol_x, vol_y;
   uint32_t tie; /* bit i: a sample exactly on edge i belongs to this triangle */
+  float w[3];   /* homogeneous w of vertex i (1, or 0 at infinity): the sum is Σ w_i V_i */
 } tri_setup;
 
 enum { SETUP_CULLED = 0, SETUP_FRONT = 1, SETUP_BACK = 2 };
@@ -251,14 +269,18 @@ static inline float tri_vol(const tri_setup *t, float sx, float sy) {
  * e: sign-normalised edge values at the sample; tie: bit i set when the sample
  * belongs to this triangle if it lies exactly on edge i; vol: the sign-normalised
  * volume at the sample (positive when the hit lies ahead of the ray origin).
- * On a hit returns true with t = V / ΣV_i and λ_i = V_i / ΣV_i. */
-static inline bool sample_test(const float e[3], uint32_t tie, float vol,
-                               float *t, float *l1, float *l2) {
+ * w: the vertices' homogeneous w (appendix eqs. 5–11: a vertex at infinity has
+ * w = 0 and leaves the sum). On a hit returns true with t = V / Σw_iV_i and
+ * λ_i = V_i / Σw_iV_i. */
+static inline bool sample_test_w(const float e[3], const float w[3], uint32_t tie, float vol,
+                                 float *t, float *l1, float *l2) {
   bool in0 = e[0] > 0.0f || (e[0] == 0.0f && (tie & 1u));
   bool in1 = e[1] > 0.0f || (e[1] == 0.0f && (tie & 2u));
   bool in2 = e[2] > 0.0f || (e[2] == 0.0f && (tie & 4u));
   if (!(in0 & in1 & in2)) return false;
-  float sum = e[0] + e[1] + e[2];
+  /* Appendix eq. 10: only finite vertices count, Σ w_i V_i; e·1 == e exactly, so
+   * ordinary triangles keep the bits of e0 + e1 + e2. */
+  float sum = e[0] * w[0] + e[1] * w[1] + e[2] * w[2];
   /* sum == 0: all three on their edges (a degenerate sliver) or a pixel with no ray */
   if (!(sum > 0.0f) || !(vol > 0.0f)) return false;
   float inv = 1.0f / sum;
@@ -266,6 +288,11 @@ static inline bool sample_test(const float e[3], uint32_t tie, float vol,
   *l1 = e[1] * inv;
   *l2 = e[2] * inv;
   return true;
+}
+/* The same for a triangle of finite vertices (every w = 1). */
+static inline bool sample_test(const float e[3], uint32_t tie, float vol, float *t, float *l1, float *l2) {
+  static const float ones[3] = {1.0f, 1.0f, 1.0f};
+  return sample_test_w(e, ones, tie, vol, t, l1, l2);
 }
 
 /* ---- visibility buffer and frames --------------------------------------- */
@@ -289,7 +316,7 @@ static inline int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float
                                  size_t k) {
   float e[3], t, l1, l2;
   tri_edges_w(ts, w, e);
-  if (!sample_test(e, ts->tie, tri_vol(ts, sx, sy), &t, &l1, &l2)) return 0;
+  if (!sample_test_w(e, ts->w, ts->tie, tri_vol(ts, sx, sy), &t, &l1, &l2)) return 0;
   if (!depth_wins(t, id, vb->t[k], vb->id[k])) return 1;
   vb->t[k] = t;
   vb->id[k] = id;

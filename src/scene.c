@@ -22,6 +22,7 @@ void rr_scene_release(rr_scene *s) {
     for (int c = 0; c < 2; c++) free(s->uv[k][c]);
   }
   free(s->material);
+  free(s->inf);
   for (uint32_t m = 0; m < s->nmaterials; m++) {
     free(s->materials[m].texture_path);
     free(s->materials[m].texture.rgb);
@@ -69,6 +70,11 @@ rr_error scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_
       }
     }
   }
+  if (ok && s->inf && cap != s->cap) {
+    uint8_t *f = realloc(s->inf, cap);
+    if (f) s->inf = f;
+    ok = f != NULL;
+  }
   uint32_t *m = ok ? realloc(s->material, (size_t)cap * sizeof *m) : NULL;
   if (!m) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for %llu triangles", (unsigned long long)need);
   s->material = m;
@@ -78,19 +84,44 @@ rr_error scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_
 
 static bool finite3(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
+/* The plane's normal from the edge vectors out of the first finite corner f: for a
+ * finite corner k, p_k − p_f; for one at infinity, its direction. */
+static vec3 homog_normal(const vec3 p[3], unsigned inf) {
+  if (!inf) return v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]));
+  int f = !(inf & 1u) ? 0 : !(inf & 2u) ? 1 : 2;
+  int a = (f + 1) % 3, b = (f + 2) % 3;
+  vec3 u = inf >> a & 1u ? p[a] : v3_sub(p[a], p[f]), v = inf >> b & 1u ? p[b] : v3_sub(p[b], p[f]);
+  return v3_cross(u, v);
+}
+
+vec3 scene_tri_normal(const rr_scene *s, uint32_t i) {
+  vec3 p[3] = {scene_vertex(s, 0, i), scene_vertex(s, 1, i), scene_vertex(s, 2, i)};
+  return homog_normal(p, scene_inf(s, i));
+}
+
 bool scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv)[2], uint32_t mat) {
+  return scene_push_inf(s, p, 0, n, uv, mat);
+}
+
+bool scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, const float (*uv)[2], uint32_t mat) {
   /* A triangle with a non-finite coordinate or no area can never be hit
-   * consistently; it is dropped and counted, not fatal. */
-  vec3 cr = v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]));
+   * consistently; it is dropped and counted, not fatal. So is one whose three
+   * corners are all at infinity (it lies on the plane at infinity). */
+  vec3 cr = homog_normal(p, inf);
   if (!finite3(p[0]) || !finite3(p[1]) || !finite3(p[2]) || !finite3(cr) ||
-      (cr.x == 0 && cr.y == 0 && cr.z == 0)) {
+      (cr.x == 0 && cr.y == 0 && cr.z == 0) || (inf & 7u) == 7u) {
     s->skipped++;
     return false;
   }
   if (s->ntris >= s->cap && scene_reserve(s, 1, n != NULL, uv != NULL) != RR_OK) return false;
   if ((n && !s->n[0][0]) || (uv && !s->uv[0][0]))
     if (scene_reserve(s, 0, n != NULL, uv != NULL) != RR_OK) return false;
+  if (inf && !s->inf) {
+    s->inf = calloc(s->cap, 1); /* earlier triangles are finite */
+    if (!s->inf) return false;
+  }
   uint32_t i = s->ntris++;
+  if (s->inf) s->inf[i] = (uint8_t)(inf & 7u);
   for (int k = 0; k < 3; k++) {
     s->p[k][0][i] = p[k].x, s->p[k][1][i] = p[k].y, s->p[k][2][i] = p[k].z;
     if (s->n[0][0]) {
@@ -101,6 +132,7 @@ bool scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv)[2
       s->uv[k][0][i] = uv ? uv[k][0] : 0;
       s->uv[k][1][i] = uv ? uv[k][1] : 0;
     }
+    if (inf >> k & 1u) continue;
     s->bmin = v3_min(s->bmin, p[k]);
     s->bmax = v3_max(s->bmax, p[k]);
   }
@@ -127,6 +159,7 @@ void scene_update_bounds(rr_scene *s) {
   vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
   for (uint32_t i = 0; i < s->ntris; i++)
     for (int k = 0; k < 3; k++) {
+      if (scene_inf(s, i) >> k & 1u) continue;
       vec3 p = scene_vertex(s, k, i);
       lo = v3_min(lo, p);
       hi = v3_max(hi, p);
@@ -156,6 +189,34 @@ rr_error rr_scene_add_mesh(rr_scene *s, const float *pos, size_t nvert, const ui
       p[k] = v3_load(pos + 3 * (size_t)v);
     }
     scene_push(s, p, NULL, NULL, mat);
+  }
+  return rr_ok(s->dev);
+}
+
+rr_error rr_scene_add_mesh4(rr_scene *s, const float *xyzw, size_t nvert, const uint32_t *idx, size_t ntri,
+                            const float rgb[3]) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if ((!xyzw && nvert) || (!idx && ntri))
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh4: NULL positions or indices");
+  if (ntri > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh4: too many triangles");
+  for (size_t t = 0; t < 3 * ntri; t++)
+    if (idx[t] >= nvert)
+      return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh4: index %u of triangle %zu out of range (%zu vertices)",
+                     idx[t], t / 3, nvert);
+  float grey[3] = {0.8f, 0.8f, 0.8f};
+  uint32_t mat = scene_add_material(s, rgb ? rgb : grey, NULL);
+  if (mat == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
+  rr_error e = scene_reserve(s, (uint32_t)ntri, false, false);
+  if (e) return e;
+  for (size_t t = 0; t < ntri; t++) {
+    vec3 p[3];
+    unsigned inf = 0;
+    for (int k = 0; k < 3; k++) {
+      const float *v = xyzw + 4 * (size_t)idx[3 * t + k];
+      if (v[3] == 0) inf |= 1u << k, p[k] = v3(v[0], v[1], v[2]); /* a point at infinity: its direction */
+      else p[k] = v3(v[0] / v[3], v[1] / v[3], v[2] / v[3]);
+    }
+    scene_push_inf(s, p, inf, NULL, NULL, mat);
   }
   return rr_ok(s->dev);
 }

@@ -226,6 +226,42 @@ static rr_error gen_torus(rr_scene *s, int nu, int nv, float R, float r, vec3 ce
   return RR_OK;
 }
 
+/* ---- infinite ground (homogeneous vertices) ------------------------------------- */
+
+/* The plane y = 0 without end: four triangles fanning from the origin to the
+ * points at infinity (w = 0) in the directions +x, -z, -x, +z, counter-clockwise
+ * seen from +y, so triangle q holds quadrant q: 0 (x > 0, z < 0), 1 (x < 0,
+ * z < 0), 2 (x < 0, z > 0), 3 (x > 0, z > 0). On it, clear of the plane so that
+ * nothing is coplanar with it: a sphere and a box (the generators' meshes, moved). */
+static rr_error gen_ground(rr_scene *s) {
+  uint32_t ground_m, ball_m;
+  rr_error e = add_material(s, 0.55f, 0.62f, 0.45f, &ground_m);
+  if (!e) e = add_material(s, 0.20f, 0.45f, 0.85f, &ball_m);
+  if (!e) e = reserve(s, 4, false);
+  if (e) return e;
+  const vec3 origin = v3(0, 0, 0), dir[4] = {v3(1, 0, 0), v3(0, 0, -1), v3(-1, 0, 0), v3(0, 0, 1)};
+  for (int q = 0; q < 4; q++) {
+    vec3 p[3] = {origin, dir[q], dir[(q + 1) % 4]};
+    scene_push_inf(s, p, 6u, NULL, NULL, ground_m); /* corners 1 and 2 at infinity */
+  }
+  e = gen_sphere(s, 24, v3(-1.5f, 1.05f, 0.5f), 1.0f, ball_m);
+  uint32_t t0 = s->ntris;
+  if (!e) e = gen_box(s, 1);
+  if (e) return e;
+  /* the unit box [-1,1]^3 to half size, standing 0.05 above the plane at (1.5, -0.5):
+   * the same map for every corner keeps shared corners identical */
+  for (uint32_t i = t0; i < s->ntris; i++)
+    for (int k = 0; k < 3; k++) {
+      s->p[k][0][i] = s->p[k][0][i] * 0.5f + 1.5f;
+      s->p[k][1][i] = s->p[k][1][i] * 0.5f + 0.55f;
+      s->p[k][2][i] = s->p[k][2][i] * 0.5f - 0.5f;
+    }
+  float *box_rgb = s->materials[s->nmaterials - 1].color;
+  box_rgb[0] = 0.90f, box_rgb[1] = 0.55f, box_rgb[2] = 0.20f;
+  scene_update_bounds(s);
+  return RR_OK;
+}
+
 /* ---- grid of copies ----------------------------------------------------------------- */
 
 /* grid:PATH:N — N×N copies of a mesh file on the XZ plane, copy k = j·N + i moved by
@@ -518,6 +554,8 @@ rr_error scene_load_builtin(rr_scene *s, const char *name) {
   } else if ((arg = builtin_arg(name, "rooms"))) {
     e = size_arg(s, name, arg, 4, 1, 100, &n);
     if (!e) e = gen_rooms(s, (int)n);
+  } else if (strcmp(name, "ground") == 0) {
+    e = gen_ground(s);
   } else if (strncmp(name, "grid:", 5) == 0) {
     e = load_grid(s, name);
   } else {

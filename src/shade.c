@@ -21,6 +21,7 @@ typedef struct hit {
 } hit;
 
 static vec3 geometric_normal(const rr_scene *s, uint32_t i) {
+  if (scene_inf(s, i)) return v3_norm(scene_tri_normal(s, i)); /* corners at infinity */
   vec3 p0 = scene_vertex(s, 0, i);
   return v3_norm(v3_cross(v3_sub(scene_vertex(s, 1, i), p0), v3_sub(scene_vertex(s, 2, i), p0)));
 }
