@@ -14,10 +14,17 @@
  * decisions keep a relative safety margin so they never remove a winning triangle. */
 #include "rr.h"
 
+#include <float.h>
 #include <string.h>
 
 #define HIZ 8               /* hierarchical z-buffer tile size: frusta split down to it */
-#define DEPTH_MARGIN 1e-3f  /* relative slack of every depth comparison used for culling */
+/* Relative slack of the node occlusion test. The t that 3D rasterization computes
+ * for a small far triangle seen at a grazing angle can lie percents in front of
+ * its box (the edge values' sum cancels), and rc keeps such hits; early-z per
+ * triangle uses a proven floor (computed_t_floor), but a node knows no triangle,
+ * so it keeps this empirical slack: a hit more than 2% in front of its box is
+ * still culled. */
+#define DEPTH_MARGIN 2e-2f
 
 typedef struct tile_rect { int x0, y0, x1, y1; } tile_rect; /* samples [x0, x1) × [y0, y1) */
 
@@ -81,7 +88,7 @@ static void mark_dirty(trav *t, tile_rect r) {
 typedef struct tri_job {
   tri_setup ts;
   uint32_t id;
-  float zmin;      /* nearest depth of the triangle (0 when it reaches the eye plane) */
+  float zmin;      /* a floor under any t computed for the triangle (0: none known) */
   float slack[3];  /* planar: how far below zero a rounded corner value may fall for an inside sample */
   tri_cone cone;   /* curved: what bounds the triangle's directions */
   int bb[4];       /* inclusive screen bounds */
@@ -144,7 +151,7 @@ static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
         }
       }
       if (out) continue;
-      if (t->o->early_z && j->zmin > 0 && j->zmin * (1 - DEPTH_MARGIN) > hiz_max(t, b)) continue;
+      if (t->o->early_z && j->zmin > hiz_max(t, b)) continue;
       /* refined: count the bins that turn out to hold none of the triangle */
       uint64_t in = bin_raster(t, j, b, size / 4 > 1 ? size / 4 : 1);
       t->st.bins++;
@@ -152,6 +159,18 @@ static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
       covered += in;
     }
   return covered;
+}
+
+/* A floor under the t that sample_test() computes for a triangle at any sample,
+ * from the floor zmin of the exact t: the sum of the edge values carries an error
+ * of at most ~5 ulps of `mag` (the sum of the terms' magnitudes), so the computed
+ * t >= vol / (vol / zmin + err). Seen at a grazing angle the error can be large
+ * (percents), and early-z must not drop a hit that rc keeps. */
+static float computed_t_floor(float zmin, float mag, float vol) {
+  if (!(zmin > 0) || !(vol > 0)) return 0;
+  float err = 6.0f * FLT_EPSILON * mag;
+  float floor_t = zmin / (1.0f + err * zmin / vol) * (1.0f - 8.0f * FLT_EPSILON);
+  return floor_t > 0 && isfinite(floor_t) ? floor_t : 0;
 }
 
 /* Triangle setup for a frustum: false when the triangle cannot cover a sample. */
@@ -168,10 +187,13 @@ static bool prepare(const trav *t, uint32_t id, tri_job *j) {
       float z = v3_dot(scene_q(t->s, k, id, c->eye), c->fwd);
       zmin = minf(zmin, inf >> k & 1u ? (z >= 0 ? INFINITY : -INFINITY) : z);
     }
-    j->zmin = zmin > 0 ? zmin : 0;
-    float W = (float)t->vb->width + 1, H = (float)t->vb->height + 1;
-    for (int e = 0; e < 3; e++)
-      j->slack[e] = 1e-5f * (fabsf(j->ts.a[e]) + W * fabsf(j->ts.b[e]) + H * fabsf(j->ts.c[e]));
+    float W = (float)t->vb->width + 1, H = (float)t->vb->height + 1, mag = 0;
+    for (int e = 0; e < 3; e++) {
+      float m = fabsf(j->ts.a[e]) + W * fabsf(j->ts.b[e]) + H * fabsf(j->ts.c[e]);
+      j->slack[e] = 1e-5f * m;
+      mag += m;
+    }
+    j->zmin = c->type == RR_CAMERA_PERSPECTIVE ? computed_t_floor(zmin, mag, j->ts.vol) : 0;
   } else {
     /* the distance to the triangle's plane bounds every hit's distance from below */
     unsigned inf = scene_inf(t->s, id);
@@ -179,8 +201,9 @@ static bool prepare(const trav *t, uint32_t id, tri_job *j) {
     vec3 q0 = scene_q(t->s, 0, id, c->eye), q1 = scene_q(t->s, 1, id, c->eye), q2 = scene_q(t->s, 2, id, c->eye);
     vec3 nrm = inf ? scene_tri_normal(t->s, id) : v3_cross(v3_sub(q1, q0), v3_sub(q2, q0));
     float dist = fabsf(v3_dot(f == 0 ? q0 : f == 1 ? q1 : q2, nrm)) / v3_len(nrm);
-    j->zmin = dist > 0 && isfinite(dist) ? dist / c->dir_len_max : 0;
     tri_cone_setup(t->s, id, c, &j->ts, &j->cone);
+    float mag = (j->cone.len[0] + j->cone.len[1] + j->cone.len[2]) * c->dir_len_max * 1.7321f;
+    j->zmin = dist > 0 && isfinite(dist) ? computed_t_floor(dist / c->dir_len_max, mag, j->ts.vol) : 0;
   }
   return true;
 }
