@@ -191,9 +191,9 @@ int main(void) {
   rr_device *dev = rr_device_new();
   check_directions(dev);
   check_cube(dev);
-  check_methods(dev, "demo", 2);
-  check_methods(dev, "rooms:3", 2);
-  const char *p = test_model("stanford-bunny.obj");
+  check_methods(dev, "demo", test_quick() ? 1 : 2);
+  check_methods(dev, "rooms:3", test_quick() ? 1 : 2);
+  const char *p = test_quick() ? NULL : test_model("stanford-bunny.obj");
   if (p) check_methods(dev, p, 1);
 
   /* 2D rasterization cannot draw curved views, and says which methods can. */

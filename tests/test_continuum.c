@@ -232,11 +232,12 @@ int main(void) {
   check_outside_oracle(dev);
   check_stats(dev);
   check_occluded_oracle(dev, "demo");
-  check_scene(dev, "demo", 4, 80, 60);
-  check_scene(dev, "rooms:3", 4, 80, 60);
+  int q = test_quick();
+  check_scene(dev, "demo", q ? 2 : 4, 80, 60);
+  check_scene(dev, "rooms:3", q ? 2 : 4, 80, 60);
   check_scene(dev, "sphere:24", 2, 64, 48);
-  const char *meshes[] = {"stanford-bunny.obj", "ogre.obj", "nefertiti.obj", "suzanne.obj", "spot.obj", "cow.obj"};
-  for (int m = 0; m < 6; m++) {
+  const char *meshes[] = {"suzanne.obj", "spot.obj", "cow.obj", "stanford-bunny.obj", "ogre.obj", "nefertiti.obj"};
+  for (int m = 0; m < (q ? 2 : 6); m++) {
     const char *p = test_model(meshes[m]);
     if (p) check_scene(dev, p, 3, 64, 48);
   }

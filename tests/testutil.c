@@ -34,6 +34,11 @@ const char *test_model(const char *name) {
   return p;
 }
 
+bool test_quick(void) {
+  const char *q = getenv("RR_TEST_QUICK");
+  return q && *q && strcmp(q, "0") != 0;
+}
+
 static unsigned long long rng_state = 0x9E3779B97F4A7C15ull;
 unsigned test_rand(void) {
   rng_state = rng_state * 6364136223846793005ull + 1442695040888963407ull;

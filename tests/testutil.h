@@ -25,6 +25,9 @@ int test_done(void);
 void test_skip(const char *why);
 /* Path of a shared model, or NULL (and a note) when it is absent. */
 const char *test_model(const char *name);
+/* True when RR_TEST_QUICK is set (the sanitizer run): property tests then visit
+ * fewer views and smaller meshes, the same code paths. */
+bool test_quick(void);
 /* Deterministic random numbers for property tests. */
 unsigned test_rand(void);
 float test_randf(float lo, float hi);
