@@ -60,6 +60,9 @@ typedef struct {
   float *tlo;        /* by node */
   float (*rect)[4];  /* by node */
   wide_bounds *wb;   /* by wide node */
+  uint8_t *loose;    /* by position: a needle left to the loose pass */
+  uint32_t *loose_pos, nloose;
+  leaf_tri *loose_ts;
 } frame_setups;
 
 /* The least t that sample_test() can return for ts at any sample of camera c.
@@ -160,6 +163,21 @@ typedef struct {
 
 enum { SETUP_CHUNK = 4096 };
 
+/* A needle: a sliver whose rectangle reaches far beyond its projection (the
+ * enlarged lines of two nearly parallel edges meet far away). Kept in the tree it
+ * would widen every ancestor's rectangle, so it goes to the loose pass instead. */
+static bool is_needle(const frame_setups *fs, uint32_t id, const float r[4]) {
+  float area = (r[2] - r[0]) * (r[3] - r[1]);
+  if (!(area > 256)) return false;
+  float x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  for (int k = 0; k < 3; k++) {
+    float sx, sy;
+    if (!camera_project(fs->cam, v3_sub(scene_vertex(fs->s, k, id), fs->cam->eye), &sx, &sy)) return false;
+    x0 = fminf(x0, sx), y0 = fminf(y0, sy), x1 = fmaxf(x1, sx), y1 = fmaxf(y1, sy);
+  }
+  return area > 4 * (x1 - x0 + 2) * (y1 - y0 + 2);
+}
+
 /* Sets up the triangles of the leaves among nodes [job·chunk, (job+1)·chunk). */
 static void setup_leaves(int job, int thread, void *arg) {
   (void)thread;
@@ -173,18 +191,26 @@ static void setup_leaves(int job, int thread, void *arg) {
     for (uint32_t i = n->first; i < n->first + n->count; i++) {
       bool live = tri_setup_camera(fs->s, b->prims[i], fs->cam, fs->cull, &fs->ts[i].ts) != SETUP_CULLED;
       fs->ts[i].id = live ? b->prims[i] : RR_MISS;
+      fs->loose[i] = 0;
       float *tr = fs->trect[i];
       if (!live) {
         tr[0] = tr[1] = INFINITY, tr[2] = tr[3] = -INFINITY;
         continue;
       }
       float t = tri_bounds(&fs->ts[i].ts, fs->cam, tr);
+      fs->loose[i] = fs->cam->planar && is_needle(fs, b->prims[i], tr);
+      if (fs->loose[i]) continue;
       tlo = t < tlo ? t : tlo;
       r[0] = fminf(r[0], tr[0]), r[1] = fminf(r[1], tr[1]), r[2] = fmaxf(r[2], tr[2]), r[3] = fmaxf(r[3], tr[3]);
     }
     fs->tlo[k] = tlo;
     memcpy(fs->rect[k], r, sizeof r);
   }
+}
+
+static void setups_free(frame_setups *fs) {
+  free(fs->ts), free(fs->trect), free(fs->tlo), free(fs->rect), free(fs->wb), free(fs->loose);
+  free(fs->loose_pos), free(fs->loose_ts);
 }
 
 static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *ctx, const rr_bvh *b) {
@@ -195,12 +221,27 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
   fs->tlo = malloc((size_t)b->nnodes * sizeof *fs->tlo + 1);
   fs->rect = malloc((size_t)b->nnodes * sizeof *fs->rect + 1);
   fs->wb = aligned_alloc(16, (size_t)b->nwide * sizeof *fs->wb);
-  if (!fs->ts || !fs->trect || !fs->tlo || !fs->rect || !fs->wb) {
-    free(fs->ts), free(fs->trect), free(fs->tlo), free(fs->rect), free(fs->wb);
+  fs->loose = malloc(n + 1);
+  if (!fs->ts || !fs->trect || !fs->tlo || !fs->rect || !fs->wb || !fs->loose) {
+    free(fs->ts), free(fs->trect), free(fs->tlo), free(fs->rect), free(fs->wb), free(fs->loose);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %zu triangle setups", n);
   }
   setup_job sj = {fs, SETUP_CHUNK};
   parallel_for((int)((b->nnodes + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, &sj);
+  /* Needles leave the tree for the loose pass (in leaf order: deterministic). */
+  uint32_t nl = 0;
+  for (size_t i = 0; i < n; i++) nl += fs->loose[i];
+  fs->loose_pos = malloc((size_t)nl * sizeof *fs->loose_pos + 1);
+  fs->loose_ts = malloc((size_t)nl * sizeof *fs->loose_ts + 1);
+  if (!fs->loose_pos || !fs->loose_ts) {
+    setups_free(fs);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %zu triangle setups", n);
+  }
+  for (size_t i = 0; i < n; i++)
+    if (fs->loose[i]) {
+      fs->loose_pos[fs->nloose] = (uint32_t)i, fs->loose_ts[fs->nloose++] = fs->ts[i];
+      fs->ts[i].id = RR_MISS;
+    }
   /* Children come after their parent in the array: one backward pass. */
   for (uint32_t k = b->nnodes; k-- > 0;) {
     const bvh_node *nd = &b->nodes[k];
@@ -223,7 +264,6 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
   return RR_OK;
 }
 
-static void setups_free(frame_setups *fs) { free(fs->ts), free(fs->trect), free(fs->tlo), free(fs->rect), free(fs->wb); }
 
 /* ---- one ray ------------------------------------------------------------------ */
 
@@ -466,7 +506,7 @@ typedef struct {
   render_ctx *ctx;
   const rr_bvh *b;
   frame_setups fs;
-  int tiles_x;
+  int tiles_x, band_rows;
   thread_stats st[256];
 } frame_job;
 
@@ -644,6 +684,32 @@ static void rc_packet_tile(int job, int thread, void *arg) {
   st->evals += acc.evals, st->nodes += acc.nodes;
 }
 
+/* The loose pass: every sample of a needle's rectangle in one band of rows, with
+ * the same sample test; depth_wins() merges it with what the rays found. */
+static void loose_band(int band, int thread, void *arg) {
+  frame_job *j = arg;
+  visbuf *vb = j->ctx->vb;
+  int y0 = band * j->band_rows, y1 = y0 + j->band_rows < vb->height ? y0 + j->band_rows : vb->height;
+  uint64_t e = 0;
+  for (uint32_t q = 0; q < j->fs.nloose; q++) {
+    const float *r = j->fs.trect[j->fs.loose_pos[q]];
+    const leaf_tri *lt = &j->fs.loose_ts[q];
+    /* Samples x + 0.5 in [r0, r2]: x from ceil(r0 - 0.5) to floor(r2 - 0.5), clipped. */
+    float fx0 = fmaxf(ceilf(r[0] - 0.5f), 0), fx1 = fminf(floorf(r[2] - 0.5f), (float)(vb->width - 1));
+    float fy0 = fmaxf(ceilf(r[1] - 0.5f), (float)y0), fy1 = fminf(floorf(r[3] - 0.5f), (float)(y1 - 1));
+    if (!(fx0 <= fx1 && fy0 <= fy1)) continue;
+    for (int y = (int)fy0; y <= (int)fy1; y++)
+      for (int x = (int)fx0; x <= (int)fx1; x++) {
+        float sx = (float)x + 0.5f, sy = (float)y + 0.5f;
+        size_t k = (size_t)y * vb->width + x;
+        shade_sample_w(&lt->ts, lt->id, v3(1.0f, sx, sy), sx, sy, vb, k);
+        e++;
+        if (j->ctx->heat_e) j->ctx->heat_e[k] += 1;
+      }
+  }
+  j->st[thread].evals += e;
+}
+
 static rr_error run_frame(rr_device *dev, render_ctx *ctx, parallel_fn tile_fn) {
   /* Packets work on screen rectangles: curved cameras cast one ray per sample. */
   if (tile_fn == rc_packet_tile && !ctx->cam->planar) tile_fn = rc_bvh_tile;
@@ -663,6 +729,10 @@ static rr_error run_frame(rr_device *dev, render_ctx *ctx, parallel_fn tile_fn) 
   j->tiles_x = (vb->width + TILE - 1) / TILE;
   int tiles = j->tiles_x * ((vb->height + TILE - 1) / TILE);
   parallel_for(tiles, ctx->threads, tile_fn, j);
+  if (j->fs.nloose) { /* the needles, over their rectangles, by bands of rows */
+    j->band_rows = (vb->height + 4 * ctx->threads - 1) / (4 * ctx->threads);
+    parallel_for((vb->height + j->band_rows - 1) / j->band_rows, ctx->threads, loose_band, j);
+  }
   for (int t = 0; t < 256; t++) {
     ctx->stats->edge_evals += j->st[t].evals;
     ctx->stats->nodes += j->st[t].nodes;
