@@ -343,9 +343,10 @@ int main(void) {
   check_threads(dev, s, "random 2k");
   random_rays(s, "random 2k", 2000);
   rr_scene_release(s);
+  int q = test_quick(); /* the sanitizer run: fewer rays, the same paths */
   s = random_scene(dev, 90000, 10, 0.2f); /* big enough for the chunked parallel paths */
   check_threads(dev, s, "random 90k");
-  random_rays(s, "random 90k", 300);
+  random_rays(s, "random 90k", q ? 50 : 300);
   rr_scene_release(s);
   plane_rays(dev);
   const char *reals[] = {"stanford-bunny.obj", "teapot.obj"};
@@ -353,7 +354,7 @@ int main(void) {
     const char *p = test_model(reals[m]);
     if (!p || rr_scene_load(dev, p, &s) != RR_OK) continue;
     check_threads(dev, s, reals[m]);
-    random_rays(s, reals[m], m == 0 ? 300 : 1500);
+    random_rays(s, reals[m], q ? 100 : m == 0 ? 300 : 1500);
     rr_scene_release(s);
   }
   if (rr_scene_load(dev, "sphere:32", &s) == RR_OK) {
