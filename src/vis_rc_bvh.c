@@ -111,19 +111,21 @@ float tri_bounds(const tri_setup *ts, const camera *cam, float rect[4]) {
      * how the triangle's projection turns on screen), each clear of the slack. */
     double sg = det < 0 ? -1 : 1;
     bool bounded = sg * det > slack * mag_d;
-    double vx[3], vy[3], ex[3], ey[3];
+    double vx[3], vy[3], ex[3], ey[3], den = INFINITY;
     for (int k = 0; k < 3 && bounded; k++) {
       bounded = sg * m[k] > slack * mag_m[k];
       if (!bounded) break;
-      double v = (sg * det + slack * mag_d) / (sg * m[k] - slack * mag_m[k]);
-      smax = v > smax ? v : smax;
+      double d = sg * m[k] - slack * mag_m[k];
+      den = d < den ? d : den;
       /* The vertex itself, where E_i + u_i = E_j + u_j = 0, with a generous error. */
       int i = (k + 1) % 3, j = (k + 2) % 3;
-      double nx = -a[i] * c[j] + a[j] * c[i], ny = b[j] * a[i] - b[i] * a[j];
-      vx[k] = nx / m[k], vy[k] = ny / m[k];
-      ex[k] = 1e-9 * ((fabs(a[i] * c[j]) + fabs(a[j] * c[i])) / fabs(m[k]) + fabs(vx[k])) + 1e-6;
-      ey[k] = 1e-9 * ((fabs(b[j] * a[i]) + fabs(b[i] * a[j])) / fabs(m[k]) + fabs(vy[k])) + 1e-6;
+      double inv = 1.0 / m[k], ainv = fabs(inv);
+      vx[k] = (-a[i] * c[j] + a[j] * c[i]) * inv, vy[k] = (b[j] * a[i] - b[i] * a[j]) * inv;
+      ex[k] = 1e-9 * ((fabs(a[i] * c[j]) + fabs(a[j] * c[i])) * ainv + fabs(vx[k])) + 1e-6;
+      ey[k] = 1e-9 * ((fabs(b[j] * a[i]) + fabs(b[i] * a[j])) * ainv + fabs(vy[k])) + 1e-6;
     }
+    /* Σ(E + u) at the vertices is det/m_k: the largest has the smallest minor. */
+    if (bounded) smax = (sg * det + slack * mag_d) / den;
     if (bounded) {
       rx0 = fmin(vx[0] - ex[0], fmin(vx[1] - ex[1], vx[2] - ex[2]));
       rx1 = fmax(vx[0] + ex[0], fmax(vx[1] + ex[1], vx[2] + ex[2]));
