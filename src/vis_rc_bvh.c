@@ -80,8 +80,8 @@ typedef struct {
  * (1+u)^2 Σ(E_i + u_i). That sum is affine, so its maximum over P is at a vertex
  * of P; at the vertex where E_i + u_i and E_j + u_j vanish it equals
  * det[a' b c] / (b_i·c_j - b_j·c_i) (Cramer; a' = a + u), and P is that bounded
- * triangle when the three values are positive; otherwise the maximum over the
- * image rectangle bounds it. Curved cameras evaluate e_i = n_i·d with |d| at most
+ * triangle when the three values are positive; otherwise P clipped to the image
+ * rectangle is a convex polygon and its vertices bound both. Curved cameras evaluate e_i = n_i·d with |d| at most
  * the camera's longest ray, so the sum is at most |Σn_i|·|d| plus the error. The
  * volume (constant but for orthographic views) is bounded below over the image
  * the same way, and t = vol·(1/sum) is at least vol·(1-u)^2 / max sum. P's
@@ -134,9 +134,36 @@ float tri_bounds(const tri_setup *ts, const camera *cam, float rect[4]) {
       ry1 = fmax(vy[0] + ey[0], fmax(vy[1] + ey[1], vy[2] + ey[2]));
     }
     if (!bounded) {
+      /* P unbounded (the triangle crosses the eye's plane) or nearly degenerate:
+       * clip the image rectangle by its three half-planes, loosened by the slack,
+       * and take the polygon's extent and its largest Σ(E + u). */
+      double px[8] = {0, w, w, 0}, py[8] = {0, 0, h, h}, qx[8], qy[8];
+      int np = 4;
+      for (int i = 0; i < 3 && np; i++) {
+        double A = a[i] + slack * (fabs(a[i]) + w * fabs(b[i]) + h * fabs(c[i]));
+        int nq = 0;
+        for (int k = 0; k < np; k++) {
+          int l = (k + 1) % np;
+          double fk = A + b[i] * px[k] + c[i] * py[k], fl = A + b[i] * px[l] + c[i] * py[l];
+          if (fk >= 0) qx[nq] = px[k], qy[nq] = py[k], nq++;
+          if ((fk >= 0) != (fl >= 0)) {
+            double r = fk / (fk - fl);
+            qx[nq] = px[k] + (px[l] - px[k]) * r, qy[nq] = py[k] + (py[l] - py[k]) * r, nq++;
+          }
+        }
+        np = nq;
+        memcpy(px, qx, sizeof px), memcpy(py, qy, sizeof py);
+      }
+      if (!np) smax = -INFINITY; /* no sample of the image can pass */
       double A = a[0] + a[1] + a[2], B = b[0] + b[1] + b[2], C = c[0] + c[1] + c[2];
-      smax = A + fmax(0.5 * B, (w - 0.5) * B) + fmax(0.5 * C, (h - 0.5) * C);
+      for (int k = 0; k < np; k++) {
+        double v = A + B * px[k] + C * py[k];
+        smax = v > smax ? v : smax;
+        rx0 = k ? fmin(rx0, px[k]) : px[k], rx1 = k ? fmax(rx1, px[k]) : px[k];
+        ry0 = k ? fmin(ry0, py[k]) : py[k], ry1 = k ? fmax(ry1, py[k]) : py[k];
+      }
       smax += slack * (fabs(A) + w * fabs(B) + h * fabs(C));
+      rx0 -= 1e-6 * (w + 1), rx1 += 1e-6 * (w + 1), ry0 -= 1e-6 * (h + 1), ry1 += 1e-6 * (h + 1);
     }
   } else {
     double dmax = (double)cam->dir_len_max * (1 + 1e-6), nx = 0, ny = 0, nz = 0, err = 0;
