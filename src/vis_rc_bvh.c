@@ -30,7 +30,6 @@
 #include <string.h>
 
 #define RAY_MARGIN 0x1p-10f /* relative widening of box intervals (about 1e-3) */
-#define BIG_RECT 4096.0f    /* pixels: node rectangles larger than this also get the 3D box test */
 /* The kernels take constant mode flags: forcing them inline specialises each use. */
 #define KERNEL static inline __attribute__((always_inline))
 
@@ -414,15 +413,6 @@ KERNEL bool trace1(const rr_bvh *b, ray_state *r, const int mode) {
         __m128 in = _mm_and_ps(_mm_cmple_ps(_mm_load_ps(wb->x0), x), _mm_cmple_ps(x, _mm_load_ps(wb->x1)));
         in = _mm_and_ps(in, _mm_and_ps(_mm_cmple_ps(_mm_load_ps(wb->y0), y), _mm_cmple_ps(y, _mm_load_ps(wb->y1))));
         hits = _mm_movemask_ps(_mm_and_ps(in, _mm_cmple_ps(keyv, _mm_set1_ps(r->t))));
-        /* Slots whose rectangle is large (seen from inside a scene, big subtrees
-         * cover most of the screen) must also meet the ray in 3D: the box test,
-         * widened by RAY_MARGIN, without pruning by t. Small rectangles are
-         * selective enough on their own, and skipping the test there is faster. */
-        __m128 area = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(wb->x1), _mm_load_ps(wb->x0)),
-                                 _mm_sub_ps(_mm_load_ps(wb->y1), _mm_load_ps(wb->y0)));
-        int big = hits & _mm_movemask_ps(_mm_cmpgt_ps(area, _mm_set1_ps(BIG_RECT)));
-        __m128 unused;
-        if (big) hits &= ~big | wide_test(w, &r->q, 0.0f, _mm_setzero_ps(), INFINITY, &unused);
       } else if (mode == MODE_CURVED) {
         keyv = _mm_load_ps(r->fs->wb[ref].tlo);
         hits = wide_test(w, &r->q, r->tmin, keyv, r->t, &tnv);
@@ -575,11 +565,7 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
       r.w = camera_w(c, x, y), r.tmin = 0;
           vec3 o, d;
       uint64_t e0 = r.evals, n0 = r.nodes;
-      if (c->planar) {
-        camera_ray(c, x, y, &o, &d);
-        ray_q_init(&r.q, o, d);
-        trace1(j->b, &r, MODE_PLANAR);
-      }
+      if (c->planar) trace1(j->b, &r, MODE_PLANAR); /* rectangles only: no 3D test */
       else if (camera_ray(c, x, y, &o, &d)) { /* else a pixel without a ray: a miss */
         ray_q_init(&r.q, o, d);
         trace1(j->b, &r, MODE_CURVED);
