@@ -491,6 +491,7 @@ static void run_tile(int job, int thread, void *arg) {
 rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
   const oracles *o = ctx->oracles;
   const visbuf *vb = ctx->vb;
+  if (ctx->scene->ntris == 0) return RR_OK; /* nothing to see: the cleared buffer is the image */
   if (!ctx->scene->bvh && o->leaves)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "this method needs the scene's BVH (call rr_scene_commit)");
   /* Initial frusta: the whole image on one thread (the paper's set-up), else
