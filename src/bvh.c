@@ -493,8 +493,11 @@ typedef struct {
  * stops at ±BVH_FAR instead, so every traversal keeps working on finite boxes (no
  * inf − inf, no 0·inf from the box itself; areas overflow float but half_area
  * falls back to double). What this gives up is the part of such a triangle more
- * than 1e30 from the origin: a ray would need a slope below 1e-30 to hit it there,
- * which no camera sample computes. */
+ * than 1e30 from the origin: the sample test reaches it only where Σ w_i V_i falls
+ * below about 1e-30 of V (a ray grazing the plane to within 1e-30 rad), and there
+ * the box-culling traversals could miss a hit that rc keeps. The one alternative,
+ * a list of unbounded triangles that every traversal tests at its root, would touch
+ * every traversal for that case. */
 #define BVH_FAR 1e30f
 static void inf_bounds(unsigned inf, float v0, float v1, float v2, float *lo, float *hi) {
   float v[3] = {v0, v1, v2}, l = INFINITY, h = -INFINITY;
