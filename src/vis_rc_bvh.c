@@ -206,7 +206,7 @@ static bool is_needle(const frame_setups *fs, uint32_t id, const float r[4]) {
   float x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   for (int k = 0; k < 3; k++) {
     float sx, sy;
-    if (!camera_project(fs->cam, v3_sub(scene_vertex(fs->s, k, id), fs->cam->eye), &sx, &sy)) return false;
+    if (!camera_project(fs->cam, scene_q(fs->s, k, id, fs->cam->eye), &sx, &sy)) return false;
     x0 = fminf(x0, sx), y0 = fminf(y0, sy), x1 = fmaxf(x1, sx), y1 = fmaxf(y1, sy);
   }
   return area > 4 * (x1 - x0 + 2) * (y1 - y0 + 2);
