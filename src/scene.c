@@ -168,40 +168,17 @@ void scene_update_bounds(rr_scene *s) {
   s->bmax = hi;
 }
 
-rr_error rr_scene_add_mesh(rr_scene *s, const float *pos, size_t nvert, const uint32_t *idx,
-                           size_t ntri, const float rgb[3]) {
+/* Appends an indexed mesh of `stride` floats per vertex: xyz, or xyzw where w = 0
+ * is a point at infinity in direction xyz and other w are divided through. The
+ * indices are checked first, so a bad mesh adds nothing. */
+static rr_error add_mesh(rr_scene *s, const char *api, const float *pos, int stride, size_t nvert,
+                         const uint32_t *idx, size_t ntri, const float rgb[3]) {
   if (!s) return RR_ERROR_ARGUMENT;
-  if ((!pos && nvert) || (!idx && ntri))
-    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh: NULL positions or indices");
-  if (ntri > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh: too many triangles");
-  float grey[3] = {0.8f, 0.8f, 0.8f};
-  uint32_t mat = scene_add_material(s, rgb ? rgb : grey, NULL);
-  if (mat == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
-  rr_error e = scene_reserve(s, (uint32_t)ntri, false, false);
-  if (e) return e;
-  for (size_t t = 0; t < ntri; t++) {
-    vec3 p[3];
-    for (int k = 0; k < 3; k++) {
-      uint32_t v = idx[3 * t + k];
-      if (v >= nvert)
-        return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh: index %u of triangle %zu out of range (%zu vertices)",
-                       v, t, nvert);
-      p[k] = v3_load(pos + 3 * (size_t)v);
-    }
-    scene_push(s, p, NULL, NULL, mat);
-  }
-  return rr_ok(s->dev);
-}
-
-rr_error rr_scene_add_mesh4(rr_scene *s, const float *xyzw, size_t nvert, const uint32_t *idx, size_t ntri,
-                            const float rgb[3]) {
-  if (!s) return RR_ERROR_ARGUMENT;
-  if ((!xyzw && nvert) || (!idx && ntri))
-    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh4: NULL positions or indices");
-  if (ntri > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh4: too many triangles");
+  if ((!pos && nvert) || (!idx && ntri)) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: NULL positions or indices", api);
+  if (ntri > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: too many triangles", api);
   for (size_t t = 0; t < 3 * ntri; t++)
     if (idx[t] >= nvert)
-      return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_mesh4: index %u of triangle %zu out of range (%zu vertices)",
+      return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: index %u of triangle %zu out of range (%zu vertices)", api,
                      idx[t], t / 3, nvert);
   float grey[3] = {0.8f, 0.8f, 0.8f};
   uint32_t mat = scene_add_material(s, rgb ? rgb : grey, NULL);
@@ -212,13 +189,24 @@ rr_error rr_scene_add_mesh4(rr_scene *s, const float *xyzw, size_t nvert, const 
     vec3 p[3];
     unsigned inf = 0;
     for (int k = 0; k < 3; k++) {
-      const float *v = xyzw + 4 * (size_t)idx[3 * t + k];
-      if (v[3] == 0) inf |= 1u << k, p[k] = v3(v[0], v[1], v[2]); /* a point at infinity: its direction */
-      else p[k] = v3(v[0] / v[3], v[1] / v[3], v[2] / v[3]);
+      const float *v = pos + stride * (size_t)idx[3 * t + k];
+      float w = stride == 4 ? v[3] : 1.0f;
+      if (w == 0) inf |= 1u << k, p[k] = v3(v[0], v[1], v[2]); /* a point at infinity: its direction */
+      else p[k] = v3(v[0] / w, v[1] / w, v[2] / w); /* exact for w = 1 */
     }
     scene_push_inf(s, p, inf, NULL, NULL, mat);
   }
   return rr_ok(s->dev);
+}
+
+rr_error rr_scene_add_mesh(rr_scene *s, const float *pos, size_t nvert, const uint32_t *idx, size_t ntri,
+                           const float rgb[3]) {
+  return add_mesh(s, "rr_scene_add_mesh", pos, 3, nvert, idx, ntri, rgb);
+}
+
+rr_error rr_scene_add_mesh4(rr_scene *s, const float *xyzw, size_t nvert, const uint32_t *idx, size_t ntri,
+                            const float rgb[3]) {
+  return add_mesh(s, "rr_scene_add_mesh4", xyzw, 4, nvert, idx, ntri, rgb);
 }
 
 rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out) {
