@@ -98,14 +98,6 @@ static rr_frame *render(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   return f;
 }
 
-static int differ(const rr_frame *a, const rr_frame *b) {
-  size_t n = (size_t)a->vb.width * a->vb.height;
-  int d = 0;
-  for (size_t k = 0; k < n; k++)
-    d += a->vb.id[k] != b->vb.id[k] || memcmp(&a->vb.t[k], &b->vb.t[k], 4) || memcmp(&a->vb.l1[k], &b->vb.l1[k], 4);
-  return d;
-}
-
 static const rr_method methods3d[] = {RR_METHOD_RC_BVH,  RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
                                       RR_METHOD_3DR_FC,  RR_METHOD_3DR_FS,    RR_METHOD_3DR_FULL};
 
@@ -131,7 +123,7 @@ static void check_methods(rr_device *dev, const char *name, int views) {
       for (size_t m = 0; m < sizeof methods3d / sizeof methods3d[0]; m++) {
         rr_frame *f = render(dev, s, &cam, methods3d[m], w, h, 1 + (v + m) % 2);
         if (!f) continue;
-        int d = differ(ref, f);
+        int d = test_frames_differ(ref, f);
         CHECK(d == 0, "%s view %d, %s camera: %s differs from rc at %d samples", name, v, rr_camera_name(type),
               rr_method_name(methods3d[m]), d);
         if (type != RR_CAMERA_PERSPECTIVE && type != RR_CAMERA_ORTHOGRAPHIC) bins += f->stats.bins, empty += f->stats.bins_empty;

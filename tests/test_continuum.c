@@ -26,15 +26,6 @@ static rr_frame *render(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   return f;
 }
 
-static int differ(const rr_frame *a, const rr_frame *b) {
-  size_t n = (size_t)a->vb.width * a->vb.height;
-  int d = 0;
-  for (size_t k = 0; k < n; k++)
-    d += a->vb.id[k] != b->vb.id[k] || memcmp(&a->vb.t[k], &b->vb.t[k], 4) || memcmp(&a->vb.l1[k], &b->vb.l1[k], 4) ||
-         memcmp(&a->vb.l2[k], &b->vb.l2[k], 4);
-  return d;
-}
-
 static void random_view(const rr_scene *s, rr_camera *cam, bool inside) {
   rr_camera_init(cam);
   vec3 c = v3_scale(v3_add(s->bmin, s->bmax), 0.5f);
@@ -64,7 +55,7 @@ static void check_scene(rr_device *dev, const char *name, int views, int w, int 
       rr_frame *f = render(dev, s, &cam, all3d[m], threads, w, h, cull, NULL, 0);
       if (!f) continue;
       methods_seen[all3d[m]]++;
-      int d = differ(ref, f);
+      int d = test_frames_differ(ref, f);
       CHECK(d == 0, "%s view %d (%s, %d threads): %s differs from rc at %d samples", name, v,
             v % 2 == 0 ? "inside" : "outside", threads, rr_method_name(all3d[m]), d);
       rr_frame_release(f);
@@ -74,7 +65,7 @@ static void check_scene(rr_device *dev, const char *name, int views, int w, int 
     if (fa) {
       CHECK(fa->stats.method >= 0 && fa->stats.method < RR_METHOD_COUNT && fa->stats.why[0], "auto chose %d (%s)",
             fa->stats.method, fa->stats.why);
-      CHECK(differ(ref, fa) == 0, "%s view %d: auto (%s) differs from rc", name, v, rr_method_name(fa->stats.method));
+      CHECK(test_frames_differ(ref, fa) == 0, "%s view %d: auto (%s) differs from rc", name, v, rr_method_name(fa->stats.method));
       rr_frame_release(fa);
     }
     /* the scalar kernels give the same bits as the SIMD ones */
@@ -82,7 +73,7 @@ static void check_scene(rr_device *dev, const char *name, int views, int w, int 
     for (int k = 0; k < 2; k++) {
       rr_frame *f = render(dev, s, &cam, k ? RR_METHOD_3DR_FULL : RR_METHOD_3DR_BB, threads, w, h, cull, NULL, 0);
       if (!f) continue;
-      int d = differ(ref, f);
+      int d = test_frames_differ(ref, f);
       CHECK(d == 0, "%s view %d: scalar %s differs from rc at %d samples", name, v, k ? "3dr-full" : "3dr-bb", d);
       rr_frame_release(f);
     }
@@ -93,7 +84,7 @@ static void check_scene(rr_device *dev, const char *name, int views, int w, int 
     for (int k = 0; k < 4; k++) {
       rr_frame *f = render(dev, s, &cam, RR_METHOD_3DR_BB, threads, w, h, cull, mixes[k], 0);
       if (!f) continue;
-      int d = differ(ref, f);
+      int d = test_frames_differ(ref, f);
       CHECK(d == 0, "%s view %d: oracles %s differ from rc at %d samples", name, v, mixes[k], d);
       rr_frame_release(f);
     }

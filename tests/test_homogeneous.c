@@ -27,15 +27,6 @@ static rr_frame *render(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   return e == RR_OK ? f : NULL;
 }
 
-static int differing(const rr_frame *a, const rr_frame *b) {
-  size_t n = (size_t)a->vb.width * a->vb.height;
-  int d = 0;
-  for (size_t k = 0; k < n; k++)
-    d += a->vb.id[k] != b->vb.id[k] || memcmp(&a->vb.t[k], &b->vb.t[k], 4) || memcmp(&a->vb.l1[k], &b->vb.l1[k], 4) ||
-         memcmp(&a->vb.l2[k], &b->vb.l2[k], 4);
-  return d;
-}
-
 /* Möller–Trumbore in double, both faces; t > 0. */
 static bool tri_hit_d(const double o[3], const double d[3], const double p[3][3], double *t) {
   double e1[3], e2[3], pv[3], tv[3], qv[3];
@@ -141,7 +132,7 @@ static void check_views(rr_device *dev, const rr_scene *s, uint32_t nplane, cons
         for (int threads = 1; threads <= 2; threads++) {
           rr_frame *f = render(dev, s, &cam, METHODS[m], threads, W, H);
           if (!f) continue;
-          int d = differing(ref, f);
+          int d = test_frames_differ(ref, f);
           CHECK(d == 0, "%s %s %s: %s on %d threads differs from rc at %d samples", name, views[v].what, cname,
                 rr_method_name(METHODS[m]), threads, d);
           rr_frame_release(f);
@@ -218,7 +209,7 @@ static void check_api(rr_device *dev) {
   memcpy(cam.eye, eye, 12), memcpy(cam.target, target, 12);
   rr_frame *a = render(dev, s, &cam, RR_METHOD_RC, 1, 48, 32);
   rr_frame *b = render(dev, s, &cam, RR_METHOD_3DR_BIN, 2, 48, 32);
-  if (a && b) CHECK(differing(a, b) == 0, "add_mesh4 scene: 3dr-bin equals rc");
+  if (a && b) CHECK(test_frames_differ(a, b) == 0, "add_mesh4 scene: 3dr-bin equals rc");
   rr_frame_release(a), rr_frame_release(b);
 
   /* 2D rasterization cannot take points at infinity, and says so */

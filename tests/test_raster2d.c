@@ -204,15 +204,6 @@ static void check_fill_rule(void) {
 
 /* ---- agreement with 2dr-bb (bitwise) and 3dr-bb (within snapping) ----------------- */
 
-static int bitwise_diff(const rr_frame *a, const rr_frame *b) {
-  size_t n = (size_t)a->vb.width * a->vb.height;
-  int d = 0;
-  for (size_t k = 0; k < n; k++)
-    d += a->vb.id[k] != b->vb.id[k] || memcmp(&a->vb.t[k], &b->vb.t[k], 4) || memcmp(&a->vb.l1[k], &b->vb.l1[k], 4) ||
-         memcmp(&a->vb.l2[k], &b->vb.l2[k], 4);
-  return d;
-}
-
 /* The ray of pixel (x, y) of a planar camera, from its parameterization in double
  * (camera_ray rounds origin and direction to float). */
 static void exact_ray(const camera *c, int x, int y, double o[3], double d[3]) {
@@ -310,7 +301,7 @@ static agreement check_view(const rr_scene *s, const rr_camera *cam, int w, int 
   rr_frame *bin2 = render(s, cam, RR_METHOD_2DR_BIN, 2, w, h, cull);
   rr_frame *ref = render(s, cam, RR_METHOD_3DR_BB, 1, w, h, cull);
   if (bb && bb3 && bin && bin2 && ref) {
-    int d1 = bitwise_diff(bb, bin), d2 = bitwise_diff(bb, bb3), d3 = bitwise_diff(bb, bin2);
+    int d1 = test_frames_differ(bb, bin), d2 = test_frames_differ(bb, bb3), d3 = test_frames_differ(bb, bin2);
     CHECK(d1 == 0 && d2 == 0 && d3 == 0,
           "%s: 2dr-bin differs from 2dr-bb at %d samples, 3 threads at %d, 2dr-bin on 2 threads at %d", what, d1, d2,
           d3);

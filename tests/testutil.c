@@ -1,5 +1,7 @@
 #include "testutil.h"
 
+#include "rr.h"
+
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -45,3 +47,12 @@ unsigned test_rand(void) {
   return (unsigned)(rng_state >> 33);
 }
 float test_randf(float lo, float hi) { return lo + (hi - lo) * (test_rand() / 2147483648.0f); }
+
+int test_frames_differ(const rr_frame *a, const rr_frame *b) {
+  size_t n = (size_t)a->vb.width * a->vb.height;
+  int d = 0;
+  for (size_t k = 0; k < n; k++)
+    d += a->vb.id[k] != b->vb.id[k] || memcmp(&a->vb.t[k], &b->vb.t[k], 4) || memcmp(&a->vb.l1[k], &b->vb.l1[k], 4) ||
+         memcmp(&a->vb.l2[k], &b->vb.l2[k], 4);
+  return d;
+}

@@ -28,6 +28,9 @@ const char *test_model(const char *name);
 /* True when RR_TEST_QUICK is set (the sanitizer run): property tests then visit
  * fewer views and smaller meshes, the same code paths. */
 bool test_quick(void);
+struct rr_frame;
+/* Samples where two visibility buffers differ in any byte of id, t, λ1 or λ2. */
+int test_frames_differ(const struct rr_frame *a, const struct rr_frame *b);
 /* Deterministic random numbers for property tests. */
 unsigned test_rand(void);
 float test_randf(float lo, float hi);
