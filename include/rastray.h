@@ -194,6 +194,7 @@ typedef struct rr_stats {
   uint64_t bins;       /* bins that passed binning's coverage test and were refined */
   uint64_t bins_empty; /* of those, bins where the triangle covered no sample */
   double frame_ms;     /* wall time of the visibility pass */
+  double cpu_ms;       /* processor time the process spent in it, all threads together */
   int threads;         /* threads the pass ran on */
   int method;          /* the method that ran (what auto chose) */
   char why[160];       /* for auto: why it chose that method */

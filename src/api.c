@@ -244,9 +244,9 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                     .oracles = &o};
   f->stats.threads = ctx.threads;
   f->stats.method = opt->method;
-  double t0 = now_ms();
+  double t0 = now_ms(), c0 = cpu_ms();
   e = methods[opt->method].fn(dev, &ctx);
-  f->stats.frame_ms = now_ms() - t0;
+  f->stats.frame_ms = now_ms() - t0, f->stats.cpu_ms = cpu_ms() - c0;
   camera_release(&c);
   if (e) {
     rr_frame_release(f);

@@ -102,6 +102,101 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri
   return true;
 }
 
+/* The planar bounds of one triangle from its corners, as tri_screen_bounds gives them. */
+static inline uint32_t keep_bounded(const rr_scene *s, uint32_t i, const camera *c, tri_bound *out) {
+  out->id = i;
+  return tri_screen_bounds(s, i, c, NULL, out->bb);
+}
+
+static uint32_t tri_bounds_run_scalar(const rr_scene *s, uint32_t first, uint32_t n, const camera *c, tri_bound *out) {
+  uint32_t kept = 0;
+  for (uint32_t i = first; i < first + n; i++) kept += keep_bounded(s, i, c, out + kept);
+  return kept;
+}
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+
+/* tri_screen_bounds for eight triangles at once, for planar cameras and finite
+ * corners: the same operations in the same order (no FMA, true divisions), so the
+ * same rectangles. Lanes with a corner not strictly in front of the image plane
+ * (or projecting to no finite point) take the scalar path. */
+__attribute__((target("avx2"))) static uint32_t bounds8_avx2(const rr_scene *s, uint32_t i, const camera *c,
+                                                              tri_bound *out) {
+  const bool persp = c->type == RR_CAMERA_PERSPECTIVE;
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), half = _mm256_set1_ps(0.5f);
+  const __m256 W = _mm256_set1_ps((float)c->width), H = _mm256_set1_ps((float)c->height);
+  const __m256 inf = _mm256_set1_ps(INFINITY), absmask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  const float e[3] = {c->eye.x, c->eye.y, c->eye.z};
+  const float f[3] = {c->fwd.x, c->fwd.y, c->fwd.z}, rt[3] = {c->right.x, c->right.y, c->right.z},
+              up[3] = {c->up.x, c->up.y, c->up.z};
+  __m256 x0 = inf, y0 = inf, x1 = _mm256_set1_ps(-INFINITY), y1 = x1;
+  __m256 ok = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  for (int k = 0; k < 3; k++) {
+    __m256 q[3];
+    for (int a = 0; a < 3; a++) q[a] = _mm256_sub_ps(_mm256_loadu_ps(s->p[k][a] + i), _mm256_set1_ps(e[a]));
+#define DOT3(v) \
+  _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(q[0], _mm256_set1_ps(v[0])), _mm256_mul_ps(q[1], _mm256_set1_ps(v[1]))), \
+                _mm256_mul_ps(q[2], _mm256_set1_ps(v[2])))
+    __m256 z = DOT3(f), qr = DOT3(rt), qu = DOT3(up);
+#undef DOT3
+    __m256 sx, sy;
+    if (persp) {
+      __m256 u = _mm256_div_ps(qr, _mm256_mul_ps(z, _mm256_set1_ps(c->tan_half_w)));
+      __m256 v = _mm256_div_ps(qu, _mm256_mul_ps(z, _mm256_set1_ps(c->tan_half_h)));
+      sx = _mm256_mul_ps(_mm256_mul_ps(_mm256_add_ps(u, one), half), W);
+      sy = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(one, v), half), H);
+    } else {
+      sx = _mm256_mul_ps(_mm256_mul_ps(_mm256_add_ps(_mm256_div_ps(qr, _mm256_set1_ps(c->tan_half_w)), one), half), W);
+      sy = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(one, _mm256_div_ps(qu, _mm256_set1_ps(c->tan_half_h))), half), H);
+    }
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(z, zero, _CMP_GT_OQ));
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_and_ps(sx, absmask), inf, _CMP_LT_OQ));
+    ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_and_ps(sy, absmask), inf, _CMP_LT_OQ));
+    x0 = _mm256_min_ps(x0, sx), x1 = _mm256_max_ps(x1, sx), y0 = _mm256_min_ps(y0, sy), y1 = _mm256_max_ps(y1, sy);
+  }
+  __m256 big = _mm256_max_ps(_mm256_max_ps(_mm256_and_ps(x0, absmask), _mm256_and_ps(x1, absmask)),
+                             _mm256_max_ps(_mm256_and_ps(y0, absmask), _mm256_and_ps(y1, absmask)));
+  __m256 m = _mm256_add_ps(_mm256_set1_ps(1.0f / 64), _mm256_mul_ps(_mm256_set1_ps(1e-5f), big));
+  const int down = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC, upr = _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC;
+  __m256 lx = _mm256_max_ps(_mm256_round_ps(_mm256_sub_ps(_mm256_sub_ps(x0, half), m), upr), zero);
+  __m256 ly = _mm256_max_ps(_mm256_round_ps(_mm256_sub_ps(_mm256_sub_ps(y0, half), m), upr), zero);
+  __m256 hx = _mm256_min_ps(_mm256_round_ps(_mm256_add_ps(_mm256_sub_ps(x1, half), m), down),
+                            _mm256_set1_ps((float)(c->width - 1)));
+  __m256 hy = _mm256_min_ps(_mm256_round_ps(_mm256_add_ps(_mm256_sub_ps(y1, half), m), down),
+                            _mm256_set1_ps((float)(c->height - 1)));
+  __m256 empty = _mm256_or_ps(_mm256_cmp_ps(lx, hx, _CMP_GT_OQ), _mm256_cmp_ps(ly, hy, _CMP_GT_OQ));
+  int okm = _mm256_movemask_ps(ok), keep = okm & ~_mm256_movemask_ps(empty);
+  if (!keep && okm == 0xff) return 0;
+  int b[4][8];
+  _mm256_storeu_si256((__m256i *)b[0], _mm256_cvttps_epi32(lx));
+  _mm256_storeu_si256((__m256i *)b[1], _mm256_cvttps_epi32(ly));
+  _mm256_storeu_si256((__m256i *)b[2], _mm256_cvttps_epi32(hx));
+  _mm256_storeu_si256((__m256i *)b[3], _mm256_cvttps_epi32(hy));
+  uint32_t kept = 0;
+  for (int l = 0; l < 8; l++) {
+    if (!(okm >> l & 1)) {
+      kept += keep_bounded(s, i + (uint32_t)l, c, out + kept);
+    } else if (keep >> l & 1) {
+      out[kept] = (tri_bound){i + (uint32_t)l, {b[0][l], b[1][l], b[2][l], b[3][l]}};
+      kept++;
+    }
+  }
+  return kept;
+}
+#endif
+
+uint32_t tri_bounds_run(const rr_scene *s, uint32_t first, uint32_t n, const camera *c, bool simd, tri_bound *out) {
+  uint32_t kept = 0, i = first;
+#if defined(__x86_64__) || defined(__i386__)
+  if (simd && !s->inf && __builtin_cpu_supports("avx2"))
+    for (; i + 8 <= first + n; i += 8) kept += bounds8_avx2(s, i, c, out + kept);
+#else
+  (void)simd;
+#endif
+  return kept + tri_bounds_run_scalar(s, i, first + n - i, c, out + kept);
+}
+
 /* The sample loop, written once and specialised for planar and curved cameras. */
 static inline uint64_t raster_loop(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb,
                                    const bool planar) {
@@ -119,7 +214,6 @@ static inline uint64_t raster_loop(const tri_setup *ts, uint32_t id, const int r
 }
 
 #if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
 
 /* The planar sample loop, 8 samples of a row at a time with AVX2. Every operation
  * is the scalar one, in the same order, on IEEE single floats (no FMA, a true

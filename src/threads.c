@@ -1,9 +1,14 @@
-/* A minimal thread pool for one parallel loop at a time: jobs are dealt out
- * dynamically through an atomic counter, so uneven tiles balance themselves. */
+/* A thread pool for one parallel loop at a time: jobs are dealt out dynamically
+ * through an atomic counter, so uneven tiles balance themselves. The workers live
+ * as long as the process, since a frame runs many short loops (a batch of
+ * triangles is two of them) and starting threads for each would cost more than
+ * some loops do. A loop started while the pool is busy (another caller's thread,
+ * or a loop inside a job) runs on threads of its own instead. */
 #include "rr.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -12,45 +17,128 @@ typedef struct {
   int njobs;
   parallel_fn fn;
   void *arg;
-} pool;
+} loop;
+
+static void run_jobs(loop *l, int thread) {
+  for (;;) {
+    int job = atomic_fetch_add(&l->next, 1);
+    if (job >= l->njobs) break;
+    l->fn(job, thread, l->arg);
+  }
+}
+
+#define MAX_THREADS 256
 
 typedef struct {
-  pool *p;
-  int thread;
-} worker;
+  pthread_mutex_t busy; /* held by the caller whose loop the pool runs */
+  pthread_mutex_t mu;   /* guards what follows */
+  pthread_cond_t go, done;
+  int workers;          /* started so far: threads 1..workers */
+  unsigned gen;         /* bumped for every loop */
+  loop *cur;
+  int want;             /* threads 1..want-1 take part in the current loop */
+  int running;          /* of those, still working */
+} pool;
 
-static void *work(void *w_) {
-  worker *w = w_;
+#define POOL_INIT                                                                                     \
+  {                                                                                                   \
+    .busy = PTHREAD_MUTEX_INITIALIZER, .mu = PTHREAD_MUTEX_INITIALIZER, .go = PTHREAD_COND_INITIALIZER, \
+    .done = PTHREAD_COND_INITIALIZER                                                                  \
+  }
+static pool P = POOL_INIT;
+
+static void *pool_worker(void *arg) {
+  int id = (int)(intptr_t)arg;
+  unsigned seen = 0;
+  pthread_mutex_lock(&P.mu);
   for (;;) {
-    int job = atomic_fetch_add(&w->p->next, 1);
-    if (job >= w->p->njobs) break;
-    w->p->fn(job, w->thread, w->p->arg);
+    while (P.gen == seen) pthread_cond_wait(&P.go, &P.mu);
+    seen = P.gen;
+    if (id >= P.want) continue;
+    loop *l = P.cur;
+    pthread_mutex_unlock(&P.mu);
+    run_jobs(l, id);
+    pthread_mutex_lock(&P.mu);
+    if (--P.running == 0) pthread_cond_signal(&P.done);
   }
   return NULL;
+}
+
+/* A forked child has none of the parent's workers. */
+static void pool_after_fork(void) {
+  pool fresh = POOL_INIT;
+  P = fresh;
+}
+
+static pthread_once_t atfork_once = PTHREAD_ONCE_INIT;
+static void register_atfork(void) { pthread_atfork(NULL, NULL, pool_after_fork); }
+
+/* The fallback: threads started for this loop alone. */
+typedef struct {
+  loop *l;
+  int thread;
+} own_arg;
+
+static void *own_thread(void *arg) {
+  own_arg *a = arg;
+  run_jobs(a->l, a->thread);
+  return NULL;
+}
+
+static void run_own_threads(loop *l, int threads) {
+  pthread_t tid[MAX_THREADS];
+  own_arg a[MAX_THREADS];
+  int started = 0;
+  for (int i = 1; i < threads; i++) {
+    a[i] = (own_arg){l, i};
+    if (pthread_create(&tid[i], NULL, own_thread, &a[i]) != 0) break;
+    started = i;
+  }
+  run_jobs(l, 0);
+  for (int i = 1; i <= started; i++) pthread_join(tid[i], NULL);
 }
 
 void parallel_for(int njobs, int threads, parallel_fn fn, void *arg) {
   if (threads > njobs) threads = njobs;
   if (threads < 1) threads = 1;
-  pool p = {.njobs = njobs, .fn = fn, .arg = arg};
-  atomic_init(&p.next, 0);
-  pthread_t tid[256];
-  worker w[256];
-  if (threads > 256) threads = 256;
-  int started = 0;
-  for (int i = 1; i < threads; i++) {
-    w[i] = (worker){&p, i};
-    if (pthread_create(&tid[i], NULL, work, &w[i]) != 0) break; /* run with fewer */
-    started = i;
+  if (threads > MAX_THREADS) threads = MAX_THREADS;
+  loop l = {.njobs = njobs, .fn = fn, .arg = arg};
+  atomic_init(&l.next, 0);
+  if (threads == 1) {
+    run_jobs(&l, 0);
+    return;
   }
-  w[0] = (worker){&p, 0};
-  work(&w[0]);
-  for (int i = 1; i <= started; i++) pthread_join(tid[i], NULL);
+  if (pthread_mutex_trylock(&P.busy) != 0) {
+    run_own_threads(&l, threads);
+    return;
+  }
+  pthread_once(&atfork_once, register_atfork);
+  pthread_mutex_lock(&P.mu);
+  while (P.workers < threads - 1) {
+    pthread_t tid;
+    if (pthread_create(&tid, NULL, pool_worker, (void *)(intptr_t)(P.workers + 1)) != 0) break;
+    pthread_detach(tid);
+    P.workers++;
+  }
+  P.cur = &l, P.want = P.workers + 1 < threads ? P.workers + 1 : threads, P.running = P.want - 1, P.gen++;
+  pthread_cond_broadcast(&P.go);
+  pthread_mutex_unlock(&P.mu);
+  run_jobs(&l, 0);
+  pthread_mutex_lock(&P.mu);
+  while (P.running > 0) pthread_cond_wait(&P.done, &P.mu);
+  pthread_mutex_unlock(&P.mu);
+  pthread_mutex_unlock(&P.busy);
 }
 
 int cpu_count(void) {
   long n = sysconf(_SC_NPROCESSORS_ONLN);
   return n < 1 ? 1 : n > 256 ? 256 : (int)n;
+}
+
+double cpu_ms(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
 double now_ms(void) {

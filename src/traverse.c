@@ -173,13 +173,21 @@ static float computed_t_floor(float zmin, float mag, float vol) {
   return floor_t > 0 && isfinite(floor_t) ? floor_t : 0;
 }
 
-/* Triangle setup for a frustum: false when the triangle cannot cover a sample. */
-static bool prepare(const trav *t, uint32_t id, tri_job *j) {
-  if (tri_setup_planar(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED) return false;
-  if (!tri_screen_bounds(t->s, id, t->c, &j->ts, j->bb)) return false;
+/* Triangle setup for a frustum: false when the triangle cannot cover a sample.
+ * Planar cameras bound the triangle from its corners first (or take the bounds
+ * bb the caller found), so the many triangles that fall between samples cost no
+ * setup; S counts the setups done. */
+static bool prepare(trav *t, uint32_t id, const int *bb, tri_job *j) {
+  const camera *c = t->c;
+  if (c->planar) {
+    if (bb) memcpy(j->bb, bb, sizeof j->bb);
+    else if (!tri_screen_bounds(t->s, id, c, NULL, j->bb)) return false;
+  }
+  t->st.setups++;
+  if (tri_setup_planar(t->s, id, c, t->cull_back, &j->ts) == SETUP_CULLED) return false;
+  if (!c->planar && !tri_screen_bounds(t->s, id, c, &j->ts, j->bb)) return false;
   j->id = id;
   if (!t->o->binning) return true;
-  const camera *c = t->c;
   if (c->planar) {
     float zmin = INFINITY;
     unsigned inf = scene_inf(t->s, id); /* a point at infinity: +inf ahead, -inf behind */
@@ -219,8 +227,7 @@ static void draw(trav *t, const tri_job *j, tile_rect f) {
 
 static void rasterize(trav *t, uint32_t id, tile_rect f) {
   tri_job j;
-  t->st.setups++;
-  if (prepare(t, id, &j)) draw(t, &j, f);
+  if (prepare(t, id, NULL, &j)) draw(t, &j, f);
 }
 
 /* ---- frusta against boxes ---------------------------------------------- */
@@ -420,72 +427,116 @@ static void traverse(trav *t, const frustum *f, uint32_t node) {
 
 /* ---- driving it ------------------------------------------------------------ */
 
-typedef struct trav_job {
-  render_ctx *ctx;
-  const oracles *o;
-  int tile, tiles_x, frustum;
-  float *hiz;
-  uint8_t *dirty;
-  rr_stats st[256];
-  const tri_job *pre; /* root-only on several tiles: every triangle set up once, */
-  const uint32_t *start, *list; /* and tile k's triangles list[start[k] .. start[k+1]) */
-} trav_job;
-
-#define SETUP_CHUNK 16384
-
-typedef struct setup_job {
-  trav t;
-  tri_job *pre;
-  uint32_t n;
-} setup_job;
-
-/* Sets up a chunk of triangles; those that cover nothing get bb[0] = -1. */
-static void setup_chunk(int chunk, int thread, void *arg) {
-  (void)thread;
-  setup_job *sj = arg;
-  uint32_t end = (uint32_t)(chunk + 1) * SETUP_CHUNK < sj->n ? (uint32_t)(chunk + 1) * SETUP_CHUNK : sj->n;
-  for (uint32_t i = (uint32_t)chunk * SETUP_CHUNK; i < end; i++)
-    if (!prepare(&sj->t, i, &sj->pre[i])) sj->pre[i].bb[0] = -1;
+static void add_stats(rr_stats *to, const rr_stats *s) {
+  to->setups += s->setups, to->edge_evals += s->edge_evals, to->nodes += s->nodes;
+  to->bins += s->bins, to->bins_empty += s->bins_empty;
 }
 
-/* One job: a tile of the image, itself cut into the initial frusta. */
+/* generateSamples at the root is plain rasterization; on any number of threads it
+ * runs sort-middle, like the 2D pipeline: a batch of triangles is bounded and set
+ * up in parallel chunks, then drawn in parallel bands of rows. Each triangle is set
+ * up once, so S does not depend on the thread count. */
+#define ROOT_BATCH 131072/* triangles set up before they are drawn */
+#define ROOT_CHUNK 2048  /* triangles per setup job */
+
+typedef struct root_job {
+  trav proto;     /* the frame's settings; every job works on its own copy */
+  uint32_t first, count;
+  tri_job *jobs;  /* chunk k's set-up triangles, from jobs[k * ROOT_CHUNK], */
+  int (*rows)[2]; /* and their first and last rows, which the bands scan */
+  uint32_t kept[ROOT_BATCH / ROOT_CHUNK]; /* kept[k] of them */
+  int bands, block_rows;
+  rr_stats st[256];
+} root_job;
+
+static void root_setup(int k, int thread, void *arg) {
+  root_job *rj = arg;
+  trav t = rj->proto;
+  uint32_t i0 = rj->first + (uint32_t)k * ROOT_CHUNK, end = rj->first + rj->count;
+  uint32_t n = end - i0 < ROOT_CHUNK ? end - i0 : ROOT_CHUNK, kept = 0;
+  tri_job *out = rj->jobs + (size_t)k * ROOT_CHUNK;
+  if (t.c->planar) {
+    tri_bound b[ROOT_CHUNK];
+    uint32_t nb = tri_bounds_run(t.s, i0, n, t.c, t.simd, b);
+    for (uint32_t q = 0; q < nb; q++) kept += prepare(&t, b[q].id, b[q].bb, out + kept);
+  } else {
+    for (uint32_t i = i0; i < i0 + n; i++) kept += prepare(&t, i, NULL, out + kept);
+  }
+  int(*rows)[2] = rj->rows + (size_t)k * ROOT_CHUNK;
+  for (uint32_t q = 0; q < kept; q++) rows[q][0] = out[q].bb[1], rows[q][1] = out[q].bb[3];
+  rj->kept[k] = kept;
+  add_stats(&rj->st[thread], &t.st);
+}
+
+/* Draws the batch into band b: the blocks of rows k with k % bands == b. Blocks
+ * are whole z tiles and top-level bins, so no sample, z tile or bin has two
+ * writers and the stats do not depend on the blocks; dealt out round robin, they
+ * share the work of a batch whose triangles sit in a few rows of the image. */
+static void root_band(int b, int thread, void *arg) {
+  root_job *rj = arg;
+  trav t = rj->proto;
+  int w = t.vb->width, h = t.vb->height, rows = rj->block_rows;
+  int nchunks = (int)((rj->count + ROOT_CHUNK - 1) / ROOT_CHUNK);
+  for (int k = 0; k < nchunks; k++) {
+    const tri_job *j = rj->jobs + (size_t)k * ROOT_CHUNK;
+    const int(*yy)[2] = (const int(*)[2])rj->rows + (size_t)k * ROOT_CHUNK;
+    for (uint32_t q = 0; q < rj->kept[k]; q++) {
+      int k0 = yy[q][0] / rows, k1 = yy[q][1] / rows;
+      for (int blk = k0 + ((b - k0 % rj->bands) + rj->bands) % rj->bands; blk <= k1; blk += rj->bands) {
+        tile_rect r = {0, blk * rows, w, (blk + 1) * rows < h ? (blk + 1) * rows : h};
+        draw(&t, &j[q], r);
+      }
+    }
+  }
+  add_stats(&rj->st[thread], &t.st);
+}
+
+static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *proto) {
+  root_job *rj = calloc(1, sizeof *rj);
+  tri_job *jobs = malloc((size_t)ROOT_BATCH * sizeof *jobs);
+  int(*rows)[2] = malloc((size_t)ROOT_BATCH * sizeof *rows);
+  if (!rj || !jobs || !rows) {
+    free(rj), free(jobs), free(rows);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for triangle setups");
+  }
+  rj->proto = *proto, rj->jobs = jobs, rj->rows = rows;
+  const oracles *o = ctx->oracles;
+  int align = o->binning && o->bin_size > HIZ ? (o->bin_size + HIZ - 1) / HIZ * HIZ : HIZ;
+  rj->bands = ctx->threads;
+  rj->block_rows = ctx->threads > 1 ? align : ctx->vb->height;
+  uint32_t n = ctx->scene->ntris;
+  for (uint32_t first = 0; first < n; first += ROOT_BATCH) {
+    rj->first = first, rj->count = n - first < ROOT_BATCH ? n - first : ROOT_BATCH;
+    parallel_for((int)((rj->count + ROOT_CHUNK - 1) / ROOT_CHUNK), ctx->threads, root_setup, rj);
+    parallel_for(rj->bands, ctx->threads, root_band, rj);
+  }
+  for (int i = 0; i < 256; i++) add_stats(ctx->stats, &rj->st[i]);
+  free(jobs), free(rows), free(rj);
+  return RR_OK;
+}
+
+typedef struct trav_job {
+  trav proto;
+  int tile, tiles_x, frustum;
+  rr_stats st[256];
+} trav_job;
+
+/* One job: a tile of the image, cut into the initial frusta. */
 static void run_tile(int job, int thread, void *arg) {
   trav_job *tj = arg;
-  render_ctx *ctx = tj->ctx;
-  const visbuf *vb = ctx->vb;
+  trav t = tj->proto;
   int tx = job % tj->tiles_x, ty = job / tj->tiles_x;
   tile_rect r = {tx * tj->tile, ty * tj->tile, (tx + 1) * tj->tile, (ty + 1) * tj->tile};
-  if (r.x1 > vb->width) r.x1 = vb->width;
-  if (r.y1 > vb->height) r.y1 = vb->height;
-  trav t = {.s = ctx->scene,
-            .c = ctx->cam,
-            .o = tj->o,
-            .vb = ctx->vb,
-            .cull_back = ctx->opt->cull_backfaces != 0,
-            .simd = !ctx->opt->scalar,
-            .hiz = tj->hiz,
-            .dirty = tj->dirty,
-            .tiles_x = (vb->width + HIZ - 1) / HIZ,
-            .heat_e = ctx->heat_e,
-            .heat_n = ctx->heat_n};
-  if (!tj->o->leaves) {
-    /* generateSamples at the root: plain rasterization of every triangle in order */
-    if (tj->pre)
-      for (uint32_t k = tj->start[job]; k < tj->start[job + 1]; k++) draw(&t, &tj->pre[tj->list[k]], r);
-    else
-      for (uint32_t i = 0; i < ctx->scene->ntris; i++) rasterize(&t, i, r);
-  } else {
-    int fs = tj->frustum < tj->tile ? tj->frustum : tj->tile;
-    for (int y = r.y0; y < r.y1; y += fs)
-      for (int x = r.x0; x < r.x1; x += fs) {
-        tile_rect q = {x, y, x + fs < r.x1 ? x + fs : r.x1, y + fs < r.y1 ? y + fs : r.y1};
-        frustum f = make_frustum(ctx->cam, q);
-        traverse(&t, &f, 0);
-      }
-  }
-  rr_stats *s = &tj->st[thread];
-  s->setups += t.st.setups, s->edge_evals += t.st.edge_evals, s->nodes += t.st.nodes;
-  s->bins += t.st.bins, s->bins_empty += t.st.bins_empty;
+  if (r.x1 > t.vb->width) r.x1 = t.vb->width;
+  if (r.y1 > t.vb->height) r.y1 = t.vb->height;
+  int fs = tj->frustum < tj->tile ? tj->frustum : tj->tile;
+  for (int y = r.y0; y < r.y1; y += fs)
+    for (int x = r.x0; x < r.x1; x += fs) {
+      tile_rect q = {x, y, x + fs < r.x1 ? x + fs : r.x1, y + fs < r.y1 ? y + fs : r.y1};
+      frustum f = make_frustum(t.c, q);
+      traverse(&t, &f, 0);
+    }
+  add_stats(&tj->st[thread], &t.st);
 }
 
 rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
@@ -494,81 +545,46 @@ rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
   if (ctx->scene->ntris == 0) return RR_OK; /* nothing to see: the cleared buffer is the image */
   if (!ctx->scene->bvh && o->leaves)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "this method needs the scene's BVH (call rr_scene_commit)");
-  /* Initial frusta: the whole image on one thread (the paper's set-up), else
-   * tiles dealt out to the threads; frustum_size forces a tile size. */
-  int whole = vb->width > vb->height ? vb->width : vb->height;
-  int frustum = o->frustum_size > 0 ? o->frustum_size : whole;
-  /* Jobs are tiles aligned to the z tiles, so no z tile has two writers; a job
-   * holds one initial frustum, or several small ones. */
-  int tile = ctx->threads > 1 ? (frustum < 128 ? 128 : frustum) : (frustum < whole ? frustum : whole);
-  tile = (tile + HIZ - 1) / HIZ * HIZ;
-  trav_job *tj = calloc(1, sizeof *tj);
   int tiles_x = (vb->width + HIZ - 1) / HIZ, tiles_y = (vb->height + HIZ - 1) / HIZ;
-  if (tj) {
-    tj->hiz = malloc((size_t)tiles_x * tiles_y * sizeof *tj->hiz);
-    tj->dirty = malloc((size_t)tiles_x * tiles_y);
-  }
-  if (!tj || !tj->hiz || !tj->dirty) {
-    if (tj) free(tj->hiz), free(tj->dirty);
-    free(tj);
+  float *hiz = malloc((size_t)tiles_x * tiles_y * sizeof *hiz);
+  uint8_t *dirty = calloc((size_t)tiles_x * tiles_y, 1);
+  if (!hiz || !dirty) {
+    free(hiz), free(dirty);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the hierarchical z-buffer");
   }
-  for (int k = 0; k < tiles_x * tiles_y; k++) tj->hiz[k] = INFINITY, tj->dirty[k] = 0;
-  tj->ctx = ctx, tj->o = o, tj->tile = tile, tj->frustum = frustum, tj->tiles_x = (vb->width + tile - 1) / tile;
-  int njobs = tj->tiles_x * ((vb->height + tile - 1) / tile);
-  tri_job *pre = NULL;
-  uint32_t *start = NULL, *list = NULL;
-  if (!o->leaves && njobs > 1) {
-    /* Rasterization from the root on several tiles (sort-middle): set every triangle
-     * up once, in parallel, then give each tile the list of triangles whose bounds
-     * reach it, in scene order. */
-    uint32_t n = ctx->scene->ntris;
-    pre = malloc((size_t)n * sizeof *pre + 1);
-    start = calloc((size_t)njobs + 1, sizeof *start);
-    if (!pre || !start) {
-      free(pre), free(start), free(tj->hiz), free(tj->dirty), free(tj);
-      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %u triangle setups", n);
+  for (int k = 0; k < tiles_x * tiles_y; k++) hiz[k] = INFINITY;
+  trav proto = {.s = ctx->scene,
+                .c = ctx->cam,
+                .o = o,
+                .vb = ctx->vb,
+                .cull_back = ctx->opt->cull_backfaces != 0,
+                .simd = !ctx->opt->scalar,
+                .hiz = hiz,
+                .dirty = dirty,
+                .tiles_x = tiles_x,
+                .heat_e = ctx->heat_e,
+                .heat_n = ctx->heat_n};
+  rr_error err = RR_OK;
+  if (!o->leaves) {
+    err = rasterize_root(dev, ctx, &proto);
+  } else {
+    /* Initial frusta: the whole image on one thread (the paper's set-up), else
+     * tiles aligned to the z tiles dealt out to the threads (no z tile has two
+     * writers); frustum_size forces a tile size. */
+    trav_job *tj = calloc(1, sizeof *tj);
+    if (!tj) {
+      free(hiz), free(dirty);
+      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the traversal");
     }
-    setup_job sj = {.t = {.s = ctx->scene, .c = ctx->cam, .o = o, .vb = ctx->vb,
-                          .cull_back = ctx->opt->cull_backfaces != 0},
-                    .pre = pre,
-                    .n = n};
-    parallel_for((int)((n + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_chunk, &sj);
-    ctx->stats->setups += n;
-    uint64_t total = 0;
-    for (int pass = 0; pass < 2; pass++) {
-      if (pass == 1) {
-        for (int k = 0; k < njobs; k++) start[k + 1] += start[k];
-        total = start[njobs];
-        list = malloc(total * sizeof *list + 1);
-        if (!list) {
-          free(pre), free(start), free(tj->hiz), free(tj->dirty), free(tj);
-          return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %llu tile entries", (unsigned long long)total);
-        }
-      }
-      for (uint32_t i = 0; i < n; i++) {
-        const int *bb = pre[i].bb;
-        if (bb[0] < 0) continue;
-        for (int ty = bb[1] / tile; ty <= bb[3] / tile; ty++)
-          for (int tx = bb[0] / tile; tx <= bb[2] / tile; tx++) {
-            int k = ty * tj->tiles_x + tx;
-            if (pass == 0) start[k + 1]++;
-            else list[start[k]++] = i;
-          }
-      }
-    }
-    for (int k = njobs; k > 0; k--) start[k] = start[k - 1]; /* the fill advanced each start to the next's */
-    start[0] = 0;
-    tj->pre = pre, tj->start = start, tj->list = list;
+    int whole = vb->width > vb->height ? vb->width : vb->height;
+    int frustum = o->frustum_size > 0 ? o->frustum_size : whole;
+    int tile = ctx->threads > 1 ? (frustum < 128 ? 128 : frustum) : (frustum < whole ? frustum : whole);
+    tile = (tile + HIZ - 1) / HIZ * HIZ;
+    tj->proto = proto, tj->tile = tile, tj->frustum = frustum, tj->tiles_x = (vb->width + tile - 1) / tile;
+    parallel_for(tj->tiles_x * ((vb->height + tile - 1) / tile), ctx->threads, run_tile, tj);
+    for (int i = 0; i < 256; i++) add_stats(ctx->stats, &tj->st[i]);
+    free(tj);
   }
-  parallel_for(njobs, ctx->threads, run_tile, tj);
-  for (int i = 0; i < 256; i++) {
-    ctx->stats->setups += tj->st[i].setups;
-    ctx->stats->edge_evals += tj->st[i].edge_evals;
-    ctx->stats->nodes += tj->st[i].nodes;
-    ctx->stats->bins += tj->st[i].bins;
-    ctx->stats->bins_empty += tj->st[i].bins_empty;
-  }
-  free(pre), free(start), free(list), free(tj->hiz), free(tj->dirty), free(tj);
-  return RR_OK;
+  free(hiz), free(dirty);
+  return err;
 }

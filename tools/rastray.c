@@ -114,6 +114,11 @@ static int cmp_double(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
+static double median(double *v, int n) {
+  qsort(v, n, sizeof *v, cmp_double);
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 static double now_ms(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -276,7 +281,8 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   if (rr_camera_check(dev, &cam) != RR_OK) die(EXIT_USAGE, "%s", rr_device_message(dev));
   if (cube_dir && cam.type != RR_CAMERA_CUBE) die(EXIT_USAGE, "--cube-faces needs --camera cube");
 
-  double *times = malloc(sizeof(double) * repeat);
+  double *times = malloc(sizeof(double) * repeat), *cpus = malloc(sizeof(double) * repeat);
+  if (!times || !cpus) die(EXIT_INPUT, "out of memory for %d repeats", repeat);
   rr_frame *frame = NULL;
   for (int r = 0; r < repeat; r++) {
     rr_frame_release(frame);
@@ -284,11 +290,10 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
     if (e) die(e == RR_ERROR_ARGUMENT || e == RR_ERROR_UNSUPPORTED ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
     rr_stats st;
     rr_frame_get_stats(frame, &st);
-    times[r] = st.frame_ms;
+    times[r] = st.frame_ms, cpus[r] = st.cpu_ms;
   }
-  qsort(times, repeat, sizeof *times, cmp_double);
-  double frame_ms = repeat % 2 ? times[repeat / 2] : 0.5 * (times[repeat / 2 - 1] + times[repeat / 2]);
-  free(times);
+  double frame_ms = median(times, repeat), cpu_ms = median(cpus, repeat);
+  free(times), free(cpus);
 
   if (out || cube_dir) {
     rr_image img;
@@ -312,10 +317,10 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   int threads = st.threads;
   if (stats)
     fprintf(stderr,
-            "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f total_ms=%.1f "
+            "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f cpu_ms=%.3f total_ms=%.1f "
             "setups=%llu edge_evals=%llu nodes=%llu bins=%llu bins_empty=%llu\n",
-            method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, threads, frame_ms, total_ms,
-            (unsigned long long)st.setups, (unsigned long long)st.edge_evals, (unsigned long long)st.nodes,
+            method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, threads, frame_ms, cpu_ms,
+            total_ms, (unsigned long long)st.setups, (unsigned long long)st.edge_evals, (unsigned long long)st.nodes,
             (unsigned long long)st.bins, (unsigned long long)st.bins_empty);
   if (stats && st.why[0]) fprintf(stderr, "auto chose %s: %s\n", method, st.why);
   if (json) {
@@ -326,10 +331,10 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
     fprintf(f,
             "{\"scene\": \"%s\", \"method\": \"%s\", \"camera\": \"%s\", \"triangles\": %llu, "
             "\"skipped\": %llu, \"width\": %d, \"height\": %d, \"threads\": %d, \"repeat\": %d, "
-            "\"frame_ms\": %.3f, \"total_ms\": %.3f, \"setups\": %llu, \"edge_evals\": %llu, \"nodes\": %llu, "
+            "\"frame_ms\": %.3f, \"cpu_ms\": %.3f, \"total_ms\": %.3f, \"setups\": %llu, \"edge_evals\": %llu, \"nodes\": %llu, "
             "\"bins\": %llu, \"bins_empty\": %llu, \"auto\": \"%s\"}\n",
             scene_name, method, rr_camera_name(cam.type), (unsigned long long)info.triangles, (unsigned long long)info.skipped, opt.width,
-            opt.height, threads, repeat, frame_ms, total_ms, (unsigned long long)st.setups,
+            opt.height, threads, repeat, frame_ms, cpu_ms, total_ms, (unsigned long long)st.setups,
             (unsigned long long)st.edge_evals, (unsigned long long)st.nodes, (unsigned long long)st.bins,
             (unsigned long long)st.bins_empty, st.why);
     if (fclose(f) != 0 || rename(tmp, json) != 0) {
