@@ -231,16 +231,20 @@ __attribute__((target("avx2"))) static uint64_t raster_loop_avx2(const tri_setup
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), bias = _mm256_set1_epi32((int)0x80000000);
   const __m256i idv = _mm256_set1_epi32((int)id), id_biased = _mm256_xor_si256(idv, bias);
   uint64_t covered = 0;
-  for (int y = r[1]; y <= r[3]; y++) {
-    const __m256 sy = _mm256_set1_ps((float)y + 0.5f);
-    size_t row = (size_t)y * vb->width;
-    for (int x = r[0]; x <= r[2]; x += 8) {
-      __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(x), lane);
-      __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(r[2] + 1), xi);
-      __m256 sx = _mm256_add_ps(_mm256_cvtepi32_ps(xi), _mm256_set1_ps(0.5f));
-      __m256 ev[3], in = _mm256_castsi256_ps(valid);
+  /* Columns of 8 samples, then rows: the terms in sx are the same on every row. */
+  for (int x = r[0]; x <= r[2]; x += 8) {
+    __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(x), lane);
+    const __m256 valid = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(r[2] + 1), xi));
+    const __m256 sx = _mm256_add_ps(_mm256_cvtepi32_ps(xi), _mm256_set1_ps(0.5f));
+    __m256 ax[3];
+    for (int e = 0; e < 3; e++) ax[e] = _mm256_add_ps(_mm256_mul_ps(a[e], one), _mm256_mul_ps(b[e], sx));
+    const __m256 vx = _mm256_add_ps(vol, _mm256_mul_ps(sx, vol_x));
+    for (int y = r[1]; y <= r[3]; y++) {
+      const __m256 sy = _mm256_set1_ps((float)y + 0.5f);
+      size_t row = (size_t)y * vb->width;
+      __m256 ev[3], in = valid;
       for (int e = 0; e < 3; e++) {
-        ev[e] = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(a[e], one), _mm256_mul_ps(b[e], sx)), _mm256_mul_ps(c[e], sy));
+        ev[e] = _mm256_add_ps(ax[e], _mm256_mul_ps(c[e], sy));
         __m256 pos = _mm256_cmp_ps(ev[e], zero, _CMP_GT_OQ);
         __m256 on = _mm256_and_ps(_mm256_cmp_ps(ev[e], zero, _CMP_EQ_OQ), tie[e]);
         in = _mm256_and_ps(in, _mm256_or_ps(pos, on));
@@ -248,7 +252,7 @@ __attribute__((target("avx2"))) static uint64_t raster_loop_avx2(const tri_setup
       if (!_mm256_movemask_ps(in)) continue;
       __m256 sum = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ev[0], w0), _mm256_mul_ps(ev[1], w1)),
                                  _mm256_mul_ps(ev[2], w2));
-      __m256 v = _mm256_add_ps(_mm256_add_ps(vol, _mm256_mul_ps(sx, vol_x)), _mm256_mul_ps(sy, vol_y));
+      __m256 v = _mm256_add_ps(vx, _mm256_mul_ps(sy, vol_y));
       in = _mm256_and_ps(in, _mm256_and_ps(_mm256_cmp_ps(sum, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, zero, _CMP_GT_OQ)));
       int hit = _mm256_movemask_ps(in);
       if (!hit) continue;

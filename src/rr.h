@@ -248,6 +248,11 @@ enum { SETUP_CULLED = 0, SETUP_FRONT = 1, SETUP_BACK = 2 };
  * cull_backfaces is set). */
 int tri_setup_camera(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces, tri_setup *out);
 #define tri_setup_planar tri_setup_camera
+/* tri_setup_camera for triangles ids[0..n-1] into out[k], face[k]; with simd, eight
+ * at a time (AVX2) where the camera is perspective and no corner is at infinity,
+ * with the same bits. */
+void tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces, bool simd,
+                   tri_setup *out, int *face);
 
 /* The three edge functions of a set-up triangle for evaluation vector w. The
  * order of operations is fixed (the build uses -ffp-contract=off: a fused

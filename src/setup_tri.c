@@ -101,3 +101,103 @@ int tri_setup_camera(const rr_scene *s, uint32_t i, const camera *c, bool cull_b
   }
   return face;
 }
+
+/* ---- eight triangles at once --------------------------------------------- */
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+
+typedef struct v8 { __m256 x, y, z; } v8;
+
+#define AVX2 __attribute__((target("avx2"))) static inline
+AVX2 __m256 d8(v8 a, v8 b) {
+  return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(a.x, b.x), _mm256_mul_ps(a.y, b.y)), _mm256_mul_ps(a.z, b.z));
+}
+AVX2 v8 splat8(vec3 v) { return (v8){_mm256_set1_ps(v.x), _mm256_set1_ps(v.y), _mm256_set1_ps(v.z)}; }
+AVX2 v8 sub8(v8 a, v8 b) { return (v8){_mm256_sub_ps(a.x, b.x), _mm256_sub_ps(a.y, b.y), _mm256_sub_ps(a.z, b.z)}; }
+AVX2 v8 cross8(v8 a, v8 b) {
+  return (v8){_mm256_sub_ps(_mm256_mul_ps(a.y, b.z), _mm256_mul_ps(a.z, b.y)),
+              _mm256_sub_ps(_mm256_mul_ps(a.z, b.x), _mm256_mul_ps(a.x, b.z)),
+              _mm256_sub_ps(_mm256_mul_ps(a.x, b.y), _mm256_mul_ps(a.y, b.x))};
+}
+AVX2 v8 blend8(v8 a, v8 b, __m256 m) {
+  return (v8){_mm256_blendv_ps(a.x, b.x, m), _mm256_blendv_ps(a.y, b.y, m), _mm256_blendv_ps(a.z, b.z, m)};
+}
+AVX2 v8 scale8(v8 a, __m256 s) { return (v8){_mm256_mul_ps(a.x, s), _mm256_mul_ps(a.y, s), _mm256_mul_ps(a.z, s)}; }
+/* lex_less and lex_positive, lane by lane, with the scalar comparisons' NaN behaviour */
+AVX2 __m256 lex_less8(v8 a, v8 b) {
+  __m256 nx = _mm256_cmp_ps(a.x, b.x, _CMP_NEQ_UQ), ny = _mm256_cmp_ps(a.y, b.y, _CMP_NEQ_UQ);
+  __m256 tail = _mm256_blendv_ps(_mm256_cmp_ps(a.z, b.z, _CMP_LT_OQ), _mm256_cmp_ps(a.y, b.y, _CMP_LT_OQ), ny);
+  return _mm256_blendv_ps(tail, _mm256_cmp_ps(a.x, b.x, _CMP_LT_OQ), nx);
+}
+AVX2 __m256 lex_positive8(__m256 g1, __m256 g2, __m256 g3) {
+  const __m256 z = _mm256_setzero_ps();
+  __m256 t2 = _mm256_or_ps(_mm256_cmp_ps(g2, z, _CMP_GT_OQ),
+                           _mm256_and_ps(_mm256_cmp_ps(g2, z, _CMP_EQ_OQ), _mm256_cmp_ps(g3, z, _CMP_GT_OQ)));
+  return _mm256_or_ps(_mm256_cmp_ps(g1, z, _CMP_GT_OQ), _mm256_and_ps(_mm256_cmp_ps(g1, z, _CMP_EQ_OQ), t2));
+}
+
+/* tri_setup_camera for eight finite triangles and a perspective camera: the same
+ * operations in the same order, so the same bits. */
+__attribute__((target("avx2"))) static void setup8_avx2(const rr_scene *s, const uint32_t *ids, const camera *c,
+                                                         bool cull, tri_setup *out, int *face) {
+  __m256i idx = _mm256_loadu_si256((const __m256i *)ids);
+  v8 eye = splat8(c->eye), q[3];
+  for (int k = 0; k < 3; k++) {
+    v8 p = {_mm256_i32gather_ps(s->p[k][0], idx, 4), _mm256_i32gather_ps(s->p[k][1], idx, 4),
+            _mm256_i32gather_ps(s->p[k][2], idx, 4)};
+    q[k] = sub8(p, eye);
+  }
+  v8 n[3];
+  for (int e = 0; e < 3; e++) {
+    v8 a = q[(e + 1) % 3], b = q[(e + 2) % 3];
+    __m256 swap = lex_less8(b, a);
+    v8 l = blend8(a, b, swap), h = blend8(b, a, swap);
+    v8 m = cross8(h, sub8(l, h));
+    const __m256 sgn = _mm256_set1_ps(-0.0f); /* v3_neg flips the sign bit, zeros too */
+    v8 neg = {_mm256_xor_ps(m.x, sgn), _mm256_xor_ps(m.y, sgn), _mm256_xor_ps(m.z, sgn)};
+    n[e] = blend8(m, neg, swap);
+  }
+  __m256 vol = d8(q[0], n[0]);
+  const __m256 zero = _mm256_setzero_ps(), inf = _mm256_set1_ps(INFINITY);
+  __m256 absvol = _mm256_and_ps(vol, _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)));
+  __m256 seen = _mm256_and_ps(_mm256_cmp_ps(vol, zero, _CMP_NEQ_UQ), _mm256_cmp_ps(absvol, inf, _CMP_LT_OQ));
+  __m256 front = _mm256_cmp_ps(vol, zero, _CMP_GT_OQ);
+  __m256 sign = _mm256_blendv_ps(_mm256_set1_ps(-1.0f), _mm256_set1_ps(1.0f), front);
+  float a[3][8], b[3][8], cc[3][8], vs[8], vx[8];
+  int tie[8] = {0};
+  v8 d0 = splat8(c->d0), dx = splat8(c->dx), dy = splat8(c->dy), fwd = splat8(c->fwd);
+  for (int e = 0; e < 3; e++) {
+    v8 ne = scale8(n[e], sign);
+    __m256 ae = d8(ne, d0), be = d8(ne, dx), ce = d8(ne, dy);
+    _mm256_storeu_ps(a[e], ae), _mm256_storeu_ps(b[e], be), _mm256_storeu_ps(cc[e], ce);
+    int bits = _mm256_movemask_ps(lex_positive8(be, ce, d8(ne, fwd)));
+    for (int l = 0; l < 8; l++) tie[l] |= (bits >> l & 1) << e;
+  }
+  _mm256_storeu_ps(vs, _mm256_mul_ps(vol, sign));
+  _mm256_storeu_ps(vx, _mm256_mul_ps(zero, sign));
+  int seen_m = _mm256_movemask_ps(seen), front_m = _mm256_movemask_ps(front);
+  for (int l = 0; l < 8; l++) {
+    int f = !(seen_m >> l & 1) ? SETUP_CULLED : front_m >> l & 1 ? SETUP_FRONT : cull ? SETUP_CULLED : SETUP_BACK;
+    face[l] = f;
+    if (f == SETUP_CULLED) continue;
+    tri_setup *o = &out[l];
+    for (int e = 0; e < 3; e++) o->a[e] = a[e][l], o->b[e] = b[e][l], o->c[e] = cc[e][l];
+    o->vol = vs[l], o->vol_x = vx[l], o->vol_y = vx[l];
+    o->tie = (uint32_t)tie[l];
+    o->w[0] = o->w[1] = o->w[2] = 1.0f;
+  }
+}
+#endif
+
+void tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces, bool simd,
+                   tri_setup *out, int *face) {
+  int k = 0;
+#if defined(__x86_64__) || defined(__i386__)
+  if (simd && c->type == RR_CAMERA_PERSPECTIVE && !s->inf && __builtin_cpu_supports("avx2"))
+    for (; k + 8 <= n; k += 8) setup8_avx2(s, ids + k, c, cull_backfaces, out + k, face + k);
+#else
+  (void)simd;
+#endif
+  for (; k < n; k++) face[k] = tri_setup_camera(s, ids[k], c, cull_backfaces, &out[k]);
+}

@@ -173,21 +173,11 @@ static float computed_t_floor(float zmin, float mag, float vol) {
   return floor_t > 0 && isfinite(floor_t) ? floor_t : 0;
 }
 
-/* Triangle setup for a frustum: false when the triangle cannot cover a sample.
- * Planar cameras bound the triangle from its corners first (or take the bounds
- * bb the caller found), so the many triangles that fall between samples cost no
- * setup; S counts the setups done. */
-static bool prepare(trav *t, uint32_t id, const int *bb, tri_job *j) {
+/* Completes a set-up triangle j with what binning and early-z need. */
+static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
   const camera *c = t->c;
-  if (c->planar) {
-    if (bb) memcpy(j->bb, bb, sizeof j->bb);
-    else if (!tri_screen_bounds(t->s, id, c, NULL, j->bb)) return false;
-  }
-  t->st.setups++;
-  if (tri_setup_planar(t->s, id, c, t->cull_back, &j->ts) == SETUP_CULLED) return false;
-  if (!c->planar && !tri_screen_bounds(t->s, id, c, &j->ts, j->bb)) return false;
   j->id = id;
-  if (!t->o->binning) return true;
+  if (!t->o->binning) return;
   if (c->planar) {
     float zmin = INFINITY;
     unsigned inf = scene_inf(t->s, id); /* a point at infinity: +inf ahead, -inf behind */
@@ -213,6 +203,22 @@ static bool prepare(trav *t, uint32_t id, const int *bb, tri_job *j) {
     float mag = (j->cone.len[0] + j->cone.len[1] + j->cone.len[2]) * c->dir_len_max * 1.7321f;
     j->zmin = dist > 0 && isfinite(dist) ? computed_t_floor(dist / c->dir_len_max, mag, j->ts.vol) : 0;
   }
+}
+
+/* Triangle setup for a frustum: false when the triangle cannot cover a sample.
+ * Planar cameras bound the triangle from its corners first (or take the bounds
+ * bb the caller found), so the many triangles that fall between samples cost no
+ * setup; S counts the setups done. */
+static bool prepare(trav *t, uint32_t id, const int *bb, tri_job *j) {
+  const camera *c = t->c;
+  if (c->planar) {
+    if (bb) memcpy(j->bb, bb, sizeof j->bb);
+    else if (!tri_screen_bounds(t->s, id, c, NULL, j->bb)) return false;
+  }
+  t->st.setups++;
+  if (tri_setup_planar(t->s, id, c, t->cull_back, &j->ts) == SETUP_CULLED) return false;
+  if (!c->planar && !tri_screen_bounds(t->s, id, c, &j->ts, j->bb)) return false;
+  finish_setup(t, id, j);
   return true;
 }
 
@@ -456,9 +462,25 @@ static void root_setup(int k, int thread, void *arg) {
   uint32_t n = end - i0 < ROOT_CHUNK ? end - i0 : ROOT_CHUNK, kept = 0;
   tri_job *out = rj->jobs + (size_t)k * ROOT_CHUNK;
   if (t.c->planar) {
+    /* bounded from their corners, then the triangles that may cover a sample set
+     * up eight at a time */
     tri_bound b[ROOT_CHUNK];
     uint32_t nb = tri_bounds_run(t.s, i0, n, t.c, t.simd, b);
-    for (uint32_t q = 0; q < nb; q++) kept += prepare(&t, b[q].id, b[q].bb, out + kept);
+    t.st.setups += nb;
+    for (uint32_t q = 0; q < nb; q += 8) {
+      int m = nb - q < 8 ? (int)(nb - q) : 8, face[8];
+      uint32_t ids[8];
+      tri_setup ts[8];
+      for (int l = 0; l < m; l++) ids[l] = b[q + l].id;
+      tri_setup_run(t.s, ids, m, t.c, t.cull_back, t.simd, ts, face);
+      for (int l = 0; l < m; l++) {
+        if (face[l] == SETUP_CULLED) continue;
+        tri_job *j = out + kept++;
+        j->ts = ts[l];
+        memcpy(j->bb, b[q + l].bb, sizeof j->bb);
+        finish_setup(&t, ids[l], j);
+      }
+    }
   } else {
     for (uint32_t i = i0; i < i0 + n; i++) kept += prepare(&t, i, NULL, out + kept);
   }
