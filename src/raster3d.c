@@ -76,7 +76,7 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri
     if (!(v3_dot(q, c->fwd) > 0)) behind++;
     else if (camera_project(c, q, &sx, &sy) && isfinite(sx) && isfinite(sy)) {
       projected++;
-      x0 = fminf(x0, sx), x1 = fmaxf(x1, sx), y0 = fminf(y0, sy), y1 = fmaxf(y1, sy);
+      x0 = minf(x0, sx), x1 = maxf(x1, sx), y0 = minf(y0, sy), y1 = maxf(y1, sy); /* finite: no libm calls */
     }
   }
   if (!c->planar) {
@@ -91,9 +91,9 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri
     /* The margin covers the rounding of the projection and of the edge functions,
      * a few ulps of the larger coordinate; a whole pixel would double the area of
      * the small triangles of real meshes. */
-    float m = 1.0f / 64 + 1e-5f * fmaxf(fmaxf(fabsf(x0), fabsf(x1)), fmaxf(fabsf(y0), fabsf(y1)));
-    float lx = fmaxf(ceilf(x0 - 0.5f - m), 0.0f), hx = fminf(floorf(x1 - 0.5f + m), (float)(c->width - 1));
-    float ly = fmaxf(ceilf(y0 - 0.5f - m), 0.0f), hy = fminf(floorf(y1 - 0.5f + m), (float)(c->height - 1));
+    float m = 1.0f / 64 + 1e-5f * maxf(maxf(fabsf(x0), fabsf(x1)), maxf(fabsf(y0), fabsf(y1)));
+    float lx = maxf(ceilf(x0 - 0.5f - m), 0.0f), hx = minf(floorf(x1 - 0.5f + m), (float)(c->width - 1));
+    float ly = maxf(ceilf(y0 - 0.5f - m), 0.0f), hy = minf(floorf(y1 - 0.5f + m), (float)(c->height - 1));
     if (lx > hx || ly > hy) return false;
     r[0] = (int)lx, r[1] = (int)ly, r[2] = (int)hx, r[3] = (int)hy;
     return true;

@@ -67,15 +67,13 @@ static float hiz_tile(trav *t, int tx, int ty) {
   return t->hiz[k];
 }
 
-/* The farthest depth stored in a rectangle (aligned to HIZ tiles, or inside one). */
-static float hiz_max(trav *t, tile_rect r) {
-  float m = 0;
+/* Is every depth stored in the z tiles of a rectangle nearer than z? Most
+ * queries are answered no by the first tile, so it stops there. */
+static bool hiz_nearer(trav *t, tile_rect r, float z) {
   for (int ty = r.y0 / HIZ; ty <= (r.y1 - 1) / HIZ; ty++)
-    for (int tx = r.x0 / HIZ; tx <= (r.x1 - 1) / HIZ; tx++) {
-      m = maxf(m, hiz_tile(t, tx, ty));
-      if (m == INFINITY) return m;
-    }
-  return m;
+    for (int tx = r.x0 / HIZ; tx <= (r.x1 - 1) / HIZ; tx++)
+      if (!(hiz_tile(t, tx, ty) < z)) return false;
+  return true;
 }
 
 static void mark_dirty(trav *t, tile_rect r) {
@@ -151,7 +149,7 @@ static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
         }
       }
       if (out) continue;
-      if (t->o->early_z && j->zmin > hiz_max(t, b)) continue;
+      if (t->o->early_z && hiz_nearer(t, b, j->zmin)) continue;
       /* refined: count the bins that turn out to hold none of the triangle */
       uint64_t in = bin_raster(t, j, b, size / 4 > 1 ? size / 4 : 1);
       t->st.bins++;
@@ -240,9 +238,8 @@ static void rasterize(trav *t, uint32_t id, tile_rect f) {
 
 typedef struct frustum {
   tile_rect r;
-  int nplanes;       /* planar cameras: inward side planes n·p + off >= 0 */
-  vec3 plane[4];
-  float off[4];
+  int nplanes;       /* planar cameras: inward side planes n·p + off >= 0, */
+  float nx[4], ny[4], nz[4], off[4]; /* stored by component for the box test */
   int has_cone;      /* curved cameras: 1 with a cone of the frustum's directions, -1 without rays */
   vec3 axis;
   float angle;
@@ -250,30 +247,34 @@ typedef struct frustum {
   vec3 origin, dir;
 } frustum;
 
+static void set_plane(frustum *f, int i, vec3 n, vec3 point) {
+  f->nx[i] = n.x, f->ny[i] = n.y, f->nz[i] = n.z, f->off[i] = -v3_dot(n, point);
+}
+
 static frustum make_frustum(const camera *c, tile_rect r) {
   frustum f = {.r = r};
   f.has_ray = camera_ray(c, (r.x0 + r.x1 - 1) / 2, (r.y0 + r.y1 - 1) / 2, &f.origin, &f.dir);
   if (c->type == RR_CAMERA_PERSPECTIVE) {
     /* Planes through the eye and the outer pixel edges: half a pixel beyond the
-     * outer sample centres, conservative for every sample. */
+     * outer sample centres, conservative for every sample. With rays
+     * d = d0 + x·dx + y·dy, the plane of column x has normal (d0 + x·dx) × dy, and
+     * its dot with d(x', y) is det(dx, dy, d0)·(x - x'); rows likewise. */
     float x0 = (float)r.x0, x1 = (float)r.x1, y0 = (float)r.y0, y1 = (float)r.y1;
-    vec3 d00 = camera_dir(c, x0, y0), d10 = camera_dir(c, x1, y0), d11 = camera_dir(c, x1, y1),
-         d01 = camera_dir(c, x0, y1), centre = camera_dir(c, 0.5f * (x0 + x1), 0.5f * (y0 + y1));
-    vec3 n[4] = {v3_cross(d00, d10), v3_cross(d10, d11), v3_cross(d11, d01), v3_cross(d01, d00)};
+    float s = v3_dot(v3_cross(c->dx, c->dy), c->d0) > 0 ? 1.0f : -1.0f;
+    vec3 col0 = v3_cross(c->d0, c->dy), col1 = v3_cross(c->dx, c->dy);
+    vec3 row0 = v3_cross(c->d0, c->dx), row1 = v3_cross(c->dy, c->dx);
     f.nplanes = 4;
-    for (int i = 0; i < 4; i++) {
-      f.plane[i] = v3_dot(n[i], centre) < 0 ? v3_neg(n[i]) : n[i];
-      f.off[i] = -v3_dot(f.plane[i], c->eye);
-    }
+    set_plane(&f, 0, v3_scale(v3_add(col0, v3_scale(col1, x0)), -s), c->eye);
+    set_plane(&f, 1, v3_scale(v3_add(col0, v3_scale(col1, x1)), s), c->eye);
+    set_plane(&f, 2, v3_scale(v3_add(row0, v3_scale(row1, y0)), s), c->eye);
+    set_plane(&f, 3, v3_scale(v3_add(row0, v3_scale(row1, y1)), -s), c->eye);
   } else if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
     /* Parallel rays: a box-shaped prism along fwd over the rectangle's origins. */
     vec3 lo = v3_add(c->eye, v3_add(c->o0, v3_add(v3_scale(c->ox, (float)r.x0), v3_scale(c->oy, (float)r.y0))));
     vec3 hi = v3_add(c->eye, v3_add(c->o0, v3_add(v3_scale(c->ox, (float)r.x1), v3_scale(c->oy, (float)r.y1))));
     f.nplanes = 4;
-    f.plane[0] = c->right, f.off[0] = -v3_dot(c->right, lo);
-    f.plane[1] = v3_neg(c->right), f.off[1] = v3_dot(c->right, hi);
-    f.plane[2] = c->up, f.off[2] = -v3_dot(c->up, hi);
-    f.plane[3] = v3_neg(c->up), f.off[3] = v3_dot(c->up, lo);
+    set_plane(&f, 0, c->right, lo), set_plane(&f, 1, v3_neg(c->right), hi);
+    set_plane(&f, 2, c->up, hi), set_plane(&f, 3, v3_neg(c->up), lo);
   } else {
     f.has_cone = camera_rect_cone(c, r.x0, r.y0, r.x1, r.y1, &f.axis, &f.angle);
   }
@@ -291,6 +292,22 @@ static float box_max_plane(const bvh_node *b, vec3 n, float off, float *mag) {
   }
   *mag = s;
   return m;
+}
+
+/* box_max_plane for the four side planes at once (the loop vectorises): does the
+ * box lie wholly outside one of them? */
+static bool box_outside_sides(const frustum *f, const bvh_node *b) {
+  float m[4], s[4];
+  for (int i = 0; i < 4; i++) {
+    float lx = f->nx[i] * b->lo[0], hx = f->nx[i] * b->hi[0];
+    float ly = f->ny[i] * b->lo[1], hy = f->ny[i] * b->hi[1];
+    float lz = f->nz[i] * b->lo[2], hz = f->nz[i] * b->hi[2];
+    m[i] = f->off[i] + maxf(lx, hx) + maxf(ly, hy) + maxf(lz, hz);
+    s[i] = fabsf(f->off[i]) + (fabsf(lx) + fabsf(hx)) + (fabsf(ly) + fabsf(hy)) + (fabsf(lz) + fabsf(hz));
+  }
+  bool out = false;
+  for (int i = 0; i < 4; i++) out |= m[i] < -1e-5f * s[i];
+  return out;
 }
 
 /* A lower bound of the ray parameter t of any hit inside the box, in the units of
@@ -335,12 +352,8 @@ static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
   /* A frustum of one sample is its ray: the classic ray-box test. */
   if (f->r.x1 - f->r.x0 == 1 && f->r.y1 - f->r.y0 == 1) return !centre_hits(f, b);
   float mag;
-  if (f->nplanes) {
-    if (box_max_plane(b, c->fwd, -v3_dot(c->fwd, c->eye), &mag) <= -1e-6f * mag) return true;
-    for (int i = 0; i < f->nplanes; i++)
-      if (box_max_plane(b, f->plane[i], f->off[i], &mag) < -1e-5f * mag) return true;
-    return false;
-  }
+  if (f->nplanes) return box_max_plane(b, c->fwd, -v3_dot(c->fwd, c->eye), &mag) <= -1e-6f * mag ||
+                        box_outside_sides(f, b);
   if (f->has_cone <= 0) return f->has_cone < 0;
   /* the box's bounding sphere against the cone */
   vec3 lo = v3_load(b->lo), hi = v3_load(b->hi);
@@ -369,9 +382,14 @@ static bool should_split(const trav *t, const frustum *f, const bvh_node *b) {
   return px * px < o->split_ratio * (float)w * (float)h; /* box size in pixels, squared */
 }
 
-bool oracle_occluded(const camera *c, const bvh_node *b, float farthest) {
+/* The depth in front of which a hit inside box b may lie (0: anywhere). */
+static float occlusion_depth(const camera *c, const bvh_node *b) {
   float z = box_tmin(b, c);
-  return z > 0 && z * (1 - DEPTH_MARGIN) > farthest;
+  return z > 0 ? z * (1 - DEPTH_MARGIN) : 0;
+}
+
+bool oracle_occluded(const camera *c, const bvh_node *b, float farthest) {
+  return farthest < occlusion_depth(c, b);
 }
 
 bool oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bvh_node *b) {
@@ -415,7 +433,7 @@ static void traverse(trav *t, const frustum *f, uint32_t node) {
   t->st.nodes++;
   charge(t->heat_n, t->vb->width, f->r, 1.0f);
   if (o->cull_outside && is_outside(f, n, t->c)) return;
-  if (o->cull_occluded && oracle_occluded(t->c, n, hiz_max(t, f->r))) return;
+  if (o->cull_occluded && hiz_nearer(t, f->r, occlusion_depth(t->c, n))) return;
   if (should_split(t, f, n)) {
     split(t, f, node);
     return;
