@@ -3,9 +3,11 @@
  * scene, camera, resolution and threads, in the same run), the ratio of each to
  * llvmpipe, and how often their triangle ids agree with llvmpipe's and 3dr-bb's.
  *
- * Methods are timed in interleaved rounds (median per method).
+ * Methods are timed in interleaved rounds (median per method). --instructions:
+ * instead, the instructions of one frame of each, counted by running this again
+ * under callgrind (use a smaller --size).
  *
- * usage: bench_raster [--size N|WxH] [--threads N] [--reps N] [--cull] [SCENE...]
+ * usage: bench_raster [--size N|WxH] [--threads N] [--reps N] [--cull] [--instructions] [SCENE...]
  * SCENE: a built-in name, a path, or a file of the shared model directory
  * (default: stanford-bunny.obj ogre.obj nefertiti.obj grid:teapot.obj:19). */
 #include "benchutil.h"
@@ -43,12 +45,13 @@ static double same_hits(const uint32_t *a, const uint32_t *b, size_t n) {
 }
 
 static void usage(void) {
-  fprintf(stderr, "usage: bench_raster [--size N|WxH] [--threads N] [--reps N] [--cull] [SCENE...]\n");
+  fprintf(stderr, "usage: bench_raster [--size N|WxH] [--threads N] [--reps N] [--cull] [--instructions] [SCENE...]\n");
   exit(2);
 }
 
 int main(int argc, char **argv) {
   int w = 1024, h = 1024, threads = 1, reps = 7, cull = 0;
+  bool count = false; /* under callgrind for --instructions */
   const char *scenes[64];
   int nscenes = 0;
   for (int i = 1; i < argc; i++) {
@@ -61,6 +64,8 @@ int main(int argc, char **argv) {
       reps = atoi(argv[++i]);
     } else if (strcmp(a, "--cull") == 0) {
       cull = 1;
+    } else if (strcmp(a, "--instructions") == 0) {
+      count = true;
     } else if (a[0] == '-' || nscenes == 64) {
       usage();
     } else {
@@ -68,7 +73,9 @@ int main(int argc, char **argv) {
     }
   }
   if (w < 1 || h < 1 || threads < 1 || threads > 256 || reps < 1) usage();
+  if (count && !bench_on_valgrind()) return bench_instructions_main(argv);
   if (reps < 5) reps = 5; /* a median of at least five */
+  if (count) reps = 1;    /* round 0 warms up, round 1 is counted */
   if (reps > 64) reps = 64;
   if (nscenes == 0) {
     static const char *defaults[] = {"stanford-bunny.obj", "ogre.obj", "nefertiti.obj", "grid:teapot.obj:19"};
@@ -116,7 +123,12 @@ int main(int argc, char **argv) {
     for (int rep = 0; rep <= reps; rep++) {
       for (int m = 0; m < NMETHODS; m++) {
         rr_frame_release(frames[m]);
-        if (rr_render(dev, s, &cam, &opt[m], &frames[m]) != RR_OK) {
+        char part[160];
+        snprintf(part, sizeof part, "%s %s", scenes[si], rr_method_name(methods[m]));
+        if (count && rep) bench_count_start();
+        rr_error e = rr_render(dev, s, &cam, &opt[m], &frames[m]);
+        if (count && rep) bench_count_stop(part);
+        if (e != RR_OK) {
           fprintf(stderr, "bench_raster: %s\n", rr_device_message(dev));
           return 1;
         }
@@ -126,7 +138,11 @@ int main(int argc, char **argv) {
       }
 #ifdef RR_HAVE_OSMESA
       if (have_gl) {
+        char part[160];
+        snprintf(part, sizeof part, "%s llvmpipe", scenes[si]);
+        if (count && rep) bench_count_start();
         double ms = osmesa_render(gl, &cam, cull, 1);
+        if (count && rep) bench_count_stop(part);
         if (rep) t[NMETHODS][rep - 1] = ms;
       }
 #endif

@@ -4,12 +4,14 @@
  * packets), in one process, on the same scene, camera and thread count.
  *
  *   bench_rc [SCENE...] [--threads N]... [--method NAME]... [--reps N] [--size WxH]
- *            [--quality medium|high]
+ *            [--quality medium|high] [--instructions]
  *
  * Per mode: build ms, frame ms (median of --reps, default 5), Mrays/s, time ratio
  * to Embree's rtcIntersect1 (frame; build for the build column), agreement with
  * Embree's rtcIntersect1 (same hit/miss; depth within 1e-4 relative where both
- * hit; same triangle) and whether the visibility buffer is bit-identical to 3dr-bb. */
+ * hit; same triangle) and whether the visibility buffer is bit-identical to 3dr-bb.
+ * --instructions: instead, the instructions of one frame (or cast) of each mode,
+ * counted by running this again under callgrind (use a smaller --size). */
 #include "benchutil.h"
 #include "rr.h"
 #ifdef RR_HAVE_EMBREE
@@ -21,6 +23,7 @@
 
 typedef struct {
   int reps, w, h, quality;
+  bool count; /* under callgrind for --instructions: count one frame per mode */
   int threads[8], nthreads;
   int methods[RR_METHOD_COUNT], nmethods;
 } bench_rc_opts;
@@ -73,12 +76,18 @@ static void bench_rc_scene(rr_device *dev, const char *name, const bench_rc_opts
       have_embree = true;
       const int widths[2] = {1, 8};
       for (int wi = 0; wi < 2; wi++) {
+        char mode[64], part[160];
+        snprintf(mode, sizeof mode, "embree-%d (%s)", widths[wi], o->quality >= 2 ? "high" : "medium");
+        snprintf(part, sizeof part, "%s %dt %s", name, threads, mode);
         double t[64];
-        for (int r = 0; r < o->reps; r++) t[r] = peer_embree_cast(e, &c, widths[wi], threads, eids, et);
+        if (o->count) peer_embree_cast(e, &c, widths[wi], threads, eids, et); /* warm-up, as bench_count_frame */
+        for (int r = 0; r < o->reps; r++) {
+          if (o->count) bench_count_start(); /* the single rep under callgrind */
+          t[r] = peer_embree_cast(e, &c, widths[wi], threads, eids, et);
+          if (o->count) bench_count_stop(part);
+        }
         double ms = bench_median(t, o->reps);
         if (wi == 0) emb_ms = ms;
-        char mode[64];
-        snprintf(mode, sizeof mode, "embree-%d (%s)", widths[wi], o->quality >= 2 ? "high" : "medium");
         bench_rc_row(mode, wi == 0 ? emb_build : -1, 0, ms, emb_ms, o->w, o->h, NULL, NULL);
       }
       /* Keep rtcIntersect1's result as the reference. */
@@ -92,7 +101,10 @@ static void bench_rc_scene(rr_device *dev, const char *name, const bench_rc_opts
       rr_render_options_init(&opt);
       opt.method = (rr_method)o->methods[mi], opt.width = o->w, opt.height = o->h, opt.threads = threads;
       rr_frame *f = NULL;
-      double ms = bench_render(dev, s, &cam, &opt, o->reps, &f);
+      char part[160];
+      snprintf(part, sizeof part, "%s %dt %s", name, threads, rr_method_name(opt.method));
+      double ms = o->count ? bench_count_frame(dev, s, &cam, &opt, part, &f)
+                           : bench_render(dev, s, &cam, &opt, o->reps, &f);
       const uint32_t *ids = rr_frame_ids(f);
       const float *t = rr_frame_t(f);
       bench_agreement a;
@@ -129,12 +141,15 @@ int main(int argc, char **argv) {
     else if (strcmp(a, "--reps") == 0 && v) o.reps = atoi(v), i++;
     else if (strcmp(a, "--size") == 0 && v && sscanf(v, "%dx%d", &o.w, &o.h) == 2) i++;
     else if (strcmp(a, "--quality") == 0 && v) o.quality = strcmp(v, "high") == 0 ? 2 : 1, i++;
+    else if (strcmp(a, "--instructions") == 0) o.count = true;
     else if (a[0] == '-') {
       fprintf(stderr, "usage: bench_rc [SCENE...] [--threads N]... [--method NAME]... [--reps N] [--size WxH] "
-                      "[--quality medium|high]\n");
+                      "[--quality medium|high] [--instructions]\n");
       return 2;
     } else if (nscenes < 64) scenes[nscenes++] = a;
   }
+  if (o.count && !bench_on_valgrind()) return bench_instructions_main(argv);
+  if (o.count) o.reps = 1;
   if (o.reps < 1) o.reps = 1;
   if (o.reps > 64) o.reps = 64;
   if (o.w < 1 || o.h < 1 || o.w > RR_MAX_SIZE || o.h > RR_MAX_SIZE) o.w = o.h = 1024;

@@ -31,4 +31,45 @@ bench_agreement bench_compare(const uint32_t *id_a, const float *depth_a, const 
                               size_t n);
 /* Eye distances of a frame (t times the length of each sample's ray direction). */
 float *bench_depths(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_frame *frame);
+
+/* ---- memory -------------------------------------------------------------- */
+
+/* Bytes malloc has handed out and not taken back, over all arenas and mmapped
+ * chunks (mallinfo2): what a data structure holds, to the byte, when measured
+ * before and after making it. Blind to memory mapped without malloc. */
+double bench_heap_bytes(void);
+/* Gives freed memory back to the system and restarts the kernel's peak resident
+ * set (/proc/self/clear_refs), so that bench_rss_peak() then reports the most
+ * memory resident above this point. False when the restart is not allowed. */
+bool bench_rss_mark(void);
+/* Bytes of the peak resident set since bench_rss_mark above the resident set at
+ * the mark; page-granular, and counts every allocator, thread stack and mapping. */
+double bench_rss_peak(void);
+
+/* ---- instruction counts (valgrind's callgrind) --------------------------- */
+
+/* Whether this process runs under valgrind (false when built without its headers). */
+bool bench_on_valgrind(void);
+/* bench_render's counterpart under callgrind: renders one frame to warm up, then
+ * one more whose instructions callgrind counts and dumps as a part named `name`
+ * (nothing is counted outside callgrind). Returns that frame's ms (meaningless under
+ * valgrind); *out keeps the frame. Exits on failure. */
+double bench_count_frame(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
+                         const char *name, rr_frame **out);
+/* The same around any code: zero and start counting, then stop and dump as `name`. */
+void bench_count_start(void);
+void bench_count_stop(const char *name);
+/* Runs this program's executable with argv[1..] under callgrind, instrumentation off
+ * until bench_count_start, its stdout discarded (timings under valgrind mean
+ * nothing); the parts go to a new directory whose path is written to dir.
+ * Returns the exit status, or -1 when valgrind could not be started. */
+int bench_callgrind_run(char *const argv[], char *dir, size_t dir_size);
+/* Calls fn(name, instructions, arg) for each part a callgrind run dumped in dir;
+ * returns how many there were. */
+int bench_callgrind_parts(const char *dir, void (*fn)(const char *name, uint64_t instructions, void *arg),
+                          void *arg);
+/* --instructions of a benchmark program not under valgrind: runs it again under
+ * callgrind (where it counts one frame per method with bench_count_*), then
+ * prints every part and its instructions. Returns the exit code for main. */
+int bench_instructions_main(char *const argv[]);
 #endif

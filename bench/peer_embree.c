@@ -2,13 +2,26 @@
 #include "peer_embree.h"
 
 #include <embree3/rtcore.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
 
 struct peer_embree {
   RTCDevice dev;
   RTCScene scene;
+  atomic_llong bytes, peak; /* reported by Embree's memory monitor, from any of its threads */
+  peer_embree_memory mem;
 };
+
+/* Embree calls this before each allocation (bytes > 0) and after each release (< 0). */
+static bool embree_monitor(void *user, ssize_t bytes, bool post) {
+  (void)post;
+  peer_embree *e = user;
+  long long now = atomic_fetch_add(&e->bytes, bytes) + bytes, peak = atomic_load(&e->peak);
+  while (now > peak && !atomic_compare_exchange_weak(&e->peak, &peak, now)) {
+  }
+  return true; /* never refuse an allocation */
+}
 
 static void embree_error(void *user, enum RTCError code, const char *msg) {
   (void)user;
@@ -27,6 +40,7 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
     return NULL;
   }
   rtcSetDeviceErrorFunction(e->dev, embree_error, NULL);
+  rtcSetDeviceMemoryMonitorFunction(e->dev, embree_monitor, e);
   /* One vertex per triangle corner, so triangle i has Embree primID i. */
   RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
   float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
@@ -49,11 +63,17 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
   rtcSetSceneBuildQuality(e->scene, quality >= 2 ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
   rtcAttachGeometry(e->scene, g);
   rtcReleaseGeometry(g);
+  long long before = atomic_load(&e->bytes);
+  atomic_store(&e->peak, before);
   double t0 = now_ms();
   rtcCommitScene(e->scene);
   *build_ms = now_ms() - t0;
+  long long after = atomic_load(&e->bytes);
+  e->mem = (peer_embree_memory){(double)after, (double)(after - before), (double)atomic_load(&e->peak)};
   return e;
 }
+
+peer_embree_memory peer_embree_bytes(const peer_embree *e) { return e->mem; }
 
 void peer_embree_release(peer_embree *e) {
   if (!e) return;

@@ -12,6 +12,13 @@ typedef struct peer_embree peer_embree;
  * NULL (and a message on stderr) on failure. */
 peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double *build_ms);
 void peer_embree_release(peer_embree *e);
+/* Embree's own account of its memory (its memory monitor callback), in bytes:
+ * what the scene holds after rtcCommitScene (geometry buffers and BVH), the part
+ * the commit added (the BVH), and the most it held during the commit. */
+typedef struct {
+  double scene, bvh, build_peak;
+} peer_embree_memory;
+peer_embree_memory peer_embree_bytes(const peer_embree *e);
 /* Casts one primary ray per pixel of camera c: width = 1 uses rtcIntersect1,
  * width = 8 rtcIntersect8 on 2x4-pixel packets; tiles dealt to `threads` threads.
  * Writes ids (RR_MISS on a miss) and t (+inf on a miss) in rastray's layout and
