@@ -594,6 +594,17 @@ static bool collapse_wide(rr_bvh *b) {
   uint32_t next = 1;
   collapse_node(b, 0, 0, &next);
   b->nwide = next;
+  /* about half of the room is used: keep what is */
+  bvh_wide *exact = aligned_alloc(64, (size_t)next * sizeof(bvh_wide));
+  uint32_t *exact_node = malloc((size_t)next * 4 * sizeof(uint32_t));
+  if (exact && exact_node) {
+    memcpy(exact, b->wide, (size_t)next * sizeof(bvh_wide));
+    memcpy(exact_node, b->wide_node, (size_t)next * 4 * sizeof(uint32_t));
+    free(b->wide), free(b->wide_node);
+    b->wide = exact, b->wide_node = exact_node;
+  } else {
+    free(exact), free(exact_node);
+  }
   return true;
 }
 
@@ -790,6 +801,7 @@ rr_error rr_scene_commit(rr_scene *s) {
   rr_build_options opt;
   rr_build_options_init(&opt);
   if (s->dev) opt = s->dev->build;
+  scene_trim(s);
   struct rr_bvh *b;
   rr_error e = bvh_build(s, &opt, &b);
   if (e) return e;

@@ -281,13 +281,15 @@ __attribute__((target("avx2"))) static uint64_t raster_loop_avx2(const tri_setup
 /* Tests every sample of rectangle r against one triangle; returns the evaluations. */
 uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb,
                      uint64_t *covered, bool simd) {
-  uint64_t n;
+  uint64_t n, samples = (uint64_t)(r[2] - r[0] + 1) * (uint64_t)(r[3] - r[1] + 1);
 #if defined(__x86_64__) || defined(__i386__)
-  if (simd && c->planar && __builtin_cpu_supports("avx2")) n = raster_loop_avx2(ts, id, r, vb);
+  /* a rectangle of a few samples (most triangles of a detailed mesh) costs less
+   * than the vector loop's setup; both paths give the same bits */
+  if (simd && c->planar && samples > 2 && __builtin_cpu_supports("avx2")) n = raster_loop_avx2(ts, id, r, vb);
   else
 #endif
     n = c->planar ? raster_loop(ts, id, r, c, vb, true) : raster_loop(ts, id, r, c, vb, false);
   (void)simd;
   if (covered) *covered += n;
-  return (uint64_t)(r[2] - r[0] + 1) * (uint64_t)(r[3] - r[1] + 1);
+  return samples;
 }

@@ -98,6 +98,8 @@ vec3 scene_tri_normal(const rr_scene *s, uint32_t i);
 
 /* Grows the scene to hold `more` triangles; with_normals/with_uvs allocate those arrays. */
 rr_error scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_uvs);
+/* Gives back the room reserve doubled into (at commit: the scene is complete). */
+void scene_trim(rr_scene *s);
 /* Appends one triangle (positions, optional corner normals/uvs); drops and counts
  * degenerate or non-finite ones. Returns true when kept. */
 bool scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv)[2], uint32_t mat);

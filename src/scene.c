@@ -32,6 +32,8 @@ void rr_scene_release(rr_scene *s) {
   free(s);
 }
 
+static bool resize(rr_scene *s, uint32_t cap, bool add_n, bool add_uv);
+
 static bool grow(float **arr, uint32_t cap) {
   float *p = realloc(*arr, (size_t)cap * sizeof **arr);
   if (!p) return false;
@@ -52,6 +54,17 @@ rr_error scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_
     while (cap < need) cap = cap > UINT32_MAX / 2 ? UINT32_MAX - 1 : cap * 2;
   }
   if (cap == s->cap && !add_n && !add_uv) return RR_OK;
+  if (!resize(s, cap, add_n, add_uv))
+    return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for %llu triangles", (unsigned long long)need);
+  return RR_OK;
+}
+
+void scene_trim(rr_scene *s) {
+  if (s->ntris && s->ntris < s->cap) resize(s, s->ntris, false, false); /* on failure the arrays stay as they were */
+}
+
+/* Every per-triangle array to cap entries; add_n / add_uv start those arrays. */
+static bool resize(rr_scene *s, uint32_t cap, bool add_n, bool add_uv) {
   bool ok = true;
   for (int k = 0; k < 3; k++) {
     for (int c = 0; c < 3; c++) {
@@ -76,10 +89,10 @@ rr_error scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_
     ok = f != NULL;
   }
   uint32_t *m = ok ? realloc(s->material, (size_t)cap * sizeof *m) : NULL;
-  if (!m) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for %llu triangles", (unsigned long long)need);
+  if (!m) return false;
   s->material = m;
   s->cap = cap;
-  return RR_OK;
+  return true;
 }
 
 static bool finite3(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }

@@ -34,6 +34,7 @@ typedef struct trav {
   const oracles *o;
   visbuf *vb;
   bool cull_back, simd;
+  bool hiz_used;     /* occlusion culling or early-z read the z tiles: keep them current */
   float *hiz;        /* per HIZ×HIZ tile: the farthest t stored (recomputed when dirty) */
   uint8_t *dirty;
   int tiles_x;
@@ -99,7 +100,7 @@ static uint64_t raster_samples(trav *t, const tri_job *j, tile_rect r) {
   uint64_t covered = 0;
   t->st.edge_evals += raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd);
   charge(t->heat_e, t->vb->width, r, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
-  mark_dirty(t, r);
+  if (t->hiz_used) mark_dirty(t, r);
   return covered;
 }
 
@@ -599,6 +600,7 @@ rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
                 .vb = ctx->vb,
                 .cull_back = ctx->opt->cull_backfaces != 0,
                 .simd = !ctx->opt->scalar,
+                .hiz_used = o->cull_occluded || (o->binning && o->early_z),
                 .hiz = hiz,
                 .dirty = dirty,
                 .tiles_x = tiles_x,
