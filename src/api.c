@@ -149,11 +149,18 @@ static bool visbuf_alloc(visbuf *vb, int w, int h) {
 }
 
 /* auto: every candidate renders the view once at half the resolution in each
- * direction, and the fastest renders the frame. The candidates are the exact
+ * direction, and the fastest renders the frame. The device remembers the choice,
+ * so rendering the same view again (animation holds, --repeat) skips the trial. The candidates are the exact
  * methods (bit-identical to ray casting); the 2D pipeline's snapped vertices are
  * for comparison, not a default. A trial costs about a quarter of a
  * frame per candidate and round; a cost model from S, E and N would be cheaper but has to
  * know this machine's costs, which the trial measures directly. */
+static bool same_view(const struct auto_choice *a, const struct auto_choice *b) {
+  return a->scene == b->scene && a->bvh == b->bvh && a->ntris == b->ntris &&
+         memcmp(&a->cam, &b->cam, sizeof a->cam) == 0 && a->width == b->width && a->height == b->height &&
+         a->threads == b->threads && a->cull == b->cull && a->scalar == b->scalar;
+}
+
 static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                             const rr_render_options *opt, rr_frame **out) {
   static const rr_method planar[] = {RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC,
@@ -161,6 +168,17 @@ static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_came
   static const rr_method curved[] = {RR_METHOD_RC_PACKET, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL};
   if (opt->oracles && *opt->oracles)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "oracles apply to the 3dr methods: choose one instead of auto");
+  struct auto_choice key = {.scene = scene, .bvh = scene->bvh, .ntris = scene->ntris, .cam = *cam,
+                            .width = opt->width, .height = opt->height, .threads = opt->threads,
+                            .cull = opt->cull_backfaces != 0, .scalar = opt->scalar != 0};
+  struct auto_choice *last = dev ? &dev->auto_choice : NULL;
+  if (last && last->scene && same_view(last, &key)) {
+    rr_render_options t = *opt;
+    t.method = (rr_method)last->method;
+    rr_error e = rr_render(dev, scene, cam, &t, out);
+    if (!e) snprintf((*out)->stats.why, sizeof (*out)->stats.why, "%s", last->why);
+    return e;
+  }
   bool flat = cam->type == RR_CAMERA_PERSPECTIVE || cam->type == RR_CAMERA_ORTHOGRAPHIC;
   const rr_method *cand = flat ? planar : curved;
   int n = flat ? 5 : 4, best = -1;
@@ -191,10 +209,15 @@ static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_came
   t = *opt;
   t.method = (rr_method)best;
   rr_error e = rr_render(dev, scene, cam, &t, out);
-  if (!e)
-    snprintf((*out)->stats.why, sizeof (*out)->stats.why, "fastest in a %dx%d trial (ms: %s)", opt->width / 2,
-             opt->height / 2, trial);
-  return e;
+  if (e) return e;
+  snprintf((*out)->stats.why, sizeof (*out)->stats.why, "fastest in a %dx%d trial (ms: %s)", opt->width / 2,
+           opt->height / 2, trial);
+  if (last) {
+    key.method = best;
+    snprintf(key.why, sizeof key.why, "%s", (*out)->stats.why);
+    *last = key;
+  }
+  return RR_OK;
 }
 
 rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,

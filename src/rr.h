@@ -18,6 +18,14 @@ struct rr_device {
   rr_error error;
   char message[512];
   rr_build_options build; /* used by rr_scene_commit; zeros mean defaults */
+  struct auto_choice {    /* auto's last trial: the same view again reuses its choice */
+    const void *scene, *bvh;
+    uint32_t ntris;
+    rr_camera cam;
+    int width, height, threads, cull, scalar;
+    int method;
+    char why[160];
+  } auto_choice;
 };
 
 /* Records a failure in dev (when not NULL) and returns its code. */
