@@ -121,8 +121,12 @@ static uint32_t tri_bounds_run_scalar(const rr_scene *s, uint32_t first, uint32_
  * corners: the same operations in the same order (no FMA, true divisions), so the
  * same rectangles. Lanes with a corner not strictly in front of the image plane
  * (or projecting to no finite point) take the scalar path. */
-__attribute__((target("avx2"))) static uint32_t bounds8_avx2(const rr_scene *s, uint32_t i, const camera *c,
-                                                              tri_bound *out) {
+/* Triangles ids[0..n-1] (n <= 8), or first..first+n-1 when ids is NULL. */
+__attribute__((target("avx2"))) static uint32_t bounds8_avx2(const rr_scene *s, uint32_t first, const uint32_t *ids,
+                                                              int n, const camera *c, tri_bound *out) {
+  uint32_t lane_id[8];
+  for (int l = 0; l < 8; l++) lane_id[l] = ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1);
+  const __m256i idx = _mm256_loadu_si256((const __m256i *)lane_id);
   const bool persp = c->type == RR_CAMERA_PERSPECTIVE;
   const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), half = _mm256_set1_ps(0.5f);
   const __m256 W = _mm256_set1_ps((float)c->width), H = _mm256_set1_ps((float)c->height);
@@ -134,7 +138,10 @@ __attribute__((target("avx2"))) static uint32_t bounds8_avx2(const rr_scene *s, 
   __m256 ok = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
   for (int k = 0; k < 3; k++) {
     __m256 q[3];
-    for (int a = 0; a < 3; a++) q[a] = _mm256_sub_ps(_mm256_loadu_ps(s->p[k][a] + i), _mm256_set1_ps(e[a]));
+    for (int a = 0; a < 3; a++) {
+      __m256 p = ids || n < 8 ? _mm256_i32gather_ps(s->p[k][a], idx, 4) : _mm256_loadu_ps(s->p[k][a] + first);
+      q[a] = _mm256_sub_ps(p, _mm256_set1_ps(e[a]));
+    }
 #define DOT3(v) \
   _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(q[0], _mm256_set1_ps(v[0])), _mm256_mul_ps(q[1], _mm256_set1_ps(v[1]))), \
                 _mm256_mul_ps(q[2], _mm256_set1_ps(v[2])))
@@ -166,19 +173,19 @@ __attribute__((target("avx2"))) static uint32_t bounds8_avx2(const rr_scene *s, 
   __m256 hy = _mm256_min_ps(_mm256_round_ps(_mm256_add_ps(_mm256_sub_ps(y1, half), m), down),
                             _mm256_set1_ps((float)(c->height - 1)));
   __m256 empty = _mm256_or_ps(_mm256_cmp_ps(lx, hx, _CMP_GT_OQ), _mm256_cmp_ps(ly, hy, _CMP_GT_OQ));
-  int okm = _mm256_movemask_ps(ok), keep = okm & ~_mm256_movemask_ps(empty);
-  if (!keep && okm == 0xff) return 0;
+  int lanes = (1 << n) - 1, okm = _mm256_movemask_ps(ok) & lanes, keep = okm & ~_mm256_movemask_ps(empty);
+  if (!keep && okm == lanes) return 0;
   int b[4][8];
   _mm256_storeu_si256((__m256i *)b[0], _mm256_cvttps_epi32(lx));
   _mm256_storeu_si256((__m256i *)b[1], _mm256_cvttps_epi32(ly));
   _mm256_storeu_si256((__m256i *)b[2], _mm256_cvttps_epi32(hx));
   _mm256_storeu_si256((__m256i *)b[3], _mm256_cvttps_epi32(hy));
   uint32_t kept = 0;
-  for (int l = 0; l < 8; l++) {
+  for (int l = 0; l < n; l++) {
     if (!(okm >> l & 1)) {
-      kept += keep_bounded(s, i + (uint32_t)l, c, out + kept);
+      kept += keep_bounded(s, lane_id[l], c, out + kept);
     } else if (keep >> l & 1) {
-      out[kept] = (tri_bound){i + (uint32_t)l, {b[0][l], b[1][l], b[2][l], b[3][l]}};
+      out[kept] = (tri_bound){lane_id[l], {b[0][l], b[1][l], b[2][l], b[3][l]}};
       kept++;
     }
   }
@@ -190,11 +197,24 @@ uint32_t tri_bounds_run(const rr_scene *s, uint32_t first, uint32_t n, const cam
   uint32_t kept = 0, i = first;
 #if defined(__x86_64__) || defined(__i386__)
   if (simd && !s->inf && __builtin_cpu_supports("avx2"))
-    for (; i + 8 <= first + n; i += 8) kept += bounds8_avx2(s, i, c, out + kept);
+    for (; i + 8 <= first + n; i += 8) kept += bounds8_avx2(s, i, NULL, 8, c, out + kept);
 #else
   (void)simd;
 #endif
   return kept + tri_bounds_run_scalar(s, i, first + n - i, c, out + kept);
+}
+
+uint32_t tri_bounds_list(const rr_scene *s, const uint32_t *ids, uint32_t n, const camera *c, bool simd,
+                         tri_bound *out) {
+  uint32_t kept = 0, k = 0;
+#if defined(__x86_64__) || defined(__i386__)
+  if (simd && !s->inf && __builtin_cpu_supports("avx2"))
+    for (; k < n; k += 8) kept += bounds8_avx2(s, 0, ids + k, n - k < 8 ? (int)(n - k) : 8, c, out + kept);
+#else
+  (void)simd;
+#endif
+  for (; k < n; k++) kept += keep_bounded(s, ids[k], c, out + kept);
+  return kept;
 }
 
 /* The sample loop, written once and specialised for planar and curved cameras. */

@@ -417,6 +417,9 @@ typedef struct tri_bound {
   int bb[4]; /* inclusive pixel rectangle, as tri_screen_bounds */
 } tri_bound;
 uint32_t tri_bounds_run(const rr_scene *s, uint32_t first, uint32_t n, const camera *c, bool simd, tri_bound *out);
+/* The same for triangles ids[0..n-1] (a BVH leaf's). */
+uint32_t tri_bounds_list(const rr_scene *s, const uint32_t *ids, uint32_t n, const camera *c, bool simd,
+                         tri_bound *out);
 /* Tests every sample of an inclusive rectangle against one set-up triangle and
  * returns the number of edge-function evaluations; adds the samples the
  * triangle covers to *covered. simd: use AVX2 where the processor has it. */

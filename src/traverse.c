@@ -420,7 +420,17 @@ static void generate(trav *t, const frustum *f, uint32_t node) {
   const rr_bvh *bvh = t->s->bvh;
   const bvh_node *n = &bvh->nodes[node];
   if (n->count) {
-    for (uint32_t k = 0; k < n->count; k++) rasterize(t, bvh->prims[n->first + k], f->r);
+    if (!t->c->planar) {
+      for (uint32_t k = 0; k < n->count; k++) rasterize(t, bvh->prims[n->first + k], f->r);
+      return;
+    }
+    /* planar: the leaf's triangles bounded together, then set up one by one */
+    tri_bound b[BVH_MAX_LEAF];
+    uint32_t nb = tri_bounds_list(t->s, bvh->prims + n->first, n->count, t->c, t->simd, b);
+    for (uint32_t k = 0; k < nb; k++) {
+      tri_job j;
+      if (prepare(t, b[k].id, b[k].bb, &j)) draw(t, &j, f->r);
+    }
     return;
   }
   generate(t, f, n->first);
@@ -620,7 +630,11 @@ rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
     }
     int whole = vb->width > vb->height ? vb->width : vb->height;
     int frustum = o->frustum_size > 0 ? o->frustum_size : whole;
-    int tile = ctx->threads > 1 ? (frustum < 128 ? 128 : frustum) : (frustum < whole ? frustum : whole);
+    /* On several threads a job is a tile of 128..256 samples: whole-image frusta
+     * start there (one job would leave the other threads idle), small ones are
+     * grouped. */
+    int tile = ctx->threads > 1 ? (frustum < 128 ? 128 : frustum > 256 ? 256 : frustum)
+                                : (frustum < whole ? frustum : whole);
     tile = (tile + HIZ - 1) / HIZ * HIZ;
     tj->proto = proto, tj->tile = tile, tj->frustum = frustum, tj->tiles_x = (vb->width + tile - 1) / tile;
     parallel_for(tj->tiles_x * ((vb->height + tile - 1) / tile), ctx->threads, run_tile, tj);

@@ -59,6 +59,15 @@ static void check_bounds(const rr_scene *s, const camera *c, const char *what) {
   CHECK(na == nb && memcmp(a, b, na * sizeof *a) == 0, "%s: AVX2 bounds differ from scalar (%u vs %u kept)", what, nb,
         na);
   CHECK(na > 0, "%s: no triangle bounded on screen", what);
+  /* lists of ids (a BVH leaf's), of every length up to 20: gathers and padded lanes */
+  static uint32_t ids[20];
+  int differ = 0;
+  for (uint32_t len = 1; len <= 20; len++) {
+    for (uint32_t k = 0; k < len; k++) ids[k] = test_rand() % s->ntris;
+    na = tri_bounds_list(s, ids, len, c, false, a), nb = tri_bounds_list(s, ids, len, c, true, b);
+    differ += na != nb || memcmp(a, b, na * sizeof *a) != 0;
+  }
+  CHECK(differ == 0, "%s: AVX2 bounds of id lists differ from scalar for %d lengths", what, differ);
 }
 
 static void check_setup(const rr_scene *s, const camera *c, bool cull, const char *what) {
