@@ -116,6 +116,11 @@ rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height
     c->d0 = v3_add(c->fwd, v3_sub(v3_scale(c->up, c->tan_half_h), v3_scale(c->right, c->tan_half_w)));
     c->dx = v3_scale(c->right, 2.0f * c->tan_half_w / (float)width);
     c->dy = v3_scale(c->up, -2.0f * c->tan_half_h / (float)height);
+    /* the planes through the eye and a column x (a row y) of the image have normals
+     * linear in x (y); the sign makes them face increasing x (y) */
+    float s = v3_dot(v3_cross(c->dx, c->dy), c->d0) > 0 ? 1.0f : -1.0f;
+    c->col_n0 = v3_scale(v3_cross(c->d0, c->dy), -s), c->col_n1 = v3_scale(v3_cross(c->dx, c->dy), -s);
+    c->row_n0 = v3_scale(v3_cross(c->d0, c->dx), s), c->row_n1 = v3_scale(v3_cross(c->dy, c->dx), s);
     return rr_ok(dev);
   }
   if (in->type == RR_CAMERA_ORTHOGRAPHIC) {

@@ -200,6 +200,8 @@ typedef struct camera {
   bool planar;
   vec3 eye, right, up, fwd;
   vec3 d0, dx, dy;
+  vec3 col_n0, col_n1, row_n0, row_n1; /* perspective: n0 + x·n1 is the plane of column x, */
+                                      /* row y likewise, facing increasing x (y) */
   vec3 o0, ox, oy;
   float tan_half_h, tan_half_w;
   vec3 *dirs;

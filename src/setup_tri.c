@@ -137,11 +137,13 @@ AVX2 __m256 lex_positive8(__m256 g1, __m256 g2, __m256 g3) {
   return _mm256_or_ps(_mm256_cmp_ps(g1, z, _CMP_GT_OQ), _mm256_and_ps(_mm256_cmp_ps(g1, z, _CMP_EQ_OQ), t2));
 }
 
-/* tri_setup_camera for eight finite triangles and a perspective camera: the same
+/* tri_setup_camera for count <= 8 finite triangles and a perspective camera: the same
  * operations in the same order, so the same bits. */
-__attribute__((target("avx2"))) static void setup8_avx2(const rr_scene *s, const uint32_t *ids, const camera *c,
-                                                         bool cull, tri_setup *out, int *face) {
-  __m256i idx = _mm256_loadu_si256((const __m256i *)ids);
+__attribute__((target("avx2"))) static void setup8_avx2(const rr_scene *s, const uint32_t *ids, int count,
+                                                         const camera *c, bool cull, tri_setup *out, int *face) {
+  uint32_t lane_id[8];
+  for (int l = 0; l < 8; l++) lane_id[l] = ids[l < count ? l : count - 1];
+  __m256i idx = _mm256_loadu_si256((const __m256i *)lane_id);
   v8 eye = splat8(c->eye), q[3];
   for (int k = 0; k < 3; k++) {
     v8 p = {_mm256_i32gather_ps(s->p[k][0], idx, 4), _mm256_i32gather_ps(s->p[k][1], idx, 4),
@@ -177,7 +179,7 @@ __attribute__((target("avx2"))) static void setup8_avx2(const rr_scene *s, const
   _mm256_storeu_ps(vs, _mm256_mul_ps(vol, sign));
   _mm256_storeu_ps(vx, _mm256_mul_ps(zero, sign));
   int seen_m = _mm256_movemask_ps(seen), front_m = _mm256_movemask_ps(front);
-  for (int l = 0; l < 8; l++) {
+  for (int l = 0; l < count; l++) {
     int f = !(seen_m >> l & 1) ? SETUP_CULLED : front_m >> l & 1 ? SETUP_FRONT : cull ? SETUP_CULLED : SETUP_BACK;
     face[l] = f;
     if (f == SETUP_CULLED) continue;
@@ -195,7 +197,7 @@ void tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *
   int k = 0;
 #if defined(__x86_64__) || defined(__i386__)
   if (simd && c->type == RR_CAMERA_PERSPECTIVE && !s->inf && __builtin_cpu_supports("avx2"))
-    for (; k + 8 <= n; k += 8) setup8_avx2(s, ids + k, c, cull_backfaces, out + k, face + k);
+    for (; k < n; k += 8) setup8_avx2(s, ids + k, n - k < 8 ? n - k : 8, c, cull_backfaces, out + k, face + k);
 #else
   (void)simd;
 #endif

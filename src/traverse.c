@@ -221,6 +221,28 @@ static bool prepare(trav *t, uint32_t id, const int *bb, tri_job *j) {
   return true;
 }
 
+/* Sets up the bounded triangles b[0..nb-1] of a planar camera, eight at a time,
+ * into out; returns how many can be seen. */
+static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job *out) {
+  uint32_t kept = 0;
+  t->st.setups += nb;
+  for (uint32_t q = 0; q < nb; q += 8) {
+    int m = nb - q < 8 ? (int)(nb - q) : 8, face[8];
+    uint32_t ids[8];
+    tri_setup ts[8];
+    for (int l = 0; l < m; l++) ids[l] = b[q + l].id;
+    tri_setup_run(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face);
+    for (int l = 0; l < m; l++) {
+      if (face[l] == SETUP_CULLED) continue;
+      tri_job *j = out + kept++;
+      j->ts = ts[l];
+      memcpy(j->bb, b[q + l].bb, sizeof j->bb);
+      finish_setup(t, ids[l], j);
+    }
+  }
+  return kept;
+}
+
 /* Rasterizes a prepared triangle into the samples of f it may cover. */
 static void draw(trav *t, const tri_job *j, tile_rect f) {
   tile_rect r = {j->bb[0] > f.x0 ? j->bb[0] : f.x0, j->bb[1] > f.y0 ? j->bb[1] : f.y0,
@@ -259,16 +281,14 @@ static frustum make_frustum(const camera *c, tile_rect r) {
     /* Planes through the eye and the outer pixel edges: half a pixel beyond the
      * outer sample centres, conservative for every sample. With rays
      * d = d0 + x·dx + y·dy, the plane of column x has normal (d0 + x·dx) × dy, and
-     * its dot with d(x', y) is det(dx, dy, d0)·(x - x'); rows likewise. */
+     * its dot with d(x', y) is det(dx, dy, d0)·(x - x'); rows likewise
+     * (camera_setup keeps these normals, turned to face increasing x and y). */
     float x0 = (float)r.x0, x1 = (float)r.x1, y0 = (float)r.y0, y1 = (float)r.y1;
-    float s = v3_dot(v3_cross(c->dx, c->dy), c->d0) > 0 ? 1.0f : -1.0f;
-    vec3 col0 = v3_cross(c->d0, c->dy), col1 = v3_cross(c->dx, c->dy);
-    vec3 row0 = v3_cross(c->d0, c->dx), row1 = v3_cross(c->dy, c->dx);
     f.nplanes = 4;
-    set_plane(&f, 0, v3_scale(v3_add(col0, v3_scale(col1, x0)), -s), c->eye);
-    set_plane(&f, 1, v3_scale(v3_add(col0, v3_scale(col1, x1)), s), c->eye);
-    set_plane(&f, 2, v3_scale(v3_add(row0, v3_scale(row1, y0)), s), c->eye);
-    set_plane(&f, 3, v3_scale(v3_add(row0, v3_scale(row1, y1)), -s), c->eye);
+    set_plane(&f, 0, v3_add(c->col_n0, v3_scale(c->col_n1, x0)), c->eye);
+    set_plane(&f, 1, v3_neg(v3_add(c->col_n0, v3_scale(c->col_n1, x1))), c->eye);
+    set_plane(&f, 2, v3_add(c->row_n0, v3_scale(c->row_n1, y0)), c->eye);
+    set_plane(&f, 3, v3_neg(v3_add(c->row_n0, v3_scale(c->row_n1, y1))), c->eye);
   } else if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
     /* Parallel rays: a box-shaped prism along fwd over the rectangle's origins. */
     vec3 lo = v3_add(c->eye, v3_add(c->o0, v3_add(v3_scale(c->ox, (float)r.x0), v3_scale(c->oy, (float)r.y0))));
@@ -424,13 +444,12 @@ static void generate(trav *t, const frustum *f, uint32_t node) {
       for (uint32_t k = 0; k < n->count; k++) rasterize(t, bvh->prims[n->first + k], f->r);
       return;
     }
-    /* planar: the leaf's triangles bounded together, then set up one by one */
+    /* planar: the leaf's triangles bounded, then set up, together */
     tri_bound b[BVH_MAX_LEAF];
+    tri_job j[BVH_MAX_LEAF];
     uint32_t nb = tri_bounds_list(t->s, bvh->prims + n->first, n->count, t->c, t->simd, b);
-    for (uint32_t k = 0; k < nb; k++) {
-      tri_job j;
-      if (prepare(t, b[k].id, b[k].bb, &j)) draw(t, &j, f->r);
-    }
+    uint32_t kept = setup_bounded(t, b, nb, j);
+    for (uint32_t k = 0; k < kept; k++) draw(t, &j[k], f->r);
     return;
   }
   generate(t, f, n->first);
@@ -491,25 +510,9 @@ static void root_setup(int k, int thread, void *arg) {
   uint32_t n = end - i0 < ROOT_CHUNK ? end - i0 : ROOT_CHUNK, kept = 0;
   tri_job *out = rj->jobs + (size_t)k * ROOT_CHUNK;
   if (t.c->planar) {
-    /* bounded from their corners, then the triangles that may cover a sample set
-     * up eight at a time */
+    /* bounded from their corners, then set up eight at a time */
     tri_bound b[ROOT_CHUNK];
-    uint32_t nb = tri_bounds_run(t.s, i0, n, t.c, t.simd, b);
-    t.st.setups += nb;
-    for (uint32_t q = 0; q < nb; q += 8) {
-      int m = nb - q < 8 ? (int)(nb - q) : 8, face[8];
-      uint32_t ids[8];
-      tri_setup ts[8];
-      for (int l = 0; l < m; l++) ids[l] = b[q + l].id;
-      tri_setup_run(t.s, ids, m, t.c, t.cull_back, t.simd, ts, face);
-      for (int l = 0; l < m; l++) {
-        if (face[l] == SETUP_CULLED) continue;
-        tri_job *j = out + kept++;
-        j->ts = ts[l];
-        memcpy(j->bb, b[q + l].bb, sizeof j->bb);
-        finish_setup(&t, ids[l], j);
-      }
-    }
+    kept = setup_bounded(&t, b, tri_bounds_run(t.s, i0, n, t.c, t.simd, b), out);
   } else {
     for (uint32_t i = i0; i < i0 + n; i++) kept += prepare(&t, i, NULL, out + kept);
   }
