@@ -31,8 +31,6 @@
 #define MAX_SUB (MAX_POLY - 2)
 #define BATCH 16384 /* triangles set up before they are rasterized */
 #define CHUNK 2048  /* triangles per setup job */
-/* Kernels are specialised by constant flags; the compiler must inline them to do so. */
-#define KERNEL static inline __attribute__((always_inline))
 
 /* ---- vertex stage ---------------------------------------------------------- */
 

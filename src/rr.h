@@ -50,6 +50,9 @@ static inline vec3 v3_cross(vec3 a, vec3 b) {
 static inline float v3_len(vec3 a) { return sqrtf(v3_dot(a, a)); }
 static inline vec3 v3_norm(vec3 a) { float l = v3_len(a); return l > 0 ? v3_scale(a, 1.0f / l) : a; }
 /* Plain comparisons: fminf/fmaxf handle NaN and are library calls at -O2. */
+/* Hot kernels written once and specialised by their constant arguments. */
+#define KERNEL static inline __attribute__((always_inline))
+
 static inline float minf(float a, float b) { return a < b ? a : b; }
 static inline float maxf(float a, float b) { return a > b ? a : b; }
 static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }

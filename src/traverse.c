@@ -44,7 +44,7 @@ typedef struct trav {
 
 /* ---- per-pixel statistics ------------------------------------------------ */
 
-static void charge(float *heat, int width, tile_rect r, float amount) {
+KERNEL void charge(float *heat, int width, tile_rect r, float amount) {
   if (!heat) return;
   float each = amount / (float)((r.x1 - r.x0) * (r.y1 - r.y0));
   for (int y = r.y0; y < r.y1; y++)
@@ -95,7 +95,7 @@ typedef struct tri_job {
 
 /* Tests every sample of r; the one kernel every generateSamples path ends in.
  * Returns the samples the triangle covers. */
-static uint64_t raster_samples(trav *t, const tri_job *j, tile_rect r) {
+KERNEL uint64_t raster_samples(trav *t, const tri_job *j, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
   t->st.edge_evals += raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd);
@@ -244,7 +244,7 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
 }
 
 /* Rasterizes a prepared triangle into the samples of f it may cover. */
-static void draw(trav *t, const tri_job *j, tile_rect f) {
+KERNEL void draw(trav *t, const tri_job *j, tile_rect f) {
   tile_rect r = {j->bb[0] > f.x0 ? j->bb[0] : f.x0, j->bb[1] > f.y0 ? j->bb[1] : f.y0,
                  j->bb[2] + 1 < f.x1 ? j->bb[2] + 1 : f.x1, j->bb[3] + 1 < f.y1 ? j->bb[3] + 1 : f.y1};
   if (r.x0 >= r.x1 || r.y0 >= r.y1) return;

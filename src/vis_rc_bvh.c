@@ -30,8 +30,6 @@
 #include <string.h>
 
 #define RAY_MARGIN 0x1p-10f /* relative widening of box intervals (about 1e-3) */
-/* The kernels take constant mode flags: forcing them inline specialises each use. */
-#define KERNEL static inline __attribute__((always_inline))
 
 /* ---- per-frame triangle setups and exact pruning bounds ------------------------ */
 
