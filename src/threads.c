@@ -35,9 +35,9 @@ typedef struct {
   pthread_cond_t go, done;
   int workers;          /* started so far: threads 1..workers */
   unsigned gen;         /* bumped for every loop */
-  loop *cur;
-  int want;             /* threads 1..want-1 take part in the current loop */
-  int running;          /* of those, still working */
+  loop *cur;            /* the loop workers may join, NULL once its caller ran out of jobs */
+  int want;             /* threads 1..want-1 may take part in it */
+  int active;           /* workers inside it */
 } pool;
 
 #define POOL_INIT                                                                                     \
@@ -54,12 +54,13 @@ static void *pool_worker(void *arg) {
   for (;;) {
     while (P.gen == seen) pthread_cond_wait(&P.go, &P.mu);
     seen = P.gen;
-    if (id >= P.want) continue;
+    if (id >= P.want || !P.cur) continue; /* woke too late: the loop is over */
     loop *l = P.cur;
+    P.active++;
     pthread_mutex_unlock(&P.mu);
     run_jobs(l, id);
     pthread_mutex_lock(&P.mu);
-    if (--P.running == 0) pthread_cond_signal(&P.done);
+    if (--P.active == 0 && !P.cur) pthread_cond_signal(&P.done);
   }
   return NULL;
 }
@@ -120,12 +121,15 @@ void parallel_for(int njobs, int threads, parallel_fn fn, void *arg) {
     pthread_detach(tid);
     P.workers++;
   }
-  P.cur = &l, P.want = P.workers + 1 < threads ? P.workers + 1 : threads, P.running = P.want - 1, P.gen++;
+  P.cur = &l, P.want = P.workers + 1 < threads ? P.workers + 1 : threads, P.active = 0, P.gen++;
   pthread_cond_broadcast(&P.go);
   pthread_mutex_unlock(&P.mu);
   run_jobs(&l, 0);
+  /* Wait only for the workers inside the loop: one that a busy machine has not
+   * scheduled yet would find no job, and waiting for it would cost its delay. */
   pthread_mutex_lock(&P.mu);
-  while (P.running > 0) pthread_cond_wait(&P.done, &P.mu);
+  P.cur = NULL;
+  while (P.active > 0) pthread_cond_wait(&P.done, &P.mu);
   pthread_mutex_unlock(&P.mu);
   pthread_mutex_unlock(&P.busy);
 }
