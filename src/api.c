@@ -163,9 +163,10 @@ static bool same_view(const struct auto_choice *a, const struct auto_choice *b) 
 
 static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                             const rr_render_options *opt, rr_frame **out) {
-  static const rr_method planar[] = {RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC,
-                                     RR_METHOD_3DR_FULL};
-  static const rr_method curved[] = {RR_METHOD_RC_PACKET, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL};
+  /* the usual winners first, so the others can be dropped after one round */
+  static const rr_method planar[] = {RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL,
+                                     RR_METHOD_RC_PACKET};
+  static const rr_method curved[] = {RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL, RR_METHOD_RC_PACKET};
   if (opt->oracles && *opt->oracles)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "oracles apply to the 3dr methods: choose one instead of auto");
   struct auto_choice key = {.scene = scene, .bvh = scene->bvh, .ntris = scene->ntris, .cam = *cam,
@@ -192,7 +193,9 @@ static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_came
   for (int i = 0; i < n; i++) {
     t.method = cand[i];
     double ms = INFINITY;
-    for (int round = 0; round < 2; round++) { /* the first round also warms the caches */
+    /* The first round also warms the caches; a candidate more than twice as slow
+     * as the best so far cannot win and gets no second. */
+    for (int round = 0; round < 2 && (round == 0 || !(ms > 2 * best_ms)); round++) {
       rr_frame *f;
       rr_error e = rr_render(dev, scene, cam, &t, &f);
       if (e == RR_ERROR_UNSUPPORTED) break;
