@@ -1,7 +1,8 @@
 /* Cameras beyond the pinhole: each camera's rays against an independent
  * double-precision reference; every 3D method bit-identical to rc for every
- * camera (curved binning and culling are conservative); the cube's faces agree
- * with six 90° perspective renders; 2D methods refuse curved cameras. */
+ * camera, on 1, 2 or 8 threads (curved binning and culling are conservative);
+ * the cube's faces agree with six 90° perspective renders; 2D methods refuse
+ * curved cameras. */
 #include "rr.h"
 #include "testutil.h"
 
@@ -87,45 +88,38 @@ static void check_directions(rr_device *dev) {
         "ortho corner ray from (%g,%g,%g) along (%g,%g,%g)", o.x, o.y, o.z, d.x, d.y, d.z);
 }
 
-static rr_frame *render(rr_device *dev, const rr_scene *s, const rr_camera *cam, rr_method m, int w, int h,
-                        int threads) {
-  rr_render_options opt;
-  rr_render_options_init(&opt);
-  opt.method = m, opt.width = w, opt.height = h, opt.threads = threads;
-  rr_frame *f = NULL;
-  rr_error e = rr_render(dev, s, cam, &opt, &f);
-  CHECK(e == RR_OK, "%s with %s: %s", rr_method_name(m), rr_camera_name(cam->type), rr_device_message(dev));
-  return f;
-}
-
 static const rr_method methods3d[] = {RR_METHOD_RC_BVH,  RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
                                       RR_METHOD_3DR_FC,  RR_METHOD_3DR_FS,    RR_METHOD_3DR_FULL};
 
-/* Every camera, every 3D method, bit-identical to rc; random views, some inside. */
+/* Every camera, every 3D method, bit-identical to rc; random views, some inside.
+ * The thread count goes round 1, 2 and 8 with the camera and the method, so each
+ * method meets each count on every scene. (test_homogeneous renders every camera
+ * and method on all three counts and compares S, E and N too; curved
+ * rasterization of these meshes is slow enough to render each view once here.) */
 static void check_methods(rr_device *dev, const char *name, int views) {
   rr_scene *s;
   if (rr_scene_load(dev, name, &s) != RR_OK) {
     CHECK(0, "load %s", name);
     return;
   }
-  vec3 c = v3_scale(v3_add(s->bmin, s->bmax), 0.5f);
-  float r = 0.5f * v3_len(v3_sub(s->bmax, s->bmin));
   uint64_t bins = 0, empty = 0;
   for (int v = 0; v < views; v++) {
     for (int type = 0; type < RR_CAMERA_COUNT; type++) {
-      vec3 dir = v3_norm(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)));
-      vec3 eye = v3_add(c, v3_scale(dir, r * (v % 2 ? test_randf(0.05f, 0.5f) : test_randf(1.2f, 2.5f))));
-      vec3 target = v3_add(c, v3_scale(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)), 0.3f * r));
-      rr_camera cam = make_camera((rr_camera_type)type, eye, target, type == RR_CAMERA_FISHEYE ? 200 : 70);
+      float fov = type == RR_CAMERA_FISHEYE ? 200 : 70;
+      rr_camera cam = test_random_view(s, v % 2 ? 0.05f : 1.2f, v % 2 ? 0.5f : 2.5f, 0.3f, fov, fov);
+      cam.type = (rr_camera_type)type;
       int w = type == RR_CAMERA_CUBE ? 64 : 56, h = 48;
-      rr_frame *ref = render(dev, s, &cam, RR_METHOD_RC, w, h, 2);
+      rr_frame *ref = test_render(dev, s, &cam, RR_METHOD_RC, 2, w, h, 0);
       if (!ref) continue;
+      char what[256];
+      snprintf(what, sizeof what, "%s view %d, %s camera", name, v, rr_camera_name(type));
       for (size_t m = 0; m < sizeof methods3d / sizeof methods3d[0]; m++) {
-        rr_frame *f = render(dev, s, &cam, methods3d[m], w, h, 1 + (v + m) % 2);
+        int threads = test_threads[(v + type + m) % TEST_NTHREADS];
+        rr_frame *f = test_render(dev, s, &cam, methods3d[m], threads, w, h, 0);
         if (!f) continue;
         int d = test_frames_differ(ref, f);
-        CHECK(d == 0, "%s view %d, %s camera: %s differs from rc at %d samples", name, v, rr_camera_name(type),
-              rr_method_name(methods3d[m]), d);
+        CHECK(d == 0, "%s: %s on %d threads differs from rc at %d samples", what, rr_method_name(methods3d[m]),
+              threads, d);
         if (type != RR_CAMERA_PERSPECTIVE && type != RR_CAMERA_ORTHOGRAPHIC) bins += f->stats.bins, empty += f->stats.bins_empty;
         rr_frame_release(f);
       }
@@ -144,7 +138,7 @@ static void check_cube(rr_device *dev) {
   vec3 eye = v3(3.3f, 1.4f, 4.1f), f = v3(1, 0, 0), u = v3(0, 1, 0);
   rr_camera cube = make_camera(RR_CAMERA_CUBE, eye, v3_add(eye, f), 90);
   const int F = 48;
-  rr_frame *cf = render(dev, s, &cube, RR_METHOD_3DR_FULL, 4 * F, 3 * F, 2);
+  rr_frame *cf = test_render(dev, s, &cube, RR_METHOD_3DR_FULL, 2, 4 * F, 3 * F, 0);
   /* faces of the cross: (col, row, forward, up) in the camera basis right = f × u */
   vec3 r = v3_cross(f, u);
   struct {
@@ -156,7 +150,7 @@ static void check_cube(rr_device *dev) {
   for (int k = 0; k < 6 && cf; k++) {
     rr_camera p = make_camera(RR_CAMERA_PERSPECTIVE, eye, v3_add(eye, faces[k].fwd), 90);
     memcpy(p.up, &faces[k].up, 12);
-    rr_frame *pf = render(dev, s, &p, RR_METHOD_3DR_BB, F, F, 1);
+    rr_frame *pf = test_render(dev, s, &p, RR_METHOD_3DR_BB, 1, F, F, 0);
     if (!pf) continue;
     for (int y = 0; y < F; y++)
       for (int x = 0; x < F; x++) {

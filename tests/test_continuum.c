@@ -1,7 +1,9 @@
 /* The continuum: every method is one traversal order of the same (sample,
- * triangle) tests, so every method gives a visibility buffer bit-identical to rc's,
- * on built-in scenes and real meshes at random views (from inside too). Also: the
- * oracles are conservative, statistics are deterministic and add up per pixel. */
+ * triangle) tests, so every 3D method (and auto) gives a visibility buffer
+ * bit-identical to rc's, on built-in scenes and real meshes at random views (from
+ * inside too), on 1, 2 and 8 threads with the same S, E and N on each; the 2D
+ * methods give their own on any number of threads. Also: the oracles are
+ * conservative, statistics are deterministic and add up per pixel. */
 #include "rr.h"
 #include "testutil.h"
 
@@ -10,84 +12,103 @@
 static const rr_method all3d[] = {RR_METHOD_RC_BVH,  RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
                                   RR_METHOD_3DR_FC,  RR_METHOD_3DR_FS,    RR_METHOD_3DR_FULL};
 
-static int scalar; /* nonzero: render without SIMD kernels */
-
-static rr_frame *render(rr_device *dev, const rr_scene *s, const rr_camera *cam, rr_method m, int threads, int w,
-                        int h, int cull, const char *oracles, int heat) {
-  rr_render_options opt;
-  rr_render_options_init(&opt);
-  opt.scalar = scalar;
-  opt.method = m, opt.width = w, opt.height = h, opt.threads = threads, opt.cull_backfaces = cull;
-  opt.oracles = oracles, opt.heat = heat;
-  rr_frame *f = NULL;
-  rr_error e = rr_render(dev, s, cam, &opt, &f);
-  if (e == RR_ERROR_UNSUPPORTED) return NULL; /* a method this build lacks: reported by its own test */
-  CHECK(e == RR_OK, "render %s: %s", rr_method_name(m), rr_device_message(dev));
-  return f;
-}
-
-static void random_view(const rr_scene *s, rr_camera *cam, bool inside) {
-  rr_camera_init(cam);
-  vec3 c = v3_scale(v3_add(s->bmin, s->bmax), 0.5f);
-  float r = 0.5f * v3_len(v3_sub(s->bmax, s->bmin));
-  vec3 dir = v3_norm(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)));
-  vec3 eye = v3_add(c, v3_scale(dir, r * (inside ? test_randf(0.05f, 0.6f) : test_randf(1.2f, 3))));
-  vec3 target = v3_add(c, v3_scale(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)), 0.4f * r));
-  memcpy(cam->eye, &eye, 12), memcpy(cam->target, &target, 12);
-  cam->fov_deg = test_randf(30, 110);
-}
-
 static int methods_seen[RR_METHOD_COUNT];
+static int views_done; /* picks the thread count of the scalar and oracle renders */
 
+/* A random view from inside the scene's bounds or from outside. */
+static rr_camera random_view(const rr_scene *s, bool inside) {
+  return test_random_view(s, inside ? 0.05f : 1.2f, inside ? 0.6f : 3, 0.4f, 30, 110);
+}
+
+/* One view, on 1, 2 and 8 threads: every 3D method and auto against ref, and
+ * the 2D methods against 2dr-bb on one thread. */
+static void check_methods(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_render_options *base,
+                          const rr_frame *ref, const char *what) {
+  rr_render_options opt = *base;
+  for (size_t m = 0; m < sizeof all3d / sizeof all3d[0]; m++) {
+    opt.method = all3d[m];
+    rr_frame *f = test_render_threads(dev, s, cam, &opt, ref, what);
+    methods_seen[all3d[m]] += f != NULL;
+    rr_frame_release(f);
+  }
+  /* auto picks one of the methods, says why, and so gives the same picture */
+  opt.method = RR_METHOD_AUTO;
+  rr_frame *fa = test_render_threads(dev, s, cam, &opt, ref, what);
+  if (fa) {
+    CHECK(fa->stats.method >= 0 && fa->stats.method < RR_METHOD_COUNT && fa->stats.why[0], "auto chose %d (%s)",
+          fa->stats.method, fa->stats.why);
+    rr_frame_release(fa);
+  }
+  /* the 2D pipeline snaps its vertices, so it is not rc's picture, but it is its
+   * own on any number of threads, and 2dr-bin's is 2dr-bb's */
+  opt.method = RR_METHOD_2DR_BB;
+  rr_frame *bb = test_render_threads(dev, s, cam, &opt, NULL, what);
+  if (bb) {
+    methods_seen[RR_METHOD_2DR_BB]++;
+    opt.method = RR_METHOD_2DR_BIN;
+    rr_frame *bin = test_render_threads(dev, s, cam, &opt, bb, what);
+    methods_seen[RR_METHOD_2DR_BIN] += bin != NULL;
+    rr_frame_release(bin), rr_frame_release(bb);
+  }
+}
+
+/* Views of a scene at w×h: every method against rc (check_methods); the scalar
+ * kernels and mixes of oracles on one of the thread counts, in turn. Then views of
+ * 384×288, large enough for several tiles, blocks of rows and bands on several
+ * threads (rc-bvh's tiles, 3dr's four 256-sample tiles and five 64-row blocks,
+ * 2dr's bands), where rc-bvh on one thread stands in for rc (rc would take
+ * seconds; rc-bvh equals it on the small views). */
 static void check_scene(rr_device *dev, const char *name, int views, int w, int h) {
   rr_scene *s = NULL;
   if (rr_scene_load(dev, name, &s) != RR_OK) {
     CHECK(0, "load %s: %s", name, rr_device_message(dev));
     return;
   }
+  rr_render_options opt;
+  rr_render_options_init(&opt);
+  char what[256];
   for (int v = 0; v < views; v++) {
-    rr_camera cam;
-    random_view(s, &cam, v % 2 == 0);
-    int cull = v % 3 == 2, threads = 1 + v % 2;
-    rr_frame *ref = render(dev, s, &cam, RR_METHOD_RC, 2, w, h, cull, NULL, 0);
+    bool inside = v % 2 == 0;
+    rr_camera cam = random_view(s, inside);
+    int cull = v % 3 == 2, threads = test_threads[views_done++ % TEST_NTHREADS];
+    rr_frame *ref = test_render(dev, s, &cam, RR_METHOD_RC, 2, w, h, cull);
     if (!ref) continue;
-    for (size_t m = 0; m < sizeof all3d / sizeof all3d[0]; m++) {
-      rr_frame *f = render(dev, s, &cam, all3d[m], threads, w, h, cull, NULL, 0);
-      if (!f) continue;
-      methods_seen[all3d[m]]++;
-      int d = test_frames_differ(ref, f);
-      CHECK(d == 0, "%s view %d (%s, %d threads): %s differs from rc at %d samples", name, v,
-            v % 2 == 0 ? "inside" : "outside", threads, rr_method_name(all3d[m]), d);
-      rr_frame_release(f);
-    }
-    /* auto picks one of the methods, says why, and so gives the same picture */
-    rr_frame *fa = render(dev, s, &cam, RR_METHOD_AUTO, threads, w, h, cull, NULL, 0);
-    if (fa) {
-      CHECK(fa->stats.method >= 0 && fa->stats.method < RR_METHOD_COUNT && fa->stats.why[0], "auto chose %d (%s)",
-            fa->stats.method, fa->stats.why);
-      CHECK(test_frames_differ(ref, fa) == 0, "%s view %d: auto (%s) differs from rc", name, v, rr_method_name(fa->stats.method));
-      rr_frame_release(fa);
-    }
+    snprintf(what, sizeof what, "%s view %d (%s, cull %d)", name, v, inside ? "inside" : "outside", cull);
+    opt.width = w, opt.height = h, opt.cull_backfaces = cull;
+    check_methods(dev, s, &cam, &opt, ref, what);
     /* the scalar kernels give the same bits as the SIMD ones */
-    scalar = 1;
+    rr_render_options o = opt;
+    o.threads = threads, o.scalar = 1;
     for (int k = 0; k < 2; k++) {
-      rr_frame *f = render(dev, s, &cam, k ? RR_METHOD_3DR_FULL : RR_METHOD_3DR_BB, threads, w, h, cull, NULL, 0);
+      o.method = k ? RR_METHOD_3DR_FULL : RR_METHOD_3DR_BB;
+      rr_frame *f = test_render_opt(dev, s, &cam, &o);
       if (!f) continue;
       int d = test_frames_differ(ref, f);
-      CHECK(d == 0, "%s view %d: scalar %s differs from rc at %d samples", name, v, k ? "3dr-full" : "3dr-bb", d);
+      CHECK(d == 0, "%s: scalar %s on %d threads differs from rc at %d samples", what, rr_method_name(o.method),
+            threads, d);
       rr_frame_release(f);
     }
-    scalar = 0;
     /* points between the named methods */
     const char *mixes[] = {"frustum=1,leaves=1,outside=1", "frustum=32,leaves=1,outside=1,occluded=1,binning=1",
                            "leaves=1,split=16,split-ratio=2,binning=1,bin=16,bin-min=1", "binning=1,early-z=0,bin=8"};
+    o.scalar = 0, o.method = RR_METHOD_3DR_BB;
     for (int k = 0; k < 4; k++) {
-      rr_frame *f = render(dev, s, &cam, RR_METHOD_3DR_BB, threads, w, h, cull, mixes[k], 0);
+      o.oracles = mixes[k];
+      rr_frame *f = test_render_opt(dev, s, &cam, &o);
       if (!f) continue;
       int d = test_frames_differ(ref, f);
-      CHECK(d == 0, "%s view %d: oracles %s differ from rc at %d samples", name, v, mixes[k], d);
+      CHECK(d == 0, "%s: oracles %s on %d threads differ from rc at %d samples", what, mixes[k], threads, d);
       rr_frame_release(f);
     }
+    rr_frame_release(ref);
+  }
+  for (int v = 0; v < (test_quick() ? 1 : 2); v++) {
+    rr_camera cam = random_view(s, v == 1);
+    opt.width = 384, opt.height = 288, opt.cull_backfaces = v;
+    rr_frame *ref = test_render(dev, s, &cam, RR_METHOD_RC_BVH, 1, opt.width, opt.height, opt.cull_backfaces);
+    if (!ref) continue;
+    snprintf(what, sizeof what, "%s large view %d (%s, cull %d)", name, v, v == 1 ? "inside" : "outside", v);
+    check_methods(dev, s, &cam, &opt, ref, what);
     rr_frame_release(ref);
   }
   rr_scene_release(s);
@@ -151,10 +172,9 @@ static void check_occluded_oracle(rr_device *dev, const char *name) {
       for (uint32_t k = 0; k < s->bvh->nodes[n].count; k++) leaf_of[s->bvh->prims[s->bvh->nodes[n].first + k]] = n;
   int tested = 0, culled = 0;
   for (int v = 0; v < 4; v++) {
-    rr_camera cam;
-    random_view(s, &cam, v % 2 == 0);
-    rr_frame *f = render(dev, s, &cam, RR_METHOD_RC_BVH, 2, 96, 72, 0, NULL, 0);
-    if (!f) f = render(dev, s, &cam, RR_METHOD_3DR_BB, 2, 96, 72, 0, NULL, 0);
+    rr_camera cam = random_view(s, v % 2 == 0);
+    rr_frame *f = test_render(dev, s, &cam, RR_METHOD_RC_BVH, 2, 96, 72, 0);
+    if (!f) f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 2, 96, 72, 0);
     camera c;
     camera_setup(dev, &cam, 96, 72, &c);
     for (int y0 = 0; y0 < 72; y0 += 8)
@@ -192,10 +212,13 @@ static void check_stats(rr_device *dev) {
   rr_camera cam;
   rr_camera_init(&cam);
   rr_camera_frame(dev, s, 160, 120, &cam);
+  rr_render_options opt;
+  rr_render_options_init(&opt);
+  opt.width = 160, opt.height = 120, opt.threads = 2, opt.cull_backfaces = 1, opt.heat = 1;
   for (size_t m = 0; m < sizeof all3d / sizeof all3d[0]; m++) {
-    rr_method method = all3d[m];
-    rr_frame *a = render(dev, s, &cam, method, 2, 160, 120, 1, NULL, 1);
-    rr_frame *b = render(dev, s, &cam, method, 2, 160, 120, 1, NULL, 1);
+    rr_method method = opt.method = all3d[m];
+    rr_frame *a = test_render_opt(dev, s, &cam, &opt);
+    rr_frame *b = test_render_opt(dev, s, &cam, &opt);
     if (!a || !b) {
       rr_frame_release(a), rr_frame_release(b);
       continue;
@@ -232,8 +255,8 @@ int main(void) {
     const char *p = test_model(meshes[m]);
     if (p) check_scene(dev, p, 3, 64, 48);
   }
-  for (size_t m = 0; m < sizeof all3d / sizeof all3d[0]; m++)
-    printf("%s compared on %d views\n", rr_method_name(all3d[m]), methods_seen[all3d[m]]);
+  for (int m = RR_METHOD_RC_BVH; m < RR_METHOD_COUNT; m++)
+    printf("%s compared on %d views\n", rr_method_name(m), methods_seen[m]);
   rr_device_release(dev);
   return test_done();
 }

@@ -1,72 +1,33 @@
 /* rc-bvh and rc-packet traverse the BVH but call the same sample test as rc and
  * 3dr-bb: their visibility buffers (ids, t, λ1, λ2) must be bit-identical, at
  * random views of real meshes (some with the eye inside the bounds), on built-in
- * scenes with shared edges through pixel centres, at full size, on 1 and 2 threads. */
+ * scenes with shared edges through pixel centres, at full size, on 1, 2 and 8 threads. */
 #include "rr.h"
 #include "testutil.h"
 
-#include <string.h>
-
-static int ndiff(const rr_frame *a, const rr_frame *b, int *hits) {
-  size_t n = (size_t)a->vb.width * a->vb.height;
-  int d = 0, h = 0;
-  for (size_t k = 0; k < n; k++) {
-    d += a->vb.id[k] != b->vb.id[k] || memcmp(&a->vb.t[k], &b->vb.t[k], 4) || memcmp(&a->vb.l1[k], &b->vb.l1[k], 4) ||
-         memcmp(&a->vb.l2[k], &b->vb.l2[k], 4);
-    h += a->vb.id[k] != RR_MISS;
-  }
-  if (hits) *hits = h;
-  return d;
-}
-
-static rr_frame *render(rr_device *dev, const rr_scene *s, const rr_camera *cam, rr_method m, int threads, int w,
-                        int h, int cull) {
-  rr_render_options opt;
-  rr_render_options_init(&opt);
-  opt.method = m, opt.width = w, opt.height = h, opt.threads = threads, opt.cull_backfaces = cull;
-  rr_frame *f = NULL;
-  rr_error e = rr_render(dev, s, cam, &opt, &f);
-  CHECK(e == RR_OK, "render %s: %s", rr_method_name(m), rr_device_message(dev));
-  return f;
-}
-
-static void random_view(const rr_scene *s, rr_camera *cam, float dist_lo, float dist_hi) {
-  rr_camera_init(cam);
-  vec3 c = v3_scale(v3_add(s->bmin, s->bmax), 0.5f);
-  float r = 0.5f * v3_len(v3_sub(s->bmax, s->bmin));
-  vec3 dir = v3_norm(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)));
-  vec3 eye = v3_add(c, v3_scale(dir, r * test_randf(dist_lo, dist_hi)));
-  vec3 target = v3_add(c, v3_scale(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)), 0.3f * r));
-  memcpy(cam->eye, &eye, 12), memcpy(cam->target, &target, 12);
-  cam->fov_deg = test_randf(30, 100);
-}
-
-/* Renders a view with the reference and with rc-bvh / rc-packet on 1 and 2 threads. */
+/* Renders a view with the reference and with rc-bvh / rc-packet on 1, 2 and 8
+ * threads: the same bits as the reference, and the same S, E and N on each. */
 static void check_view(rr_device *dev, const rr_scene *s, const char *name, int v, const rr_camera *cam,
                        rr_method ref_method, int w, int h, int cull) {
-  rr_frame *ref = render(dev, s, cam, ref_method, 2, w, h, cull);
+  rr_frame *ref = test_render(dev, s, cam, ref_method, 2, w, h, cull);
   if (!ref) return;
   const rr_method ms[2] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET};
-  uint64_t setups1 = 0;
-  for (int m = 0; m < 2; m++)
-    for (int threads = 1; threads <= 2; threads++) {
-      rr_frame *f = render(dev, s, cam, ms[m], threads, w, h, cull);
-      if (!f) continue;
-      int hits, d = ndiff(ref, f, &hits);
-      CHECK(d == 0, "%s view %d (%dx%d, cull %d): %s on %d threads differs from %s at %d of %d samples", name, v, w,
-            h, cull, rr_method_name(ms[m]), threads, rr_method_name(ref_method), d, w * h);
-      CHECK(f->stats.setups <= s->ntris, "S counts distinct setups (%llu > %u)", (unsigned long long)f->stats.setups,
-            s->ntris);
-      CHECK(f->stats.nodes > 0, "N counted");
-      if (threads == 1) setups1 = f->stats.setups;
-      else CHECK(f->stats.setups == setups1, "S does not depend on threads (%llu vs %llu)",
-                 (unsigned long long)f->stats.setups, (unsigned long long)setups1);
-      if (m == 0 && threads == 1)
-        printf("%s view %d %dx%d: %d hits, S=%llu E=%llu N=%llu\n", name, v, w, h, hits,
-               (unsigned long long)f->stats.setups, (unsigned long long)f->stats.edge_evals,
-               (unsigned long long)f->stats.nodes);
-      rr_frame_release(f);
-    }
+  char what[256];
+  snprintf(what, sizeof what, "%s view %d (%dx%d, cull %d)", name, v, w, h, cull);
+  for (int m = 0; m < 2; m++) {
+    rr_render_options opt;
+    rr_render_options_init(&opt);
+    opt.method = ms[m], opt.width = w, opt.height = h, opt.cull_backfaces = cull;
+    rr_frame *f = test_render_threads(dev, s, cam, &opt, ref, what);
+    if (!f) continue;
+    CHECK(f->stats.setups <= s->ntris, "S counts distinct setups (%llu > %u)", (unsigned long long)f->stats.setups,
+          s->ntris);
+    CHECK(f->stats.nodes > 0, "N counted");
+    if (m == 0)
+      printf("%s: %d hits, S=%llu E=%llu N=%llu\n", what, test_frame_hits(ref), (unsigned long long)f->stats.setups,
+             (unsigned long long)f->stats.edge_evals, (unsigned long long)f->stats.nodes);
+    rr_frame_release(f);
+  }
   rr_frame_release(ref);
 }
 
@@ -77,8 +38,7 @@ static void check_scene(rr_device *dev, const char *path, const char *name, int 
     return;
   }
   for (int v = 0; v < views_rc + views_bb; v++) {
-    rr_camera cam;
-    random_view(s, &cam, v % 3 == 0 ? 0.1f : 1.0f, v % 3 == 0 ? 0.9f : 3.0f);
+    rr_camera cam = test_random_view(s, v % 3 == 0 ? 0.1f : 1.0f, v % 3 == 0 ? 0.9f : 3.0f, 0.3f, 30, 100);
     if (v < views_rc) check_view(dev, s, name, v, &cam, RR_METHOD_RC, 40, 30, v % 2);
     else check_view(dev, s, name, v, &cam, RR_METHOD_3DR_BB, 200, 150, v % 2);
   }
@@ -138,8 +98,7 @@ static void bound_views(rr_device *dev) {
   rr_scene *s;
   if (p && rr_scene_load(dev, p, &s) == RR_OK) {
     for (int v = 0; v < 3; v++) {
-      rr_camera cam;
-      random_view(s, &cam, v == 0 ? 0.2f : 1.0f, v == 0 ? 0.8f : 2.0f);
+      rr_camera cam = test_random_view(s, v == 0 ? 0.2f : 1.0f, v == 0 ? 0.8f : 2.0f, 0.3f, 30, 100);
       check_bound(dev, s, &cam, 64, 48, "bunny bound");
     }
     rr_scene_release(s);
@@ -165,8 +124,7 @@ int main(void) {
   rr_scene *tp = NULL;
   if (teapot && rr_scene_load(dev, teapot, &tp) == RR_OK) {
     for (int v = 0; v < (q ? 1 : 3); v++) {
-      rr_camera cam;
-      random_view(tp, &cam, 1.0f, 2.0f);
+      rr_camera cam = test_random_view(tp, 1.0f, 2.0f, 0.3f, 30, 100);
       check_view(dev, tp, "teapot", v, &cam, RR_METHOD_3DR_BB, 512, 384, v % 2);
     }
     rr_scene_release(tp);
@@ -180,7 +138,7 @@ int main(void) {
     cam.fov_deg = 50;
     rr_camera_frame(dev, s, 1024, 1024, &cam);
     check_view(dev, s, "bunny framed", 0, &cam, RR_METHOD_3DR_BB, 1024, 1024, 0);
-    random_view(s, &cam, 0.2f, 0.5f);
+    cam = test_random_view(s, 0.2f, 0.5f, 0.3f, 30, 100);
     if (!q) check_view(dev, s, "bunny inside", 1, &cam, RR_METHOD_3DR_BB, 1024, 1024, 1);
     rr_scene_release(s);
   }

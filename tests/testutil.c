@@ -1,7 +1,5 @@
 #include "testutil.h"
 
-#include "rr.h"
-
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -55,4 +53,108 @@ int test_frames_differ(const rr_frame *a, const rr_frame *b) {
     d += a->vb.id[k] != b->vb.id[k] || memcmp(&a->vb.t[k], &b->vb.t[k], 4) || memcmp(&a->vb.l1[k], &b->vb.l1[k], 4) ||
          memcmp(&a->vb.l2[k], &b->vb.l2[k], 4);
   return d;
+}
+
+int test_frame_hits(const rr_frame *f) {
+  size_t n = (size_t)f->vb.width * f->vb.height;
+  int hits = 0;
+  for (size_t k = 0; k < n; k++) hits += f->vb.id[k] != RR_MISS;
+  return hits;
+}
+
+rr_frame *test_render_opt(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_render_options *opt) {
+  rr_frame *f = NULL;
+  rr_error e = rr_render(dev, s, cam, opt, &f);
+  CHECK(e == RR_OK, "%s (%s camera, %dx%d, %d threads%s%s): %s", rr_method_name(opt->method),
+        rr_camera_name(cam->type), opt->width, opt->height, opt->threads, opt->oracles ? ", oracles " : "",
+        opt->oracles ? opt->oracles : "", rr_device_message(dev));
+  if (e == RR_OK) return f;
+  rr_frame_release(f);
+  return NULL;
+}
+
+rr_frame *test_render(rr_device *dev, const rr_scene *s, const rr_camera *cam, rr_method m, int threads, int w, int h,
+                      int cull) {
+  rr_render_options opt;
+  rr_render_options_init(&opt);
+  opt.method = m, opt.width = w, opt.height = h, opt.threads = threads, opt.cull_backfaces = cull;
+  return test_render_opt(dev, s, cam, &opt);
+}
+
+const int test_threads[TEST_NTHREADS] = {1, 2, 8};
+
+/* Which of S, E and N a method keeps on any number of threads (*any) and on any
+ * number above one (*several). The ray casters trace every ray and packet alike in
+ * tiles of a fixed size; rasterization from the root (3dr-bb, 3dr-bin) sets each
+ * triangle up once and draws whole blocks of rows that no two threads share;
+ * 2dr-bb sets up in chunks and draws bands of rows; 3dr-fc starts from frusta of
+ * 256 samples on any number of threads: all three on any number. 3dr-fs and
+ * 3dr-full start from the whole image on one thread but from tiles of 256 samples
+ * on several, so only several threads agree among themselves (and with one
+ * thread on an image of one tile). 2dr-bin picks a triangle's first block size
+ * from its rectangle clipped to a band of rows, and the bands depend on the thread
+ * count: S only. auto times its candidates and may choose another method. */
+enum { SAME_S = 1, SAME_E = 2, SAME_N = 4, SAME_ALL = 7 };
+static void same_stats(rr_method m, int *any, int *several) {
+  *any = *several = 0;
+  switch (m) {
+  case RR_METHOD_AUTO: return;
+  case RR_METHOD_2DR_BIN: *any = SAME_S; return;
+  case RR_METHOD_3DR_FS:
+  case RR_METHOD_3DR_FULL: *several = SAME_ALL; return;
+  default: *any = SAME_ALL; return;
+  }
+}
+
+/* Checks the statistics of b (on b->stats.threads threads) against a's. */
+static void check_same_stats(const rr_frame *a, const rr_frame *b, int same, const char *what) {
+  const rr_stats *x = &a->stats, *y = &b->stats;
+  const char *name = rr_method_name(y->method);
+  CHECK(!(same & SAME_S) || x->setups == y->setups, "%s: %s sets up S = %llu triangles on %d threads, %llu on %d",
+        what, name, (unsigned long long)y->setups, y->threads, (unsigned long long)x->setups, x->threads);
+  CHECK(!(same & SAME_E) || x->edge_evals == y->edge_evals, "%s: %s evaluates E = %llu on %d threads, %llu on %d",
+        what, name, (unsigned long long)y->edge_evals, y->threads, (unsigned long long)x->edge_evals, x->threads);
+  CHECK(!(same & SAME_N) || x->nodes == y->nodes, "%s: %s visits N = %llu nodes on %d threads, %llu on %d", what,
+        name, (unsigned long long)y->nodes, y->threads, (unsigned long long)x->nodes, x->threads);
+}
+
+rr_frame *test_render_threads(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_render_options *opt,
+                              const rr_frame *ref, const char *what) {
+  rr_render_options o = *opt;
+  rr_frame *one = NULL, *several = NULL; /* the frames on 1 thread and on the first count above */
+  int any, on_several;
+  same_stats(o.method, &any, &on_several);
+  for (int k = 0; k < TEST_NTHREADS; k++) {
+    o.threads = test_threads[k];
+    rr_frame *f = test_render_opt(dev, s, cam, &o);
+    if (!f) continue;
+    const rr_frame *base = ref ? ref : one;
+    if (base) {
+      int d = test_frames_differ(base, f);
+      CHECK(d == 0, "%s: %s on %d threads differs from %s at %d of %d samples", what, rr_method_name(o.method),
+            o.threads, ref ? rr_method_name(ref->stats.method) : "its frame on 1 thread", d,
+            f->vb.width * f->vb.height);
+    }
+    if (one && any) check_same_stats(one, f, any, what);
+    if (several && on_several) check_same_stats(several, f, on_several, what);
+    if (o.threads == 1 && !one) one = f;
+    else if (o.threads > 1 && !several) several = f;
+    else rr_frame_release(f);
+  }
+  if (!one) return several;
+  rr_frame_release(several);
+  return one;
+}
+
+rr_camera test_random_view(const rr_scene *s, float dist_lo, float dist_hi, float aim, float fov_lo, float fov_hi) {
+  rr_camera cam;
+  rr_camera_init(&cam);
+  vec3 c = v3_scale(v3_add(s->bmin, s->bmax), 0.5f);
+  float r = 0.5f * v3_len(v3_sub(s->bmax, s->bmin));
+  vec3 dir = v3_norm(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)));
+  vec3 eye = v3_add(c, v3_scale(dir, r * (dist_lo == dist_hi ? dist_lo : test_randf(dist_lo, dist_hi))));
+  vec3 target = v3_add(c, v3_scale(v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1)), aim * r));
+  memcpy(cam.eye, &eye, 12), memcpy(cam.target, &target, 12);
+  cam.fov_deg = fov_lo == fov_hi ? fov_lo : test_randf(fov_lo, fov_hi);
+  return cam;
 }

@@ -5,6 +5,8 @@
 #include <stdbool.h>
 #include <stdio.h>
 
+#include "rr.h"
+
 extern int test_passed, test_failed;
 
 #define CHECK(cond, ...)                                                   \
@@ -28,9 +30,33 @@ const char *test_model(const char *name);
 /* True when RR_TEST_QUICK is set (the sanitizer run): property tests then visit
  * fewer views and smaller meshes, the same code paths. */
 bool test_quick(void);
-struct rr_frame;
 /* Samples where two visibility buffers differ in any byte of id, t, λ1 or λ2. */
-int test_frames_differ(const struct rr_frame *a, const struct rr_frame *b);
+int test_frames_differ(const rr_frame *a, const rr_frame *b);
+/* Samples of a frame that hit a triangle. */
+int test_frame_hits(const rr_frame *f);
+/* Renders w×h with method m on `threads` threads (cull: back faces culled) and
+ * checks that it succeeds; the frame, or NULL. */
+rr_frame *test_render(rr_device *dev, const rr_scene *s, const rr_camera *cam, rr_method m, int threads, int w, int h,
+                      int cull);
+/* The same with every option given. */
+rr_frame *test_render_opt(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_render_options *opt);
+/* The thread counts of the bit-identity tests: one, two, and more threads than
+ * cores (eight: tiles and bands are still dealt out dynamically on two cores). */
+enum { TEST_NTHREADS = 3 };
+extern const int test_threads[TEST_NTHREADS];
+/* Renders as *opt says (opt->threads aside) on each of test_threads and checks that
+ * every frame equals ref byte for byte (ids, t, λ1, λ2), or the one-thread frame
+ * when ref is NULL, and that S, E and N do not depend on the thread count where
+ * the method promises it (see testutil.c). `what` names the view in messages.
+ * Returns the one-thread frame (the caller releases it), or NULL. */
+rr_frame *test_render_threads(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_render_options *opt,
+                              const rr_frame *ref, const char *what);
+/* A random view of s: the eye at dist_lo..dist_hi times the radius of the scene's
+ * bounds from their centre, in a random direction (below 1: inside the bounds),
+ * looking at a point within aim times that radius of the centre, with a field of
+ * view of fov_lo..fov_hi degrees; the rest as rr_camera_init (perspective, y up).
+ * A range of one value (lo == hi) draws no random number. */
+rr_camera test_random_view(const rr_scene *s, float dist_lo, float dist_hi, float aim, float fov_lo, float fov_hi);
 /* Deterministic random numbers for property tests. */
 unsigned test_rand(void);
 float test_randf(float lo, float hi);
