@@ -497,7 +497,7 @@ typedef struct root_job {
   trav proto;     /* the frame's settings; every job works on its own copy */
   uint32_t first, count;
   tri_job *jobs;  /* chunk k's set-up triangles, from jobs[k * ROOT_CHUNK], */
-  int (*rows)[2]; /* and their first and last rows, which the bands scan */
+  int (*span)[3]; /* and their first and last blocks of rows and the band of the first */
   uint32_t kept[ROOT_BATCH / ROOT_CHUNK]; /* kept[k] of them */
   int bands, block_rows;
   rr_stats st[256];
@@ -516,8 +516,12 @@ static void root_setup(int k, int thread, void *arg) {
   } else {
     for (uint32_t i = i0; i < i0 + n; i++) kept += prepare(&t, i, NULL, out + kept);
   }
-  int(*rows)[2] = rj->rows + (size_t)k * ROOT_CHUNK;
-  for (uint32_t q = 0; q < kept; q++) rows[q][0] = out[q].bb[1], rows[q][1] = out[q].bb[3];
+  /* what the bands scan, worked out once here */
+  int(*span)[3] = rj->span + (size_t)k * ROOT_CHUNK;
+  for (uint32_t q = 0; q < kept; q++) {
+    span[q][0] = out[q].bb[1] / rj->block_rows, span[q][1] = out[q].bb[3] / rj->block_rows;
+    span[q][2] = span[q][0] % rj->bands;
+  }
   rj->kept[k] = kept;
   add_stats(&rj->st[thread], &t.st);
 }
@@ -533,10 +537,11 @@ static void root_band(int b, int thread, void *arg) {
   int nchunks = (int)((rj->count + ROOT_CHUNK - 1) / ROOT_CHUNK);
   for (int k = 0; k < nchunks; k++) {
     const tri_job *j = rj->jobs + (size_t)k * ROOT_CHUNK;
-    const int(*yy)[2] = (const int(*)[2])rj->rows + (size_t)k * ROOT_CHUNK;
+    const int(*span)[3] = (const int(*)[3])rj->span + (size_t)k * ROOT_CHUNK;
     for (uint32_t q = 0; q < rj->kept[k]; q++) {
-      int k0 = yy[q][0] / rows, k1 = yy[q][1] / rows;
-      for (int blk = k0 + ((b - k0 % rj->bands) + rj->bands) % rj->bands; blk <= k1; blk += rj->bands) {
+      int skip = b - span[q][2]; /* blocks from the first to band b's first */
+      if (skip < 0) skip += rj->bands;
+      for (int blk = span[q][0] + skip; blk <= span[q][1]; blk += rj->bands) {
         tile_rect r = {0, blk * rows, w, (blk + 1) * rows < h ? (blk + 1) * rows : h};
         draw(&t, &j[q], r);
       }
@@ -548,15 +553,17 @@ static void root_band(int b, int thread, void *arg) {
 static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *proto) {
   root_job *rj = calloc(1, sizeof *rj);
   tri_job *jobs = malloc((size_t)ROOT_BATCH * sizeof *jobs);
-  int(*rows)[2] = malloc((size_t)ROOT_BATCH * sizeof *rows);
-  if (!rj || !jobs || !rows) {
-    free(rj), free(jobs), free(rows);
+  int(*span)[3] = malloc((size_t)ROOT_BATCH * sizeof *span);
+  if (!rj || !jobs || !span) {
+    free(rj), free(jobs), free(span);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for triangle setups");
   }
-  rj->proto = *proto, rj->jobs = jobs, rj->rows = rows;
+  rj->proto = *proto, rj->jobs = jobs, rj->span = span;
   const oracles *o = ctx->oracles;
-  int align = o->binning && o->bin_size > HIZ ? (o->bin_size + HIZ - 1) / HIZ * HIZ : HIZ;
-  rj->bands = ctx->threads;
+  /* blocks of whole top-level bins, else of 4 z tiles (few small triangles then
+   * straddle two); 4 bands a thread deal the work out finely enough */
+  int align = o->binning && o->bin_size > HIZ ? (o->bin_size + HIZ - 1) / HIZ * HIZ : 4 * HIZ;
+  rj->bands = ctx->threads > 1 ? 4 * ctx->threads : 1;
   rj->block_rows = ctx->threads > 1 ? align : ctx->vb->height;
   uint32_t n = ctx->scene->ntris;
   for (uint32_t first = 0; first < n; first += ROOT_BATCH) {
@@ -565,7 +572,7 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
     parallel_for(rj->bands, ctx->threads, root_band, rj);
   }
   for (int i = 0; i < 256; i++) add_stats(ctx->stats, &rj->st[i]);
-  free(jobs), free(rows), free(rj);
+  free(jobs), free(span), free(rj);
   return RR_OK;
 }
 
