@@ -208,23 +208,6 @@ static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
   }
 }
 
-/* Triangle setup for a frustum: false when the triangle cannot cover a sample.
- * Planar cameras bound the triangle from its corners first (or take the bounds
- * bb the caller found), so the many triangles that fall between samples cost no
- * setup; S counts the setups done. */
-static bool prepare(trav *t, uint32_t id, const int *bb, tri_job *j) {
-  const camera *c = t->c;
-  if (c->planar) {
-    if (bb) memcpy(j->bb, bb, sizeof j->bb);
-    else if (!tri_screen_bounds(t->s, id, c, NULL, j->bb)) return false;
-  }
-  t->st.setups++;
-  if (tri_setup_planar(t->s, id, c, t->cull_back, &j->ts) == SETUP_CULLED) return false;
-  if (!c->planar && !tri_screen_bounds(t->s, id, c, &j->ts, j->bb)) return false;
-  finish_setup(t, id, j);
-  return true;
-}
-
 /* Sets up the bounded triangles b[0..nb-1] of a planar camera, eight at a time,
  * into out; returns how many can be seen. */
 static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job *out) {
@@ -247,6 +230,32 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
   return kept;
 }
 
+/* Triangle setup: triangles ids[0..n-1] (first..first+n-1 when ids is NULL) into
+ * out, keeping those that may cover a sample; returns how many. Planar cameras
+ * bound the triangles from their corners first (into scratch, room for n), so the
+ * many that fall between samples cost no setup; curved cameras bound a set-up
+ * triangle by its cone. S counts the setups done. */
+static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, tri_bound *scratch,
+                                tri_job *out) {
+  if (t->c->planar) {
+    uint32_t nb = ids ? tri_bounds_list(t->s, ids, n, t->c, t->simd, scratch)
+                      : tri_bounds_run(t->s, first, n, t->c, t->simd, scratch);
+    return setup_bounded(t, scratch, nb, out);
+  }
+  uint32_t kept = 0;
+  t->st.setups += n;
+  for (uint32_t k = 0; k < n; k++) {
+    uint32_t id = ids ? ids[k] : first + k;
+    tri_job *j = out + kept;
+    if (tri_setup_camera(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED ||
+        !tri_screen_bounds(t->s, id, t->c, &j->ts, j->bb))
+      continue;
+    finish_setup(t, id, j);
+    kept++;
+  }
+  return kept;
+}
+
 /* Rasterizes a prepared triangle into the samples of f it may cover. */
 KERNEL void draw(trav *t, const tri_job *j, tile_rect f) {
   tile_rect r = {j->bb[0] > f.x0 ? j->bb[0] : f.x0, j->bb[1] > f.y0 ? j->bb[1] : f.y0,
@@ -254,11 +263,6 @@ KERNEL void draw(trav *t, const tri_job *j, tile_rect f) {
   if (r.x0 >= r.x1 || r.y0 >= r.y1) return;
   if (t->o->binning) bin_raster(t, j, r, t->o->bin_size);
   else raster_samples(t, j, r);
-}
-
-static void rasterize(trav *t, uint32_t id, tile_rect f) {
-  tri_job j;
-  if (prepare(t, id, NULL, &j)) draw(t, &j, f);
 }
 
 /* ---- frusta against boxes ---------------------------------------------- */
@@ -444,15 +448,9 @@ static void generate(trav *t, const frustum *f, uint32_t node) {
   const rr_bvh *bvh = t->s->bvh;
   const bvh_node *n = &bvh->nodes[node];
   if (n->count) {
-    if (!t->c->planar) {
-      for (uint32_t k = 0; k < n->count; k++) rasterize(t, bvh->prims[n->first + k], f->r);
-      return;
-    }
-    /* planar: the leaf's triangles bounded, then set up, together */
     tri_bound b[BVH_MAX_LEAF];
     tri_job j[BVH_MAX_LEAF];
-    uint32_t nb = tri_bounds_list(t->s, bvh->prims + n->first, n->count, t->c, t->simd, b);
-    uint32_t kept = setup_bounded(t, b, nb, j);
+    uint32_t kept = setup_triangles(t, 0, bvh->prims + n->first, n->count, b, j);
     for (uint32_t k = 0; k < kept; k++) draw(t, &j[k], f->r);
     return;
   }
@@ -494,7 +492,7 @@ static void add_stats(rr_stats *to, const rr_stats *s) {
  * runs sort-middle, like the 2D pipeline: a batch of triangles is bounded and set
  * up in parallel chunks, then drawn in parallel bands of rows. Each triangle is set
  * up once, so S does not depend on the thread count. */
-#define ROOT_BATCH 131072/* triangles set up before they are drawn */
+#define ROOT_BATCH 131072 /* triangles set up before they are drawn */
 #define ROOT_CHUNK 2048  /* triangles per setup job */
 
 typedef struct root_job {
@@ -511,15 +509,10 @@ static void root_setup(int k, int thread, void *arg) {
   root_job *rj = arg;
   trav t = rj->proto;
   uint32_t i0 = rj->first + (uint32_t)k * ROOT_CHUNK, end = rj->first + rj->count;
-  uint32_t n = end - i0 < ROOT_CHUNK ? end - i0 : ROOT_CHUNK, kept = 0;
+  uint32_t n = end - i0 < ROOT_CHUNK ? end - i0 : ROOT_CHUNK;
   tri_job *out = rj->jobs + (size_t)k * ROOT_CHUNK;
-  if (t.c->planar) {
-    /* bounded from their corners, then set up eight at a time */
-    tri_bound b[ROOT_CHUNK];
-    kept = setup_bounded(&t, b, tri_bounds_run(t.s, i0, n, t.c, t.simd, b), out);
-  } else {
-    for (uint32_t i = i0; i < i0 + n; i++) kept += prepare(&t, i, NULL, out + kept);
-  }
+  tri_bound scratch[ROOT_CHUNK];
+  uint32_t kept = setup_triangles(&t, i0, NULL, n, scratch, out);
   /* what the bands scan, worked out once here */
   int(*span)[3] = rj->span + (size_t)k * ROOT_CHUNK;
   for (uint32_t q = 0; q < kept; q++) {
