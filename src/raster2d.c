@@ -584,7 +584,9 @@ static void bin_block_claims(const tri2d *t, int level, int bx, int by, bin_ctx 
  * parent's), and would only add tests. */
 KERNEL void raster_bin(const tri2d *t, int y0, int y1, bin_ctx *bc, const bool count) {
   int ry0 = y0 > t->rect[1] ? y0 : t->rect[1], ry1 = y1 < t->rect[3] ? y1 : t->rect[3];
-  int extent = t->rect[2] - t->rect[0] > ry1 - ry0 ? t->rect[2] - t->rect[0] : ry1 - ry0;
+  /* the level from the whole rectangle, not its part in this band: the same
+   * blocks on any number of bands, so E does not depend on the thread count */
+  int h = t->rect[3] - t->rect[1], extent = t->rect[2] - t->rect[0] > h ? t->rect[2] - t->rect[0] : h;
   int level = 0;
   while (level < LEVELS - 1 && extent >= 2 * block_size(level)) level++;
   const int s = block_size(level), m = ~(s - 1);

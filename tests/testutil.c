@@ -87,19 +87,17 @@ const int test_threads[TEST_NTHREADS] = {1, 2, 8};
  * number above one (*several). The ray casters trace every ray and packet alike in
  * tiles of a fixed size; rasterization from the root (3dr-bb, 3dr-bin) sets each
  * triangle up once and draws whole blocks of rows that no two threads share;
- * 2dr-bb sets up in chunks and draws bands of rows; 3dr-fc starts from frusta of
- * 256 samples on any number of threads: all three on any number. 3dr-fs and
- * 3dr-full start from the whole image on one thread but from tiles of 256 samples
- * on several, so only several threads agree among themselves (and with one
- * thread on an image of one tile). 2dr-bin picks a triangle's first block size
- * from its rectangle clipped to a band of rows, and the bands depend on the thread
- * count: S only. auto times its candidates and may choose another method. */
+ * 2dr-bb and 2dr-bin set up in chunks and draw bands of whole blocks; 3dr-fc starts
+ * from frusta of 256 samples on any number of threads: all three on any number.
+ * 3dr-fs and 3dr-full start from the whole image on one thread but from tiles of
+ * 256 samples on several, so only several threads agree among themselves (and
+ * with one thread on an image of one tile). auto times its candidates and may
+ * choose another method. */
 enum { SAME_S = 1, SAME_E = 2, SAME_N = 4, SAME_ALL = 7 };
 static void same_stats(rr_method m, int *any, int *several) {
   *any = *several = 0;
   switch (m) {
   case RR_METHOD_AUTO: return;
-  case RR_METHOD_2DR_BIN: *any = SAME_S; return;
   case RR_METHOD_3DR_FS:
   case RR_METHOD_3DR_FULL: *several = SAME_ALL; return;
   default: *any = SAME_ALL; return;
