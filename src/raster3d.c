@@ -108,12 +108,6 @@ static inline uint32_t keep_bounded(const rr_scene *s, uint32_t i, const camera 
   return tri_screen_bounds(s, i, c, NULL, out->bb);
 }
 
-static uint32_t tri_bounds_run_scalar(const rr_scene *s, uint32_t first, uint32_t n, const camera *c, tri_bound *out) {
-  uint32_t kept = 0;
-  for (uint32_t i = first; i < first + n; i++) kept += keep_bounded(s, i, c, out + kept);
-  return kept;
-}
-
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 
@@ -193,27 +187,17 @@ __attribute__((target("avx2"))) static uint32_t bounds8_avx2(const rr_scene *s, 
 }
 #endif
 
-uint32_t tri_bounds_run(const rr_scene *s, uint32_t first, uint32_t n, const camera *c, bool simd, tri_bound *out) {
-  uint32_t kept = 0, i = first;
-#if defined(__x86_64__) || defined(__i386__)
-  if (simd && !s->inf && __builtin_cpu_supports("avx2"))
-    for (; i + 8 <= first + n; i += 8) kept += bounds8_avx2(s, i, NULL, 8, c, out + kept);
-#else
-  (void)simd;
-#endif
-  return kept + tri_bounds_run_scalar(s, i, first + n - i, c, out + kept);
-}
-
-uint32_t tri_bounds_list(const rr_scene *s, const uint32_t *ids, uint32_t n, const camera *c, bool simd,
-                         tri_bound *out) {
+uint32_t tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
+                           bool simd, tri_bound *out) {
   uint32_t kept = 0, k = 0;
 #if defined(__x86_64__) || defined(__i386__)
   if (simd && !s->inf && __builtin_cpu_supports("avx2"))
-    for (; k < n; k += 8) kept += bounds8_avx2(s, 0, ids + k, n - k < 8 ? (int)(n - k) : 8, c, out + kept);
+    for (; k < n; k += 8)
+      kept += bounds8_avx2(s, first + k, ids ? ids + k : NULL, n - k < 8 ? (int)(n - k) : 8, c, out + kept);
 #else
   (void)simd;
 #endif
-  for (; k < n; k++) kept += keep_bounded(s, ids[k], c, out + kept);
+  for (; k < n; k++) kept += keep_bounded(s, ids ? ids[k] : first + k, c, out + kept);
   return kept;
 }
 

@@ -414,17 +414,15 @@ bool raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, do
  * directions no edge plane excludes. */
 bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int rect[4]);
 /* Planar cameras bound a triangle from its corners alone, before its setup: most
- * triangles of a detailed mesh fall between samples. tri_bounds_run bounds
- * triangles first .. first+n-1 (8 at a time with AVX2 when simd) and writes those
- * whose rectangle holds a sample to out; returns how many. */
+ * triangles of a detailed mesh fall between samples. tri_corner_bounds bounds triangles
+ * ids[0..n-1] (first..first+n-1 when ids is NULL), 8 at a time with AVX2 when
+ * simd, and writes those whose rectangle holds a sample to out; returns how many. */
 typedef struct tri_bound {
   uint32_t id;
   int bb[4]; /* inclusive pixel rectangle, as tri_screen_bounds */
 } tri_bound;
-uint32_t tri_bounds_run(const rr_scene *s, uint32_t first, uint32_t n, const camera *c, bool simd, tri_bound *out);
-/* The same for triangles ids[0..n-1] (a BVH leaf's). */
-uint32_t tri_bounds_list(const rr_scene *s, const uint32_t *ids, uint32_t n, const camera *c, bool simd,
-                         tri_bound *out);
+uint32_t tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
+                           bool simd, tri_bound *out);
 /* Tests every sample of an inclusive rectangle against one set-up triangle and
  * returns the number of edge-function evaluations; adds the samples the
  * triangle covers to *covered. simd: use AVX2 where the processor has it. */

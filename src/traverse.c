@@ -238,9 +238,7 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
 static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, tri_bound *scratch,
                                 tri_job *out) {
   if (t->c->planar) {
-    uint32_t nb = ids ? tri_bounds_list(t->s, ids, n, t->c, t->simd, scratch)
-                      : tri_bounds_run(t->s, first, n, t->c, t->simd, scratch);
-    return setup_bounded(t, scratch, nb, out);
+    return setup_bounded(t, scratch, tri_corner_bounds(t->s, first, ids, n, t->c, t->simd, scratch), out);
   }
   uint32_t kept = 0;
   t->st.setups += n;

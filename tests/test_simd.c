@@ -55,7 +55,8 @@ static bool random_camera(rr_device *dev, rr_camera_type type, float scale, int 
 static void check_bounds(const rr_scene *s, const camera *c, const char *what) {
   static tri_bound a[N], b[N];
   uint32_t first = test_rand() % 5, n = s->ntris - first - test_rand() % 7; /* unaligned starts and tails */
-  uint32_t na = tri_bounds_run(s, first, n, c, false, a), nb = tri_bounds_run(s, first, n, c, true, b);
+  uint32_t na = tri_corner_bounds(s, first, NULL, n, c, false, a);
+  uint32_t nb = tri_corner_bounds(s, first, NULL, n, c, true, b);
   CHECK(na == nb && memcmp(a, b, na * sizeof *a) == 0, "%s: AVX2 bounds differ from scalar (%u vs %u kept)", what, nb,
         na);
   CHECK(na > 0, "%s: no triangle bounded on screen", what);
@@ -64,7 +65,7 @@ static void check_bounds(const rr_scene *s, const camera *c, const char *what) {
   int differ = 0;
   for (uint32_t len = 1; len <= 20; len++) {
     for (uint32_t k = 0; k < len; k++) ids[k] = test_rand() % s->ntris;
-    na = tri_bounds_list(s, ids, len, c, false, a), nb = tri_bounds_list(s, ids, len, c, true, b);
+    na = tri_corner_bounds(s, 0, ids, len, c, false, a), nb = tri_corner_bounds(s, 0, ids, len, c, true, b);
     differ += na != nb || memcmp(a, b, na * sizeof *a) != 0;
   }
   CHECK(differ == 0, "%s: AVX2 bounds of id lists differ from scalar for %d lengths", what, differ);
