@@ -13,7 +13,7 @@
  * --instructions: instead, the instructions of one frame (or cast) of each mode,
  * counted by running this again under callgrind (use a smaller --size). */
 #include "benchutil.h"
-#include "rr.h"
+#include "vis/vis.h"
 #ifdef RR_HAVE_EMBREE
 #include "peer_embree.h"
 #endif
@@ -44,7 +44,7 @@ static void bench_rc_scene(rr_device *dev, const char *name, const bench_rc_opts
   rr_camera cam;
   bench_camera(dev, s, o->w, o->h, &cam);
   camera c;
-  if (camera_setup(dev, &cam, o->w, o->h, &c) != RR_OK) {
+  if (rr_cam_setup(dev, &cam, o->w, o->h, &c) != RR_OK) {
     fprintf(stderr, "bench_rc: %s\n", rr_device_message(dev));
     exit(1);
   }
@@ -125,7 +125,7 @@ static void bench_rc_scene(rr_device *dev, const char *name, const bench_rc_opts
     }
   }
   free(eids), free(et), free(bb_ids), free(bb_t);
-  camera_release(&c);
+  rr_cam_release(&c);
   rr_scene_release(s);
 }
 
@@ -155,7 +155,7 @@ int main(int argc, char **argv) {
   if (o.w < 1 || o.h < 1 || o.w > RR_MAX_SIZE || o.h > RR_MAX_SIZE) o.w = o.h = 1024;
   if (!o.nthreads) {
     o.threads[o.nthreads++] = 1;
-    if (cpu_count() > 1) o.threads[o.nthreads++] = cpu_count();
+    if (rr_cpu_count() > 1) o.threads[o.nthreads++] = rr_cpu_count();
   }
   if (!o.nmethods) {
     o.methods[o.nmethods++] = RR_METHOD_3DR_BB; /* first: the bitwise reference */

@@ -14,7 +14,7 @@
  *   bench_table [--threads N] [--reps N] [--size N] [--out PREFIX]
  *               [--instructions] [--instr-size N] [SCENE...] */
 #include "benchutil.h"
-#include "rr.h"
+#include "vis/vis.h"
 #ifdef RR_HAVE_EMBREE
 #include "peer_embree.h"
 #endif
@@ -177,7 +177,7 @@ static void run_embree(rr_device *dev, const rr_scene *s, const rr_camera *cam, 
   peer_embree_release(e);
   e = peer_embree_new(s, o->threads, 2, &build);
   camera c;
-  if (!e || camera_setup(dev, cam, o->size, o->size, &c) != RR_OK) {
+  if (!e || rr_cam_setup(dev, cam, o->size, o->size, &c) != RR_OK) {
     peer_embree_release(e);
     return;
   }
@@ -197,7 +197,7 @@ static void run_embree(rr_device *dev, const rr_scene *s, const rr_camera *cam, 
     fprintf(stderr, "  embree-%d   %9.1f ms (no culling)\n", w ? 8 : 1, cl->ms);
   }
   free(ids), free(t);
-  camera_release(&c);
+  rr_cam_release(&c);
   peer_embree_release(e);
 }
 #endif

@@ -65,9 +65,9 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
   rtcReleaseGeometry(g);
   long long before = atomic_load(&e->bytes);
   atomic_store(&e->peak, before);
-  double t0 = now_ms();
+  double t0 = rr_now_ms();
   rtcCommitScene(e->scene);
-  *build_ms = now_ms() - t0;
+  *build_ms = rr_now_ms() - t0;
   long long after = atomic_load(&e->bytes);
   e->mem = (peer_embree_memory){(double)after, (double)(after - before), (double)atomic_load(&e->peak)};
   return e;
@@ -151,7 +151,7 @@ static void cast8_tile(int job, int thread, void *arg) {
 double peer_embree_cast(peer_embree *e, const camera *c, int width, int threads, uint32_t *ids, float *t) {
   cast_job j = {e, c, width, (c->width + EMB_TILE - 1) / EMB_TILE, ids, t};
   int tiles = j.tiles_x * ((c->height + EMB_TILE - 1) / EMB_TILE);
-  double t0 = now_ms();
-  parallel_for(tiles, threads, width == 8 ? cast8_tile : cast1_tile, &j);
-  return now_ms() - t0;
+  double t0 = rr_now_ms();
+  rr_parallel_for(tiles, threads, width == 8 ? cast8_tile : cast1_tile, &j);
+  return rr_now_ms() - t0;
 }

@@ -1,9 +1,9 @@
 /* Embree 3 as a peer of the ray-casting methods (bench only): the same triangles,
  * the same rays (origin = eye, direction = camera_dir of each sample), the same
- * thread pool (parallel_for). Compiled when the build finds Embree 3. */
+ * thread pool (rr_parallel_for). Compiled when the build finds Embree 3. */
 #ifndef RR_PEER_EMBREE_H
 #define RR_PEER_EMBREE_H
-#include "rr.h"
+#include "vis/vis.h"
 
 typedef struct peer_embree peer_embree;
 

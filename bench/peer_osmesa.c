@@ -5,7 +5,7 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include "peer_osmesa.h"
 
-#include "rr.h"
+#include "vis/vis.h"
 
 #include <GL/osmesa.h>
 #include <stdio.h>
@@ -22,7 +22,7 @@ struct osmesa_peer {
   vec3 bmin, bmax;
 };
 
-static double now(void) { return now_ms(); }
+static double now(void) { return rr_now_ms(); }
 
 static int cmp_double(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
@@ -153,13 +153,13 @@ static void clip_matrix(const camera *c, const osmesa_peer *p, double m[16]) {
 
 double osmesa_render(osmesa_peer *p, const rr_camera *cam, int cull, int reps) {
   camera c;
-  if (camera_setup(NULL, cam, p->w, p->h, &c) != RR_OK || cam->type != RR_CAMERA_PERSPECTIVE) {
+  if (rr_cam_setup(NULL, cam, p->w, p->h, &c) != RR_OK || cam->type != RR_CAMERA_PERSPECTIVE) {
     fprintf(stderr, "osmesa: needs a valid perspective camera\n");
     return -1;
   }
   double m[16];
   clip_matrix(&c, p, m);
-  camera_release(&c);
+  rr_cam_release(&c);
   glMatrixMode(GL_PROJECTION);
   glLoadMatrixd(m);
   if (cull) {

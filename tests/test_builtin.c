@@ -1,6 +1,7 @@
 /* Built-in scenes: exact plane coordinates, closed and consistently wound sphere and
  * box, grid copies that are exact translations, and the name errors. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <string.h>
@@ -11,7 +12,7 @@ static rr_device *dev;
 static rr_scene *load(const char *name, rr_error *err) {
   rr_scene *s = NULL;
   rr_error e = rr_scene_new(dev, &s);
-  if (!e) e = scene_load_builtin(s, name);
+  if (!e) e = rr_scene_load_builtin(s, name);
   if (err) *err = e;
   if (e) {
     rr_scene_release(s);
@@ -161,7 +162,7 @@ static void test_grid(int n) {
   const char *path = RR_DATA_DIR "/teapot.obj";
   rr_scene *ref = NULL;
   rr_error e = rr_scene_new(dev, &ref);
-  if (!e) e = scene_load_file(ref, path);
+  if (!e) e = rr_scene_load_file(ref, path);
   CHECK(e == RR_OK, "loading %s: %s", path, rr_device_message(dev));
   char name[512];
   snprintf(name, sizeof name, "grid:%s:%d", path, n);

@@ -3,7 +3,8 @@
  * rr_intersect / rr_occluded against brute force with the same sample test (rays
  * from inside, rays parallel to faces, rays through shared vertices), and bad
  * input: empty scenes, degenerate triangles, huge and tiny coordinates. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <string.h>
@@ -161,12 +162,12 @@ static rr_scene *random_scene(rr_device *dev, uint32_t n, float spread, float si
 /* Brute force: every triangle with the same sample test, the same tie rule on t. */
 static rr_hit brute(const rr_scene *s, const rr_ray *ray, int *any) {
   camera rc;
-  ray_camera(ray->org, ray->dir, &rc);
+  rr_cam_for_ray(ray->org, ray->dir, &rc);
   rr_hit h = {RR_MISS, INFINITY, 0, 0};
   *any = 0;
   for (uint32_t i = 0; i < s->ntris; i++) {
     float t, l1, l2;
-    if (!ray_tri_hit(s, i, &rc, false, ray->tmin, ray->tmax, &t, &l1, &l2)) continue;
+    if (!rr_tri_ray_hit(s, i, &rc, false, ray->tmin, ray->tmax, &t, &l1, &l2)) continue;
     *any = 1;
     if (depth_wins(t, i, h.t, h.prim)) h = (rr_hit){i, t, l1, l2};
   }

@@ -3,7 +3,8 @@
  * camera, on 1, 2 or 8 threads (curved binning and culling are conservative);
  * the cube's faces agree with six 90° perspective renders; 2D methods refuse
  * curved cameras. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <string.h>
@@ -56,7 +57,7 @@ static void check_directions(rr_device *dev) {
   for (size_t t = 0; t < sizeof types / sizeof types[0]; t++) {
     rr_camera rc = make_camera(types[t], v3(1, 2, 3), v3(-1, 0.5f, -2), types[t] == RR_CAMERA_FISHEYE ? 230 : 60);
     camera c;
-    if (camera_setup(dev, &rc, W, H, &c) != RR_OK) {
+    if (rr_cam_setup(dev, &rc, W, H, &c) != RR_OK) {
       CHECK(0, "camera %s: %s", rr_camera_name(types[t]), rr_device_message(dev));
       continue;
     }
@@ -66,7 +67,7 @@ static void check_directions(rr_device *dev) {
       bool has_ref;
       reference_dir(&rc, W, H, x, y, ref, &has_ref);
       vec3 o, d;
-      bool has = camera_ray(&c, x, y, &o, &d);
+      bool has = rr_cam_ray(&c, x, y, &o, &d);
       CHECK(has == has_ref, "%s (%d,%d): ray %d, reference %d", rr_camera_name(types[t]), x, y, has, has_ref);
       if (!has || !has_ref) continue;
       double ld = sqrt((double)d.x * d.x + (double)d.y * d.y + (double)d.z * d.z);
@@ -75,15 +76,15 @@ static void check_directions(rr_device *dev) {
       CHECK(cosang > 1 - 1e-10 || acos(fmin(cosang, 1)) < 2e-6, "%s (%d,%d): direction off by %g rad",
             rr_camera_name(types[t]), x, y, acos(fmin(cosang, 1)));
     }
-    camera_release(&c);
+    rr_cam_release(&c);
   }
   /* Orthographic: parallel rays along fwd from the image plane through the eye. */
   rr_camera rc = make_camera(RR_CAMERA_ORTHOGRAPHIC, v3(0, 0, 5), v3(0, 0, 0), 45);
   rc.ortho_height = 4;
   camera c;
-  CHECK(camera_setup(dev, &rc, 40, 20, &c) == RR_OK, "ortho");
+  CHECK(rr_cam_setup(dev, &rc, 40, 20, &c) == RR_OK, "ortho");
   vec3 o, d;
-  camera_ray(&c, 0, 0, &o, &d);
+  rr_cam_ray(&c, 0, 0, &o, &d);
   CHECK(fabsf(o.x - (-4 + 0.1f)) < 1e-5f && fabsf(o.y - (2 - 0.1f)) < 1e-5f && o.z == 5 && d.z == -1,
         "ortho corner ray from (%g,%g,%g) along (%g,%g,%g)", o.x, o.y, o.z, d.x, d.y, d.z);
 }

@@ -1,6 +1,7 @@
 /* The command-line tool end to end: outputs that round-trip, statistics, and every
  * bad input giving a one-line message, its exit code and no output file. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <stdio.h>

@@ -4,7 +4,8 @@
  * inside too), on 1, 2 and 8 threads with the same S, E and N on each; the 2D
  * methods give their own on any number of threads. Also: the oracles are
  * conservative, statistics are deterministic and add up per pixel. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <string.h>
@@ -125,7 +126,7 @@ static void check_outside_oracle(rr_device *dev) {
     rc.target[0] = test_randf(-1, 1), rc.target[1] = test_randf(-1, 1), rc.target[2] = test_randf(-1, 1);
     rc.fov_deg = test_randf(20, 120);
     camera c;
-    if (camera_setup(dev, &rc, 48, 32, &c) != RR_OK) continue;
+    if (rr_cam_setup(dev, &rc, 48, 32, &c) != RR_OK) continue;
     int x0 = test_rand() % 40, y0 = test_rand() % 28;
     int x1 = x0 + 1 + test_rand() % (48 - x0), y1 = y0 + 1 + test_rand() % (32 - y0);
     if (iter % 5 == 0) x1 = x0 + 1, y1 = y0 + 1;
@@ -146,7 +147,7 @@ static void check_outside_oracle(rr_device *dev) {
         }
         hit = t0 <= t1;
       }
-    bool out = oracle_outside(&c, x0, y0, x1, y1, &b);
+    bool out = rr_oracle_outside(&c, x0, y0, x1, y1, &b);
     CHECK(!(hit && out), "iter %d: a box met by a sample ray of [%d,%d)x[%d,%d) was culled", iter, x0, x1, y0, y1);
     culled += out, kept += !out;
   }
@@ -176,7 +177,7 @@ static void check_occluded_oracle(rr_device *dev, const char *name) {
     rr_frame *f = test_render(dev, s, &cam, RR_METHOD_RC_BVH, 2, 96, 72, 0);
     if (!f) f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 2, 96, 72, 0);
     camera c;
-    camera_setup(dev, &cam, 96, 72, &c);
+    rr_cam_setup(dev, &cam, 96, 72, &c);
     for (int y0 = 0; y0 < 72; y0 += 8)
       for (int x0 = 0; x0 < 96; x0 += 8) {
         float far = 0;
@@ -187,14 +188,14 @@ static void check_occluded_oracle(rr_device *dev, const char *name) {
             uint32_t id = f->vb.id[y * 96 + x];
             if (id == RR_MISS) continue;
             tested++;
-            bool occ = oracle_occluded(&c, &s->bvh->nodes[leaf_of[id]], far);
+            bool occ = rr_oracle_occluded(&c, &s->bvh->nodes[leaf_of[id]], far);
             CHECK(!occ, "%s: the leaf of visible triangle %u was culled as occluded", name, id);
           }
         /* and it does cull: a box well behind everything in the tile */
         bvh_node behind = s->bvh->nodes[0];
         vec3 shift = v3_scale(c.fwd, 3 * far + 10 * v3_len(v3_sub(s->bmax, s->bmin)));
         for (int a = 0; a < 3; a++) behind.lo[a] += v3_get(shift, a), behind.hi[a] += v3_get(shift, a);
-        culled += isfinite(far) && oracle_occluded(&c, &behind, far);
+        culled += isfinite(far) && rr_oracle_occluded(&c, &behind, far);
       }
     rr_frame_release(f);
   }

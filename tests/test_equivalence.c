@@ -2,7 +2,8 @@
  * sample test: their visibility buffers must be bit-identical, on built-in scenes
  * and on real meshes at random views (some from inside the mesh's bounds), with
  * 3dr-bb on 1, 2 and 8 threads. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 static void check_scene(rr_device *dev, const char *name, int views, int w, int h) {

@@ -6,7 +6,8 @@
  * double precision against the analytic plane y = 0 and the objects' triangles.
  * Also: rr_scene_add_mesh4 (dehomogenisation, three corners at infinity skipped),
  * rr_intersect, and the 2D methods' refusal. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <string.h>
@@ -60,8 +61,8 @@ static uint32_t reference(const rr_scene *s, uint32_t nplane, vec3 of, vec3 df, 
 static int against_reference(rr_device *dev, const rr_scene *s, uint32_t nplane, const rr_camera *rc,
                              const rr_frame *f, int *rays, int *plane_hits, double *worst_near) {
   camera c;
-  if (camera_setup(dev, rc, f->vb.width, f->vb.height, &c) != RR_OK) {
-    CHECK(0, "camera_setup: %s", rr_device_message(dev));
+  if (rr_cam_setup(dev, rc, f->vb.width, f->vb.height, &c) != RR_OK) {
+    CHECK(0, "rr_cam_setup: %s", rr_device_message(dev));
     return -1;
   }
   int bad = 0;
@@ -69,7 +70,7 @@ static int against_reference(rr_device *dev, const rr_scene *s, uint32_t nplane,
     for (int x = 0; x < f->vb.width; x++) {
       size_t k = (size_t)y * f->vb.width + x;
       vec3 o, d;
-      if (!camera_ray(&c, x, y, &o, &d)) {
+      if (!rr_cam_ray(&c, x, y, &o, &d)) {
         bad += f->vb.id[k] != RR_MISS;
         continue;
       }
@@ -89,7 +90,7 @@ static int against_reference(rr_device *dev, const rr_scene *s, uint32_t nplane,
         if (t * v3_len(d) < 50 && rel > *worst_near) *worst_near = rel;
       }
     }
-  camera_release(&c);
+  rr_cam_release(&c);
   return bad;
 }
 

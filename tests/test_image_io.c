@@ -3,7 +3,8 @@
  * clean parse errors, and material textures. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <dirent.h>
@@ -501,7 +502,7 @@ static void test_textures(void) {
   memset(&s, 0, sizeof s);
   s.materials = mats;
   s.nmaterials = 5;
-  scene_load_textures(&s, dir);
+  rr_scene_load_textures(&s, dir);
 
   rr_texture *t = &mats[0].texture;
   CHECK(t->width == 4 && t->height == 2 && t->rgb && memcmp(t->rgb, rgb.data, 24) == 0,

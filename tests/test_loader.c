@@ -1,6 +1,7 @@
 /* Scene import: polygons fan-triangulated in file order, negative OBJ indices,
  * PLY and glTF files, materials with textures, and every bad input. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <stdio.h>

@@ -4,7 +4,8 @@
  * for bit on 1, 2 and 8 threads; and it agrees with 3D rasterization (3dr-bb) where
  * snapping allows: near and across the eye plane, behind it, on huge triangles,
  * inside closed meshes, and on real meshes. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <string.h>
@@ -22,7 +23,7 @@ static rr_camera pub_camera(vec3 eye, vec3 target, vec3 up, float fov) {
 static camera make_cam(vec3 eye, vec3 target, vec3 up, float fov, int w, int h) {
   rr_camera rc = pub_camera(eye, target, up, fov);
   camera c;
-  rr_error e = camera_setup(dev, &rc, w, h, &c);
+  rr_error e = rr_cam_setup(dev, &rc, w, h, &c);
   CHECK(e == RR_OK, "camera: %s", rr_device_message(dev));
   return c;
 }
@@ -53,7 +54,7 @@ static void check_projection(const rr_scene *s) {
       vec3 d = camera_dir(&c, x + 0.5f, y + 0.5f);
       vec3 p = v3_add(c.eye, v3_scale(d, test_randf(0.1f, 20)));
       double sx, sy;
-      bool ok = raster2d_project(s, &c, p, &sx, &sy);
+      bool ok = rr_raster2d_project(s, &c, p, &sx, &sy);
       CHECK(ok, "a point in front of the eye is behind the near plane");
       if (!ok) continue;
       double err = fmax(fabs(sx - (x + 0.5)), fabs(sy - (y + 0.5)));
@@ -71,13 +72,13 @@ static void check_projection(const rr_scene *s) {
     rc.type = RR_CAMERA_ORTHOGRAPHIC, rc.ortho_height = test_randf(0.5f, 4);
     int w = 64 + (int)(test_rand() % 500), h = 64 + (int)(test_rand() % 500);
     camera c;
-    if (camera_setup(dev, &rc, w, h, &c) != RR_OK) continue;
+    if (rr_cam_setup(dev, &rc, w, h, &c) != RR_OK) continue;
     for (int k = 0; k < 20; k++) {
       int x = (int)(test_rand() % (unsigned)w), y = (int)(test_rand() % (unsigned)h);
       vec3 o, d;
-      camera_ray(&c, x, y, &o, &d);
+      rr_cam_ray(&c, x, y, &o, &d);
       double sx, sy;
-      if (!raster2d_project(s, &c, v3_add(o, v3_scale(d, test_randf(0.1f, 4))), &sx, &sy)) {
+      if (!rr_raster2d_project(s, &c, v3_add(o, v3_scale(d, test_randf(0.1f, 4))), &sx, &sy)) {
         CHECK(0, "orthographic: a point in front of the image plane is behind the near plane");
         continue;
       }
@@ -99,7 +100,7 @@ static void check_claims(const rr_scene *s, const camera *c, int mode, const cha
   for (int run = 0; run < 3; run++) {
     bool bin = run > 0;
     int threads = run == 2 ? 3 : 1;
-    rr_error e = raster2d_claims(s, c, bin, threads, front, back);
+    rr_error e = rr_raster2d_claims(s, c, bin, threads, front, back);
     CHECK(e == RR_OK, "claims: %s", rr_device_message(dev));
     int holes = 0, doubles = 0, unequal = 0;
     for (size_t k = 0; k < n; k++) {
@@ -113,7 +114,7 @@ static void check_claims(const rr_scene *s, const camera *c, int mode, const cha
         double hit[3][3], t = 0;
         for (int j = 0; j < 3; j++) {
           vec3 o, d;
-          camera_ray(c, x + (j == 1), y + (j == 2), &o, &d);
+          rr_cam_ray(c, x + (j == 1), y + (j == 2), &o, &d);
           double tj = -(double)o.y / d.y;
           hit[j][0] = o.x + tj * d.x, hit[j][2] = o.z + tj * d.z;
           if (j == 0) t = tj;
@@ -147,13 +148,13 @@ static void check_fill_rule(void) {
     /* Orthographic, one pixel per cell: centres on vertices, then random views. */
     rr_camera rc = pub_camera(v3(-0.5f, 10, -0.5f), v3(-0.5f, 0, -0.5f), v3(0, 0, -1), 45);
     rc.type = RR_CAMERA_ORTHOGRAPHIC, rc.ortho_height = 64;
-    CHECK(camera_setup(dev, &rc, 64, 64, &c) == RR_OK, "orthographic camera");
+    CHECK(rr_cam_setup(dev, &rc, 64, 64, &c) == RR_OK, "orthographic camera");
     check_claims(plane, &c, 0, "plane, orthographic, pixel centres on vertices");
     for (int v = 0; v < 3; v++) {
       rc = pub_camera(v3(test_randf(-20, 20), test_randf(2, 30), test_randf(-20, 20)),
                       v3(test_randf(-10, 10), 0, test_randf(-10, 10)), v3(0, 1, 0), 45);
       rc.type = RR_CAMERA_ORTHOGRAPHIC, rc.ortho_height = test_randf(5, 60);
-      CHECK(camera_setup(dev, &rc, 96, 72, &c) == RR_OK, "orthographic camera");
+      CHECK(rr_cam_setup(dev, &rc, 96, 72, &c) == RR_OK, "orthographic camera");
       check_claims(plane, &c, 1, "plane, orthographic, random view");
     }
   }
@@ -195,7 +196,7 @@ static void check_fill_rule(void) {
 /* ---- agreement with 2dr-bb (bitwise) and 3dr-bb (within snapping) ----------------- */
 
 /* The ray of pixel (x, y) of a planar camera, from its parameterization in double
- * (camera_ray rounds origin and direction to float). */
+ * (rr_cam_ray rounds origin and direction to float). */
 static void exact_ray(const camera *c, int x, int y, double o[3], double d[3]) {
   double sx = x + 0.5, sy = y + 0.5;
   bool ortho = c->type == RR_CAMERA_ORTHOGRAPHIC;
@@ -281,7 +282,7 @@ static agreement check_view(const rr_scene *s, const rr_camera *cam, int w, int 
                             double min_id, double min_hit) {
   agreement g = {0};
   camera c;
-  if (camera_setup(dev, cam, w, h, &c) != RR_OK) {
+  if (rr_cam_setup(dev, cam, w, h, &c) != RR_OK) {
     CHECK(0, "%s: camera: %s", what, rr_device_message(dev));
     return g;
   }

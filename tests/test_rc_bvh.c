@@ -2,7 +2,8 @@
  * 3dr-bb: their visibility buffers (ids, t, λ1, λ2) must be bit-identical, at
  * random views of real meshes (some with the eye inside the bounds), on built-in
  * scenes with shared edges through pixel centres, at full size, on 1, 2 and 8 threads. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 /* Renders a view with the reference and with rc-bvh / rc-packet on 1, 2 and 8
@@ -46,17 +47,17 @@ static void check_scene(rr_device *dev, const char *path, const char *name, int 
 }
 
 /* The culling bounds themselves: at every sample where a triangle passes the
- * sample test, its t is at least the bound of tri_bounds() and the sample lies in
+ * sample test, its t is at least the bound of rr_tri_bounds() and the sample lies in
  * its rectangle; grazing views stress them most. */
 static void check_bound(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h, const char *name) {
   camera c;
-  if (camera_setup(dev, cam, w, h, &c) != RR_OK) return;
+  if (rr_cam_setup(dev, cam, w, h, &c) != RR_OK) return;
   long checked = 0, broken = 0;
   uint32_t step = s->ntris > 20000 ? s->ntris / 20000 : 1;
   for (uint32_t i = 0; i < s->ntris; i += step) {
     tri_setup ts;
-    if (tri_setup_planar(s, i, &c, false, &ts) == SETUP_CULLED) continue;
-    float rect[4], lo = tri_bounds(&ts, &c, rect);
+    if (rr_tri_setup(s, i, &c, false, &ts) == SETUP_CULLED) continue;
+    float rect[4], lo = rr_tri_bounds(&ts, &c, rect);
     for (int y = 0; y < h; y++)
       for (int x = 0; x < w; x++) {
         float e[3], t, l1, l2;
@@ -71,7 +72,7 @@ static void check_bound(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   }
   printf("%s: %ld hits at or above the pruning bound\n", name, checked);
   CHECK(broken == 0, "%s: %ld of %ld hits below the pruning bound", name, broken, checked);
-  camera_release(&c);
+  rr_cam_release(&c);
 }
 
 static void bound_views(rr_device *dev) {

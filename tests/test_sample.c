@@ -1,6 +1,7 @@
 /* The one sample test against a double-precision reference on random triangles
  * and rays: hit/miss away from edges, t and barycentrics to a tight tolerance. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 typedef struct { double x, y, z; } dvec;
@@ -18,7 +19,7 @@ int main(void) {
     rr_scene *s;
     rr_scene_new(dev, &s);
     vec3 p[3] = {rand_v(2), rand_v(2), rand_v(2)};
-    if (!scene_push(s, p, NULL, NULL, 0)) {
+    if (!rr_scene_push(s, p, NULL, NULL, 0)) {
       rr_scene_release(s);
       continue;
     }
@@ -29,12 +30,12 @@ int main(void) {
     rc.target[0] = target.x, rc.target[1] = target.y, rc.target[2] = target.z;
     rc.fov_deg = test_randf(20, 90);
     camera c;
-    if (camera_setup(dev, &rc, 64, 48, &c) != RR_OK) {
+    if (rr_cam_setup(dev, &rc, 64, 48, &c) != RR_OK) {
       rr_scene_release(s);
       continue;
     }
     tri_setup ts;
-    int face = tri_setup_planar(s, 0, &c, false, &ts);
+    int face = rr_tri_setup(s, 0, &c, false, &ts);
     for (int k = 0; k < 8; k++) {
       float sx = test_randf(0, 64), sy = test_randf(0, 48);
       /* reference: the same ray in double precision (Cramer's rule) */
@@ -80,18 +81,18 @@ int main(void) {
   rr_scene *s;
   rr_scene_new(dev, &s);
   vec3 p[3] = {v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0)};
-  scene_push(s, p, NULL, NULL, 0);
+  rr_scene_push(s, p, NULL, NULL, 0);
   rr_camera rc;
   rr_camera_init(&rc);
   camera c;
-  camera_setup(dev, &rc, 8, 8, &c);
+  rr_cam_setup(dev, &rc, 8, 8, &c);
   tri_setup ts;
-  CHECK(tri_setup_planar(s, 0, &c, false, &ts) == SETUP_FRONT, "CCW triangle seen from +z is a front face");
-  CHECK(tri_setup_planar(s, 0, &c, true, &ts) == SETUP_FRONT, "front faces survive culling");
+  CHECK(rr_tri_setup(s, 0, &c, false, &ts) == SETUP_FRONT, "CCW triangle seen from +z is a front face");
+  CHECK(rr_tri_setup(s, 0, &c, true, &ts) == SETUP_FRONT, "front faces survive culling");
   rc.eye[2] = -3;
-  camera_setup(dev, &rc, 8, 8, &c);
-  CHECK(tri_setup_planar(s, 0, &c, false, &ts) == SETUP_BACK, "seen from -z it is a back face");
-  CHECK(tri_setup_planar(s, 0, &c, true, &ts) == SETUP_CULLED, "back faces are culled on request");
+  rr_cam_setup(dev, &rc, 8, 8, &c);
+  CHECK(rr_tri_setup(s, 0, &c, false, &ts) == SETUP_BACK, "seen from -z it is a back face");
+  CHECK(rr_tri_setup(s, 0, &c, true, &ts) == SETUP_CULLED, "back faces are culled on request");
   rr_scene_release(s);
   rr_device_release(dev);
   return test_done();

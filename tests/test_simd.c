@@ -4,7 +4,8 @@
  * coordinates, corners behind the eye, tiny and huge coordinates, perspective and
  * orthographic cameras (the setup's AVX2 path is perspective only). The sample loop's AVX2
  * path is compared with the scalar one through whole frames in test_continuum. */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <string.h>
@@ -49,14 +50,14 @@ static bool random_camera(rr_device *dev, rr_camera_type type, float scale, int 
   rc.target[0] = test_randf(-0.3f, 0.3f) * scale, rc.target[1] = 0, rc.target[2] = 0;
   rc.fov_deg = test_randf(20, 110);
   rc.ortho_height = 2 * scale;
-  return camera_setup(dev, &rc, w, h, c) == RR_OK;
+  return rr_cam_setup(dev, &rc, w, h, c) == RR_OK;
 }
 
 static void check_bounds(const rr_scene *s, const camera *c, const char *what) {
   static tri_bound a[N], b[N];
   uint32_t first = test_rand() % 5, n = s->ntris - first - test_rand() % 7; /* unaligned starts and tails */
-  uint32_t na = tri_corner_bounds(s, first, NULL, n, c, false, a);
-  uint32_t nb = tri_corner_bounds(s, first, NULL, n, c, true, b);
+  uint32_t na = rr_tri_corner_bounds(s, first, NULL, n, c, false, a);
+  uint32_t nb = rr_tri_corner_bounds(s, first, NULL, n, c, true, b);
   CHECK(na == nb && memcmp(a, b, na * sizeof *a) == 0, "%s: AVX2 bounds differ from scalar (%u vs %u kept)", what, nb,
         na);
   CHECK(na > 0, "%s: no triangle bounded on screen", what);
@@ -65,7 +66,7 @@ static void check_bounds(const rr_scene *s, const camera *c, const char *what) {
   int differ = 0;
   for (uint32_t len = 1; len <= 20; len++) {
     for (uint32_t k = 0; k < len; k++) ids[k] = test_rand() % s->ntris;
-    na = tri_corner_bounds(s, 0, ids, len, c, false, a), nb = tri_corner_bounds(s, 0, ids, len, c, true, b);
+    na = rr_tri_corner_bounds(s, 0, ids, len, c, false, a), nb = rr_tri_corner_bounds(s, 0, ids, len, c, true, b);
     differ += na != nb || memcmp(a, b, na * sizeof *a) != 0;
   }
   CHECK(differ == 0, "%s: AVX2 bounds of id lists differ from scalar for %d lengths", what, differ);
@@ -78,8 +79,8 @@ static void check_setup(const rr_scene *s, const camera *c, bool cull, const cha
   int n = (int)s->ntris - (int)(test_rand() % 9);
   for (int k = 0; k < n; k++) ids[k] = test_rand() % s->ntris;
   memset(a, 0, sizeof a), memset(b, 0, sizeof b);
-  tri_setup_run(s, ids, n, c, cull, false, a, fa);
-  tri_setup_run(s, ids, n, c, cull, true, b, fb);
+  rr_tri_setup_run(s, ids, n, c, cull, false, a, fa);
+  rr_tri_setup_run(s, ids, n, c, cull, true, b, fb);
   int faces = 0, setups = 0, culled = 0;
   for (int k = 0; k < n; k++) {
     faces += fa[k] != fb[k];
@@ -109,7 +110,7 @@ int main(void) {
         snprintf(what, sizeof what, "scale %g view %d %s", scales[sc], v, rr_camera_name(ct));
         check_bounds(s, &c, what);
         check_setup(s, &c, v % 2 == 1, what);
-        camera_release(&c);
+        rr_cam_release(&c);
       }
     }
     rr_scene_release(s);

@@ -2,7 +2,8 @@
  * nearest). On a tessellated plane and on closed meshes, with views that put many
  * pixel centres exactly on vertices and edges, each sample on the surface must be
  * claimed exactly once, by rc's loop (all samples) and by 3dr-bb's (bounding boxes). */
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 #include "testutil.h"
 
 #include <string.h>
@@ -19,10 +20,10 @@ static void count_claims(const rr_scene *s, const camera *c, bool use_bounds, ui
   memset(front, 0, n), memset(back, 0, n);
   for (uint32_t i = 0; i < s->ntris; i++) {
     tri_setup ts;
-    int face = tri_setup_planar(s, i, c, false, &ts);
+    int face = rr_tri_setup(s, i, c, false, &ts);
     if (face == SETUP_CULLED) continue;
     int r[4] = {0, 0, c->width - 1, c->height - 1};
-    if (use_bounds && !tri_screen_bounds(s, i, c, &ts, r)) continue;
+    if (use_bounds && !rr_tri_screen_bounds(s, i, c, &ts, r)) continue;
     for (int y = r[1]; y <= r[3]; y++)
       for (int x = r[0]; x <= r[2]; x++) {
         float e[3], t, l1, l2;
@@ -38,7 +39,7 @@ static camera make_cam(rr_device *dev, vec3 eye, vec3 target, vec3 up, float fov
   rr_camera rc = {.type = RR_CAMERA_PERSPECTIVE, .fov_deg = fov};
   memcpy(rc.eye, &eye, 12), memcpy(rc.target, &target, 12), memcpy(rc.up, &up, 12);
   camera c;
-  rr_error e = camera_setup(dev, &rc, w, h, &c);
+  rr_error e = rr_cam_setup(dev, &rc, w, h, &c);
   CHECK(e == RR_OK, "camera: %s", rr_device_message(dev));
   return c;
 }

@@ -5,7 +5,8 @@
 #include <stdbool.h>
 #include <stdio.h>
 
-#include "rr.h"
+#include "vis/vis.h"
+#include "io/io.h"
 
 extern int test_passed, test_failed;
 

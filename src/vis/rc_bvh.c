@@ -2,7 +2,7 @@
  * packets of primary rays) and the public queries rr_intersect / rr_occluded.
  *
  * Leaves run the project's one sample test, so the methods produce the same bits
- * as rc and 3dr-bb: a primary ray tests a triangle set up by tri_setup_camera()
+ * as rc and 3dr-bb: a primary ray tests a triangle set up by rr_tri_setup()
  * for the camera (once per frame, kept in leaf order) with shade_sample_w() at
  * its sample. Traversal only decides which (sample, triangle) pairs are visited,
  * and for primary rays it never skips the winner, by construction:
@@ -23,7 +23,7 @@
  * widened by RAY_MARGIN relative to t (NaN slabs ignored); arbitrary rays also
  * prune by box entry, which is exact but for triangles whose plane passes within
  * rounding of the ray's origin (their hits are numerical noise in any method). */
-#include "rr.h"
+#include "vis/vis.h"
 
 #include <emmintrin.h>
 #include <stddef.h>
@@ -68,126 +68,6 @@ typedef struct {
   leaf_tri *loose_ts;
 } frame_setups;
 
-/* The least t that sample_test() can return for ts at any sample of camera c.
- *
- * Planar cameras evaluate e_i = a + sx·b + sy·c in float, with an error below
- * u_i = 4u·(|a| + |sx·b| + |sy·c|) (u = 2^-24, bounded over the image); a passing
- * sample has every computed e_i >= 0, so it lies in P = {E_i >= -u_i} for the
- * exact edge functions E_i of the setup values, and the computed sum is at most
- * (1+u)^2 Σ(E_i + u_i). That sum is affine, so its maximum over P is at a vertex
- * of P; at the vertex where E_i + u_i and E_j + u_j vanish it equals
- * det[a' b c] / (b_i·c_j - b_j·c_i) (Cramer; a' = a + u), and P is that bounded
- * triangle when the three values are positive; otherwise P clipped to the image
- * rectangle is a convex polygon and its vertices bound both. Curved cameras evaluate e_i = n_i·d with |d| at most
- * the camera's longest ray, so the sum is at most |Σn_i|·|d| plus the error. The
- * volume (constant but for orthographic views) is bounded below over the image
- * the same way, and t = vol·(1/sum) is at least vol·(1-u)^2 / max sum. P's
- * vertices also bound the samples where the triangle can pass: rect (x0, y0, x1,
- * y1; the whole plane when P is unbounded or the camera curved). Double
- * arithmetic carries a relative slack far above its own rounding. Points at
- * infinity: sample_test sums w_i·e_i with w_i in {0, 1} and every e_i >= 0 on P,
- * so the plain sum bounds it too (curved cameras use |Σ w_i n_i|). */
-float tri_bounds(const tri_setup *ts, const camera *cam, float rect[4]) {
-  const double u = 0x1p-24, slack = 1e-12;
-  int w = cam->width, h = cam->height;
-  double smax = -INFINITY;
-  double rx0 = -INFINITY, ry0 = -INFINITY, rx1 = INFINITY, ry1 = INFINITY;
-  if (cam->planar) {
-    double a[3], b[3], c[3];
-    for (int i = 0; i < 3; i++) {
-      b[i] = ts->b[i], c[i] = ts->c[i];
-      a[i] = ts->a[i] + 4 * u * (fabs(ts->a[i]) + w * fabs(b[i]) + h * fabs(c[i]));
-    }
-    double m[3], mag_m[3];
-    for (int k = 0; k < 3; k++) {
-      int i = (k + 1) % 3, j = (k + 2) % 3;
-      m[k] = b[i] * c[j] - b[j] * c[i], mag_m[k] = fabs(b[i] * c[j]) + fabs(b[j] * c[i]);
-    }
-    double det = a[0] * m[0] + a[1] * m[1] + a[2] * m[2];
-    double mag_d = fabs(a[0]) * mag_m[0] + fabs(a[1]) * mag_m[1] + fabs(a[2]) * mag_m[2];
-    /* Bounded when det and the three minors share a sign (either: it depends on
-     * how the triangle's projection turns on screen), each clear of the slack. */
-    double sg = det < 0 ? -1 : 1;
-    bool bounded = sg * det > slack * mag_d;
-    double vx[3], vy[3], ex[3], ey[3], den = INFINITY;
-    for (int k = 0; k < 3 && bounded; k++) {
-      bounded = sg * m[k] > slack * mag_m[k];
-      if (!bounded) break;
-      double d = sg * m[k] - slack * mag_m[k];
-      den = d < den ? d : den;
-      /* The vertex itself, where E_i + u_i = E_j + u_j = 0, with a generous error. */
-      int i = (k + 1) % 3, j = (k + 2) % 3;
-      double inv = 1.0 / m[k], ainv = fabs(inv);
-      vx[k] = (-a[i] * c[j] + a[j] * c[i]) * inv, vy[k] = (b[j] * a[i] - b[i] * a[j]) * inv;
-      ex[k] = 1e-9 * ((fabs(a[i] * c[j]) + fabs(a[j] * c[i])) * ainv + fabs(vx[k])) + 1e-6;
-      ey[k] = 1e-9 * ((fabs(b[j] * a[i]) + fabs(b[i] * a[j])) * ainv + fabs(vy[k])) + 1e-6;
-    }
-    /* Σ(E + u) at the vertices is det/m_k: the largest has the smallest minor. */
-    if (bounded) smax = (sg * det + slack * mag_d) / den;
-    if (bounded) {
-      rx0 = fmin(vx[0] - ex[0], fmin(vx[1] - ex[1], vx[2] - ex[2]));
-      rx1 = fmax(vx[0] + ex[0], fmax(vx[1] + ex[1], vx[2] + ex[2]));
-      ry0 = fmin(vy[0] - ey[0], fmin(vy[1] - ey[1], vy[2] - ey[2]));
-      ry1 = fmax(vy[0] + ey[0], fmax(vy[1] + ey[1], vy[2] + ey[2]));
-    }
-    if (!bounded) {
-      /* P unbounded (the triangle crosses the eye's plane) or nearly degenerate:
-       * clip the image rectangle by its three half-planes, loosened by the slack,
-       * and take the polygon's extent and its largest Σ(E + u). */
-      double px[8] = {0, w, w, 0}, py[8] = {0, 0, h, h}, qx[8], qy[8];
-      int np = 4;
-      for (int i = 0; i < 3 && np; i++) {
-        double A = a[i] + slack * (fabs(a[i]) + w * fabs(b[i]) + h * fabs(c[i]));
-        int nq = 0;
-        for (int k = 0; k < np; k++) {
-          int l = (k + 1) % np;
-          double fk = A + b[i] * px[k] + c[i] * py[k], fl = A + b[i] * px[l] + c[i] * py[l];
-          if (fk >= 0) qx[nq] = px[k], qy[nq] = py[k], nq++;
-          if ((fk >= 0) != (fl >= 0)) {
-            double r = fk / (fk - fl);
-            qx[nq] = px[k] + (px[l] - px[k]) * r, qy[nq] = py[k] + (py[l] - py[k]) * r, nq++;
-          }
-        }
-        np = nq;
-        memcpy(px, qx, sizeof px), memcpy(py, qy, sizeof py);
-      }
-      if (!np) smax = -INFINITY; /* no sample of the image can pass */
-      double A = a[0] + a[1] + a[2], B = b[0] + b[1] + b[2], C = c[0] + c[1] + c[2];
-      for (int k = 0; k < np; k++) {
-        double v = A + B * px[k] + C * py[k];
-        smax = v > smax ? v : smax;
-        rx0 = k ? fmin(rx0, px[k]) : px[k], rx1 = k ? fmax(rx1, px[k]) : px[k];
-        ry0 = k ? fmin(ry0, py[k]) : py[k], ry1 = k ? fmax(ry1, py[k]) : py[k];
-      }
-      smax += slack * (fabs(A) + w * fabs(B) + h * fabs(C));
-      rx0 -= 1e-6 * (w + 1), rx1 += 1e-6 * (w + 1), ry0 -= 1e-6 * (h + 1), ry1 += 1e-6 * (h + 1);
-    }
-  } else {
-    double dmax = (double)cam->dir_len_max * (1 + 1e-6), nx = 0, ny = 0, nz = 0, err = 0;
-    for (int i = 0; i < 3; i++) {
-      nx += ts->a[i] * ts->w[i], ny += ts->b[i] * ts->w[i], nz += ts->c[i] * ts->w[i]; /* Σ w_i n_i */
-      err += 4 * u * (fabs(ts->a[i]) + fabs(ts->b[i]) + fabs(ts->c[i]));
-    }
-    smax = (sqrt(nx * nx + ny * ny + nz * nz) + err) * dmax * (1 + slack);
-  }
-  /* Rounded outwards to float; samples are small integers + 0.5, so this is loose. */
-  rect[0] = (float)rx0 - 1e-3f, rect[1] = (float)ry0 - 1e-3f, rect[2] = (float)rx1 + 1e-3f, rect[3] = (float)ry1 + 1e-3f;
-  if (!(smax > 0)) { /* no sample can pass */
-    rect[0] = rect[1] = INFINITY, rect[2] = rect[3] = -INFINITY;
-    return INFINITY;
-  }
-  double vmin = ts->vol; /* exact when vol_x = vol_y = 0: vol + 0 + 0 */
-  if (ts->vol_x != 0 || ts->vol_y != 0) {
-    double v0 = ts->vol, vx = ts->vol_x, vy = ts->vol_y;
-    vmin = v0 + fmin(0.5 * vx, (w - 0.5) * vx) + fmin(0.5 * vy, (h - 0.5) * vy);
-    vmin -= 4 * u * (fabs(v0) + w * fabs(vx) + h * fabs(vy)) + slack * fabs(v0);
-  }
-  if (!(vmin > 0)) return 0;
-  double t = vmin * (1 - u) * (1 - u) / (smax * (1 + u) * (1 + u)) * (1 - 1e-9);
-  float f = (float)t;
-  return (double)f > t ? nextafterf(f, 0) : f;
-}
-
 typedef struct {
   frame_setups *fs;
   int chunk;
@@ -204,7 +84,7 @@ static bool is_needle(const frame_setups *fs, uint32_t id, const float r[4]) {
   float x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   for (int k = 0; k < 3; k++) {
     float sx, sy;
-    if (!camera_project(fs->cam, scene_q(fs->s, k, id, fs->cam->eye), &sx, &sy)) return false;
+    if (!rr_cam_project(fs->cam, scene_q(fs->s, k, id, fs->cam->eye), &sx, &sy)) return false;
     x0 = fminf(x0, sx), y0 = fminf(y0, sy), x1 = fmaxf(x1, sx), y1 = fmaxf(y1, sy);
   }
   return area > 4 * (x1 - x0 + 2) * (y1 - y0 + 2);
@@ -221,7 +101,7 @@ static void setup_leaves(int job, int thread, void *arg) {
     if (!n->count) continue;
     float tlo = INFINITY, r[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
     for (uint32_t i = n->first; i < n->first + n->count; i++) {
-      bool live = tri_setup_camera(fs->s, b->prims[i], fs->cam, fs->cull, &fs->ts[i].ts) != SETUP_CULLED;
+      bool live = rr_tri_setup(fs->s, b->prims[i], fs->cam, fs->cull, &fs->ts[i].ts) != SETUP_CULLED;
       fs->ts[i].id = live ? b->prims[i] : RR_MISS;
       fs->loose[i] = 0;
       float *tr = fs->trect[i];
@@ -229,7 +109,7 @@ static void setup_leaves(int job, int thread, void *arg) {
         tr[0] = tr[1] = INFINITY, tr[2] = tr[3] = -INFINITY;
         continue;
       }
-      float t = tri_bounds(&fs->ts[i].ts, fs->cam, tr);
+      float t = rr_tri_bounds(&fs->ts[i].ts, fs->cam, tr);
       fs->loose[i] = fs->cam->planar && is_needle(fs, b->prims[i], tr);
       if (fs->loose[i]) continue;
       tlo = t < tlo ? t : tlo;
@@ -259,7 +139,7 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %zu triangle setups", n);
   }
   setup_job sj = {fs, SETUP_CHUNK};
-  parallel_for((int)((b->nnodes + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, &sj);
+  rr_parallel_for((int)((b->nnodes + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, &sj);
   /* Needles leave the tree for the loose pass (in leaf order: deterministic). */
   uint32_t nl = 0;
   for (size_t i = 0; i < n; i++) nl += fs->loose[i];
@@ -376,7 +256,7 @@ KERNEL bool leaf_test(const rr_bvh *b, const bvh_node *n, ray_state *r, const in
       uint32_t id = b->prims[i];
       float t, l1, l2;
       r->setups++, r->evals++;
-      if (!ray_tri_hit(r->s, id, r->rcam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
+      if (!rr_tri_ray_hit(r->s, id, r->rcam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
       if (mode == MODE_ANY) return true;
       if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
     }
@@ -452,28 +332,7 @@ KERNEL bool trace1(const rr_bvh *b, ray_state *r, const int mode) {
 
 /* ---- arbitrary rays -------------------------------------------------------------- */
 
-void ray_camera(const float org[3], const float dir[3], camera *out) {
-  memset(out, 0, sizeof *out);
-  vec3 d = v3_load(dir);
-  out->eye = v3_load(org);
-  out->d0 = d;
-  /* dx: perpendicular to d in the plane of its two largest components; dy = d × dx. */
-  float ax = fabsf(d.x), ay = fabsf(d.y), az = fabsf(d.z);
-  vec3 u = ax <= ay && ax <= az ? v3(0, d.z, -d.y) : ay <= az ? v3(-d.z, 0, d.x) : v3(d.y, -d.x, 0);
-  out->dx = u;
-  out->dy = v3_cross(d, u);
-  out->fwd = d;
-}
 
-bool ray_tri_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull, float tmin, float tmax, float *t,
-                 float *l1, float *l2) {
-  tri_setup ts;
-  if (tri_setup_planar(s, i, ray, cull, &ts) == SETUP_CULLED) return false;
-  float e[3];
-  tri_edges(&ts, 0.0f, 0.0f, e); /* = a[i]: the edge functions along the ray itself */
-  if (!sample_test_w(e, ts.w, ts.tie, ts.vol, t, l1, l2)) return false;
-  return *t >= tmin && *t <= tmax;
-}
 
 static rr_error ray_begin(const rr_scene *s, const rr_ray *ray, const rr_bvh **b, bool *empty) {
   if (!s || !ray) return RR_ERROR_ARGUMENT;
@@ -483,7 +342,7 @@ static rr_error ray_begin(const rr_scene *s, const rr_ray *ray, const rr_bvh **b
   if (ray->dir[0] == 0 && ray->dir[1] == 0 && ray->dir[2] == 0)
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "ray with a zero direction");
   if (isnan(ray->tmin) || isnan(ray->tmax)) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "ray with a NaN range");
-  *b = bvh_of(s->dev, s, empty);
+  *b = rr_bvh_of(s->dev, s, empty);
   return *b || *empty ? RR_OK : s->dev ? s->dev->error : RR_ERROR_ARGUMENT;
 }
 
@@ -502,7 +361,7 @@ rr_error rr_intersect(const rr_scene *s, const rr_ray *ray, rr_hit *hit) {
   rr_error e = ray_begin(s, ray, &b, &empty);
   if (e || empty) return e;
   camera rc;
-  ray_camera(ray->org, ray->dir, &rc);
+  rr_cam_for_ray(ray->org, ray->dir, &rc);
   ray_state r;
   ray_state_init(&r, s, ray, &rc);
   trace1(b, &r, MODE_CLOSEST);
@@ -518,7 +377,7 @@ rr_error rr_occluded(const rr_scene *s, const rr_ray *ray, int *occluded) {
   rr_error e = ray_begin(s, ray, &b, &empty);
   if (e || empty) return e;
   camera rc;
-  ray_camera(ray->org, ray->dir, &rc);
+  rr_cam_for_ray(ray->org, ray->dir, &rc);
   ray_state r;
   ray_state_init(&r, s, ray, &rc);
   *occluded = trace1(b, &r, MODE_ANY);
@@ -564,7 +423,7 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
           vec3 o, d;
       uint64_t e0 = r.evals, n0 = r.nodes;
       if (c->planar) trace1(j->b, &r, MODE_PLANAR); /* rectangles only: no 3D test */
-      else if (camera_ray(c, x, y, &o, &d)) { /* else a pixel without a ray: a miss */
+      else if (rr_cam_ray(c, x, y, &o, &d)) { /* else a pixel without a ray: a miss */
         ray_q_init(&r.q, o, d);
         trace1(j->b, &r, MODE_CURVED);
       }
@@ -742,11 +601,11 @@ static void loose_band(int band, int thread, void *arg) {
   j->st[thread].evals += e;
 }
 
-static rr_error run_frame(rr_device *dev, render_ctx *ctx, parallel_fn tile_fn) {
+static rr_error run_frame(rr_device *dev, render_ctx *ctx, rr_parallel_fn tile_fn) {
   /* Packets work on screen rectangles: curved cameras cast one ray per sample. */
   if (tile_fn == rc_packet_tile && !ctx->cam->planar) tile_fn = rc_bvh_tile;
   bool empty;
-  const rr_bvh *b = bvh_of(dev, ctx->scene, &empty);
+  const rr_bvh *b = rr_bvh_of(dev, ctx->scene, &empty);
   if (empty) return RR_OK; /* the visibility buffer is already all misses */
   if (!b) return dev ? dev->error : RR_ERROR_ARGUMENT;
   frame_job *j = calloc(1, sizeof *j);
@@ -760,10 +619,10 @@ static rr_error run_frame(rr_device *dev, render_ctx *ctx, parallel_fn tile_fn) 
   const visbuf *vb = ctx->vb;
   j->tiles_x = (vb->width + TILE - 1) / TILE;
   int tiles = j->tiles_x * ((vb->height + TILE - 1) / TILE);
-  parallel_for(tiles, ctx->threads, tile_fn, j);
+  rr_parallel_for(tiles, ctx->threads, tile_fn, j);
   if (j->fs.nloose) { /* the needles, over their rectangles, by bands of rows */
     j->band_rows = (vb->height + 4 * ctx->threads - 1) / (4 * ctx->threads);
-    parallel_for((vb->height + j->band_rows - 1) / j->band_rows, ctx->threads, loose_band, j);
+    rr_parallel_for((vb->height + j->band_rows - 1) / j->band_rows, ctx->threads, loose_band, j);
   }
   for (int t = 0; t < 256; t++) {
     ctx->stats->edge_evals += j->st[t].evals;
@@ -774,6 +633,6 @@ static rr_error run_frame(rr_device *dev, render_ctx *ctx, parallel_fn tile_fn) 
   return RR_OK;
 }
 
-rr_error vis_rc_bvh(rr_device *dev, render_ctx *ctx) { return run_frame(dev, ctx, rc_bvh_tile); }
+rr_error rr_vis_rc_bvh(rr_device *dev, render_ctx *ctx) { return run_frame(dev, ctx, rc_bvh_tile); }
 
-rr_error vis_rc_packet(rr_device *dev, render_ctx *ctx) { return run_frame(dev, ctx, rc_packet_tile); }
+rr_error rr_vis_rc_packet(rr_device *dev, render_ctx *ctx) { return run_frame(dev, ctx, rc_packet_tile); }

@@ -12,7 +12,7 @@
  * Depth here is the ray parameter t along d(x, y) = d0 + x dx + y dy; for the
  * perspective camera d·fwd = 1, so t is also the distance along fwd. Culling
  * decisions keep a relative safety margin so they never remove a winning triangle. */
-#include "rr.h"
+#include "vis/vis.h"
 
 #include <float.h>
 #include <string.h>
@@ -102,7 +102,7 @@ typedef struct tri_job {
 KERNEL uint64_t raster_samples(trav *t, const tri_job *j, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
-  t->st.edge_evals += raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd);
+  t->st.edge_evals += rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd);
   charge(t->heat_e, t->vb->width, r, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
   if (t->hiz_used) mark_dirty(t, r);
   return covered;
@@ -145,10 +145,10 @@ static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
          * the same for the parabolic map by shifting the corners). */
         vec3 axis;
         float angle;
-        int cone = camera_rect_cone(t->c, b.x0, b.y0, b.x1, b.y1, &axis, &angle);
+        int cone = rr_cam_rect_cone(t->c, b.x0, b.y0, b.x1, b.y1, &axis, &angle);
         if (cone < 0) continue; /* no rays here: nothing to refine */
         if (cone > 0 && angle < 1.5f) {
-          out = cone_excludes(&j->cone, &j->ts, axis, angle);
+          out = rr_cone_excludes(&j->cone, &j->ts, axis, angle);
           t->st.edge_evals += 1;
           if (t->heat_e) t->heat_e[(size_t)((b.y0 + b.y1) / 2) * t->vb->width + (b.x0 + b.x1) / 2] += 1;
         }
@@ -200,9 +200,9 @@ static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
     unsigned inf = scene_inf(t->s, id);
     int f = !(inf & 1u) ? 0 : !(inf & 2u) ? 1 : 2; /* a finite corner */
     vec3 q0 = scene_q(t->s, 0, id, c->eye), q1 = scene_q(t->s, 1, id, c->eye), q2 = scene_q(t->s, 2, id, c->eye);
-    vec3 nrm = inf ? scene_tri_normal(t->s, id) : v3_cross(v3_sub(q1, q0), v3_sub(q2, q0));
+    vec3 nrm = inf ? rr_scene_tri_normal(t->s, id) : v3_cross(v3_sub(q1, q0), v3_sub(q2, q0));
     float dist = fabsf(v3_dot(f == 0 ? q0 : f == 1 ? q1 : q2, nrm)) / v3_len(nrm);
-    tri_cone_setup(t->s, id, c, &j->ts, &j->cone);
+    rr_tri_cone_setup(t->s, id, c, &j->ts, &j->cone);
     float mag = (j->cone.len[0] + j->cone.len[1] + j->cone.len[2]) * c->dir_len_max * 1.7321f;
     j->zmin = dist > 0 && isfinite(dist) ? computed_t_floor(dist / c->dir_len_max, mag, j->ts.vol) : 0;
   }
@@ -218,7 +218,7 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
     uint32_t ids[8];
     tri_setup ts[8];
     for (int l = 0; l < m; l++) ids[l] = b[q + l].id;
-    tri_setup_run(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face);
+    rr_tri_setup_run(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face);
     for (int l = 0; l < m; l++) {
       if (face[l] == SETUP_CULLED) continue;
       tri_job *j = out + kept++;
@@ -238,15 +238,15 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
 static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, tri_bound *scratch,
                                 tri_job *out) {
   if (t->c->planar) {
-    return setup_bounded(t, scratch, tri_corner_bounds(t->s, first, ids, n, t->c, t->simd, scratch), out);
+    return setup_bounded(t, scratch, rr_tri_corner_bounds(t->s, first, ids, n, t->c, t->simd, scratch), out);
   }
   uint32_t kept = 0;
   t->st.setups += n;
   for (uint32_t k = 0; k < n; k++) {
     uint32_t id = ids ? ids[k] : first + k;
     tri_job *j = out + kept;
-    if (tri_setup_camera(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED ||
-        !tri_screen_bounds(t->s, id, t->c, &j->ts, j->bb))
+    if (rr_tri_setup(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED ||
+        !rr_tri_screen_bounds(t->s, id, t->c, &j->ts, j->bb))
       continue;
     finish_setup(t, id, j);
     kept++;
@@ -282,13 +282,13 @@ static void set_plane(frustum *f, int i, vec3 n, vec3 point) {
 
 static frustum make_frustum(const camera *c, tile_rect r) {
   frustum f = {.r = r};
-  f.has_ray = camera_ray(c, (r.x0 + r.x1 - 1) / 2, (r.y0 + r.y1 - 1) / 2, &f.origin, &f.dir);
+  f.has_ray = rr_cam_ray(c, (r.x0 + r.x1 - 1) / 2, (r.y0 + r.y1 - 1) / 2, &f.origin, &f.dir);
   if (c->type == RR_CAMERA_PERSPECTIVE) {
     /* Planes through the eye and the outer pixel edges: half a pixel beyond the
      * outer sample centres, conservative for every sample. With rays
      * d = d0 + x·dx + y·dy, the plane of column x has normal (d0 + x·dx) × dy, and
      * its dot with d(x', y) is det(dx, dy, d0)·(x - x'); rows likewise
-     * (camera_setup keeps these normals, turned to face increasing x and y). */
+     * (rr_cam_setup keeps these normals, turned to face increasing x and y). */
     float x0 = (float)r.x0, x1 = (float)r.x1, y0 = (float)r.y0, y1 = (float)r.y1;
     f.nplanes = 4;
     set_plane(&f, 0, v3_add(c->col_n0, v3_scale(c->col_n1, x0)), c->eye);
@@ -303,7 +303,7 @@ static frustum make_frustum(const camera *c, tile_rect r) {
     set_plane(&f, 0, c->right, lo), set_plane(&f, 1, v3_neg(c->right), hi);
     set_plane(&f, 2, c->up, hi), set_plane(&f, 3, v3_neg(c->up), lo);
   } else {
-    f.has_cone = camera_rect_cone(c, r.x0, r.y0, r.x1, r.y1, &f.axis, &f.angle);
+    f.has_cone = rr_cam_rect_cone(c, r.x0, r.y0, r.x1, r.y1, &f.axis, &f.angle);
   }
   return f;
 }
@@ -415,11 +415,11 @@ static float occlusion_depth(const camera *c, const bvh_node *b) {
   return z > 0 ? z * (1 - DEPTH_MARGIN) : 0;
 }
 
-bool oracle_occluded(const camera *c, const bvh_node *b, float farthest) {
+bool rr_oracle_occluded(const camera *c, const bvh_node *b, float farthest) {
   return farthest < occlusion_depth(c, b);
 }
 
-bool oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bvh_node *b) {
+bool rr_oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bvh_node *b) {
   tile_rect r = {x0, y0, x1, y1};
   frustum f = make_frustum(c, r);
   return is_outside(&f, b, c);
@@ -574,8 +574,8 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
   uint32_t n = ctx->scene->ntris;
   for (uint32_t first = 0; first < n; first += ROOT_BATCH) {
     rj->first = first, rj->count = n - first < ROOT_BATCH ? n - first : ROOT_BATCH;
-    parallel_for((int)((rj->count + ROOT_CHUNK - 1) / ROOT_CHUNK), ctx->threads, root_setup, rj);
-    parallel_for(rj->bands, ctx->threads, root_band, rj);
+    rr_parallel_for((int)((rj->count + ROOT_CHUNK - 1) / ROOT_CHUNK), ctx->threads, root_setup, rj);
+    rr_parallel_for(rj->bands, ctx->threads, root_band, rj);
   }
   for (int i = 0; i < 256; i++) add_stats(ctx->stats, &rj->st[i]);
   free(jobs), free(span), free(rj);
@@ -606,7 +606,7 @@ static void run_tile(int job, int thread, void *arg) {
   add_stats(&tj->st[thread], &t.st);
 }
 
-rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
+rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
   const oracles *o = ctx->oracles;
   const visbuf *vb = ctx->vb;
   if (ctx->scene->ntris == 0) return RR_OK; /* nothing to see: the cleared buffer is the image */
@@ -653,7 +653,7 @@ rr_error vis_traverse(rr_device *dev, render_ctx *ctx) {
                                 : (frustum < whole ? frustum : whole);
     tile = (tile + HIZ - 1) / HIZ * HIZ;
     tj->proto = proto, tj->tile = tile, tj->frustum = frustum, tj->tiles_x = (vb->width + tile - 1) / tile;
-    parallel_for(tj->tiles_x * ((vb->height + tile - 1) / tile), ctx->threads, run_tile, tj);
+    rr_parallel_for(tj->tiles_x * ((vb->height + tile - 1) / tile), ctx->threads, run_tile, tj);
     for (int i = 0; i < 256; i++) add_stats(ctx->stats, &tj->st[i]);
     free(tj);
   }

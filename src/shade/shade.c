@@ -1,6 +1,6 @@
 /* Deferred shading: reads only the visibility buffer (id, t, λ1, λ2) and the
  * scene, so it never knows which method made the frame. */
-#include "rr.h"
+#include "vis/vis.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -21,7 +21,7 @@ typedef struct hit {
 } hit;
 
 static vec3 geometric_normal(const rr_scene *s, uint32_t i) {
-  if (scene_inf(s, i)) return v3_norm(scene_tri_normal(s, i)); /* corners at infinity */
+  if (scene_inf(s, i)) return v3_norm(rr_scene_tri_normal(s, i)); /* corners at infinity */
   vec3 p0 = scene_vertex(s, 0, i);
   return v3_norm(v3_cross(v3_sub(scene_vertex(s, 1, i), p0), v3_sub(scene_vertex(s, 2, i), p0)));
 }
@@ -30,7 +30,7 @@ static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, i
   hit h = {0};
   size_t k = (size_t)y * vb->width + x;
   vec3 o, d;
-  h.has_ray = camera_ray(c, x, y, &o, &d);
+  h.has_ray = rr_cam_ray(c, x, y, &o, &d);
   h.id = vb->id[k];
   if (h.id == RR_MISS || h.id >= s->ntris) return h;
   h.valid = true;
@@ -263,9 +263,9 @@ rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
   if ((int)mode < 0 || mode >= RR_SHADE_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shade mode %d", (int)mode);
   camera c;
-  rr_error e = camera_setup(dev, cam, f->vb.width, f->vb.height, &c);
+  rr_error e = rr_cam_setup(dev, cam, f->vb.width, f->vb.height, &c);
   if (!e) e = shade_frame(dev, s, &c, f, mode, out);
-  camera_release(&c);
+  rr_cam_release(&c);
   return e;
 }
 
@@ -273,8 +273,8 @@ rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, c
                       rr_image *out) {
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_frame_aov: NULL argument");
   camera c;
-  rr_error e = camera_setup(dev, cam, f->vb.width, f->vb.height, &c);
+  rr_error e = rr_cam_setup(dev, cam, f->vb.width, f->vb.height, &c);
   if (!e) e = frame_aov(dev, s, &c, f, aov, out);
-  camera_release(&c);
+  rr_cam_release(&c);
   return e;
 }

@@ -4,7 +4,7 @@
  * triangles is two of them) and starting threads for each would cost more than
  * some loops do. A loop started while the pool is busy (another caller's thread,
  * or a loop inside a job) runs on threads of its own instead. */
-#include "rr.h"
+#include "core/core.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
@@ -15,7 +15,7 @@
 typedef struct {
   atomic_int next;
   int njobs;
-  parallel_fn fn;
+  rr_parallel_fn fn;
   void *arg;
 } loop;
 
@@ -99,7 +99,7 @@ static void run_own_threads(loop *l, int threads) {
   for (int i = 1; i <= started; i++) pthread_join(tid[i], NULL);
 }
 
-void parallel_for(int njobs, int threads, parallel_fn fn, void *arg) {
+void rr_parallel_for(int njobs, int threads, rr_parallel_fn fn, void *arg) {
   if (threads > njobs) threads = njobs;
   if (threads < 1) threads = 1;
   if (threads > MAX_THREADS) threads = MAX_THREADS;
@@ -134,18 +134,18 @@ void parallel_for(int njobs, int threads, parallel_fn fn, void *arg) {
   pthread_mutex_unlock(&P.busy);
 }
 
-int cpu_count(void) {
+int rr_cpu_count(void) {
   long n = sysconf(_SC_NPROCESSORS_ONLN);
   return n < 1 ? 1 : n > 256 ? 256 : (int)n;
 }
 
-double cpu_ms(void) {
+double rr_cpu_ms(void) {
   struct timespec ts;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-double now_ms(void) {
+double rr_now_ms(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;

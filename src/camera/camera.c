@@ -1,5 +1,5 @@
 /* Cameras: the ray direction of every sample, and bounds for rasterization. */
-#include "rr.h"
+#include "camera/camera.h"
 
 #include <string.h>
 
@@ -91,7 +91,7 @@ static vec3 curved_dir(const camera *c, const rr_camera *in, int x, int y) {
   }
 }
 
-rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
+rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
   memset(c, 0, sizeof *c);
   rr_error e = rr_camera_check(dev, in);
   if (e) return e;
@@ -161,7 +161,7 @@ rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height
   c->cells_x = (width + CAMERA_CELL - 1) / CAMERA_CELL, c->cells_y = (height + CAMERA_CELL - 1) / CAMERA_CELL;
   c->cells = malloc((size_t)c->cells_x * c->cells_y * 4 * sizeof *c->cells);
   if (!c->cells) {
-    camera_release(c);
+    rr_cam_release(c);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
   }
   for (int cy = 0; cy < c->cells_y; cy++)
@@ -171,19 +171,19 @@ rr_error camera_setup(rr_device *dev, const rr_camera *in, int width, int height
       int y1 = (cy + 1) * CAMERA_CELL < height ? (cy + 1) * CAMERA_CELL : height;
       vec3 axis = v3(0, 0, 0);
       float angle;
-      int cone = camera_rect_cone(c, cx * CAMERA_CELL, cy * CAMERA_CELL, x1, y1, &axis, &angle);
+      int cone = rr_cam_rect_cone(c, cx * CAMERA_CELL, cy * CAMERA_CELL, x1, y1, &axis, &angle);
       cell[0] = axis.x, cell[1] = axis.y, cell[2] = axis.z;
       cell[3] = cone < 0 ? -1.0f : cone > 0 && angle < 1.5f ? angle : 2.0f; /* no rays, a cone, no bound */
     }
   return rr_ok(dev);
 }
 
-void camera_release(camera *c) {
+void rr_cam_release(camera *c) {
   free(c->dirs), free(c->cells);
   c->dirs = NULL, c->cells = NULL;
 }
 
-bool camera_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
+bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
   float sx = (float)x + 0.5f, sy = (float)y + 0.5f;
   *origin = c->eye;
   switch (c->type) {
@@ -200,7 +200,7 @@ bool camera_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
   }
 }
 
-bool camera_project(const camera *c, vec3 p, float *sx, float *sy) {
+bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy) {
   float z = v3_dot(p, c->fwd);
   if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
     if (!(z > 0)) return false;
@@ -215,7 +215,7 @@ bool camera_project(const camera *c, vec3 p, float *sx, float *sy) {
   return true;
 }
 
-int camera_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle) {
+int rr_cam_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle) {
   if (c->planar) return 0;
   if (c->type == RR_CAMERA_CUBE && (x0 / c->face != (x1 - 1) / c->face || y0 / c->face != (y1 - 1) / c->face))
     return 0; /* the cross is discontinuous between faces */
@@ -268,4 +268,17 @@ rr_error rr_camera_frame(rr_device *dev, const rr_scene *s, int width, int heigh
   cam->target[0] = centre.x, cam->target[1] = centre.y, cam->target[2] = centre.z;
   cam->up[0] = 0, cam->up[1] = 1, cam->up[2] = 0;
   return rr_ok(dev);
+}
+
+void rr_cam_for_ray(const float org[3], const float dir[3], camera *out) {
+  memset(out, 0, sizeof *out);
+  vec3 d = v3_load(dir);
+  out->eye = v3_load(org);
+  out->d0 = d;
+  /* dx: perpendicular to d in the plane of its two largest components; dy = d × dx. */
+  float ax = fabsf(d.x), ay = fabsf(d.y), az = fabsf(d.z);
+  vec3 u = ax <= ay && ax <= az ? v3(0, d.z, -d.y) : ay <= az ? v3(-d.z, 0, d.x) : v3(d.y, -d.x, 0);
+  out->dx = u;
+  out->dy = v3_cross(d, u);
+  out->fwd = d;
 }

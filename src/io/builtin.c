@@ -4,7 +4,7 @@
  * Closed meshes compute each vertex position once and index it, so a vertex shared
  * by several triangles has bitwise identical coordinates in all of them: the shared
  * sample test then leaves no cracks and counts no pixel twice along shared edges. */
-#include "rr.h"
+#include "io/io.h"
 
 #include <string.h>
 
@@ -49,17 +49,17 @@ static rr_error size_arg(rr_scene *s, const char *name, const char *arg, long de
 
 static rr_error add_material(rr_scene *s, float r, float g, float b, uint32_t *out) {
   float rgb[3] = {r, g, b};
-  *out = scene_add_material(s, rgb, NULL);
+  *out = rr_scene_add_material(s, rgb, NULL);
   if (*out == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
   return RR_OK;
 }
 
-/* Reserves room first so that scene_push can only refuse degenerate triangles. */
+/* Reserves room first so that rr_scene_push can only refuse degenerate triangles. */
 static rr_error reserve(rr_scene *s, uint64_t more, bool with_normals) {
   if (more > UINT32_MAX - 1 - (uint64_t)s->ntris)
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "scene too large: %llu more triangles",
                    (unsigned long long)more);
-  return scene_reserve(s, (uint32_t)more, with_normals, false);
+  return rr_scene_reserve(s, (uint32_t)more, with_normals, false);
 }
 
 /* Pushes triangle (a, b, c) of an indexed vertex array; nrm may be NULL. */
@@ -68,9 +68,9 @@ static void push_idx(rr_scene *s, const vec3 *pos, const vec3 *nrm, uint32_t a, 
   vec3 p[3] = {pos[a], pos[b], pos[c]};
   if (nrm) {
     vec3 n[3] = {nrm[a], nrm[b], nrm[c]};
-    scene_push(s, p, n, NULL, mat);
+    rr_scene_push(s, p, n, NULL, mat);
   } else {
-    scene_push(s, p, NULL, NULL, mat);
+    rr_scene_push(s, p, NULL, NULL, mat);
   }
 }
 
@@ -80,8 +80,8 @@ static void push_quad(rr_scene *s, vec3 a, vec3 b, vec3 c, vec3 d, const vec3 *f
   vec3 t0[3] = {a, b, c}, t1[3] = {a, c, d};
   vec3 n[3];
   if (flat) n[0] = n[1] = n[2] = *flat;
-  scene_push(s, t0, flat ? n : NULL, NULL, mat);
-  scene_push(s, t1, flat ? n : NULL, NULL, mat);
+  rr_scene_push(s, t0, flat ? n : NULL, NULL, mat);
+  rr_scene_push(s, t1, flat ? n : NULL, NULL, mat);
 }
 
 /* ---- plane ------------------------------------------------------------------------ */
@@ -242,7 +242,7 @@ static rr_error gen_ground(rr_scene *s) {
   const vec3 origin = v3(0, 0, 0), dir[4] = {v3(1, 0, 0), v3(0, 0, -1), v3(-1, 0, 0), v3(0, 0, 1)};
   for (int q = 0; q < 4; q++) {
     vec3 p[3] = {origin, dir[q], dir[(q + 1) % 4]};
-    scene_push_inf(s, p, 6u, NULL, NULL, ground_m); /* corners 1 and 2 at infinity */
+    rr_scene_push_inf(s, p, 6u, NULL, NULL, ground_m); /* corners 1 and 2 at infinity */
   }
   e = gen_sphere(s, 24, v3(-1.5f, 1.05f, 0.5f), 1.0f, ball_m);
   uint32_t t0 = s->ntris;
@@ -258,7 +258,7 @@ static rr_error gen_ground(rr_scene *s) {
     }
   float *box_rgb = s->materials[s->nmaterials - 1].color;
   box_rgb[0] = 0.90f, box_rgb[1] = 0.55f, box_rgb[2] = 0.20f;
-  scene_update_bounds(s);
+  rr_scene_update_bounds(s);
   return RR_OK;
 }
 
@@ -266,7 +266,7 @@ static rr_error gen_ground(rr_scene *s) {
 
 /* grid:PATH:N — N×N copies of a mesh file on the XZ plane, copy k = j·N + i moved by
  * (i·1.25·sx, 0, j·1.25·sz). The copies are written straight into the arrays rather
- * than through scene_push: a translated sliver could round to zero area and be
+ * than through rr_scene_push: a translated sliver could round to zero area and be
  * dropped, which would break the rule that copy k's triangle m has id k·T + m. */
 static rr_error load_grid(rr_scene *s, const char *name) {
   const char *rest = name + strlen("grid:");
@@ -284,7 +284,7 @@ static rr_error load_grid(rr_scene *s, const char *name) {
   path[len] = 0;
   uint32_t t0 = s->ntris;
   uint64_t skipped0 = s->skipped;
-  rr_error e = scene_load_file(s, path);
+  rr_error e = rr_scene_load_file(s, path);
   free(path);
   if (e) return e;
 
@@ -305,7 +305,7 @@ static rr_error load_grid(rr_scene *s, const char *name) {
   if (!isfinite((float)(n - 1) * 1.25f * sx) || !isfinite((float)(n - 1) * 1.25f * sz))
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "grid '%s': the mesh is too large to replicate", name);
 
-  e = scene_reserve(s, (uint32_t)(total - T), false, false);
+  e = rr_scene_reserve(s, (uint32_t)(total - T), false, false);
   if (e) return e;
   for (uint64_t copy = 1; copy < copies; copy++) {
     float ox = (float)(copy % n) * 1.25f * sx, oz = (float)(copy / n) * 1.25f * sz;
@@ -326,7 +326,7 @@ static rr_error load_grid(rr_scene *s, const char *name) {
   s->ntris = (uint32_t)(t0 + total);
   /* Count the file's dropped triangles once per copy, as loading it N² times would. */
   s->skipped += (s->skipped - skipped0) * (copies - 1);
-  scene_update_bounds(s);
+  rr_scene_update_bounds(s);
   return RR_OK;
 }
 
@@ -433,7 +433,7 @@ static int corner_cmp(const void *pa, const void *pb) {
  * turn by less than 60° from its own, so creases (the teapot's rim) stay sharp. */
 static rr_error smooth_normals(rr_scene *s, uint32_t t0, uint32_t t1) {
   size_t nt = t1 - t0, nc = 3 * nt;
-  rr_error e = scene_reserve(s, 0, true, false);
+  rr_error e = rr_scene_reserve(s, 0, true, false);
   if (e) return e;
   corner_key *c = malloc(nc * sizeof *c);
   vec3 *fn = malloc(nt * sizeof *fn);
@@ -475,7 +475,7 @@ static rr_error place_file(rr_scene *s, const char *path, float size, float yaw,
                            float z, uint32_t *first_mat) {
   uint32_t t0 = s->ntris;
   *first_mat = s->nmaterials;
-  rr_error e = scene_load_file(s, path);
+  rr_error e = rr_scene_load_file(s, path);
   if (!e && s->ntris == t0) e = rr_fail(s->dev, RR_ERROR_EMPTY, "demo mesh '%s' has no triangles", path);
   if (!e) e = smooth_normals(s, t0, s->ntris);
   if (e) return e;
@@ -528,13 +528,13 @@ static rr_error gen_demo(rr_scene *s) {
   if (!e) e = gen_sphere(s, 32, v3(0.9f, 0.35f, 1.6f), 0.35f, gold_m);
   if (!e) e = gen_torus(s, 48, 24, 0.5f, 0.17f, v3(-1.6f, 0.17f, 1.7f), green_m);
   if (e) return e;
-  scene_update_bounds(s);
+  rr_scene_update_bounds(s);
   return RR_OK;
 }
 
 /* ---- entry point ------------------------------------------------------------------- */
 
-rr_error scene_load_builtin(rr_scene *s, const char *name) {
+rr_error rr_scene_load_builtin(rr_scene *s, const char *name) {
   const char *arg;
   long n;
   rr_error e;

@@ -1,6 +1,6 @@
 /* rc: Durand's loop, every sample × every triangle. The reference method; it
  * calls the same sample test as every other method, in the other loop order. */
-#include "rr.h"
+#include "vis/vis.h"
 
 typedef struct {
   render_ctx *ctx;
@@ -25,7 +25,7 @@ static void rc_row(int y, int thread, void *arg) {
   job->evals[thread] += (uint64_t)vb->width * job->n;
 }
 
-rr_error vis_rc(rr_device *dev, render_ctx *ctx) {
+rr_error rr_vis_rc(rr_device *dev, render_ctx *ctx) {
   const rr_scene *s = ctx->scene;
   /* One setup per triangle for the eye, reused by every ray (the paper's
    * "at the cost of additional per-triangle storage"). */
@@ -37,10 +37,10 @@ rr_error vis_rc(rr_device *dev, render_ctx *ctx) {
   }
   uint32_t n = 0;
   for (uint32_t i = 0; i < s->ntris; i++)
-    if (tri_setup_planar(s, i, ctx->cam, ctx->opt->cull_backfaces, &setup[n]) != SETUP_CULLED) ids[n++] = i;
+    if (rr_tri_setup(s, i, ctx->cam, ctx->opt->cull_backfaces, &setup[n]) != SETUP_CULLED) ids[n++] = i;
   ctx->stats->setups += s->ntris;
   rc_job job = {.ctx = ctx, .setup = setup, .ids = ids, .n = n};
-  parallel_for(ctx->vb->height, ctx->threads, rc_row, &job);
+  rr_parallel_for(ctx->vb->height, ctx->threads, rc_row, &job);
   for (int t = 0; t < 256; t++) ctx->stats->edge_evals += job.evals[t];
   free(setup), free(ids);
   return RR_OK;

@@ -3,7 +3,7 @@
  * Polygons are fan-triangulated here rather than by assimp, so primitive ids follow
  * the documented order: meshes in node order (file order), faces in file order,
  * face k of n corners giving triangles (0, j, j+1). */
-#include "rr.h"
+#include "io/io.h"
 
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
@@ -38,7 +38,7 @@ static rr_error add_mesh(rr_scene *s, const struct aiMesh *mesh, const struct ai
     if (mesh->mFaces[f].mNumIndices >= 3) ntri += mesh->mFaces[f].mNumIndices - 2;
   if (ntri > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "mesh too large");
   bool has_n = mesh->mNormals != NULL, has_uv = mesh->mTextureCoords[0] != NULL;
-  rr_error e = scene_reserve(s, (uint32_t)ntri, has_n, has_uv);
+  rr_error e = rr_scene_reserve(s, (uint32_t)ntri, has_n, has_uv);
   if (e) return e;
   bool ident = is_identity(m);
   for (unsigned f = 0; f < mesh->mNumFaces; f++) {
@@ -63,7 +63,7 @@ static rr_error add_mesh(rr_scene *s, const struct aiMesh *mesh, const struct ai
           uv[k][1] = mesh->mTextureCoords[0][v].y;
         }
       }
-      scene_push(s, p, has_n ? n : NULL, has_uv ? (const float(*)[2])uv : NULL, mat_base + mesh->mMaterialIndex);
+      rr_scene_push(s, p, has_n ? n : NULL, has_uv ? (const float(*)[2])uv : NULL, mat_base + mesh->mMaterialIndex);
     }
   }
   return RR_OK;
@@ -107,13 +107,13 @@ static rr_error add_materials(rr_scene *s, const struct aiScene *sc) {
     float rgb[3] = {c.r, c.g, c.b};
     /* A textured material's texture carries the colour; OBJ files often leave Kd at 0. */
     if (has_tex && rgb[0] + rgb[1] + rgb[2] == 0) rgb[0] = rgb[1] = rgb[2] = 1;
-    if (scene_add_material(s, rgb, has_tex ? tex.data : NULL) == UINT32_MAX)
+    if (rr_scene_add_material(s, rgb, has_tex ? tex.data : NULL) == UINT32_MAX)
       return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding materials");
   }
   return RR_OK;
 }
 
-rr_error scene_load_file(rr_scene *s, const char *path) {
+rr_error rr_scene_load_file(rr_scene *s, const char *path) {
   struct stat st;
   if (stat(path, &st) != 0)
     return rr_fail(s->dev, RR_ERROR_IO, "cannot open scene '%s': %s", path, strerror(errno));
@@ -143,6 +143,6 @@ rr_error scene_load_file(rr_scene *s, const char *path) {
   char *slash = strrchr(dir, '/');
   if (slash) *slash = 0;
   else strcpy(dir, ".");
-  scene_load_textures(s, dir);
+  rr_scene_load_textures(s, dir);
   return RR_OK;
 }

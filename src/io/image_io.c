@@ -7,7 +7,7 @@
  * before touching pixels: a malformed file is an RR_ERROR_PARSE, never a crash. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "rr.h"
+#include "io/io.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -401,7 +401,7 @@ static rr_error check_fits(rr_device *dev, image_format fmt, const rr_image *img
   return RR_OK;
 }
 
-rr_error image_write_file(rr_device *dev, const rr_image *img, const char *path) {
+rr_error rr_image_write_file(rr_device *dev, const rr_image *img, const char *path) {
   if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write an image: no path");
   image_format fmt = format_of(path);
   if (fmt == FMT_UNKNOWN) return unknown_format(dev, "write", path);
@@ -872,7 +872,7 @@ done:
   return e;
 }
 
-rr_error image_read_file(rr_device *dev, const char *path, rr_image *out) {
+rr_error rr_image_read_file(rr_device *dev, const char *path, rr_image *out) {
   if (!out) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot read an image: no output image");
   memset(out, 0, sizeof *out);
   if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot read an image: no path");
@@ -899,11 +899,11 @@ rr_error image_read_file(rr_device *dev, const char *path, rr_image *out) {
 /* ---- public API --------------------------------------------------------------- */
 
 rr_error rr_image_write(rr_device *dev, const rr_image *img, const char *path) {
-  return image_write_file(dev, img, path);
+  return rr_image_write_file(dev, img, path);
 }
 
 rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out) {
-  return image_read_file(dev, path, out);
+  return rr_image_read_file(dev, path, out);
 }
 
 void rr_image_free(rr_image *img) {

@@ -17,7 +17,7 @@
  * or incrementally (along a row) gives the same numbers: 2dr-bin produces the same
  * visibility buffer as 2dr-bb bit for bit, and a sample on an edge shared by two
  * triangles is claimed by exactly one of them. */
-#include "rr.h"
+#include "vis/vis.h"
 
 #include <string.h>
 
@@ -269,7 +269,7 @@ static void snap(const pipe2d *pp, const cvert *c, int64_t *x, int64_t *y) {
  * covers no sample (degenerate after snapping, culled, or between sample centres). */
 static bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], tri2d *t) {
   /* Twice the signed area, y down: negative for a triangle that is counter-clockwise
-   * as the viewer sees it, the front face (as tri_setup_planar decides it). */
+   * as the viewer sees it, the front face (as rr_tri_setup decides it). */
   int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
   if (area == 0) return false;
   t->back = area > 0;
@@ -685,8 +685,8 @@ static rr_error run2d(rr_device *dev, const rr_scene *s, const camera *c, bool c
   for (uint32_t first = 0; first < s->ntris; first += BATCH) {
     job->first = first;
     job->count = s->ntris - first < BATCH ? s->ntris - first : BATCH;
-    parallel_for((int)((job->count + CHUNK - 1) / CHUNK), threads, setup_job, job);
-    parallel_for(bands, threads, band_job, job);
+    rr_parallel_for((int)((job->count + CHUNK - 1) / CHUNK), threads, setup_job, job);
+    rr_parallel_for(bands, threads, band_job, job);
   }
   for (int t = 0; t < 256; t++) stats->setups += job->setups[t], stats->edge_evals += job->evals[t];
   if (need_hiz) hiz_free(&hz);
@@ -694,17 +694,17 @@ static rr_error run2d(rr_device *dev, const rr_scene *s, const camera *c, bool c
   return RR_OK;
 }
 
-rr_error vis_2dr_bb(rr_device *dev, render_ctx *ctx) {
+rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx) {
   target tg = {.vb = ctx->vb, .heat = ctx->heat_e};
   return run2d(dev, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, false, ctx->threads, tg, ctx->stats);
 }
 
-rr_error vis_2dr_bin(rr_device *dev, render_ctx *ctx) {
+rr_error rr_vis_2dr_bin(rr_device *dev, render_ctx *ctx) {
   target tg = {.vb = ctx->vb, .heat = ctx->heat_e};
   return run2d(dev, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, true, ctx->threads, tg, ctx->stats);
 }
 
-rr_error raster2d_claims(const rr_scene *s, const camera *c, bool bin, int threads, uint8_t *front, uint8_t *back) {
+rr_error rr_raster2d_claims(const rr_scene *s, const camera *c, bool bin, int threads, uint8_t *front, uint8_t *back) {
   size_t n = (size_t)c->width * c->height;
   memset(front, 0, n), memset(back, 0, n);
   visbuf vb = {.width = c->width, .height = c->height};
@@ -713,7 +713,7 @@ rr_error raster2d_claims(const rr_scene *s, const camera *c, bool bin, int threa
   return run2d(NULL, s, c, false, bin, threads < 1 ? 1 : threads, tg, &st);
 }
 
-bool raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, double *sy) {
+bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, double *sy) {
   pipe2d pp;
   if (!pipe_setup(&pp, s, c, false)) return false;
   cvert v;

@@ -1,8 +1,10 @@
-/* 3D rasterization kernels shared by the traversal's configurations: a triangle's
- * screen bounds and the test of every sample of a rectangle (paper sect. 3.2, 5).
- * A triangle that crosses the eye plane has no bounded projection and is tested
- * over the whole screen; 3D edge functions need no clipping for that. */
-#include "rr.h"
+/* Triangle bounds for a camera: which samples a set-up triangle may cover (screen
+ * rectangles, cones of curved views) and the least t it can give (paper sect. 3.2, 5).
+ * A triangle that crosses the eye plane has no bounded projection and is bounded by
+ * the whole screen; 3D edge functions need no clipping for that. */
+#include "prim/triangle.h"
+
+#include <string.h>
 
 /* Samples a set-up triangle may cover, as an inclusive pixel rectangle. Returns
  * false when it covers none. */
@@ -11,7 +13,7 @@
  * triangle's directions? Two conservative tests: the triangle's bounding cap
  * (tight for small triangles), and the four planes through the eye a hit must lie
  * inside of: V_i >= 0 for the three edges and Σw_iV_i > 0 (t > 0). */
-bool cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float angle) {
+bool rr_cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float angle) {
   if (tc->cap_angle >= 0 && acosf(fminf(1.0f, v3_dot(axis, tc->cap_axis))) > angle + tc->cap_angle + 1e-5f)
     return true;
   float lim = sinf(angle) + 1e-5f, sum = 0;
@@ -23,7 +25,7 @@ bool cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float ang
   return sum < -tc->len[3] * lim;
 }
 
-void tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, tri_cone *tc) {
+void rr_tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, tri_cone *tc) {
   for (int e = 0; e < 3; e++) tc->len[e] = sqrtf(ts->a[e] * ts->a[e] + ts->b[e] * ts->b[e] + ts->c[e] * ts->c[e]);
   const float *w = ts->w; /* the sum that must be positive is Σ w_i V_i */
   float sx = ts->a[0] * w[0] + ts->a[1] * w[1] + ts->a[2] * w[2];
@@ -46,13 +48,13 @@ void tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri_se
 
 static bool curved_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int r[4]) {
   tri_cone tc;
-  tri_cone_setup(s, i, c, ts, &tc);
+  rr_tri_cone_setup(s, i, c, ts, &tc);
   int x0 = c->cells_x, y0 = c->cells_y, x1 = -1, y1 = -1;
   for (int cy = 0; cy < c->cells_y; cy++)
     for (int cx = 0; cx < c->cells_x; cx++) {
       const float *cell = c->cells + 4 * ((size_t)cy * c->cells_x + cx);
       if (cell[3] < 0) continue; /* no rays */
-      if (cell[3] < 1.5f && cone_excludes(&tc, ts, v3(cell[0], cell[1], cell[2]), cell[3])) continue;
+      if (cell[3] < 1.5f && rr_cone_excludes(&tc, ts, v3(cell[0], cell[1], cell[2]), cell[3])) continue;
       x0 = cx < x0 ? cx : x0, x1 = cx > x1 ? cx : x1, y0 = cy < y0 ? cy : y0, y1 = cy > y1 ? cy : y1;
     }
   if (x1 < 0) return false;
@@ -62,7 +64,7 @@ static bool curved_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
   return true;
 }
 
-bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int r[4]) {
+bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int r[4]) {
   float x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   int behind = 0, projected = 0;
   /* A point at infinity projects to its vanishing point when its direction points
@@ -74,7 +76,7 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri
     vec3 q = scene_q(s, k, i, c->eye);
     float sx, sy;
     if (!(v3_dot(q, c->fwd) > 0)) behind++;
-    else if (camera_project(c, q, &sx, &sy) && isfinite(sx) && isfinite(sy)) {
+    else if (rr_cam_project(c, q, &sx, &sy) && isfinite(sx) && isfinite(sy)) {
       projected++;
       x0 = minf(x0, sx), x1 = maxf(x1, sx), y0 = minf(y0, sy), y1 = maxf(y1, sy); /* finite: no libm calls */
     }
@@ -102,16 +104,16 @@ bool tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri
   return true;
 }
 
-/* The planar bounds of one triangle from its corners, as tri_screen_bounds gives them. */
+/* The planar bounds of one triangle from its corners, as rr_tri_screen_bounds gives them. */
 static inline uint32_t keep_bounded(const rr_scene *s, uint32_t i, const camera *c, tri_bound *out) {
   out->id = i;
-  return tri_screen_bounds(s, i, c, NULL, out->bb);
+  return rr_tri_screen_bounds(s, i, c, NULL, out->bb);
 }
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 
-/* tri_screen_bounds for eight triangles at once, for planar cameras and finite
+/* rr_tri_screen_bounds for eight triangles at once, for planar cameras and finite
  * corners: the same operations in the same order (no FMA, true divisions), so the
  * same rectangles. Lanes with a corner not strictly in front of the image plane
  * (or projecting to no finite point) take the scalar path. */
@@ -187,7 +189,7 @@ __attribute__((target("avx2"))) static uint32_t bounds8_avx2(const rr_scene *s, 
 }
 #endif
 
-uint32_t tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
+uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
                            bool simd, tri_bound *out) {
   uint32_t kept = 0, k = 0;
 #if defined(__x86_64__) || defined(__i386__)
@@ -201,99 +203,122 @@ uint32_t tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *id
   return kept;
 }
 
-/* The sample loop, written once and specialised for planar and curved cameras. */
-static inline uint64_t raster_loop(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb,
-                                   const bool planar) {
-  uint64_t covered = 0;
-  for (int y = r[1]; y <= r[3]; y++) {
-    float sy = (float)y + 0.5f;
-    size_t row = (size_t)y * vb->width;
-    for (int x = r[0]; x <= r[2]; x++) {
-      float sx = (float)x + 0.5f;
-      vec3 w = planar ? v3(1.0f, sx, sy) : c->dirs[row + x];
-      covered += shade_sample_w(ts, id, w, sx, sy, vb, row + x) != 0;
+/* The least t that sample_test() can return for ts at any sample of camera c.
+ *
+ * Planar cameras evaluate e_i = a + sx·b + sy·c in float, with an error below
+ * u_i = 4u·(|a| + |sx·b| + |sy·c|) (u = 2^-24, bounded over the image); a passing
+ * sample has every computed e_i >= 0, so it lies in P = {E_i >= -u_i} for the
+ * exact edge functions E_i of the setup values, and the computed sum is at most
+ * (1+u)^2 Σ(E_i + u_i). That sum is affine, so its maximum over P is at a vertex
+ * of P; at the vertex where E_i + u_i and E_j + u_j vanish it equals
+ * det[a' b c] / (b_i·c_j - b_j·c_i) (Cramer; a' = a + u), and P is that bounded
+ * triangle when the three values are positive; otherwise P clipped to the image
+ * rectangle is a convex polygon and its vertices bound both. Curved cameras evaluate e_i = n_i·d with |d| at most
+ * the camera's longest ray, so the sum is at most |Σn_i|·|d| plus the error. The
+ * volume (constant but for orthographic views) is bounded below over the image
+ * the same way, and t = vol·(1/sum) is at least vol·(1-u)^2 / max sum. P's
+ * vertices also bound the samples where the triangle can pass: rect (x0, y0, x1,
+ * y1; the whole plane when P is unbounded or the camera curved). Double
+ * arithmetic carries a relative slack far above its own rounding. Points at
+ * infinity: sample_test sums w_i·e_i with w_i in {0, 1} and every e_i >= 0 on P,
+ * so the plain sum bounds it too (curved cameras use |Σ w_i n_i|). */
+float rr_tri_bounds(const tri_setup *ts, const camera *cam, float rect[4]) {
+  const double u = 0x1p-24, slack = 1e-12;
+  int w = cam->width, h = cam->height;
+  double smax = -INFINITY;
+  double rx0 = -INFINITY, ry0 = -INFINITY, rx1 = INFINITY, ry1 = INFINITY;
+  if (cam->planar) {
+    double a[3], b[3], c[3];
+    for (int i = 0; i < 3; i++) {
+      b[i] = ts->b[i], c[i] = ts->c[i];
+      a[i] = ts->a[i] + 4 * u * (fabs(ts->a[i]) + w * fabs(b[i]) + h * fabs(c[i]));
     }
-  }
-  return covered;
-}
-
-#if defined(__x86_64__) || defined(__i386__)
-
-/* The planar sample loop, 8 samples of a row at a time with AVX2. Every operation
- * is the scalar one, in the same order, on IEEE single floats (no FMA, a true
- * division), so the bits are those of raster_loop: the same sample test. */
-__attribute__((target("avx2"))) static uint64_t raster_loop_avx2(const tri_setup *ts, uint32_t id, const int r[4],
-                                                                  visbuf *vb) {
-  __m256 a[3], b[3], c[3], tie[3];
-  for (int e = 0; e < 3; e++) {
-    a[e] = _mm256_set1_ps(ts->a[e]), b[e] = _mm256_set1_ps(ts->b[e]), c[e] = _mm256_set1_ps(ts->c[e]);
-    tie[e] = _mm256_castsi256_ps(_mm256_set1_epi32(ts->tie & (1u << e) ? -1 : 0));
-  }
-  const __m256 w0 = _mm256_set1_ps(ts->w[0]), w1 = _mm256_set1_ps(ts->w[1]), w2 = _mm256_set1_ps(ts->w[2]);
-  const __m256 vol = _mm256_set1_ps(ts->vol), vol_x = _mm256_set1_ps(ts->vol_x), vol_y = _mm256_set1_ps(ts->vol_y);
-  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
-  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), bias = _mm256_set1_epi32((int)0x80000000);
-  const __m256i idv = _mm256_set1_epi32((int)id), id_biased = _mm256_xor_si256(idv, bias);
-  uint64_t covered = 0;
-  /* Columns of 8 samples, then rows: the terms in sx are the same on every row. */
-  for (int x = r[0]; x <= r[2]; x += 8) {
-    __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(x), lane);
-    const __m256 valid = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(r[2] + 1), xi));
-    const __m256 sx = _mm256_add_ps(_mm256_cvtepi32_ps(xi), _mm256_set1_ps(0.5f));
-    __m256 ax[3];
-    for (int e = 0; e < 3; e++) ax[e] = _mm256_add_ps(_mm256_mul_ps(a[e], one), _mm256_mul_ps(b[e], sx));
-    const __m256 vx = _mm256_add_ps(vol, _mm256_mul_ps(sx, vol_x));
-    for (int y = r[1]; y <= r[3]; y++) {
-      const __m256 sy = _mm256_set1_ps((float)y + 0.5f);
-      size_t row = (size_t)y * vb->width;
-      __m256 ev[3], in = valid;
-      for (int e = 0; e < 3; e++) {
-        ev[e] = _mm256_add_ps(ax[e], _mm256_mul_ps(c[e], sy));
-        __m256 pos = _mm256_cmp_ps(ev[e], zero, _CMP_GT_OQ);
-        __m256 on = _mm256_and_ps(_mm256_cmp_ps(ev[e], zero, _CMP_EQ_OQ), tie[e]);
-        in = _mm256_and_ps(in, _mm256_or_ps(pos, on));
+    double m[3], mag_m[3];
+    for (int k = 0; k < 3; k++) {
+      int i = (k + 1) % 3, j = (k + 2) % 3;
+      m[k] = b[i] * c[j] - b[j] * c[i], mag_m[k] = fabs(b[i] * c[j]) + fabs(b[j] * c[i]);
+    }
+    double det = a[0] * m[0] + a[1] * m[1] + a[2] * m[2];
+    double mag_d = fabs(a[0]) * mag_m[0] + fabs(a[1]) * mag_m[1] + fabs(a[2]) * mag_m[2];
+    /* Bounded when det and the three minors share a sign (either: it depends on
+     * how the triangle's projection turns on screen), each clear of the slack. */
+    double sg = det < 0 ? -1 : 1;
+    bool bounded = sg * det > slack * mag_d;
+    double vx[3], vy[3], ex[3], ey[3], den = INFINITY;
+    for (int k = 0; k < 3 && bounded; k++) {
+      bounded = sg * m[k] > slack * mag_m[k];
+      if (!bounded) break;
+      double d = sg * m[k] - slack * mag_m[k];
+      den = d < den ? d : den;
+      /* The vertex itself, where E_i + u_i = E_j + u_j = 0, with a generous error. */
+      int i = (k + 1) % 3, j = (k + 2) % 3;
+      double inv = 1.0 / m[k], ainv = fabs(inv);
+      vx[k] = (-a[i] * c[j] + a[j] * c[i]) * inv, vy[k] = (b[j] * a[i] - b[i] * a[j]) * inv;
+      ex[k] = 1e-9 * ((fabs(a[i] * c[j]) + fabs(a[j] * c[i])) * ainv + fabs(vx[k])) + 1e-6;
+      ey[k] = 1e-9 * ((fabs(b[j] * a[i]) + fabs(b[i] * a[j])) * ainv + fabs(vy[k])) + 1e-6;
+    }
+    /* Σ(E + u) at the vertices is det/m_k: the largest has the smallest minor. */
+    if (bounded) smax = (sg * det + slack * mag_d) / den;
+    if (bounded) {
+      rx0 = fmin(vx[0] - ex[0], fmin(vx[1] - ex[1], vx[2] - ex[2]));
+      rx1 = fmax(vx[0] + ex[0], fmax(vx[1] + ex[1], vx[2] + ex[2]));
+      ry0 = fmin(vy[0] - ey[0], fmin(vy[1] - ey[1], vy[2] - ey[2]));
+      ry1 = fmax(vy[0] + ey[0], fmax(vy[1] + ey[1], vy[2] + ey[2]));
+    }
+    if (!bounded) {
+      /* P unbounded (the triangle crosses the eye's plane) or nearly degenerate:
+       * clip the image rectangle by its three half-planes, loosened by the slack,
+       * and take the polygon's extent and its largest Σ(E + u). */
+      double px[8] = {0, w, w, 0}, py[8] = {0, 0, h, h}, qx[8], qy[8];
+      int np = 4;
+      for (int i = 0; i < 3 && np; i++) {
+        double A = a[i] + slack * (fabs(a[i]) + w * fabs(b[i]) + h * fabs(c[i]));
+        int nq = 0;
+        for (int k = 0; k < np; k++) {
+          int l = (k + 1) % np;
+          double fk = A + b[i] * px[k] + c[i] * py[k], fl = A + b[i] * px[l] + c[i] * py[l];
+          if (fk >= 0) qx[nq] = px[k], qy[nq] = py[k], nq++;
+          if ((fk >= 0) != (fl >= 0)) {
+            double r = fk / (fk - fl);
+            qx[nq] = px[k] + (px[l] - px[k]) * r, qy[nq] = py[k] + (py[l] - py[k]) * r, nq++;
+          }
+        }
+        np = nq;
+        memcpy(px, qx, sizeof px), memcpy(py, qy, sizeof py);
       }
-      if (!_mm256_movemask_ps(in)) continue;
-      __m256 sum = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ev[0], w0), _mm256_mul_ps(ev[1], w1)),
-                                 _mm256_mul_ps(ev[2], w2));
-      __m256 v = _mm256_add_ps(vx, _mm256_mul_ps(sy, vol_y));
-      in = _mm256_and_ps(in, _mm256_and_ps(_mm256_cmp_ps(sum, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, zero, _CMP_GT_OQ)));
-      int hit = _mm256_movemask_ps(in);
-      if (!hit) continue;
-      covered += (uint64_t)__builtin_popcount((unsigned)hit);
-      __m256 inv = _mm256_div_ps(one, sum);
-      __m256 t = _mm256_mul_ps(v, inv);
-      /* depth_wins: nearer, or as near with a lower id */
-      __m256i mi = _mm256_castps_si256(in);
-      __m256 bt = _mm256_maskload_ps(vb->t + row + x, mi);
-      __m256i bid = _mm256_maskload_epi32((const int *)vb->id + row + x, mi);
-      __m256 lower_id = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_xor_si256(bid, bias), id_biased));
-      __m256 wins = _mm256_or_ps(_mm256_cmp_ps(t, bt, _CMP_LT_OQ),
-                                 _mm256_and_ps(_mm256_cmp_ps(t, bt, _CMP_EQ_OQ), lower_id));
-      __m256i w = _mm256_castps_si256(_mm256_and_ps(in, wins));
-      if (_mm256_testz_si256(w, w)) continue;
-      _mm256_maskstore_ps(vb->t + row + x, w, t);
-      _mm256_maskstore_epi32((int *)vb->id + row + x, w, idv);
-      _mm256_maskstore_ps(vb->l1 + row + x, w, _mm256_mul_ps(ev[1], inv));
-      _mm256_maskstore_ps(vb->l2 + row + x, w, _mm256_mul_ps(ev[2], inv));
+      if (!np) smax = -INFINITY; /* no sample of the image can pass */
+      double A = a[0] + a[1] + a[2], B = b[0] + b[1] + b[2], C = c[0] + c[1] + c[2];
+      for (int k = 0; k < np; k++) {
+        double v = A + B * px[k] + C * py[k];
+        smax = v > smax ? v : smax;
+        rx0 = k ? fmin(rx0, px[k]) : px[k], rx1 = k ? fmax(rx1, px[k]) : px[k];
+        ry0 = k ? fmin(ry0, py[k]) : py[k], ry1 = k ? fmax(ry1, py[k]) : py[k];
+      }
+      smax += slack * (fabs(A) + w * fabs(B) + h * fabs(C));
+      rx0 -= 1e-6 * (w + 1), rx1 += 1e-6 * (w + 1), ry0 -= 1e-6 * (h + 1), ry1 += 1e-6 * (h + 1);
     }
+  } else {
+    double dmax = (double)cam->dir_len_max * (1 + 1e-6), nx = 0, ny = 0, nz = 0, err = 0;
+    for (int i = 0; i < 3; i++) {
+      nx += ts->a[i] * ts->w[i], ny += ts->b[i] * ts->w[i], nz += ts->c[i] * ts->w[i]; /* Σ w_i n_i */
+      err += 4 * u * (fabs(ts->a[i]) + fabs(ts->b[i]) + fabs(ts->c[i]));
+    }
+    smax = (sqrt(nx * nx + ny * ny + nz * nz) + err) * dmax * (1 + slack);
   }
-  return covered;
-}
-#endif
-
-/* Tests every sample of rectangle r against one triangle; returns the evaluations. */
-uint64_t raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb,
-                     uint64_t *covered, bool simd) {
-  uint64_t n, samples = (uint64_t)(r[2] - r[0] + 1) * (uint64_t)(r[3] - r[1] + 1);
-#if defined(__x86_64__) || defined(__i386__)
-  /* a rectangle of a few samples (most triangles of a detailed mesh) costs less
-   * than the vector loop's setup; both paths give the same bits */
-  if (simd && c->planar && samples > 2 && __builtin_cpu_supports("avx2")) n = raster_loop_avx2(ts, id, r, vb);
-  else
-#endif
-    n = c->planar ? raster_loop(ts, id, r, c, vb, true) : raster_loop(ts, id, r, c, vb, false);
-  (void)simd;
-  if (covered) *covered += n;
-  return samples;
+  /* Rounded outwards to float; samples are small integers + 0.5, so this is loose. */
+  rect[0] = (float)rx0 - 1e-3f, rect[1] = (float)ry0 - 1e-3f, rect[2] = (float)rx1 + 1e-3f, rect[3] = (float)ry1 + 1e-3f;
+  if (!(smax > 0)) { /* no sample can pass */
+    rect[0] = rect[1] = INFINITY, rect[2] = rect[3] = -INFINITY;
+    return INFINITY;
+  }
+  double vmin = ts->vol; /* exact when vol_x = vol_y = 0: vol + 0 + 0 */
+  if (ts->vol_x != 0 || ts->vol_y != 0) {
+    double v0 = ts->vol, vx = ts->vol_x, vy = ts->vol_y;
+    vmin = v0 + fmin(0.5 * vx, (w - 0.5) * vx) + fmin(0.5 * vy, (h - 0.5) * vy);
+    vmin -= 4 * u * (fabs(v0) + w * fabs(vx) + h * fabs(vy)) + slack * fabs(v0);
+  }
+  if (!(vmin > 0)) return 0;
+  double t = vmin * (1 - u) * (1 - u) / (smax * (1 + u) * (1 + u)) * (1 - 1e-9);
+  float f = (float)t;
+  return (double)f > t ? nextafterf(f, 0) : f;
 }

@@ -1,5 +1,5 @@
 /* Scene storage: triangles in structure-of-arrays form, materials, bounds. */
-#include "rr.h"
+#include "accel/bvh.h"
 
 #include <string.h>
 
@@ -28,7 +28,7 @@ void rr_scene_release(rr_scene *s) {
     free(s->materials[m].texture.rgb);
   }
   free(s->materials);
-  scene_free_bvh(s);
+  rr_bvh_release(s->bvh);
   free(s);
 }
 
@@ -41,7 +41,7 @@ static bool grow(float **arr, uint32_t cap) {
   return true;
 }
 
-rr_error scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_uvs) {
+rr_error rr_scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_uvs) {
   uint64_t need = (uint64_t)s->ntris + more;
   if (need > UINT32_MAX - 1)
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "scene too large: %llu triangles", (unsigned long long)need);
@@ -59,7 +59,7 @@ rr_error scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_
   return RR_OK;
 }
 
-void scene_trim(rr_scene *s) {
+void rr_scene_trim(rr_scene *s) {
   if (s->ntris && s->ntris < s->cap) resize(s, s->ntris, false, false); /* on failure the arrays stay as they were */
 }
 
@@ -107,16 +107,16 @@ static vec3 homog_normal(const vec3 p[3], unsigned inf) {
   return v3_cross(u, v);
 }
 
-vec3 scene_tri_normal(const rr_scene *s, uint32_t i) {
+vec3 rr_scene_tri_normal(const rr_scene *s, uint32_t i) {
   vec3 p[3] = {scene_vertex(s, 0, i), scene_vertex(s, 1, i), scene_vertex(s, 2, i)};
   return homog_normal(p, scene_inf(s, i));
 }
 
-bool scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv)[2], uint32_t mat) {
-  return scene_push_inf(s, p, 0, n, uv, mat);
+bool rr_scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv)[2], uint32_t mat) {
+  return rr_scene_push_inf(s, p, 0, n, uv, mat);
 }
 
-bool scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, const float (*uv)[2], uint32_t mat) {
+bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, const float (*uv)[2], uint32_t mat) {
   /* A triangle with a non-finite coordinate or no area can never be hit
    * consistently; it is dropped and counted, not fatal. So is one whose three
    * corners are all at infinity (it lies on the plane at infinity). */
@@ -126,9 +126,9 @@ bool scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, c
     s->skipped++;
     return false;
   }
-  if (s->ntris >= s->cap && scene_reserve(s, 1, n != NULL, uv != NULL) != RR_OK) return false;
+  if (s->ntris >= s->cap && rr_scene_reserve(s, 1, n != NULL, uv != NULL) != RR_OK) return false;
   if ((n && !s->n[0][0]) || (uv && !s->uv[0][0]))
-    if (scene_reserve(s, 0, n != NULL, uv != NULL) != RR_OK) return false;
+    if (rr_scene_reserve(s, 0, n != NULL, uv != NULL) != RR_OK) return false;
   if (inf && !s->inf) {
     s->inf = calloc(s->cap, 1); /* earlier triangles are finite */
     if (!s->inf) return false;
@@ -153,7 +153,7 @@ bool scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, c
   return true;
 }
 
-uint32_t scene_add_material(rr_scene *s, const float color[3], const char *texture_path) {
+uint32_t rr_scene_add_material(rr_scene *s, const float color[3], const char *texture_path) {
   rr_material *m = realloc(s->materials, (s->nmaterials + 1) * sizeof *m);
   if (!m) return UINT32_MAX;
   s->materials = m;
@@ -168,7 +168,7 @@ uint32_t scene_add_material(rr_scene *s, const float color[3], const char *textu
   return s->nmaterials++;
 }
 
-void scene_update_bounds(rr_scene *s) {
+void rr_scene_update_bounds(rr_scene *s) {
   vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
   for (uint32_t i = 0; i < s->ntris; i++)
     for (int k = 0; k < 3; k++) {
@@ -194,9 +194,9 @@ static rr_error add_mesh(rr_scene *s, const char *api, const float *pos, int str
       return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: index %u of triangle %zu out of range (%zu vertices)", api,
                      idx[t], t / 3, nvert);
   float grey[3] = {0.8f, 0.8f, 0.8f};
-  uint32_t mat = scene_add_material(s, rgb ? rgb : grey, NULL);
+  uint32_t mat = rr_scene_add_material(s, rgb ? rgb : grey, NULL);
   if (mat == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
-  rr_error e = scene_reserve(s, (uint32_t)ntri, false, false);
+  rr_error e = rr_scene_reserve(s, (uint32_t)ntri, false, false);
   if (e) return e;
   for (size_t t = 0; t < ntri; t++) {
     vec3 p[3];
@@ -207,7 +207,7 @@ static rr_error add_mesh(rr_scene *s, const char *api, const float *pos, int str
       if (w == 0) inf |= 1u << k, p[k] = v3(v[0], v[1], v[2]); /* a point at infinity: its direction */
       else p[k] = v3(v[0] / w, v[1] / w, v[2] / w); /* exact for w = 1 */
     }
-    scene_push_inf(s, p, inf, NULL, NULL, mat);
+    rr_scene_push_inf(s, p, inf, NULL, NULL, mat);
   }
   return rr_ok(s->dev);
 }
@@ -222,25 +222,6 @@ rr_error rr_scene_add_mesh4(rr_scene *s, const float *xyzw, size_t nvert, const 
   return add_mesh(s, "rr_scene_add_mesh4", xyzw, 4, nvert, idx, ntri, rgb);
 }
 
-rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out) {
-  if (!out || !path) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_scene_load: NULL argument");
-  *out = NULL;
-  rr_scene *s;
-  rr_error e = rr_scene_new(dev, &s);
-  if (e) return e;
-  e = scene_load_builtin(s, path);
-  if (e == RR_ERROR_UNSUPPORTED) e = scene_load_file(s, path);
-  if (!e && s->ntris == 0)
-    e = rr_fail(dev, RR_ERROR_EMPTY, "scene '%s' has no triangles%s", path,
-                s->skipped ? " (all were degenerate or non-finite)" : "");
-  if (!e) e = rr_scene_commit(s);
-  if (e) {
-    rr_scene_release(s);
-    return e;
-  }
-  *out = s;
-  return rr_ok(dev);
-}
 
 rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
   if (!s || !info) return RR_ERROR_ARGUMENT;
@@ -250,6 +231,21 @@ rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
   info->materials = s->nmaterials;
   info->bounds_min[0] = s->bmin.x, info->bounds_min[1] = s->bmin.y, info->bounds_min[2] = s->bmin.z;
   info->bounds_max[0] = s->bmax.x, info->bounds_max[1] = s->bmax.y, info->bounds_max[2] = s->bmax.z;
-  bvh_fill_info(s, info);
+  rr_bvh_fill_info(s->bvh, info);
   return RR_OK;
+}
+
+/* The scene is complete: give back spare room and build the BVH with the device's options. */
+rr_error rr_scene_commit(rr_scene *s) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  rr_build_options opt;
+  rr_build_options_init(&opt);
+  if (s->dev) opt = s->dev->build;
+  rr_scene_trim(s);
+  struct rr_bvh *b;
+  rr_error e = rr_bvh_build(s, &opt, &b);
+  if (e) return e;
+  rr_bvh_release(s->bvh);
+  s->bvh = b;
+  return rr_ok(s->dev);
 }

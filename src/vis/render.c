@@ -1,35 +1,8 @@
-/* The public API's devices, errors, method table and the visibility pass. */
-#include "rr.h"
+/* The method table and the visibility pass (rr_render): a frame from a scene, a camera and options. */
+#include "vis/vis.h"
 
 #include <stdio.h>
 #include <string.h>
-
-rr_device *rr_device_new(void) { return calloc(1, sizeof(rr_device)); }
-
-void rr_device_release(rr_device *dev) { free(dev); }
-
-rr_error rr_device_error(const rr_device *dev) { return dev ? dev->error : RR_ERROR_ARGUMENT; }
-
-const char *rr_device_message(const rr_device *dev) { return dev ? dev->message : "no device"; }
-
-rr_error rr_fail(rr_device *dev, rr_error code, const char *fmt, ...) {
-  if (dev) {
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(dev->message, sizeof dev->message, fmt, ap);
-    va_end(ap);
-    dev->error = code;
-  }
-  return code;
-}
-
-rr_error rr_ok(rr_device *dev) {
-  if (dev) {
-    dev->error = RR_OK;
-    dev->message[0] = 0;
-  }
-  return RR_OK;
-}
 
 /* ---- names ---------------------------------------------------------------- */
 
@@ -41,20 +14,20 @@ static const struct {
   vis_method_fn fn;
   oracles o;
 } methods[RR_METHOD_COUNT] = {
-    [RR_METHOD_RC] = {"rc", vis_rc, {0}},
-    [RR_METHOD_RC_BVH] = {"rc-bvh", vis_rc_bvh, {0}},
-    [RR_METHOD_RC_PACKET] = {"rc-packet", vis_rc_packet, {0}},
-    [RR_METHOD_2DR_BB] = {"2dr-bb", vis_2dr_bb, {0}},
-    [RR_METHOD_2DR_BIN] = {"2dr-bin", vis_2dr_bin, {0}},
-    [RR_METHOD_3DR_BB] = {"3dr-bb", vis_traverse, {.bin_size = 64, .bin_min = 4}},
-    [RR_METHOD_3DR_BIN] = {"3dr-bin", vis_traverse, {.binning = 1, .early_z = 1, .bin_size = 64, .bin_min = 4}},
-    [RR_METHOD_3DR_FC] = {"3dr-fc", vis_traverse,
+    [RR_METHOD_RC] = {"rc", rr_vis_rc, {0}},
+    [RR_METHOD_RC_BVH] = {"rc-bvh", rr_vis_rc_bvh, {0}},
+    [RR_METHOD_RC_PACKET] = {"rc-packet", rr_vis_rc_packet, {0}},
+    [RR_METHOD_2DR_BB] = {"2dr-bb", rr_vis_2dr_bb, {0}},
+    [RR_METHOD_2DR_BIN] = {"2dr-bin", rr_vis_2dr_bin, {0}},
+    [RR_METHOD_3DR_BB] = {"3dr-bb", rr_vis_traverse, {.bin_size = 64, .bin_min = 4}},
+    [RR_METHOD_3DR_BIN] = {"3dr-bin", rr_vis_traverse, {.binning = 1, .early_z = 1, .bin_size = 64, .bin_min = 4}},
+    [RR_METHOD_3DR_FC] = {"3dr-fc", rr_vis_traverse,
                           {.frustum_size = 256, .leaves = 1, .cull_outside = 1, .binning = 1, .early_z = 1,
                            .bin_size = 64, .bin_min = 4}},
-    [RR_METHOD_3DR_FS] = {"3dr-fs", vis_traverse,
+    [RR_METHOD_3DR_FS] = {"3dr-fs", rr_vis_traverse,
                           {.leaves = 1, .cull_outside = 1, .cull_occluded = 1, .split_min = 8, .split_ratio = 0.25f,
                            .bin_size = 64, .bin_min = 4}},
-    [RR_METHOD_3DR_FULL] = {"3dr-full", vis_traverse,
+    [RR_METHOD_3DR_FULL] = {"3dr-full", rr_vis_traverse,
                             {.leaves = 1, .cull_outside = 1, .cull_occluded = 1, .split_min = 8, .split_ratio = 0.25f,
                              .binning = 1, .early_z = 1, .bin_size = 64, .bin_min = 4}},
 };
@@ -234,7 +207,7 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad thread count %d (0 for all cores, at most 256)", opt->threads);
   oracles o = methods[opt->method].o;
   if (opt->oracles && *opt->oracles) {
-    if (methods[opt->method].fn != vis_traverse)
+    if (methods[opt->method].fn != rr_vis_traverse)
       return rr_fail(dev, RR_ERROR_ARGUMENT, "oracles apply to the 3dr methods, not to '%s'", methods[opt->method].name);
     rr_error e = parse_oracles(dev, opt->oracles, &o);
     if (e) return e;
@@ -248,21 +221,21 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                    "rc-packet, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full)",
                    methods[opt->method].name, rr_camera_name(cam->type));
   camera c;
-  rr_error e = camera_setup(dev, cam, opt->width, opt->height, &c);
+  rr_error e = rr_cam_setup(dev, cam, opt->width, opt->height, &c);
   if (e) return e;
   rr_frame *f = calloc(1, sizeof *f);
   size_t npix = (size_t)opt->width * opt->height;
   if (!f || !visbuf_alloc(&f->vb, opt->width, opt->height) ||
       (opt->heat && (!(f->heat_e = calloc(npix, sizeof(float))) || !(f->heat_n = calloc(npix, sizeof(float)))))) {
     rr_frame_release(f);
-    camera_release(&c);
+    rr_cam_release(&c);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d visibility buffer", opt->width, opt->height);
   }
   f->method = opt->method;
   render_ctx ctx = {.scene = scene,
                     .cam = &c,
                     .opt = opt,
-                    .threads = opt->threads ? opt->threads : cpu_count(),
+                    .threads = opt->threads ? opt->threads : rr_cpu_count(),
                     .vb = &f->vb,
                     .stats = &f->stats,
                     .heat_e = f->heat_e,
@@ -270,10 +243,10 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                     .oracles = &o};
   f->stats.threads = ctx.threads;
   f->stats.method = opt->method;
-  double t0 = now_ms(), c0 = cpu_ms();
+  double t0 = rr_now_ms(), c0 = rr_cpu_ms();
   e = methods[opt->method].fn(dev, &ctx);
-  f->stats.frame_ms = now_ms() - t0, f->stats.cpu_ms = cpu_ms() - c0;
-  camera_release(&c);
+  f->stats.frame_ms = rr_now_ms() - t0, f->stats.cpu_ms = rr_cpu_ms() - c0;
+  rr_cam_release(&c);
   if (e) {
     rr_frame_release(f);
     return e;

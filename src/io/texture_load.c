@@ -4,7 +4,7 @@
  * texture (width 0) and shades with its base colour. */
 #define _POSIX_C_SOURCE 200809L
 
-#include "rr.h"
+#include "io/io.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -42,7 +42,7 @@ static bool load_rgb(rr_texture *tex, const char *file) {
   return rgb != NULL;
 }
 
-void scene_load_textures(rr_scene *s, const char *base_dir) {
+void rr_scene_load_textures(rr_scene *s, const char *base_dir) {
   if (!s) return;
   for (uint32_t i = 0; i < s->nmaterials; i++) {
     rr_material *m = &s->materials[i];

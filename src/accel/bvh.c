@@ -13,7 +13,7 @@
  * at an odd index; the array starts 32 bytes past a 64-byte boundary so a pair
  * shares one cache line. The top of the tree (ranges too big for one task) comes
  * first, then each task's subtree in depth-first order. */
-#include "rr.h"
+#include "accel/bvh.h"
 
 #include <emmintrin.h>
 #include <string.h>
@@ -322,7 +322,7 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
   chunk_job job = {.bd = bd, .t = t, .m = &m};
   if (big) {
     job.chunk_bins = malloc(sizeof(bins) * nchunks);
-    parallel_for(nchunks, threads, chunk_bin, &job);
+    rr_parallel_for(nchunks, threads, chunk_bin, &job);
     bins_clear(b, nb);
     for (int c = 0; c < nchunks; c++) bins_merge(b, &job.chunk_bins[c], nb);
     free(job.chunk_bins);
@@ -350,7 +350,7 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
     job.nleft = malloc(sizeof(uint32_t) * nchunks);
     job.offset = malloc(sizeof(uint32_t) * 2 * nchunks);
     job.ccb = malloc(sizeof(box4) * 2 * nchunks);
-    parallel_for(nchunks, threads, chunk_count, &job);
+    rr_parallel_for(nchunks, threads, chunk_count, &job);
     uint32_t nl = 0;
     for (int c = 0; c < nchunks; c++) job.offset[c] = nl, nl += job.nleft[c];
     uint32_t nr = nl;
@@ -358,8 +358,8 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
       job.offset[nchunks + c] = nr;
       nr += (c == nchunks - 1 ? t->count - (uint32_t)c * BVH_CHUNK : BVH_CHUNK) - job.nleft[c];
     }
-    parallel_for(nchunks, threads, chunk_scatter, &job);
-    parallel_for(nchunks, threads, chunk_copy, &job);
+    rr_parallel_for(nchunks, threads, chunk_scatter, &job);
+    rr_parallel_for(nchunks, threads, chunk_copy, &job);
     sp->l.cbox = box_empty(), sp->r.cbox = box_empty();
     for (int c = 0; c < nchunks; c++) box_merge(&sp->l.cbox, job.ccb[2 * c]), box_merge(&sp->r.cbox, job.ccb[2 * c + 1]);
     sp->mid = nl;
@@ -608,17 +608,12 @@ static bool collapse_wide(rr_bvh *b) {
   return true;
 }
 
-static void bvh_free(struct rr_bvh *b) {
+void rr_bvh_release(rr_bvh *b) {
   if (!b) return;
   free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node);
   free(b);
 }
 
-void scene_free_bvh(rr_scene *s) {
-  if (!s) return;
-  bvh_free(s->bvh);
-  s->bvh = NULL;
-}
 
 void rr_build_options_init(rr_build_options *opt) {
   if (!opt) return;
@@ -652,12 +647,12 @@ static double sah_cost(const struct rr_bvh *b) {
   return ra > 0 ? sum / ra : 0;
 }
 
-rr_error bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out) {
+rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out) {
   *out = NULL;
-  double t0 = now_ms();
+  double t0 = rr_now_ms();
   builder bd = {.bins = opt->bins ? opt->bins : BVH_DEFAULT_BINS,
                 .leaf_size = opt->leaf_size ? opt->leaf_size : BVH_DEFAULT_LEAF,
-                .threads = opt->threads ? opt->threads : cpu_count()};
+                .threads = opt->threads ? opt->threads : rr_cpu_count()};
   struct rr_bvh *b = calloc(1, sizeof *b);
   if (!b) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for the BVH");
   b->nprims = s->ntris;
@@ -679,7 +674,7 @@ rr_error bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out
   if (!bd.refs || !bd.scratch || !cb) goto oom;
 
   ref_job rj = {s, bd.refs, cb};
-  parallel_for(nchunks, bd.threads, make_refs, &rj);
+  rr_parallel_for(nchunks, bd.threads, make_refs, &rj);
   task root = {.start = 0, .count = n, .node = 0, .depth = 0, .box = cb[0], .cbox = cb[1]};
   for (int c = 1; c < nchunks; c++) box_merge(&root.box, cb[2 * c]), box_merge(&root.cbox, cb[2 * c + 1]);
   /* The root sits alone before the pairs, so pairs start at odd indices. */
@@ -712,7 +707,7 @@ rr_error bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out
       for (uint32_t i = 0; i < frontier.n; i++)
         if (frontier.v[i].count < BVH_PAR_MIN) mt[k++] = frontier.v[i];
       lj.t = mt, lj.s = ms;
-      parallel_for(nmid, bd.threads, split_one, &lj);
+      rr_parallel_for(nmid, bd.threads, split_one, &lj);
       k = 0;
       for (uint32_t i = 0; i < frontier.n; i++)
         if (frontier.v[i].count < BVH_PAR_MIN) splits[i] = ms[k++];
@@ -747,7 +742,7 @@ rr_error bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out
   depths = calloc(small.n, sizeof *depths);
   if (!local || !leaves || !depths) goto oom;
   sub_job sj = {&bd, top.v, small.v, local, leaves, depths};
-  parallel_for((int)small.n, bd.threads, build_subtree, &sj);
+  rr_parallel_for((int)small.n, bd.threads, build_subtree, &sj);
 
   /* Assemble: the top, then each task's nodes with their child indices moved. */
   uint64_t total = top.n;
@@ -781,7 +776,7 @@ rr_error bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out
   b->sah_cost = sah_cost(b);
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
              (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t));
-  b->build_ms = now_ms() - t0;
+  b->build_ms = rr_now_ms() - t0;
   *out = b;
   b = NULL;
   goto done;
@@ -792,25 +787,12 @@ done:
   free(local), free(leaves), free(depths), free(splits);
   free(frontier.v), free(next.v), free(small.v), free(top.v);
   free(bd.refs), free(bd.scratch), free(cb);
-  bvh_free(b);
+  rr_bvh_release(b);
   return err;
 }
 
-rr_error rr_scene_commit(rr_scene *s) {
-  if (!s) return RR_ERROR_ARGUMENT;
-  rr_build_options opt;
-  rr_build_options_init(&opt);
-  if (s->dev) opt = s->dev->build;
-  scene_trim(s);
-  struct rr_bvh *b;
-  rr_error e = bvh_build(s, &opt, &b);
-  if (e) return e;
-  scene_free_bvh(s);
-  s->bvh = b;
-  return rr_ok(s->dev);
-}
 
-const rr_bvh *bvh_of(rr_device *dev, const rr_scene *s, bool *empty) {
+const rr_bvh *rr_bvh_of(rr_device *dev, const rr_scene *s, bool *empty) {
   *empty = s->ntris == 0;
   if (*empty) return NULL;
   if (!s->bvh || s->bvh->nprims != s->ntris) {
@@ -820,8 +802,7 @@ const rr_bvh *bvh_of(rr_device *dev, const rr_scene *s, bool *empty) {
   return s->bvh;
 }
 
-void bvh_fill_info(const rr_scene *s, rr_scene_info *info) {
-  const struct rr_bvh *b = s->bvh;
+void rr_bvh_fill_info(const rr_bvh *b, rr_scene_info *info) {
   if (!b) return;
   info->bvh_nodes = b->nnodes;
   info->bvh_leaves = b->nleaves;

@@ -5,7 +5,7 @@
  * edge's endpoints in a canonical order (lexicographic on coordinates) and negated
  * when the triangle runs the edge the other way; negation is exact in IEEE
  * arithmetic, so every later dot product is exactly opposite too. */
-#include "rr.h"
+#include "prim/triangle.h"
 
 static bool lex_less(vec3 a, vec3 b) {
   if (a.x != b.x) return a.x < b.x;
@@ -48,7 +48,7 @@ static bool lex_positive(float g1, float g2, float g3) {
  * for any mix of points and directions (q_j·n_j is the same for every j). Only the
  * finite vertices enter the sum (eq. 10): t = V / Σ w_i V_i, λ_i = V_i / Σ w_i V_i;
  * tri_setup.w carries the w_i (1 for ordinary triangles, whose bits do not change). */
-int tri_setup_camera(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces, tri_setup *out) {
+int rr_tri_setup(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces, tri_setup *out) {
   unsigned inf = scene_inf(s, i);
   vec3 q[3];
   for (int k = 0; k < 3; k++) q[k] = scene_q(s, k, i, c->eye);
@@ -137,7 +137,7 @@ AVX2 __m256 lex_positive8(__m256 g1, __m256 g2, __m256 g3) {
   return _mm256_or_ps(_mm256_cmp_ps(g1, z, _CMP_GT_OQ), _mm256_and_ps(_mm256_cmp_ps(g1, z, _CMP_EQ_OQ), t2));
 }
 
-/* tri_setup_camera for count <= 8 finite triangles and a perspective camera: the same
+/* rr_tri_setup for count <= 8 finite triangles and a perspective camera: the same
  * operations in the same order, so the same bits. */
 __attribute__((target("avx2"))) static void setup8_avx2(const rr_scene *s, const uint32_t *ids, int count,
                                                          const camera *c, bool cull, tri_setup *out, int *face) {
@@ -192,7 +192,7 @@ __attribute__((target("avx2"))) static void setup8_avx2(const rr_scene *s, const
 }
 #endif
 
-void tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces, bool simd,
+void rr_tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces, bool simd,
                    tri_setup *out, int *face) {
   int k = 0;
 #if defined(__x86_64__) || defined(__i386__)
@@ -201,5 +201,15 @@ void tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *
 #else
   (void)simd;
 #endif
-  for (; k < n; k++) face[k] = tri_setup_camera(s, ids[k], c, cull_backfaces, &out[k]);
+  for (; k < n; k++) face[k] = rr_tri_setup(s, ids[k], c, cull_backfaces, &out[k]);
+}
+
+bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull, float tmin, float tmax, float *t,
+                 float *l1, float *l2) {
+  tri_setup ts;
+  if (rr_tri_setup(s, i, ray, cull, &ts) == SETUP_CULLED) return false;
+  float e[3];
+  tri_edges(&ts, 0.0f, 0.0f, e); /* = a[i]: the edge functions along the ray itself */
+  if (!sample_test_w(e, ts.w, ts.tie, ts.vol, t, l1, l2)) return false;
+  return *t >= tmin && *t <= tmax;
 }

@@ -1,0 +1,51 @@
+/* Acceleration: the binned-SAH BVH over a scene's triangles and its 4-wide form. */
+#ifndef RR_BVH_H
+#define RR_BVH_H
+
+#include "scene/scene.h"
+
+/* 32-byte node with its own bounds. A leaf (count > 0) holds triangles
+ * bvh->prims[first .. first + count); an inner node's children are nodes[first]
+ * and nodes[first + 1]. The root is node 0. */
+typedef struct bvh_node {
+  float lo[3], hi[3];
+  uint32_t first, count;
+} bvh_node;
+
+typedef struct rr_bvh {
+  bvh_node *nodes;
+  uint32_t nnodes, nleaves, depth;
+  uint32_t *prims; /* triangle ids in leaf order */
+  double sah_cost, build_ms;
+  uint64_t bytes;
+  void *node_mem;  /* the allocation behind nodes (sibling pairs share a cache line) */
+  uint32_t nprims; /* triangles the tree was built over (== scene->ntris when current) */
+  int bins, leaf_size;
+  struct bvh_wide *wide; /* the same tree collapsed to 4 children per node, for single rays */
+  uint32_t *wide_node;   /* per wide node, per slot: the node of `nodes` it is (UINT32_MAX: empty) */
+  uint32_t nwide;
+} rr_bvh;
+
+/* A 4-wide node: up to four of the binary tree's nodes side by side, bounds as
+ * lanes per axis (an empty slot has an empty box). A slot with count > 0 is a leaf
+ * holding prims [ref, ref + count); with count 0 it is wide node `ref`. Root: 0. */
+typedef struct bvh_wide {
+  float lo[3][4], hi[3][4];
+  uint32_t ref[4], count[4];
+} bvh_wide;
+
+enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK = 128 };
+
+/* Builds a binned-SAH BVH over the scene's triangles (src/bvh.c); the tree is the
+ * same for any opt->threads. An empty scene gets NULL. */
+rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, rr_bvh **out);
+/* The scene's BVH when it is current, else NULL with a message in dev (an empty
+ * scene also gives NULL, with *empty set: every ray misses). */
+const rr_bvh *rr_bvh_of(rr_device *dev, const rr_scene *s, bool *empty);
+
+/* Frees a BVH (NULL is ignored). */
+void rr_bvh_release(rr_bvh *b);
+/* Adds a BVH's figures to a scene's info (NULL adds nothing). */
+void rr_bvh_fill_info(const rr_bvh *b, rr_scene_info *info);
+
+#endif

@@ -1,0 +1,65 @@
+/* Cameras resolved for an image: a ray for every sample, planar bases, cones of curved views. */
+#ifndef RR_CAMERA_H
+#define RR_CAMERA_H
+
+#include "scene/scene.h"
+
+/* A camera resolved for an image. Sample (sx, sy) of pixel (x, y) is
+ * (x + 0.5, y + 0.5), row 0 at the top. Planar cameras (perspective, orthographic)
+ * have edge functions linear in (sx, sy): a perspective ray leaves the eye along
+ * d0 + sx·dx + sy·dy; an orthographic ray leaves eye + o0 + sx·ox + sy·oy along fwd.
+ * Curved cameras (parabolic, lat-long, fisheye, cube) keep one direction per
+ * sample in `dirs` (zero where the image has no ray), and bound the directions of
+ * a rectangle of samples by a cone whose half-angle grows by `lipschitz` radians
+ * per pixel of distance. */
+typedef struct camera {
+  rr_camera_type type;
+  int width, height;
+  bool planar;
+  vec3 eye, right, up, fwd;
+  vec3 d0, dx, dy;
+  vec3 col_n0, col_n1, row_n0, row_n1; /* perspective: n0 + x·n1 is the plane of column x, */
+                                      /* row y likewise, facing increasing x (y) */
+  vec3 o0, ox, oy;
+  float tan_half_h, tan_half_w;
+  vec3 *dirs;
+  float lipschitz;
+  float dir_len_max; /* longest |d| of the camera's rays */
+  int face;          /* cube: side of a face in pixels */
+  int cells_x, cells_y; /* curved: cones of CAMERA_CELL² cells of samples, 4 floats each: */
+  float *cells;         /* unit axis and half-angle; no bound when >= 1.5, no rays when < 0 */
+} camera;
+
+#define CAMERA_CELL 32
+
+/* Resolves a public camera for an image size; rr_cam_release frees it. */
+rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *out);
+void rr_cam_release(camera *c);
+/* The ray of sample (sx, sy) of a planar perspective camera (unnormalised). */
+static inline vec3 camera_dir(const camera *c, float sx, float sy) {
+  return v3_add(c->d0, v3_add(v3_scale(c->dx, sx), v3_scale(c->dy, sy)));
+}
+/* The ray of pixel (x, y) for any camera: origin and (unnormalised) direction;
+ * false when the pixel has no ray (outside a hemisphere's disk, a cube's cross). */
+bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir);
+/* What a triangle's edge functions are evaluated against at pixel (x, y):
+ * (1, sx, sy) for planar cameras, the ray direction for curved ones. */
+static inline vec3 camera_w(const camera *c, int x, int y) {
+  return c->planar ? v3(1.0f, (float)x + 0.5f, (float)y + 0.5f) : c->dirs[(size_t)y * c->width + x];
+}
+/* Projects a point given relative to the eye to sample coordinates (planar
+ * cameras); false when it is not strictly in front of the image plane. */
+bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy);
+/* A cone (unit axis, half-angle) holding the directions of the samples
+ * [x0, x1) × [y0, y1) of a curved camera: 1 when found, 0 when none is known,
+ * -1 when none of the samples has a ray. */
+int rr_cam_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle);
+
+/* A pseudo-camera for one arbitrary ray: eye = origin, d0 = direction and dx, dy
+ * two fixed directions perpendicular to it, so rr_tri_setup() sets a triangle
+ * up for the ray, and its edge functions at sample (0, 0) are the ray's. The tie
+ * bits (top-left rule) then come from the derivatives along dx, then dy: a ray
+ * through a shared edge or vertex hits exactly one triangle. */
+void rr_cam_for_ray(const float org[3], const float dir[3], camera *out);
+
+#endif

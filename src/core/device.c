@@ -1,0 +1,32 @@
+/* Devices and their errors: the one place a failure is recorded. */
+#include "core/core.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+rr_device *rr_device_new(void) { return calloc(1, sizeof(rr_device)); }
+
+void rr_device_release(rr_device *dev) { free(dev); }
+
+rr_error rr_device_error(const rr_device *dev) { return dev ? dev->error : RR_ERROR_ARGUMENT; }
+
+const char *rr_device_message(const rr_device *dev) { return dev ? dev->message : "no device"; }
+
+rr_error rr_fail(rr_device *dev, rr_error code, const char *fmt, ...) {
+  if (dev) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(dev->message, sizeof dev->message, fmt, ap);
+    va_end(ap);
+    dev->error = code;
+  }
+  return code;
+}
+
+rr_error rr_ok(rr_device *dev) {
+  if (dev) {
+    dev->error = RR_OK;
+    dev->message[0] = 0;
+  }
+  return RR_OK;
+}

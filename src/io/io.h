@@ -1,0 +1,19 @@
+/* Input and output: scene import (assimp, built-ins), textures and image files. */
+#ifndef RR_IO_H
+#define RR_IO_H
+
+#include "scene/scene.h"
+
+/* Loaders: assimp files and the built-in scenes. */
+rr_error rr_scene_load_file(rr_scene *s, const char *path);
+/* Returns RR_OK when `name` named a built-in scene (and fills s), RR_ERROR_UNSUPPORTED
+ * when it is not a built-in name; other codes are real failures. */
+rr_error rr_scene_load_builtin(rr_scene *s, const char *name);
+/* Loads the textures named by the materials (missing files leave textures empty). */
+void rr_scene_load_textures(rr_scene *s, const char *base_dir);
+
+/* Writers and readers by extension, in image_io.c. */
+rr_error rr_image_write_file(rr_device *dev, const rr_image *img, const char *path);
+rr_error rr_image_read_file(rr_device *dev, const char *path, rr_image *out);
+
+#endif

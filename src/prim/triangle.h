@@ -1,0 +1,113 @@
+/* The triangle kind: setup for an eye, the one sample test, bounds for a camera. */
+#ifndef RR_TRIANGLE_H
+#define RR_TRIANGLE_H
+
+#include "camera/camera.h"
+
+/* A triangle set up for a camera (paper eqs. 1–3 and appendix). Its edge functions
+ * at a sample are V_i = a[i]·w.x + b[i]·w.y + c[i]·w.z for the camera's w
+ * (camera_w): for planar cameras that is a + sx·b + sy·c (eq. 3), for curved ones
+ * (a, b, c) is the edge normal n_i and V_i = n_i·d. The volume at the sample is
+ * vol + sx·vol_x + sy·vol_y (constant but for orthographic views, whose ray origin
+ * moves). Everything is sign-normalised so that the inside is positive whichever
+ * face is seen. */
+typedef struct tri_setup {
+  float a[3], b[3], c[3];
+  float vol, vol_x, vol_y;
+  uint32_t tie; /* bit i: a sample exactly on edge i belongs to this triangle */
+  float w[3];   /* homogeneous w of vertex i (1, or 0 at infinity): the sum is Σ w_i V_i */
+} tri_setup;
+
+enum { SETUP_CULLED = 0, SETUP_FRONT = 1, SETUP_BACK = 2 };
+
+/* Sets up triangle `i` of `s` for camera `c`. Returns SETUP_FRONT, SETUP_BACK, or
+ * SETUP_CULLED when the triangle cannot be seen (edge-on, or a back face and
+ * cull_backfaces is set). */
+int rr_tri_setup(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces, tri_setup *out);
+/* rr_tri_setup for triangles ids[0..n-1] into out[k], face[k]; with simd, eight
+ * at a time (AVX2) where the camera is perspective and no corner is at infinity,
+ * with the same bits. */
+void rr_tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces, bool simd,
+                   tri_setup *out, int *face);
+
+/* The three edge functions of a set-up triangle for evaluation vector w. The
+ * order of operations is fixed (the build uses -ffp-contract=off: a fused
+ * multiply-add would change the bits) so every method computes the same values
+ * for the same (triangle, sample). */
+static inline void tri_edges_w(const tri_setup *t, vec3 w, float e[3]) {
+  for (int i = 0; i < 3; i++) e[i] = t->a[i] * w.x + t->b[i] * w.y + t->c[i] * w.z;
+}
+/* The same for a planar camera's sample (sx, sy): w = (1, sx, sy), same bits. */
+static inline void tri_edges(const tri_setup *t, float sx, float sy, float e[3]) {
+  tri_edges_w(t, v3(1.0f, sx, sy), e);
+}
+/* The volume term at sample (sx, sy). */
+static inline float tri_vol(const tri_setup *t, float sx, float sy) {
+  return t->vol + sx * t->vol_x + sy * t->vol_y;
+}
+
+/* The one sample test (paper eq. 2 with the top-left rule of sect. 4.2).
+ * e: sign-normalised edge values at the sample; tie: bit i set when the sample
+ * belongs to this triangle if it lies exactly on edge i; vol: the sign-normalised
+ * volume at the sample (positive when the hit lies ahead of the ray origin).
+ * w: the vertices' homogeneous w (appendix eqs. 5–11: a vertex at infinity has
+ * w = 0 and leaves the sum). On a hit returns true with t = V / Σw_iV_i and
+ * λ_i = V_i / Σw_iV_i. */
+static inline bool sample_test_w(const float e[3], const float w[3], uint32_t tie, float vol,
+                                 float *t, float *l1, float *l2) {
+  bool in0 = e[0] > 0.0f || (e[0] == 0.0f && (tie & 1u));
+  bool in1 = e[1] > 0.0f || (e[1] == 0.0f && (tie & 2u));
+  bool in2 = e[2] > 0.0f || (e[2] == 0.0f && (tie & 4u));
+  if (!(in0 & in1 & in2)) return false;
+  /* Appendix eq. 10: only finite vertices count, Σ w_i V_i; e·1 == e exactly, so
+   * ordinary triangles keep the bits of e0 + e1 + e2. */
+  float sum = e[0] * w[0] + e[1] * w[1] + e[2] * w[2];
+  /* sum == 0: all three on their edges (a degenerate sliver) or a pixel with no ray */
+  if (!(sum > 0.0f) || !(vol > 0.0f)) return false;
+  float inv = 1.0f / sum;
+  *t = vol * inv;
+  *l1 = e[1] * inv;
+  *l2 = e[2] * inv;
+  return true;
+}
+/* The same for a triangle of finite vertices (every w = 1). */
+static inline bool sample_test(const float e[3], uint32_t tie, float vol, float *t, float *l1, float *l2) {
+  static const float ones[3] = {1.0f, 1.0f, 1.0f};
+  return sample_test_w(e, ones, tie, vol, t, l1, l2);
+}
+
+/* The one sample test for an arbitrary ray set up by rr_cam_for_ray(): true on a hit
+ * with t in [tmin, tmax] (t along the unnormalised direction). */
+bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull_backfaces, float tmin, float tmax,
+                 float *t, float *l1, float *l2);
+
+/* The inclusive pixel rectangle a set-up triangle's samples may lie in; false when
+ * none. For curved cameras it is the bounding box of the cells whose cone of
+ * directions no edge plane excludes. */
+bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int rect[4]);
+/* Planar cameras bound a triangle from its corners alone, before its setup: most
+ * triangles of a detailed mesh fall between samples. rr_tri_corner_bounds bounds triangles
+ * ids[0..n-1] (first..first+n-1 when ids is NULL), 8 at a time with AVX2 when
+ * simd, and writes those whose rectangle holds a sample to out; returns how many. */
+typedef struct tri_bound {
+  uint32_t id;
+  int bb[4]; /* inclusive pixel rectangle, as rr_tri_screen_bounds */
+} tri_bound;
+uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
+                           bool simd, tri_bound *out);
+/* Curved cameras: what bounds a triangle's directions from the eye. */
+typedef struct tri_cone {
+  float len[4];      /* lengths of the three edge normals and of their sum */
+  vec3 cap_axis;     /* a cap holding the triangle's directions, */
+  float cap_angle;   /* or a negative angle when none under 90° does */
+} tri_cone;
+void rr_tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, tri_cone *tc);
+/* May a triangle be excluded from a cone of directions (unit axis, half-angle)? */
+bool rr_cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float angle);
+
+/* The least t that sample_test() can return for a set-up triangle at any sample of
+ * camera c, and (planar cameras) a rectangle x0, y0, x1, y1 of sample coordinates
+ * holding every sample where it can pass: the exact culling of rc-bvh, rc-packet. */
+float rr_tri_bounds(const tri_setup *ts, const camera *c, float rect[4]);
+
+#endif

@@ -1,0 +1,102 @@
+/* Visibility: the visibility buffer, the methods of the continuum and their shared kernels. */
+#ifndef RR_VIS_H
+#define RR_VIS_H
+
+#include "accel/bvh.h"
+#include "prim/triangle.h"
+
+typedef struct visbuf {
+  int width, height;
+  uint32_t *id;
+  float *t, *l1, *l2;
+} visbuf;
+
+/* The depth test shared by every method: nearer wins; on equal t the lower id wins,
+ * so the result does not depend on the order in which triangles are visited. */
+static inline bool depth_wins(float t, uint32_t id, float best_t, uint32_t best_id) {
+  return t < best_t || (t == best_t && id < best_id);
+}
+
+/* Tests one set-up triangle at pixel k, whose sample is (sx, sy) with evaluation
+ * vector w, and keeps it when it is nearer. Returns 0 when the triangle does not
+ * cover the sample, 1 when it covers it behind what is stored, 2 when it is kept. */
+static inline int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, float sy, visbuf *vb,
+                                 size_t k) {
+  float e[3], t, l1, l2;
+  tri_edges_w(ts, w, e);
+  if (!sample_test_w(e, ts->w, ts->tie, tri_vol(ts, sx, sy), &t, &l1, &l2)) return 0;
+  if (!depth_wins(t, id, vb->t[k], vb->id[k])) return 1;
+  vb->t[k] = t;
+  vb->id[k] = id;
+  vb->l1[k] = l1;
+  vb->l2[k] = l2;
+  return 2;
+}
+
+/* The same for a planar camera's sample (sx, sy). */
+static inline int shade_sample(const tri_setup *ts, uint32_t id, float sx, float sy, visbuf *vb, size_t k) {
+  return shade_sample_w(ts, id, v3(1.0f, sx, sy), sx, sy, vb, k);
+}
+
+struct rr_frame {
+  visbuf vb;
+  float *heat_e, *heat_n; /* per-pixel E and N, when options.heat was set */
+  rr_stats stats;
+  rr_method method;
+};
+
+/* A pass of a method: fills vb (cleared to misses) and adds to stats. */
+typedef struct render_ctx {
+  const rr_scene *scene;
+  const camera *cam;
+  const rr_render_options *opt;
+  int threads;
+  visbuf *vb;
+  rr_stats *stats;
+  float *heat_e, *heat_n; /* optional per-pixel E and N charges */
+  const struct oracles *oracles; /* the traversal's settings, for the 3dr methods */
+} render_ctx;
+
+/* The oracles of the continuum's traversal (paper Fig. 8), as settings. */
+typedef struct oracles {
+  int frustum_size;  /* side of the initial frusta; 0: whole image (tiles on several threads) */
+  bool leaves;       /* generateSamples at BVH leaves (false: at the root, plain rasterization) */
+  bool cull_outside; /* isOutside: frustum culling of BVH nodes */
+  bool cull_occluded;/* isOccluded: hierarchical z-buffer test of BVH nodes */
+  int split_min;     /* splitFrustum down to this side (0: never split) */
+  float split_ratio; /* split when a node's projected area is below ratio × the frustum's */
+  bool binning;      /* rasterize hierarchically in bins rather than every sample of the bounds */
+  bool early_z;      /* reject bins hidden behind the stored depths */
+  int bin_size;      /* top bin side */
+  int bin_min;       /* bins this small are tested sample by sample */
+} oracles;
+
+/* The continuum's one traversal, steered by ctx->oracles (src/traverse.c). */
+rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx);
+/* isOutside: may the box be culled from the frustum of samples [x0, x1) × [y0, y1)? */
+bool rr_oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bvh_node *box);
+/* isOccluded: may the box be culled when the farthest depth stored in a frustum is `farthest`? */
+bool rr_oracle_occluded(const camera *c, const bvh_node *box, float farthest);
+
+typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
+
+rr_error rr_vis_rc(rr_device *dev, render_ctx *ctx);
+/* rc-bvh and rc-packet: single rays and 8x8 ray packets through the BVH (src/rr_vis_rc_bvh.c). */
+rr_error rr_vis_rc_bvh(rr_device *dev, render_ctx *ctx);
+rr_error rr_vis_rc_packet(rr_device *dev, render_ctx *ctx);
+/* 2dr-bb and 2dr-bin: projection, clipping, fixed-point 2D edge functions (src/raster2d.c). */
+rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx);
+rr_error rr_vis_2dr_bin(rr_device *dev, render_ctx *ctx);
+/* Test hook: runs the 2D pipeline (binning when `bin`) over every triangle but, instead
+ * of the z test, counts in front[k] / back[k] every triangle that claims sample k. */
+rr_error rr_raster2d_claims(const rr_scene *s, const camera *c, bool bin, int threads, uint8_t *front, uint8_t *back);
+/* Test hook: where the 2D pipeline's vertex stage puts world point p on the screen;
+ * false when p is behind its near plane. */
+bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, double *sy);
+/* Tests every sample of an inclusive rectangle against one set-up triangle and
+ * returns the number of edge-function evaluations; adds the samples the
+ * triangle covers to *covered. simd: use AVX2 where the processor has it. */
+uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb,
+                     uint64_t *covered, bool simd);
+
+#endif
