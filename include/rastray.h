@@ -106,12 +106,20 @@ typedef struct rr_hit {
   float l1, l2;  /* barycentrics of the hit: weights of the triangle's vertices 1 and 2 */
 } rr_hit;
 
+/* Threading: rr_intersect and rr_occluded only read the scene, so any number of
+ * threads may call them at once on one committed scene, each passing its own
+ * device (or NULL). A device records the outcome of every call made with it, so
+ * it serves one thread at a time. Nothing may change or release the scene
+ * (rr_scene_add_mesh, rr_scene_commit, rr_scene_release) while queries run. */
+
 /* Closest hit of a ray through the committed scene's BVH, with the one sample test
  * of every method (ties in t go to the lower id; a ray through a shared edge hits
- * exactly one triangle). Needs a committed scene. */
-rr_error rr_intersect(const rr_scene *scene, const rr_ray *ray, rr_hit *hit);
-/* Whether the ray hits any triangle with tmin <= t <= tmax (*occluded = 0 or 1). */
-rr_error rr_occluded(const rr_scene *scene, const rr_ray *ray, int *occluded);
+ * exactly one triangle). Needs a committed scene. The outcome goes to dev, which
+ * may be NULL (then only the returned code tells it). */
+rr_error rr_intersect(rr_device *dev, const rr_scene *scene, const rr_ray *ray, rr_hit *hit);
+/* Whether the ray hits any triangle with tmin <= t <= tmax (*occluded = 0 or 1);
+ * dev as for rr_intersect. */
+rr_error rr_occluded(rr_device *dev, const rr_scene *scene, const rr_ray *ray, int *occluded);
 
 /* ---- cameras ------------------------------------------------------------- */
 

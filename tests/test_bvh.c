@@ -180,8 +180,8 @@ static void check_ray(const rr_scene *s, const rr_ray *ray, const char *name) {
   rr_hit h;
   int occ, any;
   rr_hit ref = brute(s, ray, &any);
-  CHECK(rr_intersect(s, ray, &h) == RR_OK, "%s: rr_intersect failed", name);
-  CHECK(rr_occluded(s, ray, &occ) == RR_OK, "%s: rr_occluded failed", name);
+  CHECK(rr_intersect(s->dev, s, ray, &h) == RR_OK, "%s: rr_intersect failed", name);
+  CHECK(rr_occluded(s->dev, s, ray, &occ) == RR_OK, "%s: rr_occluded failed", name);
   bool same = h.prim == ref.prim && memcmp(&h.t, &ref.t, 4) == 0 && memcmp(&h.l1, &ref.l1, 4) == 0 &&
               memcmp(&h.l2, &ref.l2, 4) == 0;
   CHECK(same, "%s: ray (%g %g %g) + t (%g %g %g): rr_intersect %u t=%.9g, brute force %u t=%.9g", name, ray->org[0],
@@ -227,7 +227,7 @@ static void plane_rays(rr_device *dev) {
         rr_ray ray = {{(float)i + (h == 1 ? 0.5f : 0), 2, (float)j + (h == 2 ? 0.5f : 0)}, {0, -1, 0}, 0, INFINITY};
         if (h == 0 && (i + j) % 2) ray.dir[0] = 0.25f, ray.org[0] -= 0.5f; /* oblique through the vertex */
         rr_hit hit;
-        rr_intersect(s, &ray, &hit);
+        rr_intersect(dev, s, &ray, &hit);
         holes += hit.prim == RR_MISS;
         check_ray(s, &ray, "plane:8 vertices");
       }
@@ -250,8 +250,8 @@ static void bad_input(rr_device *dev) {
   rr_ray ray = {{0, 0, 5}, {0, 0, -1}, 0, INFINITY};
   rr_hit hit;
   int occ;
-  CHECK(rr_intersect(s, &ray, &hit) == RR_OK && hit.prim == RR_MISS && isinf(hit.t), "empty scene: a miss");
-  CHECK(rr_occluded(s, &ray, &occ) == RR_OK && occ == 0, "empty scene: not occluded");
+  CHECK(rr_intersect(dev, s, &ray, &hit) == RR_OK && hit.prim == RR_MISS && isinf(hit.t), "empty scene: a miss");
+  CHECK(rr_occluded(dev, s, &ray, &occ) == RR_OK && occ == 0, "empty scene: not occluded");
   rr_camera cam;
   rr_camera_init(&cam);
   for (int m = RR_METHOD_RC_BVH; m <= RR_METHOD_RC_PACKET; m++) {
@@ -270,21 +270,21 @@ static void bad_input(rr_device *dev) {
   const uint32_t didx[] = {0, 1, 2, 0, 0, 3, 1, 1, 1};
   CHECK(rr_scene_add_mesh(s, deg, 4, didx, 3, rgb) == RR_OK && s->ntris == 0, "degenerate triangles dropped");
   CHECK(rr_scene_commit(s) == RR_OK && s->bvh == NULL, "degenerate-only commit");
-  CHECK(rr_intersect(s, &ray, &hit) == RR_OK && hit.prim == RR_MISS, "degenerate-only scene: a miss");
+  CHECK(rr_intersect(dev, s, &ray, &hit) == RR_OK && hit.prim == RR_MISS, "degenerate-only scene: a miss");
   /* A scene changed after its commit: a clear message, not a stale tree. */
   const float tri[] = {-1, -1, 0, 1, -1, 0, 0, 1, 0};
   const uint32_t tidx[] = {0, 1, 2};
   rr_scene_add_mesh(s, tri, 3, tidx, 1, rgb);
-  CHECK(rr_intersect(s, &ray, &hit) != RR_OK && strstr(rr_device_message(dev), "rr_scene_commit"),
+  CHECK(rr_intersect(dev, s, &ray, &hit) != RR_OK && strstr(rr_device_message(dev), "rr_scene_commit"),
         "uncommitted scene: '%s'", rr_device_message(dev));
   rr_scene_commit(s);
-  CHECK(rr_intersect(s, &ray, &hit) == RR_OK && hit.prim == 0 && hit.t == 5.0f, "one triangle: hit at t=5 (%g)",
+  CHECK(rr_intersect(dev, s, &ray, &hit) == RR_OK && hit.prim == 0 && hit.t == 5.0f, "one triangle: hit at t=5 (%g)",
         hit.t);
   /* Bad rays. */
   rr_ray nan_ray = {{0, 0, NAN}, {0, 0, -1}, 0, INFINITY}, zero = {{0, 0, 5}, {0, 0, 0}, 0, INFINITY};
-  CHECK(rr_intersect(s, &nan_ray, &hit) == RR_ERROR_ARGUMENT, "NaN origin refused");
-  CHECK(rr_occluded(s, &zero, &occ) == RR_ERROR_ARGUMENT, "zero direction refused");
-  CHECK(rr_intersect(s, &ray, NULL) == RR_ERROR_ARGUMENT && rr_intersect(NULL, &ray, &hit) == RR_ERROR_ARGUMENT,
+  CHECK(rr_intersect(dev, s, &nan_ray, &hit) == RR_ERROR_ARGUMENT, "NaN origin refused");
+  CHECK(rr_occluded(dev, s, &zero, &occ) == RR_ERROR_ARGUMENT, "zero direction refused");
+  CHECK(rr_intersect(dev, s, &ray, NULL) == RR_ERROR_ARGUMENT && rr_intersect(dev, NULL, &ray, &hit) == RR_ERROR_ARGUMENT,
         "NULL arguments refused");
   rr_build_options bad = {.threads = -1};
   CHECK(rr_device_set_build_options(dev, &bad) == RR_ERROR_ARGUMENT, "bad build options refused");

@@ -185,7 +185,7 @@ static void check_api(rr_device *dev) {
                   0,
                   INFINITY};
     rr_hit hit;
-    CHECK(rr_intersect(s, &ray, &hit) == RR_OK, "rr_intersect");
+    CHECK(rr_intersect(dev, s, &ray, &hit) == RR_OK, "rr_intersect");
     double t;
     uint32_t id = reference_api(v3_load(ray.org), v3_load(ray.dir), &t);
     n++;

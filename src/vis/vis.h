@@ -81,7 +81,7 @@ bool rr_oracle_occluded(const camera *c, const bvh_node *box, float farthest);
 typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
 
 rr_error rr_vis_rc(rr_device *dev, render_ctx *ctx);
-/* rc-bvh and rc-packet: single rays and 8x8 ray packets through the BVH (src/rr_vis_rc_bvh.c). */
+/* rc-bvh and rc-packet: single rays and 8x8 ray packets through the BVH (vis/rc_bvh.c). */
 rr_error rr_vis_rc_bvh(rr_device *dev, render_ctx *ctx);
 rr_error rr_vis_rc_packet(rr_device *dev, render_ctx *ctx);
 /* 2dr-bb and 2dr-bin: projection, clipping, fixed-point 2D edge functions (src/raster2d.c). */

@@ -1,0 +1,132 @@
+/* The one traversal of the 4-wide BVH, shared by every ray caster: primary rays
+ * and 8x8 packets of them (vis/rc_bvh.c), arbitrary rays (vis/ray_query.c).
+ *
+ * The stack, the order in which slots are entered and the rule that drops a
+ * stacked slot are written once, in bvh_trace(). What is traced, one ray or a
+ * packet, is a policy of three functions passed as constants (the kernel and
+ * the policy are inlined together, so each caller gets its own specialised loop):
+ * - node: which slots of a wide node to enter, with the key that orders them
+ *   (nearest entered first, the others stacked farthest first), the key that
+ *   drops a stacked slot on pop and, for a packet, the lanes that enter it;
+ * - leaf: tests a leaf's triangles; true ends the traversal (an any-hit query);
+ * - best: the best t so far (a packet: its lanes' largest), above which a
+ *   stacked slot is dropped on pop.
+ * A policy only reads the tree and writes its own state: one traversal touches
+ * nothing shared. */
+#ifndef RR_BVH_TRACE_H
+#define RR_BVH_TRACE_H
+
+#include "core/simd.h"
+#include "vis/vis.h"
+
+#include <stddef.h>
+
+#define RAY_MARGIN 0x1p-10f /* relative widening of box intervals (about 1e-3) */
+
+/* A ray prepared for the slab tests of a wide node: origin and inverse direction
+ * broadcast to four lanes, and per axis the byte offsets in a bvh_wide of the
+ * near and far planes' lanes (lo or hi, by the direction's sign). */
+typedef struct {
+  rr_vf4 o[3], inv[3];
+  int wn[3], wf[3];
+} ray_q;
+
+KERNEL void ray_q_init(ray_q *q, vec3 o, vec3 d) {
+  float dv[3] = {d.x, d.y, d.z}, ov[3] = {o.x, o.y, o.z};
+  for (int a = 0; a < 3; a++) {
+    float inv = 1.0f / dv[a]; /* ±inf for a zero component, by its sign */
+    bool neg = inv < 0;
+    q->wn[a] = (int)(neg ? offsetof(bvh_wide, hi[a]) : offsetof(bvh_wide, lo[a]));
+    q->wf[a] = (int)(neg ? offsetof(bvh_wide, lo[a]) : offsetof(bvh_wide, hi[a]));
+    q->o[a] = rr_vf4_splat(ov[a]);
+    q->inv[a] = rr_vf4_splat(inv);
+  }
+}
+
+/* The slab test of the ray against the four boxes of a wide node, the interval
+ * widened by RAY_MARGIN relative to t. Returns the slots whose box the ray meets
+ * with exit >= tmin and whose `key` (per slot) is not above `best`; the widened
+ * entries go to tn. A NaN slab (0·inf: the origin on a plane the ray runs in)
+ * is ignored: min and max keep their second operand. */
+KERNEL int wide_test(const bvh_wide *w, const ray_q *q, float tmin, rr_vf4 key, float best, rr_vf4 *tn) {
+  const char *base = (const char *)w;
+  rr_vf4 t0 = rr_vf4_splat(-INFINITY), t1 = rr_vf4_splat(INFINITY);
+  for (int a = 0; a < 3; a++) {
+    rr_vf4 tnear = (rr_vf4_load_aligned((const float *)(base + q->wn[a])) - q->o[a]) * q->inv[a];
+    rr_vf4 tfar = (rr_vf4_load_aligned((const float *)(base + q->wf[a])) - q->o[a]) * q->inv[a];
+    t0 = rr_vf4_max(tnear, t0);
+    t1 = rr_vf4_min(tfar, t1);
+  }
+  const rr_vf4 margin = rr_vf4_splat(RAY_MARGIN);
+  t0 = t0 - rr_vf4_abs(t0) * margin;
+  t1 = t1 + rr_vf4_abs(t1) * margin;
+  *tn = t0;
+  return rr_vi4_bits((t0 <= t1) & (t1 >= rr_vf4_splat(tmin)) & (key <= rr_vf4_splat(best)));
+}
+
+/* What a policy's node test says of the slots it enters (bit i of its result). */
+typedef struct {
+  rr_vf4 order;      /* the nearest is entered, the others stacked farthest first */
+  rr_vf4 key;        /* a stacked slot is dropped on pop when its key is above best() */
+  uint64_t lanes[4]; /* the lanes that enter each slot (a single ray: left as they are) */
+} trace_slots;
+
+/* The policy: q is the traced ray's or packet's state, `lanes` the lanes of it
+ * that reached this node or leaf. */
+typedef int (*trace_node_fn)(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s);
+typedef bool (*trace_leaf_fn)(void *q, uint32_t first, uint32_t count, uint64_t lanes);
+typedef float (*trace_best_fn)(const void *q);
+
+/* The non-empty slots of a wide node: what N counts for a node test. */
+KERNEL uint64_t wide_slots(const bvh_wide *w) {
+  return (uint64_t)(w->ref[0] != UINT32_MAX) + (w->ref[1] != UINT32_MAX) + (w->ref[2] != UINT32_MAX) +
+         (w->ref[3] != UINT32_MAX);
+}
+
+/* Front-to-back traversal of the 4-wide tree from its root with `lanes`: the
+ * slots the node test enters, in order, the nearest visited and the others
+ * stacked, each dropped on pop when best() is already nearer than its key
+ * (strictly: an equal t with a lower id still wins). True when leaf() ended it. */
+KERNEL bool bvh_trace(const rr_bvh *b, void *q, uint64_t lanes, trace_node_fn node, trace_leaf_fn leaf,
+                      trace_best_fn best) {
+  struct {
+    uint32_t ref, count;
+    float key;
+  } stack[3 * BVH_STACK];
+  uint64_t stack_lanes[3 * BVH_STACK]; /* apart, so a single ray's stack stays small */
+  int sp = 0;
+  uint32_t ref = 0, count = 0; /* wide node 0 */
+  for (;;) {
+    if (count) {
+      if (leaf(q, ref, count, lanes)) return true;
+    } else {
+      const bvh_wide *w = &b->wide[ref];
+      trace_slots s = {.lanes = {lanes, lanes, lanes, lanes}};
+      int hits = node(q, w, ref, lanes, &s);
+      if (hits) {
+        int order[4], n = 0;
+        for (int h = hits; h; h &= h - 1) {
+          int i = __builtin_ctz(h), j = n++;
+          for (; j > 0 && s.order[order[j - 1]] < s.order[i]; j--) order[j] = order[j - 1]; /* farthest first */
+          order[j] = i;
+        }
+        for (int j = 0; j < n - 1; j++) {
+          int i = order[j];
+          stack[sp].ref = w->ref[i], stack[sp].count = w->count[i], stack[sp].key = s.key[i];
+          stack_lanes[sp++] = s.lanes[i];
+        }
+        int i = order[n - 1];
+        ref = w->ref[i], count = w->count[i], lanes = s.lanes[i];
+        continue;
+      }
+    }
+    for (;;) {
+      if (!sp) return false;
+      sp--;
+      if (!(stack[sp].key > best(q))) break; /* equal t may still win on id */
+    }
+    ref = stack[sp].ref, count = stack[sp].count, lanes = stack_lanes[sp];
+  }
+}
+
+#endif
