@@ -283,7 +283,8 @@ typedef struct {
   uint64_t valid;
   rr_vf4 sx[2], sy[2];
   float maxbest; /* the largest best t of the lanes: no lane can use a node whose bound is above */
-  float heat_e[PN], heat_n[PN]; /* E and N charged to each lane (a node test is shared by its lanes) */
+  bool heat; /* charge E and N to the lanes (a node test is shared by its lanes) */
+  float heat_e[PN], heat_n[PN];
   const frame_setups *fs;
   uint64_t evals, nodes;
 } packet;
@@ -313,8 +314,10 @@ KERNEL int packet_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes,
   s->order = s->key = wb->tlo;
   uint64_t tested = wide_slots(w);
   p->nodes += tested;
-  float share = (float)tested / (float)__builtin_popcountll(lanes);
-  for (uint64_t l = lanes; l; l &= l - 1) p->heat_n[__builtin_ctzll(l)] += share;
+  if (p->heat) {
+    float share = (float)tested / (float)__builtin_popcountll(lanes);
+    for (uint64_t l = lanes; l; l &= l - 1) p->heat_n[__builtin_ctzll(l)] += share;
+  }
   return hits;
 }
 
@@ -348,7 +351,7 @@ static void rc_packet_tile(int job, int thread, void *arg) {
   frame_job *j = arg;
   visbuf *vb = j->ctx->vb;
   int tx0 = job % j->tiles_x * TILE, ty0 = job / j->tiles_x * TILE;
-  packet pk = {.fs = &j->fs}, *p = &pk;
+  packet pk = {.fs = &j->fs, .heat = j->ctx->heat_e != NULL}, *p = &pk;
   for (int py = ty0; py < ty0 + TILE && py < vb->height; py += PK)
     for (int px = tx0; px < tx0 + TILE && px < vb->width; px += PK) {
       p->x0 = px, p->y0 = py, p->valid = 0, p->maxbest = INFINITY;
