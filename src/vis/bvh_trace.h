@@ -93,7 +93,7 @@ KERNEL bool bvh_trace(const rr_bvh *b, void *q, uint64_t lanes, trace_node_fn no
     uint32_t ref, count;
     float key;
   } stack[3 * BVH_STACK];
-  uint64_t stack_lanes[3 * BVH_STACK]; /* apart, so a single ray's stack stays small */
+  uint64_t stack_lanes[3 * BVH_STACK]; /* apart: a single ray never reads it and its stack stays small */
   int sp = 0;
   uint32_t ref = 0, count = 0; /* wide node 0 */
   for (;;) {

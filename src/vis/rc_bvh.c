@@ -171,7 +171,7 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
   return RR_OK;
 }
 
-/* ---- primary rays: tiles of the image dealt to threads ---------------------------- */
+/* ---- primary rays: tiles of the image dealt to threads -------------------------- */
 
 enum { TILE = 32, PK = 8, PN = PK * PK };
 
@@ -225,6 +225,7 @@ KERNEL int ray_node_curved(void *q, const bvh_wide *w, uint32_t ref, uint64_t la
   return wide_test(w, &r->q, 0, s->key, r->t, &s->order);
 }
 
+/* Tests the leaf's triangles, set up for the frame, at the ray's sample. */
 KERNEL bool ray_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
   (void)lanes;
   primary_ray *r = q;
