@@ -18,6 +18,7 @@ extern "C" {
 #define RR_VERSION "0.1.0"
 #define RR_MISS 0xFFFFFFFFu /* primitive id of a sample that hits nothing */
 #define RR_MAX_SIZE 16384   /* largest image side accepted */
+#define RR_MAX_SAMPLES 16   /* most samples per pixel */
 
 typedef enum rr_error {
   RR_OK = 0,
@@ -171,7 +172,10 @@ const char *rr_method_name(int method);
 
 typedef struct rr_render_options {
   rr_method method;
-  int width, height;  /* image size in samples (one per pixel) */
+  int width, height;  /* image size in pixels */
+  int samples;        /* samples per pixel, 1..RR_MAX_SAMPLES (default 1) */
+  float sample_pos[RR_MAX_SAMPLES][2]; /* sample s at (x + sample_pos[s][0], y + sample_pos[s][1]) in pixel
+                                          (x, y); each in [0, 1) (default: one sample at the centre) */
   int threads;        /* 0: all cores */
   int cull_backfaces; /* nonzero: triangles seen from behind are invisible */
   int heat;           /* nonzero: also record E and N charged to each pixel (AOVs evals, nodes) */
@@ -184,7 +188,8 @@ typedef struct rr_render_options {
                          bin side), bin-min=N (bins tested sample by sample) */
 } rr_render_options;
 
-/* Fills options with defaults: 3dr-bb, 1024x768, all cores, no culling. */
+/* Fills options with defaults: 3dr-bb, 1024x768, one sample at each pixel's centre,
+ * all cores, no culling. */
 void rr_render_options_init(rr_render_options *opt);
 
 typedef struct rr_stats {
@@ -209,9 +214,13 @@ void rr_frame_release(rr_frame *frame);
 rr_error rr_frame_get_stats(const rr_frame *frame, rr_stats *stats);
 /* Width and height of the frame's visibility buffer. */
 rr_error rr_frame_get_size(const rr_frame *frame, int *width, int *height);
+/* Samples per pixel of the frame (options.samples). */
+rr_error rr_frame_get_samples(const rr_frame *frame, int *samples);
 /* Read-only views of the visibility buffer, row 0 at the top: primitive id
  * (RR_MISS on a miss), ray parameter t along the unnormalised camera ray
- * (+inf on a miss) and barycentrics λ1, λ2 of the hit. */
+ * (+inf on a miss) and barycentrics λ1, λ2 of the hit. With several samples per
+ * pixel they hold one width × height layer per sample, sample s at offset
+ * s·width·height. */
 const uint32_t *rr_frame_ids(const rr_frame *frame);
 const float *rr_frame_t(const rr_frame *frame);
 const float *rr_frame_bary1(const rr_frame *frame);
