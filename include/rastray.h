@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define RR_VERSION "0.1.0"
-#define RR_MISS 0xFFFFFFFFu /* primitive id of a sample that hits nothing */
+#define RR_MISS 0xFFFFFFFFu /* the id (primitive, geometry, material) where nothing is hit */
 #define RR_MAX_SIZE 16384   /* largest image side accepted */
 
 typedef enum rr_error {

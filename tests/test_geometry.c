@@ -145,8 +145,8 @@ static void test_obj(rr_device *dev) {
   if (!s) return;
   rr_scene_info in;
   rr_scene_get_info(s, &in);
-  CHECK(in.triangles == 5 && in.skipped == 1 && in.geometries == 4, "multi.obj: %llu triangles, %llu skipped, %u geometries",
-        (unsigned long long)in.triangles, (unsigned long long)in.skipped, in.geometries);
+  CHECK(in.triangles == 5 && in.skipped == 1 && in.geometries == 4,
+        "multi.obj: %llu triangles, %llu skipped, %u geometries", (unsigned long long)in.triangles, (unsigned long long)in.skipped, in.geometries);
   const char *names[4] = {"first", "first", "second", "grp"};
   const uint32_t first[4] = {0, 1, 2, 4}, count[4] = {1, 1, 2, 1};
   const float blue[4] = {0, 1, 1, 1}; /* the last two objects keep the current material */
@@ -177,7 +177,8 @@ static void test_builtins(rr_device *dev) {
       CHECK(s->ngeoms == 6, "demo: %u geometries", s->ngeoms);
       for (uint32_t g = 0; g < 6 && g < s->ngeoms; g++) {
         rr_geometry_info gi = geometry(s, g);
-        CHECK(named(&gi, names[g]) && gi.count > 0, "demo geometry %u: %s, %u triangles", g, gi.name, gi.count);
+        CHECK(named(&gi, names[g]) && gi.count > 0, "demo geometry %u: %s, %u triangles", g,
+              gi.name ? gi.name : "(none)", gi.count);
       }
     }
     if (k == 4) CHECK(s->ngeoms == 4 * 6, "rooms:2: %u geometries (six a room)", s->ngeoms);
@@ -266,8 +267,8 @@ static rr_image read_u32(rr_device *dev, const char *name) {
 
 static void test_cli(rr_device *dev) {
   char out[8192];
-  int rc = run("render multi.obj --size 48x32 --method 3dr-bb --aov id=i.npy --aov mesh=m.npy --aov material=t.npy", out,
-               sizeof out);
+  int rc = run("render multi.obj --size 48x32 --method 3dr-bb --aov id=i.npy --aov mesh=m.npy --aov material=t.npy",
+               out, sizeof out);
   CHECK(rc == 0, "render exit %d", rc);
   rr_image id = read_u32(dev, "i.npy"), mesh = read_u32(dev, "m.npy"), mat = read_u32(dev, "t.npy");
   rr_scene *s = NULL;

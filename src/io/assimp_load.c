@@ -41,8 +41,9 @@ static rr_error add_mesh(rr_scene *s, const struct aiNode *node, const struct ai
   if (ntri > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "mesh too large");
   bool has_n = mesh->mNormals != NULL, has_uv = mesh->mTextureCoords[0] != NULL;
   uint32_t mat = mat_base + mesh->mMaterialIndex;
+  const char *name = node->mName.length ? node->mName.data : mesh->mName.data;
   rr_error e = rr_scene_reserve(s, (uint32_t)ntri, has_n, has_uv);
-  if (!e) e = rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, node->mName.length ? node->mName.data : mesh->mName.data);
+  if (!e) e = rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, name);
   if (e) return e;
   bool ident = is_identity(m);
   for (unsigned f = 0; f < mesh->mNumFaces; f++) {

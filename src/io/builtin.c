@@ -393,8 +393,8 @@ static rr_error push_column(rr_scene *s, float cx, float cz, float radius, int s
 
 /* rooms:N — N×N rooms of ROOM_SIZE units, each with floor, ceiling, four walls with a
  * door in the middle of each (so the rooms open into each other), and three prism
- * columns: six geometries a room. Walls of neighbouring rooms stand a little apart, so a view across the
- * array crosses many large overlapping layers. */
+ * columns: six geometries a room. Walls of neighbouring rooms stand a little apart,
+ * so a view across the array crosses many large overlapping layers. */
 static rr_error gen_rooms(rr_scene *s, int n) {
   uint32_t floor_m, wall_m, ceil_m, col_m[3];
   rr_error e = add_material(s, 0.55f, 0.45f, 0.35f, &floor_m);

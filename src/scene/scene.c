@@ -252,7 +252,8 @@ rr_error rr_scene_get_geometry(const rr_scene *s, uint32_t prim, uint32_t *geom,
 }
 
 rr_error rr_scene_get_geometry_info(const rr_scene *s, uint32_t geom, rr_geometry_info *info) {
-  if (!s || !info) return s ? rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_geometry_info: info is NULL") : RR_ERROR_ARGUMENT;
+  if (!s) return RR_ERROR_ARGUMENT;
+  if (!info) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_geometry_info: info is NULL");
   if (geom >= s->ngeoms)
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_geometry_info: geometry %u out of range (%u in the scene)",
                    geom, s->ngeoms);

@@ -21,7 +21,7 @@ typedef struct rr_material {
 
 /* A geometry: a run of primitives of one kind that a loader opened (a file's
  * node/mesh pair, an rr_scene_add_mesh call, a built-in object). Its primitives are
- * the global ids from `first` up to the next geometry's first (the last one's run to
+ * the global ids from `first` up to the next geometry's first (the last one's up to
  * ntris); the geometries tile [0, ntris) in order, and an empty one (every triangle
  * dropped) has the same first as the next. */
 typedef struct scene_geometry {
