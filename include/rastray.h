@@ -16,7 +16,7 @@ extern "C" {
 #endif
 
 #define RR_VERSION "0.1.0"
-#define RR_MISS 0xFFFFFFFFu /* primitive id of a sample that hits nothing */
+#define RR_MISS 0xFFFFFFFFu /* the id (primitive, geometry, material) where nothing is hit */
 #define RR_MAX_SIZE 16384   /* largest image side accepted */
 #define RR_MAX_SAMPLES 16   /* most samples per pixel */
 
@@ -31,7 +31,7 @@ typedef enum rr_error {
 } rr_error;
 
 typedef struct rr_device rr_device; /* owns error state; one per thread of control */
-typedef struct rr_scene rr_scene;   /* triangles, attributes, materials, BVH */
+typedef struct rr_scene rr_scene;   /* geometries of triangles, attributes, materials, BVH */
 typedef struct rr_frame rr_frame;   /* a visibility buffer plus its statistics */
 
 /* Creates a device; returns NULL only when out of memory. */
@@ -52,8 +52,9 @@ const char *rr_device_message(const rr_device *dev);
 rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out);
 /* Creates an empty scene to be filled with rr_scene_add_mesh. */
 rr_error rr_scene_new(rr_device *dev, rr_scene **out);
-/* Appends an indexed triangle mesh (xyz positions, 3 indices per triangle, RGB
- * base colour). Degenerate and non-finite triangles are skipped and counted. */
+/* Appends an indexed triangle mesh as one new geometry (numbered after the scene's
+ * others) with a new material of base colour rgb (NULL: grey); 3 indices per
+ * triangle. Degenerate and non-finite triangles are skipped and counted. */
 rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
                            const uint32_t *indices, size_t ntriangles, const float rgb[3]);
 /* The same with homogeneous xyzw vertices: w != 0 is divided out, w = 0 is a point at infinity in direction xyz (3D methods only). */
@@ -81,6 +82,7 @@ typedef struct rr_scene_info {
   uint64_t triangles;    /* triangles kept */
   uint64_t skipped;      /* degenerate or non-finite triangles dropped at load */
   uint32_t materials;    /* materials */
+  uint32_t geometries;   /* geometries (meshes), ids 0 .. geometries - 1 */
   float bounds_min[3], bounds_max[3];
   /* BVH (zero before it is built) */
   uint64_t bvh_nodes, bvh_leaves;
@@ -92,6 +94,34 @@ typedef struct rr_scene_info {
 
 /* Fills what is known about a scene. */
 rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
+
+/* ---- geometries ---------------------------------------------------------- */
+/* A scene is a list of geometries, each a run of primitives of one kind: a mesh of a
+ * file's node/mesh pair, one rr_scene_add_mesh call or one object of a built-in
+ * scene, in the order they were added. Primitive ids (the visibility buffer's ids)
+ * are global: geometry g holds ids [first, first + count). */
+
+/* What a geometry is made of (like Embree's RTC_GEOMETRY_TYPE_*). */
+typedef enum rr_geometry_kind {
+  RR_GEOMETRY_TRIANGLE = 0, /* a triangle mesh */
+  RR_GEOMETRY_KIND_COUNT
+} rr_geometry_kind;
+
+/* The name of a geometry kind ("triangle"), NULL when out of range. */
+const char *rr_geometry_kind_name(int kind);
+
+typedef struct rr_geometry_info {
+  rr_geometry_kind kind;
+  uint32_t first, count; /* its primitives: global ids first .. first + count - 1 */
+  uint32_t material;     /* the material of all its primitives */
+  const char *name;      /* the name the file gives it, NULL when none; valid until the scene changes */
+} rr_geometry_info;
+
+/* The geometry holding primitive `prim` and prim's index within it (*local = prim -
+ * first); RR_MISS maps to RR_MISS in both. Either pointer may be NULL. */
+rr_error rr_scene_get_geometry(const rr_scene *scene, uint32_t prim, uint32_t *geom, uint32_t *local);
+/* Fills what is known about geometry `geom` (0 .. rr_scene_info.geometries - 1). */
+rr_error rr_scene_get_geometry_info(const rr_scene *scene, uint32_t geom, rr_geometry_info *info);
 
 /* ---- ray queries --------------------------------------------------------- */
 
@@ -105,6 +135,7 @@ typedef struct rr_hit {
   uint32_t prim; /* triangle id, RR_MISS when nothing is hit */
   float t;       /* ray parameter of the hit (+inf on a miss) */
   float l1, l2;  /* barycentrics of the hit: weights of the triangle's vertices 1 and 2 */
+  uint32_t geom; /* the geometry holding prim (rr_scene_get_geometry), RR_MISS on a miss */
 } rr_hit;
 
 /* Closest hit of a ray through the committed scene's BVH, with the one sample test
@@ -248,10 +279,13 @@ typedef enum rr_aov {
   RR_AOV_BARY,      /* 2 floats: λ1, λ2, 0 on a miss */
   RR_AOV_EVALS,     /* 1 float: edge evaluations charged to the pixel (needs options.heat) */
   RR_AOV_NODES,     /* 1 float: BVH nodes visited charged to the pixel (needs options.heat) */
+  RR_AOV_MESH,      /* 1 uint32: geometry id (segmentation by mesh), RR_MISS on a miss */
+  RR_AOV_MATERIAL,  /* 1 uint32: material index (segmentation by material), RR_MISS on a miss */
   RR_AOV_COUNT
 } rr_aov;
 
-/* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes"); -1 when unknown. */
+/* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
+ * "material"); -1 when unknown. */
 int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;

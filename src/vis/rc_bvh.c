@@ -355,7 +355,7 @@ static void ray_state_init(ray_state *r, const rr_scene *s, const rr_ray *ray, c
 
 rr_error rr_intersect(const rr_scene *s, const rr_ray *ray, rr_hit *hit) {
   if (!hit) return s ? rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_intersect: hit is NULL") : RR_ERROR_ARGUMENT;
-  *hit = (rr_hit){RR_MISS, INFINITY, 0, 0};
+  *hit = rr_scene_hit(s, RR_MISS, INFINITY, 0, 0);
   const rr_bvh *b = NULL;
   bool empty = false;
   rr_error e = ray_begin(s, ray, &b, &empty);
@@ -365,7 +365,7 @@ rr_error rr_intersect(const rr_scene *s, const rr_ray *ray, rr_hit *hit) {
   ray_state r;
   ray_state_init(&r, s, ray, &rc);
   trace1(b, &r, MODE_CLOSEST);
-  if (r.id != RR_MISS) *hit = (rr_hit){r.id, r.t, r.l1, r.l2};
+  if (r.id != RR_MISS) *hit = rr_scene_hit(s, r.id, r.t, r.l1, r.l2);
   return RR_OK;
 }
 

@@ -90,7 +90,8 @@ int rr_shade_from_name(const char *name) {
 }
 
 int rr_aov_from_name(const char *name) {
-  static const char *const names[RR_AOV_COUNT] = {"depth", "id", "normal", "bary", "evals", "nodes"};
+  static const char *const names[RR_AOV_COUNT] = {"depth", "id", "normal", "bary",
+                                                  "evals", "nodes", "mesh", "material"};
   return name_index(names, RR_AOV_COUNT, name);
 }
 
