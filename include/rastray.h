@@ -16,8 +16,9 @@ extern "C" {
 #endif
 
 #define RR_VERSION "0.1.0"
-#define RR_MISS 0xFFFFFFFFu /* primitive id of a sample that hits nothing */
+#define RR_MISS 0xFFFFFFFFu /* the id (primitive, geometry, material) where nothing is hit */
 #define RR_MAX_SIZE 16384   /* largest image side accepted */
+#define RR_MAX_SAMPLES 16   /* most samples per pixel */
 
 typedef enum rr_error {
   RR_OK = 0,
@@ -30,7 +31,7 @@ typedef enum rr_error {
 } rr_error;
 
 typedef struct rr_device rr_device; /* owns error state; one per thread of control */
-typedef struct rr_scene rr_scene;   /* triangles, attributes, materials, BVH */
+typedef struct rr_scene rr_scene;   /* geometries of triangles, attributes, materials, BVH */
 typedef struct rr_frame rr_frame;   /* a visibility buffer plus its statistics */
 
 /* Creates a device; returns NULL only when out of memory. */
@@ -51,8 +52,9 @@ const char *rr_device_message(const rr_device *dev);
 rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out);
 /* Creates an empty scene to be filled with rr_scene_add_mesh. */
 rr_error rr_scene_new(rr_device *dev, rr_scene **out);
-/* Appends an indexed triangle mesh (xyz positions, 3 indices per triangle, RGB
- * base colour). Degenerate and non-finite triangles are skipped and counted. */
+/* Appends an indexed triangle mesh as one new geometry (numbered after the scene's
+ * others) with a new material of base colour rgb (NULL: grey); 3 indices per
+ * triangle. Degenerate and non-finite triangles are skipped and counted. */
 rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
                            const uint32_t *indices, size_t ntriangles, const float rgb[3]);
 /* The same with homogeneous xyzw vertices: w != 0 is divided out, w = 0 is a point at infinity in direction xyz (3D methods only). */
@@ -80,6 +82,7 @@ typedef struct rr_scene_info {
   uint64_t triangles;    /* triangles kept */
   uint64_t skipped;      /* degenerate or non-finite triangles dropped at load */
   uint32_t materials;    /* materials */
+  uint32_t geometries;   /* geometries (meshes), ids 0 .. geometries - 1 */
   float bounds_min[3], bounds_max[3];
   /* BVH (zero before it is built) */
   uint64_t bvh_nodes, bvh_leaves;
@@ -91,6 +94,34 @@ typedef struct rr_scene_info {
 
 /* Fills what is known about a scene. */
 rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
+
+/* ---- geometries ---------------------------------------------------------- */
+/* A scene is a list of geometries, each a run of primitives of one kind: a mesh of a
+ * file's node/mesh pair, one rr_scene_add_mesh call or one object of a built-in
+ * scene, in the order they were added. Primitive ids (the visibility buffer's ids)
+ * are global: geometry g holds ids [first, first + count). */
+
+/* What a geometry is made of (like Embree's RTC_GEOMETRY_TYPE_*). */
+typedef enum rr_geometry_kind {
+  RR_GEOMETRY_TRIANGLE = 0, /* a triangle mesh */
+  RR_GEOMETRY_KIND_COUNT
+} rr_geometry_kind;
+
+/* The name of a geometry kind ("triangle"), NULL when out of range. */
+const char *rr_geometry_kind_name(int kind);
+
+typedef struct rr_geometry_info {
+  rr_geometry_kind kind;
+  uint32_t first, count; /* its primitives: global ids first .. first + count - 1 */
+  uint32_t material;     /* the material of all its primitives */
+  const char *name;      /* the name the file gives it, NULL when none; valid until the scene changes */
+} rr_geometry_info;
+
+/* The geometry holding primitive `prim` and prim's index within it (*local = prim -
+ * first); RR_MISS maps to RR_MISS in both. Either pointer may be NULL. */
+rr_error rr_scene_get_geometry(const rr_scene *scene, uint32_t prim, uint32_t *geom, uint32_t *local);
+/* Fills what is known about geometry `geom` (0 .. rr_scene_info.geometries - 1). */
+rr_error rr_scene_get_geometry_info(const rr_scene *scene, uint32_t geom, rr_geometry_info *info);
 
 /* ---- ray queries --------------------------------------------------------- */
 
@@ -104,6 +135,7 @@ typedef struct rr_hit {
   uint32_t prim; /* triangle id, RR_MISS when nothing is hit */
   float t;       /* ray parameter of the hit (+inf on a miss) */
   float l1, l2;  /* barycentrics of the hit: weights of the triangle's vertices 1 and 2 */
+  uint32_t geom; /* the geometry holding prim (rr_scene_get_geometry), RR_MISS on a miss */
 } rr_hit;
 
 /* Threading: rr_intersect and rr_occluded only read the scene, so any number of
@@ -179,7 +211,10 @@ const char *rr_method_name(int method);
 
 typedef struct rr_render_options {
   rr_method method;
-  int width, height;  /* image size in samples (one per pixel) */
+  int width, height;  /* image size in pixels */
+  int samples;        /* samples per pixel, 1..RR_MAX_SAMPLES (default 1) */
+  float sample_pos[RR_MAX_SAMPLES][2]; /* sample s at (x + sample_pos[s][0], y + sample_pos[s][1]) in pixel
+                                          (x, y); each in [0, 1) (default: one sample at the centre) */
   int threads;        /* 0: all cores */
   int cull_backfaces; /* nonzero: triangles seen from behind are invisible */
   int heat;           /* nonzero: also record E and N charged to each pixel (AOVs evals, nodes) */
@@ -192,7 +227,8 @@ typedef struct rr_render_options {
                          bin side), bin-min=N (bins tested sample by sample) */
 } rr_render_options;
 
-/* Fills options with defaults: 3dr-bb, 1024x768, all cores, no culling. */
+/* Fills options with defaults: 3dr-bb, 1024x768, one sample at each pixel's centre,
+ * all cores, no culling. */
 void rr_render_options_init(rr_render_options *opt);
 
 typedef struct rr_stats {
@@ -217,9 +253,13 @@ void rr_frame_release(rr_frame *frame);
 rr_error rr_frame_get_stats(const rr_frame *frame, rr_stats *stats);
 /* Width and height of the frame's visibility buffer. */
 rr_error rr_frame_get_size(const rr_frame *frame, int *width, int *height);
+/* Samples per pixel of the frame (options.samples). */
+rr_error rr_frame_get_samples(const rr_frame *frame, int *samples);
 /* Read-only views of the visibility buffer, row 0 at the top: primitive id
  * (RR_MISS on a miss), ray parameter t along the unnormalised camera ray
- * (+inf on a miss) and barycentrics λ1, λ2 of the hit. */
+ * (+inf on a miss) and barycentrics λ1, λ2 of the hit. With several samples per
+ * pixel they hold one width × height layer per sample, sample s at offset
+ * s·width·height. */
 const uint32_t *rr_frame_ids(const rr_frame *frame);
 const float *rr_frame_t(const rr_frame *frame);
 const float *rr_frame_bary1(const rr_frame *frame);
@@ -247,10 +287,13 @@ typedef enum rr_aov {
   RR_AOV_BARY,      /* 2 floats: λ1, λ2, 0 on a miss */
   RR_AOV_EVALS,     /* 1 float: edge evaluations charged to the pixel (needs options.heat) */
   RR_AOV_NODES,     /* 1 float: BVH nodes visited charged to the pixel (needs options.heat) */
+  RR_AOV_MESH,      /* 1 uint32: geometry id (segmentation by mesh), RR_MISS on a miss */
+  RR_AOV_MATERIAL,  /* 1 uint32: material index (segmentation by material), RR_MISS on a miss */
   RR_AOV_COUNT
 } rr_aov;
 
-/* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes"); -1 when unknown. */
+/* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
+ * "material"); -1 when unknown. */
 int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;

@@ -163,13 +163,13 @@ static rr_scene *random_scene(rr_device *dev, uint32_t n, float spread, float si
 static rr_hit brute(const rr_scene *s, const rr_ray *ray, int *any) {
   camera rc;
   rr_cam_for_ray(ray->org, ray->dir, &rc);
-  rr_hit h = {RR_MISS, INFINITY, 0, 0};
+  rr_hit h = rr_scene_hit(s, RR_MISS, INFINITY, 0, 0);
   *any = 0;
   for (uint32_t i = 0; i < s->ntris; i++) {
     float t, l1, l2;
     if (!rr_tri_ray_hit(s, i, &rc, false, ray->tmin, ray->tmax, &t, &l1, &l2)) continue;
     *any = 1;
-    if (depth_wins(t, i, h.t, h.prim)) h = (rr_hit){i, t, l1, l2};
+    if (depth_wins(t, i, h.t, h.prim)) h = rr_scene_hit(s, i, t, l1, l2);
   }
   return h;
 }

@@ -47,7 +47,8 @@ unsigned test_rand(void) {
 float test_randf(float lo, float hi) { return lo + (hi - lo) * (test_rand() / 2147483648.0f); }
 
 int test_frames_differ(const rr_frame *a, const rr_frame *b) {
-  size_t n = (size_t)a->vb.width * a->vb.height;
+  if (a->samples != b->samples) return a->vb.width * a->vb.height * (a->samples > b->samples ? a->samples : b->samples);
+  size_t n = (size_t)a->vb.width * a->vb.height * a->samples; /* every sample layer */
   int d = 0;
   for (size_t k = 0; k < n; k++)
     d += a->vb.id[k] != b->vb.id[k] || memcmp(&a->vb.t[k], &b->vb.t[k], 4) || memcmp(&a->vb.l1[k], &b->vb.l1[k], 4) ||
@@ -56,7 +57,7 @@ int test_frames_differ(const rr_frame *a, const rr_frame *b) {
 }
 
 int test_frame_hits(const rr_frame *f) {
-  size_t n = (size_t)f->vb.width * f->vb.height;
+  size_t n = (size_t)f->vb.width * f->vb.height * f->samples;
   int hits = 0;
   for (size_t k = 0; k < n; k++) hits += f->vb.id[k] != RR_MISS;
   return hits;

@@ -31,7 +31,8 @@ const char *test_model(const char *name);
 /* True when RR_TEST_QUICK is set (the sanitizer run): property tests then visit
  * fewer views and smaller meshes, the same code paths. */
 bool test_quick(void);
-/* Samples where two visibility buffers differ in any byte of id, t, λ1 or λ2. */
+/* Samples where two visibility buffers differ in any byte of id, t, λ1 or λ2 (every
+ * sample layer; frames of different sample counts differ everywhere). */
 int test_frames_differ(const rr_frame *a, const rr_frame *b);
 /* Samples of a frame that hit a triangle. */
 int test_frame_hits(const rr_frame *f);

@@ -25,7 +25,7 @@ static void die(int code, const char *fmt, ...) {
 
 static const char usage[] =
     "usage: rastray render [SCENE] [options]     render SCENE (a mesh file or built-in name; default demo)\n"
-    "       rastray info SCENE                   print the scene's triangles and BVH figures\n"
+    "       rastray info SCENE                   print the scene's triangles, geometries and BVH figures\n"
     "       rastray --help | --version\n"
     "\n"
     "scenes: a file assimp reads (.obj .ply .gltf .glb .dae .3ds ...), or demo, plane[:N],\n"
@@ -45,8 +45,8 @@ static const char usage[] =
     "                      camera; without --eye/--target the scene is framed automatically\n"
     "  --shade MODE        lambert (default), id, normal, depth, heat-evals, heat-nodes\n"
     "  -o PATH             colour image: .png, .exr or .pfm (default rastray.png unless --aov is given)\n"
-    "  --aov NAME=PATH     write an AOV (depth, id, normal, bary, evals, nodes) as .npy, .pfm or\n"
-    "                      .exr; repeatable\n"
+    "  --aov NAME=PATH     write an AOV as .npy, .pfm or .exr; repeatable. NAME: depth, id (triangle),\n"
+    "                      mesh (geometry id), material (index), normal, bary, evals, nodes\n"
     "  --threads N         threads (default: all cores)\n"
     "  --repeat N          run the visibility pass N times, report the median time\n"
     "  --stats             print key=value statistics to stderr\n"
@@ -168,6 +168,14 @@ static int cmd_info(rr_device *dev, int argc, char **argv) {
   printf("triangles    %llu (%llu degenerate or non-finite skipped)\n", (unsigned long long)in.triangles,
          (unsigned long long)in.skipped);
   printf("materials    %u\n", in.materials);
+  printf("geometries   %u\n", in.geometries);
+  enum { LISTED = 32 }; /* a scene of more lists none: the list would drown the rest */
+  for (uint32_t g = 0; in.geometries <= LISTED && g < in.geometries; g++) {
+    rr_geometry_info gi;
+    rr_scene_get_geometry_info(scene, g, &gi);
+    printf("  %-4u %-24s %u %s%s, material %u\n", g, gi.name ? gi.name : "-", gi.count,
+           rr_geometry_kind_name(gi.kind), gi.count == 1 ? "" : "s", gi.material);
+  }
   printf("bounds       (%g, %g, %g) .. (%g, %g, %g)\n", in.bounds_min[0], in.bounds_min[1], in.bounds_min[2],
          in.bounds_max[0], in.bounds_max[1], in.bounds_max[2]);
   printf("bvh nodes    %llu\n", (unsigned long long)in.bvh_nodes);
@@ -242,7 +250,8 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
         die(EXIT_USAGE, "bad --aov '%s' (expected NAME=PATH)", v);
       memcpy(name, v, eq - v), name[eq - v] = 0;
       int k = rr_aov_from_name(name);
-      if (k < 0) die(EXIT_USAGE, "unknown AOV '%s' (expected depth, id, normal, bary, evals or nodes)", name);
+      if (k < 0)
+        die(EXIT_USAGE, "unknown AOV '%s' (expected depth, id, mesh, material, normal, bary, evals or nodes)", name);
       if (k == RR_AOV_EVALS || k == RR_AOV_NODES) opt.heat = 1;
       if (naov == 16) die(EXIT_USAGE, "too many --aov (at most 16)");
       aovs[naov++] = (aov_out){(rr_aov)k, eq + 1};

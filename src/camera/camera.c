@@ -52,7 +52,7 @@ rr_error rr_camera_check(rr_device *dev, const rr_camera *c) {
 
 /* The direction of pixel (x, y) of a curved camera; zero where it has no ray. */
 static vec3 curved_dir(const camera *c, const rr_camera *in, int x, int y) {
-  double W = c->width, H = c->height, sx = x + 0.5, sy = y + 0.5;
+  double W = c->width, H = c->height, sx = x + (double)c->sx0, sy = y + (double)c->sy0;
   double u = 2 * sx / W - 1, v = 1 - 2 * sy / H;
   vec3 r = c->right, up = c->up, f = c->fwd;
   switch (c->type) {
@@ -77,7 +77,7 @@ static vec3 curved_dir(const camera *c, const rr_camera *in, int x, int y) {
     /* horizontal cross: row 0 top face, row 1 left/front/right/back, row 2 bottom */
     int F = c->face, col = x / F, row = y / F;
     if (col > 3 || row > 2 || (row != 1 && col != 1)) return v3(0, 0, 0);
-    float a = (float)(2 * (x - col * F + 0.5) / F - 1), b = (float)(1 - 2 * (y - row * F + 0.5) / F);
+    float a = (float)(2 * (x - col * F + (double)c->sx0) / F - 1), b = (float)(1 - 2 * (y - row * F + (double)c->sy0) / F);
     vec3 ff = f, fr = r, fu = up;
     if (row == 0) ff = up, fu = v3_neg(f);
     else if (row == 2) ff = v3_neg(up), fu = f;
@@ -92,9 +92,19 @@ static vec3 curved_dir(const camera *c, const rr_camera *in, int x, int y) {
 }
 
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
+  static const float centre[2] = {0.5f, 0.5f};
+  return rr_cam_setup_at(dev, in, width, height, centre, c);
+}
+
+rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int height, const float sample[2],
+                         camera *c) {
   memset(c, 0, sizeof *c);
   rr_error e = rr_camera_check(dev, in);
   if (e) return e;
+  if (!(sample[0] >= 0.0f && sample[0] < 1.0f && sample[1] >= 0.0f && sample[1] < 1.0f))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad sample position (%g, %g) (each in [0, 1))", (double)sample[0],
+                   (double)sample[1]);
+  c->sx0 = sample[0], c->sy0 = sample[1];
   if (width < 1 || height < 1 || width > RR_MAX_SIZE || height > RR_MAX_SIZE)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad image size %dx%d (1..%d per side)", width, height, RR_MAX_SIZE);
   if (in->type == RR_CAMERA_CUBE && (width != height / 3 * 4 || height % 3))
@@ -184,7 +194,7 @@ void rr_cam_release(camera *c) {
 }
 
 bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
-  float sx = (float)x + 0.5f, sy = (float)y + 0.5f;
+  float sx = (float)x + c->sx0, sy = (float)y + c->sy0;
   *origin = c->eye;
   switch (c->type) {
   case RR_CAMERA_PERSPECTIVE:

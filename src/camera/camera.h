@@ -4,8 +4,11 @@
 
 #include "scene/scene.h"
 
-/* A camera resolved for an image. Sample (sx, sy) of pixel (x, y) is
- * (x + 0.5, y + 0.5), row 0 at the top. Planar cameras (perspective, orthographic)
+/* A camera resolved for an image and one position of the sample pattern: the
+ * sample (sx, sy) of pixel (x, y) is (x + sx0, y + sy0), row 0 at the top, and
+ * (sx0, sy0) is the only place a position inside the pixel is written (the centre,
+ * 0.5, 0.5, for one sample per pixel). A pattern of N samples renders N such
+ * cameras, one layer of the visibility buffer each. Planar cameras (perspective, orthographic)
  * have edge functions linear in (sx, sy): a perspective ray leaves the eye along
  * d0 + sx·dx + sy·dy; an orthographic ray leaves eye + o0 + sx·ox + sy·oy along fwd.
  * Curved cameras (parabolic, lat-long, fisheye, cube) keep one direction per
@@ -15,6 +18,7 @@
 typedef struct camera {
   rr_camera_type type;
   int width, height;
+  float sx0, sy0; /* the sample's position inside every pixel, in [0, 1) */
   bool planar;
   vec3 eye, right, up, fwd;
   vec3 d0, dx, dy;
@@ -34,6 +38,9 @@ typedef struct camera {
 
 /* Resolves a public camera for an image size; rr_cam_release frees it. */
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *out);
+/* The same for the sample at `sample` (x, y in [0, 1)) inside every pixel. */
+rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int height, const float sample[2],
+                         camera *out);
 void rr_cam_release(camera *c);
 /* The ray of sample (sx, sy) of a planar perspective camera (unnormalised). */
 static inline vec3 camera_dir(const camera *c, float sx, float sy) {
@@ -45,7 +52,7 @@ bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir);
 /* What a triangle's edge functions are evaluated against at pixel (x, y):
  * (1, sx, sy) for planar cameras, the ray direction for curved ones. */
 static inline vec3 camera_w(const camera *c, int x, int y) {
-  return c->planar ? v3(1.0f, (float)x + 0.5f, (float)y + 0.5f) : c->dirs[(size_t)y * c->width + x];
+  return c->planar ? v3(1.0f, (float)x + c->sx0, (float)y + c->sy0) : c->dirs[(size_t)y * c->width + x];
 }
 /* Projects a point given relative to the eye to sample coordinates (planar
  * cameras); false when it is not strictly in front of the image plane. */

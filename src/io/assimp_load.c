@@ -2,7 +2,9 @@
  *
  * Polygons are fan-triangulated here rather than by assimp, so primitive ids follow
  * the documented order: meshes in node order (file order), faces in file order,
- * face k of n corners giving triangles (0, j, j+1). */
+ * face k of n corners giving triangles (0, j, j+1). Each node/mesh pair is one
+ * geometry, named after its node (an OBJ object or group, a glTF node), else after
+ * its mesh; assimp splits an OBJ object by material into meshes of one node. */
 #include "io/io.h"
 
 #include <assimp/cimport.h>
@@ -31,14 +33,17 @@ static bool is_identity(const struct aiMatrix4x4 *m) {
          m->c4 == 0 && m->d1 == 0 && m->d2 == 0 && m->d3 == 0;
 }
 
-static rr_error add_mesh(rr_scene *s, const struct aiMesh *mesh, const struct aiMatrix4x4 *m,
-                         uint32_t mat_base) {
+static rr_error add_mesh(rr_scene *s, const struct aiNode *node, const struct aiMesh *mesh,
+                         const struct aiMatrix4x4 *m, uint32_t mat_base) {
   uint64_t ntri = 0;
   for (unsigned f = 0; f < mesh->mNumFaces; f++)
     if (mesh->mFaces[f].mNumIndices >= 3) ntri += mesh->mFaces[f].mNumIndices - 2;
   if (ntri > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "mesh too large");
   bool has_n = mesh->mNormals != NULL, has_uv = mesh->mTextureCoords[0] != NULL;
+  uint32_t mat = mat_base + mesh->mMaterialIndex;
+  const char *name = node->mName.length ? node->mName.data : mesh->mName.data;
   rr_error e = rr_scene_reserve(s, (uint32_t)ntri, has_n, has_uv);
+  if (!e) e = rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, name);
   if (e) return e;
   bool ident = is_identity(m);
   for (unsigned f = 0; f < mesh->mNumFaces; f++) {
@@ -63,7 +68,7 @@ static rr_error add_mesh(rr_scene *s, const struct aiMesh *mesh, const struct ai
           uv[k][1] = mesh->mTextureCoords[0][v].y;
         }
       }
-      rr_scene_push(s, p, has_n ? n : NULL, has_uv ? (const float(*)[2])uv : NULL, mat_base + mesh->mMaterialIndex);
+      rr_scene_push(s, p, has_n ? n : NULL, has_uv ? (const float(*)[2])uv : NULL, mat);
     }
   }
   return RR_OK;
@@ -85,7 +90,7 @@ static rr_error add_node(rr_scene *s, const struct aiScene *sc, const struct aiN
   struct aiMatrix4x4 m = mat_mul(parent, &node->mTransformation);
   for (unsigned i = 0; i < node->mNumMeshes; i++) {
     if (node->mMeshes[i] >= sc->mNumMeshes) return rr_fail(s->dev, RR_ERROR_PARSE, "node names a missing mesh");
-    rr_error e = add_mesh(s, sc->mMeshes[node->mMeshes[i]], &m, mat_base);
+    rr_error e = add_mesh(s, node, sc->mMeshes[node->mMeshes[i]], &m, mat_base);
     if (e) return e;
   }
   for (unsigned c = 0; c < node->mNumChildren; c++) {

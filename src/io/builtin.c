@@ -1,5 +1,6 @@
 /* Built-in scenes generated in code: exact test meshes (plane, sphere, box), a grid
  * of copies of a mesh file, a many-layered benchmark (rooms) and the default demo.
+ * Each object is one geometry, named after what it is ("sphere", "floor"...).
  *
  * Closed meshes compute each vertex position once and index it, so a vertex shared
  * by several triangles has bitwise identical coordinates in all of them: the shared
@@ -54,6 +55,11 @@ static rr_error add_material(rr_scene *s, float r, float g, float b, uint32_t *o
   return RR_OK;
 }
 
+/* Opens the geometry of one object of material mat. */
+static rr_error open_object(rr_scene *s, const char *name, uint32_t mat) {
+  return rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, name);
+}
+
 /* Reserves room first so that rr_scene_push can only refuse degenerate triangles. */
 static rr_error reserve(rr_scene *s, uint64_t more, bool with_normals) {
   if (more > UINT32_MAX - 1 - (uint64_t)s->ntris)
@@ -93,6 +99,7 @@ static rr_error gen_plane(rr_scene *s, int n) {
   uint32_t mat;
   rr_error e = add_material(s, 0.8f, 0.8f, 0.8f, &mat);
   if (!e) e = reserve(s, 2 * (uint64_t)n * n, false);
+  if (!e) e = open_object(s, "plane", mat);
   if (e) return e;
   int lo = -(n / 2);
   for (int j = 0; j < n; j++)
@@ -117,6 +124,7 @@ static rr_error gen_sphere(rr_scene *s, int seg, vec3 centre, float radius, uint
   vec3 *dir = malloc(nv * sizeof *dir), *pos = malloc(nv * sizeof *pos);
   rr_error e = dir && pos ? reserve(s, 2 * (uint64_t)seg * (rings - 1), true)
                           : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory generating a sphere");
+  if (!e) e = open_object(s, "sphere", mat);
   if (e) {
     free(dir), free(pos);
     return e;
@@ -160,6 +168,7 @@ static rr_error gen_box(rr_scene *s, int n) {
   rr_error e = g ? add_material(s, 0.8f, 0.8f, 0.8f, &mat)
                  : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory generating a box");
   if (!e) e = reserve(s, 12 * (uint64_t)n * n, true);
+  if (!e) e = open_object(s, "box", mat);
   if (e) {
     free(g);
     return e;
@@ -200,6 +209,7 @@ static rr_error gen_torus(rr_scene *s, int nu, int nv, float R, float r, vec3 ce
   vec3 *pos = malloc(count * sizeof *pos), *nrm = malloc(count * sizeof *nrm);
   rr_error e = pos && nrm ? reserve(s, 2 * (uint64_t)count, true)
                           : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory generating a torus");
+  if (!e) e = open_object(s, "torus", mat);
   if (e) {
     free(pos), free(nrm);
     return e;
@@ -238,6 +248,7 @@ static rr_error gen_ground(rr_scene *s) {
   rr_error e = add_material(s, 0.55f, 0.62f, 0.45f, &ground_m);
   if (!e) e = add_material(s, 0.20f, 0.45f, 0.85f, &ball_m);
   if (!e) e = reserve(s, 4, false);
+  if (!e) e = open_object(s, "ground", ground_m);
   if (e) return e;
   const vec3 origin = v3(0, 0, 0), dir[4] = {v3(1, 0, 0), v3(0, 0, -1), v3(-1, 0, 0), v3(0, 0, 1)};
   for (int q = 0; q < 4; q++) {
@@ -267,7 +278,8 @@ static rr_error gen_ground(rr_scene *s) {
 /* grid:PATH:N — N×N copies of a mesh file on the XZ plane, copy k = j·N + i moved by
  * (i·1.25·sx, 0, j·1.25·sz). The copies are written straight into the arrays rather
  * than through rr_scene_push: a translated sliver could round to zero area and be
- * dropped, which would break the rule that copy k's triangle m has id k·T + m. */
+ * dropped, which would break the rule that copy k's triangle m has id k·T + m. Each
+ * copy has its own geometries, like the file's, named as in the file. */
 static rr_error load_grid(rr_scene *s, const char *name) {
   const char *rest = name + strlen("grid:");
   const char *colon = strrchr(rest, ':'); /* PATH may itself contain ':' */
@@ -282,7 +294,7 @@ static rr_error load_grid(rr_scene *s, const char *name) {
   if (!path) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory reading '%s'", name);
   memcpy(path, rest, len);
   path[len] = 0;
-  uint32_t t0 = s->ntris;
+  uint32_t t0 = s->ntris, g0 = s->ngeoms;
   uint64_t skipped0 = s->skipped;
   rr_error e = rr_scene_load_file(s, path);
   free(path);
@@ -307,9 +319,14 @@ static rr_error load_grid(rr_scene *s, const char *name) {
 
   e = rr_scene_reserve(s, (uint32_t)(total - T), false, false);
   if (e) return e;
+  uint32_t g1 = s->ngeoms;
   for (uint64_t copy = 1; copy < copies; copy++) {
     float ox = (float)(copy % n) * 1.25f * sx, oz = (float)(copy / n) * 1.25f * sz;
     size_t dst = t0 + copy * T;
+    for (uint32_t g = g0; g < g1; g++) {
+      e = rr_scene_repeat_geometry(s, g, s->geoms[g].first + (uint32_t)(copy * T));
+      if (e) return e;
+    }
     for (int k = 0; k < 3; k++) {
       for (uint32_t m = 0; m < T; m++) {
         s->p[k][0][dst + m] = s->p[k][0][t0 + m] + ox;
@@ -355,9 +372,12 @@ static void push_wall(rr_scene *s, vec3 a, vec3 b, uint32_t mat) {
   push_quad(s, v3_add(l, door), v3_add(r, door), v3_add(r, up), v3_add(l, up), NULL, mat);
 }
 
-/* A prism column of `sides` sides standing from the floor to the ceiling. It has no
- * caps: they would lie in the floor and ceiling planes and fight with them. */
-static void push_column(rr_scene *s, float cx, float cz, float radius, int sides, uint32_t mat) {
+/* A prism column of `sides` sides standing from the floor to the ceiling, a geometry
+ * of its own. It has no caps: they would lie in the floor and ceiling planes and
+ * fight with them. */
+static rr_error push_column(rr_scene *s, float cx, float cz, float radius, int sides, uint32_t mat) {
+  rr_error e = open_object(s, "column", mat);
+  if (e) return e;
   vec3 bot[12], top[12];
   for (int k = 0; k < sides; k++) {
     double ph = 2 * PI * k / sides; /* counter-clockwise seen from +y */
@@ -368,12 +388,13 @@ static void push_column(rr_scene *s, float cx, float cz, float radius, int sides
     int k1 = (k + 1) % sides;
     push_quad(s, bot[k], bot[k1], top[k1], top[k], NULL, mat); /* faces outward */
   }
+  return RR_OK;
 }
 
 /* rooms:N — N×N rooms of ROOM_SIZE units, each with floor, ceiling, four walls with a
  * door in the middle of each (so the rooms open into each other), and three prism
- * columns. Walls of neighbouring rooms stand a little apart, so a view across the
- * array crosses many large overlapping layers. */
+ * columns: six geometries a room. Walls of neighbouring rooms stand a little apart,
+ * so a view across the array crosses many large overlapping layers. */
 static rr_error gen_rooms(rr_scene *s, int n) {
   uint32_t floor_m, wall_m, ceil_m, col_m[3];
   rr_error e = add_material(s, 0.55f, 0.45f, 0.35f, &floor_m);
@@ -392,9 +413,12 @@ static rr_error gen_rooms(rr_scene *s, int n) {
       float z0 = (float)(rj * ROOM_SIZE) + ROOM_INSET, z1 = (float)((rj + 1) * ROOM_SIZE) - ROOM_INSET;
       vec3 c00 = v3(x0, 0, z0), c10 = v3(x1, 0, z0), c11 = v3(x1, 0, z1), c01 = v3(x0, 0, z1);
       vec3 up = v3(0, ROOM_H, 0);
+      if ((e = open_object(s, "floor", floor_m))) return e;
       push_quad(s, c00, c01, c11, c10, NULL, floor_m); /* faces +y */
+      if ((e = open_object(s, "ceiling", ceil_m))) return e;
       push_quad(s, v3_add(c00, up), v3_add(c10, up), v3_add(c11, up), v3_add(c01, up), NULL,
                 ceil_m); /* faces -y */
+      if ((e = open_object(s, "walls", wall_m))) return e;
       push_wall(s, c00, c10, wall_m);
       push_wall(s, c10, c11, wall_m);
       push_wall(s, c11, c01, wall_m);
@@ -407,7 +431,8 @@ static rr_error gen_rooms(rr_scene *s, int n) {
         float cz = 0.5f * (z0 + z1) + ((q & 2) ? 2.0f : -2.0f) + rng_next(&rng) - 0.5f;
         float radius = 0.3f + 0.3f * rng_next(&rng);
         int sides = 8 + (int)(rng_next(&rng) * 5.0f); /* 8..12 */
-        push_column(s, cx, cz, radius, sides, col_m[(q + ri + rj) % 3]);
+        e = push_column(s, cx, cz, radius, sides, col_m[(q + ri + rj) % 3]);
+        if (e) return e;
       }
     }
   return RR_OK;
@@ -468,15 +493,17 @@ static rr_error smooth_normals(rr_scene *s, uint32_t t0, uint32_t t1) {
   return RR_OK;
 }
 
-/* Loads a mesh file into s, gives it smooth normals, scales it uniformly by `size`
- * divided by its largest extent, turns it by `yaw` degrees about +y and stands the
- * bottom centre of its bounds at (x, 0, z). Returns the first material it added. */
-static rr_error place_file(rr_scene *s, const char *path, float size, float yaw, float x,
+/* Loads a mesh file into s, names its geometries `name`, gives it smooth normals,
+ * scales it uniformly by `size` divided by its largest extent, turns it by `yaw`
+ * degrees about +y and stands the bottom centre of its bounds at (x, 0, z). Returns
+ * the first material it added. */
+static rr_error place_file(rr_scene *s, const char *path, const char *name, float size, float yaw, float x,
                            float z, uint32_t *first_mat) {
-  uint32_t t0 = s->ntris;
+  uint32_t t0 = s->ntris, g0 = s->ngeoms;
   *first_mat = s->nmaterials;
   rr_error e = rr_scene_load_file(s, path);
   if (!e && s->ntris == t0) e = rr_fail(s->dev, RR_ERROR_EMPTY, "demo mesh '%s' has no triangles", path);
+  for (uint32_t g = g0; !e && g < s->ngeoms; g++) e = rr_scene_name_geometry(s, g, name);
   if (!e) e = smooth_normals(s, t0, s->ntris);
   if (e) return e;
   float cy = cosf(yaw * (float)(PI / 180)), sy = sinf(yaw * (float)(PI / 180));
@@ -512,18 +539,19 @@ static rr_error gen_demo(rr_scene *s) {
   if (!e) e = add_material(s, 0.95f, 0.70f, 0.18f, &gold_m);
   if (!e) e = add_material(s, 0.30f, 0.72f, 0.42f, &green_m);
   if (!e) e = reserve(s, 2, true);
+  if (!e) e = open_object(s, "floor", floor_m);
   if (e) return e;
   vec3 up = v3(0, 1, 0);
   const float fy = -0.01f; /* just below the objects resting on y = 0 */
   push_quad(s, v3(-5.0f, fy, -3.0f), v3(-5.0f, fy, 3.0f), v3(5.0f, fy, 3.0f), v3(5.0f, fy, -3.0f),
             &up, floor_m);
 
-  e = place_file(s, RR_DATA_DIR "/teapot.obj", 3.2f, -20.0f, -0.6f, -0.3f, &teapot_m);
+  e = place_file(s, RR_DATA_DIR "/teapot.obj", "teapot", 3.2f, -20.0f, -0.6f, -0.3f, &teapot_m);
   if (e) return e;
   for (uint32_t m = teapot_m; m < s->nmaterials; m++) { /* the file has no colour of its own */
     s->materials[m].color[0] = 0.86f, s->materials[m].color[1] = 0.30f, s->materials[m].color[2] = 0.24f;
   }
-  e = place_file(s, RR_DATA_DIR "/spot.obj", 1.9f, 145.0f, 2.6f, 0.3f, &spot_m);
+  e = place_file(s, RR_DATA_DIR "/spot.obj", "spot", 1.9f, 145.0f, 2.6f, 0.3f, &spot_m);
   if (!e) e = gen_sphere(s, 48, v3(-3.3f, 0.6f, 0.9f), 0.6f, blue_m);
   if (!e) e = gen_sphere(s, 32, v3(0.9f, 0.35f, 1.6f), 0.35f, gold_m);
   if (!e) e = gen_torus(s, 48, 24, 0.5f, 0.17f, v3(-1.6f, 0.17f, 1.7f), green_m);

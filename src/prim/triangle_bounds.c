@@ -94,8 +94,8 @@ bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
      * a few ulps of the larger coordinate; a whole pixel would double the area of
      * the small triangles of real meshes. */
     float m = 1.0f / 64 + 1e-5f * maxf(maxf(fabsf(x0), fabsf(x1)), maxf(fabsf(y0), fabsf(y1)));
-    float lx = maxf(ceilf(x0 - 0.5f - m), 0.0f), hx = minf(floorf(x1 - 0.5f + m), (float)(c->width - 1));
-    float ly = maxf(ceilf(y0 - 0.5f - m), 0.0f), hy = minf(floorf(y1 - 0.5f + m), (float)(c->height - 1));
+    float lx = maxf(ceilf(x0 - c->sx0 - m), 0.0f), hx = minf(floorf(x1 - c->sx0 + m), (float)(c->width - 1));
+    float ly = maxf(ceilf(y0 - c->sy0 - m), 0.0f), hy = minf(floorf(y1 - c->sy0 + m), (float)(c->height - 1));
     if (lx > hx || ly > hy) return false;
     r[0] = (int)lx, r[1] = (int)ly, r[2] = (int)hx, r[3] = (int)hy;
     return true;
@@ -162,11 +162,12 @@ __attribute__((target("avx2"))) static uint32_t bounds8_avx2(const rr_scene *s, 
                              _mm256_max_ps(_mm256_and_ps(y0, absmask), _mm256_and_ps(y1, absmask)));
   __m256 m = _mm256_add_ps(_mm256_set1_ps(1.0f / 64), _mm256_mul_ps(_mm256_set1_ps(1e-5f), big));
   const int down = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC, upr = _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC;
-  __m256 lx = _mm256_max_ps(_mm256_round_ps(_mm256_sub_ps(_mm256_sub_ps(x0, half), m), upr), zero);
-  __m256 ly = _mm256_max_ps(_mm256_round_ps(_mm256_sub_ps(_mm256_sub_ps(y0, half), m), upr), zero);
-  __m256 hx = _mm256_min_ps(_mm256_round_ps(_mm256_add_ps(_mm256_sub_ps(x1, half), m), down),
+  const __m256 ox = _mm256_set1_ps(c->sx0), oy = _mm256_set1_ps(c->sy0);
+  __m256 lx = _mm256_max_ps(_mm256_round_ps(_mm256_sub_ps(_mm256_sub_ps(x0, ox), m), upr), zero);
+  __m256 ly = _mm256_max_ps(_mm256_round_ps(_mm256_sub_ps(_mm256_sub_ps(y0, oy), m), upr), zero);
+  __m256 hx = _mm256_min_ps(_mm256_round_ps(_mm256_add_ps(_mm256_sub_ps(x1, ox), m), down),
                             _mm256_set1_ps((float)(c->width - 1)));
-  __m256 hy = _mm256_min_ps(_mm256_round_ps(_mm256_add_ps(_mm256_sub_ps(y1, half), m), down),
+  __m256 hy = _mm256_min_ps(_mm256_round_ps(_mm256_add_ps(_mm256_sub_ps(y1, oy), m), down),
                             _mm256_set1_ps((float)(c->height - 1)));
   __m256 empty = _mm256_or_ps(_mm256_cmp_ps(lx, hx, _CMP_GT_OQ), _mm256_cmp_ps(ly, hy, _CMP_GT_OQ));
   int lanes = (1 << n) - 1, okm = _mm256_movemask_ps(ok) & lanes, keep = okm & ~_mm256_movemask_ps(empty);

@@ -1,4 +1,4 @@
-/* Scene storage: triangles in structure-of-arrays form, materials, bounds. */
+/* Scene storage: triangles in structure-of-arrays form, geometries, materials, bounds. */
 #include "accel/bvh.h"
 
 #include <string.h>
@@ -28,6 +28,8 @@ void rr_scene_release(rr_scene *s) {
     free(s->materials[m].texture.rgb);
   }
   free(s->materials);
+  free(s->geoms);
+  free(s->names);
   rr_bvh_release(s->bvh);
   free(s);
 }
@@ -133,6 +135,7 @@ bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n
     s->inf = calloc(s->cap, 1); /* earlier triangles are finite */
     if (!s->inf) return false;
   }
+  if (!s->ngeoms && rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, NULL) != RR_OK) return false;
   uint32_t i = s->ntris++;
   if (s->inf) s->inf[i] = (uint8_t)(inf & 7u);
   for (int k = 0; k < 3; k++) {
@@ -168,6 +171,98 @@ uint32_t rr_scene_add_material(rr_scene *s, const float color[3], const char *te
   return s->nmaterials++;
 }
 
+/* Appends name to the name pool and gives its offset (NO_NAME for NULL or ""). */
+static rr_error intern_name(rr_scene *s, const char *name, uint32_t *out) {
+  if (!name || !*name) {
+    *out = NO_NAME;
+    return RR_OK;
+  }
+  size_t len = strlen(name) + 1;
+  if (s->names_len + len >= NO_NAME)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "geometry names longer than 4 GiB in all");
+  if (s->names_len + len > s->names_cap) {
+    size_t cap = s->names_cap ? 2 * s->names_cap : 256;
+    if (cap < s->names_len + len) cap = s->names_len + len;
+    char *p = realloc(s->names, cap);
+    if (!p) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory naming a geometry");
+    s->names = p, s->names_cap = cap;
+  }
+  memcpy(s->names + s->names_len, name, len);
+  *out = (uint32_t)s->names_len;
+  s->names_len += len;
+  return RR_OK;
+}
+
+static rr_error append_geometry(rr_scene *s, scene_geometry g) {
+  if (s->ngeoms == s->geoms_cap) {
+    uint32_t cap = s->geoms_cap ? 2 * s->geoms_cap : 16;
+    scene_geometry *p = s->geoms_cap <= UINT32_MAX / 2 ? realloc(s->geoms, (size_t)cap * sizeof *p) : NULL;
+    if (!p) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for %u geometries", s->ngeoms + 1);
+    s->geoms = p, s->geoms_cap = cap;
+  }
+  s->geoms[s->ngeoms++] = g;
+  return RR_OK;
+}
+
+rr_error rr_scene_open_geometry(rr_scene *s, prim_kind kind, uint32_t material, const char *name) {
+  uint32_t off;
+  rr_error e = intern_name(s, name, &off);
+  return e ? e : append_geometry(s, (scene_geometry){s->ntris, material, kind, off});
+}
+
+rr_error rr_scene_repeat_geometry(rr_scene *s, uint32_t g, uint32_t first) {
+  scene_geometry copy = s->geoms[g]; /* by value: appending may move the table */
+  copy.first = first;
+  return append_geometry(s, copy);
+}
+
+rr_error rr_scene_name_geometry(rr_scene *s, uint32_t g, const char *name) {
+  return intern_name(s, name, &s->geoms[g].name);
+}
+
+uint32_t rr_scene_geometry_of(const rr_scene *s, uint32_t prim) {
+  if (prim >= s->ntris) return RR_MISS;
+  /* The last geometry starting at or before prim (geoms[0] starts at 0); an empty
+   * geometry starts where the next does, so the search passes over it. */
+  uint32_t lo = 0, n = s->ngeoms;
+  while (n > 1) {
+    uint32_t half = n / 2;
+    if (s->geoms[lo + half].first <= prim) lo += half;
+    n -= half;
+  }
+  return lo;
+}
+
+rr_hit rr_scene_hit(const rr_scene *s, uint32_t prim, float t, float l1, float l2) {
+  return (rr_hit){.prim = prim, .t = t, .l1 = l1, .l2 = l2,
+                  .geom = prim == RR_MISS ? RR_MISS : rr_scene_geometry_of(s, prim)};
+}
+
+const char *rr_geometry_kind_name(int kind) { return prim_kind_name(kind); }
+
+rr_error rr_scene_get_geometry(const rr_scene *s, uint32_t prim, uint32_t *geom, uint32_t *local) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  uint32_t g = rr_scene_geometry_of(s, prim);
+  if (geom) *geom = g;
+  if (local) *local = g == RR_MISS ? RR_MISS : prim - s->geoms[g].first;
+  if (g == RR_MISS && prim != RR_MISS)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_geometry: primitive %u out of range (%u in the scene)",
+                   prim, s->ntris);
+  return RR_OK;
+}
+
+rr_error rr_scene_get_geometry_info(const rr_scene *s, uint32_t geom, rr_geometry_info *info) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if (!info) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_geometry_info: info is NULL");
+  if (geom >= s->ngeoms)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_geometry_info: geometry %u out of range (%u in the scene)",
+                   geom, s->ngeoms);
+  const scene_geometry *g = &s->geoms[geom];
+  *info = (rr_geometry_info){g->kind, g->first, scene_geometry_end(s, geom) - g->first, g->material,
+                             g->name == NO_NAME ? NULL : s->names + g->name};
+  return RR_OK;
+}
+
 void rr_scene_update_bounds(rr_scene *s) {
   vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
   for (uint32_t i = 0; i < s->ntris; i++)
@@ -197,6 +292,7 @@ static rr_error add_mesh(rr_scene *s, const char *api, const float *pos, int str
   uint32_t mat = rr_scene_add_material(s, rgb ? rgb : grey, NULL);
   if (mat == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
   rr_error e = rr_scene_reserve(s, (uint32_t)ntri, false, false);
+  if (!e) e = rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, NULL);
   if (e) return e;
   for (size_t t = 0; t < ntri; t++) {
     vec3 p[3];
@@ -229,6 +325,7 @@ rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
   info->triangles = s->ntris;
   info->skipped = s->skipped;
   info->materials = s->nmaterials;
+  info->geometries = s->ngeoms;
   info->bounds_min[0] = s->bmin.x, info->bounds_min[1] = s->bmin.y, info->bounds_min[2] = s->bmin.z;
   info->bounds_max[0] = s->bmax.x, info->bounds_max[1] = s->bmax.y, info->bounds_max[2] = s->bmax.z;
   rr_bvh_fill_info(s->bvh, info);

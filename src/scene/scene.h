@@ -1,8 +1,10 @@
-/* Scene storage: triangles in structure-of-arrays form, materials and textures, bounds. */
+/* Scene storage: triangles in structure-of-arrays form, the geometries they form,
+ * materials and textures, bounds. */
 #ifndef RR_SCENE_H
 #define RR_SCENE_H
 
 #include "core/core.h"
+#include "prim/prim.h"
 
 struct rr_bvh;
 
@@ -17,6 +19,20 @@ typedef struct rr_material {
   rr_texture texture;
 } rr_material;
 
+/* A geometry: a run of primitives of one kind that a loader opened (a file's
+ * node/mesh pair, an rr_scene_add_mesh call, a built-in object). Its primitives are
+ * the global ids from `first` up to the next geometry's first (the last one's up to
+ * ntris); the geometries tile [0, ntris) in order, and an empty one (every triangle
+ * dropped) has the same first as the next. */
+typedef struct scene_geometry {
+  uint32_t first;
+  uint32_t material; /* the material of every primitive in it */
+  prim_kind kind;
+  uint32_t name; /* offset of its name in the scene's name pool, NO_NAME when none */
+} scene_geometry;
+
+#define NO_NAME UINT32_MAX
+
 /* Triangles in structure-of-arrays form: component c of vertex k of triangle i is
  * p[k][c][i]. Normals and UVs are per triangle corner and may be NULL. */
 struct rr_scene {
@@ -25,9 +41,13 @@ struct rr_scene {
   float *p[3][3];
   float *n[3][3];  /* optional vertex normals */
   float *uv[3][2]; /* optional texture coordinates */
-  uint32_t *material;
+  uint32_t *material; /* per triangle: its geometry's material, read per pixel by shading */
   rr_material *materials;
   uint32_t nmaterials;
+  scene_geometry *geoms; /* at least one once there is a triangle */
+  uint32_t ngeoms, geoms_cap;
+  char *names; /* the geometries' names, each ending in a NUL */
+  size_t names_len, names_cap;
   uint64_t skipped;
   /* Homogeneous input: bit k of inf[i] set when corner k of triangle i is a point at
    * infinity (w = 0), whose p then holds its direction; NULL when there is none. */
@@ -61,6 +81,26 @@ bool rr_scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv
 /* The same with corners at infinity (bit k of inf: p[k] is a direction); a triangle
  * with all three at infinity is dropped and counted. */
 bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, const float (*uv)[2], uint32_t mat);
+/* Opens a geometry: the primitives pushed from now on, until the next opens, are
+ * its. name may be NULL or "" (none). A push into a scene without geometries opens
+ * an unnamed one with the triangle's material. */
+rr_error rr_scene_open_geometry(rr_scene *s, prim_kind kind, uint32_t material, const char *name);
+/* Opens a geometry like g (kind, material, name) whose primitives start at `first`,
+ * for loaders that write primitives straight into the arrays (copies of a mesh);
+ * first may not be below the last geometry's. */
+rr_error rr_scene_repeat_geometry(rr_scene *s, uint32_t g, uint32_t first);
+/* Names geometry g (name NULL or "": none). */
+rr_error rr_scene_name_geometry(rr_scene *s, uint32_t g, const char *name);
+/* One past geometry g's last primitive id. */
+static inline uint32_t scene_geometry_end(const rr_scene *s, uint32_t g) {
+  return g + 1 < s->ngeoms ? s->geoms[g + 1].first : s->ntris;
+}
+/* The geometry of primitive id prim (binary search: shading asks per pixel);
+ * RR_MISS when prim is RR_MISS or out of range. */
+uint32_t rr_scene_geometry_of(const rr_scene *s, uint32_t prim);
+/* A ray query's answer for primitive prim (RR_MISS: a miss, s may then be NULL) hit
+ * at t with barycentrics l1, l2: the rr_hit with prim's geometry filled in. */
+rr_hit rr_scene_hit(const rr_scene *s, uint32_t prim, float t, float l1, float l2);
 /* Adds a material and returns its index (UINT32_MAX when out of memory). */
 uint32_t rr_scene_add_material(rr_scene *s, const float color[3], const char *texture_path);
 /* Recomputes bounds. */

@@ -224,12 +224,19 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp,
   return rr_ok(dev);
 }
 
+/* The value of an integer AOV (id, mesh, material) at a sample that saw primitive id. */
+static uint32_t id_aov(const rr_scene *s, rr_aov aov, uint32_t id) {
+  if (aov == RR_AOV_ID) return id;
+  if (id >= s->ntris) return RR_MISS;
+  return aov == RR_AOV_MESH ? rr_scene_geometry_of(s, id) : s->material[id];
+}
+
 static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cp, const rr_frame *f, rr_aov aov,
                           rr_image *out) {
   const camera c = *cp;
   const visbuf *vb = &f->vb;
   rr_error e;
-  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1};
+  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1, 1, 1};
   if ((int)aov < 0 || aov >= RR_AOV_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AOV %d", (int)aov);
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
@@ -239,13 +246,14 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cp, c
     memcpy(out->data, counts, (size_t)vb->width * vb->height * sizeof(float));
     return rr_ok(dev);
   }
-  e = image_alloc(dev, out, vb->width, vb->height, channels[aov], aov == RR_AOV_ID ? RR_PIXEL_U32 : RR_PIXEL_F32);
+  bool ints = aov == RR_AOV_ID || aov == RR_AOV_MESH || aov == RR_AOV_MATERIAL;
+  e = image_alloc(dev, out, vb->width, vb->height, channels[aov], ints ? RR_PIXEL_U32 : RR_PIXEL_F32);
   if (e) return e;
   for (int y = 0; y < vb->height; y++)
     for (int x = 0; x < vb->width; x++) {
       size_t k = (size_t)y * vb->width + x;
-      if (aov == RR_AOV_ID) {
-        ((uint32_t *)out->data)[k] = vb->id[k];
+      if (ints) {
+        ((uint32_t *)out->data)[k] = id_aov(s, aov, vb->id[k]);
         continue;
       }
       float *o = (float *)out->data + channels[aov] * k;

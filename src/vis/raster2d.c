@@ -44,6 +44,11 @@ typedef struct pipe2d {
   bool depth_is_w;   /* pinhole: t = w_c, so the vertex stage skips the depth row */
   int width, height;
   bool cull;
+  /* The kernels test samples at sub-pixel SUBPIX/2 of each pixel; the pattern's
+   * sample (sx0, sy0), snapped to sub-pixels like the vertices, is reached by
+   * moving the snapped vertices by `shift` (0 for the centre). */
+  int64_t shift_x, shift_y;
+  double sx0, sy0;
 } pipe2d;
 
 static void mat4_mul(double r[4][4], const double a[4][4], const double b[4][4]) {
@@ -90,6 +95,8 @@ static bool inverse3(const double a[3], const double b[3], const double c[3], do
 static bool pipe_setup(pipe2d *pp, const rr_scene *s, const camera *c, bool cull) {
   bool ortho = c->type == RR_CAMERA_ORTHOGRAPHIC;
   if (c->type != RR_CAMERA_PERSPECTIVE && !ortho) return false; /* curved views have no projection */
+  pp->shift_x = SUBPIX / 2 - (int64_t)lround(c->sx0 * SUBPIX), pp->shift_y = SUBPIX / 2 - (int64_t)lround(c->sy0 * SUBPIX);
+  pp->sx0 = (double)(SUBPIX / 2 - pp->shift_x) / SUBPIX, pp->sy0 = (double)(SUBPIX / 2 - pp->shift_y) / SUBPIX;
   vec3 axis[3] = {c->right, c->up, c->fwd};
   double view[4][4] = {{0}}, proj[4][4] = {{0}};
   for (int r = 0; r < 3; r++) {
@@ -248,10 +255,10 @@ static bool interpolation_planes(const pipe2d *pp, const cvert v[3], planes *pl)
   return true;
 }
 
-/* A plane re-referenced to the sample (x + 0.5, y + 0.5), where float keeps the
- * most precision for the triangle's own samples. */
-static void plane_at(const double p[3], int x, int y, float out[3]) {
-  out[0] = (float)(p[2] + p[0] * (x + 0.5) + p[1] * (y + 0.5));
+/* A plane re-referenced to the sample (sx, sy), where float keeps the most
+ * precision for the triangle's own samples. */
+static void plane_at(const double p[3], double sx, double sy, float out[3]) {
+  out[0] = (float)(p[2] + p[0] * sx + p[1] * sy);
   out[1] = (float)p[0], out[2] = (float)p[1];
 }
 
@@ -261,8 +268,8 @@ static int64_t floor_div(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a +
 static void snap(const pipe2d *pp, const cvert *c, int64_t *x, int64_t *y) {
   double iw = 1.0 / c->v[CW];
   double sx = (c->v[CX] * iw * pp->hw + pp->hw) * SUBPIX, sy = (pp->hh - c->v[CY] * iw * pp->hh) * SUBPIX;
-  *x = (int64_t)(sx >= 0 ? sx + 0.5 : sx - 0.5);
-  *y = (int64_t)(sy >= 0 ? sy + 0.5 : sy - 0.5);
+  *x = (int64_t)(sx >= 0 ? sx + 0.5 : sx - 0.5) + pp->shift_x;
+  *y = (int64_t)(sy >= 0 ? sy + 0.5 : sy - 0.5) + pp->shift_y;
 }
 
 /* Sets up the coverage of one (sub-)triangle of snapped vertices; false when it
@@ -274,7 +281,7 @@ static bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], 
   if (area == 0) return false;
   t->back = area > 0;
   if (t->back && pp->cull) return false;
-  /* The samples (x + 0.5, y + 0.5) inside the snapped vertices' bounds. */
+  /* The samples (x + 0.5, y + 0.5) inside the snapped (shifted) vertices' bounds. */
   int64_t x0 = X[0], x1 = X[0], y0 = Y[0], y1 = Y[0];
   for (int k = 1; k < 3; k++) {
     x0 = X[k] < x0 ? X[k] : x0, x1 = X[k] > x1 ? X[k] : x1;
@@ -302,11 +309,12 @@ static bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], 
 }
 
 /* Sets up the interpolation of a (sub-)triangle that covers samples. */
-static void setup_interp(tri2d *t, const planes *pl, const double depth[3], uint32_t id) {
-  plane_at(pl->w, t->rect[0], t->rect[1], t->pw);
-  plane_at(pl->t, t->rect[0], t->rect[1], t->pt);
-  plane_at(pl->l1, t->rect[0], t->rect[1], t->p1);
-  plane_at(pl->l2, t->rect[0], t->rect[1], t->p2);
+static void setup_interp(const pipe2d *pp, tri2d *t, const planes *pl, const double depth[3], uint32_t id) {
+  double sx = t->rect[0] + pp->sx0, sy = t->rect[1] + pp->sy0; /* the reference sample */
+  plane_at(pl->w, sx, sy, t->pw);
+  plane_at(pl->t, sx, sy, t->pt);
+  plane_at(pl->l1, sx, sy, t->p1);
+  plane_at(pl->l2, sx, sy, t->p2);
   /* Depth is linear on the triangle, so its range is that of the vertices. The
    * clamp also makes early-z exact: no sample of the triangle is nearer than tmin. */
   double lo = depth[0] < depth[1] ? depth[0] : depth[1], hi = depth[0] > depth[1] ? depth[0] : depth[1];
@@ -351,7 +359,7 @@ static int setup_scene_tri(const pipe2d *pp, const rr_scene *s, uint32_t i, tri2
     if (!setup_tri(pp, tx, ty, &out[m])) continue;
     if (!have_planes && !(have_planes = interpolation_planes(pp, orig, &pl))) return 0;
     double depth[3] = {poly[cur][0].v[CT], poly[cur][k].v[CT], poly[cur][k + 1].v[CT]};
-    setup_interp(&out[m++], &pl, depth, i);
+    setup_interp(pp, &out[m++], &pl, depth, i);
   }
   return m;
 }

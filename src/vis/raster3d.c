@@ -7,10 +7,10 @@ static inline uint64_t raster_loop(const tri_setup *ts, uint32_t id, const int r
                                    const bool planar) {
   uint64_t covered = 0;
   for (int y = r[1]; y <= r[3]; y++) {
-    float sy = (float)y + 0.5f;
+    float sy = (float)y + c->sy0;
     size_t row = (size_t)y * vb->width;
     for (int x = r[0]; x <= r[2]; x++) {
-      float sx = (float)x + 0.5f;
+      float sx = (float)x + c->sx0;
       vec3 w = planar ? v3(1.0f, sx, sy) : c->dirs[row + x];
       covered += shade_sample_w(ts, id, w, sx, sy, vb, row + x) != 0;
     }
@@ -25,7 +25,7 @@ static inline uint64_t raster_loop(const tri_setup *ts, uint32_t id, const int r
  * is the scalar one, in the same order, on IEEE single floats (no FMA, a true
  * division), so the bits are those of raster_loop: the same sample test. */
 __attribute__((target("avx2"))) static uint64_t raster_loop_avx2(const tri_setup *ts, uint32_t id, const int r[4],
-                                                                  visbuf *vb) {
+                                                                  float sx0, float sy0, visbuf *vb) {
   __m256 a[3], b[3], c[3], tie[3];
   for (int e = 0; e < 3; e++) {
     a[e] = _mm256_set1_ps(ts->a[e]), b[e] = _mm256_set1_ps(ts->b[e]), c[e] = _mm256_set1_ps(ts->c[e]);
@@ -41,12 +41,12 @@ __attribute__((target("avx2"))) static uint64_t raster_loop_avx2(const tri_setup
   for (int x = r[0]; x <= r[2]; x += 8) {
     __m256i xi = _mm256_add_epi32(_mm256_set1_epi32(x), lane);
     const __m256 valid = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(r[2] + 1), xi));
-    const __m256 sx = _mm256_add_ps(_mm256_cvtepi32_ps(xi), _mm256_set1_ps(0.5f));
+    const __m256 sx = _mm256_add_ps(_mm256_cvtepi32_ps(xi), _mm256_set1_ps(sx0));
     __m256 ax[3];
     for (int e = 0; e < 3; e++) ax[e] = _mm256_add_ps(_mm256_mul_ps(a[e], one), _mm256_mul_ps(b[e], sx));
     const __m256 vx = _mm256_add_ps(vol, _mm256_mul_ps(sx, vol_x));
     for (int y = r[1]; y <= r[3]; y++) {
-      const __m256 sy = _mm256_set1_ps((float)y + 0.5f);
+      const __m256 sy = _mm256_set1_ps((float)y + sy0);
       size_t row = (size_t)y * vb->width;
       __m256 ev[3], in = valid;
       for (int e = 0; e < 3; e++) {
@@ -91,7 +91,7 @@ uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const 
 #if defined(__x86_64__) || defined(__i386__)
   /* a rectangle of a few samples (most triangles of a detailed mesh) costs less
    * than the vector loop's setup; both paths give the same bits */
-  if (simd && c->planar && samples > 2 && __builtin_cpu_supports("avx2")) n = raster_loop_avx2(ts, id, r, vb);
+  if (simd && c->planar && samples > 2 && __builtin_cpu_supports("avx2")) n = raster_loop_avx2(ts, id, r, c->sx0, c->sy0, vb);
   else
 #endif
     n = c->planar ? raster_loop(ts, id, r, c, vb, true) : raster_loop(ts, id, r, c, vb, false);

@@ -80,12 +80,12 @@ static rr_error query_begin(rr_device *dev, const char *fn, const rr_scene *s, c
 }
 
 rr_error rr_intersect(rr_device *dev, const rr_scene *scene, const rr_ray *ray, rr_hit *hit) {
-  if (hit) *hit = (rr_hit){RR_MISS, INFINITY, 0, 0};
+  if (hit) *hit = rr_scene_hit(scene, RR_MISS, INFINITY, 0, 0);
   query_ray r;
   rr_error e = query_begin(dev, "rr_intersect", scene, ray, hit, &r);
   if (e) return e;
   if (r.b) bvh_trace(r.b, &r, 1, query_node, query_leaf_closest, query_best);
-  if (r.id != RR_MISS) *hit = (rr_hit){r.id, r.t, r.l1, r.l2};
+  if (r.id != RR_MISS) *hit = rr_scene_hit(scene, r.id, r.t, r.l1, r.l2);
   return rr_ok(dev);
 }
 

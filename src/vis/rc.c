@@ -13,11 +13,12 @@ typedef struct {
 static void rc_row(int y, int thread, void *arg) {
   rc_job *job = arg;
   visbuf *vb = job->ctx->vb;
-  float sy = (float)y + 0.5f;
+  const camera *c = job->ctx->cam;
+  float sy = (float)y + c->sy0;
   for (int x = 0; x < vb->width; x++) {
     size_t k = (size_t)y * vb->width + x;
-    float sx = (float)x + 0.5f;
-    vec3 w = camera_w(job->ctx->cam, x, y);
+    float sx = (float)x + c->sx0;
+    vec3 w = camera_w(c, x, y);
     for (uint32_t j = 0; j < job->n; j++) shade_sample_w(&job->setup[j], job->ids[j], w, sx, sy, vb, k);
   }
   if (job->ctx->heat_e)

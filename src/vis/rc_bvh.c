@@ -255,7 +255,7 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
       for (int k = 0; k < 16; k++) {
         int x = bx + (k & 3), y = by + (k >> 2);
         if (x >= x1 || y >= y1) continue;
-        r.sx = (float)x + 0.5f, r.sy = (float)y + 0.5f;
+        r.sx = (float)x + c->sx0, r.sy = (float)y + c->sy0;
         r.t = INFINITY, r.id = RR_MISS, r.l1 = r.l2 = 0;
         r.w = camera_w(c, x, y);
         vec3 o, d;
@@ -336,7 +336,7 @@ KERNEL bool packet_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes)
     for (; in; in &= in - 1) {
       int k = __builtin_ctzll(in);
       p->heat_e[k] += 1;
-      float sx = (float)(p->x0 + (k & 7)) + 0.5f, sy = (float)(p->y0 + (k >> 3)) + 0.5f;
+      float sx = (float)(p->x0 + (k & 7)) + fs->cam->sx0, sy = (float)(p->y0 + (k >> 3)) + fs->cam->sy0;
       shade_sample_w(&lt->ts, lt->id, v3(1.0f, sx, sy), sx, sy, &pvb, k);
     }
   }
@@ -357,7 +357,7 @@ static void rc_packet_tile(int job, int thread, void *arg) {
     for (int px = tx0; px < tx0 + TILE && px < vb->width; px += PK) {
       p->x0 = px, p->y0 = py, p->valid = 0, p->maxbest = INFINITY;
       float cx[PK], cy[PK];
-      for (int k = 0; k < PK; k++) cx[k] = (float)(px + k) + 0.5f, cy[k] = (float)(py + k) + 0.5f;
+      for (int k = 0; k < PK; k++) cx[k] = (float)(px + k) + j->ctx->cam->sx0, cy[k] = (float)(py + k) + j->ctx->cam->sy0;
       p->sx[0] = rr_vf4_load(cx), p->sx[1] = rr_vf4_load(cx + 4);
       p->sy[0] = rr_vf4_load(cy), p->sy[1] = rr_vf4_load(cy + 4);
       for (int k = 0; k < PN; k++) {
@@ -381,18 +381,19 @@ static void rc_packet_tile(int job, int thread, void *arg) {
 static void loose_band(int band, int thread, void *arg) {
   frame_job *j = arg;
   visbuf *vb = j->ctx->vb;
+  const camera *c = j->ctx->cam;
   int y0 = band * j->band_rows, y1 = y0 + j->band_rows < vb->height ? y0 + j->band_rows : vb->height;
   uint64_t e = 0;
   for (uint32_t q = 0; q < j->fs.nloose; q++) {
     const float *r = j->fs.trect[j->fs.loose_pos[q]];
     const leaf_tri *lt = &j->fs.loose_ts[q];
-    /* Samples x + 0.5 in [r0, r2]: x from ceil(r0 - 0.5) to floor(r2 - 0.5), clipped. */
-    float fx0 = fmaxf(ceilf(r[0] - 0.5f), 0), fx1 = fminf(floorf(r[2] - 0.5f), (float)(vb->width - 1));
-    float fy0 = fmaxf(ceilf(r[1] - 0.5f), (float)y0), fy1 = fminf(floorf(r[3] - 0.5f), (float)(y1 - 1));
+    /* Samples x + sx0 in [r0, r2]: x from ceil(r0 - sx0) to floor(r2 - sx0), clipped. */
+    float fx0 = fmaxf(ceilf(r[0] - c->sx0), 0), fx1 = fminf(floorf(r[2] - c->sx0), (float)(vb->width - 1));
+    float fy0 = fmaxf(ceilf(r[1] - c->sy0), (float)y0), fy1 = fminf(floorf(r[3] - c->sy0), (float)(y1 - 1));
     if (!(fx0 <= fx1 && fy0 <= fy1)) continue;
     for (int y = (int)fy0; y <= (int)fy1; y++)
       for (int x = (int)fx0; x <= (int)fx1; x++) {
-        float sx = (float)x + 0.5f, sy = (float)y + 0.5f;
+        float sx = (float)x + c->sx0, sy = (float)y + c->sy0;
         size_t k = (size_t)y * vb->width + x;
         shade_sample_w(&lt->ts, lt->id, v3(1.0f, sx, sy), sx, sy, vb, k);
         e++;

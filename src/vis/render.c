@@ -90,7 +90,8 @@ int rr_shade_from_name(const char *name) {
 }
 
 int rr_aov_from_name(const char *name) {
-  static const char *const names[RR_AOV_COUNT] = {"depth", "id", "normal", "bary", "evals", "nodes"};
+  static const char *const names[RR_AOV_COUNT] = {"depth", "id", "normal", "bary",
+                                                  "evals", "nodes", "mesh", "material"};
   return name_index(names, RR_AOV_COUNT, name);
 }
 
@@ -98,7 +99,8 @@ int rr_aov_from_name(const char *name) {
 
 void rr_render_options_init(rr_render_options *opt) {
   if (!opt) return;
-  *opt = (rr_render_options){.method = RR_METHOD_3DR_BB, .width = 1024, .height = 768, .threads = 0};
+  *opt = (rr_render_options){.method = RR_METHOD_3DR_BB, .width = 1024, .height = 768, .threads = 0, .samples = 1};
+  opt->sample_pos[0][0] = opt->sample_pos[0][1] = 0.5f;
 }
 
 static void visbuf_free(visbuf *vb) {
@@ -106,8 +108,9 @@ static void visbuf_free(visbuf *vb) {
   memset(vb, 0, sizeof *vb);
 }
 
-static bool visbuf_alloc(visbuf *vb, int w, int h) {
-  size_t n = (size_t)w * h;
+/* A buffer of `samples` layers of w × h (vb->width and height are those of one layer). */
+static bool visbuf_alloc(visbuf *vb, int w, int h, int samples) {
+  size_t n = (size_t)w * h * samples;
   vb->width = w, vb->height = h;
   vb->id = malloc(n * sizeof *vb->id);
   vb->t = malloc(n * sizeof *vb->t);
@@ -220,18 +223,27 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                    "method '%s' projects onto a plane and cannot render a %s camera; the 3D methods can (rc, rc-bvh, "
                    "rc-packet, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full)",
                    methods[opt->method].name, rr_camera_name(cam->type));
+  if (opt->samples < 1 || opt->samples > RR_MAX_SAMPLES)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad sample count %d (1..%d per pixel)", opt->samples, RR_MAX_SAMPLES);
+  for (int s = 0; s < opt->samples; s++) { /* every position, before any work */
+    const float *p = opt->sample_pos[s];
+    if (!(p[0] >= 0.0f && p[0] < 1.0f && p[1] >= 0.0f && p[1] < 1.0f))
+      return rr_fail(dev, RR_ERROR_ARGUMENT, "bad position (%g, %g) of sample %d (each in [0, 1))", (double)p[0],
+                     (double)p[1], s);
+  }
   camera c;
-  rr_error e = rr_cam_setup(dev, cam, opt->width, opt->height, &c);
+  rr_error e = rr_cam_setup_at(dev, cam, opt->width, opt->height, opt->sample_pos[0], &c);
   if (e) return e;
   rr_frame *f = calloc(1, sizeof *f);
   size_t npix = (size_t)opt->width * opt->height;
-  if (!f || !visbuf_alloc(&f->vb, opt->width, opt->height) ||
+  if (!f || !visbuf_alloc(&f->vb, opt->width, opt->height, opt->samples) ||
       (opt->heat && (!(f->heat_e = calloc(npix, sizeof(float))) || !(f->heat_n = calloc(npix, sizeof(float)))))) {
     rr_frame_release(f);
     rr_cam_release(&c);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d visibility buffer", opt->width, opt->height);
   }
   f->method = opt->method;
+  f->samples = opt->samples;
   render_ctx ctx = {.scene = scene,
                     .cam = &c,
                     .opt = opt,
@@ -244,7 +256,19 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   f->stats.threads = ctx.threads;
   f->stats.method = opt->method;
   double t0 = rr_now_ms(), c0 = rr_cpu_ms();
-  e = methods[opt->method].fn(dev, &ctx);
+  /* A pattern of N samples is N passes of the method, each with the camera of one
+   * position writing its own layer: every method and camera takes the positions
+   * as data. (A triangle is set up once per pass: S grows with N.) */
+  for (int s = 0; s < opt->samples && !e; s++) {
+    if (s > 0) {
+      rr_cam_release(&c);
+      if ((e = rr_cam_setup_at(dev, cam, opt->width, opt->height, opt->sample_pos[s], &c))) break;
+    }
+    visbuf layer = {opt->width, opt->height, f->vb.id + s * npix, f->vb.t + s * npix, f->vb.l1 + s * npix,
+                    f->vb.l2 + s * npix};
+    ctx.vb = &layer;
+    e = methods[opt->method].fn(dev, &ctx);
+  }
   f->stats.frame_ms = rr_now_ms() - t0, f->stats.cpu_ms = rr_cpu_ms() - c0;
   rr_cam_release(&c);
   if (e) {
@@ -271,6 +295,12 @@ rr_error rr_frame_get_stats(const rr_frame *f, rr_stats *stats) {
 rr_error rr_frame_get_size(const rr_frame *f, int *w, int *h) {
   if (!f || !w || !h) return RR_ERROR_ARGUMENT;
   *w = f->vb.width, *h = f->vb.height;
+  return RR_OK;
+}
+
+rr_error rr_frame_get_samples(const rr_frame *f, int *samples) {
+  if (!f || !samples) return RR_ERROR_ARGUMENT;
+  *samples = f->samples;
   return RR_OK;
 }
 

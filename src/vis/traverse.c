@@ -125,7 +125,9 @@ static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
       }
       bool out = false;
       if (t->c->planar) {
-        float xs[2] = {b.x0 + 0.5f, b.x1 - 0.5f}, ys[2] = {b.y0 + 0.5f, b.y1 - 0.5f};
+        /* the bin's corner samples */
+        float xs[2] = {(float)b.x0 + t->c->sx0, (float)(b.x1 - 1) + t->c->sx0};
+        float ys[2] = {(float)b.y0 + t->c->sy0, (float)(b.y1 - 1) + t->c->sy0};
         for (int e = 0; e < 3 && !out; e++) {
           bool all_out = true;
           for (int k = 0; k < 4 && all_out; k++)

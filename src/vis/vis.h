@@ -20,7 +20,7 @@ static inline bool depth_wins(float t, uint32_t id, float best_t, uint32_t best_
 /* Tests one set-up triangle at pixel k, whose sample is (sx, sy) with evaluation
  * vector w, and keeps it when it is nearer. Returns 0 when the triangle does not
  * cover the sample, 1 when it covers it behind what is stored, 2 when it is kept. */
-static inline int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, float sy, visbuf *vb,
+KERNEL int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, float sy, visbuf *vb,
                                  size_t k) {
   float e[3], t, l1, l2;
   tri_edges_w(ts, w, e);
@@ -34,7 +34,7 @@ static inline int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float
 }
 
 /* The same for a planar camera's sample (sx, sy). */
-static inline int shade_sample(const tri_setup *ts, uint32_t id, float sx, float sy, visbuf *vb, size_t k) {
+KERNEL int shade_sample(const tri_setup *ts, uint32_t id, float sx, float sy, visbuf *vb, size_t k) {
   return shade_sample_w(ts, id, v3(1.0f, sx, sy), sx, sy, vb, k);
 }
 
@@ -43,6 +43,7 @@ struct rr_frame {
   float *heat_e, *heat_n; /* per-pixel E and N, when options.heat was set */
   rr_stats stats;
   rr_method method;
+  int samples; /* vb holds this many layers of vb.width × vb.height */
 };
 
 /* A pass of a method: fills vb (cleared to misses) and adds to stats. */

@@ -1,0 +1,153 @@
+/* Sample positions are data: a pattern of N positions inside the pixel gives N
+ * layers of the visibility buffer, and every method and camera takes the
+ * positions as they are. The 3D methods and ray casters stay bit-identical at any
+ * position; a layer is the frame of one sample at that position; positions mean
+ * what they say (a 2x2 grid in W×H is the centre of 2W×2H); the 2D pipeline, which
+ * snaps positions to 1/256 pixel like its vertices, agrees with them. */
+#include "testutil.h"
+
+#include <string.h>
+
+/* Rotated-grid positions, none at the centre. */
+static const float rgss[4][2] = {{0.375f, 0.125f}, {0.875f, 0.375f}, {0.125f, 0.625f}, {0.625f, 0.875f}};
+
+static rr_render_options pattern_options(rr_method m, int w, int h, int n, const float (*pos)[2]) {
+  rr_render_options o;
+  rr_render_options_init(&o);
+  o.method = m, o.width = w, o.height = h, o.threads = 2, o.samples = n;
+  memcpy(o.sample_pos, pos, (size_t)n * sizeof o.sample_pos[0]);
+  return o;
+}
+
+/* Every exact method against rc-bvh over all layers, and each layer against a
+ * one-sample frame at its position. */
+static void check_methods(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h, const char *what) {
+  bool planar = cam->type == RR_CAMERA_PERSPECTIVE || cam->type == RR_CAMERA_ORTHOGRAPHIC;
+  rr_render_options o = pattern_options(RR_METHOD_RC_BVH, w, h, 4, rgss);
+  rr_frame *ref = test_render_opt(dev, s, cam, &o);
+  if (!ref) return;
+  CHECK(ref->samples == 4, "%s: %d layers", what, ref->samples);
+  CHECK(test_frame_hits(ref) > 0, "%s: the view hits nothing", what);
+  /* rc, the slow reference, is held to rc-bvh by test_equivalence */
+  const rr_method ms[] = {RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
+                          RR_METHOD_3DR_FC, RR_METHOD_3DR_FS, RR_METHOD_3DR_FULL};
+  for (size_t i = 0; i < sizeof ms / sizeof ms[0]; i++) {
+    if (ms[i] == RR_METHOD_RC_PACKET && !planar) continue;
+    o.method = ms[i];
+    rr_frame *f = test_render_opt(dev, s, cam, &o);
+    if (!f) continue;
+    int d = test_frames_differ(ref, f);
+    CHECK(d == 0, "%s: %s differs from rc-bvh in %d of %d samples", what, rr_method_name(ms[i]), d, 4 * w * h);
+    rr_frame_release(f);
+  }
+  size_t npix = (size_t)w * h;
+  for (int k = 0; k < 4; k++) {
+    rr_render_options one = pattern_options(RR_METHOD_3DR_BIN, w, h, 1, &rgss[k]);
+    rr_frame *f = test_render_opt(dev, s, cam, &one);
+    if (!f) continue;
+    bool same = memcmp(f->vb.id, ref->vb.id + k * npix, npix * 4) == 0 &&
+                memcmp(f->vb.t, ref->vb.t + k * npix, npix * 4) == 0 &&
+                memcmp(f->vb.l1, ref->vb.l1 + k * npix, npix * 4) == 0;
+    CHECK(same, "%s: layer %d is not the frame of one sample at (%g, %g)", what, k, rgss[k][0], rgss[k][1]);
+    rr_frame_release(f);
+  }
+  rr_frame_release(ref);
+}
+
+/* A 2x2 grid of W×H samples is the centre grid of 2W×2H: the same rays up to
+ * rounding of the directions, so nearly every id agrees. */
+static void check_positions(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h) {
+  const float grid[4][2] = {{0.25f, 0.25f}, {0.75f, 0.25f}, {0.25f, 0.75f}, {0.75f, 0.75f}};
+  rr_render_options o = pattern_options(RR_METHOD_3DR_BB, w, h, 4, grid);
+  rr_frame *a = test_render_opt(dev, s, cam, &o);
+  rr_render_options big = pattern_options(RR_METHOD_3DR_BB, 2 * w, 2 * h, 1, grid);
+  big.sample_pos[0][0] = big.sample_pos[0][1] = 0.5f;
+  rr_frame *b = test_render_opt(dev, s, cam, &big);
+  rr_render_options mid = pattern_options(RR_METHOD_3DR_BB, w, h, 1, grid);
+  mid.sample_pos[0][0] = mid.sample_pos[0][1] = 0.5f;
+  rr_frame *c = test_render_opt(dev, s, cam, &mid);
+  if (a && b && c) {
+    int agree = 0, moved = 0, n = 4 * w * h;
+    for (int k = 0; k < 4; k++)
+      for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+          uint32_t id = a->vb.id[(size_t)k * w * h + (size_t)y * w + x];
+          agree += id == b->vb.id[(size_t)(2 * y + k / 2) * 2 * w + 2 * x + k % 2];
+          moved += id != c->vb.id[(size_t)y * w + x];
+        }
+    CHECK(agree >= n * 99 / 100, "2x2 grid vs centres of the doubled image: %d of %d ids agree", agree, n);
+    CHECK(moved > 0, "the grid's samples see the same ids as the centre everywhere: positions unused?");
+    printf("2x2 grid: %d of %d ids as in the doubled image; %d differ from the centre\n", agree, n, moved);
+  }
+  rr_frame_release(a), rr_frame_release(b), rr_frame_release(c);
+}
+
+/* The 2D pipeline at the same positions agrees with 3D rasterization on ids. */
+static void check_2d(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h) {
+  rr_render_options o = pattern_options(RR_METHOD_3DR_BB, w, h, 4, rgss);
+  rr_frame *a = test_render_opt(dev, s, cam, &o);
+  o.method = RR_METHOD_2DR_BIN;
+  rr_frame *b = test_render_opt(dev, s, cam, &o);
+  if (a && b) {
+    int n = 4 * w * h, agree = 0;
+    for (int k = 0; k < n; k++) agree += a->vb.id[k] == b->vb.id[k];
+    CHECK(agree >= n * 995 / 1000, "2dr-bin agrees with 3dr-bb on %d of %d ids", agree, n);
+  }
+  rr_frame_release(a), rr_frame_release(b);
+}
+
+static void check_bad(rr_device *dev, const rr_scene *s, const rr_camera *cam) {
+  rr_render_options o = pattern_options(RR_METHOD_3DR_BB, 8, 8, 4, rgss);
+  const float bad[][2] = {{1.0f, 0.5f}, {-0.1f, 0.5f}, {0.5f, NAN}, {0.5f, INFINITY}};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    rr_render_options b = o;
+    b.sample_pos[3][0] = bad[i][0], b.sample_pos[3][1] = bad[i][1];
+    rr_frame *f = (rr_frame *)1;
+    CHECK(rr_render(dev, s, cam, &b, &f) == RR_ERROR_ARGUMENT && f == NULL, "position (%g, %g) accepted",
+          (double)bad[i][0], (double)bad[i][1]);
+  }
+  const int counts[] = {0, -1, RR_MAX_SAMPLES + 1};
+  for (size_t i = 0; i < sizeof counts / sizeof counts[0]; i++) {
+    rr_render_options b = o;
+    b.samples = counts[i];
+    rr_frame *f = (rr_frame *)1;
+    CHECK(rr_render(dev, s, cam, &b, &f) == RR_ERROR_ARGUMENT && f == NULL, "%d samples accepted", counts[i]);
+  }
+  rr_render_options d;
+  rr_render_options_init(&d);
+  CHECK(d.samples == 1 && d.sample_pos[0][0] == 0.5f && d.sample_pos[0][1] == 0.5f, "default: one centre sample");
+}
+
+int main(void) {
+  rr_device *dev = rr_device_new();
+  rr_scene *s = NULL;
+  const char *bunny = test_model("stanford-bunny.obj");
+  if (rr_scene_load(dev, bunny && !test_quick() ? bunny : "demo", &s) != RR_OK) {
+    CHECK(0, "load: %s", rr_device_message(dev));
+    return test_done();
+  }
+  for (int type = 0; type < RR_CAMERA_COUNT; type++) {
+    rr_camera cam;
+    rr_camera_init(&cam);
+    rr_camera_frame(dev, s, 64, 48, &cam);
+    cam.type = (rr_camera_type)type;
+    if (type >= RR_CAMERA_PARABOLIC) { /* from inside, looking around */
+      float c[3];
+      for (int a = 0; a < 3; a++) c[a] = 0.5f * (v3_get(s->bmin, a) + v3_get(s->bmax, a));
+      memcpy(cam.eye, c, sizeof c);
+      cam.target[0] = c[0] + 1, cam.target[1] = c[1], cam.target[2] = c[2];
+      cam.fov_deg = 200;
+    }
+    bool curved = type >= RR_CAMERA_PARABOLIC; /* exact but slow: smaller images */
+    check_methods(dev, s, &cam, curved ? 32 : 64, curved ? 24 : 48, rr_camera_name(type));
+  }
+  rr_camera cam;
+  rr_camera_init(&cam);
+  rr_camera_frame(dev, s, 96, 72, &cam);
+  check_positions(dev, s, &cam, 96, 72);
+  check_2d(dev, s, &cam, 96, 72);
+  check_bad(dev, s, &cam);
+  rr_scene_release(s);
+  rr_device_release(dev);
+  return test_done();
+}
