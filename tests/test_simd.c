@@ -138,8 +138,10 @@ static void check_raster(const rr_scene *s, const camera *c, const char *what) {
     for (int simd = 0; simd < 2; simd++) evals[simd] += rr_raster_rect(&ts, id, r, c, &vb[simd], &covered[simd], simd);
     drawn++;
   }
-  bool same = memcmp(vb[0].id, vb[1].id, n * sizeof(uint32_t)) == 0 && memcmp(vb[0].t, vb[1].t, n * sizeof(float)) == 0 &&
-              memcmp(vb[0].l1, vb[1].l1, n * sizeof(float)) == 0 && memcmp(vb[0].l2, vb[1].l2, n * sizeof(float)) == 0;
+  bool same = memcmp(vb[0].id, vb[1].id, n * sizeof(uint32_t)) == 0;
+  same = same && memcmp(vb[0].t, vb[1].t, n * sizeof(float)) == 0;
+  same = same && memcmp(vb[0].l1, vb[1].l1, n * sizeof(float)) == 0;
+  same = same && memcmp(vb[0].l2, vb[1].l2, n * sizeof(float)) == 0;
   CHECK(same && evals[0] == evals[1] && covered[0] == covered[1],
         "%s: the AVX2 sample loop differs from the plain one (%llu vs %llu covered)", what,
         (unsigned long long)covered[1], (unsigned long long)covered[0]);

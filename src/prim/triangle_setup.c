@@ -27,11 +27,16 @@
  * w[i+1]·q[i+2]), in the same canonical order), and the volume V(o) = V − o·Σ w_i n_i;
  * the face is the sign of d·Σ w_i n_i.
  *
+ * The edge functions for the camera's w (triangle.h), after the normals are
+ * turned to face the inside: perspective a, b, c = n·d0, n·dx, n·dy (eq. 3);
+ * orthographic a = n·d + m·o0, b = m·ox, c = m·oy; curved (a, b, c) = n.
+ *
  * The top-left rule: a sample on an edge belongs to the triangle whose inside lies
  * to its right (V_i,x > 0), or below for a horizontal edge (V_i,y > 0). Exactly one
  * of n and −n is positive in the lexicographic order of (g1, g2, g3), the edge's
- * screen derivatives and its value along the view direction, so the two triangles
- * of a shared edge never both own, nor both refuse, its samples. */
+ * screen derivatives (b and c; n·right and −n·up for curved views) and its value
+ * along the view direction, so the two triangles of a shared edge never both own,
+ * nor both refuse, its samples. */
 #define W 1
 #define TARGET
 #include "prim/triangle_setup_tmp.h"

@@ -2,10 +2,10 @@
  * triangle_setup.c includes once per width, with W and TARGET defined.
  *
  * Triangles ids[0..count-1] (count <= W; the padding lanes repeat the last one)
- * into out[l] and face[l], for any camera and any corners at infinity: the
- * operations of the scalar formulation (comments in triangle_setup.c) in the
- * same order, lane by lane, so every width gives the same bits. A culled
- * triangle's out[l] is not written. */
+ * into out[l] and face[l], for any camera and any corners at infinity, as
+ * triangle_setup.c describes it. Lanes hold one triangle each and never mix, and
+ * the operations are IEEE single floats in a fixed order (no FMA), so every width
+ * gives the same bits. A culled triangle's out[l] is not written. */
 #define VF RR_VF(W)
 #define VI RR_VI(W)
 #define VF_(op) RR_VF_OP(W, op)
@@ -24,7 +24,8 @@ typedef struct {
 #define DOT3(a, b) ((a).x * (b).x + (a).y * (b).y + (a).z * (b).z)
 #define CROSS3(a, b) \
   ((V3){(a).y * (b).z - (a).z * (b).y, (a).z * (b).x - (a).x * (b).z, (a).x * (b).y - (a).y * (b).x})
-#define SELECT3(m, a, b) ((V3){VF_(select)(m, (a).x, (b).x), VF_(select)(m, (a).y, (b).y), VF_(select)(m, (a).z, (b).z)})
+#define SELECT3(m, a, b) \
+  ((V3){VF_(select)(m, (a).x, (b).x), VF_(select)(m, (a).y, (b).y), VF_(select)(m, (a).z, (b).z)})
 /* lex_less(a, b) and lex_positive(g1, g2, g3) as masks, with the scalar comparisons' NaN behaviour */
 #define LEX_LESS3(a, b) \
   VI_(select)((a).x != (b).x, (a).x < (b).x, VI_(select)((a).y != (b).y, (a).y < (b).y, (a).z < (b).z))

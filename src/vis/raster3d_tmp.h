@@ -41,9 +41,9 @@ TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32
     for (int y = r[1]; y <= r[3]; y++) {
       const VF sy = VF_(splat)((float)y + c->sy0);
       const size_t k = (size_t)y * width + (size_t)x;
-      VF wx, wy, wz; /* curved: the camera's ray direction per sample */
+      VF wx = zero, wy = zero, wz = zero; /* curved: the camera's ray direction per sample */
       if (!planar)
-        for (int l = 0; l < W; l++) {
+        for (int l = 0; l < W; l++) { /* (lanes past r[2] read the first one's) */
           vec3 d = c->dirs[k + (size_t)(x + l <= r[2] ? l : 0)];
           wx[l] = d.x, wy[l] = d.y, wz[l] = d.z;
         }
