@@ -15,10 +15,8 @@
 TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
                                                        const camera *c, tri_bound *out) {
   int32_t lane_id[W], lane_inf[W] = {0};
-  for (int l = 0; l < W; l++) {
-    int k = l < n ? l : n - 1;
-    lane_id[l] = (int32_t)(ids ? ids[k] : first + (uint32_t)k);
-  }
+  for (int l = 0; l < W; l++)
+    lane_id[l] = (int32_t)(ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1));
   if (s->inf)
     for (int l = 0; l < W; l++) lane_inf[l] = s->inf[lane_id[l]];
   const VI idx = VI_(load)(lane_id), inf = VI_(load)(lane_inf);
