@@ -1,13 +1,17 @@
-/* The AVX2 kernels that work on eight triangles at once (corner bounds, triangle
- * setup) against their scalar definitions, byte for byte: random triangles,
- * triangles sharing edges and vertices (the canonical edge order's ties), equal
- * coordinates, corners behind the eye, tiny and huge coordinates, perspective and
- * orthographic cameras (the setup's AVX2 path is perspective only). The sample loop's AVX2
- * path is compared with the scalar one through whole frames in test_continuum. */
+/* The kernel templates' AVX2 instances (eight lanes) against their plain ones
+ * (one lane), byte for byte: the corner bounds, the triangle setup and the sample
+ * loop. Random triangles, triangles sharing edges and vertices (the canonical edge
+ * order's ties), equal coordinates, corners behind the eye and at infinity, tiny
+ * and huge coordinates, perspective and orthographic cameras, backface culling,
+ * unaligned runs, id lists of every length (padded lanes) and rectangles whose
+ * width is no multiple of eight. The sample loop is also compared through whole
+ * frames in test_continuum. */
 #include "vis/vis.h"
+#include "core/simd.h"
 #include "io/io.h"
 #include "testutil.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 enum { N = 4000 };
@@ -18,10 +22,11 @@ static vec3 vertex(int kind, float scale) {
   return v3(test_randf(-scale, scale), test_randf(-scale, scale), test_randf(-scale, scale));
 }
 
-static rr_scene *random_scene(rr_device *dev, float scale) {
+/* with_inf: some corners at infinity (w = 0: xyz is a direction) */
+static rr_scene *random_scene(rr_device *dev, float scale, bool with_inf) {
   rr_scene *s;
   rr_scene_new(dev, &s);
-  static float pos[N * 9];
+  static float pos[N * 9], pos4[N * 12];
   static uint32_t idx[N * 3];
   for (int t = 0; t < N; t++) {
     int kind = t % 3;
@@ -37,7 +42,16 @@ static rr_scene *random_scene(rr_device *dev, float scale) {
       memcpy(&pos[t * 9 + 3], &pos[(t - 1) * 9], 3 * sizeof(float));
     }
   }
-  CHECK(rr_scene_add_mesh(s, pos, N * 3, idx, N, NULL) == RR_OK, "add_mesh: %s", rr_device_message(dev));
+  if (!with_inf) {
+    CHECK(rr_scene_add_mesh(s, pos, N * 3, idx, N, NULL) == RR_OK, "add_mesh: %s", rr_device_message(dev));
+    return s;
+  }
+  for (int v = 0; v < N * 3; v++) {
+    memcpy(&pos4[v * 4], &pos[v * 3], 3 * sizeof(float));
+    pos4[v * 4 + 3] = v % 5 == 2 || v % 13 == 4 ? 0.0f : 1.0f;
+  }
+  CHECK(rr_scene_add_mesh4(s, pos4, N * 3, idx, N, NULL) == RR_OK, "add_mesh4: %s", rr_device_message(dev));
+  CHECK(s->inf, "corners at infinity");
   return s;
 }
 
@@ -92,24 +106,75 @@ static void check_setup(const rr_scene *s, const camera *c, bool cull, const cha
   CHECK(culled < n && (!cull || culled > 0), "%s: %d of %d culled (the case mix is not exercised)", what, culled, n);
 }
 
+/* The sample loop over rectangles of set-up triangles into two visibility
+ * buffers, one lane and eight at a time; the buffers start with random depths
+ * and ids, so the depth test's ties (equal t, lower id) are met too. */
+static void check_raster(const rr_scene *s, const camera *c, const char *what) {
+  enum { TRIS = 300 };
+  int w = c->width, h = c->height;
+  size_t n = (size_t)w * h;
+  visbuf vb[2];
+  for (int k = 0; k < 2; k++) {
+    vb[k] = (visbuf){w, h, malloc(n * sizeof(uint32_t)), malloc(n * sizeof(float)), calloc(n, sizeof(float)),
+                     calloc(n, sizeof(float))};
+    CHECK(vb[k].id && vb[k].t && vb[k].l1 && vb[k].l2, "out of memory");
+    if (!vb[k].id || !vb[k].t || !vb[k].l1 || !vb[k].l2) return;
+  }
+  for (size_t k = 0; k < n; k++) {
+    vb[0].id[k] = vb[1].id[k] = test_rand() % 4 ? RR_MISS : test_rand() % s->ntris;
+    vb[0].t[k] = vb[1].t[k] = test_rand() % 4 ? INFINITY : test_randf(0.0f, 2.0f);
+  }
+  uint64_t evals[2] = {0, 0}, covered[2] = {0, 0};
+  int drawn = 0;
+  for (int k = 0; k < TRIS; k++) {
+    uint32_t id = test_rand() % s->ntris;
+    tri_setup ts;
+    int r[4];
+    if (rr_tri_setup(s, id, c, false, &ts) == SETUP_CULLED || !rr_tri_screen_bounds(s, id, c, &ts, r)) continue;
+    /* the triangle's rectangle, or a random one (samples outside it too) */
+    if (k % 3 == 0) {
+      r[0] = test_rand() % w, r[1] = test_rand() % h;
+      r[2] = r[0] + (int)(test_rand() % (unsigned)(w - r[0])), r[3] = r[1] + (int)(test_rand() % (unsigned)(h - r[1]));
+    }
+    for (int simd = 0; simd < 2; simd++) evals[simd] += rr_raster_rect(&ts, id, r, c, &vb[simd], &covered[simd], simd);
+    drawn++;
+  }
+  bool same = memcmp(vb[0].id, vb[1].id, n * sizeof(uint32_t)) == 0;
+  same = same && memcmp(vb[0].t, vb[1].t, n * sizeof(float)) == 0;
+  same = same && memcmp(vb[0].l1, vb[1].l1, n * sizeof(float)) == 0;
+  same = same && memcmp(vb[0].l2, vb[1].l2, n * sizeof(float)) == 0;
+  CHECK(same && evals[0] == evals[1] && covered[0] == covered[1],
+        "%s: the AVX2 sample loop differs from the plain one (%llu vs %llu covered)", what,
+        (unsigned long long)covered[1], (unsigned long long)covered[0]);
+  CHECK(drawn > 0 && covered[0] > 0, "%s: no sample covered (the case mix is not exercised)", what);
+  for (int k = 0; k < 2; k++) free(vb[k].id), free(vb[k].t), free(vb[k].l1), free(vb[k].l2);
+}
+
 int main(void) {
+#ifdef RR_SIMD_X86
   if (!__builtin_cpu_supports("avx2")) {
-    test_skip("no AVX2 on this processor: the scalar kernels are the only ones");
+    test_skip("no AVX2 on this processor: the plain kernels are the only ones");
     return test_done();
   }
+#else
+  test_skip("no AVX2 instances in this build: the plain kernels are the only ones");
+  return test_done();
+#endif
   rr_device *dev = rr_device_new();
   const float scales[] = {1.0f, 1e-3f, 1e4f};
-  for (int sc = 0; sc < 3; sc++) {
-    rr_scene *s = random_scene(dev, scales[sc]);
+  for (int sc = 0; sc < 4; sc++) {
+    rr_scene *s = random_scene(dev, scales[sc % 3], sc == 3);
     for (int v = 0; v < (test_quick() ? 4 : 16); v++) {
       char what[96];
       for (int type = 0; type < 2; type++) {
         camera c;
         rr_camera_type ct = type ? RR_CAMERA_ORTHOGRAPHIC : RR_CAMERA_PERSPECTIVE;
-        if (!random_camera(dev, ct, scales[sc], 97 + v, 61 + 3 * v, &c)) continue;
-        snprintf(what, sizeof what, "scale %g view %d %s", scales[sc], v, rr_camera_name(ct));
+        if (!random_camera(dev, ct, scales[sc % 3], 97 + v, 61 + 3 * v, &c)) continue;
+        snprintf(what, sizeof what, "scale %g%s view %d %s", scales[sc % 3], sc == 3 ? " at infinity" : "", v,
+                 rr_camera_name(ct));
         check_bounds(s, &c, what);
         check_setup(s, &c, v % 2 == 1, what);
+        check_raster(s, &c, what);
         rr_cam_release(&c);
       }
     }

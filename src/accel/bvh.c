@@ -15,7 +15,8 @@
  * first, then each task's subtree in depth-first order. */
 #include "accel/bvh.h"
 
-#include <emmintrin.h>
+#include "core/simd.h"
+
 #include <string.h>
 
 enum {
@@ -39,25 +40,25 @@ typedef struct {
 } pref;
 
 typedef struct {
-  __m128 lo, hi;
+  rr_vf4 lo, hi;
 } box4;
 
 static inline box4 box_empty(void) {
-  box4 b = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
+  box4 b = {rr_vf4_splat(INFINITY), rr_vf4_splat(-INFINITY)};
   return b;
 }
 
-static inline __m128 xyz_mask(void) { return _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1)); }
+static inline rr_vi4 xyz_mask(void) { return (rr_vi4){-1, -1, -1, 0}; }
 
-static inline void ref_load(const pref *r, __m128 *lo, __m128 *hi) {
-  __m128 m = xyz_mask();
-  *lo = _mm_and_ps(_mm_load_ps(r->lo), m);
-  *hi = _mm_and_ps(_mm_load_ps(r->hi), m);
+static inline void ref_load(const pref *r, rr_vf4 *lo, rr_vf4 *hi) {
+  rr_vi4 m = xyz_mask();
+  *lo = (rr_vf4)((rr_vi4)rr_vf4_load(r->lo) & m);
+  *hi = (rr_vf4)((rr_vi4)rr_vf4_load(r->hi) & m);
 }
 
-static inline void box_grow(box4 *b, __m128 lo, __m128 hi) {
-  b->lo = _mm_min_ps(b->lo, lo);
-  b->hi = _mm_max_ps(b->hi, hi);
+static inline void box_grow(box4 *b, rr_vf4 lo, rr_vf4 hi) {
+  b->lo = rr_vf4_min(b->lo, lo);
+  b->hi = rr_vf4_max(b->hi, hi);
 }
 
 static inline void box_merge(box4 *b, box4 o) { box_grow(b, o.lo, o.hi); }
@@ -65,51 +66,44 @@ static inline void box_merge(box4 *b, box4 o) { box_grow(b, o.lo, o.hi); }
 /* Half the surface area: in float lanes, and again in double when that overflows
  * (boxes wider than about 1e19). An empty box has none. */
 static inline double half_area(box4 b) {
-  __m128 e = _mm_sub_ps(b.hi, b.lo);
-  __m128 p = _mm_mul_ps(e, _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1)));
-  float v[4], lo[4];
-  _mm_storeu_ps(v, p);
-  float a = v[0] + v[1] + v[2];
+  rr_vf4 e = b.hi - b.lo, p = e * rr_vf4_yzx(e);
+  float a = p[0] + p[1] + p[2];
   if (isfinite(a) && a >= 0) return a;
-  _mm_storeu_ps(lo, b.lo), _mm_storeu_ps(v, e);
-  if (!(v[0] >= 0)) return 0; /* empty (or NaN) */
-  float hi[4];
-  _mm_storeu_ps(hi, b.hi);
-  double x = (double)hi[0] - lo[0], y = (double)hi[1] - lo[1], z = (double)hi[2] - lo[2];
+  if (!(e[0] >= 0)) return 0; /* empty (or NaN) */
+  double x = (double)b.hi[0] - b.lo[0], y = (double)b.hi[1] - b.lo[1], z = (double)b.hi[2] - b.lo[2];
   return x * y + y * z + z * x;
 }
 
 /* Maps centroids to bins: bin = clamp((c - cmin) * scale, 0, nb - 1), per axis. */
 typedef struct {
-  __m128 cmin, scale, top;
+  rr_vf4 cmin, scale, top;
   int nb;
   bool ok[3]; /* axis has extent */
 } binmap;
 
 static binmap binmap_make(box4 cbox, int nb) {
   binmap m;
-  float lo[4], hi[4], sc[4] = {0, 0, 0, 0};
-  _mm_storeu_ps(lo, cbox.lo), _mm_storeu_ps(hi, cbox.hi);
+  float sc[4] = {0, 0, 0, 0};
   for (int a = 0; a < 3; a++) {
-    float ext = hi[a] - lo[a];
+    float ext = cbox.hi[a] - cbox.lo[a];
     float s = (float)nb / ext;
     m.ok[a] = ext > 0 && isfinite(ext) && isfinite(s);
     sc[a] = m.ok[a] ? s : 0;
   }
-  m.cmin = _mm_and_ps(cbox.lo, xyz_mask());
-  m.scale = _mm_loadu_ps(sc);
-  m.top = _mm_set1_ps((float)(nb - 1));
+  m.cmin = (rr_vf4)((rr_vi4)cbox.lo & xyz_mask());
+  m.scale = rr_vf4_load(sc);
+  m.top = rr_vf4_splat((float)(nb - 1));
   m.nb = nb;
   return m;
 }
 
-static inline __m128 centroid(__m128 lo, __m128 hi) { return _mm_mul_ps(_mm_add_ps(lo, hi), _mm_set1_ps(0.5f)); }
+static inline rr_vf4 centroid(rr_vf4 lo, rr_vf4 hi) { return (lo + hi) * rr_vf4_splat(0.5f); }
 
 /* Bin indices of a centroid on the three axes (NaN lands in bin 0). */
-static inline __m128i bin_of(const binmap *m, __m128 c) {
-  __m128 f = _mm_mul_ps(_mm_sub_ps(c, m->cmin), m->scale);
-  f = _mm_min_ps(_mm_max_ps(f, _mm_setzero_ps()), m->top);
-  return _mm_cvttps_epi32(f);
+static inline rr_vi4 bin_of(const binmap *m, rr_vf4 c) {
+  rr_vf4 f = (c - m->cmin) * m->scale;
+  f = rr_vf4_min(rr_vf4_max(f, rr_vf4_splat(0.0f)), m->top);
+  return rr_vi4_trunc(f);
 }
 
 typedef struct {
@@ -125,10 +119,9 @@ static void bins_clear(bins *b, int nb) {
 static void bin_range(const pref *r, uint32_t n, const binmap *m, bins *b) {
   bins_clear(b, m->nb);
   for (uint32_t i = 0; i < n; i++) {
-    __m128 lo, hi;
+    rr_vf4 lo, hi;
     ref_load(&r[i], &lo, &hi);
-    int idx[4];
-    _mm_storeu_si128((__m128i *)idx, bin_of(m, centroid(lo, hi)));
+    rr_vi4 idx = bin_of(m, centroid(lo, hi));
     for (int a = 0; a < 3; a++) {
       box_grow(&b->box[a][idx[a]], lo, hi);
       b->n[a][idx[a]]++;
@@ -190,10 +183,9 @@ static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, doub
 }
 
 static inline int ref_bin(const pref *r, const binmap *m, int axis) {
-  __m128 lo, hi;
+  rr_vf4 lo, hi;
   ref_load(r, &lo, &hi);
-  int idx[4];
-  _mm_storeu_si128((__m128i *)idx, bin_of(m, centroid(lo, hi)));
+  rr_vi4 idx = bin_of(m, centroid(lo, hi));
   return idx[axis];
 }
 
@@ -201,10 +193,10 @@ static inline int ref_bin(const pref *r, const binmap *m, int axis) {
 static void range_bounds(const pref *r, uint32_t n, box4 *box, box4 *cbox) {
   *box = box_empty(), *cbox = box_empty();
   for (uint32_t i = 0; i < n; i++) {
-    __m128 lo, hi;
+    rr_vf4 lo, hi;
     ref_load(&r[i], &lo, &hi);
     box_grow(box, lo, hi);
-    __m128 c = centroid(lo, hi);
+    rr_vf4 c = centroid(lo, hi);
     box_grow(cbox, c, c);
   }
 }
@@ -214,11 +206,10 @@ static uint32_t partition_small(pref *r, uint32_t n, const binmap *m, int axis, 
   cb[0] = box_empty(), cb[1] = box_empty();
   uint32_t i = 0, j = n;
   while (i < j) {
-    __m128 lo, hi;
+    rr_vf4 lo, hi;
     ref_load(&r[i], &lo, &hi);
-    __m128 c = centroid(lo, hi);
-    int idx[4];
-    _mm_storeu_si128((__m128i *)idx, bin_of(m, c));
+    rr_vf4 c = centroid(lo, hi);
+    rr_vi4 idx = bin_of(m, c);
     if (idx[axis] < pos) {
       box_grow(&cb[0], c, c);
       i++;
@@ -272,11 +263,10 @@ static void chunk_scatter(int c, int thread, void *arg) {
   uint32_t li = j->offset[c], ri = j->offset[nchunks + c];
   box4 cb[2] = {box_empty(), box_empty()};
   for (uint32_t i = 0; i < n; i++) {
-    __m128 lo, hi;
+    rr_vf4 lo, hi;
     ref_load(&r[i], &lo, &hi);
-    __m128 cen = centroid(lo, hi);
-    int idx[4];
-    _mm_storeu_si128((__m128i *)idx, bin_of(j->m, cen));
+    rr_vf4 cen = centroid(lo, hi);
+    rr_vi4 idx = bin_of(j->m, cen);
     int side = idx[j->axis] >= j->pos;
     box_grow(&cb[side], cen, cen);
     out[side ? ri++ : li++] = r[i];
@@ -377,9 +367,7 @@ children:
 }
 
 static void store_box(bvh_node *n, box4 b) {
-  float lo[4], hi[4];
-  _mm_storeu_ps(lo, b.lo), _mm_storeu_ps(hi, b.hi);
-  memcpy(n->lo, lo, 12), memcpy(n->hi, hi, 12);
+  memcpy(n->lo, &b.lo, 12), memcpy(n->hi, &b.hi, 12);
 }
 
 /* ---- growable arrays ---------------------------------------------------------- */
@@ -531,10 +519,10 @@ static void make_refs(int c, int thread, void *arg) {
       r->hi[x] = fmaxf(v0, fmaxf(v1, v2));
     }
     r->id = i, r->pad = 0;
-    __m128 lo, hi;
+    rr_vf4 lo, hi;
     ref_load(r, &lo, &hi);
     box_grow(&b, lo, hi);
-    __m128 cen = centroid(lo, hi);
+    rr_vf4 cen = centroid(lo, hi);
     box_grow(&cb, cen, cen);
   }
   j->cb[2 * c] = b, j->cb[2 * c + 1] = cb;

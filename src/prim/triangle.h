@@ -25,8 +25,7 @@ enum { SETUP_CULLED = 0, SETUP_FRONT = 1, SETUP_BACK = 2 };
  * cull_backfaces is set). */
 int rr_tri_setup(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces, tri_setup *out);
 /* rr_tri_setup for triangles ids[0..n-1] into out[k], face[k]; with simd, eight
- * at a time (AVX2) where the camera is perspective and no corner is at infinity,
- * with the same bits. */
+ * at a time where the processor has AVX2, with the same bits. */
 void rr_tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces, bool simd,
                    tri_setup *out, int *face);
 

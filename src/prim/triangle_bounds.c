@@ -3,6 +3,7 @@
  * A triangle that crosses the eye plane has no bounded projection and is bounded by
  * the whole screen; 3D edge functions need no clipping for that. */
 #include "prim/triangle.h"
+#include "core/simd.h"
 
 #include <string.h>
 
@@ -64,143 +65,51 @@ static bool curved_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
   return true;
 }
 
+/* Planar cameras: the hull of the corners' projections. A point at infinity
+ * projects to its vanishing point when its direction points ahead; the projection
+ * of the segment from a point to it is then the segment to the vanishing point, so
+ * the hull of the three still bounds the triangle. A triangle with a corner not
+ * strictly ahead of the eye (or projecting to no finite point), or one with a
+ * corner at infinity in an orthographic view, is bounded by the whole screen; one
+ * with no corner ahead is unseen (every camera ray has d·fwd > 0). Sample
+ * (x + sx0) lies in [x0, x1] for x in [ceil(x0 - sx0), floor(x1 - sx0)], widened
+ * by a margin that covers the rounding of the projection and of the edge
+ * functions, a few ulps of the larger coordinate (a whole pixel would double the
+ * area of the small triangles of real meshes). */
+#define W 1
+#define TARGET
+#include "prim/triangle_bounds_tmp.h"
+#ifdef RR_SIMD_X86
+#define W 8
+#define TARGET RR_TARGET_AVX2
+#include "prim/triangle_bounds_tmp.h"
+#endif
+
 bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int r[4]) {
-  float x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  int behind = 0, projected = 0;
-  /* A point at infinity projects to its vanishing point when its direction points
-   * ahead; the projection of the segment from a point to it is then the segment
-   * to the vanishing point, so the hull of the three still bounds the triangle.
-   * An orthographic view sees such a triangle unbounded: whole screen. */
-  bool ortho_inf = c->type == RR_CAMERA_ORTHOGRAPHIC && scene_inf(s, i);
-  for (int k = 0; k < 3; k++) {
-    vec3 q = scene_q(s, k, i, c->eye);
-    float sx, sy;
-    if (!(v3_dot(q, c->fwd) > 0)) behind++;
-    else if (rr_cam_project(c, q, &sx, &sy) && isfinite(sx) && isfinite(sy)) {
-      projected++;
-      x0 = minf(x0, sx), x1 = maxf(x1, sx), y0 = minf(y0, sy), y1 = maxf(y1, sy); /* finite: no libm calls */
-    }
-  }
-  if (!c->planar) {
-    /* Curved views have no straight-edged projection; hemispheres see nothing
-     * wholly behind the eye plane. */
-    if (behind == 3 && c->type == RR_CAMERA_PARABOLIC) return false;
-    return curved_bounds(s, i, c, ts, r);
-  }
-  if (behind == 3) return false; /* every camera ray has d·fwd > 0: unreachable */
-  if (projected == 3 && !ortho_inf) {
-    /* Sample (x + 0.5) lies in [x0, x1] for x in [ceil(x0 - 0.5), floor(x1 - 0.5)]. */
-    /* The margin covers the rounding of the projection and of the edge functions,
-     * a few ulps of the larger coordinate; a whole pixel would double the area of
-     * the small triangles of real meshes. */
-    float m = 1.0f / 64 + 1e-5f * maxf(maxf(fabsf(x0), fabsf(x1)), maxf(fabsf(y0), fabsf(y1)));
-    float lx = maxf(ceilf(x0 - c->sx0 - m), 0.0f), hx = minf(floorf(x1 - c->sx0 + m), (float)(c->width - 1));
-    float ly = maxf(ceilf(y0 - c->sy0 - m), 0.0f), hy = minf(floorf(y1 - c->sy0 + m), (float)(c->height - 1));
-    if (lx > hx || ly > hy) return false;
-    r[0] = (int)lx, r[1] = (int)ly, r[2] = (int)hx, r[3] = (int)hy;
+  if (c->planar) {
+    tri_bound b;
+    if (!corner_bounds1(s, i, NULL, 1, c, &b)) return false;
+    memcpy(r, b.bb, sizeof b.bb);
     return true;
   }
-  r[0] = 0, r[1] = 0, r[2] = c->width - 1, r[3] = c->height - 1;
-  return true;
+  /* Curved views have no straight-edged projection; hemispheres see nothing
+   * wholly behind the eye plane. */
+  int behind = 0;
+  for (int k = 0; k < 3; k++) behind += !(v3_dot(scene_q(s, k, i, c->eye), c->fwd) > 0);
+  if (behind == 3 && c->type == RR_CAMERA_PARABOLIC) return false;
+  return curved_bounds(s, i, c, ts, r);
 }
-
-/* The planar bounds of one triangle from its corners, as rr_tri_screen_bounds gives them. */
-static inline uint32_t keep_bounded(const rr_scene *s, uint32_t i, const camera *c, tri_bound *out) {
-  out->id = i;
-  return rr_tri_screen_bounds(s, i, c, NULL, out->bb);
-}
-
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-
-/* rr_tri_screen_bounds for eight triangles at once, for planar cameras and finite
- * corners: the same operations in the same order (no FMA, true divisions), so the
- * same rectangles. Lanes with a corner not strictly in front of the image plane
- * (or projecting to no finite point) take the scalar path. */
-/* Triangles ids[0..n-1] (n <= 8), or first..first+n-1 when ids is NULL. */
-__attribute__((target("avx2"))) static uint32_t bounds8_avx2(const rr_scene *s, uint32_t first, const uint32_t *ids,
-                                                              int n, const camera *c, tri_bound *out) {
-  uint32_t lane_id[8];
-  for (int l = 0; l < 8; l++) lane_id[l] = ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1);
-  const __m256i idx = _mm256_loadu_si256((const __m256i *)lane_id);
-  const bool persp = c->type == RR_CAMERA_PERSPECTIVE;
-  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), half = _mm256_set1_ps(0.5f);
-  const __m256 W = _mm256_set1_ps((float)c->width), H = _mm256_set1_ps((float)c->height);
-  const __m256 inf = _mm256_set1_ps(INFINITY), absmask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  const float e[3] = {c->eye.x, c->eye.y, c->eye.z};
-  const float f[3] = {c->fwd.x, c->fwd.y, c->fwd.z}, rt[3] = {c->right.x, c->right.y, c->right.z},
-              up[3] = {c->up.x, c->up.y, c->up.z};
-  __m256 x0 = inf, y0 = inf, x1 = _mm256_set1_ps(-INFINITY), y1 = x1;
-  __m256 ok = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
-  for (int k = 0; k < 3; k++) {
-    __m256 q[3];
-    for (int a = 0; a < 3; a++) {
-      __m256 p = ids || n < 8 ? _mm256_i32gather_ps(s->p[k][a], idx, 4) : _mm256_loadu_ps(s->p[k][a] + first);
-      q[a] = _mm256_sub_ps(p, _mm256_set1_ps(e[a]));
-    }
-#define DOT3(v) \
-  _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(q[0], _mm256_set1_ps(v[0])), _mm256_mul_ps(q[1], _mm256_set1_ps(v[1]))), \
-                _mm256_mul_ps(q[2], _mm256_set1_ps(v[2])))
-    __m256 z = DOT3(f), qr = DOT3(rt), qu = DOT3(up);
-#undef DOT3
-    __m256 sx, sy;
-    if (persp) {
-      __m256 u = _mm256_div_ps(qr, _mm256_mul_ps(z, _mm256_set1_ps(c->tan_half_w)));
-      __m256 v = _mm256_div_ps(qu, _mm256_mul_ps(z, _mm256_set1_ps(c->tan_half_h)));
-      sx = _mm256_mul_ps(_mm256_mul_ps(_mm256_add_ps(u, one), half), W);
-      sy = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(one, v), half), H);
-    } else {
-      sx = _mm256_mul_ps(_mm256_mul_ps(_mm256_add_ps(_mm256_div_ps(qr, _mm256_set1_ps(c->tan_half_w)), one), half), W);
-      sy = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(one, _mm256_div_ps(qu, _mm256_set1_ps(c->tan_half_h))), half), H);
-    }
-    ok = _mm256_and_ps(ok, _mm256_cmp_ps(z, zero, _CMP_GT_OQ));
-    ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_and_ps(sx, absmask), inf, _CMP_LT_OQ));
-    ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_and_ps(sy, absmask), inf, _CMP_LT_OQ));
-    x0 = _mm256_min_ps(x0, sx), x1 = _mm256_max_ps(x1, sx), y0 = _mm256_min_ps(y0, sy), y1 = _mm256_max_ps(y1, sy);
-  }
-  __m256 big = _mm256_max_ps(_mm256_max_ps(_mm256_and_ps(x0, absmask), _mm256_and_ps(x1, absmask)),
-                             _mm256_max_ps(_mm256_and_ps(y0, absmask), _mm256_and_ps(y1, absmask)));
-  __m256 m = _mm256_add_ps(_mm256_set1_ps(1.0f / 64), _mm256_mul_ps(_mm256_set1_ps(1e-5f), big));
-  const int down = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC, upr = _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC;
-  const __m256 ox = _mm256_set1_ps(c->sx0), oy = _mm256_set1_ps(c->sy0);
-  __m256 lx = _mm256_max_ps(_mm256_round_ps(_mm256_sub_ps(_mm256_sub_ps(x0, ox), m), upr), zero);
-  __m256 ly = _mm256_max_ps(_mm256_round_ps(_mm256_sub_ps(_mm256_sub_ps(y0, oy), m), upr), zero);
-  __m256 hx = _mm256_min_ps(_mm256_round_ps(_mm256_add_ps(_mm256_sub_ps(x1, ox), m), down),
-                            _mm256_set1_ps((float)(c->width - 1)));
-  __m256 hy = _mm256_min_ps(_mm256_round_ps(_mm256_add_ps(_mm256_sub_ps(y1, oy), m), down),
-                            _mm256_set1_ps((float)(c->height - 1)));
-  __m256 empty = _mm256_or_ps(_mm256_cmp_ps(lx, hx, _CMP_GT_OQ), _mm256_cmp_ps(ly, hy, _CMP_GT_OQ));
-  int lanes = (1 << n) - 1, okm = _mm256_movemask_ps(ok) & lanes, keep = okm & ~_mm256_movemask_ps(empty);
-  if (!keep && okm == lanes) return 0;
-  int b[4][8];
-  _mm256_storeu_si256((__m256i *)b[0], _mm256_cvttps_epi32(lx));
-  _mm256_storeu_si256((__m256i *)b[1], _mm256_cvttps_epi32(ly));
-  _mm256_storeu_si256((__m256i *)b[2], _mm256_cvttps_epi32(hx));
-  _mm256_storeu_si256((__m256i *)b[3], _mm256_cvttps_epi32(hy));
-  uint32_t kept = 0;
-  for (int l = 0; l < n; l++) {
-    if (!(okm >> l & 1)) {
-      kept += keep_bounded(s, lane_id[l], c, out + kept);
-    } else if (keep >> l & 1) {
-      out[kept] = (tri_bound){lane_id[l], {b[0][l], b[1][l], b[2][l], b[3][l]}};
-      kept++;
-    }
-  }
-  return kept;
-}
-#endif
 
 uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
-                           bool simd, tri_bound *out) {
+                              bool simd, tri_bound *out) {
   uint32_t kept = 0, k = 0;
-#if defined(__x86_64__) || defined(__i386__)
-  if (simd && !s->inf && __builtin_cpu_supports("avx2"))
+#ifdef RR_SIMD_X86
+  if (simd && __builtin_cpu_supports("avx2"))
     for (; k < n; k += 8)
-      kept += bounds8_avx2(s, first + k, ids ? ids + k : NULL, n - k < 8 ? (int)(n - k) : 8, c, out + kept);
-#else
-  (void)simd;
+      kept += corner_bounds8(s, first + k, ids ? ids + k : NULL, n - k < 8 ? (int)(n - k) : 8, c, out + kept);
 #endif
-  for (; k < n; k++) kept += keep_bounded(s, ids ? ids[k] : first + k, c, out + kept);
+  (void)simd;
+  for (; k < n; k++) kept += corner_bounds1(s, first + k, ids ? ids + k : NULL, 1, c, out + kept);
   return kept;
 }
 

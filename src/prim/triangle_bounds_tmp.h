@@ -1,0 +1,85 @@
+/* Corner bounds for W triangles at once: a kernel template (core/simd.h) that
+ * triangle_bounds.c includes once per width, with W and TARGET defined.
+ *
+ * The pixel rectangles of triangles ids[0..n-1] (first..first+n-1 when ids is
+ * NULL; n <= W, the padding lanes repeat the last one) for a planar camera, from
+ * their projected corners, as rr_tri_screen_bounds defines them (the comments
+ * there): the same operations in the same order (no FMA, true divisions), lane by
+ * lane, so every width gives the same rectangles. Writes the triangles whose
+ * rectangle holds a sample to out, in order; returns how many. */
+#define VF RR_VF(W)
+#define VI RR_VI(W)
+#define VF_(op) RR_VF_OP(W, op)
+#define VI_(op) RR_VI_OP(W, op)
+
+TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
+                                                       const camera *c, tri_bound *out) {
+  int32_t lane_id[W], lane_inf[W] = {0};
+  for (int l = 0; l < W; l++)
+    lane_id[l] = (int32_t)(ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1));
+  if (s->inf)
+    for (int l = 0; l < W; l++) lane_inf[l] = s->inf[lane_id[l]];
+  const VI idx = VI_(load)(lane_id), inf = VI_(load)(lane_inf);
+  const bool persp = c->type == RR_CAMERA_PERSPECTIVE, contiguous = !ids && n == W;
+  const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f), half = VF_(splat)(0.5f);
+  const VF inf_f = VF_(splat)(INFINITY), width = VF_(splat)((float)c->width), height = VF_(splat)((float)c->height);
+  const VF last_x = VF_(splat)((float)(c->width - 1)), last_y = VF_(splat)((float)(c->height - 1));
+  const VF eye[3] = {VF_(splat)(c->eye.x), VF_(splat)(c->eye.y), VF_(splat)(c->eye.z)};
+  const VF fwd[3] = {VF_(splat)(c->fwd.x), VF_(splat)(c->fwd.y), VF_(splat)(c->fwd.z)};
+  const VF right[3] = {VF_(splat)(c->right.x), VF_(splat)(c->right.y), VF_(splat)(c->right.z)};
+  const VF up[3] = {VF_(splat)(c->up.x), VF_(splat)(c->up.y), VF_(splat)(c->up.z)};
+  VF x0 = inf_f, y0 = inf_f, x1 = -inf_f, y1 = -inf_f;
+  /* some corner ahead of the eye; every corner projects to a finite point */
+  VI ahead_any = VI_(splat)(0), projected = VI_(splat)(-1);
+#pragma GCC unroll 3
+  for (int k = 0; k < 3; k++) {
+    VF q[3]; /* the corner relative to the eye, or its direction when at infinity */
+#pragma GCC unroll 3
+    for (int a = 0; a < 3; a++) {
+      VF p = contiguous ? VF_(load)(s->p[k][a] + first) : VF_(gather)(s->p[k][a], idx);
+      q[a] = p - eye[a];
+      if (s->inf) q[a] = VF_(select)(-((inf >> k) & 1), p, q[a]);
+    }
+#define DOT3(v) (q[0] * v[0] + q[1] * v[1] + q[2] * v[2])
+    const VF z = DOT3(fwd), qr = DOT3(right), qu = DOT3(up);
+#undef DOT3
+    VF sx, sy; /* rr_cam_project */
+    if (persp) {
+      VF u = qr / (z * VF_(splat)(c->tan_half_w)), v = qu / (z * VF_(splat)(c->tan_half_h));
+      sx = (u + one) * half * width;
+      sy = (one - v) * half * height;
+    } else {
+      sx = (qr / VF_(splat)(c->tan_half_w) + one) * half * width;
+      sy = (one - qu / VF_(splat)(c->tan_half_h)) * half * height;
+    }
+    const VI ahead = z > zero;
+    ahead_any |= ahead;
+    projected &= ahead & (VF_(abs)(sx) < inf_f) & (VF_(abs)(sy) < inf_f);
+    x0 = VF_(min)(x0, sx), x1 = VF_(max)(x1, sx), y0 = VF_(min)(y0, sy), y1 = VF_(max)(y1, sy);
+  }
+  /* an orthographic view sees a triangle with a corner at infinity unbounded */
+  const VI bounded = c->type == RR_CAMERA_ORTHOGRAPHIC ? projected & (inf == 0) : projected;
+  const VF big = VF_(max)(VF_(max)(VF_(abs)(x0), VF_(abs)(x1)), VF_(max)(VF_(abs)(y0), VF_(abs)(y1)));
+  const VF m = VF_(splat)(1.0f / 64) + VF_(splat)(1e-5f) * big;
+  const VF ox = VF_(splat)(c->sx0), oy = VF_(splat)(c->sy0); /* the sample's position in the pixel */
+  VF lx = VF_(max)(VF_(ceil)(x0 - ox - m), zero), hx = VF_(min)(VF_(floor)(x1 - ox + m), last_x);
+  VF ly = VF_(max)(VF_(ceil)(y0 - oy - m), zero), hy = VF_(min)(VF_(floor)(y1 - oy + m), last_y);
+  const VI empty = (lx > hx) | (ly > hy);
+  const int keep = VI_(bits)(ahead_any & ~(bounded & empty)) & ((1 << n) - 1);
+  if (!keep) return 0;
+  /* not bounded: the whole screen */
+  lx = VF_(select)(bounded, lx, zero), ly = VF_(select)(bounded, ly, zero);
+  hx = VF_(select)(bounded, hx, last_x), hy = VF_(select)(bounded, hy, last_y);
+  const VI bx0 = VI_(trunc)(lx), by0 = VI_(trunc)(ly), bx1 = VI_(trunc)(hx), by1 = VI_(trunc)(hy);
+  uint32_t kept = 0;
+  for (int l = 0; l < n; l++)
+    if (keep >> l & 1) out[kept++] = (tri_bound){(uint32_t)lane_id[l], {bx0[l], by0[l], bx1[l], by1[l]}};
+  return kept;
+}
+
+#undef VF
+#undef VI
+#undef VF_
+#undef VI_
+#undef W
+#undef TARGET

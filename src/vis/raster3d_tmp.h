@@ -1,0 +1,82 @@
+/* The 3D rasterizer's sample loop for W lanes: a kernel template (core/simd.h)
+ * that raster3d.c includes once per width, with W and TARGET defined.
+ *
+ * Every sample of rectangle r against one set-up triangle, W samples of a row at
+ * a time, columns then rows (the terms in sx are the same on every row). A lane is
+ * the sample test of prim/triangle.h (sample_test_w) and the depth test of
+ * vis/vis.h (depth_wins): the same operations in the same order on IEEE single
+ * floats (no FMA, a true division), so every width gives their bits. Lanes past
+ * r[2] are masked off and touch no memory. */
+#define VF RR_VF(W)
+#define VI RR_VI(W)
+#define VF_(op) RR_VF_OP(W, op)
+#define VI_(op) RR_VI_OP(W, op)
+
+TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32_t id, const int r[4],
+                                                     const camera *c, visbuf *vb, const bool planar) {
+  VF a[3], b[3], cc[3];
+  VI tie[3];
+#pragma GCC unroll 3
+  for (int e = 0; e < 3; e++) {
+    a[e] = VF_(splat)(ts->a[e]), b[e] = VF_(splat)(ts->b[e]), cc[e] = VF_(splat)(ts->c[e]);
+    tie[e] = VI_(splat)(ts->tie >> e & 1u ? -1 : 0);
+  }
+  const VF w0 = VF_(splat)(ts->w[0]), w1 = VF_(splat)(ts->w[1]), w2 = VF_(splat)(ts->w[2]);
+  const VF vol = VF_(splat)(ts->vol), vol_x = VF_(splat)(ts->vol_x), vol_y = VF_(splat)(ts->vol_y);
+  const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
+  /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
+  const VI idv = VI_(splat)((int32_t)id), bias = VI_(splat)(INT32_MIN), id_biased = idv ^ bias;
+  const VI end = VI_(splat)(r[2] + 1);
+  float *best_t = vb->t, *l1 = vb->l1, *l2 = vb->l2;
+  int32_t *best_id = (int32_t *)vb->id;
+  const size_t width = (size_t)vb->width;
+  uint64_t covered = 0;
+  for (int x = r[0]; x <= r[2]; x += W) {
+    const VI xi = VI_(splat)(x) + VI_(lanes)(), valid = end > xi;
+    const VF sx = VF_(from_int)(xi) + VF_(splat)(c->sx0);
+    VF ax[3]; /* planar: a·1 + b·sx, the part of each edge function that rows share */
+#pragma GCC unroll 3
+    for (int e = 0; e < 3; e++) ax[e] = a[e] * one + b[e] * sx;
+    const VF vx = vol + sx * vol_x;
+    for (int y = r[1]; y <= r[3]; y++) {
+      const VF sy = VF_(splat)((float)y + c->sy0);
+      const size_t k = (size_t)y * width + (size_t)x;
+      VF wx = zero, wy = zero, wz = zero; /* curved: the camera's ray direction per sample */
+      if (!planar)
+        for (int l = 0; l < W; l++) { /* (lanes past r[2] read the first one's) */
+          vec3 d = c->dirs[k + (size_t)(x + l <= r[2] ? l : 0)];
+          wx[l] = d.x, wy[l] = d.y, wz[l] = d.z;
+        }
+      VF ev[3];
+      VI in = valid;
+#pragma GCC unroll 3
+      for (int e = 0; e < 3; e++) {
+        ev[e] = planar ? ax[e] + cc[e] * sy : a[e] * wx + b[e] * wy + cc[e] * wz;
+        in &= (ev[e] > zero) | ((ev[e] == zero) & tie[e]);
+      }
+      if (!VI_(bits)(in)) continue;
+      const VF sum = ev[0] * w0 + ev[1] * w1 + ev[2] * w2, v = vx + sy * vol_y;
+      in &= (sum > zero) & (v > zero);
+      int hit = VI_(bits)(in);
+      if (!hit) continue;
+      covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
+      const VF inv = one / sum, t = v * inv;
+      const VF bt = VF_(load_masked)(best_t + k, in);
+      const VI bid = VI_(load_masked)(best_id + k, in);
+      const VI wins = in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased)));
+      if (!VI_(bits)(wins)) continue;
+      VF_(store_masked)(best_t + k, wins, t);
+      VI_(store_masked)(best_id + k, wins, idv);
+      VF_(store_masked)(l1 + k, wins, ev[1] * inv);
+      VF_(store_masked)(l2 + k, wins, ev[2] * inv);
+    }
+  }
+  return covered;
+}
+
+#undef VF
+#undef VI
+#undef VF_
+#undef VI_
+#undef W
+#undef TARGET
