@@ -256,7 +256,7 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
       if (naov == 16) die(EXIT_USAGE, "too many --aov (at most 16)");
       aovs[naov++] = (aov_out){(rr_aov)k, eq + 1};
     } else if (strcmp(a, "--threads") == 0) {
-      opt.threads = (int)parse_int(a, arg_value(&i, argc, argv), 1, 256);
+      opt.threads = (int)parse_int(a, arg_value(&i, argc, argv), 1, RR_MAX_THREADS);
     } else if (strcmp(a, "--repeat") == 0) {
       repeat = (int)parse_int(a, arg_value(&i, argc, argv), 1, 1000);
     } else if (strcmp(a, "--stats") == 0) {

@@ -183,7 +183,8 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
       float angle;
       int cone = rr_cam_rect_cone(c, cx * CAMERA_CELL, cy * CAMERA_CELL, x1, y1, &axis, &angle);
       cell[0] = axis.x, cell[1] = axis.y, cell[2] = axis.z;
-      cell[3] = cone < 0 ? -1.0f : cone > 0 && angle < 1.5f ? angle : 2.0f; /* no rays, a cone, no bound */
+      /* no rays, a cone, no bound */
+      cell[3] = cone < 0 ? -1.0f : cone > 0 && angle < CAMERA_NO_CONE ? angle : CAMERA_NO_CONE;
     }
   return rr_ok(dev);
 }

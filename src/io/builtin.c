@@ -97,7 +97,7 @@ static void push_quad(rr_scene *s, vec3 a, vec3 b, vec3 c, vec3 d, const vec3 *f
  * along its (x0,z0)-(x1,z1) diagonal; both halves are counter-clockwise from +y. */
 static rr_error gen_plane(rr_scene *s, int n) {
   uint32_t mat;
-  rr_error e = add_material(s, 0.8f, 0.8f, 0.8f, &mat);
+  rr_error e = add_material(s, SCENE_GREY, SCENE_GREY, SCENE_GREY, &mat);
   if (!e) e = reserve(s, 2 * (uint64_t)n * n, false);
   if (!e) e = open_object(s, "plane", mat);
   if (e) return e;
@@ -165,7 +165,7 @@ static rr_error gen_sphere(rr_scene *s, int seg, vec3 centre, float radius, uint
 static rr_error gen_box(rr_scene *s, int n) {
   uint32_t mat;
   float *g = malloc(((size_t)n + 1) * sizeof *g);
-  rr_error e = g ? add_material(s, 0.8f, 0.8f, 0.8f, &mat)
+  rr_error e = g ? add_material(s, SCENE_GREY, SCENE_GREY, SCENE_GREY, &mat)
                  : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory generating a box");
   if (!e) e = reserve(s, 12 * (uint64_t)n * n, true);
   if (!e) e = open_object(s, "box", mat);
@@ -249,6 +249,7 @@ static rr_error gen_ground(rr_scene *s) {
   if (!e) e = add_material(s, 0.20f, 0.45f, 0.85f, &ball_m);
   if (!e) e = reserve(s, 4, false);
   if (!e) e = open_object(s, "ground", ground_m);
+  if (!e) e = rr_scene_reserve_inf(s);
   if (e) return e;
   const vec3 origin = v3(0, 0, 0), dir[4] = {v3(1, 0, 0), v3(0, 0, -1), v3(-1, 0, 0), v3(0, 0, 1)};
   for (int q = 0; q < 4; q++) {
@@ -574,7 +575,7 @@ rr_error rr_scene_load_builtin(rr_scene *s, const char *name) {
   } else if ((arg = builtin_arg(name, "sphere"))) {
     uint32_t mat;
     e = size_arg(s, name, arg, 32, 4, 4096, &n);
-    if (!e) e = add_material(s, 0.8f, 0.8f, 0.8f, &mat);
+    if (!e) e = add_material(s, SCENE_GREY, SCENE_GREY, SCENE_GREY, &mat);
     if (!e) e = gen_sphere(s, (int)n, v3(0, 0, 0), 1.0f, mat);
   } else if ((arg = builtin_arg(name, "box"))) {
     e = size_arg(s, name, arg, 8, 1, 1024, &n);
