@@ -71,7 +71,7 @@ static void fail_each(const char *what, sequence seq, const char *arg) {
 static uint64_t scene_print(const rr_scene *s) {
   rr_scene_info info;
   rr_scene_get_info(s, &info);
-  uint64_t h = mix(mix(mix(mix(0, info.triangles), info.skipped), info.materials), info.bvh_nodes);
+  uint64_t h = mix(mix(mix(mix(mix(0, info.triangles), info.skipped), info.materials), info.geometries), info.bvh_nodes);
   for (uint32_t i = 0; i < s->ntris; i++)
     for (int k = 0; k < 3; k++) {
       h = mix_bytes(h, &s->p[k][0][i], 4), h = mix_bytes(h, &s->p[k][1][i], 4), h = mix_bytes(h, &s->p[k][2][i], 4);

@@ -12,6 +12,8 @@
  * is read and written under `mu`, and a caller leaves only when no worker is still
  * inside its loop, whose state lives on that caller's stack. A loop reaches no
  * caller data but through fn and arg. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, sysconf, pthreads */
+
 #include "core/core.h"
 
 #include <pthread.h>

@@ -9,8 +9,6 @@
 
 #include <string.h>
 
-static const double PI = 3.14159265358979323846;
-
 /* ---- name parsing -------------------------------------------------------------- */
 
 /* When `name` is `key` or `key:ARG`, returns ARG ("" for the bare key); else NULL. */
@@ -132,9 +130,9 @@ static rr_error gen_sphere(rr_scene *s, int seg, vec3 centre, float radius, uint
   dir[0] = v3(0, 1, 0);
   dir[nv - 1] = v3(0, -1, 0);
   for (int r = 1; r < rings; r++) {
-    double th = PI * r / rings;
+    double th = RR_PI * r / rings;
     for (int j = 0; j < seg; j++) {
-      double ph = 2 * PI * j / seg;
+      double ph = 2 * RR_PI * j / seg;
       dir[1 + (size_t)(r - 1) * seg + j] =
           v3((float)(sin(th) * cos(ph)), (float)cos(th), (float)(-sin(th) * sin(ph)));
     }
@@ -215,9 +213,9 @@ static rr_error gen_torus(rr_scene *s, int nu, int nv, float R, float r, vec3 ce
     return e;
   }
   for (int i = 0; i < nu; i++) {
-    double u = 2 * PI * i / nu;
+    double u = 2 * RR_PI * i / nu;
     for (int j = 0; j < nv; j++) {
-      double w = 2 * PI * j / nv;
+      double w = 2 * RR_PI * j / nv;
       double cu = cos(u), su = -sin(u), cw = cos(w), sw = sin(w);
       nrm[(size_t)i * nv + j] = v3((float)(cw * cu), (float)sw, (float)(cw * su));
       pos[(size_t)i * nv + j] =
@@ -381,7 +379,7 @@ static rr_error push_column(rr_scene *s, float cx, float cz, float radius, int s
   if (e) return e;
   vec3 bot[12], top[12];
   for (int k = 0; k < sides; k++) {
-    double ph = 2 * PI * k / sides; /* counter-clockwise seen from +y */
+    double ph = 2 * RR_PI * k / sides; /* counter-clockwise seen from +y */
     bot[k] = v3(cx + radius * (float)cos(ph), 0, cz - radius * (float)sin(ph));
     top[k] = v3(bot[k].x, ROOM_H, bot[k].z);
   }
@@ -507,7 +505,7 @@ static rr_error place_file(rr_scene *s, const char *path, const char *name, floa
   for (uint32_t g = g0; !e && g < s->ngeoms; g++) e = rr_scene_name_geometry(s, g, name);
   if (!e) e = smooth_normals(s, t0, s->ntris);
   if (e) return e;
-  float cy = cosf(yaw * (float)(PI / 180)), sy = sinf(yaw * (float)(PI / 180));
+  float cy = cosf(yaw * (float)(RR_PI / 180)), sy = sinf(yaw * (float)(RR_PI / 180));
   vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
   for (uint32_t i = t0; i < s->ntris; i++)
     for (int k = 0; k < 3; k++) {

@@ -1,4 +1,6 @@
 /* The method table and the visibility pass (rr_render): a frame from a scene, a camera and options. */
+#define _POSIX_C_SOURCE 200809L /* strtok_r */
+
 #include "vis/vis.h"
 
 #include <stdio.h>
