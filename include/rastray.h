@@ -19,6 +19,7 @@ extern "C" {
 #define RR_MISS 0xFFFFFFFFu /* the id (primitive, geometry, material) where nothing is hit */
 #define RR_MAX_SIZE 16384   /* largest image side accepted */
 #define RR_MAX_SAMPLES 16   /* most samples per pixel */
+#define RR_MAX_THREADS 256  /* most threads an option may ask for */
 
 typedef enum rr_error {
   RR_OK = 0,
@@ -65,7 +66,7 @@ rr_error rr_scene_add_mesh4(rr_scene *scene, const float *xyzw, size_t nvertices
 rr_error rr_scene_commit(rr_scene *scene);
 
 typedef struct rr_build_options {
-  int threads;   /* threads building the BVH; 0: all cores. The tree does not depend on it. */
+  int threads;   /* threads building the BVH; 0: all cores (at most RR_MAX_THREADS). The tree does not depend on it. */
   int bins;      /* SAH bins per axis, 2..64 (default 32) */
   int leaf_size; /* most triangles in a leaf, 1..64 (default 4) */
 } rr_build_options;
@@ -215,7 +216,7 @@ typedef struct rr_render_options {
   int samples;        /* samples per pixel, 1..RR_MAX_SAMPLES (default 1) */
   float sample_pos[RR_MAX_SAMPLES][2]; /* sample s at (x + sample_pos[s][0], y + sample_pos[s][1]) in pixel
                                           (x, y); each in [0, 1) (default: one sample at the centre) */
-  int threads;        /* 0: all cores */
+  int threads;        /* 0: all cores; at most RR_MAX_THREADS */
   int cull_backfaces; /* nonzero: triangles seen from behind are invisible */
   int heat;           /* nonzero: also record E and N charged to each pixel (AOVs evals, nodes) */
   int scalar;         /* nonzero: no SIMD kernels (for comparison; results are the same bits) */

@@ -56,7 +56,7 @@ static bool check_tree(const rr_scene *s, const char *name) {
       }
     } else {
       /* Children: a sibling pair at an odd index after the parent (the layout
-       * pair_test and the per-frame bounds rely on). */
+       * the traversals and the per-frame bounds rely on). */
       if (n->first % 2 != 1 || n->first <= k || n->first + 1 >= b->nnodes) {
         bad = 1;
         CHECK(0, "%s: inner node %u has children at %u", name, k, n->first);

@@ -23,6 +23,9 @@ static void die(int code, const char *fmt, ...) {
   exit(code);
 }
 
+#define STRING(x) #x
+#define VALUE(x) STRING(x) /* a macro's value as a string literal */
+
 static const char usage[] =
     "usage: rastray render [SCENE] [options]     render SCENE (a mesh file or built-in name; default demo)\n"
     "       rastray info SCENE                   print the scene's triangles, geometries and BVH figures\n"
@@ -37,7 +40,7 @@ static const char usage[] =
     "                      rc-bvh, rc-packet, 2dr-bb, 2dr-bin, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full\n"
     "  --oracles K=V,...   override a 3dr method's traversal: frustum=N leaves=0|1 outside=0|1\n"
     "                      occluded=0|1 split=N split-ratio=F binning=0|1 early-z=0|1 bin=N bin-min=N\n"
-    "  --size WxH          image size (default 1024x768, at most 16384 a side)\n"
+    "  --size WxH          image size (default 1024x768, at most " VALUE(RR_MAX_SIZE) " a side)\n"
     "  --camera NAME       perspective (default), orthographic, parabolic, latlong, fisheye, cube\n"
     "  --ortho-height H    orthographic view height (default 2·|target-eye|·tan(fov/2))\n"
     "  --cube-faces DIR    cube camera: also write the six faces as DIR/front.png, right, back, ...\n"
@@ -47,7 +50,7 @@ static const char usage[] =
     "  -o PATH             colour image: .png, .exr or .pfm (default rastray.png unless --aov is given)\n"
     "  --aov NAME=PATH     write an AOV as .npy, .pfm or .exr; repeatable. NAME: depth, id (triangle),\n"
     "                      mesh (geometry id), material (index), normal, bary, evals, nodes\n"
-    "  --threads N         threads (default: all cores)\n"
+    "  --threads N         threads, at most " VALUE(RR_MAX_THREADS) " (default: all cores)\n"
     "  --repeat N          run the visibility pass N times, report the median time\n"
     "  --stats             print key=value statistics to stderr\n"
     "  --stats-json PATH   write the statistics as one JSON object\n"
@@ -256,7 +259,7 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
       if (naov == 16) die(EXIT_USAGE, "too many --aov (at most 16)");
       aovs[naov++] = (aov_out){(rr_aov)k, eq + 1};
     } else if (strcmp(a, "--threads") == 0) {
-      opt.threads = (int)parse_int(a, arg_value(&i, argc, argv), 1, 256);
+      opt.threads = (int)parse_int(a, arg_value(&i, argc, argv), 1, RR_MAX_THREADS);
     } else if (strcmp(a, "--repeat") == 0) {
       repeat = (int)parse_int(a, arg_value(&i, argc, argv), 1, 1000);
     } else if (strcmp(a, "--stats") == 0) {

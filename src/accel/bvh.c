@@ -150,6 +150,7 @@ typedef struct {
 typedef struct {
   pref *refs, *scratch;
   int bins, leaf_size, threads;
+  bool oom; /* an allocation failed (only the building thread splits big ranges, which allocate) */
 } builder;
 
 /* Chooses the cheapest binned SAH split; returns false when every centroid falls
@@ -296,7 +297,8 @@ static void median_split(builder *bd, const task *t, split *sp) {
 }
 
 /* Decides how to split t (or not) and partitions its references; `threads` only
- * says how many threads may help with a big range. */
+ * says how many threads may help with a big range. Out of memory, t stays a leaf
+ * and bd->oom is set. */
 static void split_task(builder *bd, const task *t, int threads, split *sp) {
   sp->mid = 0;
   if (t->count <= 1) return;
@@ -312,6 +314,10 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
   chunk_job job = {.bd = bd, .t = t, .m = &m};
   if (big) {
     job.chunk_bins = malloc(sizeof(bins) * nchunks);
+    if (!job.chunk_bins) {
+      bd->oom = true;
+      return;
+    }
     rr_parallel_for(nchunks, threads, chunk_bin, &job);
     bins_clear(b, nb);
     for (int c = 0; c < nchunks; c++) bins_merge(b, &job.chunk_bins[c], nb);
@@ -340,6 +346,11 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
     job.nleft = malloc(sizeof(uint32_t) * nchunks);
     job.offset = malloc(sizeof(uint32_t) * 2 * nchunks);
     job.ccb = malloc(sizeof(box4) * 2 * nchunks);
+    if (!job.nleft || !job.offset || !job.ccb) {
+      free(job.nleft), free(job.offset), free(job.ccb);
+      bd->oom = true;
+      return;
+    }
     rr_parallel_for(nchunks, threads, chunk_count, &job);
     uint32_t nl = 0;
     for (int c = 0; c < nchunks; c++) job.offset[c] = nl, nl += job.nleft[c];
@@ -528,6 +539,9 @@ static void make_refs(int c, int thread, void *arg) {
   j->cb[2 * c] = b, j->cb[2 * c + 1] = cb;
 }
 
+/* Memory on 64-byte cache lines, rounded up to whole lines (as aligned_alloc requires). */
+static void *alloc_lines(size_t bytes) { return aligned_alloc(64, (bytes + 63) & ~(size_t)63); }
+
 /* ---- the 4-wide copy ------------------------------------------------------------ */
 
 static double node_area(const bvh_node *n) {
@@ -576,14 +590,14 @@ static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
 static bool collapse_wide(rr_bvh *b) {
   /* At most one wide node per inner binary node (plus a leaf root). */
   uint32_t cap = (b->nnodes - 1) / 2 + 1;
-  b->wide = aligned_alloc(64, (size_t)cap * sizeof(bvh_wide));
+  b->wide = alloc_lines((size_t)cap * sizeof(bvh_wide));
   b->wide_node = malloc((size_t)cap * 4 * sizeof(uint32_t));
   if (!b->wide || !b->wide_node) return false;
   uint32_t next = 1;
   collapse_node(b, 0, 0, &next);
   b->nwide = next;
   /* about half of the room is used: keep what is */
-  bvh_wide *exact = aligned_alloc(64, (size_t)next * sizeof(bvh_wide));
+  bvh_wide *exact = alloc_lines((size_t)next * sizeof(bvh_wide));
   uint32_t *exact_node = malloc((size_t)next * 4 * sizeof(uint32_t));
   if (exact && exact_node) {
     memcpy(exact, b->wide, (size_t)next * sizeof(bvh_wide));
@@ -610,8 +624,9 @@ void rr_build_options_init(rr_build_options *opt) {
 
 rr_error rr_device_set_build_options(rr_device *dev, const rr_build_options *opt) {
   if (!dev || !opt) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_device_set_build_options: NULL argument");
-  if (opt->threads < 0 || opt->threads > 256)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad build thread count %d (0 for all cores, at most 256)", opt->threads);
+  if (opt->threads < 0 || opt->threads > RR_MAX_THREADS)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad build thread count %d (0 for all cores, at most %d)", opt->threads,
+                   RR_MAX_THREADS);
   if (opt->bins != 0 && (opt->bins < 2 || opt->bins > BVH_MAX_BINS))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad SAH bin count %d (2..%d)", opt->bins, BVH_MAX_BINS);
   if (opt->leaf_size != 0 && (opt->leaf_size < 1 || opt->leaf_size > BVH_MAX_LEAF))
@@ -650,8 +665,8 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
     return RR_OK;
   }
   uint32_t n = s->ntris;
-  bd.refs = aligned_alloc(64, ((size_t)n * sizeof(pref) + 63) & ~(size_t)63);
-  bd.scratch = aligned_alloc(64, ((size_t)n * sizeof(pref) + 63) & ~(size_t)63);
+  bd.refs = alloc_lines((size_t)n * sizeof(pref));
+  bd.scratch = alloc_lines((size_t)n * sizeof(pref));
   int nchunks = (int)((n + BVH_CHUNK - 1) / BVH_CHUNK);
   box4 *cb = malloc(sizeof(box4) * 2 * nchunks);
   task_vec frontier = {0}, next = {0}, small = {0};
@@ -671,10 +686,12 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   uint32_t top_leaves = 0, top_depth = 0;
   if (root.count > BVH_TASK_MAX) task_push(&frontier, root);
   else task_push(&small, root);
+  if (frontier.oom || small.oom) goto oom;
 
   while (frontier.n) {
-    splits = realloc(splits, sizeof *splits * frontier.n);
-    if (!splits) goto oom;
+    split *grown = realloc(splits, sizeof *splits * frontier.n);
+    if (!grown) goto oom;
+    splits = grown;
     /* Big ranges one at a time with all threads inside; the rest one per thread. */
     level_job lj = {&bd, frontier.v, splits};
     int nmid = 0;
@@ -682,6 +699,7 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
       if (frontier.v[i].count >= BVH_PAR_MIN) split_task(&bd, &frontier.v[i], bd.threads, &splits[i]);
       else nmid++;
     }
+    if (bd.oom) goto oom;
     if (nmid) {
       /* Ranges below BVH_PAR_MIN, in parallel; a range is split the same way
        * whichever thread does it. */
@@ -739,7 +757,7 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
     total += local[i].n;
   }
   if (total > UINT32_MAX / 2) goto oom;
-  b->node_mem = aligned_alloc(64, ((size_t)(total + 2) * sizeof(bvh_node) + 63) & ~(size_t)63);
+  b->node_mem = alloc_lines((size_t)(total + 2) * sizeof(bvh_node));
   b->prims = malloc((size_t)n * sizeof *b->prims);
   if (!b->node_mem || !b->prims) goto oom;
   b->nodes = (bvh_node *)b->node_mem + 1;

@@ -62,14 +62,14 @@ static vec3 curved_dir(const camera *c, const rr_camera *in, int x, int y) {
     return v3_add(v3_add(v3_scale(r, (float)u), v3_scale(up, (float)v)), v3_scale(f, (float)(0.5 - 0.5 * rr)));
   }
   case RR_CAMERA_LATLONG: {
-    double phi = 2 * M_PI * sx / W - M_PI, theta = M_PI * sy / H;
+    double phi = 2 * RR_PI * sx / W - RR_PI, theta = RR_PI * sy / H;
     return v3_add(v3_scale(v3_add(v3_scale(r, (float)sin(phi)), v3_scale(f, (float)cos(phi))), (float)sin(theta)),
                   v3_scale(up, (float)cos(theta)));
   }
   case RR_CAMERA_FISHEYE: {
     double rad = sqrt(u * u + v * v);
     if (rad > 1) return v3(0, 0, 0);
-    double a = rad * in->fov_deg * M_PI / 360, psi = atan2(v, u);
+    double a = rad * in->fov_deg * RR_PI / 360, psi = atan2(v, u);
     return v3_add(v3_scale(v3_add(v3_scale(r, (float)cos(psi)), v3_scale(up, (float)sin(psi))), (float)sin(a)),
                   v3_scale(f, (float)cos(a)));
   }
@@ -117,7 +117,7 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
   c->fwd = v3_norm(v3_sub(v3_load(in->target), c->eye));
   c->right = v3_norm(v3_cross(c->fwd, v3_load(in->up)));
   c->up = v3_cross(c->right, c->fwd);
-  c->tan_half_h = tanf(in->fov_deg * (float)M_PI / 360.0f);
+  c->tan_half_h = tanf(in->fov_deg * (float)RR_PI / 360.0f);
   c->tan_half_w = c->tan_half_h * (float)width / (float)height;
   c->planar = in->type == RR_CAMERA_PERSPECTIVE || in->type == RR_CAMERA_ORTHOGRAPHIC;
   c->dir_len_max = 1;
@@ -156,10 +156,10 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     c->lipschitz = 2.0f * 2.0f / (float)(width < height ? width : height);
     break;
   case RR_CAMERA_LATLONG: /* ds² = dθ² + sin²θ dφ² <= dθ² + dφ² */
-    c->lipschitz = fmaxf(2.0f * (float)M_PI / (float)width, (float)M_PI / (float)height);
+    c->lipschitz = fmaxf(2.0f * (float)RR_PI / (float)width, (float)RR_PI / (float)height);
     break;
   case RR_CAMERA_FISHEYE: /* angle = r·fov/2; the tangential rate sin(a)/r is smaller */
-    c->lipschitz = in->fov_deg * (float)M_PI / 360.0f * 2.0f / (float)(width < height ? width : height);
+    c->lipschitz = in->fov_deg * (float)RR_PI / 360.0f * 2.0f / (float)(width < height ? width : height);
     break;
   default: /* cube: a 90° face, atan' <= 1 on its [-1, 1] image plane */
     c->lipschitz = 2.0f / (float)c->face;
@@ -183,7 +183,8 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
       float angle;
       int cone = rr_cam_rect_cone(c, cx * CAMERA_CELL, cy * CAMERA_CELL, x1, y1, &axis, &angle);
       cell[0] = axis.x, cell[1] = axis.y, cell[2] = axis.z;
-      cell[3] = cone < 0 ? -1.0f : cone > 0 && angle < 1.5f ? angle : 2.0f; /* no rays, a cone, no bound */
+      /* no rays, a cone, no bound */
+      cell[3] = cone < 0 ? -1.0f : cone > 0 && angle < CAMERA_NO_CONE ? angle : CAMERA_NO_CONE;
     }
   return rr_ok(dev);
 }
@@ -256,7 +257,7 @@ rr_error rr_camera_frame(rr_device *dev, const rr_scene *s, int width, int heigh
   if (s->ntris == 0) return rr_fail(dev, RR_ERROR_EMPTY, "cannot frame an empty scene");
   if (width < 1 || height < 1) return rr_fail(dev, RR_ERROR_ARGUMENT, "bad image size %dx%d", width, height);
   vec3 centre = v3_scale(v3_add(s->bmin, s->bmax), 0.5f);
-  float th = cam->fov_deg > 0 && cam->fov_deg < 180 ? tanf(cam->fov_deg * (float)M_PI / 360.0f) : 0.41f;
+  float th = cam->fov_deg > 0 && cam->fov_deg < 180 ? tanf(cam->fov_deg * (float)RR_PI / 360.0f) : 0.41f;
   float tw = th * (float)width / (float)height, fill = 0.94f;
   /* Look from the front and a little above; back off until every corner of the
    * bounding box is inside the view: for a corner at offset o from the centre, at

@@ -31,10 +31,14 @@ typedef struct camera {
   float dir_len_max; /* longest |d| of the camera's rays */
   int face;          /* cube: side of a face in pixels */
   int cells_x, cells_y; /* curved: cones of CAMERA_CELL² cells of samples, 4 floats each: */
-  float *cells;         /* unit axis and half-angle; no bound when >= 1.5, no rays when < 0 */
+  float *cells;         /* unit axis and half-angle; no bound when >= CAMERA_NO_CONE, no rays when < 0 */
 } camera;
 
 #define CAMERA_CELL 32
+/* Cones (and caps) of directions this wide or wider bound nothing: the cone tests
+ * hold for half-angles under 90° only (a little more than 1.5 radians). A cell
+ * without a useful cone stores this half-angle. */
+#define CAMERA_NO_CONE 1.5f
 
 /* Resolves a public camera for an image size; rr_cam_release frees it. */
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *out);

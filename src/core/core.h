@@ -13,9 +13,6 @@
 /* Hot kernels written once and specialised by their constant arguments. */
 #define KERNEL static inline __attribute__((always_inline))
 
-/* More threads than this are refused: every per-thread array is sized by it. */
-#define RR_MAX_THREADS 256
-
 struct rr_device {
   rr_error error;
   char message[512];
@@ -37,7 +34,8 @@ rr_error rr_fail(rr_device *dev, rr_error code, const char *fmt, ...)
 rr_error rr_ok(rr_device *dev);
 
 /* Runs fn(job, thread, arg) for job = 0..njobs-1, dealt out dynamically to
- * `threads` threads (the caller's thread is one of them). */
+ * `threads` threads (the caller's thread is one of them; at most RR_MAX_THREADS,
+ * which sizes every per-thread array, so thread < RR_MAX_THREADS). */
 typedef void (*rr_parallel_fn)(int job, int thread, void *arg);
 void rr_parallel_for(int njobs, int threads, rr_parallel_fn fn, void *arg);
 /* Number of cores available. */

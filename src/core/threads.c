@@ -3,7 +3,17 @@
  * as long as the process, since a frame runs many short loops (a batch of
  * triangles is two of them) and starting threads for each would cost more than
  * some loops do. A loop started while the pool is busy (another caller's thread,
- * or a loop inside a job) runs on threads of its own instead. */
+ * or a loop inside a job) runs on threads of its own instead.
+ *
+ * The pool is the library's one piece of shared mutable state, shared by every
+ * device on purpose (threads are a resource of the process). It is safe from any
+ * number of threads: `busy` lets one caller's loop in at a time (the others run
+ * their own threads, so no device ever waits for another), everything else in it
+ * is read and written under `mu`, and a caller leaves only when no worker is still
+ * inside its loop, whose state lives on that caller's stack. A loop reaches no
+ * caller data but through fn and arg. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, sysconf, pthreads */
+
 #include "core/core.h"
 
 #include <pthread.h>
@@ -26,8 +36,6 @@ static void run_jobs(loop *l, int thread) {
     l->fn(job, thread, l->arg);
   }
 }
-
-#define MAX_THREADS 256
 
 typedef struct {
   pthread_mutex_t busy; /* held by the caller whose loop the pool runs */
@@ -87,8 +95,8 @@ static void *own_thread(void *arg) {
 }
 
 static void run_own_threads(loop *l, int threads) {
-  pthread_t tid[MAX_THREADS];
-  own_arg a[MAX_THREADS];
+  pthread_t tid[RR_MAX_THREADS];
+  own_arg a[RR_MAX_THREADS];
   int started = 0;
   for (int i = 1; i < threads; i++) {
     a[i] = (own_arg){l, i};
@@ -102,7 +110,7 @@ static void run_own_threads(loop *l, int threads) {
 void rr_parallel_for(int njobs, int threads, rr_parallel_fn fn, void *arg) {
   if (threads > njobs) threads = njobs;
   if (threads < 1) threads = 1;
-  if (threads > MAX_THREADS) threads = MAX_THREADS;
+  if (threads > RR_MAX_THREADS) threads = RR_MAX_THREADS;
   loop l = {.njobs = njobs, .fn = fn, .arg = arg};
   atomic_init(&l.next, 0);
   if (threads == 1) {
@@ -136,17 +144,15 @@ void rr_parallel_for(int njobs, int threads, rr_parallel_fn fn, void *arg) {
 
 int rr_cpu_count(void) {
   long n = sysconf(_SC_NPROCESSORS_ONLN);
-  return n < 1 ? 1 : n > 256 ? 256 : (int)n;
+  return n < 1 ? 1 : n > RR_MAX_THREADS ? RR_MAX_THREADS : (int)n;
 }
 
-double rr_cpu_ms(void) {
+static double clock_ms(clockid_t clock) {
   struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  clock_gettime(clock, &ts);
   return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-double rr_now_ms(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
+double rr_cpu_ms(void) { return clock_ms(CLOCK_PROCESS_CPUTIME_ID); }
+
+double rr_now_ms(void) { return clock_ms(CLOCK_MONOTONIC); }

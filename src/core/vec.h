@@ -4,6 +4,8 @@
 
 #include <math.h>
 
+#define RR_PI 3.14159265358979323846 /* M_PI is POSIX (XSI), not C */
+
 typedef struct { float x, y, z; } vec3;
 
 static inline vec3 v3(float x, float y, float z) { vec3 r = {x, y, z}; return r; }

@@ -103,7 +103,7 @@ static rr_error add_node(rr_scene *s, const struct aiScene *sc, const struct aiN
 static rr_error add_materials(rr_scene *s, const struct aiScene *sc) {
   for (unsigned i = 0; i < sc->mNumMaterials; i++) {
     const struct aiMaterial *am = sc->mMaterials[i];
-    struct aiColor4D c = {0.8f, 0.8f, 0.8f, 1.0f};
+    struct aiColor4D c = {SCENE_GREY, SCENE_GREY, SCENE_GREY, 1.0f};
     aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &c);
     struct aiString tex;
     tex.length = 0;

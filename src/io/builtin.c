@@ -9,8 +9,6 @@
 
 #include <string.h>
 
-static const double PI = 3.14159265358979323846;
-
 /* ---- name parsing -------------------------------------------------------------- */
 
 /* When `name` is `key` or `key:ARG`, returns ARG ("" for the bare key); else NULL. */
@@ -97,7 +95,7 @@ static void push_quad(rr_scene *s, vec3 a, vec3 b, vec3 c, vec3 d, const vec3 *f
  * along its (x0,z0)-(x1,z1) diagonal; both halves are counter-clockwise from +y. */
 static rr_error gen_plane(rr_scene *s, int n) {
   uint32_t mat;
-  rr_error e = add_material(s, 0.8f, 0.8f, 0.8f, &mat);
+  rr_error e = add_material(s, SCENE_GREY, SCENE_GREY, SCENE_GREY, &mat);
   if (!e) e = reserve(s, 2 * (uint64_t)n * n, false);
   if (!e) e = open_object(s, "plane", mat);
   if (e) return e;
@@ -132,9 +130,9 @@ static rr_error gen_sphere(rr_scene *s, int seg, vec3 centre, float radius, uint
   dir[0] = v3(0, 1, 0);
   dir[nv - 1] = v3(0, -1, 0);
   for (int r = 1; r < rings; r++) {
-    double th = PI * r / rings;
+    double th = RR_PI * r / rings;
     for (int j = 0; j < seg; j++) {
-      double ph = 2 * PI * j / seg;
+      double ph = 2 * RR_PI * j / seg;
       dir[1 + (size_t)(r - 1) * seg + j] =
           v3((float)(sin(th) * cos(ph)), (float)cos(th), (float)(-sin(th) * sin(ph)));
     }
@@ -165,7 +163,7 @@ static rr_error gen_sphere(rr_scene *s, int seg, vec3 centre, float radius, uint
 static rr_error gen_box(rr_scene *s, int n) {
   uint32_t mat;
   float *g = malloc(((size_t)n + 1) * sizeof *g);
-  rr_error e = g ? add_material(s, 0.8f, 0.8f, 0.8f, &mat)
+  rr_error e = g ? add_material(s, SCENE_GREY, SCENE_GREY, SCENE_GREY, &mat)
                  : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory generating a box");
   if (!e) e = reserve(s, 12 * (uint64_t)n * n, true);
   if (!e) e = open_object(s, "box", mat);
@@ -215,9 +213,9 @@ static rr_error gen_torus(rr_scene *s, int nu, int nv, float R, float r, vec3 ce
     return e;
   }
   for (int i = 0; i < nu; i++) {
-    double u = 2 * PI * i / nu;
+    double u = 2 * RR_PI * i / nu;
     for (int j = 0; j < nv; j++) {
-      double w = 2 * PI * j / nv;
+      double w = 2 * RR_PI * j / nv;
       double cu = cos(u), su = -sin(u), cw = cos(w), sw = sin(w);
       nrm[(size_t)i * nv + j] = v3((float)(cw * cu), (float)sw, (float)(cw * su));
       pos[(size_t)i * nv + j] =
@@ -249,6 +247,7 @@ static rr_error gen_ground(rr_scene *s) {
   if (!e) e = add_material(s, 0.20f, 0.45f, 0.85f, &ball_m);
   if (!e) e = reserve(s, 4, false);
   if (!e) e = open_object(s, "ground", ground_m);
+  if (!e) e = rr_scene_reserve_inf(s);
   if (e) return e;
   const vec3 origin = v3(0, 0, 0), dir[4] = {v3(1, 0, 0), v3(0, 0, -1), v3(-1, 0, 0), v3(0, 0, 1)};
   for (int q = 0; q < 4; q++) {
@@ -380,7 +379,7 @@ static rr_error push_column(rr_scene *s, float cx, float cz, float radius, int s
   if (e) return e;
   vec3 bot[12], top[12];
   for (int k = 0; k < sides; k++) {
-    double ph = 2 * PI * k / sides; /* counter-clockwise seen from +y */
+    double ph = 2 * RR_PI * k / sides; /* counter-clockwise seen from +y */
     bot[k] = v3(cx + radius * (float)cos(ph), 0, cz - radius * (float)sin(ph));
     top[k] = v3(bot[k].x, ROOM_H, bot[k].z);
   }
@@ -506,7 +505,7 @@ static rr_error place_file(rr_scene *s, const char *path, const char *name, floa
   for (uint32_t g = g0; !e && g < s->ngeoms; g++) e = rr_scene_name_geometry(s, g, name);
   if (!e) e = smooth_normals(s, t0, s->ntris);
   if (e) return e;
-  float cy = cosf(yaw * (float)(PI / 180)), sy = sinf(yaw * (float)(PI / 180));
+  float cy = cosf(yaw * (float)(RR_PI / 180)), sy = sinf(yaw * (float)(RR_PI / 180));
   vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
   for (uint32_t i = t0; i < s->ntris; i++)
     for (int k = 0; k < 3; k++) {
@@ -574,7 +573,7 @@ rr_error rr_scene_load_builtin(rr_scene *s, const char *name) {
   } else if ((arg = builtin_arg(name, "sphere"))) {
     uint32_t mat;
     e = size_arg(s, name, arg, 32, 4, 4096, &n);
-    if (!e) e = add_material(s, 0.8f, 0.8f, 0.8f, &mat);
+    if (!e) e = add_material(s, SCENE_GREY, SCENE_GREY, SCENE_GREY, &mat);
     if (!e) e = gen_sphere(s, (int)n, v3(0, 0, 0), 1.0f, mat);
   } else if ((arg = builtin_arg(name, "box"))) {
     e = size_arg(s, name, arg, 8, 1, 1024, &n);

@@ -43,7 +43,7 @@ void rr_tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri
     tc->cap_axis = v3_norm(m);
     float r = 0;
     for (int k = 0; k < 3; k++) r = fmaxf(r, acosf(fminf(1.0f, v3_dot(u[k], tc->cap_axis))));
-    if (r < 1.5f) tc->cap_angle = r * 1.0001f + 1e-5f;
+    if (r < CAMERA_NO_CONE) tc->cap_angle = r * 1.0001f + 1e-5f;
   }
 }
 
@@ -55,7 +55,7 @@ static bool curved_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
     for (int cx = 0; cx < c->cells_x; cx++) {
       const float *cell = c->cells + 4 * ((size_t)cy * c->cells_x + cx);
       if (cell[3] < 0) continue; /* no rays */
-      if (cell[3] < 1.5f && rr_cone_excludes(&tc, ts, v3(cell[0], cell[1], cell[2]), cell[3])) continue;
+      if (cell[3] < CAMERA_NO_CONE && rr_cone_excludes(&tc, ts, v3(cell[0], cell[1], cell[2]), cell[3])) continue;
       x0 = cx < x0 ? cx : x0, x1 = cx > x1 ? cx : x1, y0 = cy < y0 ? cy : y0, y1 = cy > y1 ? cy : y1;
     }
   if (x1 < 0) return false;

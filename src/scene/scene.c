@@ -61,11 +61,19 @@ rr_error rr_scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool wi
   return RR_OK;
 }
 
+rr_error rr_scene_reserve_inf(rr_scene *s) {
+  if (s->inf) return RR_OK;
+  s->inf = calloc(s->cap ? s->cap : 1, 1); /* earlier triangles are finite */
+  return s->inf ? RR_OK : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for corners at infinity");
+}
+
 void rr_scene_trim(rr_scene *s) {
   if (s->ntris && s->ntris < s->cap) resize(s, s->ntris, false, false); /* on failure the arrays stay as they were */
 }
 
-/* Every per-triangle array to cap entries; add_n / add_uv start those arrays. */
+/* Every per-triangle array to cap entries; add_n / add_uv start those arrays.
+ * On failure each array holds at least min(cap, s->cap) entries, which s->cap then
+ * says, and the arrays it was to start are not there. */
 static bool resize(rr_scene *s, uint32_t cap, bool add_n, bool add_uv) {
   bool ok = true;
   for (int k = 0; k < 3; k++) {
@@ -91,7 +99,14 @@ static bool resize(rr_scene *s, uint32_t cap, bool add_n, bool add_uv) {
     ok = f != NULL;
   }
   uint32_t *m = ok ? realloc(s->material, (size_t)cap * sizeof *m) : NULL;
-  if (!m) return false;
+  if (!m) {
+    for (int k = 0; k < 3; k++) {
+      for (int c = 0; c < 3 && add_n; c++) free(s->n[k][c]), s->n[k][c] = NULL;
+      for (int c = 0; c < 2 && add_uv; c++) free(s->uv[k][c]), s->uv[k][c] = NULL;
+    }
+    if (cap < s->cap) s->cap = cap;
+    return false;
+  }
   s->material = m;
   s->cap = cap;
   return true;
@@ -131,10 +146,7 @@ bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n
   if (s->ntris >= s->cap && rr_scene_reserve(s, 1, n != NULL, uv != NULL) != RR_OK) return false;
   if ((n && !s->n[0][0]) || (uv && !s->uv[0][0]))
     if (rr_scene_reserve(s, 0, n != NULL, uv != NULL) != RR_OK) return false;
-  if (inf && !s->inf) {
-    s->inf = calloc(s->cap, 1); /* earlier triangles are finite */
-    if (!s->inf) return false;
-  }
+  if (inf && rr_scene_reserve_inf(s) != RR_OK) return false;
   if (!s->ngeoms && rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, NULL) != RR_OK) return false;
   uint32_t i = s->ntris++;
   if (s->inf) s->inf[i] = (uint8_t)(inf & 7u);
@@ -284,14 +296,18 @@ static rr_error add_mesh(rr_scene *s, const char *api, const float *pos, int str
   if (!s) return RR_ERROR_ARGUMENT;
   if ((!pos && nvert) || (!idx && ntri)) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: NULL positions or indices", api);
   if (ntri > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: too many triangles", api);
-  for (size_t t = 0; t < 3 * ntri; t++)
+  bool inf = false;
+  for (size_t t = 0; t < 3 * ntri; t++) {
     if (idx[t] >= nvert)
       return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: index %u of triangle %zu out of range (%zu vertices)", api,
                      idx[t], t / 3, nvert);
-  float grey[3] = {0.8f, 0.8f, 0.8f};
+    inf = inf || (stride == 4 && pos[4 * (size_t)idx[t] + 3] == 0);
+  }
+  float grey[3] = {SCENE_GREY, SCENE_GREY, SCENE_GREY};
   uint32_t mat = rr_scene_add_material(s, rgb ? rgb : grey, NULL);
   if (mat == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
   rr_error e = rr_scene_reserve(s, (uint32_t)ntri, false, false);
+  if (!e && inf) e = rr_scene_reserve_inf(s);
   if (!e) e = rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, NULL);
   if (e) return e;
   for (size_t t = 0; t < ntri; t++) {

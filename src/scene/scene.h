@@ -8,6 +8,9 @@
 
 struct rr_bvh;
 
+/* The base colour of a mesh that names none (every channel). */
+#define SCENE_GREY 0.8f
+
 typedef struct rr_texture {
   int width, height; /* 0 when the file could not be read */
   uint8_t *rgb;      /* 3 bytes per texel, row 0 at the top */
@@ -73,6 +76,10 @@ vec3 rr_scene_tri_normal(const rr_scene *s, uint32_t i);
 
 /* Grows the scene to hold `more` triangles; with_normals/with_uvs allocate those arrays. */
 rr_error rr_scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_uvs);
+/* Starts the flags of corners at infinity (those so far are finite), which then
+ * grow with the other arrays: after it, with room reserved, pushing such a triangle
+ * cannot run out of memory. */
+rr_error rr_scene_reserve_inf(rr_scene *s);
 /* Gives back the room reserve doubled into (at commit: the scene is complete). */
 void rr_scene_trim(rr_scene *s);
 /* Appends one triangle (positions, optional corner normals/uvs); drops and counts

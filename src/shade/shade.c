@@ -11,6 +11,10 @@
 #include <stb_easy_font.h>
 #pragma GCC diagnostic pop
 
+/* Colours are shaded in linear light; textures and the output are encoded with this
+ * power (sRGB, approximately). */
+#define GAMMA 2.2f
+
 typedef struct hit {
   bool valid, has_ray;
   uint32_t id;
@@ -73,12 +77,12 @@ static void texel(const rr_texture *t, float u, float v, float rgb[3]) {
       for (int c = 0; c < 3; c++) rgb[c] += w * p[c] / 255.0f;
     }
   /* textures are sRGB-encoded; shading works in linear light */
-  for (int c = 0; c < 3; c++) rgb[c] = powf(rgb[c], 2.2f);
+  for (int c = 0; c < 3; c++) rgb[c] = powf(rgb[c], GAMMA);
 }
 
 static void base_color(const rr_scene *s, const hit *h, float rgb[3]) {
   const rr_material *m = s->nmaterials ? &s->materials[s->material[h->id] % s->nmaterials] : NULL;
-  rgb[0] = rgb[1] = rgb[2] = 0.8f;
+  rgb[0] = rgb[1] = rgb[2] = SCENE_GREY;
   if (!m) return;
   memcpy(rgb, m->color, sizeof m->color);
   if (m->texture.width > 0 && s->uv[0][0]) {
@@ -96,7 +100,7 @@ static uint32_t hash32(uint32_t x) {
   return x;
 }
 
-static float to_display(float linear) { return powf(fminf(fmaxf(linear, 0.0f), 1.0f), 1.0f / 2.2f); }
+static float to_display(float linear) { return powf(fminf(fmaxf(linear, 0.0f), 1.0f), 1.0f / GAMMA); }
 
 static rr_error image_alloc(rr_device *dev, rr_image *img, int w, int h, int ch, rr_pixel_type type) {
   size_t size = type == RR_PIXEL_U8 ? 1 : 4;
@@ -115,12 +119,15 @@ static void heat_color(float v, float *o) {
   for (int c = 0; c < 3; c++) o[c] = stops[i][c] * (1 - f) + stops[i + 1][c] * f;
 }
 
-/* Draws text with stb_easy_font's quads, scaled by `scale`, into an RGB float image. */
-static void draw_text(rr_image *img, float x, float y, float scale, const char *text) {
-  static char buf[64 * 1024];
+/* Room for stb_easy_font's quads (64 bytes each) of one line of up to 127 characters. */
+enum { TEXT_BUF = 64 * 1024 };
+
+/* Draws text with stb_easy_font's quads, scaled by `scale`, into an RGB float
+ * image; buf (TEXT_BUF bytes) receives the quads. */
+static void draw_text(rr_image *img, char *buf, float x, float y, float scale, const char *text) {
   char t[128];
   snprintf(t, sizeof t, "%s", text);
-  int quads = stb_easy_font_print(0, 0, t, NULL, buf, sizeof buf);
+  int quads = stb_easy_font_print(0, 0, t, NULL, buf, TEXT_BUF);
   float *px = img->data;
   for (int q = 0; q < quads; q++) {
     const float *v0 = (const float *)(buf + q * 64), *v2 = (const float *)(buf + q * 64 + 32);
@@ -136,7 +143,7 @@ static void draw_text(rr_image *img, float x, float y, float scale, const char *
 
 /* Per-pixel counts as a heat map on a log scale up to the largest value, with a
  * legend: the ramp along the bottom, its range and the mean. */
-static void shade_heat(const float *heat, rr_image *img, const char *what) {
+static rr_error shade_heat(rr_device *dev, const float *heat, rr_image *img, const char *what) {
   size_t n = (size_t)img->width * img->height;
   float top = 0;
   double sum = 0;
@@ -146,7 +153,9 @@ static void shade_heat(const float *heat, rr_image *img, const char *what) {
   int bar = img->height / 40 > 5 ? img->height / 40 : 5;
   float scale = bar / 7.0f > 1 ? bar / 7.0f : 1, line = 11 * scale;
   int y0 = img->height - bar - 3, ytext = (int)(y0 - line - 2);
-  if (ytext < 0 || img->width < 64) return;
+  if (ytext < 0 || img->width < 64) return RR_OK;
+  char *buf = malloc(TEXT_BUF); /* each call its own: two threads may draw legends at once */
+  if (!buf) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a heat map's legend");
   int x0 = img->width * 3 / 5, x1 = img->width - 8;
   for (int y = ytext - 2; y < img->height; y++)
     for (int x = 0; x < img->width; x++) {
@@ -156,10 +165,12 @@ static void shade_heat(const float *heat, rr_image *img, const char *what) {
     }
   char label[128];
   snprintf(label, sizeof label, "%s per pixel (log), mean %.1f", what, sum / n);
-  draw_text(img, 4, (float)ytext, scale, label);
-  draw_text(img, (float)x0 - 8 * scale, (float)y0 - 2 * scale, scale, "0");
+  draw_text(img, buf, 4, (float)ytext, scale, label);
+  draw_text(img, buf, (float)x0 - 8 * scale, (float)y0 - 2 * scale, scale, "0");
   snprintf(label, sizeof label, "%.0f", top);
-  draw_text(img, (float)x1 - stb_easy_font_width(label) * scale, (float)ytext, scale, label);
+  draw_text(img, buf, (float)x1 - stb_easy_font_width(label) * scale, (float)ytext, scale, label);
+  free(buf);
+  return RR_OK;
 }
 
 static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp, const rr_frame *f,
@@ -174,7 +185,12 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp,
   e = image_alloc(dev, out, vb->width, vb->height, 3, RR_PIXEL_F32);
   if (e) return e;
   if (heat) {
-    shade_heat(counts, out, mode == RR_SHADE_HEAT_EVALS ? "edge evaluations" : "BVH nodes");
+    e = shade_heat(dev, counts, out, mode == RR_SHADE_HEAT_EVALS ? "edge evaluations" : "BVH nodes");
+    if (e) {
+      free(out->data);
+      out->data = NULL;
+      return e;
+    }
     return rr_ok(dev);
   }
   float dmin = INFINITY, dmax = 0;

@@ -7,7 +7,7 @@ typedef struct {
   const tri_setup *setup;
   const uint32_t *ids;
   uint32_t n;
-  uint64_t evals[256];
+  uint64_t evals[RR_MAX_THREADS];
 } rc_job;
 
 static void rc_row(int y, int thread, void *arg) {
@@ -42,7 +42,7 @@ rr_error rr_vis_rc(rr_device *dev, render_ctx *ctx) {
   ctx->stats->setups += s->ntris;
   rc_job job = {.ctx = ctx, .setup = setup, .ids = ids, .n = n};
   rr_parallel_for(ctx->vb->height, ctx->threads, rc_row, &job);
-  for (int t = 0; t < 256; t++) ctx->stats->edge_evals += job.evals[t];
+  for (int t = 0; t < RR_MAX_THREADS; t++) ctx->stats->edge_evals += job.evals[t];
   free(setup), free(ids);
   return RR_OK;
 }

@@ -1,4 +1,6 @@
 /* The method table and the visibility pass (rr_render): a frame from a scene, a camera and options. */
+#define _POSIX_C_SOURCE 200809L /* strtok_r */
+
 #include "vis/vis.h"
 
 #include <stdio.h>
@@ -206,8 +208,9 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   if (opt->method == RR_METHOD_AUTO) return render_auto(dev, scene, cam, opt, out);
   if ((int)opt->method < 0 || opt->method >= RR_METHOD_COUNT)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown method %d", (int)opt->method);
-  if (opt->threads < 0 || opt->threads > 256)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad thread count %d (0 for all cores, at most 256)", opt->threads);
+  if (opt->threads < 0 || opt->threads > RR_MAX_THREADS)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad thread count %d (0 for all cores, at most %d)", opt->threads,
+                   RR_MAX_THREADS);
   oracles o = methods[opt->method].o;
   if (opt->oracles && *opt->oracles) {
     if (methods[opt->method].fn != rr_vis_traverse)

@@ -149,7 +149,7 @@ static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
         float angle;
         int cone = rr_cam_rect_cone(t->c, b.x0, b.y0, b.x1, b.y1, &axis, &angle);
         if (cone < 0) continue; /* no rays here: nothing to refine */
-        if (cone > 0 && angle < 1.5f) {
+        if (cone > 0 && angle < CAMERA_NO_CONE) {
           out = rr_cone_excludes(&j->cone, &j->ts, axis, angle);
           t->st.edge_evals += 1;
           if (t->heat_e) t->heat_e[(size_t)((b.y0 + b.y1) / 2) * t->vb->width + (b.x0 + b.x1) / 2] += 1;
