@@ -125,8 +125,8 @@ static rr_error api(const fixture *fx, uint64_t *print) {
   rr_ray ray = {{0.25f, 0.25f, 2}, {0, 0, -1}, 0, INFINITY};
   rr_hit hit;
   int occluded;
-  if (!e) e = rr_intersect(s, &ray, &hit);
-  if (!e) e = rr_occluded(s, &ray, &occluded);
+  if (!e) e = rr_intersect(fx->dev, s, &ray, &hit);
+  if (!e) e = rr_occluded(fx->dev, s, &ray, &occluded);
   if (!e) e = rr_scene_add_mesh(s, quad, 4, quad_idx + 3, 1, NULL);
   if (!e) e = rr_scene_commit(s);
   if (!e) *print = mix(mix(scene_print(s), hit.prim), (uint64_t)occluded);
