@@ -7,9 +7,6 @@
 
 #include <string.h>
 
-/* Samples a set-up triangle may cover, as an inclusive pixel rectangle. Returns
- * false when it covers none. */
-/* Curved views: the cells whose cone no edge plane leaves wholly outside. */
 /* Curved views: does a cone of directions (unit axis, half-angle) miss the
  * triangle's directions? Two conservative tests: the triangle's bounding cap
  * (tight for small triangles), and the four planes through the eye a hit must lie
@@ -215,7 +212,7 @@ float rr_tri_bounds(const tri_setup *ts, const camera *cam, float rect[4]) {
     }
     smax = (sqrt(nx * nx + ny * ny + nz * nz) + err) * dmax * (1 + slack);
   }
-  /* Rounded outwards to float; samples are small integers + 0.5, so this is loose. */
+  /* Rounded outwards to float; samples are small integers + sx0, so this is loose. */
   rect[0] = (float)rx0 - 1e-3f, rect[1] = (float)ry0 - 1e-3f, rect[2] = (float)rx1 + 1e-3f, rect[3] = (float)ry1 + 1e-3f;
   if (!(smax > 0)) { /* no sample can pass */
     rect[0] = rect[1] = INFINITY, rect[2] = rect[3] = -INFINITY;
@@ -224,7 +221,8 @@ float rr_tri_bounds(const tri_setup *ts, const camera *cam, float rect[4]) {
   double vmin = ts->vol; /* exact when vol_x = vol_y = 0: vol + 0 + 0 */
   if (ts->vol_x != 0 || ts->vol_y != 0) {
     double v0 = ts->vol, vx = ts->vol_x, vy = ts->vol_y;
-    vmin = v0 + fmin(0.5 * vx, (w - 0.5) * vx) + fmin(0.5 * vy, (h - 0.5) * vy);
+    double x0 = cam->sx0, x1 = w - 1 + x0, y0 = cam->sy0, y1 = h - 1 + y0; /* the extreme samples */
+    vmin = v0 + fmin(x0 * vx, x1 * vx) + fmin(y0 * vy, y1 * vy);
     vmin -= 4 * u * (fabs(v0) + w * fabs(vx) + h * fabs(vy)) + slack * fabs(v0);
   }
   if (!(vmin > 0)) return 0;
