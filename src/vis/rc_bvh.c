@@ -185,7 +185,7 @@ typedef struct {
   const rr_bvh *b;
   frame_setups fs;
   int tiles_x, band_rows;
-  thread_stats st[256];
+  thread_stats st[RR_MAX_THREADS];
 } frame_job;
 
 /* ---- one ray per sample: the traversal's policy ------------------------------ */
@@ -426,7 +426,7 @@ static rr_error run_frame(rr_device *dev, render_ctx *ctx, rr_parallel_fn tile_f
     j->band_rows = (vb->height + 4 * ctx->threads - 1) / (4 * ctx->threads);
     rr_parallel_for((vb->height + j->band_rows - 1) / j->band_rows, ctx->threads, loose_band, j);
   }
-  for (int t = 0; t < 256; t++) {
+  for (int t = 0; t < RR_MAX_THREADS; t++) {
     ctx->stats->edge_evals += j->st[t].evals;
     ctx->stats->nodes += j->st[t].nodes;
   }
