@@ -28,9 +28,9 @@ void rr_hiz_free(hiz *h);
 /* Recomputes block (i, j) of level l > 0 from the level below; returns its farthest depth. */
 float rr_hiz_refresh(hiz *h, int l, int i, int j);
 
-/* Recomputes block (i, j) of level 0 from the samples; inlined, since the queries
- * of 3dr recompute a tile at about every other rectangle they ask about. Four
- * samples at a time (blocks are at least 4 wide): the maxima are independent. */
+/* Recomputes block (i, j) of level 0 from the samples. Inlined into the queries (a
+ * call cost 3dr-bin 0.5% of its instructions), four samples a step (blocks are at
+ * least 4 wide). */
 static inline float hiz_refresh_samples(hiz *h, int i, int j) {
   const visbuf *vb = h->vb;
   int s = 1 << h->shift;

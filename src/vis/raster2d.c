@@ -492,8 +492,8 @@ KERNEL void bin_block(const tri2d *t, int level, int bx, int by, bin_ctx *bc, co
       }
     return;
   }
-  uint64_t n = (uint64_t)(x1 - x0 + 1) * (uint64_t)(y1 - y0 + 1);
-  bc->evals += n;
+  int n = (x1 - x0 + 1) * (y1 - y0 + 1);
+  bc->evals += (uint64_t)n;
   heat_charge(bc->tg->heat, vb->width, x0, y0, x1 + 1, y1 + 1, (float)n);
   if (!count && wrote) hiz_mark(bc->hz, x0, y0, x1 + 1, y1 + 1);
 }
@@ -558,7 +558,7 @@ KERNEL void draw2d(bin_ctx *bc, const tri2d *t, int y0, int y1, const bool bin, 
   int ry0 = y0 > t->rect[1] ? y0 : t->rect[1], ry1 = y1 - 1 < t->rect[3] ? y1 - 1 : t->rect[3];
   uint64_t n = raster_bb(t, ry0, ry1, bc->tg, count);
   bc->evals += n;
-  if (bc->tg->heat) /* one evaluation a sample */
+  if (bc->tg->heat) /* tested here, so that the common case does not convert n */
     heat_charge(bc->tg->heat, bc->tg->vb->width, t->rect[0], ry0, t->rect[2] + 1, ry1 + 1, (float)n);
 }
 

@@ -25,7 +25,7 @@ typedef struct sortmiddle sortmiddle;
 struct sortmiddle {
   /* Filled by the method. */
   void *arg;            /* the method's pass */
-  size_t size;          /* bytes of a set-up primitive (a multiple of its alignment) */
+  size_t size;          /* bytes of a set-up primitive */
   uint32_t batch;       /* primitives set up before any is drawn */
   uint32_t chunk;       /* primitives a setup job takes */
   uint32_t out_max;     /* set-up primitives one primitive may yield (clipping) */

@@ -504,7 +504,7 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
 typedef struct trav_job {
   trav proto;
   int tile, tiles_x, frustum;
-  rr_stats st[256];
+  rr_stats st[RR_MAX_THREADS];
 } trav_job;
 
 /* One job: a tile of the image, cut into the initial frusta. */
@@ -566,7 +566,7 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
     tile = (tile + HIZ - 1) / HIZ * HIZ;
     tj->proto = proto, tj->tile = tile, tj->frustum = frustum, tj->tiles_x = (vb->width + tile - 1) / tile;
     rr_parallel_for(tj->tiles_x * ((vb->height + tile - 1) / tile), ctx->threads, run_tile, tj);
-    for (int i = 0; i < 256; i++) add_stats(ctx->stats, &tj->st[i]);
+    for (int i = 0; i < RR_MAX_THREADS; i++) add_stats(ctx->stats, &tj->st[i]);
     free(tj);
   }
   rr_hiz_free(&hz);
