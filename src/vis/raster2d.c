@@ -17,7 +17,8 @@
  * or incrementally (along a row) gives the same numbers: 2dr-bin produces the same
  * visibility buffer as 2dr-bb bit for bit, and a sample on an edge shared by two
  * triangles is claimed by exactly one of them. */
-#include "vis/vis.h"
+#include "vis/hiz.h"
+#include "vis/sortmiddle.h"
 
 #include <string.h>
 
@@ -31,6 +32,7 @@
 #define MAX_SUB (MAX_POLY - 2)
 #define BATCH 16384 /* triangles set up before they are rasterized */
 #define CHUNK 2048  /* triangles per setup job */
+_Static_assert(CHUNK * MAX_SUB <= SM_CHUNK_MAX, "a band lists a chunk's sub-triangles by 16-bit index");
 
 /* ---- vertex stage ---------------------------------------------------------- */
 
@@ -374,12 +376,6 @@ typedef struct target {
   float *heat; /* optional: edge evaluations charged to each sample (heat maps) */
 } target;
 
-/* Charges one evaluation to every sample of a rectangle; off the hot path. */
-static void charge(float *heat, int width, int x0, int y0, int x1, int y1) {
-  for (int y = y0; y <= y1; y++)
-    for (int x = x0; x <= x1; x++) heat[(size_t)y * width + x] += 1;
-}
-
 /* Shades covered sample k at (dx, dy) pixels from the triangle's reference sample;
  * qr, tr, r1, r2: the planes' values at the start of the row. count: claims mode. */
 KERNEL bool shade2d(const tri2d *t, float dx, float qr, float tr, float r1, float r2, const target *tg, size_t k,
@@ -442,75 +438,11 @@ KERNEL uint64_t raster_bb(const tri2d *t, int y0, int y1, const target *tg, cons
 
 /* ---- 2dr-bin: hierarchical binning and early-z --------------------------------- */
 
-/* Block sizes by level: 4², 16², 64² samples (a level-2 block is a tile). */
+/* Block sizes by level: 4², 16², 64² samples (a level-2 block is a tile); the
+ * hierarchical z-buffer keeps the farthest depth of each. */
 #define LEVELS 3
 static inline int block_shift(int level) { return 2 + 2 * level; }
 static inline int block_size(int level) { return 1 << block_shift(level); }
-
-/* Farthest stored depth per block, at each level. Level 0 is exact after every
- * write; levels 1 and 2 are recomputed from their children when marked dirty. A
- * block with a miss has +inf. */
-typedef struct hiz {
-  int w[LEVELS], h[LEVELS];
-  float *zmax[LEVELS];
-  uint8_t *dirty[LEVELS];
-} hiz;
-
-static void hiz_free(hiz *h) {
-  for (int l = 0; l < LEVELS; l++) free(h->zmax[l]), free(h->dirty[l]);
-}
-
-static bool hiz_alloc(hiz *h, int width, int height) {
-  memset(h, 0, sizeof *h);
-  bool ok = true;
-  for (int l = 0; l < LEVELS; l++) {
-    int s = block_size(l);
-    h->w[l] = (width + s - 1) / s, h->h[l] = (height + s - 1) / s;
-    size_t n = (size_t)h->w[l] * h->h[l];
-    h->zmax[l] = malloc(n * sizeof(float));
-    h->dirty[l] = calloc(n, 1);
-    if (!h->zmax[l] || !h->dirty[l]) ok = false;
-    else
-      for (size_t k = 0; k < n; k++) h->zmax[l][k] = INFINITY;
-  }
-  if (!ok) hiz_free(h);
-  return ok;
-}
-
-static float hiz_get(hiz *h, int l, int i, int j) {
-  size_t k = (size_t)j * h->w[l] + i;
-  if (l > 0 && h->dirty[l][k]) {
-    float m = -INFINITY;
-    for (int cj = 4 * j; cj < 4 * j + 4 && cj < h->h[l - 1]; cj++)
-      for (int ci = 4 * i; ci < 4 * i + 4 && ci < h->w[l - 1]; ci++) {
-        float z = hiz_get(h, l - 1, ci, cj);
-        m = z > m ? z : m;
-      }
-    h->zmax[l][k] = m;
-    h->dirty[l][k] = 0;
-  }
-  return h->zmax[l][k];
-}
-
-/* Recomputes the level-0 blocks over samples [x0, x1] × [y0, y1]. */
-static void hiz_update(hiz *h, const visbuf *vb, int x0, int y0, int x1, int y1) {
-  for (int j = y0 >> 2; j <= y1 >> 2; j++)
-    for (int i = x0 >> 2; i <= x1 >> 2; i++) {
-      float m = -INFINITY;
-      int ye = 4 * j + 4 < vb->height ? 4 * j + 4 : vb->height, xe = 4 * i + 4 < vb->width ? 4 * i + 4 : vb->width;
-      for (int y = 4 * j; y < ye; y++)
-        for (int x = 4 * i; x < xe; x++) {
-          float z = vb->t[(size_t)y * vb->width + x];
-          m = z > m ? z : m;
-        }
-      size_t k = (size_t)j * h->w[0] + i;
-      if (m < h->zmax[0][k]) {
-        h->zmax[0][k] = m;
-        h->dirty[1][(size_t)(j >> 2) * h->w[1] + (i >> 2)] = 1;
-        h->dirty[2][(size_t)(j >> 4) * h->w[2] + (i >> 4)] = 1;
-      }
-    }
-}
 
 typedef struct bin_ctx {
   const target *tg;
@@ -546,11 +478,7 @@ KERNEL void bin_block(const tri2d *t, int level, int bx, int by, bin_ctx *bc, co
     accept &= lo >= 0;
   }
   bc->evals += 4; /* counted as the four corners, as 3dr-bin counts a bin */
-  if (bc->tg->heat) {
-    float *h = bc->tg->heat;
-    int w = vb->width;
-    h[(size_t)by * w + bx] += 1, h[(size_t)by * w + ex] += 1, h[(size_t)ey * w + bx] += 1, h[(size_t)ey * w + ex] += 1;
-  }
+  heat_charge_corners(bc->tg->heat, vb->width, bx, by, ex + 1, ey + 1);
   if (hi < 0) return;
   int x0 = bx, y0 = by, x1 = ex, y1 = ey;
   bool wrote = false;
@@ -572,9 +500,10 @@ KERNEL void bin_block(const tri2d *t, int level, int bx, int by, bin_ctx *bc, co
       }
     return;
   }
-  bc->evals += (uint64_t)(x1 - x0 + 1) * (uint64_t)(y1 - y0 + 1);
-  if (bc->tg->heat) charge(bc->tg->heat, vb->width, x0, y0, x1, y1);
-  if (!count && wrote) hiz_update(bc->hz, vb, x0, y0, x1, y1);
+  int n = (x1 - x0 + 1) * (y1 - y0 + 1);
+  bc->evals += (uint64_t)n;
+  heat_charge(bc->tg->heat, vb->width, x0, y0, x1 + 1, y1 + 1, (float)n);
+  if (!count && wrote) hiz_mark(bc->hz, x0, y0, x1 + 1, y1 + 1);
 }
 
 static void bin_block_z(const tri2d *t, int level, int bx, int by, bin_ctx *bc) {
@@ -602,66 +531,68 @@ KERNEL void raster_bin(const tri2d *t, int y0, int y1, bin_ctx *bc, const bool c
     for (int bx = t->rect[0] & m; bx <= t->rect[2]; bx += s) bin_block(t, level, bx, by, bc, count);
 }
 
-/* ---- the pass: batches of setups, then bands of rows ------------------------- */
+/* ---- the pass: sort-middle (vis/sortmiddle.h) ------------------------------------ */
 
-typedef struct job2d {
+typedef struct pass2d {
   const rr_scene *scene;
   const pipe2d *pp;
   bool bin;
   target tg;
-  hiz *hz;
-  uint32_t first, count; /* the triangles of the current batch */
-  tri2d *tris;           /* setup job j writes from tris[j * CHUNK * MAX_SUB] */
-  uint32_t ntris[BATCH / CHUNK];
-  int band_rows;
-  uint64_t setups[256], evals[256];
-} job2d;
+  hiz *hz; /* NULL unless 2dr-bin tests depths */
+  uint64_t setups[RR_MAX_THREADS], evals[RR_MAX_THREADS];
+} pass2d;
 
-static void setup_job(int j, int thread, void *arg) {
-  job2d *job = arg;
-  uint32_t i0 = job->first + (uint32_t)j * CHUNK, i1 = i0 + CHUNK;
-  if (i1 > job->first + job->count) i1 = job->first + job->count;
-  tri2d *out = job->tris + (size_t)j * CHUNK * MAX_SUB;
-  uint32_t n = 0;
+static uint32_t setup2d(void *arg, int thread, uint32_t first, uint32_t n, void *out) {
+  pass2d *p = arg;
+  tri2d *t = out;
+  uint32_t m = 0;
   uint64_t setups = 0;
-  for (uint32_t i = i0; i < i1; i++) n += setup_scene_tri(job->pp, job->scene, i, out + n, &setups);
-  job->ntris[j] = n;
-  job->setups[thread] += setups;
+  for (uint32_t i = first; i < first + n; i++) m += setup_scene_tri(p->pp, p->scene, i, t + m, &setups);
+  p->setups[thread] += setups;
+  return m;
 }
 
-KERNEL void band_loop(job2d *job, int y0, int y1, int thread, const bool bin, const bool count) {
-  bin_ctx bc = {.tg = &job->tg, .hz = job->hz};
-  uint64_t evals = 0;
-  int nchunks = (int)((job->count + CHUNK - 1) / CHUNK);
-  for (int j = 0; j < nchunks; j++) {
-    const tri2d *tris = job->tris + (size_t)j * CHUNK * MAX_SUB;
-    for (uint32_t k = 0; k < job->ntris[j]; k++) {
-      const tri2d *t = &tris[k];
-      if (t->rect[3] < y0 || t->rect[1] > y1) continue;
-      if (bin) {
-        raster_bin(t, y0, y1, &bc, count);
-        continue;
-      }
-      int ry0 = y0 > t->rect[1] ? y0 : t->rect[1], ry1 = y1 < t->rect[3] ? y1 : t->rect[3];
-      evals += raster_bb(t, ry0, ry1, &job->tg, count);
-      if (job->tg.heat) charge(job->tg.heat, job->tg.vb->width, t->rect[0], ry0, t->rect[2], ry1);
-    }
+static void rows2d(const void *prim, int *y0, int *y1) {
+  const tri2d *t = prim;
+  *y0 = t->rect[1], *y1 = t->rect[3];
+}
+
+/* Rows [y0, y1) of a set-up triangle: every sample of its rectangle there, or bins. */
+KERNEL void draw2d(bin_ctx *bc, const tri2d *t, int y0, int y1, const bool bin, const bool count) {
+  if (bin) {
+    raster_bin(t, y0, y1 - 1, bc, count);
+    return;
   }
-  job->evals[thread] += evals + bc.evals;
+  int ry0 = y0 > t->rect[1] ? y0 : t->rect[1], ry1 = y1 - 1 < t->rect[3] ? y1 - 1 : t->rect[3];
+  uint64_t n = raster_bb(t, ry0, ry1, bc->tg, count);
+  bc->evals += n;
+  if (bc->tg->heat) /* tested here, so that the common case does not convert n */
+    heat_charge(bc->tg->heat, bc->tg->vb->width, t->rect[0], ry0, t->rect[2] + 1, ry1 + 1, (float)n);
 }
 
-/* One band of rows: its own samples and blocks, so no sample has two writers. */
-static void band_job(int band, int thread, void *arg) {
-  job2d *job = arg;
-  int y0 = band * job->band_rows, y1 = y0 + job->band_rows - 1;
-  if (y1 > job->tg.vb->height - 1) y1 = job->tg.vb->height - 1;
-  bool count = job->tg.front != NULL;
-  if (job->bin) {
-    if (count) band_loop(job, y0, y1, thread, true, true);
-    else band_loop(job, y0, y1, thread, true, false);
+/* draw2d for each mode, as the band loop takes them */
+KERNEL void draw_bb_z(void *bc, const void *t, int y0, int y1) { draw2d(bc, t, y0, y1, false, false); }
+KERNEL void draw_bb_claims(void *bc, const void *t, int y0, int y1) { draw2d(bc, t, y0, y1, false, true); }
+KERNEL void draw_bin_z(void *bc, const void *t, int y0, int y1) { draw2d(bc, t, y0, y1, true, false); }
+KERNEL void draw_bin_claims(void *bc, const void *t, int y0, int y1) { draw2d(bc, t, y0, y1, true, true); }
+
+KERNEL void band2d(const sortmiddle *sm, int b, int thread, const bool bin, const bool count) {
+  pass2d *p = sm->arg;
+  bin_ctx bc = {.tg = &p->tg, .hz = p->hz};
+  sm_draw_band(sm, b, &bc, bin ? (count ? draw_bin_claims : draw_bin_z) : count ? draw_bb_claims : draw_bb_z);
+  p->evals[thread] += bc.evals;
+}
+
+static void band_job(int b, int thread, void *arg) {
+  const sortmiddle *sm = arg;
+  const pass2d *p = sm->arg;
+  bool count = p->tg.front != NULL;
+  if (p->bin) {
+    if (count) band2d(sm, b, thread, true, true);
+    else band2d(sm, b, thread, true, false);
   } else {
-    if (count) band_loop(job, y0, y1, thread, false, true);
-    else band_loop(job, y0, y1, thread, false, false);
+    if (count) band2d(sm, b, thread, false, true);
+    else band2d(sm, b, thread, false, false);
   }
 }
 
@@ -674,32 +605,28 @@ static rr_error run2d(rr_device *dev, const rr_scene *s, const camera *c, bool c
                    "(rc, rc-bvh, rc-packet, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full)");
   if (!pipe_setup(&pp, s, c, cull))
     return rr_fail(dev, RR_ERROR_UNSUPPORTED, "2D rasterization needs a planar camera (perspective or orthographic)");
-  job2d *job = calloc(1, sizeof *job);
-  tri2d *tris = malloc((size_t)BATCH * MAX_SUB * sizeof *tris);
-  hiz hz;
-  memset(&hz, 0, sizeof hz);
+  pass2d *p = calloc(1, sizeof *p);
+  hiz hz = {0};
   bool need_hiz = bin && !tg.front;
-  if (!job || !tris || (need_hiz && !hiz_alloc(&hz, c->width, c->height))) {
-    free(job), free(tris);
+  if (!p || (need_hiz && !rr_hiz_init(&hz, tg.vb, block_shift(0), LEVELS))) {
+    free(p);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for 2D rasterization");
   }
-  *job = (job2d){.scene = s, .pp = &pp, .bin = bin, .tg = tg, .hz = need_hiz ? &hz : NULL, .tris = tris};
-  /* Bands are whole tiles; one band when one thread. */
-  const int tile = block_size(LEVELS - 1);
-  int bands = threads > 1 ? 4 * threads : 1;
-  job->band_rows = (c->height + bands - 1) / bands;
-  job->band_rows = (job->band_rows + tile - 1) / tile * tile;
-  bands = (c->height + job->band_rows - 1) / job->band_rows;
-  for (uint32_t first = 0; first < s->ntris; first += BATCH) {
-    job->first = first;
-    job->count = s->ntris - first < BATCH ? s->ntris - first : BATCH;
-    rr_parallel_for((int)((job->count + CHUNK - 1) / CHUNK), threads, setup_job, job);
-    rr_parallel_for(bands, threads, band_job, job);
-  }
-  for (int t = 0; t < 256; t++) stats->setups += job->setups[t], stats->edge_evals += job->evals[t];
-  if (need_hiz) hiz_free(&hz);
-  free(tris), free(job);
-  return RR_OK;
+  *p = (pass2d){.scene = s, .pp = &pp, .bin = bin, .tg = tg, .hz = need_hiz ? &hz : NULL};
+  sortmiddle sm = {.arg = p,
+                   .size = sizeof(tri2d),
+                   .batch = BATCH,
+                   .chunk = CHUNK,
+                   .out_max = MAX_SUB,
+                   .setup = setup2d,
+                   .rows = rows2d,
+                   .band = band_job};
+  /* blocks of whole tiles, the largest bins and depth blocks */
+  bool ok = rr_sortmiddle(&sm, s->ntris, c->height, block_size(LEVELS - 1), threads);
+  for (int t = 0; t < RR_MAX_THREADS; t++) stats->setups += p->setups[t], stats->edge_evals += p->evals[t];
+  rr_hiz_free(&hz);
+  free(p);
+  return ok ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for 2D rasterization");
 }
 
 rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx) {

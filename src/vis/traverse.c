@@ -12,12 +12,14 @@
  * Depth here is the ray parameter t along d(x, y) = d0 + x dx + y dy; for the
  * perspective camera d·fwd = 1, so t is also the distance along fwd. Culling
  * decisions keep a relative safety margin so they never remove a winning triangle. */
-#include "vis/vis.h"
+#include "vis/hiz.h"
+#include "vis/sortmiddle.h"
 
 #include <float.h>
 #include <string.h>
 
-#define HIZ 8               /* hierarchical z-buffer tile size: frusta split down to it */
+#define HIZ_SHIFT 3
+#define HIZ (1 << HIZ_SHIFT) /* hierarchical z-buffer tile size: frusta split down to it */
 /* Relative slack of the node occlusion test. The t that 3D rasterization computes
  * for a small far triangle seen at a grazing angle can lie percents in front of
  * its box (the edge values' sum cancels), and rc keeps such hits; early-z per
@@ -35,52 +37,10 @@ typedef struct trav {
   visbuf *vb;
   bool cull_back, simd;
   bool hiz_used;     /* occlusion culling or early-z read the z tiles: keep them current */
-  float *hiz;        /* per HIZ×HIZ tile: the farthest t stored (recomputed when dirty) */
-  uint8_t *dirty;
-  int tiles_x;
+  hiz *hz;           /* one level of HIZ×HIZ tiles */
   float *heat_e, *heat_n; /* optional per-pixel E and N charges */
   rr_stats st;
 } trav;
-
-/* ---- per-pixel statistics ------------------------------------------------ */
-
-KERNEL void charge(float *heat, int width, tile_rect r, float amount) {
-  if (!heat) return;
-  float each = amount / (float)((r.x1 - r.x0) * (r.y1 - r.y0));
-  for (int y = r.y0; y < r.y1; y++)
-    for (int x = r.x0; x < r.x1; x++) heat[(size_t)y * width + x] += each;
-}
-
-/* ---- hierarchical z ---------------------------------------------------- */
-
-static float hiz_tile(trav *t, int tx, int ty) {
-  int k = ty * t->tiles_x + tx;
-  if (t->dirty[k]) {
-    const visbuf *vb = t->vb;
-    int x1 = (tx + 1) * HIZ < vb->width ? (tx + 1) * HIZ : vb->width;
-    int y1 = (ty + 1) * HIZ < vb->height ? (ty + 1) * HIZ : vb->height;
-    float m = 0;
-    for (int y = ty * HIZ; y < y1; y++)
-      for (int x = tx * HIZ; x < x1; x++) m = maxf(m, vb->t[(size_t)y * vb->width + x]);
-    t->hiz[k] = m;
-    t->dirty[k] = 0;
-  }
-  return t->hiz[k];
-}
-
-/* Is every depth stored in the z tiles of a rectangle nearer than z? Most
- * queries are answered no by the first tile, so it stops there. */
-static bool hiz_nearer(trav *t, tile_rect r, float z) {
-  for (int ty = r.y0 / HIZ; ty <= (r.y1 - 1) / HIZ; ty++)
-    for (int tx = r.x0 / HIZ; tx <= (r.x1 - 1) / HIZ; tx++)
-      if (!(hiz_tile(t, tx, ty) < z)) return false;
-  return true;
-}
-
-static void mark_dirty(trav *t, tile_rect r) {
-  for (int ty = r.y0 / HIZ; ty <= (r.y1 - 1) / HIZ; ty++)
-    for (int tx = r.x0 / HIZ; tx <= (r.x1 - 1) / HIZ; tx++) t->dirty[ty * t->tiles_x + tx] = 1;
-}
 
 /* ---- rasterizing one triangle into a frustum ---------------------------- */
 
@@ -103,8 +63,8 @@ KERNEL uint64_t raster_samples(trav *t, const tri_job *j, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
   t->st.edge_evals += rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd);
-  charge(t->heat_e, t->vb->width, r, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
-  if (t->hiz_used) mark_dirty(t, r);
+  heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
+  if (t->hiz_used) hiz_mark(t->hz, r.x0, r.y0, r.x1, r.y1);
   return covered;
 }
 
@@ -135,11 +95,7 @@ static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
           out = all_out;
         }
         t->st.edge_evals += 4;
-        if (t->heat_e) {
-          int w = t->vb->width;
-          t->heat_e[(size_t)b.y0 * w + b.x0] += 1, t->heat_e[(size_t)b.y0 * w + b.x1 - 1] += 1;
-          t->heat_e[(size_t)(b.y1 - 1) * w + b.x0] += 1, t->heat_e[(size_t)(b.y1 - 1) * w + b.x1 - 1] += 1;
-        }
+        heat_charge_corners(t->heat_e, t->vb->width, b.x0, b.y0, b.x1, b.y1);
       } else {
         /* Curved views bend edges into arcs, so corners prove nothing. Bound the bin's
          * rays by a cone instead: edge e rejects the bin when its plane leaves the
@@ -152,11 +108,12 @@ static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
         if (cone > 0 && angle < CAMERA_NO_CONE) {
           out = rr_cone_excludes(&j->cone, &j->ts, axis, angle);
           t->st.edge_evals += 1;
-          if (t->heat_e) t->heat_e[(size_t)((b.y0 + b.y1) / 2) * t->vb->width + (b.x0 + b.x1) / 2] += 1;
+          int cx = (b.x0 + b.x1) / 2, cy = (b.y0 + b.y1) / 2;
+          heat_charge(t->heat_e, t->vb->width, cx, cy, cx + 1, cy + 1, 1.0f);
         }
       }
       if (out) continue;
-      if (t->o->early_z && hiz_nearer(t, b, j->zmin)) continue;
+      if (t->o->early_z && hiz_nearer(t->hz, b.x0, b.y0, b.x1, b.y1, j->zmin)) continue;
       /* refined: count the bins that turn out to hold none of the triangle */
       uint64_t in = bin_raster(t, j, b, size / 4 > 1 ? size / 4 : 1);
       t->st.bins++;
@@ -463,9 +420,9 @@ static void traverse(trav *t, const frustum *f, uint32_t node) {
   const bvh_node *n = &bvh->nodes[node];
   const oracles *o = t->o;
   t->st.nodes++;
-  charge(t->heat_n, t->vb->width, f->r, 1.0f);
+  heat_charge(t->heat_n, t->vb->width, f->r.x0, f->r.y0, f->r.x1, f->r.y1, 1.0f);
   if (o->cull_outside && is_outside(f, n, t->c)) return;
-  if (o->cull_occluded && hiz_nearer(t, f->r, occlusion_depth(t->c, n))) return;
+  if (o->cull_occluded && hiz_nearer(t->hz, f->r.x0, f->r.y0, f->r.x1, f->r.y1, occlusion_depth(t->c, n))) return;
   if (should_split(t, f, n)) {
     split(t, f, node);
     return;
@@ -489,105 +446,67 @@ static void add_stats(rr_stats *to, const rr_stats *s) {
 }
 
 /* generateSamples at the root is plain rasterization; on any number of threads it
- * runs sort-middle, like the 2D pipeline: a batch of triangles is bounded and set
- * up in parallel chunks, then drawn in parallel bands of rows. Each triangle is set
- * up once, so S does not depend on the thread count. */
+ * runs sort-middle, like the 2D pipeline (vis/sortmiddle.h): the triangles are
+ * bounded and set up in parallel chunks, then drawn in parallel bands of rows. */
 #define ROOT_BATCH 131072 /* triangles set up before they are drawn */
 #define ROOT_CHUNK 2048  /* triangles per setup job */
 
-typedef struct root_job {
-  trav proto;     /* the frame's settings; every job works on its own copy */
-  uint32_t first, count;
-  tri_job *jobs;  /* chunk k's set-up triangles, from jobs[k * ROOT_CHUNK], */
-  int (*span)[3]; /* and their first and last blocks of rows and the band of the first */
-  uint32_t kept[ROOT_BATCH / ROOT_CHUNK]; /* kept[k] of them */
-  int bands, block_rows;
-  rr_stats st[256];
-} root_job;
+typedef struct root_pass {
+  trav proto; /* the frame's settings; every job works on its own copy */
+  rr_stats st[RR_MAX_THREADS];
+} root_pass;
 
-static void root_setup(int k, int thread, void *arg) {
-  root_job *rj = arg;
-  trav t = rj->proto;
-  uint32_t i0 = rj->first + (uint32_t)k * ROOT_CHUNK, end = rj->first + rj->count;
-  uint32_t n = end - i0 < ROOT_CHUNK ? end - i0 : ROOT_CHUNK;
-  tri_job *out = rj->jobs + (size_t)k * ROOT_CHUNK;
+static uint32_t root_setup(void *arg, int thread, uint32_t first, uint32_t n, void *out) {
+  root_pass *rp = arg;
+  trav t = rp->proto;
   tri_bound scratch[ROOT_CHUNK];
-  uint32_t kept = setup_triangles(&t, i0, NULL, n, scratch, out);
-  /* what the bands scan, worked out once here */
-  int(*span)[3] = rj->span + (size_t)k * ROOT_CHUNK;
-  for (uint32_t q = 0; q < kept; q++) {
-    span[q][0] = out[q].bb[1] / rj->block_rows, span[q][1] = out[q].bb[3] / rj->block_rows;
-    span[q][2] = span[q][0] % rj->bands;
-  }
-  rj->kept[k] = kept;
-  add_stats(&rj->st[thread], &t.st);
+  uint32_t kept = setup_triangles(&t, first, NULL, n, scratch, out);
+  add_stats(&rp->st[thread], &t.st);
+  return kept;
 }
 
-/* Draws the batch into band b: the blocks of rows k with k % bands == b. Blocks
- * are whole z tiles and top-level bins, so no sample, z tile or bin has two
- * writers and the stats do not depend on the blocks; dealt out round robin, they
- * share the work of a batch whose triangles sit in a few rows of the image. */
+static void root_rows(const void *prim, int *y0, int *y1) {
+  const tri_job *j = prim;
+  *y0 = j->bb[1], *y1 = j->bb[3];
+}
+
+KERNEL void draw_rows(void *t, const void *j, int y0, int y1) {
+  draw(t, j, (tile_rect){0, y0, ((trav *)t)->vb->width, y1});
+}
+
 static void root_band(int b, int thread, void *arg) {
-  root_job *rj = arg;
-  trav t = rj->proto;
-  int w = t.vb->width, h = t.vb->height, rows = rj->block_rows;
-  int nchunks = (int)((rj->count + ROOT_CHUNK - 1) / ROOT_CHUNK);
-  for (int k = 0; k < nchunks; k++) {
-    const tri_job *j = rj->jobs + (size_t)k * ROOT_CHUNK;
-    const int(*span)[3] = (const int(*)[3])rj->span + (size_t)k * ROOT_CHUNK;
-    /* The band's triangles are scattered through the chunk (and often in another
-     * core's cache): list them first, then fetch each a few ahead of its drawing. */
-    uint16_t mine[ROOT_CHUNK];
-    int16_t first[ROOT_CHUNK];
-    int n = 0;
-    for (uint32_t q = 0; q < rj->kept[k]; q++) {
-      int skip = b - span[q][2]; /* blocks from the first to band b's first */
-      if (skip < 0) skip += rj->bands;
-      if (span[q][0] + skip <= span[q][1]) mine[n] = (uint16_t)q, first[n++] = (int16_t)skip;
-    }
-    for (int i = 0; i < n; i++) {
-      if (i + 6 < n) __builtin_prefetch(&j[mine[i + 6]]), __builtin_prefetch((const char *)&j[mine[i + 6]] + 64);
-      int q = mine[i];
-      for (int blk = span[q][0] + first[i]; blk <= span[q][1]; blk += rj->bands) {
-        tile_rect r = {0, blk * rows, w, (blk + 1) * rows < h ? (blk + 1) * rows : h};
-        draw(&t, &j[q], r);
-      }
-    }
-  }
-  add_stats(&rj->st[thread], &t.st);
+  const sortmiddle *sm = arg;
+  root_pass *rp = sm->arg;
+  trav t = rp->proto;
+  sm_draw_band(sm, b, &t, draw_rows);
+  add_stats(&rp->st[thread], &t.st);
 }
 
 static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *proto) {
-  root_job *rj = calloc(1, sizeof *rj);
-  tri_job *jobs = aligned_alloc(64, (size_t)ROOT_BATCH * sizeof *jobs);
-  int(*span)[3] = malloc((size_t)ROOT_BATCH * sizeof *span);
-  if (!rj || !jobs || !span) {
-    free(rj), free(jobs), free(span);
-    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for triangle setups");
-  }
-  rj->proto = *proto, rj->jobs = jobs, rj->span = span;
+  root_pass *rp = calloc(1, sizeof *rp);
+  if (!rp) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for triangle setups");
+  rp->proto = *proto;
+  sortmiddle sm = {.arg = rp,
+                   .size = sizeof(tri_job),
+                   .batch = ROOT_BATCH,
+                   .chunk = ROOT_CHUNK,
+                   .out_max = 1,
+                   .setup = root_setup,
+                   .rows = root_rows,
+                   .band = root_band};
+  /* blocks of whole top-level bins, else of 8 z tiles */
   const oracles *o = ctx->oracles;
-  /* blocks of whole top-level bins, else of 8 z tiles: long runs of a band's
-   * triangles lie together in the batch (few straddle two blocks); 4 bands a
-   * thread deal the work out finely enough */
   int align = o->binning && o->bin_size > HIZ ? (o->bin_size + HIZ - 1) / HIZ * HIZ : 8 * HIZ;
-  rj->bands = ctx->threads > 1 ? 4 * ctx->threads : 1;
-  rj->block_rows = ctx->threads > 1 ? align : ctx->vb->height;
-  uint32_t n = ctx->scene->ntris;
-  for (uint32_t first = 0; first < n; first += ROOT_BATCH) {
-    rj->first = first, rj->count = n - first < ROOT_BATCH ? n - first : ROOT_BATCH;
-    rr_parallel_for((int)((rj->count + ROOT_CHUNK - 1) / ROOT_CHUNK), ctx->threads, root_setup, rj);
-    rr_parallel_for(rj->bands, ctx->threads, root_band, rj);
-  }
-  for (int i = 0; i < 256; i++) add_stats(ctx->stats, &rj->st[i]);
-  free(jobs), free(span), free(rj);
-  return RR_OK;
+  bool ok = rr_sortmiddle(&sm, ctx->scene->ntris, ctx->vb->height, align, ctx->threads);
+  for (int i = 0; i < RR_MAX_THREADS; i++) add_stats(ctx->stats, &rp->st[i]);
+  free(rp);
+  return ok ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for triangle setups");
 }
 
 typedef struct trav_job {
   trav proto;
   int tile, tiles_x, frustum;
-  rr_stats st[256];
+  rr_stats st[RR_MAX_THREADS];
 } trav_job;
 
 /* One job: a tile of the image, cut into the initial frusta. */
@@ -614,14 +533,9 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
   if (ctx->scene->ntris == 0) return RR_OK; /* nothing to see: the cleared buffer is the image */
   if (!ctx->scene->bvh && o->leaves)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "this method needs the scene's BVH (call rr_scene_commit)");
-  int tiles_x = (vb->width + HIZ - 1) / HIZ, tiles_y = (vb->height + HIZ - 1) / HIZ;
-  float *hiz = malloc((size_t)tiles_x * tiles_y * sizeof *hiz);
-  uint8_t *dirty = calloc((size_t)tiles_x * tiles_y, 1);
-  if (!hiz || !dirty) {
-    free(hiz), free(dirty);
+  hiz hz;
+  if (!rr_hiz_init(&hz, vb, HIZ_SHIFT, 1))
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the hierarchical z-buffer");
-  }
-  for (int k = 0; k < tiles_x * tiles_y; k++) hiz[k] = INFINITY;
   trav proto = {.s = ctx->scene,
                 .c = ctx->cam,
                 .o = o,
@@ -629,9 +543,7 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
                 .cull_back = ctx->opt->cull_backfaces != 0,
                 .simd = !ctx->opt->scalar,
                 .hiz_used = o->cull_occluded || (o->binning && o->early_z),
-                .hiz = hiz,
-                .dirty = dirty,
-                .tiles_x = tiles_x,
+                .hz = &hz,
                 .heat_e = ctx->heat_e,
                 .heat_n = ctx->heat_n};
   rr_error err = RR_OK;
@@ -643,7 +555,7 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
      * writers); frustum_size forces a tile size. */
     trav_job *tj = calloc(1, sizeof *tj);
     if (!tj) {
-      free(hiz), free(dirty);
+      rr_hiz_free(&hz);
       return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the traversal");
     }
     int whole = vb->width > vb->height ? vb->width : vb->height;
@@ -656,9 +568,9 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
     tile = (tile + HIZ - 1) / HIZ * HIZ;
     tj->proto = proto, tj->tile = tile, tj->frustum = frustum, tj->tiles_x = (vb->width + tile - 1) / tile;
     rr_parallel_for(tj->tiles_x * ((vb->height + tile - 1) / tile), ctx->threads, run_tile, tj);
-    for (int i = 0; i < 256; i++) add_stats(ctx->stats, &tj->st[i]);
+    for (int i = 0; i < RR_MAX_THREADS; i++) add_stats(ctx->stats, &tj->st[i]);
     free(tj);
   }
-  free(hiz), free(dirty);
+  rr_hiz_free(&hz);
   return err;
 }

@@ -38,6 +38,22 @@ KERNEL int shade_sample(const tri_setup *ts, uint32_t id, float sx, float sy, vi
   return shade_sample_w(ts, id, v3(1.0f, sx, sy), sx, sy, vb, k);
 }
 
+/* Heat maps (per-pixel E and N; heat is NULL when none is kept): spreads `amount`
+ * evenly over the samples [x0, x1) × [y0, y1). */
+KERNEL void heat_charge(float *heat, int width, int x0, int y0, int x1, int y1, float amount) {
+  if (!heat) return;
+  float each = amount / (float)((x1 - x0) * (y1 - y0));
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++) heat[(size_t)y * width + x] += each;
+}
+
+/* The same for a bin's corner test: one evaluation at each corner sample. */
+KERNEL void heat_charge_corners(float *heat, int width, int x0, int y0, int x1, int y1) {
+  if (!heat) return;
+  heat[(size_t)y0 * width + x0] += 1, heat[(size_t)y0 * width + x1 - 1] += 1;
+  heat[(size_t)(y1 - 1) * width + x0] += 1, heat[(size_t)(y1 - 1) * width + x1 - 1] += 1;
+}
+
 struct rr_frame {
   visbuf vb;
   float *heat_e, *heat_n; /* per-pixel E and N, when options.heat was set */

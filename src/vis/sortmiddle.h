@@ -1,0 +1,91 @@
+/* Sort-middle rasterization on any number of threads, the driver of 2dr-bb, 2dr-bin
+ * and of 3dr-bb and 3dr-bin (generateSamples at the root): a batch of primitives is
+ * set up in parallel chunks, then drawn in parallel bands of rows.
+ *
+ * The image is cut into blocks of rows dealt out round robin: band b draws the
+ * blocks k with k % bands == b. A block is whole z-buffer blocks and top-level bins,
+ * so no sample, depth block or bin has two writers, and within a block the
+ * primitives are drawn in batch order: bits and stats do not depend on the thread
+ * count. Each primitive is set up once, so S does not either. */
+#ifndef RR_VIS_SORTMIDDLE_H
+#define RR_VIS_SORTMIDDLE_H
+
+#include "core/core.h"
+
+/* The most set-up primitives a chunk may hold, chunk × out_max (a band lists them
+ * by 16-bit index). */
+#define SM_CHUNK_MAX 16384
+
+/* The blocks of rows a set-up primitive meets, first to last, and the first's band. */
+typedef struct sm_span {
+  int first, last, band;
+} sm_span;
+
+typedef struct sortmiddle sortmiddle;
+struct sortmiddle {
+  /* Filled by the method. */
+  void *arg;            /* the method's pass */
+  size_t size;          /* bytes of a set-up primitive */
+  uint32_t batch;       /* primitives set up before any is drawn */
+  uint32_t chunk;       /* primitives a setup job takes */
+  uint32_t out_max;     /* set-up primitives one primitive may yield (clipping) */
+  /* Sets up primitives first..first+n-1 into out (room for n × out_max); returns
+   * how many were kept. On `thread`, for per-thread stats. */
+  uint32_t (*setup)(void *arg, int thread, uint32_t first, uint32_t n, void *out);
+  /* The first and last row of samples a set-up primitive may cover. */
+  void (*rows)(const void *prim, int *y0, int *y1);
+  /* Draws band `job` of the batch in this struct (arg), with sm_draw_band. */
+  rr_parallel_fn band;
+  /* Filled by rr_sortmiddle: the blocks, and the batch being drawn. */
+  int bands, block_rows, height;
+  uint32_t first, count;
+  char *prims;          /* chunk k's set-up primitives from prims + k × chunk × out_max × size, */
+  sm_span *span;        /* their spans from the same index, */
+  uint32_t *kept;       /* and kept[k] of them */
+};
+
+/* Runs the pass over primitives 0..n-1 of an image `height` rows high, on `threads`
+ * threads. Blocks are `align` rows (a multiple of every block a band must own
+ * alone), four bands a thread; one band of the whole image on one thread. Returns
+ * false when out of memory. */
+bool rr_sortmiddle(sortmiddle *sm, uint32_t n, int height, int align, int threads);
+
+/* Draws band b of the current batch: draw(state, prim, y0, y1) for every set-up
+ * primitive and every block of the band it meets, rows [y0, y1) of the block, in
+ * batch order. Inlined with the method's own draw, so the hot loop has no calls. */
+KERNEL void sm_draw_band(const sortmiddle *sm, int b, void *state,
+                         void (*draw)(void *state, const void *prim, int y0, int y1)) {
+  uint32_t cap = sm->chunk * sm->out_max;
+  int nchunks = (int)((sm->count + sm->chunk - 1) / sm->chunk);
+  if (sm->bands == 1) { /* one thread: every primitive meets the one block, in order */
+    for (int k = 0; k < nchunks; k++)
+      for (uint32_t q = 0; q < sm->kept[k]; q++) draw(state, sm->prims + ((size_t)k * cap + q) * sm->size, 0, sm->height);
+    return;
+  }
+  int rows = sm->block_rows, height = sm->height;
+  for (int k = 0; k < nchunks; k++) {
+    const char *prims = sm->prims + (size_t)k * cap * sm->size;
+    const sm_span *span = sm->span + (size_t)k * cap;
+    /* The band's primitives are scattered through the chunk (and often in another
+     * core's cache): list them first, then fetch each a few ahead of its drawing. */
+    uint16_t mine[SM_CHUNK_MAX];
+    int16_t skip[SM_CHUNK_MAX]; /* blocks from its first to band b's first */
+    int n = 0;
+    for (uint32_t q = 0; q < sm->kept[k]; q++) {
+      int s = b - span[q].band;
+      if (s < 0) s += sm->bands;
+      if (span[q].first + s <= span[q].last) mine[n] = (uint16_t)q, skip[n++] = (int16_t)s;
+    }
+    for (int i = 0; i < n; i++) {
+      if (i + 6 < n) {
+        const char *ahead = prims + (size_t)mine[i + 6] * sm->size;
+        __builtin_prefetch(ahead), __builtin_prefetch(ahead + 64);
+      }
+      int q = mine[i];
+      for (int blk = span[q].first + skip[i]; blk <= span[q].last; blk += sm->bands)
+        draw(state, prims + (size_t)q * sm->size, blk * rows, (blk + 1) * rows < height ? (blk + 1) * rows : height);
+    }
+  }
+}
+
+#endif
