@@ -73,14 +73,8 @@ static bool curved_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
  * by a margin that covers the rounding of the projection and of the edge
  * functions, a few ulps of the larger coordinate (a whole pixel would double the
  * area of the small triangles of real meshes). */
-#define W 1
-#define TARGET
-#include "prim/triangle_bounds_tmp.h"
-#ifdef RR_SIMD_X86
-#define W 8
-#define TARGET RR_TARGET_AVX2
-#include "prim/triangle_bounds_tmp.h"
-#endif
+#define RR_TEMPLATE "prim/triangle_bounds_tmp.h"
+#include "core/simd_widths.h"
 
 bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int r[4]) {
   if (c->planar) {

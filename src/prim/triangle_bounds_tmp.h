@@ -1,5 +1,5 @@
 /* Corner bounds for W triangles at once: a kernel template (core/simd.h) that
- * triangle_bounds.c includes once per width, with W and TARGET defined.
+ * triangle_bounds.c instantiates per width through core/simd_widths.h.
  *
  * The pixel rectangles of triangles ids[0..n-1] (first..first+n-1 when ids is
  * NULL; n <= W, the padding lanes repeat the last one) for a planar camera, from
@@ -7,10 +7,6 @@
  * there): the same operations in the same order (no FMA, true divisions), lane by
  * lane, so every width gives the same rectangles. Writes the triangles whose
  * rectangle holds a sample to out, in order; returns how many. */
-#define VF RR_VF(W)
-#define VI RR_VI(W)
-#define VF_(op) RR_VF_OP(W, op)
-#define VI_(op) RR_VI_OP(W, op)
 
 TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
                                                        const camera *c, tri_bound *out) {
@@ -76,10 +72,3 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
     if (keep >> l & 1) out[kept++] = (tri_bound){(uint32_t)lane_id[l], {bx0[l], by0[l], bx1[l], by1[l]}};
   return kept;
 }
-
-#undef VF
-#undef VI
-#undef VF_
-#undef VI_
-#undef W
-#undef TARGET

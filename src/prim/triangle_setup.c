@@ -37,14 +37,8 @@
  * screen derivatives (b and c; n·right and −n·up for curved views) and its value
  * along the view direction, so the two triangles of a shared edge never both own,
  * nor both refuse, its samples. */
-#define W 1
-#define TARGET
-#include "prim/triangle_setup_tmp.h"
-#ifdef RR_SIMD_X86
-#define W 8
-#define TARGET RR_TARGET_AVX2
-#include "prim/triangle_setup_tmp.h"
-#endif
+#define RR_TEMPLATE "prim/triangle_setup_tmp.h"
+#include "core/simd_widths.h"
 
 int rr_tri_setup(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces, tri_setup *out) {
   int face;

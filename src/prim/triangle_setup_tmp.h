@@ -1,15 +1,11 @@
 /* Triangle setup for W triangles at once: a kernel template (core/simd.h) that
- * triangle_setup.c includes once per width, with W and TARGET defined.
+ * triangle_setup.c instantiates per width through core/simd_widths.h.
  *
  * Triangles ids[0..count-1] (count <= W; the padding lanes repeat the last one)
  * into out[l] and face[l], for any camera and any corners at infinity, as
  * triangle_setup.c describes it. Lanes hold one triangle each and never mix, and
  * the operations are IEEE single floats in a fixed order (no FMA), so every width
  * gives the same bits. A culled triangle's out[l] is not written. */
-#define VF RR_VF(W)
-#define VI RR_VI(W)
-#define VF_(op) RR_VF_OP(W, op)
-#define VI_(op) RR_VI_OP(W, op)
 #define V3 RR_CAT(setup_v3_, W)
 
 /* W three-vectors, one per lane, and the vec3.h operations on them. */
@@ -139,9 +135,3 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
 #undef LEX_LESS3
 #undef LEX_POSITIVE
 #undef V3
-#undef VF
-#undef VI
-#undef VF_
-#undef VI_
-#undef W
-#undef TARGET

@@ -4,14 +4,8 @@
 #include "core/simd.h"
 
 /* The sample loop, one lane at a time (any camera) and, with AVX2, eight. */
-#define W 1
-#define TARGET
-#include "vis/raster3d_tmp.h"
-#ifdef RR_SIMD_X86
-#define W 8
-#define TARGET RR_TARGET_AVX2
-#include "vis/raster3d_tmp.h"
-#endif
+#define RR_TEMPLATE "vis/raster3d_tmp.h"
+#include "core/simd_widths.h"
 
 /* Tests every sample of rectangle r against one triangle; returns the evaluations. */
 uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb,

@@ -1,5 +1,5 @@
 /* The 3D rasterizer's sample loop for W lanes: a kernel template (core/simd.h)
- * that raster3d.c includes once per width, with W and TARGET defined.
+ * that raster3d.c instantiates per width through core/simd_widths.h.
  *
  * Every sample of rectangle r against one set-up triangle, W samples of a row at
  * a time, columns then rows (the terms in sx are the same on every row). A lane is
@@ -7,10 +7,6 @@
  * vis/vis.h (depth_wins): the same operations in the same order on IEEE single
  * floats (no FMA, a true division), so every width gives their bits. Lanes past
  * r[2] are masked off and touch no memory. */
-#define VF RR_VF(W)
-#define VI RR_VI(W)
-#define VF_(op) RR_VF_OP(W, op)
-#define VI_(op) RR_VI_OP(W, op)
 
 TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32_t id, const int r[4],
                                                      const camera *c, visbuf *vb, const bool planar) {
@@ -73,10 +69,3 @@ TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32
   }
   return covered;
 }
-
-#undef VF
-#undef VI
-#undef VF_
-#undef VI_
-#undef W
-#undef TARGET
