@@ -487,30 +487,6 @@ typedef struct {
   box4 *cb; /* per chunk: bounds, centroid bounds */
 } ref_job;
 
-/* A triangle with corners at infinity (homogeneous input) is unbounded: along an
- * axis it reaches from its finite corners towards each direction's sign. Its box
- * stops at ±BVH_FAR instead, so every traversal keeps working on finite boxes (no
- * inf − inf, no 0·inf from the box itself; areas overflow float but half_area
- * falls back to double). What this gives up is the part of such a triangle more
- * than 1e30 from the origin: the sample test reaches it only where Σ w_i V_i falls
- * below about 1e-30 of V (a ray grazing the plane to within 1e-30 rad), and there
- * the box-culling traversals could miss a hit that rc keeps. The one alternative,
- * a list of unbounded triangles that every traversal tests at its root, would touch
- * every traversal for that case. */
-#define BVH_FAR 1e30f
-static void inf_bounds(unsigned inf, float v0, float v1, float v2, float *lo, float *hi) {
-  float v[3] = {v0, v1, v2}, l = INFINITY, h = -INFINITY;
-  for (int k = 0; k < 3; k++) {
-    if (inf >> k & 1u) {
-      if (v[k] > 0) h = BVH_FAR;
-      if (v[k] < 0) l = -BVH_FAR;
-    } else {
-      l = fminf(l, fmaxf(v[k], -BVH_FAR)), h = fmaxf(h, fminf(v[k], BVH_FAR));
-    }
-  }
-  *lo = l, *hi = h;
-}
-
 static void make_refs(int c, int thread, void *arg) {
   (void)thread;
   ref_job *j = arg;
@@ -519,16 +495,7 @@ static void make_refs(int c, int thread, void *arg) {
   box4 b = box_empty(), cb = box_empty();
   for (uint32_t i = a; i < e; i++) {
     pref *r = &j->refs[i];
-    unsigned inf = scene_inf(s, i);
-    for (int x = 0; x < 3; x++) {
-      float v0 = s->p[0][x][i], v1 = s->p[1][x][i], v2 = s->p[2][x][i];
-      if (inf) {
-        inf_bounds(inf, v0, v1, v2, &r->lo[x], &r->hi[x]);
-        continue;
-      }
-      r->lo[x] = fminf(v0, fminf(v1, v2));
-      r->hi[x] = fmaxf(v0, fmaxf(v1, v2));
-    }
+    rr_tri_box(s, i, r->lo, r->hi);
     r->id = i, r->pad = 0;
     rr_vf4 lo, hi;
     ref_load(r, &lo, &hi);

@@ -2,7 +2,7 @@
 #ifndef RR_BVH_H
 #define RR_BVH_H
 
-#include "scene/scene.h"
+#include "prim/triangle.h"
 
 /* 32-byte node with its own bounds. A leaf (count > 0) holds triangles
  * bvh->prims[first .. first + count); an inner node's children are nodes[first]

@@ -109,4 +109,42 @@ bool rr_cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float 
  * holding every sample where it can pass: the exact culling of rc-bvh, rc-packet. */
 float rr_tri_bounds(const tri_setup *ts, const camera *c, float rect[4]);
 
+/* A triangle with corners at infinity (homogeneous input) is unbounded: along an
+ * axis it reaches from its finite corners towards each direction's sign. Its box
+ * stops at ±PRIM_FAR instead, so every traversal keeps working on finite boxes (no
+ * inf − inf, no 0·inf from the box itself; areas overflow float but half_area
+ * falls back to double). What this gives up is the part of such a triangle more
+ * than 1e30 from the origin: the sample test reaches it only where Σ w_i V_i falls
+ * below about 1e-30 of V (a ray grazing the plane to within 1e-30 rad), and there
+ * the box-culling traversals could miss a hit that rc keeps. The one alternative,
+ * a list of unbounded triangles that every traversal tests at its root, would touch
+ * every traversal for that case. */
+#define PRIM_FAR 1e30f
+static inline void tri_inf_box(unsigned inf, float v0, float v1, float v2, float *lo, float *hi) {
+  float v[3] = {v0, v1, v2}, l = INFINITY, h = -INFINITY;
+  for (int k = 0; k < 3; k++) {
+    if (inf >> k & 1u) {
+      if (v[k] > 0) h = PRIM_FAR;
+      if (v[k] < 0) l = -PRIM_FAR;
+    } else {
+      l = fminf(l, fmaxf(v[k], -PRIM_FAR)), h = fmaxf(h, fminf(v[k], PRIM_FAR));
+    }
+  }
+  *lo = l, *hi = h;
+}
+
+/* The kind's bounds: triangle i's world box, lo[3] and hi[3] (the BVH's references). */
+static inline void rr_tri_box(const rr_scene *s, uint32_t i, float lo[3], float hi[3]) {
+  unsigned inf = scene_inf(s, i);
+  for (int x = 0; x < 3; x++) {
+    float v0 = s->p[0][x][i], v1 = s->p[1][x][i], v2 = s->p[2][x][i];
+    if (inf) {
+      tri_inf_box(inf, v0, v1, v2, &lo[x], &hi[x]);
+      continue;
+    }
+    lo[x] = fminf(v0, fminf(v1, v2));
+    hi[x] = fmaxf(v0, fmaxf(v1, v2));
+  }
+}
+
 #endif
