@@ -45,6 +45,14 @@ static inline float tri_vol(const tri_setup *t, float sx, float sy) {
   return t->vol + sx * t->vol_x + sy * t->vol_y;
 }
 
+/* The one sample test's two conditions, written once for a sample (floats, tie 0/1)
+ * and for W samples (core/simd.h vectors, tie and results as lane masks), so every
+ * method and every width evaluates the same expressions in the same order:
+ * edge value e is inside when positive, or zero on an edge the tie rule gives it;
+ * the hit counts when the sum Σw_iV_i and the volume are both positive. */
+#define TRI_EDGE_INSIDE(e, tie, zero) (((e) > (zero)) | (((e) == (zero)) & (tie)))
+#define TRI_HIT_AHEAD(sum, vol, zero) (((sum) > (zero)) & ((vol) > (zero)))
+
 /* The one sample test (paper eq. 2 with the top-left rule of sect. 4.2).
  * e: sign-normalised edge values at the sample; tie: bit i set when the sample
  * belongs to this triangle if it lies exactly on edge i; vol: the sign-normalised
@@ -54,15 +62,14 @@ static inline float tri_vol(const tri_setup *t, float sx, float sy) {
  * λ_i = V_i / Σw_iV_i. */
 static inline bool sample_test_w(const float e[3], const float w[3], uint32_t tie, float vol,
                                  float *t, float *l1, float *l2) {
-  bool in0 = e[0] > 0.0f || (e[0] == 0.0f && (tie & 1u));
-  bool in1 = e[1] > 0.0f || (e[1] == 0.0f && (tie & 2u));
-  bool in2 = e[2] > 0.0f || (e[2] == 0.0f && (tie & 4u));
-  if (!(in0 & in1 & in2)) return false;
+  if (!(TRI_EDGE_INSIDE(e[0], (tie & 1u) != 0, 0.0f) && TRI_EDGE_INSIDE(e[1], (tie & 2u) != 0, 0.0f) &&
+        TRI_EDGE_INSIDE(e[2], (tie & 4u) != 0, 0.0f)))
+    return false;
   /* Appendix eq. 10: only finite vertices count, Σ w_i V_i; e·1 == e exactly, so
    * ordinary triangles keep the bits of e0 + e1 + e2. */
   float sum = e[0] * w[0] + e[1] * w[1] + e[2] * w[2];
   /* sum == 0: all three on their edges (a degenerate sliver) or a pixel with no ray */
-  if (!(sum > 0.0f) || !(vol > 0.0f)) return false;
+  if (!TRI_HIT_AHEAD(sum, vol, 0.0f)) return false;
   float inv = 1.0f / sum;
   *t = vol * inv;
   *l1 = e[1] * inv;

@@ -48,11 +48,11 @@ TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32
 #pragma GCC unroll 3
       for (int e = 0; e < 3; e++) {
         ev[e] = planar ? ax[e] + cc[e] * sy : a[e] * wx + b[e] * wy + cc[e] * wz;
-        in &= (ev[e] > zero) | ((ev[e] == zero) & tie[e]);
+        in &= TRI_EDGE_INSIDE(ev[e], tie[e], zero);
       }
       if (!VI_(bits)(in)) continue;
       const VF sum = ev[0] * w0 + ev[1] * w1 + ev[2] * w2, v = vx + sy * vol_y;
-      in &= (sum > zero) & (v > zero);
+      in &= TRI_HIT_AHEAD(sum, v, zero);
       int hit = VI_(bits)(in);
       if (!hit) continue;
       covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
