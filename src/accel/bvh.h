@@ -36,7 +36,7 @@ typedef struct bvh_wide {
 
 enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK = 128 };
 
-/* Builds a binned-SAH BVH over the scene's triangles (src/bvh.c); the tree is the
+/* Builds a binned-SAH BVH over the scene's triangles (accel/bvh.c); the tree is the
  * same for any opt->threads. An empty scene gets NULL. */
 rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, rr_bvh **out);
 /* The scene's BVH when it is current, else NULL with a message in dev (an empty

@@ -20,8 +20,7 @@ static inline bool depth_wins(float t, uint32_t id, float best_t, uint32_t best_
 /* Tests one set-up triangle at pixel k, whose sample is (sx, sy) with evaluation
  * vector w, and keeps it when it is nearer. Returns 0 when the triangle does not
  * cover the sample, 1 when it covers it behind what is stored, 2 when it is kept. */
-KERNEL int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, float sy, visbuf *vb,
-                                 size_t k) {
+KERNEL int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, float sy, visbuf *vb, size_t k) {
   float e[3], t, l1, l2;
   tri_edges_w(ts, w, e);
   if (!sample_test_w(e, ts->w, ts->tie, tri_vol(ts, sx, sy), &t, &l1, &l2)) return 0;
@@ -88,7 +87,7 @@ typedef struct oracles {
   int bin_min;       /* bins this small are tested sample by sample */
 } oracles;
 
-/* The continuum's one traversal, steered by ctx->oracles (src/traverse.c). */
+/* The continuum's one traversal, steered by ctx->oracles (vis/traverse.c). */
 rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx);
 /* isOutside: may the box be culled from the frustum of samples [x0, x1) × [y0, y1)? */
 bool rr_oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bvh_node *box);
@@ -101,7 +100,7 @@ rr_error rr_vis_rc(rr_device *dev, render_ctx *ctx);
 /* rc-bvh and rc-packet: single rays and 8x8 ray packets through the BVH (vis/rc_bvh.c). */
 rr_error rr_vis_rc_bvh(rr_device *dev, render_ctx *ctx);
 rr_error rr_vis_rc_packet(rr_device *dev, render_ctx *ctx);
-/* 2dr-bb and 2dr-bin: projection, clipping, fixed-point 2D edge functions (src/raster2d.c). */
+/* 2dr-bb and 2dr-bin: projection, clipping, fixed-point 2D edge functions (vis/raster2d.c). */
 rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx);
 rr_error rr_vis_2dr_bin(rr_device *dev, render_ctx *ctx);
 /* Test hook: runs the 2D pipeline (binning when `bin`) over every triangle but, instead
@@ -114,6 +113,6 @@ bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx,
  * returns the number of edge-function evaluations; adds the samples the
  * triangle covers to *covered. simd: use AVX2 where the processor has it. */
 uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb,
-                     uint64_t *covered, bool simd);
+                        uint64_t *covered, bool simd);
 
 #endif
