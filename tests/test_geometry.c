@@ -13,16 +13,6 @@
 static char dir[] = "/tmp/rr_geometry_XXXXXX";
 static const char *multi_obj; /* written by main */
 
-static const char *write_file(const char *name, const char *text) {
-  static char path[4][512];
-  static int slot;
-  char *p = path[slot++ & 3];
-  snprintf(p, sizeof path[0], "%s/%s", dir, name);
-  FILE *f = fopen(p, "wb");
-  if (f) fputs(text, f), fclose(f);
-  return p;
-}
-
 /* The table's promises on any scene: geometries tile [0, triangles) in order, every
  * id maps to the geometry holding it with its local index, and every triangle
  * carries its geometry's material. */
@@ -296,8 +286,8 @@ static void test_cli(rr_device *dev) {
 int main(void) {
   if (!mkdtemp(dir)) return 1;
   rr_device *dev = rr_device_new();
-  write_file("m.mtl", "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n");
-  multi_obj = write_file("multi.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 2 0 0\n"
+  test_write_file(dir, "m.mtl", "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n");
+  multi_obj = test_write_file(dir, "multi.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 2 0 0\n"
                                       "o first\nusemtl red\nf 1 2 3\nf 1 2 5\nusemtl blue\nf 1 3 4\n"
                                       "o second\nf 1 2 3 4\ng grp\nf 2 3 4\n");
   CHECK(rr_aov_from_name("mesh") == RR_AOV_MESH && rr_aov_from_name("material") == RR_AOV_MATERIAL, "AOV names");

@@ -10,17 +10,6 @@
 
 static char dir[] = "/tmp/rr_loader_XXXXXX";
 
-static const char *write_file(const char *name, const char *text) {
-  static char path[8][512];
-  static int slot;
-  char *p = path[slot++ & 7];
-  snprintf(p, sizeof path[0], "%s/%s", dir, name);
-  FILE *f = fopen(p, "wb");
-  fputs(text, f);
-  fclose(f);
-  return p;
-}
-
 static bool vertex_is(const rr_scene *s, int k, uint32_t i, float x, float y, float z) {
   vec3 p = scene_vertex(s, k, i);
   return p.x == x && p.y == y && p.z == z;
@@ -32,7 +21,7 @@ int main(void) {
   rr_scene *s = NULL;
 
   /* A quad and a pentagon: 2 + 3 triangles, fans (0, j, j+1) in file order. */
-  const char *obj = write_file("poly.obj",
+  const char *obj = test_write_file(dir, "poly.obj",
                                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 3 1 0\nv 2.5 2 0\nv 2 1 0\n"
                                "f 1 2 3 4\nf 5 6 7 8 9\n");
   CHECK(rr_scene_load(dev, obj, &s) == RR_OK, "%s", rr_device_message(dev));
@@ -46,7 +35,7 @@ int main(void) {
   }
 
   /* Negative (relative) indices. */
-  obj = write_file("neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 0 0 1\nf -4 -3 -1\n");
+  obj = test_write_file(dir, "neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 0 0 1\nf -4 -3 -1\n");
   CHECK(rr_scene_load(dev, obj, &s) == RR_OK, "%s", rr_device_message(dev));
   if (s) {
     CHECK(s->ntris == 2, "negative indices: %u triangles", s->ntris);
@@ -55,8 +44,8 @@ int main(void) {
   }
 
   /* Materials: a base colour and a texture path from an MTL file. */
-  write_file("m.mtl", "newmtl red\nKd 0.9 0.1 0.1\nnewmtl tex\nKd 1 1 1\nmap_Kd missing.png\n");
-  obj = write_file("mat.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+  test_write_file(dir, "m.mtl", "newmtl red\nKd 0.9 0.1 0.1\nnewmtl tex\nKd 1 1 1\nmap_Kd missing.png\n");
+  obj = test_write_file(dir, "mat.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
                               "usemtl red\nf 1/1 2/2 3/3\nusemtl tex\nf 1/1 3/3 2/2\n");
   CHECK(rr_scene_load(dev, obj, &s) == RR_OK, "%s", rr_device_message(dev));
   if (s) {
@@ -72,7 +61,7 @@ int main(void) {
   }
 
   /* PLY (ASCII) with a quad. */
-  const char *ply = write_file("q.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+  const char *ply = test_write_file(dir, "q.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
                                         "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
                                         "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
   CHECK(rr_scene_load(dev, ply, &s) == RR_OK, "%s", rr_device_message(dev));
@@ -82,7 +71,7 @@ int main(void) {
   }
 
   /* glTF 2.0 with an embedded buffer: one triangle, translated by its node. */
-  const char *gltf = write_file(
+  const char *gltf = test_write_file(dir, 
       "t.gltf",
       "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
       "\"nodes\":[{\"mesh\":0,\"translation\":[0,0,5]}],"
@@ -114,7 +103,7 @@ int main(void) {
       {"badply.ply", "ply\nformat ascii 1.0\nelement vertex 99\nend_header\n1 2\n", RR_ERROR_PARSE, "badply.ply"},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-    const char *p = bad[i].text ? write_file(bad[i].path, bad[i].text) : bad[i].path;
+    const char *p = bad[i].text ? test_write_file(dir, bad[i].path, bad[i].text) : bad[i].path;
     s = NULL;
     rr_error e = rr_scene_load(dev, p, &s);
     CHECK(e == bad[i].code && s == NULL, "%s: code %d (expected %d): %s", bad[i].path, e, bad[i].code,
@@ -126,7 +115,7 @@ int main(void) {
   CHECK(rr_scene_load(dev, dir, &s) == RR_ERROR_IO, "a directory is not a scene");
 
   /* Degenerate and non-finite triangles are skipped and counted, not fatal. */
-  obj = write_file("mixed.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv inf 0 0\nf 1 2 3\nf 1 2 4\nf 1 2 5\n");
+  obj = test_write_file(dir, "mixed.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv inf 0 0\nf 1 2 3\nf 1 2 4\nf 1 2 5\n");
   CHECK(rr_scene_load(dev, obj, &s) == RR_OK, "%s", rr_device_message(dev));
   if (s) {
     CHECK(s->ntris == 1 && s->skipped == 2, "mixed: %u kept, %llu skipped", s->ntris, (unsigned long long)s->skipped);

@@ -157,3 +157,13 @@ rr_camera test_random_view(const rr_scene *s, float dist_lo, float dist_hi, floa
   cam.fov_deg = fov_lo == fov_hi ? fov_lo : test_randf(fov_lo, fov_hi);
   return cam;
 }
+
+const char *test_write_file(const char *dir, const char *name, const char *text) {
+  static char path[8][512];
+  static int slot;
+  char *p = path[slot++ & 7];
+  snprintf(p, sizeof path[0], "%s/%s", dir, name);
+  FILE *f = fopen(p, "wb");
+  if (f) fputs(text, f), fclose(f);
+  return p;
+}

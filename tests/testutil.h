@@ -59,6 +59,10 @@ rr_frame *test_render_threads(rr_device *dev, const rr_scene *s, const rr_camera
  * view of fov_lo..fov_hi degrees; the rest as rr_camera_init (perspective, y up).
  * A range of one value (lo == hi) draws no random number. */
 rr_camera test_random_view(const rr_scene *s, float dist_lo, float dist_hi, float aim, float fov_lo, float fov_hi);
+/* Writes `text` to the file dir/name and returns its path (one of eight rotating
+ * buffers, so a few paths stay valid at once); a file that cannot be written is
+ * left missing, for the test's load to report. */
+const char *test_write_file(const char *dir, const char *name, const char *text);
 /* Deterministic random numbers for property tests. */
 unsigned test_rand(void);
 float test_randf(float lo, float hi);
