@@ -32,11 +32,6 @@ KERNEL int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, fl
   return 2;
 }
 
-/* The same for a planar camera's sample (sx, sy). */
-KERNEL int shade_sample(const tri_setup *ts, uint32_t id, float sx, float sy, visbuf *vb, size_t k) {
-  return shade_sample_w(ts, id, v3(1.0f, sx, sy), sx, sy, vb, k);
-}
-
 /* Heat maps (per-pixel E and N; heat is NULL when none is kept): spreads `amount`
  * evenly over the samples [x0, x1) × [y0, y1). */
 KERNEL void heat_charge(float *heat, int width, int x0, int y0, int x1, int y1, float amount) {
