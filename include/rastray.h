@@ -202,7 +202,7 @@ typedef enum rr_method {
   RR_METHOD_3DR_FS,   /* occlusion culling and frustum splitting down to 8², no binning */
   RR_METHOD_3DR_FULL, /* 3dr-fs followed by binning and early-z */
   RR_METHOD_COUNT,
-  RR_METHOD_AUTO = 99 /* the fastest for the scene and camera, found by short trials */
+  RR_METHOD_AUTO = 99 /* the fastest for the scene and camera by a cost model (short trials when unsure) */
 } rr_method;
 
 /* The method named `name` ("rc", "3dr-bb", ..., "auto"); -1 when unknown. */
@@ -220,6 +220,8 @@ typedef struct rr_render_options {
   int cull_backfaces; /* nonzero: triangles seen from behind are invisible */
   int heat;           /* nonzero: also record E and N charged to each pixel (AOVs evals, nodes) */
   int scalar;         /* nonzero: no SIMD kernels (for comparison; results are the same bits) */
+  int frames_hint;    /* auto: how many frames of this view the caller expects (0 or 1: one); a trial
+                         of the close candidates runs only when that many frames repay it */
   const char *oracles;/* "key=value,..." overrides of a 3dr method's traversal oracles, or NULL:
                          frustum=N (initial frustum side, 0 = whole image), leaves=0|1
                          (generate samples at BVH leaves or at the root), outside=0|1 (frustum
@@ -242,7 +244,7 @@ typedef struct rr_stats {
   double cpu_ms;       /* processor time the process spent in it, all threads together */
   int threads;         /* threads the pass ran on */
   int method;          /* the method that ran (what auto chose) */
-  char why[160];       /* for auto: why it chose that method */
+  char why[256];       /* for auto: why it chose that method ("model: ..." or "trial: ...") */
 } rr_stats;
 
 /* Computes primary visibility of a scene from a camera into a new frame. */

@@ -23,7 +23,7 @@ struct rr_device {
     rr_camera cam;
     int width, height, threads, cull, scalar;
     int method;
-    char why[160];
+    char why[256];
   } auto_choice;
 };
 

@@ -126,86 +126,11 @@ static bool visbuf_alloc(visbuf *vb, int w, int h, int samples) {
   return true;
 }
 
-/* auto: every candidate renders the view once at half the resolution in each
- * direction, and the fastest renders the frame. The device remembers the choice,
- * so rendering the same view again (animation holds, --repeat) skips the trial. The candidates are the exact
- * methods (bit-identical to ray casting); the 2D pipeline's snapped vertices are
- * for comparison, not a default. A trial costs about a quarter of a
- * frame per candidate and round; a cost model from S, E and N would be cheaper but has to
- * know this machine's costs, which the trial measures directly. */
-static bool same_view(const struct auto_choice *a, const struct auto_choice *b) {
-  return a->scene == b->scene && a->bvh == b->bvh && a->ntris == b->ntris &&
-         memcmp(&a->cam, &b->cam, sizeof a->cam) == 0 && a->width == b->width && a->height == b->height &&
-         a->threads == b->threads && a->cull == b->cull && a->scalar == b->scalar;
-}
-
-static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
-                            const rr_render_options *opt, rr_frame **out) {
-  /* the usual winners first, so the others can be dropped after one round */
-  static const rr_method planar[] = {RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL,
-                                     RR_METHOD_RC_PACKET};
-  static const rr_method curved[] = {RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL, RR_METHOD_RC_PACKET};
-  if (opt->oracles && *opt->oracles)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "oracles apply to the 3dr methods: choose one instead of auto");
-  struct auto_choice key = {.scene = scene, .bvh = scene->bvh, .ntris = scene->ntris, .cam = *cam,
-                            .width = opt->width, .height = opt->height, .threads = opt->threads,
-                            .cull = opt->cull_backfaces != 0, .scalar = opt->scalar != 0};
-  struct auto_choice *last = dev ? &dev->auto_choice : NULL;
-  if (last && last->scene && same_view(last, &key)) {
-    rr_render_options t = *opt;
-    t.method = (rr_method)last->method;
-    rr_error e = rr_render(dev, scene, cam, &t, out);
-    if (!e) snprintf((*out)->stats.why, sizeof (*out)->stats.why, "%s", last->why);
-    return e;
-  }
-  bool flat = cam->type == RR_CAMERA_PERSPECTIVE || cam->type == RR_CAMERA_ORTHOGRAPHIC;
-  const rr_method *cand = flat ? planar : curved;
-  int n = flat ? 5 : 4, best = -1;
-  double best_ms = INFINITY;
-  char trial[160] = "";
-  rr_render_options t = *opt;
-  t.width = opt->width > 1 ? opt->width / 2 : 1, t.height = opt->height > 1 ? opt->height / 2 : 1;
-  if (cam->type == RR_CAMERA_CUBE) t.width = t.height / 3 * 4, t.height = t.height / 3 * 3;
-  if (t.height < 3) t = *opt;
-  t.heat = 0, t.oracles = NULL;
-  for (int i = 0; i < n; i++) {
-    t.method = cand[i];
-    double ms = INFINITY;
-    /* The first round also warms the caches; a candidate more than twice as slow
-     * as the best so far cannot win and gets no second. */
-    for (int round = 0; round < 2 && (round == 0 || !(ms > 2 * best_ms)); round++) {
-      rr_frame *f;
-      rr_error e = rr_render(dev, scene, cam, &t, &f);
-      if (e == RR_ERROR_UNSUPPORTED) break;
-      if (e) return e;
-      ms = minf(ms, (float)f->stats.frame_ms);
-      rr_frame_release(f);
-    }
-    if (ms == INFINITY) continue;
-    size_t len = strlen(trial);
-    snprintf(trial + len, sizeof trial - len, "%s%s %.1f", len ? ", " : "", methods[cand[i]].name, ms);
-    if (ms < best_ms) best_ms = ms, best = cand[i];
-  }
-  if (best < 0) return rr_fail(dev, RR_ERROR_UNSUPPORTED, "no method can render this camera");
-  t = *opt;
-  t.method = (rr_method)best;
-  rr_error e = rr_render(dev, scene, cam, &t, out);
-  if (e) return e;
-  snprintf((*out)->stats.why, sizeof (*out)->stats.why, "fastest in a %dx%d trial (ms: %s)", opt->width / 2,
-           opt->height / 2, trial);
-  if (last) {
-    key.method = best;
-    snprintf(key.why, sizeof key.why, "%s", (*out)->stats.why);
-    *last = key;
-  }
-  return RR_OK;
-}
-
 rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                    const rr_render_options *opt, rr_frame **out) {
   if (!scene || !cam || !opt || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_render: NULL argument");
   *out = NULL;
-  if (opt->method == RR_METHOD_AUTO) return render_auto(dev, scene, cam, opt, out);
+  if (opt->method == RR_METHOD_AUTO) return rr_render_auto(dev, scene, cam, opt, out);
   if ((int)opt->method < 0 || opt->method >= RR_METHOD_COUNT)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown method %d", (int)opt->method);
   if (opt->threads < 0 || opt->threads > RR_MAX_THREADS)

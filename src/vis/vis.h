@@ -89,6 +89,11 @@ bool rr_oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bv
 /* isOccluded: may the box be culled when the farthest depth stored in a frustum is `farthest`? */
 bool rr_oracle_occluded(const camera *c, const bvh_node *box, float farthest);
 
+/* auto (vis/auto.c): the method a cost model predicts fastest, or a short trial's
+ * when the model is unsure and the frames to come repay it; renders with it. */
+rr_error rr_render_auto(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
+                        rr_frame **out);
+
 typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
 
 rr_error rr_vis_rc(rr_device *dev, render_ctx *ctx);
