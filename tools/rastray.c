@@ -413,6 +413,7 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   double *times = malloc(sizeof(double) * repeat), *cpus = malloc(sizeof(double) * repeat);
   if (!times || !cpus) die(EXIT_INPUT, "out of memory for %d repeats", repeat);
   rr_frame *frame = NULL;
+  opt.frames_hint = repeat; /* auto weighs a trial against the frames to come */
   for (int r = 0; r < repeat; r++) {
     rr_frame_release(frame);
     rr_error e = rr_render(dev, scene, &cam, &opt, &frame);

@@ -64,7 +64,7 @@ static double predict(rr_method m, const view_figures *v) {
   double UP = v->whole * P; /* whole-image rectangles: their samples are mostly skipped, ~0.3 ns each */
   bool rays = m == RR_METHOD_RC_PACKET || m == RR_METHOD_RC_BVH;
   if (rays) ns = 171 * T + (v->planar ? 15 : 100) * P;
-  else if (!v->planar) ns = (5000 * T + 10 * P) * (m == RR_METHOD_3DR_FC ? 1.3 : m == RR_METHOD_3DR_FULL ? 1.2 : 1);
+  else if (!v->planar) ns = (5000 * T + 300 * P) * (m == RR_METHOD_3DR_FC ? 1.3 : m == RR_METHOD_3DR_FULL ? 1.2 : 1);
   else if (m == RR_METHOD_3DR_BB) ns = 10 * T + 65 * S + 2.0 * A + 0.28 * UP + 0.14 * P;
   else if (m == RR_METHOD_3DR_BIN) ns = 5 * T + 76 * S + 0.43 * A + 14 * R + 1.3 * P;
   /* what fc and full save is occlusion, which no count here shows: their fits miss
@@ -117,7 +117,7 @@ static rr_error trial(rr_device *dev, const rr_scene *scene, const rr_camera *ca
       rr_frame_release(f);
     }
     size_t len = strlen(got);
-    snprintf(got + len, sizeof got - len, "%s%s %.1f", i ? ", " : "", rr_method_name(cand[i]), ms);
+    snprintf(got + len, sizeof got - len, "%s%s %.3g", i ? ", " : "", rr_method_name(cand[i]), ms);
     if (ms < best_ms) best_ms = ms, *best = cand[i];
   }
   snprintf(why, RR_WHY, "trial: %s ms at %dx%d; %.140s", got, t.width, t.height, model);
@@ -160,7 +160,7 @@ rr_error rr_render_auto(rr_device *dev, const rr_scene *scene, const rr_camera *
     int frames = opt->frames_hint > 1 ? opt->frames_hint : 1;
     int w = snprintf(why, sizeof why, "model:");
     for (int i = 0; i < n && w >= 0 && (size_t)w < sizeof why; i++)
-      w += snprintf(why + w, sizeof why - w, "%s %s %.1f", i ? "," : "", rr_method_name(cand[i]), ms[i]);
+      w += snprintf(why + w, sizeof why - w, "%s %s %.3g", i ? "," : "", rr_method_name(cand[i]), ms[i]);
     if (w >= 0 && (size_t)w < sizeof why)
       snprintf(why + w, sizeof why - w, " ms predicted (T=%.0f S=%.0f A=%.0f R=%.0f U=%.0f)", v.tris, v.setups, v.area, v.edges, v.whole);
     if (close > 1 && frames * (AUTO_MARGIN - 1) * best_ms > trial_ms) {

@@ -130,12 +130,20 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                    const rr_render_options *opt, rr_frame **out) {
   if (!scene || !cam || !opt || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_render: NULL argument");
   *out = NULL;
-  if (opt->method == RR_METHOD_AUTO) return rr_render_auto(dev, scene, cam, opt, out);
-  if ((int)opt->method < 0 || opt->method >= RR_METHOD_COUNT)
+  if (opt->method != RR_METHOD_AUTO && ((int)opt->method < 0 || opt->method >= RR_METHOD_COUNT))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown method %d", (int)opt->method);
   if (opt->threads < 0 || opt->threads > RR_MAX_THREADS)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad thread count %d (0 for all cores, at most %d)", opt->threads,
                    RR_MAX_THREADS);
+  if (opt->samples < 1 || opt->samples > RR_MAX_SAMPLES)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad sample count %d (1..%d per pixel)", opt->samples, RR_MAX_SAMPLES);
+  for (int s = 0; s < opt->samples; s++) { /* every position, before any work */
+    const float *p = opt->sample_pos[s];
+    if (!(p[0] >= 0.0f && p[0] < 1.0f && p[1] >= 0.0f && p[1] < 1.0f))
+      return rr_fail(dev, RR_ERROR_ARGUMENT, "bad position (%g, %g) of sample %d (each in [0, 1))", (double)p[0],
+                     (double)p[1], s);
+  }
+  if (opt->method == RR_METHOD_AUTO) return rr_render_auto(dev, scene, cam, opt, out);
   oracles o = methods[opt->method].o;
   if (opt->oracles && *opt->oracles) {
     if (methods[opt->method].fn != rr_vis_traverse)
@@ -151,14 +159,6 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                    "method '%s' projects onto a plane and cannot render a %s camera; the 3D methods can (rc, rc-bvh, "
                    "rc-packet, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full)",
                    methods[opt->method].name, rr_camera_name(cam->type));
-  if (opt->samples < 1 || opt->samples > RR_MAX_SAMPLES)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad sample count %d (1..%d per pixel)", opt->samples, RR_MAX_SAMPLES);
-  for (int s = 0; s < opt->samples; s++) { /* every position, before any work */
-    const float *p = opt->sample_pos[s];
-    if (!(p[0] >= 0.0f && p[0] < 1.0f && p[1] >= 0.0f && p[1] < 1.0f))
-      return rr_fail(dev, RR_ERROR_ARGUMENT, "bad position (%g, %g) of sample %d (each in [0, 1))", (double)p[0],
-                     (double)p[1], s);
-  }
   camera c;
   rr_error e = rr_cam_setup_at(dev, cam, opt->width, opt->height, opt->sample_pos[0], &c);
   if (e) return e;
