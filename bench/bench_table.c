@@ -115,7 +115,7 @@ static void log_cell(const cell *c, int r, int pass) {
 
 /* auto and the fastest exact method of the pass so far, timed in alternation so
  * that a change of load on this shared machine hits both alike. Only the frame of
- * the method auto picks is timed, not its trial. */
+ * the method auto picks is timed, not the cost model's look at the view (~0.1 ms). */
 static void run_auto(rr_device *dev, const rr_scene *s, const rr_camera *cam, const options *o, int pass,
                      scene_result *res) {
   int best = fastest(res, pass);
@@ -242,7 +242,7 @@ static void run_scene(rr_device *dev, const options *o, int sc, scene_result *re
 
 /* Under callgrind: one counted frame per method of Table 1's pass, each dumped as a
  * part named "SCENE-INDEX METHOD"; nothing else is measured or written. Not auto:
- * its trial would cost more instructions (and callgrind time) than all methods together. */
+ * it renders with one of the methods counted. */
 static int count_main(const options *o) {
   rr_device *dev = rr_device_new();
   for (int sc = 0; sc < o->nscenes; sc++) {
@@ -395,7 +395,7 @@ static void md_llvmpipe_target(FILE *md, const scene_result *res, int n, int pas
   fprintf(md, "\n");
 }
 
-/* auto pays for a trial (not timed here); the frame it then renders should be
+/* auto chooses by its cost model (not timed here); the frame it then renders should be
  * within 10% of the fastest exact method's, timed alternating with it. When auto
  * picked another method, that method's own row against the fastest's tells a
  * wrong pick from noise. */

@@ -63,7 +63,7 @@ static double predict(rr_method m, const view_figures *v) {
   double T = v->tris, S = v->setups, A = v->area, R = v->edges, P = v->samples, ns;
   double UP = v->whole * P; /* whole-image rectangles: their samples are mostly skipped, ~0.3 ns each */
   bool rays = m == RR_METHOD_RC_PACKET || m == RR_METHOD_RC_BVH;
-  if (rays) ns = 171 * T + (v->planar ? 15 : 100) * P;
+  if (rays) ns = (171 * T + (v->planar ? 15 : 100) * P) * (m == RR_METHOD_RC_BVH ? (v->planar ? 2 : 0.9) : 1);
   else if (!v->planar) ns = (5000 * T + 300 * P) * (m == RR_METHOD_3DR_FC ? 1.3 : m == RR_METHOD_3DR_FULL ? 1.2 : 1);
   else if (m == RR_METHOD_3DR_BB) ns = 10 * T + 65 * S + 2.0 * A + 0.28 * UP + 0.14 * P;
   else if (m == RR_METHOD_3DR_BIN) ns = 5 * T + 76 * S + 0.43 * A + 14 * R + 1.3 * P;
@@ -78,7 +78,8 @@ static double predict(rr_method m, const view_figures *v) {
 /* The usual winners first: on a tie the earlier one is kept. */
 static const rr_method planar[] = {RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL,
                                    RR_METHOD_RC_PACKET};
-static const rr_method curved[] = {RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL, RR_METHOD_RC_PACKET};
+static const rr_method curved[] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC,
+                                   RR_METHOD_3DR_FULL};
 
 /* The model is unsure when another candidate is predicted within this factor of the
  * best: its predictions miss by up to ±50% on the views it was fitted to. */
@@ -142,7 +143,7 @@ rr_error rr_render_auto(rr_device *dev, const rr_scene *scene, const rr_camera *
     rr_error e = measure_view(dev, scene, cam, opt, &v);
     if (e) return e;
     const rr_method *cand = v.planar ? planar : curved;
-    int n = v.planar ? 5 : 4, close = 0; /* close: how many in near[] after the best */
+    int n = 5, close = 0; /* close: how many in near[] after the best */
     double ms[5], best_ms = INFINITY;
     for (int i = 0; i < n; i++) {
       ms[i] = predict(cand[i], &v);
