@@ -89,10 +89,16 @@ bool rr_oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bv
 /* isOccluded: may the box be culled when the farthest depth stored in a frustum is `farthest`? */
 bool rr_oracle_occluded(const camera *c, const bvh_node *box, float farthest);
 
-/* auto (vis/auto.c): the method a cost model predicts fastest, or a short trial's
- * when the model is unsure and the frames to come repay it; renders with it. */
-rr_error rr_render_auto(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
-                        rr_frame **out);
+/* auto's cost model (vis/auto.c): the candidate methods for a view (exact, able to
+ * draw its camera) and each one's predicted milliseconds, with the counts behind them. */
+enum { AUTO_NCAND = 5 };
+typedef struct auto_prediction {
+  rr_method method[AUTO_NCAND];
+  double ms[AUTO_NCAND];
+  char figures[96]; /* "T=... S=... A=... R=... U=..." */
+} auto_prediction;
+rr_error rr_auto_predict(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
+                         auto_prediction *out);
 
 typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
 
