@@ -11,9 +11,7 @@
 #include <stb_easy_font.h>
 #pragma GCC diagnostic pop
 
-/* Colours are shaded in linear light; textures and the output are encoded with this
- * power (sRGB, approximately). */
-#define GAMMA 2.2f
+#define GAMMA SCENE_GAMMA
 
 typedef struct hit {
   bool valid, has_ray;
@@ -93,6 +91,9 @@ static void base_color(const rr_scene *s, const hit *h, float rgb[3]) {
     texel(&m->texture, u, v, t);
     for (int c = 0; c < 3; c++) rgb[c] *= t[c];
   }
+  if (s->col[0][0]) /* vertex colours (linear) multiply in, like glTF's COLOR_0 */
+    for (int c = 0; c < 3; c++)
+      rgb[c] *= h->l0 * s->col[0][c][h->id] + h->l1 * s->col[1][c][h->id] + h->l2 * s->col[2][c][h->id];
 }
 
 static uint32_t hash32(uint32_t x) {

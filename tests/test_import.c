@@ -1,0 +1,311 @@
+/* Everything in a file, on files the test writes: textures embedded in GLB and in
+ * data URIs, texture paths in the wrong case or with '\', missing and unreadable
+ * textures reported, vertex colours, normals under a non-uniform and a mirroring
+ * node scale, the file's cameras (by name and index) and lights, and the up axis
+ * of COLLADA and STL files in the automatic framing. */
+#include "camera/camera.h"
+#include "testutil.h"
+
+#include <stb/stb_image_write.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static char dir[] = "/tmp/rr_import_XXXXXX";
+
+/* ---- a small glTF writer: one binary buffer, JSON assembled from pieces ---- */
+
+typedef struct gltf {
+  uint8_t bin[1 << 16];
+  size_t len;
+  char views[4096], accessors[4096], images[256];
+} gltf;
+
+static void append(char *dst, size_t cap, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void append(char *dst, size_t cap, const char *fmt, ...) {
+  size_t n = strlen(dst);
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(dst + n, cap - n, fmt, ap);
+  va_end(ap);
+}
+
+/* Appends bytes as a buffer view (4-byte aligned); its index. */
+static int add_view(gltf *g, const void *data, size_t n) {
+  static int count;
+  if (g->len == 0 && g->views[0] == 0) count = 0;
+  memcpy(g->bin + g->len, data, n);
+  append(g->views, sizeof g->views, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", count ? "," : "", g->len, n);
+  g->len = (g->len + n + 3) & ~(size_t)3;
+  return count++;
+}
+
+/* Appends floats (comps per element: 2, 3 or 4) or uint16 indices (comps 1) as an accessor; its index. */
+static int add_accessor(gltf *g, const void *data, int count, int comps) {
+  static int n;
+  if (g->accessors[0] == 0) n = 0;
+  static const char *type[] = {"", "SCALAR", "VEC2", "VEC3", "VEC4"};
+  int view = add_view(g, data, (size_t)count * (comps == 1 ? 2 : 4 * comps));
+  append(g->accessors, sizeof g->accessors, "%s{\"bufferView\":%d,\"componentType\":%d,\"count\":%d,\"type\":\"%s\"",
+         n ? "," : "", view, comps == 1 ? 5123 : 5126, count, type[comps]);
+  if (comps == 3) { /* POSITION needs its bounds */
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    for (int i = 0; i < 3 * count; i++)
+      lo[i % 3] = fminf(lo[i % 3], ((const float *)data)[i]), hi[i % 3] = fmaxf(hi[i % 3], ((const float *)data)[i]);
+    append(g->accessors, sizeof g->accessors, ",\"min\":[%g,%g,%g],\"max\":[%g,%g,%g]", lo[0], lo[1], lo[2], hi[0],
+           hi[1], hi[2]);
+  }
+  append(g->accessors, sizeof g->accessors, "}");
+  return n++;
+}
+
+static char *base64(const uint8_t *p, size_t n) {
+  static const char al[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  char *o = malloc(4 * (n / 3 + 1) + 1), *q = o;
+  for (size_t i = 0; i < n; i += 3) {
+    uint32_t v = (uint32_t)p[i] << 16 | (i + 1 < n ? (uint32_t)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
+    for (int k = 0; k < 4; k++) *q++ = k <= (int)(n - i) ? al[v >> (18 - 6 * k) & 63] : '=';
+  }
+  *q = 0;
+  return o;
+}
+
+/* A 2×2 PNG: top row red, green; bottom row blue, yellow. */
+static uint8_t png[256];
+static int png_len;
+static void to_mem(void *ctx, void *data, int n) {
+  (void)ctx;
+  memcpy(png + png_len, data, (size_t)n);
+  png_len += n;
+}
+static const uint8_t texels[12] = {255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 0};
+
+/* The image of the file: a buffer view (GLB) or a data URI. */
+static void add_image(gltf *g, bool glb) {
+  if (glb) {
+    snprintf(g->images, sizeof g->images, "{\"bufferView\":%d,\"mimeType\":\"image/png\"}", add_view(g, png, png_len));
+    return;
+  }
+  char *b = base64(png, png_len);
+  snprintf(g->images, sizeof g->images, "{\"uri\":\"data:image/png;base64,%s\"}", b);
+  free(b);
+}
+
+/* Writes the file: `body` holds nodes, meshes, materials... (a comma-led JSON tail). */
+static const char *write_gltf(gltf *g, const char *name, bool glb, const char *body) {
+  static char json[1 << 17], path[512];
+  char *uri = glb ? NULL : base64(g->bin, g->len);
+  snprintf(json, sizeof json,
+           "{\"asset\":{\"version\":\"2.0\"},\"scene\":0%s%s%s%s,\"buffers\":[{\"byteLength\":%zu%s%s%s}],"
+           "\"bufferViews\":[%s],\"accessors\":[%s]}",
+           body, g->images[0] ? ",\"images\":[" : "", g->images, g->images[0] ? "]" : "", g->len,
+           uri ? ",\"uri\":\"data:application/octet-stream;base64," : "", uri ? uri : "", uri ? "\"" : "", g->views,
+           g->accessors);
+  free(uri);
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  FILE *f = fopen(path, "wb");
+  if (!f) return path;
+  if (!glb) {
+    fputs(json, f);
+  } else { /* header, JSON chunk padded with spaces, BIN chunk */
+    uint32_t jl = (uint32_t)(strlen(json) + 3) & ~3u, bl = (uint32_t)g->len;
+    while (strlen(json) < jl) strcat(json, " ");
+    uint32_t head[5] = {0x46546C67, 2, 12 + 8 + jl + 8 + bl, jl, 0x4E4F534A}, bin[2] = {bl, 0x004E4942};
+    fwrite(head, 4, 5, f), fwrite(json, 1, jl, f), fwrite(bin, 4, 2, f), fwrite(g->bin, 1, bl, f);
+  }
+  fclose(f);
+  return path;
+}
+
+/* ---- looking at renders ---- */
+
+/* The shaded colour of pixel (x, y) of a w×h render of s through cam. */
+static void pixel(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h, int x, int y, float rgb[3]) {
+  rr_frame *f = test_render(dev, s, cam, RR_METHOD_3DR_BB, 1, w, h, 0);
+  rr_image img = {0};
+  rgb[0] = rgb[1] = rgb[2] = -1;
+  if (f && rr_shade(dev, s, cam, f, RR_SHADE_LAMBERT, &img) == RR_OK)
+    memcpy(rgb, (float *)img.data + 3 * ((size_t)y * w + x), 3 * sizeof(float));
+  rr_image_free(&img);
+  rr_frame_release(f);
+}
+
+/* Whether colour c is mostly `want` (each channel within 0.25 of 0 or of the lit value). */
+static bool looks(const float c[3], float r, float g, float b) {
+  float want[3] = {r, g, b}, top = fmaxf(c[0], fmaxf(c[1], c[2]));
+  for (int k = 0; k < 3; k++)
+    if (fabsf(c[k] - want[k] * top) > 0.25f) return false;
+  return top > 0.5f;
+}
+
+/* The quad [-1, 1]² at z = 0 facing +Z, uv (0, 0) at its top left (glTF's origin),
+ * textured, with a camera 3 units in front that it fills vertically, a second one
+ * on +X looking back along -X, and a spot light. */
+static const char *textured_quad(const char *name, bool glb) {
+  static gltf g;
+  memset(&g, 0, sizeof g);
+  float pos[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[] = {0, 1, 1, 1, 1, 0, 0, 0};
+  uint16_t idx[] = {0, 1, 2, 0, 2, 3};
+  int a_pos = add_accessor(&g, pos, 4, 3), a_uv = add_accessor(&g, uv, 4, 2), a_idx = add_accessor(&g, idx, 6, 1);
+  add_image(&g, glb);
+  char body[4096];
+  snprintf(body, sizeof body,
+           ",\"scenes\":[{\"nodes\":[0,1,2,3]}],\"nodes\":[{\"mesh\":0,\"name\":\"quad\"},"
+           "{\"camera\":0,\"name\":\"front\",\"translation\":[0,0,3]},"
+           "{\"camera\":1,\"name\":\"side\",\"translation\":[3,0,0],\"rotation\":[0,0.70710678,0,0.70710678]},"
+           "{\"name\":\"Lamp\",\"translation\":[1,2,3],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}],"
+           "\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":%.8f,\"aspectRatio\":2,\"znear\":0.1}},"
+           "{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"znear\":0.1}}],"
+           "\"extensionsUsed\":[\"KHR_lights_punctual\"],\"extensions\":{\"KHR_lights_punctual\":{\"lights\":"
+           "[{\"type\":\"spot\",\"color\":[1,0.5,0.25],\"intensity\":2,\"spot\":{\"innerConeAngle\":0.2,"
+           "\"outerConeAngle\":0.4}}]}},"
+           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":%d,\"TEXCOORD_0\":%d},\"indices\":%d,"
+           "\"material\":0}]}],\"materials\":[{\"name\":\"checker\",\"pbrMetallicRoughness\":"
+           "{\"baseColorTexture\":{\"index\":0}}}],\"textures\":[{\"source\":0}]",
+           2 * atan(1.0 / 3.0), a_pos, a_uv, a_idx);
+  return write_gltf(&g, name, glb, body);
+}
+
+static void check_textured(rr_device *dev, const char *path, rr_texture_status want) {
+  rr_scene *s = NULL;
+  CHECK(rr_scene_load(dev, path, &s) == RR_OK, "%s: %s", path, rr_device_message(dev));
+  if (!s) return;
+  rr_scene_info in;
+  rr_scene_get_info(s, &in);
+  rr_material_info mi = {0};
+  CHECK(rr_scene_get_material_info(s, 0, &mi) == RR_OK && mi.texture_status == want && mi.texture_width == 2 &&
+            mi.name && strcmp(mi.name, "checker") == 0,
+        "%s: material '%s' texture '%s' %s %dx%d", path, mi.name, mi.texture, rr_texture_status_name(mi.texture_status),
+        mi.texture_width, mi.texture_height);
+  CHECK(in.textures >= 1 && in.textures_missing == 0 && in.cameras == 2 && in.lights == 1,
+        "%s: %u textures, %u missing, %u cameras, %u lights", path, in.textures, in.textures_missing, in.cameras,
+        in.lights);
+  /* Through the file's camera "front" the quad fills the image's height (glTF keeps
+   * yfov whatever the aspect); each quarter shows its texel. */
+  uint32_t front = 9, side = 9;
+  rr_camera cam;
+  CHECK(rr_scene_find_camera(dev, s, "front", &front) == RR_OK && front == 0, "camera 'front' is %u", front);
+  CHECK(rr_scene_find_camera(dev, s, "1", &side) == RR_OK && side == 1, "camera '1' is %u", side);
+  CHECK(rr_scene_find_camera(dev, s, "nope", &side) == RR_ERROR_ARGUMENT &&
+            strstr(rr_device_message(dev), "'front', 'side'") && !strchr(rr_device_message(dev), '\n'),
+        "unknown camera: '%s'", rr_device_message(dev));
+  CHECK(rr_scene_get_camera(dev, s, front, 64, 32, &cam) == RR_OK, "%s", rr_device_message(dev));
+  CHECK(fabsf(cam.eye[2] - 3) < 1e-5f && fabsf(cam.eye[0]) < 1e-5f && cam.target[2] < cam.eye[2] &&
+            fabsf(cam.fov_deg - (float)(2 * atan(1.0 / 3.0) * 180 / RR_PI)) < 1e-3f,
+        "front: eye (%g %g %g) fov %g", cam.eye[0], cam.eye[1], cam.eye[2], cam.fov_deg);
+  rr_frame *f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 1, 64, 32, 0);
+  if (f) {
+    const uint32_t *ids = rr_frame_ids(f);
+    CHECK(ids[32] != RR_MISS && ids[31 * 64 + 32] != RR_MISS && ids[16 * 64 + 10] == RR_MISS &&
+              ids[16 * 64 + 20] != RR_MISS,
+          "the quad fills the height and the middle half of the width");
+    rr_frame_release(f);
+  }
+  float c[3];
+  static const int at[4][2] = {{24, 8}, {40, 8}, {24, 24}, {40, 24}};
+  for (int q = 0; q < 4; q++) {
+    pixel(dev, s, &cam, 64, 32, at[q][0], at[q][1], c);
+    CHECK(looks(c, texels[3 * q] / 255.0f, texels[3 * q + 1] / 255.0f, texels[3 * q + 2] / 255.0f),
+          "%s: quarter %d shows (%g %g %g)", path, q, c[0], c[1], c[2]);
+  }
+  CHECK(rr_scene_get_camera(dev, s, side, 32, 32, &cam) == RR_OK && fabsf(cam.eye[0] - 3) < 1e-5f &&
+            fabsf(cam.target[0] - 2) < 1e-4f && fabsf(cam.target[2]) < 1e-4f,
+        "side: eye (%g %g %g) target (%g %g %g)", cam.eye[0], cam.eye[1], cam.eye[2], cam.target[0], cam.target[1],
+        cam.target[2]);
+  CHECK(rr_scene_get_camera(dev, s, 2, 32, 32, &cam) == RR_ERROR_ARGUMENT, "camera 2 does not exist");
+  rr_light_info l = {0};
+  CHECK(rr_scene_get_light(s, 0, &l) == RR_OK && l.type == RR_LIGHT_SPOT && l.name && strcmp(l.name, "Lamp") == 0 &&
+            fabsf(l.position[0] - 1) < 1e-5f && fabsf(l.position[1] - 2) < 1e-5f && fabsf(l.position[2] - 3) < 1e-5f &&
+            fabsf(l.direction[2] + 1) < 1e-5f && fabsf(l.color[0] - 2) < 1e-5f && fabsf(l.color[2] - 0.5f) < 1e-5f &&
+            fabsf(l.outer_cone_deg - 0.4f * 180 / (float)RR_PI) < 1e-3f,
+        "light: %s %s at (%g %g %g) towards (%g %g %g) colour (%g %g %g) cone %g", l.name, rr_light_type_name(l.type),
+        l.position[0], l.position[1], l.position[2], l.direction[0], l.direction[1], l.direction[2], l.color[0],
+        l.color[1], l.color[2], l.outer_cone_deg);
+  rr_scene_release(s);
+}
+
+/* A UV sphere of radius 1 with exact normals under a node scaled by `scale`: the
+ * normal AOV against the ellipsoid's normal (x/a², y/b², z/c²) at each hit. */
+static void check_scaled_sphere(rr_device *dev, const char *name, const float scale[3]) {
+  enum { SEG = 48, RINGS = 24, NV = (SEG + 1) * (RINGS + 1) };
+  static float pos[3 * NV], nrm[3 * NV];
+  static uint16_t idx[6 * SEG * RINGS];
+  int ni = 0;
+  for (int r = 0; r <= RINGS; r++)
+    for (int k = 0; k <= SEG; k++) {
+      double th = RR_PI * r / RINGS, ph = 2 * RR_PI * k / SEG;
+      float *p = pos + 3 * (r * (SEG + 1) + k), *n = nrm + 3 * (r * (SEG + 1) + k);
+      n[0] = p[0] = (float)(sin(th) * cos(ph)), n[1] = p[1] = (float)cos(th), n[2] = p[2] = (float)(-sin(th) * sin(ph));
+      if (r < RINGS && k < SEG) {
+        uint16_t a = (uint16_t)(r * (SEG + 1) + k), b = (uint16_t)(a + SEG + 1);
+        uint16_t t[6] = {a, b, (uint16_t)(a + 1), (uint16_t)(a + 1), b, (uint16_t)(b + 1)};
+        memcpy(idx + ni, t, sizeof t), ni += 6;
+      }
+    }
+  static gltf g;
+  memset(&g, 0, sizeof g);
+  int a_pos = add_accessor(&g, pos, NV, 3), a_n = add_accessor(&g, nrm, NV, 3), a_idx = add_accessor(&g, idx, ni, 1);
+  char body[1024];
+  snprintf(body, sizeof body,
+           ",\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"scale\":[%g,%g,%g]}],\"meshes\":[{\"primitives\":"
+           "[{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d},\"indices\":%d}]}]",
+           scale[0], scale[1], scale[2], a_pos, a_n, a_idx);
+  const char *path = write_gltf(&g, name, true, body);
+  rr_scene *s = NULL;
+  CHECK(rr_scene_load(dev, path, &s) == RR_OK, "%s: %s", name, rr_device_message(dev));
+  if (!s) return;
+  rr_camera cam;
+  rr_camera_init(&cam);
+  cam.eye[0] = 1.5f, cam.eye[1] = 2.0f, cam.eye[2] = 4.0f; /* sees the flat top and the rim */
+  enum { W = 64 };
+  rr_frame *f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 1, W, W, 1); /* culled: front faces must face out */
+  rr_image img = {0};
+  camera c;
+  if (f && rr_frame_aov(dev, s, &cam, f, RR_AOV_NORMAL, &img) == RR_OK && rr_cam_setup(dev, &cam, W, W, &c) == RR_OK) {
+    static float err[W * W];
+    int n = 0;
+    for (int y = 0; y < W; y++)
+      for (int x = 0; x < W; x++) {
+        float t = rr_frame_t(f)[y * W + x];
+        if (!isfinite(t)) continue;
+        vec3 o, d;
+        rr_cam_ray(&c, x, y, &o, &d);
+        vec3 p = v3_add(o, v3_scale(d, t));
+        vec3 want = v3_norm(v3(p.x / (scale[0] * scale[0]), p.y / (scale[1] * scale[1]), p.z / (scale[2] * scale[2])));
+        const float *got = (const float *)img.data + 3 * (y * W + x);
+        float cosang = fminf(1.0f, v3_dot(want, v3_load(got)));
+        err[n++] = acosf(cosang) * 180.0f / (float)RR_PI;
+      }
+    /* the median by counting: how many are under the bound */
+    int under = 0;
+    for (int i = 0; i < n; i++) under += err[i] < 1.0f;
+    CHECK(n > W * W / 16 && under > n / 2, "%s: %d of %d hits have normals within 1° of the ellipsoid's", name, under, n);
+    rr_cam_release(&c);
+  }
+  rr_image_free(&img);
+  rr_frame_release(f);
+  rr_scene_release(s);
+}
+
+int main(void) {
+  if (!mkdtemp(dir)) return 1;
+  rr_device *dev = rr_device_new();
+  png_len = 0;
+  stbi_write_png_to_func(to_mem, NULL, 2, 2, 3, texels, 6);
+  CHECK(png_len > 8, "PNG written");
+
+  /* Embedded textures, cameras and a light: GLB (image in a buffer view) and glTF
+   * (buffer and image as data URIs). */
+  check_textured(dev, textured_quad("quad.glb", true), RR_TEXTURE_EMBEDDED);
+  check_textured(dev, textured_quad("quad.gltf", false), RR_TEXTURE_EMBEDDED);
+
+  /* Normals under node transforms: the inverse transpose, also when mirrored. */
+  check_scaled_sphere(dev, "ellipsoid.glb", (const float[3]){1, 0.25f, 1});
+  check_scaled_sphere(dev, "mirrored.glb", (const float[3]){-1, 0.25f, 1});
+
+  char cmd[600];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  CHECK(getenv("RR_KEEP") || system(cmd) == 0, "cleanup");
+  rr_device_release(dev);
+  return test_done();
+}
