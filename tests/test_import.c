@@ -287,6 +287,168 @@ static void check_scaled_sphere(rr_device *dev, const char *name, const float sc
   rr_scene_release(s);
 }
 
+/* A triangle with red, green and blue corners (glTF COLOR_0, linear): the pixel
+ * nearest each corner (largest barycentric) shows its colour. */
+static void check_vertex_colors(rr_device *dev) {
+  static gltf g;
+  memset(&g, 0, sizeof g);
+  float pos[] = {-1, -1, 0, 1, -1, 0, 0, 1, 0}, col[] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  uint16_t idx[] = {0, 1, 2};
+  int a_pos = add_accessor(&g, pos, 3, 3), a_col = add_accessor(&g, col, 3, 3), a_idx = add_accessor(&g, idx, 3, 1);
+  char body[1024];
+  snprintf(body, sizeof body,
+           ",\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":"
+           "{\"POSITION\":%d,\"COLOR_0\":%d},\"indices\":%d,\"material\":0}]}],\"materials\":[{\"pbrMetallicRoughness\":"
+           "{\"baseColorFactor\":[1,1,1,1]}}]",
+           a_pos, a_col, a_idx);
+  rr_scene *s = NULL;
+  CHECK(rr_scene_load(dev, write_gltf(&g, "colors.gltf", false, body), &s) == RR_OK, "%s", rr_device_message(dev));
+  if (!s) return;
+  enum { W = 48 };
+  rr_camera cam;
+  rr_camera_init(&cam);
+  CHECK(rr_camera_frame(dev, s, W, W, &cam) == RR_OK, "%s", rr_device_message(dev));
+  rr_frame *f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 1, W, W, 1); /* seen from its front, +Z */
+  rr_image img = {0};
+  if (f && rr_shade(dev, s, &cam, f, RR_SHADE_LAMBERT, &img) == RR_OK) {
+    for (int k = 0; k < 3; k++) {
+      int best = -1;
+      float top = -1;
+      for (int i = 0; i < W * W; i++) {
+        if (rr_frame_ids(f)[i] == RR_MISS) continue;
+        float l1 = rr_frame_bary1(f)[i], l2 = rr_frame_bary2(f)[i], w = k == 0 ? 1 - l1 - l2 : k == 1 ? l1 : l2;
+        if (w > top) top = w, best = i;
+      }
+      const float *c = best < 0 ? (const float[3]){-1, -1, -1} : (const float *)img.data + 3 * best;
+      CHECK(top > 0.8f && looks(c, k == 0, k == 1, k == 2), "corner %d (weight %g) shows (%g %g %g)", k, top, c[0], c[1],
+            c[2]);
+    }
+  }
+  rr_image_free(&img);
+  rr_frame_release(f);
+  rr_scene_release(s);
+
+  /* OBJ colours (as PLY's) are display values: stored linear. */
+  const char *obj = test_write_file(dir, "col.obj", "v 0 0 0 0.5 0.5 0.5\nv 1 0 0 1 0 0\nv 0 1 0 0 0 1\nf 1 2 3\n");
+  CHECK(rr_scene_load(dev, obj, &s) == RR_OK, "%s", rr_device_message(dev));
+  if (s) {
+    CHECK(s->col[0][0] && fabsf(s->col[0][1][0] - powf(0.5f, SCENE_GAMMA)) < 1e-4f && s->col[1][0][0] == 1 &&
+              s->col[1][1][0] == 0,
+          "OBJ vertex colours decoded to linear: %g", s->col[0][0] ? s->col[0][1][0] : -1);
+    rr_scene_release(s);
+  }
+
+  /* The API: per-vertex colours into a white material; a non-finite one is refused. */
+  CHECK(rr_scene_new(dev, &s) == RR_OK, "new");
+  uint32_t tri[] = {0, 1, 2};
+  float nan_col[9] = {1, 0, 0, 0, 1, 0, 0, 0, NAN};
+  CHECK(rr_scene_add_mesh_colors(s, pos, 3, tri, 1, NULL, nan_col) == RR_ERROR_ARGUMENT && s->ntris == 0,
+        "a NaN colour is refused");
+  CHECK(rr_scene_add_mesh_colors(s, pos, 3, tri, 1, NULL, col) == RR_OK && s->col[0][0] && s->col[2][2][0] == 1 &&
+            s->col[0][0][0] == 1 && s->materials[s->material[0]].color[1] == 1,
+        "add_mesh_colors: %s", rr_device_message(dev));
+  rr_scene_release(s);
+}
+
+/* Texture files: a name in the wrong case, a Windows path, a missing file and an
+ * unreadable one, each with its status. */
+static void check_texture_files(rr_device *dev) {
+  char path[600];
+  snprintf(path, sizeof path, "%s/test.png", dir);
+  stbi_write_png(path, 2, 2, 3, texels, 6);
+  snprintf(path, sizeof path, "mkdir -p %s/maps && cp %s/test.png %s/maps/wood.png", dir, dir, dir);
+  CHECK(system(path) == 0, "%s", path);
+  test_write_file(dir, "bad.png", "not a PNG at all");
+  test_write_file(dir, "m.mtl", "newmtl upper\nmap_Kd TEST.PNG\nnewmtl windows\nmap_Kd Maps\\WOOD.png\n"
+                                "newmtl absent\nmap_Kd nothere.png\nnewmtl broken\nmap_Kd bad.png\n");
+  const char *obj = test_write_file(dir, "tex.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                                                  "usemtl upper\nf 1/1 2/2 3/3\nusemtl windows\nf 1/1 2/2 3/3\n"
+                                                  "usemtl absent\nf 1/1 2/2 3/3\nusemtl broken\nf 1/1 2/2 3/3\n");
+  rr_scene *s = NULL;
+  CHECK(rr_scene_load(dev, obj, &s) == RR_OK, "%s", rr_device_message(dev));
+  if (!s) return;
+  static const struct {
+    const char *name;
+    rr_texture_status status;
+  } want[] = {{"upper", RR_TEXTURE_FILE}, {"windows", RR_TEXTURE_FILE}, {"absent", RR_TEXTURE_MISSING},
+              {"broken", RR_TEXTURE_UNREADABLE}};
+  for (size_t w = 0; w < 4; w++) {
+    bool found = false;
+    for (uint32_t m = 0; m < s->nmaterials; m++) {
+      rr_material_info mi;
+      rr_scene_get_material_info(s, m, &mi);
+      if (!mi.name || strcmp(mi.name, want[w].name) != 0) continue;
+      found = true;
+      bool read = want[w].status == RR_TEXTURE_FILE;
+      CHECK(mi.texture_status == want[w].status && (!read || (mi.texture_width == 2 && !memcmp(s->materials[m].texture.rgb,
+                                                                                              texels, 12))),
+            "%s: texture '%s' is %s", mi.name, mi.texture, rr_texture_status_name(mi.texture_status));
+    }
+    CHECK(found, "material %s", want[w].name);
+  }
+  rr_scene_info in;
+  rr_scene_get_info(s, &in);
+  CHECK(in.textures == 4 && in.textures_missing == 2, "%u textures, %u missing", in.textures, in.textures_missing);
+  rr_scene_release(s);
+}
+
+/* Z-up files: COLLADA's <up_axis>Z_UP</up_axis> is turned Y-up by assimp, STL stays
+ * Z-up; either way the automatic camera sees a triangle standing on the ground and
+ * facing the front (-Y in Z-up terms) from its front, with culling. */
+static void check_up_axis(rr_device *dev) {
+  const char *dae = test_write_file(dir, "z.dae",
+      "<?xml version=\"1.0\"?><COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
+      "<asset><up_axis>Z_UP</up_axis></asset><library_cameras><camera id=\"cam\" name=\"cam\"><optics><technique_common>"
+      "<perspective><xfov>60</xfov><aspect_ratio>1</aspect_ratio><znear>0.1</znear><zfar>100</zfar></perspective>"
+      "</technique_common></optics></camera></library_cameras><library_geometries><geometry id=\"tri\"><mesh>"
+      "<source id=\"pos\"><float_array id=\"pa\" count=\"9\">0 0 0 1 0 0 0 0 1</float_array><technique_common>"
+      "<accessor source=\"#pa\" count=\"3\" stride=\"3\"><param name=\"X\" type=\"float\"/><param name=\"Y\" "
+      "type=\"float\"/><param name=\"Z\" type=\"float\"/></accessor></technique_common></source><vertices id=\"v\">"
+      "<input semantic=\"POSITION\" source=\"#pos\"/></vertices><triangles count=\"1\"><input semantic=\"VERTEX\" "
+      "source=\"#v\" offset=\"0\"/><p>0 1 2</p></triangles></mesh></geometry></library_geometries>"
+      "<library_visual_scenes><visual_scene id=\"s\"><node id=\"n\"><instance_geometry url=\"#tri\"/></node>"
+      "<node id=\"eye\" name=\"eye\"><translate>0.3 -5 0.3</translate><rotate>1 0 0 90</rotate>"
+      "<instance_camera url=\"#cam\"/></node></visual_scene></library_visual_scenes>"
+      "<scene><instance_visual_scene url=\"#s\"/></scene></COLLADA>");
+  const char *stl = test_write_file(dir, "z.stl", "solid t\nfacet normal 0 -1 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                                                   "vertex 0 0 1\nendloop\nendfacet\nendsolid t\n");
+  const char *files[2] = {dae, stl};
+  for (int i = 0; i < 2; i++) {
+    rr_scene *s = NULL;
+    CHECK(rr_scene_load(dev, files[i], &s) == RR_OK, "%s: %s", files[i], rr_device_message(dev));
+    if (!s) continue;
+    rr_scene_info in;
+    rr_scene_get_info(s, &in);
+    float up_z = i == 1; /* STL: +Z up, front -Y; COLLADA after assimp: +Y up, front +Z */
+    CHECK(in.up[2] == up_z && in.up[1] == 1 - up_z && in.front[1] == -up_z && in.front[2] == 1 - up_z,
+          "%s: up (%g %g %g) front (%g %g %g)", files[i], in.up[0], in.up[1], in.up[2], in.front[0], in.front[1],
+          in.front[2]);
+    rr_camera cam;
+    rr_camera_init(&cam);
+    rr_error e = rr_camera_frame(dev, s, 32, 32, &cam);
+    vec3 view = v3_sub(v3_load(cam.eye), v3_load(cam.target)); /* from the front, a little above */
+    CHECK(e == RR_OK && cam.up[2] == up_z && v3_dot(view, v3_load(in.front)) > 0 && v3_dot(view, v3_load(in.up)) > 0,
+          "%s: framed with up (%g %g %g) from (%g %g %g)", files[i], cam.up[0], cam.up[1], cam.up[2], cam.eye[0],
+          cam.eye[1], cam.eye[2]);
+    rr_frame *f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 1, 32, 32, 1);
+    CHECK(f && test_frame_hits(f) > 32 * 32 / 8, "%s: the front face fills the view: %d hits", files[i],
+          f ? test_frame_hits(f) : -1);
+    rr_frame_release(f);
+    if (i == 0) { /* the file's camera, 5 units in front of the triangle, converted with the scene */
+      uint32_t c = 9;
+      CHECK(in.cameras == 1 && rr_scene_find_camera(dev, s, "eye", &c) == RR_OK &&
+                rr_scene_get_camera(dev, s, c, 32, 32, &cam) == RR_OK && fabsf(cam.eye[2] - 5) < 1e-4f &&
+                fabsf(cam.target[2] - 4) < 1e-4f && fabsf(cam.fov_deg - 60) < 1e-3f,
+            "COLLADA camera: %s eye (%g %g %g) target (%g %g %g) fov %g", rr_device_message(dev), cam.eye[0], cam.eye[1],
+            cam.eye[2], cam.target[0], cam.target[1], cam.target[2], cam.fov_deg);
+      f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 1, 32, 32, 1);
+      CHECK(f && rr_frame_ids(f)[16 * 32 + 16] == 0, "the COLLADA camera looks at the triangle");
+      rr_frame_release(f);
+    }
+    rr_scene_release(s);
+  }
+}
+
 int main(void) {
   if (!mkdtemp(dir)) return 1;
   rr_device *dev = rr_device_new();
@@ -302,6 +464,10 @@ int main(void) {
   /* Normals under node transforms: the inverse transpose, also when mirrored. */
   check_scaled_sphere(dev, "ellipsoid.glb", (const float[3]){1, 0.25f, 1});
   check_scaled_sphere(dev, "mirrored.glb", (const float[3]){-1, 0.25f, 1});
+
+  check_vertex_colors(dev);
+  check_texture_files(dev);
+  check_up_axis(dev);
 
   char cmd[600];
   snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
