@@ -9,6 +9,7 @@
 #include <stb/stb_image_write.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 static char dir[] = "/tmp/rr_import_XXXXXX";
@@ -449,6 +450,41 @@ static void check_up_axis(rr_device *dev) {
   }
 }
 
+/* Runs the CLI with args in dir; its exit status, its stdout and stderr in out. */
+static int cli(const char *args, char *out, size_t cap) {
+  char cmd[1024];
+  snprintf(cmd, sizeof cmd, "cd %s && %s %s 2>&1", dir, RR_CLI, args);
+  FILE *p = popen(cmd, "r");
+  if (!p) return -1;
+  size_t n = fread(out, 1, cap - 1, p);
+  out[n] = 0;
+  int st = pclose(p);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* `info` lists materials with their textures, the textures that are missing, the
+ * cameras and lights; `render --camera-from-file` looks through a file's camera. */
+static void check_cli(void) {
+  static char out[1 << 14];
+  int st = cli("info quad.glb", out, sizeof out);
+  CHECK(st == 0 && strstr(out, "checker") && strstr(out, "'*0' (embedded, 2x2)") && strstr(out, "cameras      2") &&
+            strstr(out, "front") && strstr(out, "side") && strstr(out, "Lamp") && strstr(out, "spot"),
+        "info quad.glb (%d):\n%s", st, out);
+  st = cli("info tex.obj", out, sizeof out);
+  CHECK(st == 0 && strstr(out, "textures     4 (2 missing or unreadable)") && strstr(out, "missing    'nothere.png'") &&
+            strstr(out, "unreadable 'bad.png'") && strstr(out, "'TEST.PNG' (file, 2x2)"),
+        "info tex.obj (%d):\n%s", st, out);
+  st = cli("render quad.glb --camera-from-file=side --size 16x16 -o side.png -q", out, sizeof out);
+  CHECK(st == 0, "--camera-from-file side (%d): %s", st, out);
+  st = cli("render quad.glb --camera-from-file 0 --camera orthographic --size 16x16 -o front.png -q", out, sizeof out);
+  CHECK(st == 0, "--camera-from-file 0 (%d): %s", st, out);
+  st = cli("render quad.glb --camera-from-file nope --size 16x16 -o x.png", out, sizeof out);
+  CHECK(st == 1 && strstr(out, "'front', 'side'") && strchr(out, '\n') == out + strlen(out) - 1,
+        "unknown camera (%d): %s", st, out);
+  st = cli("render quad.glb --camera-from-file front --fov 30 --size 16x16 -o x.png", out, sizeof out);
+  CHECK(st == 2, "--camera-from-file with --fov is refused (%d): %s", st, out);
+}
+
 int main(void) {
   if (!mkdtemp(dir)) return 1;
   rr_device *dev = rr_device_new();
@@ -468,6 +504,7 @@ int main(void) {
   check_vertex_colors(dev);
   check_texture_files(dev);
   check_up_axis(dev);
+  check_cli();
 
   char cmd[600];
   snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
