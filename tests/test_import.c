@@ -485,6 +485,89 @@ static void check_cli(void) {
   CHECK(st == 2, "--camera-from-file with --fov is refused (%d): %s", st, out);
 }
 
+/* ---- a ZAE: a stored (uncompressed) zip of a COLLADA file and its texture ---- */
+
+static uint32_t crc32_of(const uint8_t *p, size_t n) {
+  uint32_t c = 0xFFFFFFFFu;
+  for (size_t i = 0; i < n; i++) {
+    c ^= p[i];
+    for (int k = 0; k < 8; k++) c = c >> 1 ^ (0xEDB88320u & -(c & 1u));
+  }
+  return ~c;
+}
+
+static void put(FILE *f, uint32_t v, int bytes) {
+  for (int i = 0; i < bytes; i++) fputc((int)(v >> 8 * i & 255), f);
+}
+
+/* Writes the entries (name, bytes, length) as a zip with no compression. */
+static const char *write_zip(const char *name, int n, const char *const names[], const void *const data[],
+                             const size_t len[]) {
+  static char path[512];
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  FILE *f = fopen(path, "wb");
+  if (!f) return path;
+  uint32_t offset[8], at = 0;
+  for (int i = 0; i < n; i++) { /* local headers and data */
+    offset[i] = at;
+    uint32_t nl = (uint32_t)strlen(names[i]);
+    put(f, 0x04034b50, 4), put(f, 20, 2), put(f, 0, 2), put(f, 0, 2), put(f, 0, 4);
+    put(f, crc32_of(data[i], len[i]), 4), put(f, (uint32_t)len[i], 4), put(f, (uint32_t)len[i], 4), put(f, nl, 2);
+    put(f, 0, 2), fputs(names[i], f), fwrite(data[i], 1, len[i], f);
+    at += 30 + nl + (uint32_t)len[i];
+  }
+  uint32_t dir_at = at;
+  for (int i = 0; i < n; i++) { /* the central directory */
+    uint32_t nl = (uint32_t)strlen(names[i]);
+    put(f, 0x02014b50, 4), put(f, 20, 2), put(f, 20, 2), put(f, 0, 2), put(f, 0, 2), put(f, 0, 4);
+    put(f, crc32_of(data[i], len[i]), 4), put(f, (uint32_t)len[i], 4), put(f, (uint32_t)len[i], 4), put(f, nl, 2);
+    put(f, 0, 2), put(f, 0, 2), put(f, 0, 2), put(f, 0, 2), put(f, 0, 4), put(f, offset[i], 4), fputs(names[i], f);
+    at += 46 + nl;
+  }
+  put(f, 0x06054b50, 4), put(f, 0, 4), put(f, (uint32_t)n, 2), put(f, (uint32_t)n, 2), put(f, at - dir_at, 4);
+  put(f, dir_at, 4), put(f, 0, 2);
+  fclose(f);
+  return path;
+}
+
+/* A ZAE whose material's texture is a file inside the archive: assimp hands it
+ * over as an embedded texture named like the file. */
+static void check_zae(rr_device *dev) {
+  static const char dae[] =
+      "<?xml version=\"1.0\"?><COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
+      "<library_images><image id=\"img\"><init_from>maps/test.png</init_from></image></library_images>"
+      "<library_effects><effect id=\"fx\"><profile_COMMON><newparam sid=\"surf\"><surface type=\"2D\"><init_from>img"
+      "</init_from></surface></newparam><newparam sid=\"samp\"><sampler2D><source>surf</source></sampler2D></newparam>"
+      "<technique sid=\"t\"><lambert><diffuse><texture texture=\"samp\" texcoord=\"UV\"/></diffuse></lambert>"
+      "</technique></profile_COMMON></effect></library_effects><library_materials><material id=\"mat\" name=\"mat\">"
+      "<instance_effect url=\"#fx\"/></material></library_materials><library_geometries><geometry id=\"tri\"><mesh>"
+      "<source id=\"pos\"><float_array id=\"pa\" count=\"9\">0 0 0 1 0 0 0 1 0</float_array><technique_common>"
+      "<accessor source=\"#pa\" count=\"3\" stride=\"3\"><param name=\"X\" type=\"float\"/><param name=\"Y\" "
+      "type=\"float\"/><param name=\"Z\" type=\"float\"/></accessor></technique_common></source><vertices id=\"v\">"
+      "<input semantic=\"POSITION\" source=\"#pos\"/></vertices><triangles count=\"1\" material=\"m\"><input "
+      "semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/><p>0 1 2</p></triangles></mesh></geometry></library_geometries>"
+      "<library_visual_scenes><visual_scene id=\"s\"><node id=\"n\"><instance_geometry url=\"#tri\"><bind_material>"
+      "<technique_common><instance_material symbol=\"m\" target=\"#mat\"/></technique_common></bind_material>"
+      "</instance_geometry></node></visual_scene></library_visual_scenes><scene><instance_visual_scene url=\"#s\"/>"
+      "</scene></COLLADA>";
+  static const char manifest[] = "<?xml version=\"1.0\"?><dae_root>scene.dae</dae_root>";
+  const char *names[] = {"manifest.xml", "scene.dae", "maps/test.png"};
+  const void *data[] = {manifest, dae, png};
+  size_t len[] = {strlen(manifest), strlen(dae), (size_t)png_len};
+  rr_scene *s = NULL;
+  CHECK(rr_scene_load(dev, write_zip("scene.zae", 3, names, data, len), &s) == RR_OK, "%s", rr_device_message(dev));
+  if (!s) return;
+  bool embedded = false;
+  for (uint32_t m = 0; m < s->nmaterials; m++) {
+    rr_material_info mi;
+    rr_scene_get_material_info(s, m, &mi);
+    embedded |= mi.texture_status == RR_TEXTURE_EMBEDDED && mi.texture_width == 2 &&
+                !memcmp(s->materials[m].texture.rgb, texels, 12);
+  }
+  CHECK(embedded, "the ZAE's texture is read from the archive");
+  rr_scene_release(s);
+}
+
 int main(void) {
   if (!mkdtemp(dir)) return 1;
   rr_device *dev = rr_device_new();
@@ -504,6 +587,7 @@ int main(void) {
   check_vertex_colors(dev);
   check_texture_files(dev);
   check_up_axis(dev);
+  check_zae(dev);
   check_cli();
 
   char cmd[600];
