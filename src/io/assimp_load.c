@@ -36,18 +36,21 @@ static vec3 xform_dir(const struct aiMatrix4x4 *m, struct aiVector3D v) {
             m->c1 * v.x + m->c2 * v.y + m->c3 * v.z);
 }
 
-/* The normal matrix of m: its upper 3×3's inverse transpose, as the cofactor matrix
- * (det · M⁻ᵀ) times the sign of det, so that normals keep their side under mirrored
- * transforms and no division by a tiny det is needed (normals are renormalised).
- * Rows of 3, row-major. */
+/* The determinant of m's upper 3×3: negative for a mirroring transform. */
+static float det3(const struct aiMatrix4x4 *m) {
+  return v3_dot(v3(m->a1, m->a2, m->a3), v3_cross(v3(m->b1, m->b2, m->b3), v3(m->c1, m->c2, m->c3)));
+}
+
+/* The normal matrix of m: its upper 3×3's inverse transpose M⁻ᵀ = C / det, where the
+ * rows of the cofactor matrix C are the cross products of M's other two rows. C
+ * times the sign of det keeps normals on their side under mirroring transforms and
+ * divides by no tiny det (normals are renormalised). Rows of 3, row-major. */
 static void normal_matrix(const struct aiMatrix4x4 *m, float out[9]) {
   vec3 r0 = v3(m->a1, m->a2, m->a3), r1 = v3(m->b1, m->b2, m->b3), r2 = v3(m->c1, m->c2, m->c3);
-  /* the cofactor matrix's rows are the cross products of M's rows: C = (r1×r2, r2×r0, r0×r1)
-   * as columns, i.e. C[i][j] = cofactor (i, j) */
-  vec3 c0 = v3_cross(r1, r2), c1 = v3_cross(r2, r0), c2 = v3_cross(r0, r1);
-  float sign = v3_dot(r0, c0) < 0 ? -1.0f : 1.0f;
-  /* M⁻¹ = Cᵀ/det has columns c0, c1, c2; its transpose has them as rows */
-  v3_store(out, v3_scale(c0, sign)), v3_store(out + 3, v3_scale(c1, sign)), v3_store(out + 6, v3_scale(c2, sign));
+  float sign = det3(m) < 0 ? -1.0f : 1.0f;
+  v3_store(out, v3_scale(v3_cross(r1, r2), sign));
+  v3_store(out + 3, v3_scale(v3_cross(r2, r0), sign));
+  v3_store(out + 6, v3_scale(v3_cross(r0, r1), sign));
 }
 
 static vec3 xform_normal(const float nm[9], struct aiVector3D v) {
@@ -81,7 +84,7 @@ static rr_error add_mesh(rr_scene *s, const struct aiNode *node, const struct ai
   normal_matrix(m, nm);
   /* A mirroring transform (det < 0) turns the winding around: swapping two corners
    * keeps the triangles' front faces where the file has them. */
-  bool mirrored = v3_dot(v3(m->a1, m->a2, m->a3), v3_cross(v3(m->b1, m->b2, m->b3), v3(m->c1, m->c2, m->c3))) < 0;
+  bool mirrored = det3(m) < 0;
   for (unsigned f = 0; f < mesh->mNumFaces; f++) {
     const struct aiFace *face = &mesh->mFaces[f];
     for (unsigned j = 1; j + 1 < face->mNumIndices; j++) {

@@ -11,8 +11,6 @@
 #include <stb_easy_font.h>
 #pragma GCC diagnostic pop
 
-#define GAMMA SCENE_GAMMA
-
 typedef struct hit {
   bool valid, has_ray;
   uint32_t id;
@@ -75,7 +73,7 @@ static void texel(const rr_texture *t, float u, float v, float rgb[3]) {
       for (int c = 0; c < 3; c++) rgb[c] += w * p[c] / 255.0f;
     }
   /* textures are sRGB-encoded; shading works in linear light */
-  for (int c = 0; c < 3; c++) rgb[c] = powf(rgb[c], GAMMA);
+  for (int c = 0; c < 3; c++) rgb[c] = powf(rgb[c], SCENE_GAMMA);
 }
 
 static void base_color(const rr_scene *s, const hit *h, float rgb[3]) {
@@ -101,7 +99,7 @@ static uint32_t hash32(uint32_t x) {
   return x;
 }
 
-static float to_display(float linear) { return powf(fminf(fmaxf(linear, 0.0f), 1.0f), 1.0f / GAMMA); }
+static float to_display(float linear) { return powf(fminf(fmaxf(linear, 0.0f), 1.0f), 1.0f / SCENE_GAMMA); }
 
 static rr_error image_alloc(rr_device *dev, rr_image *img, int w, int h, int ch, rr_pixel_type type) {
   size_t size = type == RR_PIXEL_U8 ? 1 : 4;
