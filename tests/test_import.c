@@ -393,8 +393,8 @@ static void check_texture_files(rr_device *dev) {
   rr_scene_release(s);
 }
 
-/* Z-up files: COLLADA's <up_axis>Z_UP</up_axis> is turned Y-up by assimp, STL stays
- * Z-up; either way the automatic camera sees a triangle standing on the ground and
+/* Z-up files: COLLADA's <up_axis>Z_UP</up_axis> is turned Y-up by assimp, STL and
+ * FBX (UpAxis 2) stay Z-up; either way the automatic camera sees a triangle standing on the ground and
  * facing the front (-Y in Z-up terms) from its front, with culling. */
 static void check_up_axis(rr_device *dev) {
   const char *dae = test_write_file(dir, "z.dae",
@@ -413,14 +413,23 @@ static void check_up_axis(rr_device *dev) {
       "<scene><instance_visual_scene url=\"#s\"/></scene></COLLADA>");
   const char *stl = test_write_file(dir, "z.stl", "solid t\nfacet normal 0 -1 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
                                                    "vertex 0 0 1\nendloop\nendfacet\nendsolid t\n");
-  const char *files[2] = {dae, stl};
-  for (int i = 0; i < 2; i++) {
+  /* FBX records its axes (3ds Max's Z up, front -Y), which assimp leaves as they are */
+  const char *fbx = test_write_file(dir, "z.fbx",
+      "; FBX 7.4.0 project file\nFBXHeaderExtension: {\n FBXHeaderVersion: 1003\n FBXVersion: 7400\n}\n"
+      "GlobalSettings: {\n Version: 1000\n Properties70: {\n  P: \"UpAxis\", \"int\", \"Integer\", \"\",2\n"
+      "  P: \"UpAxisSign\", \"int\", \"Integer\", \"\",1\n  P: \"FrontAxis\", \"int\", \"Integer\", \"\",1\n"
+      "  P: \"FrontAxisSign\", \"int\", \"Integer\", \"\",-1\n }\n}\nObjects: {\n"
+      " Geometry: 1000, \"Geometry::tri\", \"Mesh\" {\n  Vertices: *9 {\n   a: 0,0,0,1,0,0,0,0,1\n  }\n"
+      "  PolygonVertexIndex: *3 {\n   a: 0,1,-3\n  }\n }\n Model: 2000, \"Model::tri\", \"Mesh\" {\n  Version: 232\n }\n}\n"
+      "Connections: {\n C: \"OO\",1000,2000\n C: \"OO\",2000,0\n}\n");
+  const char *files[3] = {dae, stl, fbx};
+  for (int i = 0; i < 3; i++) {
     rr_scene *s = NULL;
     CHECK(rr_scene_load(dev, files[i], &s) == RR_OK, "%s: %s", files[i], rr_device_message(dev));
     if (!s) continue;
     rr_scene_info in;
     rr_scene_get_info(s, &in);
-    float up_z = i == 1; /* STL: +Z up, front -Y; COLLADA after assimp: +Y up, front +Z */
+    float up_z = i >= 1; /* STL, FBX: +Z up, front -Y; COLLADA after assimp: +Y up, front +Z */
     CHECK(in.up[2] == up_z && in.up[1] == 1 - up_z && in.front[1] == -up_z && in.front[2] == 1 - up_z,
           "%s: up (%g %g %g) front (%g %g %g)", files[i], in.up[0], in.up[1], in.up[2], in.front[0], in.front[1],
           in.front[2]);
