@@ -68,6 +68,12 @@ RR_API rr_error rr_scene_new(rr_device *dev, rr_scene **out);
  * triangle. Degenerate and non-finite triangles are skipped and counted. */
 RR_API rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
                                   const uint32_t *indices, size_t ntriangles, const float rgb[3]);
+/* The same with a colour per vertex (vertex_rgb: 3 floats each, linear RGB like
+ * glTF's COLOR_0; NULL: none, as rr_scene_add_mesh), interpolated across each
+ * triangle and multiplied into the base colour rgb (NULL here: white). */
+RR_API rr_error rr_scene_add_mesh_colors(rr_scene *scene, const float *positions, size_t nvertices,
+                                         const uint32_t *indices, size_t ntriangles, const float rgb[3],
+                                         const float *vertex_rgb);
 /* The same with homogeneous xyzw vertices: w != 0 is divided out, w = 0 is a point at infinity in direction xyz (3D methods only). */
 RR_API rr_error rr_scene_add_mesh4(rr_scene *scene, const float *xyzw, size_t nvertices, const uint32_t *indices,
                                    size_t ntriangles, const float rgb[3]);
@@ -101,6 +107,11 @@ typedef struct rr_scene_info {
   double bvh_sah_cost;
   double bvh_build_ms;
   uint64_t bvh_bytes;
+  uint32_t textures;         /* materials that name a texture */
+  uint32_t textures_missing; /* of those, textures not found or not decoded (rr_scene_get_material_info) */
+  uint32_t cameras, lights;  /* cameras and lights the file defines */
+  float up[3];    /* the model's up direction: +Y unless the file says otherwise (Z-up files: +Z) */
+  float front[3]; /* the side the model faces, seen by rr_camera_frame: +Z for Y-up, -Y for Z-up files */
 } rr_scene_info;
 
 /* Fills what is known about a scene. */
@@ -192,11 +203,82 @@ RR_API const char *rr_camera_name(int type);
 
 /* Fills a camera with defaults: perspective, eye (0,0,3) looking at the origin, y up, 45°. */
 RR_API void rr_camera_init(rr_camera *cam);
-/* Places eye and target so that the scene's bounds fill the view of cam->fov_deg. */
+/* Places eye and target so that the scene's bounds fill the view of cam->fov_deg,
+ * looking at the model's front from a little above (rr_scene_info.front and up:
+ * from +Z towards -Z with Y up unless the file says otherwise). */
 RR_API rr_error rr_camera_frame(rr_device *dev, const rr_scene *scene, int width, int height,
                                 rr_camera *cam);
 /* Checks a camera (finite values, eye != target, up not parallel to the view). */
 RR_API rr_error rr_camera_check(rr_device *dev, const rr_camera *cam);
+
+/* ---- materials, cameras and lights of a file ------------------------------- */
+
+/* Where a material's texture came from, or why it has none. */
+typedef enum rr_texture_status {
+  RR_TEXTURE_NONE = 0,   /* the material names no texture */
+  RR_TEXTURE_FILE,       /* read from a file (beside the scene; case and '\\' separators forgiven) */
+  RR_TEXTURE_EMBEDDED,   /* read from inside the scene file (GLB, data URI, ZAE, FBX) */
+  RR_TEXTURE_MISSING,    /* named, but not found: shaded with the base colour alone */
+  RR_TEXTURE_UNREADABLE, /* found, but not decoded (format, size): shaded with the base colour alone */
+  RR_TEXTURE_STATUS_COUNT
+} rr_texture_status;
+
+/* The name of a texture status ("none", "file", "embedded", "missing", "unreadable"), NULL when out of range. */
+RR_API const char *rr_texture_status_name(int status);
+
+typedef struct rr_material_info {
+  const char *name;     /* the file's name for it, NULL when none */
+  float color[3];       /* base colour, linear RGB */
+  const char *texture;  /* the base colour texture as the file names it ("*0": the file's first
+                           embedded one), NULL when none */
+  rr_texture_status texture_status;
+  int texture_width, texture_height; /* 0 unless the texture was read */
+} rr_material_info;
+
+/* Fills what is known about material `material` (0 .. rr_scene_info.materials - 1);
+ * pointers stay valid until the scene is released. */
+RR_API rr_error rr_scene_get_material_info(const rr_scene *scene, uint32_t material, rr_material_info *info);
+
+/* The file's camera `index` (0 .. rr_scene_info.cameras - 1) as an rr_camera for a
+ * width × height image: eye, target one unit along its view, up, and the field of
+ * view the file keeps fixed (glTF's vertical one; other formats' horizontal one,
+ * converted for the image's aspect); orthographic cameras keep their width. */
+RR_API rr_error rr_scene_get_camera(rr_device *dev, const rr_scene *scene, uint32_t index, int width, int height,
+                                    rr_camera *cam);
+/* The name of the file's camera `index`, NULL when it has none or index is out of range. */
+RR_API const char *rr_scene_camera_name(const rr_scene *scene, uint32_t index);
+/* The index of the camera named `name`, else of `name` read as a decimal index; when
+ * neither exists it fails with a message listing the cameras' names. */
+RR_API rr_error rr_scene_find_camera(rr_device *dev, const rr_scene *scene, const char *name, uint32_t *index);
+
+/* Light kinds, as assimp's aiLightSourceType. */
+typedef enum rr_light_type {
+  RR_LIGHT_UNDEFINED = 0,
+  RR_LIGHT_DIRECTIONAL, /* from infinitely far along direction */
+  RR_LIGHT_POINT,       /* from position in every direction */
+  RR_LIGHT_SPOT,        /* from position, in a cone around direction */
+  RR_LIGHT_AMBIENT,     /* everywhere */
+  RR_LIGHT_AREA,        /* a size[0] × size[1] rectangle at position facing direction */
+  RR_LIGHT_TYPE_COUNT
+} rr_light_type;
+
+/* The name of a light type ("directional", ...), NULL when out of range. */
+RR_API const char *rr_light_type_name(int type);
+
+/* A light of the file in world space, kept for lighting; nothing renders it yet. */
+typedef struct rr_light_info {
+  const char *name;     /* NULL when none; valid until the scene is released */
+  rr_light_type type;
+  float position[3];
+  float direction[3];   /* unit: where the light shines */
+  float color[3];       /* linear RGB with the file's intensity multiplied in */
+  float attenuation[3]; /* constant, linear and quadratic factors */
+  float inner_cone_deg, outer_cone_deg; /* spot: half-angles from direction (full and no light) */
+  float size[2];        /* area: extent */
+} rr_light_info;
+
+/* Fills the file's light `index` (0 .. rr_scene_info.lights - 1). */
+RR_API rr_error rr_scene_get_light(const rr_scene *scene, uint32_t index, rr_light_info *info);
 
 /* ---- visibility ---------------------------------------------------------- */
 

@@ -36,6 +36,7 @@ static void die(int code, const char *fmt, ...) {
 enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
+  OPT_CAMERA_FROM_FILE,
 };
 
 typedef struct cli_option {
@@ -81,6 +82,8 @@ static const cli_option render_options[] = {
     {"target", OPT_TARGET, "X,Y,Z", "the point the camera looks at (goes with --eye)"},
     {"up", OPT_UP, "X,Y,Z", "the camera's up direction (default 0,1,0)"},
     {"fov", OPT_FOV, "DEG", "vertical field of view (default 45; fisheye: the full angle, up to 360)"},
+    {"camera-from-file", OPT_CAMERA_FROM_FILE, "NAME|INDEX",
+     "look through a camera the scene file defines (see info); --camera may\nchange its projection"},
     {"shade", OPT_SHADE, "MODE", "lambert (default), id, normal, depth, heat-evals, heat-nodes"},
     {"output", 'o', "PATH", "colour image: .png, .exr or .pfm (default rastray.png unless --aov is given)"},
     {"aov", OPT_AOV, "NAME=PATH",
@@ -311,6 +314,51 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
     printf("  %-4u %-24s %u %s%s, material %u\n", g, gi.name ? gi.name : "-", gi.count,
            rr_geometry_kind_name(gi.kind), gi.count == 1 ? "" : "s", gi.material);
   }
+  /* Materials with their textures, then every texture that is not there (even
+   * when the materials are too many to list). */
+  for (uint32_t m = 0; in.materials <= LISTED && m < in.materials; m++) {
+    rr_material_info mi;
+    rr_scene_get_material_info(scene, m, &mi);
+    printf("  material %-3u %-20s colour (%.3g, %.3g, %.3g)", m, mi.name ? mi.name : "-", mi.color[0], mi.color[1],
+           mi.color[2]);
+    if (mi.texture && mi.texture_width)
+      printf(", texture '%s' (%s, %dx%d)", mi.texture, rr_texture_status_name(mi.texture_status), mi.texture_width,
+             mi.texture_height);
+    else if (mi.texture) printf(", texture '%s' (%s)", mi.texture, rr_texture_status_name(mi.texture_status));
+    putchar('\n');
+  }
+  printf("textures     %u (%u missing or unreadable)\n", in.textures, in.textures_missing);
+  for (uint32_t m = 0; in.textures_missing && m < in.materials; m++) {
+    rr_material_info mi;
+    rr_scene_get_material_info(scene, m, &mi);
+    if (mi.texture_status == RR_TEXTURE_MISSING || mi.texture_status == RR_TEXTURE_UNREADABLE)
+      printf("  %-10s '%s' (material %u)\n", rr_texture_status_name(mi.texture_status), mi.texture, m);
+  }
+  printf("cameras      %u\n", in.cameras);
+  for (uint32_t c = 0; c < in.cameras; c++) {
+    rr_camera fc;
+    const char *name = rr_scene_camera_name(scene, c);
+    if (rr_scene_get_camera(dev, scene, c, 1, 1, &fc) != RR_OK) { /* a file's camera the library cannot use */
+      printf("  %-4u %-24s unusable: %s\n", c, name ? name : "-", rr_device_message(dev));
+      continue;
+    }
+    printf("  %-4u %-24s %s, eye (%g, %g, %g), looking along (%g, %g, %g)", c, name ? name : "-", rr_camera_name(fc.type),
+           fc.eye[0], fc.eye[1], fc.eye[2], fc.target[0] - fc.eye[0], fc.target[1] - fc.eye[1], fc.target[2] - fc.eye[2]);
+    if (fc.type == RR_CAMERA_PERSPECTIVE) printf(", %.1f° at 1:1", fc.fov_deg);
+    putchar('\n');
+  }
+  printf("lights       %u\n", in.lights);
+  for (uint32_t l = 0; l < in.lights; l++) {
+    rr_light_info li;
+    rr_scene_get_light(scene, l, &li);
+    printf("  %-4u %-24s %s, at (%g, %g, %g), towards (%g, %g, %g), colour (%g, %g, %g)", l, li.name ? li.name : "-",
+           rr_light_type_name(li.type), li.position[0], li.position[1], li.position[2], li.direction[0],
+           li.direction[1], li.direction[2], li.color[0], li.color[1], li.color[2]);
+    if (li.type == RR_LIGHT_SPOT) printf(", cone %.1f°..%.1f°", li.inner_cone_deg, li.outer_cone_deg);
+    putchar('\n');
+  }
+  printf("up, front    (%g, %g, %g), (%g, %g, %g)\n", in.up[0], in.up[1], in.up[2], in.front[0], in.front[1],
+         in.front[2]);
   printf("bounds       (%g, %g, %g) .. (%g, %g, %g)\n", in.bounds_min[0], in.bounds_min[1], in.bounds_min[2],
          in.bounds_max[0], in.bounds_max[1], in.bounds_max[2]);
   printf("bvh nodes    %llu\n", (unsigned long long)in.bvh_nodes);
@@ -331,7 +379,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   rr_camera cam;
   rr_camera_init(&cam);
   const char *scene_name = NULL, *out = NULL, *json = NULL, *cube_dir = NULL;
-  bool have_eye = false, have_target = false, stats = false;
+  const char *file_cam = NULL;
+  bool have_eye = false, have_target = false, have_type = false, have_pose = false, stats = false;
   int shade = RR_SHADE_LAMBERT, repeat = 1, naov = 0;
   aov_out aovs[16];
   for (int key; (key = next_option(cmd, argc, argv)) != -1;) {
@@ -348,7 +397,7 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
       if (type < 0)
         die(EXIT_USAGE, "unknown camera '%s' (expected perspective, orthographic, parabolic, latlong, fisheye or cube)",
             optarg);
-      cam.type = (rr_camera_type)type;
+      cam.type = (rr_camera_type)type, have_type = true;
       break;
     }
     case OPT_ORTHO_HEIGHT:
@@ -358,9 +407,10 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_CUBE_FACES: cube_dir = optarg; break;
     case OPT_EYE: parse_vec(flag, optarg, cam.eye), have_eye = true; break;
     case OPT_TARGET: parse_vec(flag, optarg, cam.target), have_target = true; break;
-    case OPT_UP: parse_vec(flag, optarg, cam.up); break;
+    case OPT_UP: parse_vec(flag, optarg, cam.up), have_pose = true; break;
+    case OPT_CAMERA_FROM_FILE: file_cam = optarg; break;
     case OPT_FOV:
-      cam.fov_deg = parse_float(flag, optarg);
+      cam.fov_deg = parse_float(flag, optarg), have_pose = true;
       if (!(cam.fov_deg > 0 && cam.fov_deg <= 360))
         die(EXIT_USAGE, "bad value '%s' for --fov (expected 0 < fov < 180, or up to 360 for fisheye)", optarg);
       break;
@@ -396,6 +446,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   if (optind < argc) scene_name = argv[optind];
   if (argc - optind > 1) die(EXIT_USAGE, "more than one scene given ('%s' and '%s')", scene_name, argv[optind + 1]);
   if (have_eye != have_target) die(EXIT_USAGE, "--eye and --target go together");
+  if (file_cam && (have_eye || have_pose))
+    die(EXIT_USAGE, "--camera-from-file takes the view from the file: no --eye, --target, --up or --fov with it");
   if (!scene_name) scene_name = "demo";
   if (!out && naov == 0) out = "rastray.png";
   if (shade == RR_SHADE_HEAT_EVALS || shade == RR_SHADE_HEAT_NODES) opt.heat = 1;
@@ -405,8 +457,16 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   build.threads = opt.threads;
   rr_device_set_build_options(dev, &build);
   rr_scene *scene = load_scene(dev, scene_name);
-  if (!have_eye && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK)
+  if (file_cam) {
+    rr_camera_type type = cam.type;
+    uint32_t index;
+    if (rr_scene_find_camera(dev, scene, file_cam, &index) != RR_OK ||
+        rr_scene_get_camera(dev, scene, index, opt.width, opt.height, &cam) != RR_OK)
+      die(EXIT_INPUT, "%s", rr_device_message(dev));
+    if (have_type) cam.type = type;
+  } else if (!have_eye && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK) {
     die(EXIT_INPUT, "%s", rr_device_message(dev));
+  }
   if (rr_camera_check(dev, &cam) != RR_OK) die(EXIT_USAGE, "%s", rr_device_message(dev));
   if (cube_dir && cam.type != RR_CAMERA_CUBE) die(EXIT_USAGE, "--cube-faces needs --camera cube");
 

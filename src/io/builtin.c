@@ -254,7 +254,7 @@ static rr_error gen_ground(rr_scene *s) {
   const vec3 origin = v3(0, 0, 0), dir[4] = {v3(1, 0, 0), v3(0, 0, -1), v3(-1, 0, 0), v3(0, 0, 1)};
   for (int q = 0; q < 4; q++) {
     vec3 p[3] = {origin, dir[q], dir[(q + 1) % 4]};
-    rr_scene_push_inf(s, p, 6u, NULL, NULL, ground_m); /* corners 1 and 2 at infinity */
+    rr_scene_push_inf(s, p, 6u, NULL, NULL, NULL, ground_m); /* corners 1 and 2 at infinity */
   }
   e = gen_sphere(s, 24, v3(-1.5f, 1.05f, 0.5f), 1.0f, ball_m);
   uint32_t t0 = s->ntris;

@@ -11,10 +11,6 @@
 #include <stb_easy_font.h>
 #pragma GCC diagnostic pop
 
-/* Colours are shaded in linear light; textures and the output are encoded with this
- * power (sRGB, approximately). */
-#define GAMMA 2.2f
-
 typedef struct hit {
   bool valid, has_ray;
   uint32_t id;
@@ -77,7 +73,7 @@ static void texel(const rr_texture *t, float u, float v, float rgb[3]) {
       for (int c = 0; c < 3; c++) rgb[c] += w * p[c] / 255.0f;
     }
   /* textures are sRGB-encoded; shading works in linear light */
-  for (int c = 0; c < 3; c++) rgb[c] = powf(rgb[c], GAMMA);
+  for (int c = 0; c < 3; c++) rgb[c] = powf(rgb[c], SCENE_GAMMA);
 }
 
 static void base_color(const rr_scene *s, const hit *h, float rgb[3]) {
@@ -93,6 +89,9 @@ static void base_color(const rr_scene *s, const hit *h, float rgb[3]) {
     texel(&m->texture, u, v, t);
     for (int c = 0; c < 3; c++) rgb[c] *= t[c];
   }
+  if (s->col[0][0]) /* vertex colours (linear) multiply in, like glTF's COLOR_0 */
+    for (int c = 0; c < 3; c++)
+      rgb[c] *= h->l0 * s->col[0][c][h->id] + h->l1 * s->col[1][c][h->id] + h->l2 * s->col[2][c][h->id];
 }
 
 static uint32_t hash32(uint32_t x) {
@@ -100,7 +99,7 @@ static uint32_t hash32(uint32_t x) {
   return x;
 }
 
-static float to_display(float linear) { return powf(fminf(fmaxf(linear, 0.0f), 1.0f), 1.0f / GAMMA); }
+static float to_display(float linear) { return powf(fminf(fmaxf(linear, 0.0f), 1.0f), 1.0f / SCENE_GAMMA); }
 
 static rr_error image_alloc(rr_device *dev, rr_image *img, int w, int h, int ch, rr_pixel_type type) {
   size_t size = type == RR_PIXEL_U8 ? 1 : 4;
