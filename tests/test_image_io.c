@@ -53,7 +53,7 @@ static uint8_t *get_file(const char *path, size_t *n) {
 static size_t type_bytes(rr_pixel_type t) { return t == RR_PIXEL_U8 ? 1 : 4; }
 
 static rr_image make_image(int w, int h, int c, rr_pixel_type type) {
-  rr_image img = {w, h, c, type, calloc((size_t)w * h * c, type_bytes(type))};
+  rr_image img = {w, h, c, type, calloc((size_t)w * h * c, type_bytes(type)), RR_IMAGE_VALUES};
   return img;
 }
 
@@ -94,7 +94,7 @@ static void write_fails(const rr_image *img, const char *name, rr_error code) {
 static void parse_fails(const char *name, const void *bytes, size_t n, const char *what) {
   const char *path = tpath(name);
   CHECK(put_file(path, bytes, n), "cannot make %s", name);
-  rr_image out = {1, 1, 1, RR_PIXEL_U8, NULL};
+  rr_image out = {1, 1, 1, RR_PIXEL_U8, NULL, RR_IMAGE_VALUES};
   rr_error e = rr_image_read(dev, path, &out);
   CHECK(e == RR_ERROR_PARSE, "%s (%s, %zu bytes) gave %d: %s", what, name, n, e,
         rr_device_message(dev));
@@ -148,7 +148,7 @@ static void test_png(void) {
   /* floats are clamped to [0,1] and rounded; NaN becomes 0 */
   float v[6] = {-0.5f, 0.0f, 0.5f, 1.0f, 2.0f, NAN};
   uint8_t want[6] = {0, 0, 128, 255, 255, 0};
-  rr_image f = {6, 1, 1, RR_PIXEL_F32, v}, out;
+  rr_image f = {6, 1, 1, RR_PIXEL_F32, v, RR_IMAGE_VALUES}, out;
   if (round_trip(&f, "float.PNG", &out)) {
     CHECK(out.type == RR_PIXEL_U8 && out.channels == 1, "float PNG read as type %d, %d channels",
           out.type, out.channels);

@@ -148,7 +148,7 @@ static void write_cube_faces(rr_device *dev, const rr_image *cross, const char *
   } faces[6] = {{"front", 1, 1}, {"right", 2, 1}, {"back", 3, 1}, {"left", 0, 1}, {"top", 1, 0}, {"bottom", 1, 2}};
   int n = cross->height / 3;
   for (int f = 0; f < 6; f++) {
-    rr_image img = {n, n, 3, RR_PIXEL_F32, malloc((size_t)n * n * 3 * sizeof(float))};
+    rr_image img = {n, n, 3, RR_PIXEL_F32, malloc((size_t)n * n * 3 * sizeof(float)), cross->kind};
     if (!img.data) die(EXIT_INPUT, "out of memory");
     for (int y = 0; y < n; y++)
       memcpy((float *)img.data + (size_t)y * n * 3,

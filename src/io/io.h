@@ -12,8 +12,4 @@ rr_error rr_scene_load_builtin(rr_scene *s, const char *name);
 /* Loads the textures named by the materials (missing files leave textures empty). */
 void rr_scene_load_textures(rr_scene *s, const char *base_dir);
 
-/* Writers and readers by extension, in image_io.c. */
-rr_error rr_image_write_file(rr_device *dev, const rr_image *img, const char *path);
-rr_error rr_image_read_file(rr_device *dev, const char *path, rr_image *out);
-
 #endif
