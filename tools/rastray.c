@@ -2,6 +2,7 @@
  * Exit codes: 0 success, 1 bad input (files, scenes), 2 bad usage (flags, values). */
 #include "rastray.h"
 
+#include <getopt.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdarg.h>
@@ -26,35 +27,156 @@ static void die(int code, const char *fmt, ...) {
 #define STRING(x) #x
 #define VALUE(x) STRING(x) /* a macro's value as a string literal */
 
-static const char usage[] =
-    "usage: rastray render [SCENE] [options]     render SCENE (a mesh file or built-in name; default demo)\n"
-    "       rastray info SCENE                   print the scene's triangles, geometries and BVH figures\n"
-    "       rastray --help | --version\n"
-    "\n"
+/* ---- options --------------------------------------------------------------
+ * Each command has one table of options; getopt_long reads it (--opt=value and
+ * --opt value, unique prefixes, options and operands in any order) and the
+ * command's usage is printed from it. A new option is one table entry and one
+ * case in its command's switch. */
+
+enum { /* keys of the options without a short form (above every char) */
+  OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
+  OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
+};
+
+typedef struct cli_option {
+  const char *name; /* long name, without "--" */
+  int key;          /* its short letter, or an OPT_ key */
+  const char *arg;  /* the value's name in the usage; NULL: the option takes no value */
+  const char *help; /* "\n" starts a continuation line */
+} cli_option;
+
+typedef struct cli_command cli_command;
+struct cli_command {
+  const char *name;
+  const char *operands; /* in the usage line */
+  const char *summary;  /* one line */
+  const char *notes;    /* printed before the options, or NULL */
+  const cli_option *options; /* ends with a NULL name */
+  int (*run)(rr_device *dev, const cli_command *cmd, int argc, char **argv); /* argv[0]: the command's name */
+};
+
+/* Every command's last options; next_option handles them. */
+#define COMMON_OPTIONS                                                                                    \
+  {"quiet", 'q', NULL, "print nothing on stderr but errors (and --stats when asked)"},                  \
+      {"verbose", 'v', NULL, "also print what was loaded, the BVH, the method and why, the outputs"},   \
+      {"help", 'h', NULL, "print this help and exit"}
+
+static const char scenes_note[] =
     "scenes: a file assimp reads (.obj .ply .gltf .glb .dae .3ds ...), or demo, plane[:N],\n"
     "        sphere[:N], box[:N], rooms[:N], grid:PATH:N (N×N copies of a mesh), ground (an\n"
-    "        infinite plane through points at infinity, with a sphere and a box; 3D methods)\n"
-    "\n"
-    "options:\n"
-    "  --method NAME       visibility method: auto (default: the fastest exact one in a trial), rc,\n"
-    "                      rc-bvh, rc-packet, 2dr-bb, 2dr-bin, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full\n"
-    "  --oracles K=V,...   override a 3dr method's traversal: frustum=N leaves=0|1 outside=0|1\n"
-    "                      occluded=0|1 split=N split-ratio=F binning=0|1 early-z=0|1 bin=N bin-min=N\n"
-    "  --size WxH          image size (default 1024x768, at most " VALUE(RR_MAX_SIZE) " a side)\n"
-    "  --camera NAME       perspective (default), orthographic, parabolic, latlong, fisheye, cube\n"
-    "  --ortho-height H    orthographic view height (default 2·|target-eye|·tan(fov/2))\n"
-    "  --cube-faces DIR    cube camera: also write the six faces as DIR/front.png, right, back, ...\n"
-    "  --eye X,Y,Z --target X,Y,Z --up X,Y,Z --fov DEG\n"
-    "                      camera; without --eye/--target the scene is framed automatically\n"
-    "  --shade MODE        lambert (default), id, normal, depth, heat-evals, heat-nodes\n"
-    "  -o PATH             colour image: .png, .exr or .pfm (default rastray.png unless --aov is given)\n"
-    "  --aov NAME=PATH     write an AOV as .npy, .pfm or .exr; repeatable. NAME: depth, id (triangle),\n"
-    "                      mesh (geometry id), material (index), normal, bary, evals, nodes\n"
-    "  --threads N         threads, at most " VALUE(RR_MAX_THREADS) " (default: all cores)\n"
-    "  --repeat N          run the visibility pass N times, report the median time\n"
-    "  --stats             print key=value statistics to stderr\n"
-    "  --stats-json PATH   write the statistics as one JSON object\n"
-    "  --cull-backfaces    triangles seen from behind are invisible\n";
+    "        infinite plane through points at infinity, with a sphere and a box; 3D methods)\n";
+
+static const cli_option render_options[] = {
+    {"method", OPT_METHOD, "NAME",
+     "visibility method: auto (default: the fastest exact one in a trial), rc,\n"
+     "rc-bvh, rc-packet, 2dr-bb, 2dr-bin, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full"},
+    {"oracles", OPT_ORACLES, "K=V,...",
+     "override a 3dr method's traversal: frustum=N leaves=0|1 outside=0|1\n"
+     "occluded=0|1 split=N split-ratio=F binning=0|1 early-z=0|1 bin=N bin-min=N"},
+    {"size", OPT_SIZE, "WxH", "image size (default 1024x768, at most " VALUE(RR_MAX_SIZE) " a side)"},
+    {"camera", OPT_CAMERA, "NAME", "perspective (default), orthographic, parabolic, latlong, fisheye, cube"},
+    {"ortho-height", OPT_ORTHO_HEIGHT, "H", "orthographic view height (default 2·|target-eye|·tan(fov/2))"},
+    {"cube-faces", OPT_CUBE_FACES, "DIR", "cube camera: also write the six faces as DIR/front.png, right, back, ..."},
+    {"eye", OPT_EYE, "X,Y,Z", "camera position; without --eye/--target the scene is framed automatically"},
+    {"target", OPT_TARGET, "X,Y,Z", "the point the camera looks at (goes with --eye)"},
+    {"up", OPT_UP, "X,Y,Z", "the camera's up direction (default 0,1,0)"},
+    {"fov", OPT_FOV, "DEG", "vertical field of view (default 45; fisheye: the full angle, up to 360)"},
+    {"shade", OPT_SHADE, "MODE", "lambert (default), id, normal, depth, heat-evals, heat-nodes"},
+    {"output", 'o', "PATH", "colour image: .png, .exr or .pfm (default rastray.png unless --aov is given)"},
+    {"aov", OPT_AOV, "NAME=PATH",
+     "write an AOV as .npy, .pfm or .exr; repeatable. NAME: depth, id (triangle),\n"
+     "mesh (geometry id), material (index), normal, bary, evals, nodes"},
+    {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default: all cores)"},
+    {"repeat", OPT_REPEAT, "N", "run the visibility pass N times, report the median time"},
+    {"stats", OPT_STATS, NULL, "print key=value statistics to stderr"},
+    {"stats-json", OPT_STATS_JSON, "PATH", "write the statistics as one JSON object"},
+    {"cull-backfaces", OPT_CULL_BACKFACES, NULL, "triangles seen from behind are invisible"},
+    COMMON_OPTIONS,
+    {NULL, 0, NULL, NULL},
+};
+
+static const cli_option info_options[] = {
+    COMMON_OPTIONS,
+    {NULL, 0, NULL, NULL},
+};
+
+static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **argv);
+static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv);
+
+static const cli_command commands[] = {
+    {"render", "[SCENE] [options]", "render SCENE (a mesh file or built-in name; default demo)", scenes_note,
+     render_options, cmd_render},
+    {"info", "SCENE [options]", "print the scene's triangles, geometries and BVH figures", scenes_note, info_options,
+     cmd_info},
+};
+enum { NCOMMANDS = sizeof commands / sizeof commands[0] };
+
+static void print_usage(FILE *f, const cli_command *cmd) {
+  fprintf(f, "usage: rastray %s %s\n%s\n", cmd->name, cmd->operands, cmd->summary);
+  if (cmd->notes) fprintf(f, "\n%s", cmd->notes);
+  fputs("\noptions:\n", f);
+  enum { COLUMN = 24 }; /* where the help text starts */
+  for (const cli_option *o = cmd->options; o->name; o++) {
+    int n = o->key < 256 ? fprintf(f, "  -%c, ", o->key) : fprintf(f, "  ");
+    n += fprintf(f, "--%s%s%s", o->name, o->arg ? " " : "", o->arg ? o->arg : "");
+    if (n + 2 > COLUMN) fprintf(f, "\n%*s", COLUMN, "");
+    else fprintf(f, "%*s", COLUMN - n, "");
+    for (const char *h = o->help; *h; h++) {
+      fputc(*h, f);
+      if (*h == '\n') fprintf(f, "%*s", COLUMN, "");
+    }
+    fputc('\n', f);
+  }
+}
+
+static char flag[64]; /* the option being handled, "--name", for messages */
+static int verbosity;  /* -1: --quiet, 0, 1: --verbose */
+
+/* A message on stderr when the verbosity is at least `level` (0: unless --quiet). */
+static void note(int level, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void note(int level, const char *fmt, ...) {
+  if (verbosity < level) return;
+  va_list ap;
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+}
+
+/* The next option of the command's argv (argv[0] is the command's name): its key,
+ * its value in optarg; -1 after the last (the operands are then argv[optind..]).
+ * Unknown options and missing values end the program with a usage error; --help
+ * prints the command's usage and ends it. */
+static int next_option(const cli_command *cmd, int argc, char **argv) {
+  static struct option longopts[64];
+  static char shortopts[64] = ":"; /* ':': a missing value is reported as ':', not '?' */
+  if (!longopts[0].name) { /* one command per process: build its table once */
+    int n = 0, s = 1;
+    for (const cli_option *o = cmd->options; o->name; o++, n++) {
+      longopts[n] = (struct option){o->name, o->arg ? required_argument : no_argument, NULL, o->key};
+      if (o->key < 256) {
+        shortopts[s++] = (char)o->key;
+        if (o->arg) shortopts[s++] = ':';
+      }
+    }
+    opterr = 0; /* the messages are ours */
+  }
+  int key = getopt_long(argc, argv, shortopts, longopts, NULL);
+  if (key == -1) return -1;
+  /* getopt leaves the key of a known option that failed in optopt (0 for an unknown long one) */
+  const cli_option *o = cmd->options;
+  while (o->name && o->key != (key == '?' || key == ':' ? optopt : key)) o++;
+  if (o->name) snprintf(flag, sizeof flag, "--%s", o->name);
+  if (key == '?' && o->name) die(EXIT_USAGE, "%s takes no value (see --help)", flag);
+  if (key == '?' && optopt) die(EXIT_USAGE, "unknown option '-%c' (see --help)", optopt);
+  if (key == '?') die(EXIT_USAGE, "unknown option '%s' (see --help)", argv[optind - 1]);
+  if (key == ':') die(EXIT_USAGE, "%s needs a value (see --help)", argv[optind - 1]);
+  switch (key) {
+  case 'h': print_usage(stdout, cmd), exit(0);
+  case 'q': verbosity = -1; return next_option(cmd, argc, argv);
+  case 'v': verbosity = 1; return next_option(cmd, argc, argv);
+  }
+  return key;
+}
 
 static long parse_int(const char *flag, const char *s, long lo, long hi) {
   char *end;
@@ -131,6 +253,13 @@ static double now_ms(void) {
 static rr_scene *load_scene(rr_device *dev, const char *name) {
   rr_scene *scene;
   if (rr_scene_load(dev, name, &scene) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+  rr_scene_info in;
+  rr_scene_get_info(scene, &in);
+  note(1, "loaded %s: %llu triangles (%llu skipped), %u geometries, %u materials\n", name,
+       (unsigned long long)in.triangles, (unsigned long long)in.skipped, in.geometries, in.materials);
+  note(1, "bvh: %llu nodes, %llu leaves, depth %u, SAH cost %.3f, %.2f MiB, built in %.1f ms\n",
+       (unsigned long long)in.bvh_nodes, (unsigned long long)in.bvh_leaves, in.bvh_depth, in.bvh_sah_cost,
+       in.bvh_bytes / 1048576.0, in.bvh_build_ms);
   return scene;
 }
 
@@ -162,12 +291,15 @@ static void write_cube_faces(rr_device *dev, const rr_image *cross, const char *
   }
 }
 
-static int cmd_info(rr_device *dev, int argc, char **argv) {
-  if (argc != 1) die(EXIT_USAGE, "info takes one scene (see --help)");
-  rr_scene *scene = load_scene(dev, argv[0]);
+static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
+  while (next_option(cmd, argc, argv) != -1) {
+  }
+  if (argc - optind != 1) die(EXIT_USAGE, "info takes one scene (see --help)");
+  const char *scene_name = argv[optind];
+  rr_scene *scene = load_scene(dev, scene_name);
   rr_scene_info in;
   rr_scene_get_info(scene, &in);
-  printf("scene        %s\n", argv[0]);
+  printf("scene        %s\n", scene_name);
   printf("triangles    %llu (%llu degenerate or non-finite skipped)\n", (unsigned long long)in.triangles,
          (unsigned long long)in.skipped);
   printf("materials    %u\n", in.materials);
@@ -191,12 +323,7 @@ static int cmd_info(rr_device *dev, int argc, char **argv) {
   return 0;
 }
 
-static const char *arg_value(int *i, int argc, char **argv) {
-  if (*i + 1 >= argc) die(EXIT_USAGE, "%s needs a value (see --help)", argv[*i]);
-  return argv[++*i];
-}
-
-static int cmd_render(rr_device *dev, int argc, char **argv) {
+static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
   double t_start = now_ms();
   rr_render_options opt;
   rr_render_options_init(&opt);
@@ -207,77 +334,67 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
   bool have_eye = false, have_target = false, stats = false;
   int shade = RR_SHADE_LAMBERT, repeat = 1, naov = 0;
   aov_out aovs[16];
-  for (int i = 0; i < argc; i++) {
-    const char *a = argv[i];
-    if (strcmp(a, "--method") == 0) {
-      const char *v = arg_value(&i, argc, argv);
-      int m = rr_method_from_name(v);
-      if (m < 0) die(EXIT_USAGE, "unknown method '%s' (see --help)", v);
+  for (int key; (key = next_option(cmd, argc, argv)) != -1;) {
+    switch (key) {
+    case OPT_METHOD: {
+      int m = rr_method_from_name(optarg);
+      if (m < 0) die(EXIT_USAGE, "unknown method '%s' (see --help)", optarg);
       opt.method = (rr_method)m;
-    } else if (strcmp(a, "--size") == 0) {
-      parse_size(arg_value(&i, argc, argv), &opt.width, &opt.height);
-    } else if (strcmp(a, "--camera") == 0) {
-      const char *v = arg_value(&i, argc, argv);
-      int type = rr_camera_from_name(v);
+      break;
+    }
+    case OPT_SIZE: parse_size(optarg, &opt.width, &opt.height); break;
+    case OPT_CAMERA: {
+      int type = rr_camera_from_name(optarg);
       if (type < 0)
-        die(EXIT_USAGE, "unknown camera '%s' (expected perspective, orthographic, parabolic, latlong, fisheye or cube)", v);
+        die(EXIT_USAGE, "unknown camera '%s' (expected perspective, orthographic, parabolic, latlong, fisheye or cube)",
+            optarg);
       cam.type = (rr_camera_type)type;
-    } else if (strcmp(a, "--ortho-height") == 0) {
-      const char *v = arg_value(&i, argc, argv);
-      cam.ortho_height = parse_float(a, v);
-      if (!(cam.ortho_height > 0)) die(EXIT_USAGE, "bad value '%s' for --ortho-height (expected > 0)", v);
-    } else if (strcmp(a, "--cube-faces") == 0) {
-      cube_dir = arg_value(&i, argc, argv);
-    } else if (strcmp(a, "--eye") == 0) {
-      parse_vec(a, arg_value(&i, argc, argv), cam.eye), have_eye = true;
-    } else if (strcmp(a, "--target") == 0) {
-      parse_vec(a, arg_value(&i, argc, argv), cam.target), have_target = true;
-    } else if (strcmp(a, "--up") == 0) {
-      parse_vec(a, arg_value(&i, argc, argv), cam.up);
-    } else if (strcmp(a, "--fov") == 0) {
-      const char *v = arg_value(&i, argc, argv);
-      cam.fov_deg = parse_float(a, v);
-      if (!(cam.fov_deg > 0 && cam.fov_deg <= 360)) die(EXIT_USAGE, "bad value '%s' for --fov (expected 0 < fov < 180, or up to 360 for fisheye)", v);
-    } else if (strcmp(a, "--shade") == 0) {
-      const char *v = arg_value(&i, argc, argv);
-      shade = rr_shade_from_name(v);
+      break;
+    }
+    case OPT_ORTHO_HEIGHT:
+      cam.ortho_height = parse_float(flag, optarg);
+      if (!(cam.ortho_height > 0)) die(EXIT_USAGE, "bad value '%s' for --ortho-height (expected > 0)", optarg);
+      break;
+    case OPT_CUBE_FACES: cube_dir = optarg; break;
+    case OPT_EYE: parse_vec(flag, optarg, cam.eye), have_eye = true; break;
+    case OPT_TARGET: parse_vec(flag, optarg, cam.target), have_target = true; break;
+    case OPT_UP: parse_vec(flag, optarg, cam.up); break;
+    case OPT_FOV:
+      cam.fov_deg = parse_float(flag, optarg);
+      if (!(cam.fov_deg > 0 && cam.fov_deg <= 360))
+        die(EXIT_USAGE, "bad value '%s' for --fov (expected 0 < fov < 180, or up to 360 for fisheye)", optarg);
+      break;
+    case OPT_SHADE:
+      shade = rr_shade_from_name(optarg);
       if (shade < 0)
-        die(EXIT_USAGE, "unknown shade mode '%s' (expected lambert, id, normal, depth, heat-evals or heat-nodes)", v);
-    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-      out = arg_value(&i, argc, argv);
-    } else if (strcmp(a, "--aov") == 0) {
-      const char *v = arg_value(&i, argc, argv);
-      const char *eq = strchr(v, '=');
+        die(EXIT_USAGE, "unknown shade mode '%s' (expected lambert, id, normal, depth, heat-evals or heat-nodes)",
+            optarg);
+      break;
+    case 'o': out = optarg; break;
+    case OPT_AOV: {
+      const char *eq = strchr(optarg, '=');
       char name[32];
-      if (!eq || eq == v || !eq[1] || (size_t)(eq - v) >= sizeof name)
-        die(EXIT_USAGE, "bad --aov '%s' (expected NAME=PATH)", v);
-      memcpy(name, v, eq - v), name[eq - v] = 0;
+      if (!eq || eq == optarg || !eq[1] || (size_t)(eq - optarg) >= sizeof name)
+        die(EXIT_USAGE, "bad --aov '%s' (expected NAME=PATH)", optarg);
+      memcpy(name, optarg, eq - optarg), name[eq - optarg] = 0;
       int k = rr_aov_from_name(name);
       if (k < 0)
         die(EXIT_USAGE, "unknown AOV '%s' (expected depth, id, mesh, material, normal, bary, evals or nodes)", name);
       if (k == RR_AOV_EVALS || k == RR_AOV_NODES) opt.heat = 1;
       if (naov == 16) die(EXIT_USAGE, "too many --aov (at most 16)");
       aovs[naov++] = (aov_out){(rr_aov)k, eq + 1};
-    } else if (strcmp(a, "--threads") == 0) {
-      opt.threads = (int)parse_int(a, arg_value(&i, argc, argv), 1, RR_MAX_THREADS);
-    } else if (strcmp(a, "--repeat") == 0) {
-      repeat = (int)parse_int(a, arg_value(&i, argc, argv), 1, 1000);
-    } else if (strcmp(a, "--stats") == 0) {
-      stats = true;
-    } else if (strcmp(a, "--stats-json") == 0) {
-      json = arg_value(&i, argc, argv);
-    } else if (strcmp(a, "--oracles") == 0) {
-      opt.oracles = arg_value(&i, argc, argv);
-    } else if (strcmp(a, "--cull-backfaces") == 0) {
-      opt.cull_backfaces = 1;
-    } else if (a[0] == '-' && a[1]) {
-      die(EXIT_USAGE, "unknown option '%s' (see --help)", a);
-    } else if (!scene_name) {
-      scene_name = a;
-    } else {
-      die(EXIT_USAGE, "more than one scene given ('%s' and '%s')", scene_name, a);
+      break;
+    }
+    case OPT_THREADS: opt.threads = (int)parse_int(flag, optarg, 1, RR_MAX_THREADS); break;
+    case OPT_REPEAT: repeat = (int)parse_int(flag, optarg, 1, 1000); break;
+    case OPT_STATS: stats = true; break;
+    case OPT_STATS_JSON: json = optarg; break;
+    case OPT_ORACLES: opt.oracles = optarg; break;
+    case OPT_CULL_BACKFACES: opt.cull_backfaces = 1; break;
     }
   }
+  if (optind < argc) scene_name = argv[optind];
+  if (argc - optind > 1) die(EXIT_USAGE, "more than one scene given ('%s' and '%s')", scene_name, argv[optind + 1]);
   if (have_eye != have_target) die(EXIT_USAGE, "--eye and --target go together");
   if (!scene_name) scene_name = "demo";
   if (!out && naov == 0) out = "rastray.png";
@@ -335,6 +452,7 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
             total_ms, (unsigned long long)st.setups, (unsigned long long)st.edge_evals, (unsigned long long)st.nodes,
             (unsigned long long)st.bins, (unsigned long long)st.bins_empty);
   if (stats && st.why[0]) fprintf(stderr, "auto chose %s: %s\n", method, st.why);
+  else if (st.why[0]) note(1, "auto chose %s: %s\n", method, st.why);
   if (json) {
     char tmp[4096];
     snprintf(tmp, sizeof tmp, "%s.tmp", json);
@@ -354,27 +472,35 @@ static int cmd_render(rr_device *dev, int argc, char **argv) {
       die(EXIT_INPUT, "cannot write '%s'", json);
     }
   }
-  if (out && !stats) fprintf(stderr, "wrote %s (%dx%d, %s, %.1f ms)\n", out, opt.width, opt.height, method, frame_ms);
+  if (out && !stats) note(0, "wrote %s (%dx%d, %s, %.1f ms)\n", out, opt.width, opt.height, method, frame_ms);
   rr_frame_release(frame);
   rr_scene_release(scene);
   return 0;
 }
 
+/* The overview: commands and where their options are. */
+static void print_overview(FILE *f) {
+  fputs("usage: rastray COMMAND [options]\n\ncommands:\n", f);
+  for (int c = 0; c < NCOMMANDS; c++) fprintf(f, "  %-8s %s\n", commands[c].name, commands[c].summary);
+  fputs("\n'rastray COMMAND --help' lists a command's options; 'rastray --version' prints the version.\n", f);
+}
+
 int main(int argc, char **argv) {
   if (argc < 2 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0) {
-    fputs(usage, argc < 2 ? stderr : stdout);
+    print_overview(argc < 2 ? stderr : stdout);
     return argc < 2 ? EXIT_USAGE : 0;
   }
   if (strcmp(argv[1], "--version") == 0) {
     printf("rastray %s\n", RR_VERSION);
     return 0;
   }
+  const cli_command *cmd = NULL;
+  for (int c = 0; c < NCOMMANDS; c++)
+    if (strcmp(argv[1], commands[c].name) == 0) cmd = &commands[c];
+  if (!cmd) die(EXIT_USAGE, "unknown command '%s' (expected render or info; see --help)", argv[1]);
   rr_device *dev = rr_device_new();
   if (!dev) die(EXIT_INPUT, "out of memory");
-  int rc;
-  if (strcmp(argv[1], "render") == 0) rc = cmd_render(dev, argc - 2, argv + 2);
-  else if (strcmp(argv[1], "info") == 0) rc = cmd_info(dev, argc - 2, argv + 2);
-  else die(EXIT_USAGE, "unknown command '%s' (expected render or info; see --help)", argv[1]);
+  int rc = cmd->run(dev, cmd, argc - 1, argv + 1); /* the command's name stands as getopt's argv[0] */
   rr_device_release(dev);
   return rc;
 }
