@@ -17,7 +17,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <tinyexr.h>
 
 static char dir[64];
 static rr_device *dev;
@@ -532,37 +531,6 @@ static void test_textures(void) {
 
 /* ---- what images hold: EXR names, layers, colour ---------------------------------- */
 
-/* An EXR file read through tinyexr itself rather than rastray's reader. */
-typedef struct exr_file {
-  EXRHeader h;
-  EXRImage img;
-  bool ok;
-} exr_file;
-
-static bool exr_load(const char *path, exr_file *x) {
-  EXRVersion v;
-  const char *err = NULL;
-  InitEXRHeader(&x->h);
-  InitEXRImage(&x->img);
-  x->ok = ParseEXRVersionFromFile(&v, path) == TINYEXR_SUCCESS &&
-          ParseEXRHeaderFromFile(&x->h, &v, path, &err) == TINYEXR_SUCCESS &&
-          LoadEXRImageFromFile(&x->img, &x->h, path, &err) == TINYEXR_SUCCESS;
-  CHECK(x->ok, "tinyexr cannot read %s: %s", path, err ? err : "");
-  if (err) FreeEXRErrorMessage(err);
-  return x->ok;
-}
-
-static void exr_free(exr_file *x) {
-  if (x->ok) FreeEXRImage(&x->img);
-  FreeEXRHeader(&x->h);
-}
-
-static int exr_find(const exr_file *x, const char *name) {
-  for (int k = 0; k < x->h.num_channels; k++)
-    if (!strcmp(x->h.channels[k].name, name)) return k;
-  return -1;
-}
-
 /* A scene of known colours in front of rr_camera_init's camera: a quad through the
  * centre (geometry 0, colour `rgb`) and a triangle in a corner (geometry 1). */
 static rr_scene *colour_scene(const float rgb[3]) {
@@ -621,9 +589,9 @@ static void test_exr_layers(void) {
     snprintf(name, sizeof name, "layer%d.exr", i);
     CHECK(i == 0 || img->kind == RR_IMAGE_AOV + i - 1, "AOV %d has kind %d", i - 1, img->kind);
     CHECK(rr_image_write(dev, img, tpath(name)) == RR_OK, "%s: %s", name, rr_device_message(dev));
-    exr_file x;
-    if (!exr_load(tpath(name), &x)) {
-      exr_free(&x);
+    test_exr_file x;
+    if (!test_exr_load(tpath(name), &x)) {
+      test_exr_free(&x);
       continue;
     }
     int want_type = img->type == RR_PIXEL_U32 ? TINYEXR_PIXELTYPE_UINT : TINYEXR_PIXELTYPE_FLOAT;
@@ -641,7 +609,7 @@ static void test_exr_layers(void) {
         same = memcmp((const uint32_t *)img->data + p * img->channels + src, (const uint32_t *)x.img.images[k] + p, 4) == 0;
     }
     CHECK(same, "%s: values differ from the image's", name);
-    exr_free(&x);
+    test_exr_free(&x);
     total += img->channels;
 
     /* rastray's reader gives the kind back */
@@ -656,29 +624,29 @@ static void test_exr_layers(void) {
   /* every AOV and the colour as layers of one file: the single files' channels */
   CHECK(rr_image_write_layers(dev, images, 1 + RR_AOV_COUNT, tpath("all.exr")) == RR_OK, "layers: %s",
         rr_device_message(dev));
-  exr_file all;
-  if (exr_load(tpath("all.exr"), &all)) {
+  test_exr_file all;
+  if (test_exr_load(tpath("all.exr"), &all)) {
     CHECK(all.h.num_channels == total, "%d channels in all.exr, %d expected", all.h.num_channels, total);
     for (int i = 0; i <= RR_AOV_COUNT; i++) {
       char name[32];
       snprintf(name, sizeof name, "layer%d.exr", i);
-      exr_file one;
-      if (!exr_load(tpath(name), &one)) {
-        exr_free(&one);
+      test_exr_file one;
+      if (!test_exr_load(tpath(name), &one)) {
+        test_exr_free(&one);
         continue;
       }
       for (int k = 0; k < one.h.num_channels; k++) {
-        int j = exr_find(&all, one.h.channels[k].name);
+        int j = test_exr_find(&all, one.h.channels[k].name);
         CHECK(j >= 0, "all.exr lacks channel %s", one.h.channels[k].name);
         if (j < 0) continue;
         CHECK(all.h.pixel_types[j] == one.h.pixel_types[k], "all.exr: type of %s", one.h.channels[k].name);
         CHECK(memcmp(all.img.images[j], one.img.images[k], (size_t)SW * SH * 4) == 0, "all.exr: values of %s",
               one.h.channels[k].name);
       }
-      exr_free(&one);
+      test_exr_free(&one);
     }
   }
-  exr_free(&all);
+  test_exr_free(&all);
 
   /* clashing names, mixed sizes and layers outside EXR are refused, leaving nothing */
   rr_image twice[2] = {images[1 + RR_AOV_DEPTH], images[1 + RR_AOV_DEPTH]};
