@@ -364,7 +364,7 @@ rr_error rr_image_write(rr_device *dev, const rr_image *img, const char *path);
 /* Writes n images of one size as the layers of one EXR file (an output set of one). */
 rr_error rr_image_write_layers(rr_device *dev, const rr_image *images, int n, const char *path);
 /* Reads an image written by rr_image_write (.png, .pfm, .exr, .npy); an EXR of at most
- * 4 channels of one type, its kind found from their names (R, G, B, A, Y: colour). Other
+ * 4 channels of one type, its kind found from their names (R, G, B, A: colour). Other
  * files give plain values. */
 rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out);
 
