@@ -15,6 +15,14 @@
 extern "C" {
 #endif
 
+/* Marks the API's functions: the library is built with hidden visibility, so these
+ * are the only symbols its shared object exports. */
+#if defined(__GNUC__)
+#define RR_API __attribute__((visibility("default")))
+#else
+#define RR_API
+#endif
+
 #define RR_VERSION "0.1.0"
 #define RR_MISS 0xFFFFFFFFu /* the id (primitive, geometry, material) where nothing is hit */
 #define RR_MAX_SIZE 16384   /* largest image side accepted */
@@ -36,34 +44,36 @@ typedef struct rr_scene rr_scene;   /* geometries of triangles, attributes, mate
 typedef struct rr_frame rr_frame;   /* a visibility buffer plus its statistics */
 
 /* Creates a device; returns NULL only when out of memory. */
-rr_device *rr_device_new(void);
+RR_API rr_device *rr_device_new(void);
 /* Releases a device; its scenes and frames must be released first. */
-void rr_device_release(rr_device *dev);
+RR_API void rr_device_release(rr_device *dev);
 /* The code of the device's last failed call (RR_OK after a success). */
-rr_error rr_device_error(const rr_device *dev);
+RR_API rr_error rr_device_error(const rr_device *dev);
 /* A one-line message about the device's last failed call ("" after a success). */
-const char *rr_device_message(const rr_device *dev);
+RR_API const char *rr_device_message(const rr_device *dev);
 
 /* ---- scenes -------------------------------------------------------------- */
 
 /* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...)
  * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]",
  * "grid:PATH:N" (N×N copies of a mesh on the XZ plane), "ground" (an infinite
- * plane with vertices at infinity, and objects on it). */
-rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out);
+ * plane with vertices at infinity, and objects on it). "demo" reads meshes from
+ * the first directory holding them: $RASTRAY_DATA, the installed share/rastray,
+ * the source tree's data/. */
+RR_API rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out);
 /* Creates an empty scene to be filled with rr_scene_add_mesh. */
-rr_error rr_scene_new(rr_device *dev, rr_scene **out);
+RR_API rr_error rr_scene_new(rr_device *dev, rr_scene **out);
 /* Appends an indexed triangle mesh as one new geometry (numbered after the scene's
  * others) with a new material of base colour rgb (NULL: grey); 3 indices per
  * triangle. Degenerate and non-finite triangles are skipped and counted. */
-rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
-                           const uint32_t *indices, size_t ntriangles, const float rgb[3]);
+RR_API rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
+                                  const uint32_t *indices, size_t ntriangles, const float rgb[3]);
 /* The same with homogeneous xyzw vertices: w != 0 is divided out, w = 0 is a point at infinity in direction xyz (3D methods only). */
-rr_error rr_scene_add_mesh4(rr_scene *scene, const float *xyzw, size_t nvertices, const uint32_t *indices,
-                            size_t ntriangles, const float rgb[3]);
+RR_API rr_error rr_scene_add_mesh4(rr_scene *scene, const float *xyzw, size_t nvertices, const uint32_t *indices,
+                                   size_t ntriangles, const float rgb[3]);
 /* Builds what rendering needs (the BVH); called implicitly by rr_scene_load.
  * Uses the device's build options (rr_device_set_build_options). */
-rr_error rr_scene_commit(rr_scene *scene);
+RR_API rr_error rr_scene_commit(rr_scene *scene);
 
 typedef struct rr_build_options {
   int threads;   /* threads building the BVH; 0: all cores (at most RR_MAX_THREADS). The tree does not depend on it. */
@@ -72,12 +82,12 @@ typedef struct rr_build_options {
 } rr_build_options;
 
 /* Fills build options with defaults: all cores, 32 bins, leaves of at most 4 triangles. */
-void rr_build_options_init(rr_build_options *opt);
+RR_API void rr_build_options_init(rr_build_options *opt);
 /* Sets the options that later commits of this device's scenes use (like Embree's
  * device "threads=N"); rr_scene_load commits, so set them before loading. */
-rr_error rr_device_set_build_options(rr_device *dev, const rr_build_options *opt);
+RR_API rr_error rr_device_set_build_options(rr_device *dev, const rr_build_options *opt);
 /* Releases a scene. */
-void rr_scene_release(rr_scene *scene);
+RR_API void rr_scene_release(rr_scene *scene);
 
 typedef struct rr_scene_info {
   uint64_t triangles;    /* triangles kept */
@@ -94,7 +104,7 @@ typedef struct rr_scene_info {
 } rr_scene_info;
 
 /* Fills what is known about a scene. */
-rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
+RR_API rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
 
 /* ---- geometries ---------------------------------------------------------- */
 /* A scene is a list of geometries, each a run of primitives of one kind: a mesh of a
@@ -109,7 +119,7 @@ typedef enum rr_geometry_kind {
 } rr_geometry_kind;
 
 /* The name of a geometry kind ("triangle"), NULL when out of range. */
-const char *rr_geometry_kind_name(int kind);
+RR_API const char *rr_geometry_kind_name(int kind);
 
 typedef struct rr_geometry_info {
   rr_geometry_kind kind;
@@ -120,9 +130,9 @@ typedef struct rr_geometry_info {
 
 /* The geometry holding primitive `prim` and prim's index within it (*local = prim -
  * first); RR_MISS maps to RR_MISS in both. Either pointer may be NULL. */
-rr_error rr_scene_get_geometry(const rr_scene *scene, uint32_t prim, uint32_t *geom, uint32_t *local);
+RR_API rr_error rr_scene_get_geometry(const rr_scene *scene, uint32_t prim, uint32_t *geom, uint32_t *local);
 /* Fills what is known about geometry `geom` (0 .. rr_scene_info.geometries - 1). */
-rr_error rr_scene_get_geometry_info(const rr_scene *scene, uint32_t geom, rr_geometry_info *info);
+RR_API rr_error rr_scene_get_geometry_info(const rr_scene *scene, uint32_t geom, rr_geometry_info *info);
 
 /* ---- ray queries --------------------------------------------------------- */
 
@@ -149,10 +159,10 @@ typedef struct rr_hit {
  * of every method (ties in t go to the lower id; a ray through a shared edge hits
  * exactly one triangle). Needs a committed scene. The outcome goes to dev, which
  * may be NULL (then only the returned code tells it). */
-rr_error rr_intersect(rr_device *dev, const rr_scene *scene, const rr_ray *ray, rr_hit *hit);
+RR_API rr_error rr_intersect(rr_device *dev, const rr_scene *scene, const rr_ray *ray, rr_hit *hit);
 /* Whether the ray hits any triangle with tmin <= t <= tmax (*occluded = 0 or 1);
  * dev as for rr_intersect. */
-rr_error rr_occluded(rr_device *dev, const rr_scene *scene, const rr_ray *ray, int *occluded);
+RR_API rr_error rr_occluded(rr_device *dev, const rr_scene *scene, const rr_ray *ray, int *occluded);
 
 /* ---- cameras ------------------------------------------------------------- */
 
@@ -176,17 +186,17 @@ typedef struct rr_camera {
 
 /* The camera type named `name` ("perspective", "orthographic", "parabolic", "latlong",
  * "fisheye", "cube"); -1 when unknown. */
-int rr_camera_from_name(const char *name);
+RR_API int rr_camera_from_name(const char *name);
 /* The name of a camera type, NULL when out of range. */
-const char *rr_camera_name(int type);
+RR_API const char *rr_camera_name(int type);
 
 /* Fills a camera with defaults: perspective, eye (0,0,3) looking at the origin, y up, 45°. */
-void rr_camera_init(rr_camera *cam);
+RR_API void rr_camera_init(rr_camera *cam);
 /* Places eye and target so that the scene's bounds fill the view of cam->fov_deg. */
-rr_error rr_camera_frame(rr_device *dev, const rr_scene *scene, int width, int height,
-                         rr_camera *cam);
+RR_API rr_error rr_camera_frame(rr_device *dev, const rr_scene *scene, int width, int height,
+                                rr_camera *cam);
 /* Checks a camera (finite values, eye != target, up not parallel to the view). */
-rr_error rr_camera_check(rr_device *dev, const rr_camera *cam);
+RR_API rr_error rr_camera_check(rr_device *dev, const rr_camera *cam);
 
 /* ---- visibility ---------------------------------------------------------- */
 
@@ -206,9 +216,9 @@ typedef enum rr_method {
 } rr_method;
 
 /* The method named `name` ("rc", "3dr-bb", ..., "auto"); -1 when unknown. */
-int rr_method_from_name(const char *name);
+RR_API int rr_method_from_name(const char *name);
 /* The name of a method ("rc", ...), NULL when out of range. */
-const char *rr_method_name(int method);
+RR_API const char *rr_method_name(int method);
 
 typedef struct rr_render_options {
   rr_method method;
@@ -230,7 +240,7 @@ typedef struct rr_render_options {
 
 /* Fills options with defaults: 3dr-bb, 1024x768, one sample at each pixel's centre,
  * all cores, no culling. */
-void rr_render_options_init(rr_render_options *opt);
+RR_API void rr_render_options_init(rr_render_options *opt);
 
 typedef struct rr_stats {
   uint64_t setups;     /* S: triangle setups computed */
@@ -246,25 +256,25 @@ typedef struct rr_stats {
 } rr_stats;
 
 /* Computes primary visibility of a scene from a camera into a new frame. */
-rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
-                   const rr_render_options *opt, rr_frame **out);
+RR_API rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                          const rr_render_options *opt, rr_frame **out);
 /* Releases a frame. */
-void rr_frame_release(rr_frame *frame);
+RR_API void rr_frame_release(rr_frame *frame);
 /* The statistics of the pass that made the frame. */
-rr_error rr_frame_get_stats(const rr_frame *frame, rr_stats *stats);
+RR_API rr_error rr_frame_get_stats(const rr_frame *frame, rr_stats *stats);
 /* Width and height of the frame's visibility buffer. */
-rr_error rr_frame_get_size(const rr_frame *frame, int *width, int *height);
+RR_API rr_error rr_frame_get_size(const rr_frame *frame, int *width, int *height);
 /* Samples per pixel of the frame (options.samples). */
-rr_error rr_frame_get_samples(const rr_frame *frame, int *samples);
+RR_API rr_error rr_frame_get_samples(const rr_frame *frame, int *samples);
 /* Read-only views of the visibility buffer, row 0 at the top: primitive id
  * (RR_MISS on a miss), ray parameter t along the unnormalised camera ray
  * (+inf on a miss) and barycentrics λ1, λ2 of the hit. With several samples per
  * pixel they hold one width × height layer per sample, sample s at offset
  * s·width·height. */
-const uint32_t *rr_frame_ids(const rr_frame *frame);
-const float *rr_frame_t(const rr_frame *frame);
-const float *rr_frame_bary1(const rr_frame *frame);
-const float *rr_frame_bary2(const rr_frame *frame);
+RR_API const uint32_t *rr_frame_ids(const rr_frame *frame);
+RR_API const float *rr_frame_t(const rr_frame *frame);
+RR_API const float *rr_frame_bary1(const rr_frame *frame);
+RR_API const float *rr_frame_bary2(const rr_frame *frame);
 
 /* ---- shading and images -------------------------------------------------- */
 
@@ -279,7 +289,7 @@ typedef enum rr_shade_mode {
 } rr_shade_mode;
 
 /* The shade mode named `name`; -1 when unknown. */
-int rr_shade_from_name(const char *name);
+RR_API int rr_shade_from_name(const char *name);
 
 typedef enum rr_aov {
   RR_AOV_DEPTH = 0, /* 1 float: eye-to-hit distance, +inf on a miss */
@@ -295,7 +305,7 @@ typedef enum rr_aov {
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
  * "material"); -1 when unknown. */
-int rr_aov_from_name(const char *name);
+RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
 
@@ -324,13 +334,13 @@ typedef struct rr_image {
  * the background) are display colours stored decoded from sRGB, so that every file
  * shows them as designed: a PNG holds exactly the display values, an EXR the same
  * picture in linear light. */
-rr_error rr_shade(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
-                  const rr_frame *frame, rr_shade_mode mode, rr_image *out);
+RR_API rr_error rr_shade(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                         const rr_frame *frame, rr_shade_mode mode, rr_image *out);
 /* Extracts an AOV of a frame into a new image of kind RR_IMAGE_AOV + aov. */
-rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
-                      const rr_frame *frame, rr_aov aov, rr_image *out);
+RR_API rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                             const rr_frame *frame, rr_aov aov, rr_image *out);
 /* Frees the pixels of an image made by rastray. */
-void rr_image_free(rr_image *img);
+RR_API void rr_image_free(rr_image *img);
 
 /* ---- image files ----------------------------------------------------------- */
 /* A path's format is its extension (.png, .pfm, .exr, .npy) or a prefix naming it
@@ -343,30 +353,30 @@ void rr_image_free(rr_image *img);
 typedef struct rr_output rr_output; /* image files written all or nothing */
 
 /* Creates an empty output set; its failures are reported in dev. */
-rr_error rr_output_new(rr_device *dev, rr_output **out);
+RR_API rr_error rr_output_new(rr_device *dev, rr_output **out);
 /* Encodes n images as the file `path`: one image, or n > 1 images of one size as the
  * layers of one EXR (no two may share a channel name). A regular file (new or
  * replaced) is written at once under a unique temporary name in its directory
  * (path.tmp.XXXXXX); standard output and other non-regular files are kept in memory.
  * Nothing appears at path before rr_output_commit. At most one output of a set may
  * be standard output. A failed add adds nothing; the images may be freed after it. */
-rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char *path);
+RR_API rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char *path);
 /* Makes the set's outputs appear: renames every temporary over its target (when
  * one rename fails, the files renamed before it are removed again), then writes
  * the non-regular targets, standard output last. Once the files are in place, a
  * failure writing a stream leaves them. A set is committed once. */
-rr_error rr_output_commit(rr_output *set);
+RR_API rr_error rr_output_commit(rr_output *set);
 /* Releases a set, removing the temporaries of a set not committed. */
-void rr_output_release(rr_output *set);
+RR_API void rr_output_release(rr_output *set);
 
 /* Writes one image: an output set of one file. */
-rr_error rr_image_write(rr_device *dev, const rr_image *img, const char *path);
+RR_API rr_error rr_image_write(rr_device *dev, const rr_image *img, const char *path);
 /* Writes n images of one size as the layers of one EXR file (an output set of one). */
-rr_error rr_image_write_layers(rr_device *dev, const rr_image *images, int n, const char *path);
+RR_API rr_error rr_image_write_layers(rr_device *dev, const rr_image *images, int n, const char *path);
 /* Reads an image written by rr_image_write (.png, .pfm, .exr, .npy); an EXR of at most
  * 4 channels of one type, its kind found from their names (R, G, B, A: colour). Other
  * files give plain values. */
-rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out);
+RR_API rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out);
 
 #ifdef __cplusplus
 }
