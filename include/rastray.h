@@ -391,25 +391,73 @@ RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
 
+/* What an image holds. It names the image's channels in EXR files and tells the
+ * writers whether the values are colour; a zeroed image holds plain values. */
+typedef enum rr_image_kind {
+  RR_IMAGE_VALUES = 0, /* numbers written as they are; EXR channels Y | R,G | R,G,B | R,G,B,A */
+  RR_IMAGE_COLOR,      /* colour: linear light in floats, sRGB-encoded in 8 bits (alpha, the 4th
+                          channel, is linear in both); EXR channels as for values. PNG encodes float
+                          colour to sRGB, EXR and PFM decode 8-bit colour to linear light */
+  RR_IMAGE_AOV         /* RR_IMAGE_AOV + a: AOV a of rr_frame_aov, values as they are, EXR channels
+                          depth Z, normal N.X N.Y N.Z, bary bary.u bary.v (λ1, λ2), id, mesh and
+                          material (32-bit UINT), evals, nodes */
+} rr_image_kind;
+
 /* An image owned by the caller or by rastray (rr_image_free). */
 typedef struct rr_image {
   int width, height, channels;
   rr_pixel_type type;
   void *data; /* row-major, row 0 at the top, channels interleaved */
+  int kind;   /* what it holds: an rr_image_kind (RR_IMAGE_AOV + a for AOV a) */
 } rr_image;
 
-/* Shades a frame into a new float RGB image, display-encoded in [0, 1]. */
+/* Shades a frame into a new float RGB image of kind RR_IMAGE_COLOR, in linear light:
+ * lambert is the lit colour itself; the visualisations (id, normal, depth, heat maps,
+ * the background) are display colours stored decoded from sRGB, so that every file
+ * shows them as designed: a PNG holds exactly the display values, an EXR the same
+ * picture in linear light. */
 RR_API rr_error rr_shade(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                          const rr_frame *frame, rr_shade_mode mode, rr_image *out);
-/* Extracts an AOV of a frame into a new image. */
+/* Extracts an AOV of a frame into a new image of kind RR_IMAGE_AOV + aov. */
 RR_API rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                              const rr_frame *frame, rr_aov aov, rr_image *out);
 /* Frees the pixels of an image made by rastray. */
 RR_API void rr_image_free(rr_image *img);
-/* Writes an image; the format follows the extension (.png, .pfm, .exr, .npy).
- * The file is written under a temporary name and renamed, so a failure leaves nothing. */
+
+/* ---- image files ----------------------------------------------------------- */
+/* A path's format is its extension (.png, .pfm, .exr, .npy) or a prefix naming it
+ * ("exr:PATH", "png:-"); the prefix wins. "-" is standard output. Standard output and
+ * other files that are not regular files (/dev/null, a FIFO) may go without either:
+ * they take PNG for colour and 8-bit images, EXR for several layers, NPY otherwise.
+ * PNG holds 1, 3 or 4 channels of 8 bits; PFM 1 or 3 floats (ids only when exact as
+ * floats); NPY any image as it is; EXR any image, floats as FLOAT, ids as UINT. */
+
+typedef struct rr_output rr_output; /* image files written all or nothing */
+
+/* Creates an empty output set; its failures are reported in dev. */
+RR_API rr_error rr_output_new(rr_device *dev, rr_output **out);
+/* Encodes n images as the file `path`: one image, or n > 1 images of one size as the
+ * layers of one EXR (no two may share a channel name). A regular file (new or
+ * replaced) is written at once under a unique temporary name in its directory
+ * (path.tmp.XXXXXX); standard output and other non-regular files are kept in memory.
+ * Nothing appears at path before rr_output_commit. At most one output of a set may
+ * be standard output. A failed add adds nothing; the images may be freed after it. */
+RR_API rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char *path);
+/* Makes the set's outputs appear: renames every temporary over its target (when
+ * one rename fails, the files renamed before it are removed again), then writes
+ * the non-regular targets, standard output last. Once the files are in place, a
+ * failure writing a stream leaves them. A set is committed once. */
+RR_API rr_error rr_output_commit(rr_output *set);
+/* Releases a set, removing the temporaries of a set not committed. */
+RR_API void rr_output_release(rr_output *set);
+
+/* Writes one image: an output set of one file. */
 RR_API rr_error rr_image_write(rr_device *dev, const rr_image *img, const char *path);
-/* Reads an image written by rr_image_write (.png, .pfm, .exr, .npy). */
+/* Writes n images of one size as the layers of one EXR file (an output set of one). */
+RR_API rr_error rr_image_write_layers(rr_device *dev, const rr_image *images, int n, const char *path);
+/* Reads an image written by rr_image_write (.png, .pfm, .exr, .npy); an EXR of at most
+ * 4 channels of one type, its kind found from their names (R, G, B, A: colour). Other
+ * files give plain values. */
 RR_API rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out);
 
 #ifdef __cplusplus

@@ -196,7 +196,7 @@ static rr_error images(const fixture *fx, uint64_t *print) {
 static bool write_obj(rr_device *dev, const char *dir, char *obj, size_t cap) {
   char path[1024];
   float texels[2 * 2 * 3] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
-  rr_image tex = {2, 2, 3, RR_PIXEL_F32, texels};
+  rr_image tex = {2, 2, 3, RR_PIXEL_F32, texels, RR_IMAGE_VALUES};
   snprintf(path, sizeof path, "%s/tiny.png", dir);
   if (rr_image_write(dev, &tex, path) != RR_OK) return false;
   snprintf(path, sizeof path, "%s/tiny.mtl", dir);

@@ -4,6 +4,7 @@
  * node scale, the file's cameras (by name and index) and lights, and the up axis
  * of COLLADA and STL files in the automatic framing. */
 #include "camera/camera.h"
+#include "core/color.h"
 #include "testutil.h"
 
 #include <stb/stb_image_write.h>
@@ -333,7 +334,7 @@ static void check_vertex_colors(rr_device *dev) {
   const char *obj = test_write_file(dir, "col.obj", "v 0 0 0 0.5 0.5 0.5\nv 1 0 0 1 0 0\nv 0 1 0 0 0 1\nf 1 2 3\n");
   CHECK(rr_scene_load(dev, obj, &s) == RR_OK, "%s", rr_device_message(dev));
   if (s) {
-    CHECK(s->col[0][0] && fabsf(s->col[0][1][0] - powf(0.5f, SCENE_GAMMA)) < 1e-4f && s->col[1][0][0] == 1 &&
+    CHECK(s->col[0][0] && fabsf(s->col[0][1][0] - srgb_decode(0.5f)) < 1e-4f && s->col[1][0][0] == 1 &&
               s->col[1][1][0] == 0,
           "OBJ vertex colours decoded to linear: %g", s->col[0][0] ? s->col[0][1][0] : -1);
     rr_scene_release(s);

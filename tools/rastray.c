@@ -85,10 +85,16 @@ static const cli_option render_options[] = {
     {"camera-from-file", OPT_CAMERA_FROM_FILE, "NAME|INDEX",
      "look through a camera the scene file defines (see info); --camera may\nchange its projection"},
     {"shade", OPT_SHADE, "MODE", "lambert (default), id, normal, depth, heat-evals, heat-nodes"},
-    {"output", 'o', "PATH", "colour image: .png, .exr or .pfm (default rastray.png unless --aov is given)"},
-    {"aov", OPT_AOV, "NAME=PATH",
-     "write an AOV as .npy, .pfm or .exr; repeatable. NAME: depth, id (triangle),\n"
-     "mesh (geometry id), material (index), normal, bary, evals, nodes"},
+    {"output", 'o', "PATH",
+     "colour image: .png (sRGB), .exr or .pfm (linear light); default rastray.png\n"
+     "unless --aov is given. PATH may be - (stdout, PNG), FMT:PATH (png:-, exr:-),\n"
+     "or a device or FIFO such as /dev/null"},
+    {"aov", OPT_AOV, "LIST=PATH",
+     "write AOVs as .npy, .pfm or .exr (stdout: - as NPY, or FMT:-); repeatable.\n"
+     "LIST: one NAME, NAME,NAME,... or all, as the layers of one EXR. NAME: color\n"
+     "(the shaded image), depth (EXR Z), normal (N.X N.Y N.Z), bary (bary.u bary.v),\n"
+     "id (triangle), mesh (geometry id), material (index) (ids: EXR UINT), evals,\n"
+     "nodes; all: every one (evals, nodes with heat). Outputs are all or nothing"},
     {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default: all cores)"},
     {"repeat", OPT_REPEAT, "N", "run the visibility pass N times, report the median time"},
     {"stats", OPT_STATS, NULL, "print key=value statistics to stderr"},
@@ -232,10 +238,35 @@ static void parse_size(const char *s, int *w, int *h) {
   *w = (int)a, *h = (int)b;
 }
 
+/* An --aov: the images written as one file (several: the layers of one EXR). */
+enum { COLOR_BIT = 1u << RR_AOV_COUNT }; /* the shaded image, beside AOV a's bit 1 << a */
 typedef struct {
-  rr_aov aov;
+  unsigned images; /* COLOR_BIT and AOV bits */
+  bool all;        /* `all`: resolved once heat is known */
   const char *path;
 } aov_out;
+
+/* Parses --aov LIST=PATH. */
+static aov_out parse_aov(const char *arg) {
+  const char *eq = strchr(arg, '=');
+  char list[256];
+  if (!eq || eq == arg || !eq[1] || (size_t)(eq - arg) >= sizeof list)
+    die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
+  memcpy(list, arg, eq - arg), list[eq - arg] = 0;
+  aov_out a = {0, false, eq + 1};
+  char *save = NULL;
+  for (char *name = strtok_r(list, ",", &save); name; name = strtok_r(NULL, ",", &save)) {
+    int k = rr_aov_from_name(name);
+    if (!strcmp(name, "all")) a.all = true;
+    else if (!strcmp(name, "color")) a.images |= COLOR_BIT;
+    else if (k >= 0) a.images |= 1u << k;
+    else
+      die(EXIT_USAGE,
+          "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes or all)", name);
+  }
+  if (!a.images && !a.all) die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
+  return a;
+}
 
 static int cmp_double(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
@@ -266,32 +297,71 @@ static rr_scene *load_scene(rr_device *dev, const char *name) {
   return scene;
 }
 
-static void write_image(rr_device *dev, rr_image *img, const char *path) {
-  rr_error e = rr_image_write(dev, img, path);
-  rr_image_free(img);
-  if (e) die(e == RR_ERROR_ARGUMENT ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
+/* Ends the run on a failed output; the set's temporaries go first. */
+static void output_failed(rr_device *dev, rr_output *set, rr_error e) {
+  rr_output_release(set);
+  die(e == RR_ERROR_ARGUMENT ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
 }
 
-/* Cuts the six faces out of a cube camera's cross and writes DIR/<face>.png. */
-static void write_cube_faces(rr_device *dev, const rr_image *cross, const char *dir) {
+static void add_output(rr_device *dev, rr_output *set, const rr_image *images, int n, const char *path) {
+  rr_error e = rr_output_add(set, images, n, path);
+  if (e) output_failed(dev, set, e);
+}
+
+/* Cuts the six faces out of a cube camera's cross and adds DIR/<face>.png to the set. */
+static void add_cube_faces(rr_device *dev, rr_output *set, const rr_image *cross, const char *dir) {
   static const struct {
     const char *name;
     int col, row;
   } faces[6] = {{"front", 1, 1}, {"right", 2, 1}, {"back", 3, 1}, {"left", 0, 1}, {"top", 1, 0}, {"bottom", 1, 2}};
   int n = cross->height / 3;
   for (int f = 0; f < 6; f++) {
-    rr_image img = {n, n, 3, RR_PIXEL_F32, malloc((size_t)n * n * 3 * sizeof(float))};
-    if (!img.data) die(EXIT_INPUT, "out of memory");
+    rr_image img = {n, n, 3, RR_PIXEL_F32, malloc((size_t)n * n * 3 * sizeof(float)), cross->kind};
+    if (!img.data) {
+      rr_output_release(set);
+      die(EXIT_INPUT, "out of memory");
+    }
     for (int y = 0; y < n; y++)
       memcpy((float *)img.data + (size_t)y * n * 3,
              (const float *)cross->data + ((size_t)(faces[f].row * n + y) * cross->width + faces[f].col * n) * 3,
              (size_t)n * 3 * sizeof(float));
     char path[4096];
     snprintf(path, sizeof path, "%s/%s.png", dir, faces[f].name);
-    rr_error e = rr_image_write(dev, &img, path);
+    rr_error e = rr_output_add(set, &img, 1, path);
     free(img.data);
+    if (e) output_failed(dev, set, e);
+  }
+}
+
+/* Writes every output of the run as one set: all of them, or none. The colour
+ * image and each AOV are made once, whatever number of files hold them. */
+static void write_outputs(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_frame *frame,
+                          int shade, const char *out, const char *cube_dir, const aov_out *aovs, int naov) {
+  unsigned need = out || cube_dir ? COLOR_BIT : 0;
+  for (int k = 0; k < naov; k++) need |= aovs[k].images;
+  rr_image images[RR_AOV_COUNT + 1] = {{0}}; /* AOV a at a, the colour last */
+  rr_image *colour = &images[RR_AOV_COUNT];
+  for (int a = 0; a <= RR_AOV_COUNT; a++) {
+    if (!(need & 1u << a)) continue;
+    rr_error e = a == RR_AOV_COUNT ? rr_shade(dev, scene, cam, frame, (rr_shade_mode)shade, colour)
+                                   : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
     if (e) die(EXIT_INPUT, "%s", rr_device_message(dev));
   }
+  rr_output *set;
+  if (rr_output_new(dev, &set) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+  if (out) add_output(dev, set, colour, 1, out);
+  if (cube_dir) add_cube_faces(dev, set, colour, cube_dir);
+  for (int k = 0; k < naov; k++) {
+    rr_image layers[RR_AOV_COUNT + 1];
+    int n = 0;
+    for (int a = RR_AOV_COUNT; a >= 0; a--) /* the colour first, as in the help */
+      if (aovs[k].images & 1u << a) layers[n++] = images[a];
+    add_output(dev, set, layers, n, aovs[k].path);
+  }
+  rr_error e = rr_output_commit(set);
+  if (e) output_failed(dev, set, e);
+  rr_output_release(set);
+  for (int a = 0; a <= RR_AOV_COUNT; a++) rr_image_free(&images[a]);
 }
 
 static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
@@ -421,20 +491,10 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
             optarg);
       break;
     case 'o': out = optarg; break;
-    case OPT_AOV: {
-      const char *eq = strchr(optarg, '=');
-      char name[32];
-      if (!eq || eq == optarg || !eq[1] || (size_t)(eq - optarg) >= sizeof name)
-        die(EXIT_USAGE, "bad --aov '%s' (expected NAME=PATH)", optarg);
-      memcpy(name, optarg, eq - optarg), name[eq - optarg] = 0;
-      int k = rr_aov_from_name(name);
-      if (k < 0)
-        die(EXIT_USAGE, "unknown AOV '%s' (expected depth, id, mesh, material, normal, bary, evals or nodes)", name);
-      if (k == RR_AOV_EVALS || k == RR_AOV_NODES) opt.heat = 1;
+    case OPT_AOV:
       if (naov == 16) die(EXIT_USAGE, "too many --aov (at most 16)");
-      aovs[naov++] = (aov_out){(rr_aov)k, eq + 1};
+      aovs[naov++] = parse_aov(optarg);
       break;
-    }
     case OPT_THREADS: opt.threads = (int)parse_int(flag, optarg, 1, RR_MAX_THREADS); break;
     case OPT_REPEAT: repeat = (int)parse_int(flag, optarg, 1, 1000); break;
     case OPT_STATS: stats = true; break;
@@ -451,6 +511,10 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   if (!scene_name) scene_name = "demo";
   if (!out && naov == 0) out = "rastray.png";
   if (shade == RR_SHADE_HEAT_EVALS || shade == RR_SHADE_HEAT_NODES) opt.heat = 1;
+  const unsigned heat_aovs = 1u << RR_AOV_EVALS | 1u << RR_AOV_NODES;
+  for (int k = 0; k < naov; k++) opt.heat |= (aovs[k].images & heat_aovs) != 0;
+  for (int k = 0; k < naov; k++) /* all: every AOV the frame has */
+    if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~(opt.heat ? 0 : heat_aovs);
 
   rr_build_options build; /* the BVH is built on the render's threads too */
   rr_build_options_init(&build);
@@ -484,18 +548,7 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   double frame_ms = median(times, repeat), cpu_ms = median(cpus, repeat);
   free(times), free(cpus);
 
-  if (out || cube_dir) {
-    rr_image img;
-    if (rr_shade(dev, scene, &cam, frame, (rr_shade_mode)shade, &img) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
-    if (cube_dir) write_cube_faces(dev, &img, cube_dir);
-    if (out) write_image(dev, &img, out);
-    else rr_image_free(&img);
-  }
-  for (int k = 0; k < naov; k++) {
-    rr_image img;
-    if (rr_frame_aov(dev, scene, &cam, frame, aovs[k].aov, &img) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
-    write_image(dev, &img, aovs[k].path);
-  }
+  write_outputs(dev, scene, &cam, frame, shade, out, cube_dir, aovs, naov);
 
   rr_stats st;
   rr_frame_get_stats(frame, &st);

@@ -7,6 +7,7 @@
  * its mesh; assimp splits an OBJ object by material into meshes of one node.
  * Besides triangles the file gives materials (with embedded textures), vertex
  * colours, cameras, lights and its up axis. */
+#include "core/color.h"
 #include "io/io.h"
 
 #include <assimp/cimport.h>
@@ -64,8 +65,6 @@ static bool is_identity(const struct aiMatrix4x4 *m) {
          m->c4 == 0 && m->d1 == 0 && m->d2 == 0 && m->d3 == 0;
 }
 
-static float srgb_to_linear(float c) { return c > 0 ? powf(c, SCENE_GAMMA) : 0; }
-
 static rr_error add_mesh(rr_scene *s, const struct aiNode *node, const struct aiMesh *mesh,
                          const struct aiMatrix4x4 *m, uint32_t mat_base, const file_kind *kind) {
   uint64_t ntri = 0;
@@ -108,7 +107,7 @@ static rr_error add_mesh(rr_scene *s, const struct aiNode *node, const struct ai
         }
         if (has_col) {
           struct aiColor4D c = mesh->mColors[0][v];
-          col[k] = kind->colors_srgb ? v3(srgb_to_linear(c.r), srgb_to_linear(c.g), srgb_to_linear(c.b))
+          col[k] = kind->colors_srgb ? v3(srgb_decode(c.r), srgb_decode(c.g), srgb_decode(c.b))
                                      : v3(c.r, c.g, c.b);
         }
       }

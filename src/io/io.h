@@ -16,8 +16,4 @@ void rr_scene_load_textures(rr_scene *s, const char *base_dir);
  * false (tex untouched) when it cannot. */
 bool rr_texture_decode(rr_texture *tex, const void *bytes, size_t len);
 
-/* Writers and readers by extension, in image_io.c. */
-rr_error rr_image_write_file(rr_device *dev, const rr_image *img, const char *path);
-rr_error rr_image_read_file(rr_device *dev, const char *path, rr_image *out);
-
 #endif

@@ -10,10 +10,6 @@ struct rr_bvh;
 
 /* The base colour of a mesh that names none (every channel). */
 #define SCENE_GREY 0.8f
-/* Colours are shaded in linear light; textures, display-encoded vertex colours and
- * the output are encoded with this power (sRGB, approximately). */
-#define SCENE_GAMMA 2.2f
-
 typedef struct rr_texture {
   int width, height; /* 0 when the file could not be read */
   uint8_t *rgb;      /* 3 bytes per texel, row 0 at the top */
