@@ -1,20 +1,26 @@
 /* rastray: the command-line tool. Everything it does goes through rastray.h.
- * Exit codes: 0 success, 1 bad input (files, scenes), 2 bad usage (flags, values). */
-#include "rastray.h"
+ * Exit codes: 0 success, 1 bad input (files, scenes), 2 bad usage (flags, values).
+ * man/rastray.1 documents it; tests/test_cli_help.c keeps the two in step. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, mkstemp, fchmod, fdopen */
 
+#include "cli.h"
+#include "progress.h"
+
+#include <cjson/cJSON.h>
 #include <getopt.h>
 #include <math.h>
-#include <stdbool.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
-enum { EXIT_INPUT = 1, EXIT_USAGE = 2 };
+static int verbosity; /* -1: --quiet, 0, 1: --verbose */
 
-static void die(int code, const char *fmt, ...) __attribute__((noreturn, format(printf, 2, 3)));
-static void die(int code, const char *fmt, ...) {
+void die(int code, const char *fmt, ...) {
+  progress_stop();
   va_list ap;
   va_start(ap, fmt);
   fputs("rastray: ", stderr);
@@ -22,6 +28,53 @@ static void die(int code, const char *fmt, ...) {
   fputc('\n', stderr);
   va_end(ap);
   exit(code);
+}
+
+void note(int level, const char *fmt, ...) {
+  if (verbosity < level) return;
+  progress_clear();
+  va_list ap;
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+}
+
+double now_ms(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* The file is written whole or not at all: under a name of its own beside it
+ * (mkstemp), renamed over the path once complete. */
+void json_write(const cJSON *root, const char *path) {
+  char *text = cJSON_Print(root);
+  if (!text) die(EXIT_INPUT, "out of memory writing '%s'", path);
+  struct stat st;
+  bool ok;
+  if (strcmp(path, "-") == 0) {
+    ok = printf("%s\n", text) >= 0 && fflush(stdout) == 0;
+  } else if (stat(path, &st) == 0 && !S_ISREG(st.st_mode)) { /* a device or a pipe: never replaced */
+    FILE *f = fopen(path, "w");
+    ok = f && fprintf(f, "%s\n", text) >= 0;
+    ok = f && fclose(f) == 0 && ok;
+  } else {
+    char tmp[4096];
+    const char *slash = strrchr(path, '/');
+    int dir = slash ? (int)(slash - path + 1) : 0;
+    if (snprintf(tmp, sizeof tmp, "%.*s.rastray-XXXXXX", dir, path) >= (int)sizeof tmp)
+      die(EXIT_INPUT, "cannot write '%s' (path too long)", path);
+    int fd = mkstemp(tmp);
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (fd >= 0 && !f) close(fd);
+    mode_t mask = umask(0); /* mkstemp's file is private; the result gets the usual mode */
+    umask(mask);
+    ok = f && fchmod(fd, 0666 & ~mask) == 0 && fprintf(f, "%s\n", text) >= 0;
+    ok = f && fclose(f) == 0 && ok && rename(tmp, path) == 0;
+    if (!ok && fd >= 0) remove(tmp);
+  }
+  cJSON_free(text);
+  if (!ok) die(EXIT_INPUT, "cannot write '%s'", path);
 }
 
 #define STRING(x) #x
@@ -36,6 +89,7 @@ static void die(int code, const char *fmt, ...) {
 enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
+  OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS,
 };
 
 typedef struct cli_option {
@@ -57,8 +111,12 @@ struct cli_command {
 
 /* Every command's last options; next_option handles them. */
 #define COMMON_OPTIONS                                                                                    \
-  {"quiet", 'q', NULL, "print nothing on stderr but errors (and --stats when asked)"},                  \
-      {"verbose", 'v', NULL, "also print what was loaded, the BVH, the method and why, the outputs"},   \
+  {"progress", OPT_PROGRESS, NULL,                                                                      \
+   "show progress on stderr even when it is not a terminal (on a terminal it\n"                        \
+   "appears by itself once a command runs longer than a second)"},                                     \
+      {"quiet", 'q', NULL, "print nothing on stderr but errors (and --stats when asked)"},              \
+      {"verbose", 'v', NULL, "also print what was loaded, the BVH, the method and why, the outputs\n"   \
+                             "written and the time of each step"},                                      \
       {"help", 'h', NULL, "print this help and exit"}
 
 static const char scenes_note[] =
@@ -81,14 +139,18 @@ static const cli_option render_options[] = {
     {"target", OPT_TARGET, "X,Y,Z", "the point the camera looks at (goes with --eye)"},
     {"up", OPT_UP, "X,Y,Z", "the camera's up direction (default 0,1,0)"},
     {"fov", OPT_FOV, "DEG", "vertical field of view (default 45; fisheye: the full angle, up to 360)"},
+    {"camera-file", OPT_CAMERA_FILE, "FILE",
+     "read the camera from a JSON file (as --save-camera writes, or a 4x4\n"
+     "camera-to-world \"matrix\" and \"fov\"); camera flags override its values"},
+    {"save-camera", OPT_SAVE_CAMERA, "FILE", "write the camera used (after automatic framing) as JSON"},
     {"shade", OPT_SHADE, "MODE", "lambert (default), id, normal, depth, heat-evals, heat-nodes"},
     {"output", 'o', "PATH", "colour image: .png, .exr or .pfm (default rastray.png unless --aov is given)"},
     {"aov", OPT_AOV, "NAME=PATH",
      "write an AOV as .npy, .pfm or .exr; repeatable. NAME: depth, id (triangle),\n"
      "mesh (geometry id), material (index), normal, bary, evals, nodes"},
-    {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default: all cores)"},
+    {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default 0: all cores)"},
     {"repeat", OPT_REPEAT, "N", "run the visibility pass N times, report the median time"},
-    {"stats", OPT_STATS, NULL, "print key=value statistics to stderr"},
+    {"stats", OPT_STATS, NULL, "print key=value statistics to stderr, with the time of each step"},
     {"stats-json", OPT_STATS_JSON, "PATH", "write the statistics as one JSON object"},
     {"cull-backfaces", OPT_CULL_BACKFACES, NULL, "triangles seen from behind are invisible"},
     COMMON_OPTIONS,
@@ -96,20 +158,48 @@ static const cli_option render_options[] = {
 };
 
 static const cli_option info_options[] = {
+    {"threads", OPT_THREADS, "N", "threads building the BVH, at most " VALUE(RR_MAX_THREADS) " (default 0: all cores)"},
     COMMON_OPTIONS,
     {NULL, 0, NULL, NULL},
 };
 
 static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **argv);
 static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv);
+static int cmd_help(rr_device *dev, const cli_command *cmd, int argc, char **argv);
+
+static const cli_option help_options[] = {
+    {"help", 'h', NULL, "print this help and exit"},
+    {NULL, 0, NULL, NULL},
+};
 
 static const cli_command commands[] = {
     {"render", "[SCENE] [options]", "render SCENE (a mesh file or built-in name; default demo)", scenes_note,
      render_options, cmd_render},
     {"info", "SCENE [options]", "print the scene's triangles, geometries and BVH figures", scenes_note, info_options,
      cmd_info},
+    {"help", "[COMMAND]", "print the commands, or a command's options", NULL, help_options, cmd_help},
 };
 enum { NCOMMANDS = sizeof commands / sizeof commands[0] };
+
+/* The command named `name`; an unknown one ends the program with a usage error. */
+static const cli_command *find_command(const char *name) {
+  for (int c = 0; c < NCOMMANDS; c++)
+    if (strcmp(name, commands[c].name) == 0) return &commands[c];
+  char names[256] = "";
+  for (int c = 0; c < NCOMMANDS; c++)
+    snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", commands[c].name,
+             c == NCOMMANDS - 1 ? "" : c == NCOMMANDS - 2 ? " or " : ", ");
+  die(EXIT_USAGE, "unknown command '%s' (expected %s; see --help)", name, names);
+}
+
+/* The overview: the commands and where their options are. */
+static void print_overview(FILE *f) {
+  fputs("usage: rastray COMMAND [options]\n       rastray --help | --version\n\ncommands:\n", f);
+  for (int c = 0; c < NCOMMANDS; c++) fprintf(f, "  %-8s %s\n", commands[c].name, commands[c].summary);
+  fputs("\n'rastray COMMAND --help' or 'rastray help COMMAND' lists a command's options.\n"
+        "Exit status: 0 success, 1 bad input (files, scenes), 2 bad usage (options, values).\n",
+        f);
+}
 
 static void print_usage(FILE *f, const cli_command *cmd) {
   fprintf(f, "usage: rastray %s %s\n%s\n", cmd->name, cmd->operands, cmd->summary);
@@ -130,17 +220,7 @@ static void print_usage(FILE *f, const cli_command *cmd) {
 }
 
 static char flag[64]; /* the option being handled, "--name", for messages */
-static int verbosity;  /* -1: --quiet, 0, 1: --verbose */
-
-/* A message on stderr when the verbosity is at least `level` (0: unless --quiet). */
-static void note(int level, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void note(int level, const char *fmt, ...) {
-  if (verbosity < level) return;
-  va_list ap;
-  va_start(ap, fmt);
-  vfprintf(stderr, fmt, ap);
-  va_end(ap);
-}
+static bool force_progress; /* --progress */
 
 /* The next option of the command's argv (argv[0] is the command's name): its key,
  * its value in optarg; -1 after the last (the operands are then argv[optind..]).
@@ -174,6 +254,7 @@ static int next_option(const cli_command *cmd, int argc, char **argv) {
   case 'h': print_usage(stdout, cmd), exit(0);
   case 'q': verbosity = -1; return next_option(cmd, argc, argv);
   case 'v': verbosity = 1; return next_option(cmd, argc, argv);
+  case OPT_PROGRESS: force_progress = true; return next_option(cmd, argc, argv);
   }
   return key;
 }
@@ -244,19 +325,22 @@ static double median(double *v, int n) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-static double now_ms(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-static rr_scene *load_scene(rr_device *dev, const char *name) {
+/* Loads a scene, its BVH built on `threads` threads; *load_ms is the time of the
+ * load without the build. Progress shows from here on: loading is the first long step. */
+static rr_scene *load_scene(rr_device *dev, const char *name, int threads, double *load_ms) {
+  if (verbosity >= 0) progress_start(dev, force_progress);
+  rr_build_options build;
+  rr_build_options_init(&build);
+  build.threads = threads;
+  rr_device_set_build_options(dev, &build);
+  double t0 = now_ms();
   rr_scene *scene;
   if (rr_scene_load(dev, name, &scene) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
   rr_scene_info in;
   rr_scene_get_info(scene, &in);
-  note(1, "loaded %s: %llu triangles (%llu skipped), %u geometries, %u materials\n", name,
-       (unsigned long long)in.triangles, (unsigned long long)in.skipped, in.geometries, in.materials);
+  *load_ms = now_ms() - t0 - in.bvh_build_ms;
+  note(1, "loaded %s: %llu triangles (%llu skipped), %u geometries, %u materials in %.1f ms\n", name,
+       (unsigned long long)in.triangles, (unsigned long long)in.skipped, in.geometries, in.materials, *load_ms);
   note(1, "bvh: %llu nodes, %llu leaves, depth %u, SAH cost %.3f, %.2f MiB, built in %.1f ms\n",
        (unsigned long long)in.bvh_nodes, (unsigned long long)in.bvh_leaves, in.bvh_depth, in.bvh_sah_cost,
        in.bvh_bytes / 1048576.0, in.bvh_build_ms);
@@ -267,6 +351,7 @@ static void write_image(rr_device *dev, rr_image *img, const char *path) {
   rr_error e = rr_image_write(dev, img, path);
   rr_image_free(img);
   if (e) die(e == RR_ERROR_ARGUMENT ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
+  note(1, "wrote %s\n", path);
 }
 
 /* Cuts the six faces out of a cube camera's cross and writes DIR/<face>.png. */
@@ -288,15 +373,19 @@ static void write_cube_faces(rr_device *dev, const rr_image *cross, const char *
     rr_error e = rr_image_write(dev, &img, path);
     free(img.data);
     if (e) die(EXIT_INPUT, "%s", rr_device_message(dev));
+    note(1, "wrote %s\n", path);
   }
 }
 
 static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
-  while (next_option(cmd, argc, argv) != -1) {
-  }
+  int threads = 0;
+  for (int key; (key = next_option(cmd, argc, argv)) != -1;)
+    if (key == OPT_THREADS) threads = (int)parse_int(flag, optarg, 0, RR_MAX_THREADS);
   if (argc - optind != 1) die(EXIT_USAGE, "info takes one scene (see --help)");
   const char *scene_name = argv[optind];
-  rr_scene *scene = load_scene(dev, scene_name);
+  double load_ms;
+  rr_scene *scene = load_scene(dev, scene_name, threads, &load_ms);
+  progress_stop();
   rr_scene_info in;
   rr_scene_get_info(scene, &in);
   printf("scene        %s\n", scene_name);
@@ -323,6 +412,44 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
   return 0;
 }
 
+/* The fields of src named in `fields` (CAM_ bits) copied into dst. */
+static void camera_take(rr_camera *dst, const rr_camera *src, unsigned fields) {
+  if (fields & CAM_TYPE) dst->type = src->type;
+  if (fields & CAM_EYE) memcpy(dst->eye, src->eye, sizeof dst->eye);
+  if (fields & CAM_TARGET) memcpy(dst->target, src->target, sizeof dst->target);
+  if (fields & CAM_UP) memcpy(dst->up, src->up, sizeof dst->up);
+  if (fields & CAM_FOV) dst->fov_deg = src->fov_deg;
+  if (fields & CAM_ORTHO) dst->ortho_height = src->ortho_height;
+}
+
+/* The times of a render's steps, in milliseconds. */
+typedef struct {
+  double load, build, frame, cpu, shade, write, total;
+} timings;
+
+/* --stats-json: the statistics as one JSON object. */
+static void write_stats_json(const char *path, const char *scene_name, const rr_camera *cam, const rr_render_options *opt,
+                             int repeat, const rr_scene_info *info, const rr_stats *st, const timings *ms) {
+  cJSON *o = cJSON_CreateObject();
+  cJSON_AddStringToObject(o, "scene", scene_name);
+  cJSON_AddStringToObject(o, "method", rr_method_name(st->method));
+  cJSON_AddStringToObject(o, "camera", rr_camera_name(cam->type));
+  const struct {
+    const char *key;
+    double value;
+  } numbers[] = {{"triangles", (double)info->triangles}, {"skipped", (double)info->skipped},
+                 {"width", opt->width}, {"height", opt->height}, {"threads", st->threads}, {"repeat", repeat},
+                 {"load_ms", ms->load}, {"build_ms", ms->build}, {"frame_ms", ms->frame}, {"cpu_ms", ms->cpu},
+                 {"shade_ms", ms->shade}, {"write_ms", ms->write}, {"total_ms", ms->total},
+                 {"setups", (double)st->setups}, {"edge_evals", (double)st->edge_evals}, {"nodes", (double)st->nodes},
+                 {"bins", (double)st->bins}, {"bins_empty", (double)st->bins_empty}};
+  for (size_t k = 0; k < sizeof numbers / sizeof *numbers; k++) /* times to the microsecond */
+    cJSON_AddNumberToObject(o, numbers[k].key, round(numbers[k].value * 1000) / 1000);
+  cJSON_AddStringToObject(o, "auto", st->why);
+  json_write(o, path);
+  cJSON_Delete(o);
+}
+
 static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
   double t_start = now_ms();
   rr_render_options opt;
@@ -330,8 +457,9 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   opt.method = RR_METHOD_AUTO;
   rr_camera cam;
   rr_camera_init(&cam);
-  const char *scene_name = NULL, *out = NULL, *json = NULL, *cube_dir = NULL;
-  bool have_eye = false, have_target = false, stats = false;
+  const char *scene_name = NULL, *out = NULL, *json = NULL, *cube_dir = NULL, *camera_file = NULL, *save_camera = NULL;
+  unsigned given = 0; /* the camera's fields set by flags */
+  bool stats = false;
   int shade = RR_SHADE_LAMBERT, repeat = 1, naov = 0;
   aov_out aovs[16];
   for (int key; (key = next_option(cmd, argc, argv)) != -1;) {
@@ -348,19 +476,19 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
       if (type < 0)
         die(EXIT_USAGE, "unknown camera '%s' (expected perspective, orthographic, parabolic, latlong, fisheye or cube)",
             optarg);
-      cam.type = (rr_camera_type)type;
+      cam.type = (rr_camera_type)type, given |= CAM_TYPE;
       break;
     }
     case OPT_ORTHO_HEIGHT:
-      cam.ortho_height = parse_float(flag, optarg);
+      cam.ortho_height = parse_float(flag, optarg), given |= CAM_ORTHO;
       if (!(cam.ortho_height > 0)) die(EXIT_USAGE, "bad value '%s' for --ortho-height (expected > 0)", optarg);
       break;
     case OPT_CUBE_FACES: cube_dir = optarg; break;
-    case OPT_EYE: parse_vec(flag, optarg, cam.eye), have_eye = true; break;
-    case OPT_TARGET: parse_vec(flag, optarg, cam.target), have_target = true; break;
-    case OPT_UP: parse_vec(flag, optarg, cam.up); break;
+    case OPT_EYE: parse_vec(flag, optarg, cam.eye), given |= CAM_EYE; break;
+    case OPT_TARGET: parse_vec(flag, optarg, cam.target), given |= CAM_TARGET; break;
+    case OPT_UP: parse_vec(flag, optarg, cam.up), given |= CAM_UP; break;
     case OPT_FOV:
-      cam.fov_deg = parse_float(flag, optarg);
+      cam.fov_deg = parse_float(flag, optarg), given |= CAM_FOV;
       if (!(cam.fov_deg > 0 && cam.fov_deg <= 360))
         die(EXIT_USAGE, "bad value '%s' for --fov (expected 0 < fov < 180, or up to 360 for fisheye)", optarg);
       break;
@@ -385,29 +513,34 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
       aovs[naov++] = (aov_out){(rr_aov)k, eq + 1};
       break;
     }
-    case OPT_THREADS: opt.threads = (int)parse_int(flag, optarg, 1, RR_MAX_THREADS); break;
+    case OPT_THREADS: opt.threads = (int)parse_int(flag, optarg, 0, RR_MAX_THREADS); break;
     case OPT_REPEAT: repeat = (int)parse_int(flag, optarg, 1, 1000); break;
     case OPT_STATS: stats = true; break;
     case OPT_STATS_JSON: json = optarg; break;
     case OPT_ORACLES: opt.oracles = optarg; break;
     case OPT_CULL_BACKFACES: opt.cull_backfaces = 1; break;
+    case OPT_CAMERA_FILE: camera_file = optarg; break;
+    case OPT_SAVE_CAMERA: save_camera = optarg; break;
     }
   }
   if (optind < argc) scene_name = argv[optind];
   if (argc - optind > 1) die(EXIT_USAGE, "more than one scene given ('%s' and '%s')", scene_name, argv[optind + 1]);
-  if (have_eye != have_target) die(EXIT_USAGE, "--eye and --target go together");
+  if (!(given & CAM_EYE) != !(given & CAM_TARGET)) die(EXIT_USAGE, "--eye and --target go together");
   if (!scene_name) scene_name = "demo";
   if (!out && naov == 0) out = "rastray.png";
   if (shade == RR_SHADE_HEAT_EVALS || shade == RR_SHADE_HEAT_NODES) opt.heat = 1;
+  if (camera_file) { /* the file's values, where no flag gave one */
+    rr_camera from_file = cam;
+    unsigned fields = camera_file_read(camera_file, &from_file);
+    camera_take(&cam, &from_file, fields & ~given);
+    given |= fields;
+  }
 
-  rr_build_options build; /* the BVH is built on the render's threads too */
-  rr_build_options_init(&build);
-  build.threads = opt.threads;
-  rr_device_set_build_options(dev, &build);
-  rr_scene *scene = load_scene(dev, scene_name);
-  if (!have_eye && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK)
+  timings ms = {0};
+  rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load);
+  if (!(given & CAM_EYE) && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK)
     die(EXIT_INPUT, "%s", rr_device_message(dev));
-  if (rr_camera_check(dev, &cam) != RR_OK) die(EXIT_USAGE, "%s", rr_device_message(dev));
+  if (rr_camera_check(dev, &cam) != RR_OK) die(camera_file ? EXIT_INPUT : EXIT_USAGE, "%s", rr_device_message(dev));
   if (cube_dir && cam.type != RR_CAMERA_CUBE) die(EXIT_USAGE, "--cube-faces needs --camera cube");
 
   double *times = malloc(sizeof(double) * repeat), *cpus = malloc(sizeof(double) * repeat);
@@ -415,74 +548,91 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   rr_frame *frame = NULL;
   for (int r = 0; r < repeat; r++) {
     rr_frame_release(frame);
+    progress_frame(r, repeat);
     rr_error e = rr_render(dev, scene, &cam, &opt, &frame);
     if (e) die(e == RR_ERROR_ARGUMENT || e == RR_ERROR_UNSUPPORTED ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
     rr_stats st;
     rr_frame_get_stats(frame, &st);
     times[r] = st.frame_ms, cpus[r] = st.cpu_ms;
   }
-  double frame_ms = median(times, repeat), cpu_ms = median(cpus, repeat);
+  ms.frame = median(times, repeat), ms.cpu = median(cpus, repeat);
   free(times), free(cpus);
+  rr_stats st;
+  rr_frame_get_stats(frame, &st);
+  const char *method = rr_method_name(st.method);
+  if (st.why[0]) note(1, "auto chose %s: %s\n", method, st.why);
+  else note(1, "method %s (as asked)\n", method);
 
+  /* Each image is made (shade_ms), then written (write_ms). */
+  double t;
   if (out || cube_dir) {
     rr_image img;
+    progress_stage("shading");
+    t = now_ms();
     if (rr_shade(dev, scene, &cam, frame, (rr_shade_mode)shade, &img) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+    ms.shade += now_ms() - t;
+    progress_stage("writing");
+    t = now_ms();
     if (cube_dir) write_cube_faces(dev, &img, cube_dir);
     if (out) write_image(dev, &img, out);
     else rr_image_free(&img);
+    ms.write += now_ms() - t;
   }
   for (int k = 0; k < naov; k++) {
     rr_image img;
+    progress_stage("shading");
+    t = now_ms();
     if (rr_frame_aov(dev, scene, &cam, frame, aovs[k].aov, &img) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+    ms.shade += now_ms() - t;
+    progress_stage("writing");
+    t = now_ms();
     write_image(dev, &img, aovs[k].path);
+    ms.write += now_ms() - t;
   }
+  if (save_camera) {
+    t = now_ms();
+    camera_file_write(save_camera, &cam, opt.width, opt.height);
+    ms.write += now_ms() - t;
+    note(1, "wrote %s\n", save_camera);
+  }
+  progress_stop();
 
-  rr_stats st;
-  rr_frame_get_stats(frame, &st);
   rr_scene_info info;
   rr_scene_get_info(scene, &info);
-  double total_ms = now_ms() - t_start;
-  const char *method = rr_method_name(st.method);
-  int threads = st.threads;
+  ms.build = info.bvh_build_ms;
+  ms.total = now_ms() - t_start;
   if (stats)
     fprintf(stderr,
-            "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f cpu_ms=%.3f total_ms=%.1f "
-            "setups=%llu edge_evals=%llu nodes=%llu bins=%llu bins_empty=%llu\n",
-            method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, threads, frame_ms, cpu_ms,
-            total_ms, (unsigned long long)st.setups, (unsigned long long)st.edge_evals, (unsigned long long)st.nodes,
-            (unsigned long long)st.bins, (unsigned long long)st.bins_empty);
-  if (stats && st.why[0]) fprintf(stderr, "auto chose %s: %s\n", method, st.why);
-  else if (st.why[0]) note(1, "auto chose %s: %s\n", method, st.why);
-  if (json) {
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s.tmp", json);
-    FILE *f = fopen(tmp, "w");
-    if (!f) die(EXIT_INPUT, "cannot write '%s'", json);
-    fprintf(f,
-            "{\"scene\": \"%s\", \"method\": \"%s\", \"camera\": \"%s\", \"triangles\": %llu, "
-            "\"skipped\": %llu, \"width\": %d, \"height\": %d, \"threads\": %d, \"repeat\": %d, "
-            "\"frame_ms\": %.3f, \"cpu_ms\": %.3f, \"total_ms\": %.3f, \"setups\": %llu, \"edge_evals\": %llu, \"nodes\": %llu, "
-            "\"bins\": %llu, \"bins_empty\": %llu, \"auto\": \"%s\"}\n",
-            scene_name, method, rr_camera_name(cam.type), (unsigned long long)info.triangles, (unsigned long long)info.skipped, opt.width,
-            opt.height, threads, repeat, frame_ms, cpu_ms, total_ms, (unsigned long long)st.setups,
+            "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f cpu_ms=%.3f load_ms=%.1f "
+            "build_ms=%.1f shade_ms=%.1f write_ms=%.1f total_ms=%.1f setups=%llu edge_evals=%llu nodes=%llu bins=%llu "
+            "bins_empty=%llu\n",
+            method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, st.threads,
+            ms.frame, ms.cpu, ms.load, ms.build, ms.shade, ms.write, ms.total, (unsigned long long)st.setups,
             (unsigned long long)st.edge_evals, (unsigned long long)st.nodes, (unsigned long long)st.bins,
-            (unsigned long long)st.bins_empty, st.why);
-    if (fclose(f) != 0 || rename(tmp, json) != 0) {
-      remove(tmp);
-      die(EXIT_INPUT, "cannot write '%s'", json);
-    }
-  }
-  if (out && !stats) note(0, "wrote %s (%dx%d, %s, %.1f ms)\n", out, opt.width, opt.height, method, frame_ms);
+            (unsigned long long)st.bins_empty);
+  if (stats && st.why[0]) fprintf(stderr, "auto chose %s: %s\n", method, st.why);
+  if (json) write_stats_json(json, scene_name, &cam, &opt, repeat, &info, &st, &ms);
+  note(1, "times: load %.1f ms, build %.1f ms, visibility %.1f ms%s, shade %.1f ms, write %.1f ms, total %.1f ms\n",
+       ms.load, ms.build, ms.frame, repeat > 1 ? " (median)" : "", ms.shade, ms.write, ms.total);
+  if (out && !stats && verbosity == 0)
+    note(0, "wrote %s (%dx%d, %s, %.1f ms)\n", out, opt.width, opt.height, method, ms.frame);
   rr_frame_release(frame);
   rr_scene_release(scene);
   return 0;
 }
 
-/* The overview: commands and where their options are. */
-static void print_overview(FILE *f) {
-  fputs("usage: rastray COMMAND [options]\n\ncommands:\n", f);
-  for (int c = 0; c < NCOMMANDS; c++) fprintf(f, "  %-8s %s\n", commands[c].name, commands[c].summary);
-  fputs("\n'rastray COMMAND --help' lists a command's options; 'rastray --version' prints the version.\n", f);
+/* help [COMMAND]: the overview, or a command's usage. */
+static int cmd_help(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
+  (void)dev;
+  while (next_option(cmd, argc, argv) != -1) {
+  }
+  if (argc - optind > 1) die(EXIT_USAGE, "help takes at most one command");
+  if (argc - optind == 0) {
+    print_overview(stdout);
+    return 0;
+  }
+  print_usage(stdout, find_command(argv[optind]));
+  return 0;
 }
 
 int main(int argc, char **argv) {
@@ -494,10 +644,7 @@ int main(int argc, char **argv) {
     printf("rastray %s\n", RR_VERSION);
     return 0;
   }
-  const cli_command *cmd = NULL;
-  for (int c = 0; c < NCOMMANDS; c++)
-    if (strcmp(argv[1], commands[c].name) == 0) cmd = &commands[c];
-  if (!cmd) die(EXIT_USAGE, "unknown command '%s' (expected render or info; see --help)", argv[1]);
+  const cli_command *cmd = find_command(argv[1]);
   rr_device *dev = rr_device_new();
   if (!dev) die(EXIT_INPUT, "out of memory");
   int rc = cmd->run(dev, cmd, argc - 1, argv + 1); /* the command's name stands as getopt's argv[0] */

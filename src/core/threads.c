@@ -27,6 +27,7 @@ typedef struct {
   int njobs;
   rr_parallel_fn fn;
   void *arg;
+  const progress_span *span; /* reported by thread 0, the caller's */
 } loop;
 
 static void run_jobs(loop *l, int thread) {
@@ -34,6 +35,10 @@ static void run_jobs(loop *l, int thread) {
     int job = atomic_fetch_add(&l->next, 1);
     if (job >= l->njobs) break;
     l->fn(job, thread, l->arg);
+    if (thread == 0 && l->span) { /* the share taken; the loop's end is its caller's to report */
+      int taken = atomic_load_explicit(&l->next, memory_order_relaxed);
+      if (taken < l->njobs) rr_progress(l->span, (double)taken / l->njobs);
+    }
   }
 }
 
@@ -108,10 +113,14 @@ static void run_own_threads(loop *l, int threads) {
 }
 
 void rr_parallel_for(int njobs, int threads, rr_parallel_fn fn, void *arg) {
+  rr_parallel_for_progress(njobs, threads, fn, arg, NULL);
+}
+
+void rr_parallel_for_progress(int njobs, int threads, rr_parallel_fn fn, void *arg, const progress_span *span) {
   if (threads > njobs) threads = njobs;
   if (threads < 1) threads = 1;
   if (threads > RR_MAX_THREADS) threads = RR_MAX_THREADS;
-  loop l = {.njobs = njobs, .fn = fn, .arg = arg};
+  loop l = {.njobs = njobs, .fn = fn, .arg = arg, .span = span && span->dev && span->dev->progress ? span : NULL};
   atomic_init(&l.next, 0);
   if (threads == 1) {
     run_jobs(&l, 0);
