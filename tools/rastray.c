@@ -540,7 +540,10 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load);
   if (!(given & CAM_EYE) && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK)
     die(EXIT_INPUT, "%s", rr_device_message(dev));
-  if (rr_camera_check(dev, &cam) != RR_OK) die(camera_file ? EXIT_INPUT : EXIT_USAGE, "%s", rr_device_message(dev));
+  if (rr_camera_check(dev, &cam) != RR_OK) {
+    if (camera_file) die(EXIT_INPUT, "camera file '%s': %s", camera_file, rr_device_message(dev));
+    die(EXIT_USAGE, "%s", rr_device_message(dev));
+  }
   if (cube_dir && cam.type != RR_CAMERA_CUBE) die(EXIT_USAGE, "--cube-faces needs --camera cube");
 
   double *times = malloc(sizeof(double) * repeat), *cpus = malloc(sizeof(double) * repeat);
