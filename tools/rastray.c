@@ -109,6 +109,7 @@ struct cli_command {
   int (*run)(rr_device *dev, const cli_command *cmd, int argc, char **argv); /* argv[0]: the command's name */
 };
 
+#define HELP_OPTION {"help", 'h', NULL, "print this help and exit"}
 /* Every command's last options; next_option handles them. */
 #define COMMON_OPTIONS                                                                                    \
   {"progress", OPT_PROGRESS, NULL,                                                                      \
@@ -117,7 +118,7 @@ struct cli_command {
       {"quiet", 'q', NULL, "print nothing on stderr but errors (and --stats when asked)"},              \
       {"verbose", 'v', NULL, "also print what was loaded, the BVH, the method and why, the outputs\n"   \
                              "written and the time of each step"},                                      \
-      {"help", 'h', NULL, "print this help and exit"}
+      HELP_OPTION
 
 static const char scenes_note[] =
     "scenes: a file assimp reads (.obj .ply .gltf .glb .dae .3ds ...), or demo, plane[:N],\n"
@@ -168,7 +169,7 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
 static int cmd_help(rr_device *dev, const cli_command *cmd, int argc, char **argv);
 
 static const cli_option help_options[] = {
-    {"help", 'h', NULL, "print this help and exit"},
+    HELP_OPTION,
     {NULL, 0, NULL, NULL},
 };
 
@@ -219,7 +220,7 @@ static void print_usage(FILE *f, const cli_command *cmd) {
   }
 }
 
-static char flag[64]; /* the option being handled, "--name", for messages */
+static char option_name[64]; /* the option being handled, "--name", for messages */
 static bool force_progress; /* --progress */
 
 /* The next option of the command's argv (argv[0] is the command's name): its key,
@@ -245,8 +246,8 @@ static int next_option(const cli_command *cmd, int argc, char **argv) {
   /* getopt leaves the key of a known option that failed in optopt (0 for an unknown long one) */
   const cli_option *o = cmd->options;
   while (o->name && o->key != (key == '?' || key == ':' ? optopt : key)) o++;
-  if (o->name) snprintf(flag, sizeof flag, "--%s", o->name);
-  if (key == '?' && o->name) die(EXIT_USAGE, "%s takes no value (see --help)", flag);
+  if (o->name) snprintf(option_name, sizeof option_name, "--%s", o->name);
+  if (key == '?' && o->name) die(EXIT_USAGE, "%s takes no value (see --help)", option_name);
   if (key == '?' && optopt) die(EXIT_USAGE, "unknown option '-%c' (see --help)", optopt);
   if (key == '?') die(EXIT_USAGE, "unknown option '%s' (see --help)", argv[optind - 1]);
   if (key == ':') die(EXIT_USAGE, "%s needs a value (see --help)", argv[optind - 1]);
@@ -380,7 +381,7 @@ static void write_cube_faces(rr_device *dev, const rr_image *cross, const char *
 static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
   int threads = 0;
   for (int key; (key = next_option(cmd, argc, argv)) != -1;)
-    if (key == OPT_THREADS) threads = (int)parse_int(flag, optarg, 0, RR_MAX_THREADS);
+    if (key == OPT_THREADS) threads = (int)parse_int(option_name, optarg, 0, RR_MAX_THREADS);
   if (argc - optind != 1) die(EXIT_USAGE, "info takes one scene (see --help)");
   const char *scene_name = argv[optind];
   double load_ms;
@@ -480,15 +481,15 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
       break;
     }
     case OPT_ORTHO_HEIGHT:
-      cam.ortho_height = parse_float(flag, optarg), given |= CAM_ORTHO;
+      cam.ortho_height = parse_float(option_name, optarg), given |= CAM_ORTHO;
       if (!(cam.ortho_height > 0)) die(EXIT_USAGE, "bad value '%s' for --ortho-height (expected > 0)", optarg);
       break;
     case OPT_CUBE_FACES: cube_dir = optarg; break;
-    case OPT_EYE: parse_vec(flag, optarg, cam.eye), given |= CAM_EYE; break;
-    case OPT_TARGET: parse_vec(flag, optarg, cam.target), given |= CAM_TARGET; break;
-    case OPT_UP: parse_vec(flag, optarg, cam.up), given |= CAM_UP; break;
+    case OPT_EYE: parse_vec(option_name, optarg, cam.eye), given |= CAM_EYE; break;
+    case OPT_TARGET: parse_vec(option_name, optarg, cam.target), given |= CAM_TARGET; break;
+    case OPT_UP: parse_vec(option_name, optarg, cam.up), given |= CAM_UP; break;
     case OPT_FOV:
-      cam.fov_deg = parse_float(flag, optarg), given |= CAM_FOV;
+      cam.fov_deg = parse_float(option_name, optarg), given |= CAM_FOV;
       if (!(cam.fov_deg > 0 && cam.fov_deg <= 360))
         die(EXIT_USAGE, "bad value '%s' for --fov (expected 0 < fov < 180, or up to 360 for fisheye)", optarg);
       break;
@@ -513,8 +514,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
       aovs[naov++] = (aov_out){(rr_aov)k, eq + 1};
       break;
     }
-    case OPT_THREADS: opt.threads = (int)parse_int(flag, optarg, 0, RR_MAX_THREADS); break;
-    case OPT_REPEAT: repeat = (int)parse_int(flag, optarg, 1, 1000); break;
+    case OPT_THREADS: opt.threads = (int)parse_int(option_name, optarg, 0, RR_MAX_THREADS); break;
+    case OPT_REPEAT: repeat = (int)parse_int(option_name, optarg, 1, 1000); break;
     case OPT_STATS: stats = true; break;
     case OPT_STATS_JSON: json = optarg; break;
     case OPT_ORACLES: opt.oracles = optarg; break;

@@ -36,15 +36,3 @@ rr_error rr_device_set_progress(rr_device *dev, rr_progress_fn fn, void *user) {
   dev->progress = fn, dev->progress_user = user, dev->progress_ms = 0;
   return rr_ok(dev);
 }
-
-void rr_progress(const progress_span *span, double fraction) {
-  rr_device *dev = span->dev;
-  if (!dev || !dev->progress) return;
-  double f = span->lo + (span->hi - span->lo) * fraction;
-  if (f > 0 && f < 1) { /* an inner fraction: rarely enough not to matter */
-    double now = rr_now_ms();
-    if (now - dev->progress_ms < RR_PROGRESS_MS) return;
-    dev->progress_ms = now;
-  }
-  dev->progress(dev->progress_user, span->stage, f < 0 ? 0 : f > 1 ? 1 : f);
-}

@@ -11,7 +11,8 @@
  * their own threads, so no device ever waits for another), everything else in it
  * is read and written under `mu`, and a caller leaves only when no worker is still
  * inside its loop, whose state lives on that caller's stack. A loop reaches no
- * caller data but through fn and arg. */
+ * caller data but through fn and arg, and its progress span, which only the
+ * caller's own thread (thread 0) reads: progress is reported from there alone. */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime, sysconf, pthreads */
 
 #include "core/core.h"
@@ -29,6 +30,19 @@ typedef struct {
   void *arg;
   const progress_span *span; /* reported by thread 0, the caller's */
 } loop;
+
+/* Beside the pool, whose caller makes the reports. */
+void rr_progress(const progress_span *span, double fraction) {
+  rr_device *dev = span->dev;
+  if (!dev || !dev->progress) return;
+  double f = span->lo + (span->hi - span->lo) * fraction;
+  if (f > 0 && f < 1) { /* an inner fraction: rarely enough not to matter */
+    double now = rr_now_ms();
+    if (now - dev->progress_ms < RR_PROGRESS_MS) return;
+    dev->progress_ms = now;
+  }
+  dev->progress(dev->progress_user, span->stage, f < 0 ? 0 : f > 1 ? 1 : f);
+}
 
 static void run_jobs(loop *l, int thread) {
   for (;;) {
