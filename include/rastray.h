@@ -60,8 +60,9 @@ typedef void (*rr_progress_fn)(void *user, rr_progress_stage stage, double fract
 /* Sets the function this device's calls report their progress to (fn NULL: none,
  * the default, and reporting then costs nothing). A stage is reported at 0 when it
  * starts, at 1 when it ends and in between at most every RR_PROGRESS_MS, with
- * fractions that do not decrease; one call may run a stage more than once (auto
- * renders trials at a smaller size before the frame), each run starting from 0.
+ * fractions that do not decrease (a call that fails may stop short of 1); one call
+ * may run a stage more than once (auto renders trials at a smaller size before the
+ * frame), each run starting from 0.
  * Threading: fn is called only on the thread that made the call and from inside
  * it, never from the library's worker threads, so never concurrently for one
  * device (devices used by different threads may call it concurrently, each on its

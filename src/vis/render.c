@@ -265,7 +265,7 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
    * position writing its own layer: every method and camera takes the positions
    * as data. (A triangle is set up once per pass: S grows with N.) */
   for (int s = 0; s < opt->samples && !e; s++) {
-    ctx.progress = (progress_span){dev, RR_PROGRESS_RENDER, (double)s / opt->samples, (double)(s + 1) / opt->samples};
+    ctx.progress = rr_progress_part(&whole, (double)s / opt->samples, (double)(s + 1) / opt->samples);
     if (s > 0) {
       rr_cam_release(&c);
       if ((e = rr_cam_setup_at(dev, cam, opt->width, opt->height, opt->sample_pos[s], &c))) break;
