@@ -52,6 +52,32 @@ RR_API rr_error rr_device_error(const rr_device *dev);
 /* A one-line message about the device's last failed call ("" after a success). */
 RR_API const char *rr_device_message(const rr_device *dev);
 
+/* ---- progress ------------------------------------------------------------ */
+
+/* The stages of the calls that report their progress. */
+typedef enum rr_progress_stage {
+  RR_PROGRESS_LOAD = 0, /* rr_scene_load reading a file or making a built-in scene (reports 0 and 1 only) */
+  RR_PROGRESS_BUILD,    /* building the BVH (rr_scene_commit, and rr_scene_load through it) */
+  RR_PROGRESS_RENDER,   /* a visibility pass of rr_render, by tiles, rows or batches of triangles */
+  RR_PROGRESS_STAGE_COUNT
+} rr_progress_stage;
+
+/* Told that `fraction` (0..1) of `stage` is done; `user` is rr_device_set_progress's. */
+typedef void (*rr_progress_fn)(void *user, rr_progress_stage stage, double fraction);
+
+/* Sets the function this device's calls report their progress to (fn NULL: none,
+ * the default, and reporting then costs nothing). A stage is reported at 0 when it
+ * starts, at 1 when it ends and in between at most every RR_PROGRESS_MS, with
+ * fractions that do not decrease (a call that fails may stop short of 1); one call
+ * may run a stage more than once (auto renders trials at a smaller size before the
+ * frame), each run starting from 0.
+ * Threading: fn is called only on the thread that made the call and from inside
+ * it, never from the library's worker threads, so never concurrently for one
+ * device (devices used by different threads may call it concurrently, each on its
+ * own thread). It should return quickly and must not use this device. */
+RR_API rr_error rr_device_set_progress(rr_device *dev, rr_progress_fn fn, void *user);
+#define RR_PROGRESS_MS 50 /* least time between two reports of a stage's inner fractions */
+
 /* ---- scenes -------------------------------------------------------------- */
 
 /* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...)
@@ -443,6 +469,9 @@ RR_API rr_error rr_output_new(rr_device *dev, rr_output **out);
  * Nothing appears at path before rr_output_commit. At most one output of a set may
  * be standard output. A failed add adds nothing; the images may be freed after it. */
 RR_API rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char *path);
+/* Adds a file of the caller's bytes (a JSON sidecar, a report) to the set, written
+ * like an image's: path is taken as it is (no format prefix; "-" is standard output). */
+RR_API rr_error rr_output_add_bytes(rr_output *set, const void *data, size_t size, const char *path);
 /* Makes the set's outputs appear: renames every temporary over its target (when
  * one rename fails, the files renamed before it are removed again), then writes
  * the non-regular targets, standard output last. Once the files are in place, a

@@ -539,16 +539,10 @@ static image_format default_format(const rr_image *images, int n) {
   return images->kind == RR_IMAGE_COLOR || images->type == RR_PIXEL_U8 ? FMT_PNG : FMT_NPY;
 }
 
-rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char *path) {
-  if (!set) return RR_ERROR_ARGUMENT;
+/* Checks where an output goes (file inside path, after any format prefix) and
+ * starts its entry: a stream or a regular file, not written twice by one set. */
+static rr_error output_target(rr_output *set, const char *path, const char *file, output *o) {
   rr_device *dev = set->dev;
-  if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write an image: no path");
-  if (set->committed)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': the output set was committed", path);
-  if (n < 1 || !images) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no image data", path);
-  const char *file;
-  image_format fmt = format_prefix(path, &file);
-  if (!*file) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no path after the format", path);
   struct stat st;
   bool is_stdout = !strcmp(file, "-");
   bool exists = !is_stdout && stat(file, &st) == 0;
@@ -559,10 +553,52 @@ rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char
     if ((is_stdout && set->v[i].is_stdout) || (!stream && !set->v[i].stream && !strcmp(set->v[i].file, file)))
       return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': %s written twice", path,
                      is_stdout ? "standard output" : "the file");
-  if (fmt == FMT_UNKNOWN) fmt = format_of(file);
-  if (fmt == FMT_UNKNOWN && stream) fmt = default_format(images, n);
-  if (fmt == FMT_UNKNOWN) return unknown_format(dev, "write", path);
+  if (stream && !is_stdout && access(file, W_OK) != 0)
+    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", path, strerror(errno));
+  *o = (output){.stream = stream, .is_stdout = is_stdout};
+  return RR_OK;
+}
+
+/* Adds the output o of path with its bytes b, which it takes: a stream keeps them
+ * for the commit, a regular file is written to its temporary now. */
+static rr_error output_push(rr_output *set, output o, const char *path, const char *file, bytes *b) {
+  rr_device *dev = set->dev;
   rr_error e = RR_OK;
+  if (set->n == set->cap) {
+    int cap = set->cap ? 2 * set->cap : 8;
+    output *v = realloc(set->v, (size_t)cap * sizeof *v);
+    if (!v) e = rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
+    else set->v = v, set->cap = cap;
+  }
+  if (!e && !(o.spec = strdup(path))) e = rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
+  if (!e) o.file = o.spec + (file - path);
+  if (!e && o.stream) o.data = *b, *b = (bytes){0}; /* kept for the commit */
+  else if (!e) e = write_tmp(dev, &o, b);
+  bytes_free(b);
+  if (e) {
+    free(o.spec);
+    return e;
+  }
+  set->v[set->n++] = o;
+  return rr_ok(dev);
+}
+
+rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char *path) {
+  if (!set) return RR_ERROR_ARGUMENT;
+  rr_device *dev = set->dev;
+  if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write an image: no path");
+  if (set->committed)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': the output set was committed", path);
+  if (n < 1 || !images) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no image data", path);
+  const char *file;
+  image_format fmt = format_prefix(path, &file);
+  if (!*file) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no path after the format", path);
+  output o;
+  rr_error e = output_target(set, path, file, &o);
+  if (e) return e;
+  if (fmt == FMT_UNKNOWN) fmt = format_of(file);
+  if (fmt == FMT_UNKNOWN && o.stream) fmt = default_format(images, n);
+  if (fmt == FMT_UNKNOWN) return unknown_format(dev, "write", path);
   for (int i = 0; i < n && !e; i++) {
     e = check_image(dev, &images[i], path);
     if (!e && (images[i].width != images[0].width || images[i].height != images[0].height))
@@ -573,34 +609,25 @@ rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char
   if (n > 1 && fmt != FMT_EXR)
     return rr_fail(dev, RR_ERROR_UNSUPPORTED, "cannot write '%s': only EXR holds several layers", path);
   if ((e = check_fits(dev, fmt, images, path)) != RR_OK) return e;
-  if (stream && !is_stdout && access(file, W_OK) != 0)
-    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", path, strerror(errno));
-
-  if (set->n == set->cap) {
-    int cap = set->cap ? 2 * set->cap : 8;
-    output *v = realloc(set->v, (size_t)cap * sizeof *v);
-    if (!v) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
-    set->v = v;
-    set->cap = cap;
-  }
-  output o = {0};
-  o.stream = stream;
-  o.is_stdout = is_stdout;
-  o.spec = strdup(path);
-  if (!o.spec) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
-  o.file = o.spec + (file - path);
   bytes b = {0};
-  e = encode(dev, fmt, images, n, path, &b);
-  if (!e && stream) o.data = b; /* kept for the commit */
-  else if (!e) e = write_tmp(dev, &o, &b);
-  if (!stream) bytes_free(&b);
-  if (e) {
-    bytes_free(&o.data);
-    free(o.spec);
-    return e;
-  }
-  set->v[set->n++] = o;
-  return rr_ok(dev);
+  if ((e = encode(dev, fmt, images, n, path, &b)) != RR_OK) return e;
+  return output_push(set, o, path, file, &b);
+}
+
+rr_error rr_output_add_bytes(rr_output *set, const void *data, size_t size, const char *path) {
+  if (!set) return RR_ERROR_ARGUMENT;
+  rr_device *dev = set->dev;
+  if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write a file: no path");
+  if (set->committed)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': the output set was committed", path);
+  if (!data && size) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no data", path);
+  output o;
+  rr_error e = output_target(set, path, path, &o);
+  if (e) return e;
+  bytes b = {0};
+  bytes_put(&b, data, size);
+  if (b.nomem) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
+  return output_push(set, o, path, path, &b);
 }
 
 /* Writes a stream's bytes: the target opened as it is (never created or renamed onto). */
