@@ -7,7 +7,7 @@ The first ```sh block must be the two commands of a fresh machine (install and
 build, run the tests); they exist and are executable but are not run here (the
 second is what runs this test). Every later ```sh block runs with bash in a new
 directory that looks like a clone after the first command (`build`, `data`,
-`scripts` link to the real ones), and must exit 0 and leave every file it names
+`scripts`, `docs` link to the real ones), and must exit 0 and leave every file it names
 after -o, --aov NAME=, --save-camera or --stats-json. With RR_TEST_QUICK set,
 image sizes are divided by 4 (the sanitizer builds run them too)."""
 import os
@@ -19,7 +19,11 @@ import tempfile
 
 
 def sh_blocks(text):
-    return [m.group(1) for m in re.finditer(r"^```sh\n(.*?)^```", text, re.S | re.M)]
+    """The ```sh blocks, but those of the Library section: they install the package and
+    build the C example against it, which test_install.sh does (in a scratch prefix)."""
+    lib = re.search(r"^## Library\n.*?(?=^## |\Z)", text, re.S | re.M)
+    return [m.group(1) for m in re.finditer(r"^```sh\n(.*?)^```", text, re.S | re.M)
+            if not (lib and lib.start() <= m.start() < lib.end())]
 
 
 def commands(block):
@@ -76,9 +80,12 @@ def main():
             for name, target in (("build", build), ("data", os.path.join(source, "data")),
                                  ("scripts", os.path.join(source, "scripts")), ("docs", os.path.join(source, "docs"))):
                 os.symlink(os.path.abspath(target), os.path.join(clone, name))
+            # python3 is Debian's, as on a fresh machine (a python of one's own may
+            # come first in PATH and lack NumPy)
+            env = dict(os.environ, PATH="/usr/bin:" + os.environ.get("PATH", ""))
             try:
                 p = subprocess.run(["bash", "-euo", "pipefail", "-c", script], cwd=clone, capture_output=True,
-                                   text=True, timeout=300)
+                                   text=True, timeout=300, env=env)
             except subprocess.TimeoutExpired:
                 failures.append("block %d ran over 300 s:\n%s" % (b, script))
                 continue
