@@ -484,6 +484,11 @@ static void check_cli(void) {
   CHECK(st == 0 && strstr(out, "textures     4 (2 missing or unreadable)") && strstr(out, "missing    'nothere.png'") &&
             strstr(out, "unreadable 'bad.png'") && strstr(out, "'TEST.PNG' (file, 2x2)"),
         "info tex.obj (%d):\n%s", st, out);
+  st = cli("render tex.obj --size 16x16 -o tex.png", out, sizeof out);
+  CHECK(st == 0 && strstr(out, "warning: 2 of 4 textures missing or unreadable"), "render tex.obj warns (%d): %s", st,
+        out);
+  st = cli("render tex.obj --size 16x16 -o tex.png -q", out, sizeof out);
+  CHECK(st == 0 && !*out, "render tex.obj -q is quiet (%d): %s", st, out);
   st = cli("render quad.glb --camera-from-file=side --size 16x16 -o side.png -q", out, sizeof out);
   CHECK(st == 0, "--camera-from-file side (%d): %s", st, out);
   st = cli("render quad.glb --camera-from-file 0 --camera orthographic --size 16x16 -o front.png -q", out, sizeof out);

@@ -358,6 +358,9 @@ static rr_scene *load_scene(rr_device *dev, const char *name, int threads, doubl
   note(1, "bvh: %llu nodes, %llu leaves, depth %u, SAH cost %.3f, %.2f MiB, built in %.1f ms\n",
        (unsigned long long)in.bvh_nodes, (unsigned long long)in.bvh_leaves, in.bvh_depth, in.bvh_sah_cost,
        in.bvh_bytes / 1048576.0, in.bvh_build_ms);
+  if (in.textures_missing) /* rendered without them: say so, not only in info */
+    note(0, "rastray: warning: %u of %u textures missing or unreadable (rastray info '%s' lists them)\n",
+         in.textures_missing, in.textures, name);
   return scene;
 }
 
