@@ -15,6 +15,14 @@
 extern "C" {
 #endif
 
+/* Marks the API's functions: the library is built with hidden visibility, so these
+ * are the only symbols its shared object exports. */
+#if defined(__GNUC__)
+#define RR_API __attribute__((visibility("default")))
+#else
+#define RR_API
+#endif
+
 #define RR_VERSION "0.1.0"
 #define RR_MISS 0xFFFFFFFFu /* the id (primitive, geometry, material) where nothing is hit */
 #define RR_MAX_SIZE 16384   /* largest image side accepted */
@@ -36,34 +44,68 @@ typedef struct rr_scene rr_scene;   /* geometries of triangles, attributes, mate
 typedef struct rr_frame rr_frame;   /* a visibility buffer plus its statistics */
 
 /* Creates a device; returns NULL only when out of memory. */
-rr_device *rr_device_new(void);
+RR_API rr_device *rr_device_new(void);
 /* Releases a device; its scenes and frames must be released first. */
-void rr_device_release(rr_device *dev);
+RR_API void rr_device_release(rr_device *dev);
 /* The code of the device's last failed call (RR_OK after a success). */
-rr_error rr_device_error(const rr_device *dev);
+RR_API rr_error rr_device_error(const rr_device *dev);
 /* A one-line message about the device's last failed call ("" after a success). */
-const char *rr_device_message(const rr_device *dev);
+RR_API const char *rr_device_message(const rr_device *dev);
+
+/* ---- progress ------------------------------------------------------------ */
+
+/* The stages of the calls that report their progress. */
+typedef enum rr_progress_stage {
+  RR_PROGRESS_LOAD = 0, /* rr_scene_load reading a file or making a built-in scene (reports 0 and 1 only) */
+  RR_PROGRESS_BUILD,    /* building the BVH (rr_scene_commit, and rr_scene_load through it) */
+  RR_PROGRESS_RENDER,   /* a visibility pass of rr_render, by tiles, rows or batches of triangles */
+  RR_PROGRESS_STAGE_COUNT
+} rr_progress_stage;
+
+/* Told that `fraction` (0..1) of `stage` is done; `user` is rr_device_set_progress's. */
+typedef void (*rr_progress_fn)(void *user, rr_progress_stage stage, double fraction);
+
+/* Sets the function this device's calls report their progress to (fn NULL: none,
+ * the default, and reporting then costs nothing). A stage is reported at 0 when it
+ * starts, at 1 when it ends and in between at most every RR_PROGRESS_MS, with
+ * fractions that do not decrease (a call that fails may stop short of 1); one call
+ * may run a stage more than once (auto renders trials at a smaller size before the
+ * frame), each run starting from 0.
+ * Threading: fn is called only on the thread that made the call and from inside
+ * it, never from the library's worker threads, so never concurrently for one
+ * device (devices used by different threads may call it concurrently, each on its
+ * own thread). It should return quickly and must not use this device. */
+RR_API rr_error rr_device_set_progress(rr_device *dev, rr_progress_fn fn, void *user);
+#define RR_PROGRESS_MS 50 /* least time between two reports of a stage's inner fractions */
 
 /* ---- scenes -------------------------------------------------------------- */
 
 /* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...)
  * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]",
  * "grid:PATH:N" (N×N copies of a mesh on the XZ plane), "ground" (an infinite
- * plane with vertices at infinity, and objects on it). */
-rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out);
+ * plane with vertices at infinity, and objects on it). "demo" reads meshes from
+ * the first directory holding them: $RASTRAY_DATA, the installed share/rastray,
+ * the source tree's data/. */
+RR_API rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out);
 /* Creates an empty scene to be filled with rr_scene_add_mesh. */
-rr_error rr_scene_new(rr_device *dev, rr_scene **out);
+RR_API rr_error rr_scene_new(rr_device *dev, rr_scene **out);
 /* Appends an indexed triangle mesh as one new geometry (numbered after the scene's
  * others) with a new material of base colour rgb (NULL: grey); 3 indices per
  * triangle. Degenerate and non-finite triangles are skipped and counted. */
-rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
-                           const uint32_t *indices, size_t ntriangles, const float rgb[3]);
+RR_API rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
+                                  const uint32_t *indices, size_t ntriangles, const float rgb[3]);
+/* The same with a colour per vertex (vertex_rgb: 3 floats each, linear RGB like
+ * glTF's COLOR_0; NULL: none, as rr_scene_add_mesh), interpolated across each
+ * triangle and multiplied into the base colour rgb (NULL here: white). */
+RR_API rr_error rr_scene_add_mesh_colors(rr_scene *scene, const float *positions, size_t nvertices,
+                                         const uint32_t *indices, size_t ntriangles, const float rgb[3],
+                                         const float *vertex_rgb);
 /* The same with homogeneous xyzw vertices: w != 0 is divided out, w = 0 is a point at infinity in direction xyz (3D methods only). */
-rr_error rr_scene_add_mesh4(rr_scene *scene, const float *xyzw, size_t nvertices, const uint32_t *indices,
-                            size_t ntriangles, const float rgb[3]);
+RR_API rr_error rr_scene_add_mesh4(rr_scene *scene, const float *xyzw, size_t nvertices, const uint32_t *indices,
+                                   size_t ntriangles, const float rgb[3]);
 /* Builds what rendering needs (the BVH); called implicitly by rr_scene_load.
  * Uses the device's build options (rr_device_set_build_options). */
-rr_error rr_scene_commit(rr_scene *scene);
+RR_API rr_error rr_scene_commit(rr_scene *scene);
 
 typedef struct rr_build_options {
   int threads;   /* threads building the BVH; 0: all cores (at most RR_MAX_THREADS). The tree does not depend on it. */
@@ -72,12 +114,12 @@ typedef struct rr_build_options {
 } rr_build_options;
 
 /* Fills build options with defaults: all cores, 32 bins, leaves of at most 4 triangles. */
-void rr_build_options_init(rr_build_options *opt);
+RR_API void rr_build_options_init(rr_build_options *opt);
 /* Sets the options that later commits of this device's scenes use (like Embree's
  * device "threads=N"); rr_scene_load commits, so set them before loading. */
-rr_error rr_device_set_build_options(rr_device *dev, const rr_build_options *opt);
+RR_API rr_error rr_device_set_build_options(rr_device *dev, const rr_build_options *opt);
 /* Releases a scene. */
-void rr_scene_release(rr_scene *scene);
+RR_API void rr_scene_release(rr_scene *scene);
 
 typedef struct rr_scene_info {
   uint64_t triangles;    /* triangles kept */
@@ -91,10 +133,15 @@ typedef struct rr_scene_info {
   double bvh_sah_cost;
   double bvh_build_ms;
   uint64_t bvh_bytes;
+  uint32_t textures;         /* materials that name a texture */
+  uint32_t textures_missing; /* of those, textures not found or not decoded (rr_scene_get_material_info) */
+  uint32_t cameras, lights;  /* cameras and lights the file defines */
+  float up[3];    /* the model's up direction: +Y unless the file says otherwise (Z-up files: +Z) */
+  float front[3]; /* the side the model faces, seen by rr_camera_frame: +Z for Y-up, -Y for Z-up files */
 } rr_scene_info;
 
 /* Fills what is known about a scene. */
-rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
+RR_API rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
 
 /* ---- geometries ---------------------------------------------------------- */
 /* A scene is a list of geometries, each a run of primitives of one kind: a mesh of a
@@ -109,7 +156,7 @@ typedef enum rr_geometry_kind {
 } rr_geometry_kind;
 
 /* The name of a geometry kind ("triangle"), NULL when out of range. */
-const char *rr_geometry_kind_name(int kind);
+RR_API const char *rr_geometry_kind_name(int kind);
 
 typedef struct rr_geometry_info {
   rr_geometry_kind kind;
@@ -120,9 +167,9 @@ typedef struct rr_geometry_info {
 
 /* The geometry holding primitive `prim` and prim's index within it (*local = prim -
  * first); RR_MISS maps to RR_MISS in both. Either pointer may be NULL. */
-rr_error rr_scene_get_geometry(const rr_scene *scene, uint32_t prim, uint32_t *geom, uint32_t *local);
+RR_API rr_error rr_scene_get_geometry(const rr_scene *scene, uint32_t prim, uint32_t *geom, uint32_t *local);
 /* Fills what is known about geometry `geom` (0 .. rr_scene_info.geometries - 1). */
-rr_error rr_scene_get_geometry_info(const rr_scene *scene, uint32_t geom, rr_geometry_info *info);
+RR_API rr_error rr_scene_get_geometry_info(const rr_scene *scene, uint32_t geom, rr_geometry_info *info);
 
 /* ---- ray queries --------------------------------------------------------- */
 
@@ -149,10 +196,10 @@ typedef struct rr_hit {
  * of every method (ties in t go to the lower id; a ray through a shared edge hits
  * exactly one triangle). Needs a committed scene. The outcome goes to dev, which
  * may be NULL (then only the returned code tells it). */
-rr_error rr_intersect(rr_device *dev, const rr_scene *scene, const rr_ray *ray, rr_hit *hit);
+RR_API rr_error rr_intersect(rr_device *dev, const rr_scene *scene, const rr_ray *ray, rr_hit *hit);
 /* Whether the ray hits any triangle with tmin <= t <= tmax (*occluded = 0 or 1);
  * dev as for rr_intersect. */
-rr_error rr_occluded(rr_device *dev, const rr_scene *scene, const rr_ray *ray, int *occluded);
+RR_API rr_error rr_occluded(rr_device *dev, const rr_scene *scene, const rr_ray *ray, int *occluded);
 
 /* ---- cameras ------------------------------------------------------------- */
 
@@ -176,17 +223,88 @@ typedef struct rr_camera {
 
 /* The camera type named `name` ("perspective", "orthographic", "parabolic", "latlong",
  * "fisheye", "cube"); -1 when unknown. */
-int rr_camera_from_name(const char *name);
+RR_API int rr_camera_from_name(const char *name);
 /* The name of a camera type, NULL when out of range. */
-const char *rr_camera_name(int type);
+RR_API const char *rr_camera_name(int type);
 
 /* Fills a camera with defaults: perspective, eye (0,0,3) looking at the origin, y up, 45°. */
-void rr_camera_init(rr_camera *cam);
-/* Places eye and target so that the scene's bounds fill the view of cam->fov_deg. */
-rr_error rr_camera_frame(rr_device *dev, const rr_scene *scene, int width, int height,
-                         rr_camera *cam);
+RR_API void rr_camera_init(rr_camera *cam);
+/* Places eye and target so that the scene's bounds fill the view of cam->fov_deg,
+ * looking at the model's front from a little above (rr_scene_info.front and up:
+ * from +Z towards -Z with Y up unless the file says otherwise). */
+RR_API rr_error rr_camera_frame(rr_device *dev, const rr_scene *scene, int width, int height,
+                                rr_camera *cam);
 /* Checks a camera (finite values, eye != target, up not parallel to the view). */
-rr_error rr_camera_check(rr_device *dev, const rr_camera *cam);
+RR_API rr_error rr_camera_check(rr_device *dev, const rr_camera *cam);
+
+/* ---- materials, cameras and lights of a file ------------------------------- */
+
+/* Where a material's texture came from, or why it has none. */
+typedef enum rr_texture_status {
+  RR_TEXTURE_NONE = 0,   /* the material names no texture */
+  RR_TEXTURE_FILE,       /* read from a file (beside the scene; case and '\\' separators forgiven) */
+  RR_TEXTURE_EMBEDDED,   /* read from inside the scene file (GLB, data URI, ZAE, FBX) */
+  RR_TEXTURE_MISSING,    /* named, but not found: shaded with the base colour alone */
+  RR_TEXTURE_UNREADABLE, /* found, but not decoded (format, size): shaded with the base colour alone */
+  RR_TEXTURE_STATUS_COUNT
+} rr_texture_status;
+
+/* The name of a texture status ("none", "file", "embedded", "missing", "unreadable"), NULL when out of range. */
+RR_API const char *rr_texture_status_name(int status);
+
+typedef struct rr_material_info {
+  const char *name;     /* the file's name for it, NULL when none */
+  float color[3];       /* base colour, linear RGB */
+  const char *texture;  /* the base colour texture as the file names it ("*0": the file's first
+                           embedded one), NULL when none */
+  rr_texture_status texture_status;
+  int texture_width, texture_height; /* 0 unless the texture was read */
+} rr_material_info;
+
+/* Fills what is known about material `material` (0 .. rr_scene_info.materials - 1);
+ * pointers stay valid until the scene is released. */
+RR_API rr_error rr_scene_get_material_info(const rr_scene *scene, uint32_t material, rr_material_info *info);
+
+/* The file's camera `index` (0 .. rr_scene_info.cameras - 1) as an rr_camera for a
+ * width × height image: eye, target one unit along its view, up, and the field of
+ * view the file keeps fixed (glTF's vertical one; other formats' horizontal one,
+ * converted for the image's aspect); orthographic cameras keep their width. */
+RR_API rr_error rr_scene_get_camera(rr_device *dev, const rr_scene *scene, uint32_t index, int width, int height,
+                                    rr_camera *cam);
+/* The name of the file's camera `index`, NULL when it has none or index is out of range. */
+RR_API const char *rr_scene_camera_name(const rr_scene *scene, uint32_t index);
+/* The index of the camera named `name`, else of `name` read as a decimal index; when
+ * neither exists it fails with a message listing the cameras' names. */
+RR_API rr_error rr_scene_find_camera(rr_device *dev, const rr_scene *scene, const char *name, uint32_t *index);
+
+/* Light kinds, as assimp's aiLightSourceType. */
+typedef enum rr_light_type {
+  RR_LIGHT_UNDEFINED = 0,
+  RR_LIGHT_DIRECTIONAL, /* from infinitely far along direction */
+  RR_LIGHT_POINT,       /* from position in every direction */
+  RR_LIGHT_SPOT,        /* from position, in a cone around direction */
+  RR_LIGHT_AMBIENT,     /* everywhere */
+  RR_LIGHT_AREA,        /* a size[0] × size[1] rectangle at position facing direction */
+  RR_LIGHT_TYPE_COUNT
+} rr_light_type;
+
+/* The name of a light type ("directional", ...), NULL when out of range. */
+RR_API const char *rr_light_type_name(int type);
+
+/* A light of the file in world space, kept for lighting; nothing renders it yet. */
+typedef struct rr_light_info {
+  const char *name;     /* NULL when none; valid until the scene is released */
+  rr_light_type type;
+  float position[3];
+  float direction[3];   /* unit: where the light shines */
+  float color[3];       /* linear RGB with the file's intensity multiplied in */
+  float attenuation[3]; /* constant, linear and quadratic factors */
+  float inner_cone_deg, outer_cone_deg; /* spot: half-angles from direction (full and no light) */
+  float size[2];        /* area: extent */
+} rr_light_info;
+
+/* Fills the file's light `index` (0 .. rr_scene_info.lights - 1). */
+RR_API rr_error rr_scene_get_light(const rr_scene *scene, uint32_t index, rr_light_info *info);
 
 /* ---- visibility ---------------------------------------------------------- */
 
@@ -206,9 +324,9 @@ typedef enum rr_method {
 } rr_method;
 
 /* The method named `name` ("rc", "3dr-bb", ..., "auto"); -1 when unknown. */
-int rr_method_from_name(const char *name);
+RR_API int rr_method_from_name(const char *name);
 /* The name of a method ("rc", ...), NULL when out of range. */
-const char *rr_method_name(int method);
+RR_API const char *rr_method_name(int method);
 
 typedef struct rr_render_options {
   rr_method method;
@@ -232,7 +350,7 @@ typedef struct rr_render_options {
 
 /* Fills options with defaults: 3dr-bb, 1024x768, one sample at each pixel's centre,
  * all cores, no culling. */
-void rr_render_options_init(rr_render_options *opt);
+RR_API void rr_render_options_init(rr_render_options *opt);
 
 typedef struct rr_stats {
   uint64_t setups;     /* S: triangle setups computed */
@@ -248,25 +366,25 @@ typedef struct rr_stats {
 } rr_stats;
 
 /* Computes primary visibility of a scene from a camera into a new frame. */
-rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
-                   const rr_render_options *opt, rr_frame **out);
+RR_API rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                          const rr_render_options *opt, rr_frame **out);
 /* Releases a frame. */
-void rr_frame_release(rr_frame *frame);
+RR_API void rr_frame_release(rr_frame *frame);
 /* The statistics of the pass that made the frame. */
-rr_error rr_frame_get_stats(const rr_frame *frame, rr_stats *stats);
+RR_API rr_error rr_frame_get_stats(const rr_frame *frame, rr_stats *stats);
 /* Width and height of the frame's visibility buffer. */
-rr_error rr_frame_get_size(const rr_frame *frame, int *width, int *height);
+RR_API rr_error rr_frame_get_size(const rr_frame *frame, int *width, int *height);
 /* Samples per pixel of the frame (options.samples). */
-rr_error rr_frame_get_samples(const rr_frame *frame, int *samples);
+RR_API rr_error rr_frame_get_samples(const rr_frame *frame, int *samples);
 /* Read-only views of the visibility buffer, row 0 at the top: primitive id
  * (RR_MISS on a miss), ray parameter t along the unnormalised camera ray
  * (+inf on a miss) and barycentrics λ1, λ2 of the hit. With several samples per
  * pixel they hold one width × height layer per sample, sample s at offset
  * s·width·height. */
-const uint32_t *rr_frame_ids(const rr_frame *frame);
-const float *rr_frame_t(const rr_frame *frame);
-const float *rr_frame_bary1(const rr_frame *frame);
-const float *rr_frame_bary2(const rr_frame *frame);
+RR_API const uint32_t *rr_frame_ids(const rr_frame *frame);
+RR_API const float *rr_frame_t(const rr_frame *frame);
+RR_API const float *rr_frame_bary1(const rr_frame *frame);
+RR_API const float *rr_frame_bary2(const rr_frame *frame);
 
 /* ---- shading and images -------------------------------------------------- */
 
@@ -281,7 +399,7 @@ typedef enum rr_shade_mode {
 } rr_shade_mode;
 
 /* The shade mode named `name`; -1 when unknown. */
-int rr_shade_from_name(const char *name);
+RR_API int rr_shade_from_name(const char *name);
 
 typedef enum rr_aov {
   RR_AOV_DEPTH = 0, /* 1 float: eye-to-hit distance, +inf on a miss */
@@ -297,30 +415,81 @@ typedef enum rr_aov {
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
  * "material"); -1 when unknown. */
-int rr_aov_from_name(const char *name);
+RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
+
+/* What an image holds. It names the image's channels in EXR files and tells the
+ * writers whether the values are colour; a zeroed image holds plain values. */
+typedef enum rr_image_kind {
+  RR_IMAGE_VALUES = 0, /* numbers written as they are; EXR channels Y | R,G | R,G,B | R,G,B,A */
+  RR_IMAGE_COLOR,      /* colour: linear light in floats, sRGB-encoded in 8 bits (alpha, the 4th
+                          channel, is linear in both); EXR channels as for values. PNG encodes float
+                          colour to sRGB, EXR and PFM decode 8-bit colour to linear light */
+  RR_IMAGE_AOV         /* RR_IMAGE_AOV + a: AOV a of rr_frame_aov, values as they are, EXR channels
+                          depth Z, normal N.X N.Y N.Z, bary bary.u bary.v (λ1, λ2), id, mesh and
+                          material (32-bit UINT), evals, nodes */
+} rr_image_kind;
 
 /* An image owned by the caller or by rastray (rr_image_free). */
 typedef struct rr_image {
   int width, height, channels;
   rr_pixel_type type;
   void *data; /* row-major, row 0 at the top, channels interleaved */
+  int kind;   /* what it holds: an rr_image_kind (RR_IMAGE_AOV + a for AOV a) */
 } rr_image;
 
-/* Shades a frame into a new float RGB image, display-encoded in [0, 1]. */
-rr_error rr_shade(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
-                  const rr_frame *frame, rr_shade_mode mode, rr_image *out);
-/* Extracts an AOV of a frame into a new image. */
-rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
-                      const rr_frame *frame, rr_aov aov, rr_image *out);
+/* Shades a frame into a new float RGB image of kind RR_IMAGE_COLOR, in linear light:
+ * lambert is the lit colour itself; the visualisations (id, normal, depth, heat maps,
+ * the background) are display colours stored decoded from sRGB, so that every file
+ * shows them as designed: a PNG holds exactly the display values, an EXR the same
+ * picture in linear light. */
+RR_API rr_error rr_shade(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                         const rr_frame *frame, rr_shade_mode mode, rr_image *out);
+/* Extracts an AOV of a frame into a new image of kind RR_IMAGE_AOV + aov. */
+RR_API rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                             const rr_frame *frame, rr_aov aov, rr_image *out);
 /* Frees the pixels of an image made by rastray. */
-void rr_image_free(rr_image *img);
-/* Writes an image; the format follows the extension (.png, .pfm, .exr, .npy).
- * The file is written under a temporary name and renamed, so a failure leaves nothing. */
-rr_error rr_image_write(rr_device *dev, const rr_image *img, const char *path);
-/* Reads an image written by rr_image_write (.png, .pfm, .exr, .npy). */
-rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out);
+RR_API void rr_image_free(rr_image *img);
+
+/* ---- image files ----------------------------------------------------------- */
+/* A path's format is its extension (.png, .pfm, .exr, .npy) or a prefix naming it
+ * ("exr:PATH", "png:-"); the prefix wins. "-" is standard output. Standard output and
+ * other files that are not regular files (/dev/null, a FIFO) may go without either:
+ * they take PNG for colour and 8-bit images, EXR for several layers, NPY otherwise.
+ * PNG holds 1, 3 or 4 channels of 8 bits; PFM 1 or 3 floats (ids only when exact as
+ * floats); NPY any image as it is; EXR any image, floats as FLOAT, ids as UINT. */
+
+typedef struct rr_output rr_output; /* image files written all or nothing */
+
+/* Creates an empty output set; its failures are reported in dev. */
+RR_API rr_error rr_output_new(rr_device *dev, rr_output **out);
+/* Encodes n images as the file `path`: one image, or n > 1 images of one size as the
+ * layers of one EXR (no two may share a channel name). A regular file (new or
+ * replaced) is written at once under a unique temporary name in its directory
+ * (path.tmp.XXXXXX); standard output and other non-regular files are kept in memory.
+ * Nothing appears at path before rr_output_commit. At most one output of a set may
+ * be standard output. A failed add adds nothing; the images may be freed after it. */
+RR_API rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char *path);
+/* Adds a file of the caller's bytes (a JSON sidecar, a report) to the set, written
+ * like an image's: path is taken as it is (no format prefix; "-" is standard output). */
+RR_API rr_error rr_output_add_bytes(rr_output *set, const void *data, size_t size, const char *path);
+/* Makes the set's outputs appear: renames every temporary over its target (when
+ * one rename fails, the files renamed before it are removed again), then writes
+ * the non-regular targets, standard output last. Once the files are in place, a
+ * failure writing a stream leaves them. A set is committed once. */
+RR_API rr_error rr_output_commit(rr_output *set);
+/* Releases a set, removing the temporaries of a set not committed. */
+RR_API void rr_output_release(rr_output *set);
+
+/* Writes one image: an output set of one file. */
+RR_API rr_error rr_image_write(rr_device *dev, const rr_image *img, const char *path);
+/* Writes n images of one size as the layers of one EXR file (an output set of one). */
+RR_API rr_error rr_image_write_layers(rr_device *dev, const rr_image *images, int n, const char *path);
+/* Reads an image written by rr_image_write (.png, .pfm, .exr, .npy); an EXR of at most
+ * 4 channels of one type, its kind found from their names (R, G, B, A: colour). Other
+ * files give plain values. */
+RR_API rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out);
 
 #ifdef __cplusplus
 }

@@ -23,8 +23,9 @@ passed=0 failed=0
 for src in "$root"/src/*/*.c; do
   name=$(basename "$(dirname "$src")")_$(basename "$src" .c)
   # shellcheck disable=SC2086 # $flags is a list
-  if "$cc" $flags -I"$root/include" -I"$root/src" -DRR_DATA_DIR="\"$data\"" -c "$src" -o "$out/$name.o" \
-    2>"$out/$name.log" && ! { [ "$mode" = no-simd ] && grep -q 'intrin\.h' "$out/$name.log"; }; then
+  if "$cc" $flags -I"$root/include" -I"$root/src" -DRR_DATA_DIR="\"$data\"" -DRR_DATA_INSTALL_DIR="\"$data\"" \
+    -c "$src" -o "$out/$name.o" 2>"$out/$name.log" &&
+    ! { [ "$mode" = no-simd ] && grep -q 'intrin\.h' "$out/$name.log"; }; then
     passed=$((passed + 1))
   else
     failed=$((failed + 1))

@@ -86,6 +86,7 @@ static uint64_t scene_print(const rr_scene *s) {
       h = mix_bytes(h, &s->p[k][0][i], 4), h = mix_bytes(h, &s->p[k][1][i], 4), h = mix_bytes(h, &s->p[k][2][i], 4);
       if (s->n[0][0]) h = mix_bytes(h, &s->n[k][2][i], 4);
       if (s->uv[0][0]) h = mix_bytes(h, &s->uv[k][1][i], 4);
+      if (s->col[0][0]) h = mix_bytes(h, &s->col[k][1][i], 4);
     }
   return mix_bytes(h, s->material, (size_t)s->ntris * sizeof *s->material);
 }
@@ -128,6 +129,8 @@ static rr_error api(const fixture *fx, uint64_t *print) {
   if (!e) e = rr_intersect(fx->dev, s, &ray, &hit);
   if (!e) e = rr_occluded(fx->dev, s, &ray, &occluded);
   if (!e) e = rr_scene_add_mesh(s, quad, 4, quad_idx + 3, 1, NULL);
+  static const float colours[] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+  if (!e) e = rr_scene_add_mesh_colors(s, quad, 4, quad_idx, 2, NULL, colours);
   if (!e) e = rr_scene_commit(s);
   if (!e) *print = mix(mix(scene_print(s), hit.prim), (uint64_t)occluded);
   rr_scene_release(s);
@@ -193,7 +196,7 @@ static rr_error images(const fixture *fx, uint64_t *print) {
 static bool write_obj(rr_device *dev, const char *dir, char *obj, size_t cap) {
   char path[1024];
   float texels[2 * 2 * 3] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
-  rr_image tex = {2, 2, 3, RR_PIXEL_F32, texels};
+  rr_image tex = {2, 2, 3, RR_PIXEL_F32, texels, RR_IMAGE_VALUES};
   snprintf(path, sizeof path, "%s/tiny.png", dir);
   if (rr_image_write(dev, &tex, path) != RR_OK) return false;
   snprintf(path, sizeof path, "%s/tiny.mtl", dir);
@@ -231,6 +234,30 @@ int main(void) {
   snprintf(grid, sizeof grid, "grid:%s:3", obj);
   /* the file through assimp, then its copies (one sequence: loading a file is slow) */
   fx.name = grid, fail_each("a grid of copies of an OBJ file with a material and a texture", load, &fx);
+  /* a glTF file with vertex colours, an embedded PNG (a data URI), a camera and a light */
+  char gltf[1100];
+  snprintf(gltf, sizeof gltf, "%s/all.gltf", fx.dir);
+  FILE *gf = fopen(gltf, "w");
+  CHECK(gf != NULL, "cannot write %s", gltf);
+  if (gf)
+    fputs(
+      "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1,2]}],\"nodes\":[{\"mesh\":0,\"name\":\"tri\"},{"
+      "\"camera\":0,\"name\":\"cam\",\"translation\":[0,0,3]},{\"name\":\"lamp\",\"extensions\":{\"KHR_lights_punctual\":{\""
+      "light\":0}}}],\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":0.5,\"znear\":0.1}}],\"extensionsUs"
+      "ed\":[\"KHR_lights_punctual\"],\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"type\":\"point\"}]}},\"mesh"
+      "es\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"COLOR_0\":1,\"TEXCOORD_0\":2},\"material\":0}]}],\"materi"
+      "als\":[{\"name\":\"m\",\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],\"textures\":[{\"source\":0}"
+      "],\"images\":[{\"uri\":\"data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAIAAAACCAIAAAD91JpzAAAAE0lEQVR4Xm"
+      "P4z8AAxgz///9nAAAe7wT8A8yZgQAAAABJRU5ErkJggg==\"}],\"buffers\":[{\"byteLength\":96,\"uri\":\"data:applicatio"
+      "n/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAA"
+      "AAAAAAAAAAAAAAAIA/AAAAAAAAAAAAAIA/AAAAAAAAAAAAAIA/\"}],\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byt"
+      "eLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":72,\"byteLength\":2"
+      "4}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1"
+      ",1,0]},{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},{\"bufferView\":2,\"componentType\""
+      ":5126,\"count\":3,\"type\":\"VEC2\"}]}",
+        gf),
+        fclose(gf);
+  fx.name = gltf, fail_each("a glTF file with vertex colours, an embedded texture, a camera and a light", load, &fx);
 
   /* More than 32768 triangles (BVH_PAR_MIN): the BVH splits its top by chunks. */
   CHECK(rr_scene_load(fx.dev, "sphere:184", &fx.scene) == RR_OK, "sphere:184: %s", rr_device_message(fx.dev));
@@ -255,8 +282,8 @@ int main(void) {
   fail_each("images", images, &fx);
   rr_scene_release(fx.scene);
 
-  const char *files[] = {"tiny.png", "tiny.mtl", "tiny.obj"};
-  for (int k = 0; k < 3; k++) {
+  const char *files[] = {"tiny.png", "tiny.mtl", "tiny.obj", "all.gltf"};
+  for (int k = 0; k < 4; k++) {
     char path[1100];
     snprintf(path, sizeof path, "%s/%s", fx.dir, files[k]);
     unlink(path);

@@ -117,7 +117,7 @@ int main(void) {
       {"render tri.obj --eye 1,1,1 --target 1,1,1 -o o.png", 2, "eye equals target"},
       {"render tri.obj --eye 0,0,3 --target 0,0,0 --up 0,0,1 -o o.png", 2, "parallel"},
       {"render tri.obj --fov 0 -o o.png", 2, "--fov"},
-      {"render tri.obj --threads 0 -o o.png", 2, "--threads"},
+      {"render tri.obj --threads 257 -o o.png", 2, "--threads"},
       {"render tri.obj --repeat x -o o.png", 2, "'x'"},
       {"render tri.obj --aov colour=x.npy", 2, "colour"},
       {"render tri.obj --aov depth", 2, "depth"},

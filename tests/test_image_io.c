@@ -1,6 +1,8 @@
 /* Image files: exact round trips through PNG, PFM, NPY and EXR, the PFM and NPY
  * layouts on disk, failures that leave no file behind, malformed files read as
- * clean parse errors, and material textures. */
+ * clean parse errors, and material textures; EXR channel names and layers as
+ * tinyexr reads them, colour linear in float files and sRGB in PNG, standard
+ * output, /dev/null and FIFOs, and output sets written all or nothing. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "vis/vis.h"
@@ -8,10 +10,13 @@
 #include "testutil.h"
 
 #include <dirent.h>
+#include <fcntl.h>
 #include <float.h>
+#include <math.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
 
 static char dir[64];
 static rr_device *dev;
@@ -53,7 +58,7 @@ static uint8_t *get_file(const char *path, size_t *n) {
 static size_t type_bytes(rr_pixel_type t) { return t == RR_PIXEL_U8 ? 1 : 4; }
 
 static rr_image make_image(int w, int h, int c, rr_pixel_type type) {
-  rr_image img = {w, h, c, type, calloc((size_t)w * h * c, type_bytes(type))};
+  rr_image img = {w, h, c, type, calloc((size_t)w * h * c, type_bytes(type)), RR_IMAGE_VALUES};
   return img;
 }
 
@@ -94,7 +99,7 @@ static void write_fails(const rr_image *img, const char *name, rr_error code) {
 static void parse_fails(const char *name, const void *bytes, size_t n, const char *what) {
   const char *path = tpath(name);
   CHECK(put_file(path, bytes, n), "cannot make %s", name);
-  rr_image out = {1, 1, 1, RR_PIXEL_U8, NULL};
+  rr_image out = {1, 1, 1, RR_PIXEL_U8, NULL, RR_IMAGE_VALUES};
   rr_error e = rr_image_read(dev, path, &out);
   CHECK(e == RR_ERROR_PARSE, "%s (%s, %zu bytes) gave %d: %s", what, name, n, e,
         rr_device_message(dev));
@@ -148,7 +153,7 @@ static void test_png(void) {
   /* floats are clamped to [0,1] and rounded; NaN becomes 0 */
   float v[6] = {-0.5f, 0.0f, 0.5f, 1.0f, 2.0f, NAN};
   uint8_t want[6] = {0, 0, 128, 255, 255, 0};
-  rr_image f = {6, 1, 1, RR_PIXEL_F32, v}, out;
+  rr_image f = {6, 1, 1, RR_PIXEL_F32, v, RR_IMAGE_VALUES}, out;
   if (round_trip(&f, "float.PNG", &out)) {
     CHECK(out.type == RR_PIXEL_U8 && out.channels == 1, "float PNG read as type %d, %d channels",
           out.type, out.channels);
@@ -524,6 +529,333 @@ static void test_textures(void) {
   rr_image_free(&gray);
 }
 
+/* ---- what images hold: EXR names, layers, colour ---------------------------------- */
+
+/* A scene of known colours in front of rr_camera_init's camera: a quad through the
+ * centre (geometry 0, colour `rgb`) and a triangle in a corner (geometry 1). */
+static rr_scene *colour_scene(const float rgb[3]) {
+  static const float quad[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+  static const uint32_t quad_idx[] = {0, 1, 2, 0, 2, 3};
+  static const float tri[] = {-1.2f, 0.6f, 0.5f, -0.6f, 0.6f, 0.5f, -0.9f, 1.1f, 0.5f};
+  static const uint32_t tri_idx[] = {0, 1, 2};
+  static const float green[3] = {0.1f, 0.9f, 0.3f};
+  rr_scene *s = NULL;
+  rr_error e = rr_scene_new(dev, &s);
+  if (!e) e = rr_scene_add_mesh(s, quad, 4, quad_idx, 2, rgb);
+  if (!e) e = rr_scene_add_mesh(s, tri, 3, tri_idx, 1, green);
+  if (!e) e = rr_scene_commit(s);
+  CHECK(e == RR_OK, "colour scene: %s", rr_device_message(dev));
+  if (e) rr_scene_release(s);
+  return e ? NULL : s;
+}
+
+enum { SW = 33, SH = 33 }; /* odd: the centre pixel's ray is the view axis */
+
+/* The colour and every AOV of a frame of colour_scene: images[0] colour, then
+ * images[1 + a] AOV a. */
+static bool frame_images(const rr_scene *s, rr_image images[1 + RR_AOV_COUNT]) {
+  rr_camera cam;
+  rr_camera_init(&cam);
+  rr_render_options opt;
+  rr_render_options_init(&opt);
+  opt.width = SW, opt.height = SH, opt.threads = 1, opt.heat = 1;
+  rr_frame *f = NULL;
+  bool ok = rr_render(dev, s, &cam, &opt, &f) == RR_OK &&
+            rr_shade(dev, s, &cam, f, RR_SHADE_LAMBERT, &images[0]) == RR_OK;
+  for (int a = 0; ok && a < RR_AOV_COUNT; a++) ok = rr_frame_aov(dev, s, &cam, f, (rr_aov)a, &images[1 + a]) == RR_OK;
+  CHECK(ok, "frame images: %s", rr_device_message(dev));
+  rr_frame_release(f);
+  return ok;
+}
+
+/* EXR channel names and types per AOV, read back by tinyexr, one file each and all
+ * as the layers of one file with the same names, types and bits. */
+static void test_exr_layers(void) {
+  static const float rgb[3] = {0.5f, 0.2f, 0.8f};
+  static const char *const names[1 + RR_AOV_COUNT][3] = {
+      {"B", "G", "R"}, [1 + RR_AOV_DEPTH] = {"Z"}, [1 + RR_AOV_ID] = {"id"},
+      [1 + RR_AOV_NORMAL] = {"N.X", "N.Y", "N.Z"}, [1 + RR_AOV_BARY] = {"bary.u", "bary.v"},
+      [1 + RR_AOV_EVALS] = {"evals"}, [1 + RR_AOV_NODES] = {"nodes"}, [1 + RR_AOV_MESH] = {"mesh"},
+      [1 + RR_AOV_MATERIAL] = {"material"}};
+  rr_scene *s = colour_scene(rgb);
+  rr_image images[1 + RR_AOV_COUNT];
+  memset(images, 0, sizeof images);
+  if (!s || !frame_images(s, images)) goto done;
+  CHECK(images[0].kind == RR_IMAGE_COLOR, "rr_shade gives colour (kind %d)", images[0].kind);
+  int total = 0;
+  for (int i = 0; i <= RR_AOV_COUNT; i++) {
+    const rr_image *img = &images[i];
+    char name[32];
+    snprintf(name, sizeof name, "layer%d.exr", i);
+    CHECK(i == 0 || img->kind == RR_IMAGE_AOV + i - 1, "AOV %d has kind %d", i - 1, img->kind);
+    CHECK(rr_image_write(dev, img, tpath(name)) == RR_OK, "%s: %s", name, rr_device_message(dev));
+    test_exr_file x;
+    if (!test_exr_load(tpath(name), &x)) {
+      test_exr_free(&x);
+      continue;
+    }
+    int want_type = img->type == RR_PIXEL_U32 ? TINYEXR_PIXELTYPE_UINT : TINYEXR_PIXELTYPE_FLOAT;
+    CHECK(x.h.num_channels == img->channels, "%s: %d channels", name, x.h.num_channels);
+    for (int k = 0; k < x.h.num_channels && k < img->channels; k++) {
+      CHECK(!strcmp(x.h.channels[k].name, names[i][k]), "%s: channel %d is '%s', '%s' expected", name, k,
+            x.h.channels[k].name, names[i][k]);
+      CHECK(x.h.pixel_types[k] == want_type, "%s: channel %s of type %d", name, names[i][k], x.h.pixel_types[k]);
+    }
+    /* the values are the image's (channels sorted by name: colour B, G, R) */
+    bool same = x.img.width == SW && x.img.height == SH;
+    for (int k = 0; same && k < img->channels; k++) {
+      int src = i == 0 ? 2 - k : k;
+      for (size_t p = 0; same && p < (size_t)SW * SH; p++)
+        same = memcmp((const uint32_t *)img->data + p * img->channels + src, (const uint32_t *)x.img.images[k] + p, 4) == 0;
+    }
+    CHECK(same, "%s: values differ from the image's", name);
+    test_exr_free(&x);
+    total += img->channels;
+
+    /* rastray's reader gives the kind back */
+    rr_image back;
+    if (rr_image_read(dev, tpath(name), &back) == RR_OK)
+      CHECK(back.kind == img->kind, "%s read back as kind %d, %d expected", name, back.kind, img->kind);
+    else
+      CHECK(0, "%s: %s", name, rr_device_message(dev));
+    rr_image_free(&back);
+  }
+
+  /* every AOV and the colour as layers of one file: the single files' channels */
+  CHECK(rr_image_write_layers(dev, images, 1 + RR_AOV_COUNT, tpath("all.exr")) == RR_OK, "layers: %s",
+        rr_device_message(dev));
+  test_exr_file all;
+  if (test_exr_load(tpath("all.exr"), &all)) {
+    CHECK(all.h.num_channels == total, "%d channels in all.exr, %d expected", all.h.num_channels, total);
+    for (int i = 0; i <= RR_AOV_COUNT; i++) {
+      char name[32];
+      snprintf(name, sizeof name, "layer%d.exr", i);
+      test_exr_file one;
+      if (!test_exr_load(tpath(name), &one)) {
+        test_exr_free(&one);
+        continue;
+      }
+      for (int k = 0; k < one.h.num_channels; k++) {
+        int j = test_exr_find(&all, one.h.channels[k].name);
+        CHECK(j >= 0, "all.exr lacks channel %s", one.h.channels[k].name);
+        if (j < 0) continue;
+        CHECK(all.h.pixel_types[j] == one.h.pixel_types[k], "all.exr: type of %s", one.h.channels[k].name);
+        CHECK(memcmp(all.img.images[j], one.img.images[k], (size_t)SW * SH * 4) == 0, "all.exr: values of %s",
+              one.h.channels[k].name);
+      }
+      test_exr_free(&one);
+    }
+  }
+  test_exr_free(&all);
+
+  /* clashing names, mixed sizes and layers outside EXR are refused, leaving nothing */
+  rr_image twice[2] = {images[1 + RR_AOV_DEPTH], images[1 + RR_AOV_DEPTH]};
+  CHECK(rr_image_write_layers(dev, twice, 2, tpath("twice.exr")) == RR_ERROR_ARGUMENT &&
+            strstr(rr_device_message(dev), "'Z'"),
+        "two depth layers: %s", rr_device_message(dev));
+  rr_image small = make_image(3, 3, 1, RR_PIXEL_F32);
+  rr_image mixed[2] = {images[0], small};
+  CHECK(rr_image_write_layers(dev, mixed, 2, tpath("mixed.exr")) == RR_ERROR_ARGUMENT, "layers of two sizes: %s",
+        rr_device_message(dev));
+  rr_image_free(&small);
+  CHECK(rr_image_write_layers(dev, images, 2, tpath("layers.npy")) == RR_ERROR_UNSUPPORTED, "layers as NPY: %s",
+        rr_device_message(dev));
+  CHECK(!exists(tpath("twice.exr")) && !exists(tpath("mixed.exr")) && !exists(tpath("layers.npy")),
+        "a refused layered write left a file");
+done:
+  for (int i = 0; i <= RR_AOV_COUNT; i++) rr_image_free(&images[i]);
+  rr_scene_release(s);
+}
+
+/* The sRGB encoding, written out independently of the library's. */
+static int srgb8(double linear) {
+  double v = linear <= 0.0031308 ? 12.92 * linear : 1.055 * pow(linear, 1 / 2.4) - 0.055;
+  return (int)floor(v * 255 + 0.5);
+}
+
+/* Colour in float files is linear light, in PNG sRGB-encoded: a known colour lit
+ * head-on (lambert's factor 1 at the centre pixel) through EXR, PFM and PNG. */
+static void test_linear_colour(void) {
+  static const float rgb[3] = {0.5f, 0.2f, 0.8f};
+  rr_scene *s = colour_scene(rgb);
+  rr_image images[1 + RR_AOV_COUNT];
+  memset(images, 0, sizeof images);
+  if (!s || !frame_images(s, images)) goto done;
+  const rr_image *colour = &images[0];
+  size_t centre = (size_t)(SH / 2) * SW + SW / 2;
+  CHECK(rr_image_write(dev, colour, tpath("c.exr")) == RR_OK && rr_image_write(dev, colour, tpath("c.pfm")) == RR_OK &&
+            rr_image_write(dev, colour, tpath("c.png")) == RR_OK,
+        "colour files: %s", rr_device_message(dev));
+  const char *linear[] = {"c.exr", "c.pfm"};
+  for (int f = 0; f < 2; f++) {
+    rr_image back;
+    if (rr_image_read(dev, tpath(linear[f]), &back) != RR_OK) {
+      CHECK(0, "%s: %s", linear[f], rr_device_message(dev));
+      continue;
+    }
+    const float *px = (const float *)back.data + 3 * centre;
+    for (int c = 0; c < 3; c++)
+      CHECK(fabsf(px[c] - rgb[c]) < 1e-5f, "%s: channel %d is %g, linear %g expected", linear[f], c, px[c], rgb[c]);
+    rr_image_free(&back);
+  }
+  rr_image png;
+  if (rr_image_read(dev, tpath("c.png"), &png) == RR_OK) {
+    const uint8_t *px = (const uint8_t *)png.data + 3 * centre;
+    for (int c = 0; c < 3; c++)
+      CHECK(px[c] == srgb8(rgb[c]), "PNG channel %d is %d, sRGB %d expected", c, px[c], srgb8(rgb[c]));
+    rr_image_free(&png);
+  } else {
+    CHECK(0, "c.png: %s", rr_device_message(dev));
+  }
+
+  /* 8-bit colour goes to float files decoded, alpha untouched; plain values as v / 255 */
+  uint8_t enc[4] = {(uint8_t)srgb8(0.5), 0, 255, 128};
+  rr_image c8 = {1, 1, 4, RR_PIXEL_U8, enc, RR_IMAGE_COLOR}, back;
+  if (round_trip(&c8, "c8.exr", &back)) {
+    const float *px = back.data;
+    double want = pow((enc[0] / 255.0 + 0.055) / 1.055, 2.4); /* sRGB decoding, near 0.5 */
+    CHECK(fabs(px[0] - want) < 1e-5 && px[1] == 0 && px[2] == 1 && px[3] == 128 / 255.0f,
+          "8-bit colour in EXR: %g %g %g %g", px[0], px[1], px[2], px[3]);
+  }
+  rr_image_free(&back);
+done:
+  for (int i = 0; i <= RR_AOV_COUNT; i++) rr_image_free(&images[i]);
+  rr_scene_release(s);
+}
+
+/* ---- outputs that are not regular files, and output sets -------------------------- */
+
+/* The bytes that rr_image_write(img, spec) sends to standard output. */
+static uint8_t *stdout_bytes(const rr_image *img, const char *spec, size_t *n, rr_error *e) {
+  fflush(stdout);
+  int saved = dup(STDOUT_FILENO);
+  int fd = open(tpath("stdout.bin"), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  dup2(fd, STDOUT_FILENO);
+  close(fd);
+  *e = rr_image_write(dev, img, spec);
+  fflush(stdout);
+  dup2(saved, STDOUT_FILENO);
+  close(saved);
+  uint8_t *data = get_file(tpath("stdout.bin"), n);
+  unlink(tpath("stdout.bin"));
+  return data;
+}
+
+static void test_streams(void) {
+  float v[12] = {0.5f, 0.25f, 1, 0, 0, 0, 1, 1, 1, 0.1f, 0.2f, 0.3f};
+  rr_image colour = {2, 2, 3, RR_PIXEL_F32, v, RR_IMAGE_COLOR};
+  uint32_t idv[4] = {1, 2, RR_MISS, 4};
+  rr_image ids = {2, 2, 1, RR_PIXEL_U32, idv, RR_IMAGE_AOV + RR_AOV_ID};
+
+  /* /dev/null takes any format, or none */
+  const char *nulls[] = {"/dev/null", "exr:/dev/null", "npy:/dev/null"};
+  for (int i = 0; i < 3; i++) {
+    CHECK(rr_image_write(dev, &colour, nulls[i]) == RR_OK, "colour to %s: %s", nulls[i], rr_device_message(dev));
+    CHECK(rr_image_write(dev, &ids, nulls[i]) == RR_OK || i == 0, "ids to %s: %s", nulls[i], rr_device_message(dev));
+  }
+  CHECK(rr_image_write(dev, &ids, "/dev/null") == RR_OK, "ids to /dev/null (NPY): %s", rr_device_message(dev));
+  CHECK(rr_image_write(dev, &ids, "png:/dev/null") == RR_ERROR_UNSUPPORTED, "ids as PNG to /dev/null");
+  struct stat st;
+  CHECK(stat("/dev/null", &st) == 0 && S_ISCHR(st.st_mode), "/dev/null is no longer a device");
+
+  /* standard output: PNG for colour and NPY for AOVs by default, or as named */
+  struct {
+    const rr_image *img;
+    const char *spec;
+    const char *magic;
+  } outs[] = {{&colour, "-", "\x89PNG"}, {&ids, "-", "\x93NUMPY"}, {&colour, "exr:-", "\x76\x2f\x31\x01"},
+              {&ids, "EXR:-", "\x76\x2f\x31\x01"}, {&colour, "pfm:-", "PF\n"}};
+  for (size_t i = 0; i < sizeof outs / sizeof outs[0]; i++) {
+    size_t n = 0;
+    rr_error e;
+    uint8_t *data = stdout_bytes(outs[i].img, outs[i].spec, &n, &e);
+    size_t ml = strlen(outs[i].magic);
+    CHECK(e == RR_OK && data && n > ml && memcmp(data, outs[i].magic, ml) == 0, "%s to stdout: %d bytes, %s", outs[i].spec,
+          (int)n, rr_device_message(dev));
+    free(data);
+  }
+  CHECK(rr_image_write(dev, &colour, "gif:-") == RR_ERROR_ARGUMENT, "gif:- is no format");
+  CHECK(rr_image_write(dev, &colour, "png:") == RR_ERROR_ARGUMENT, "png: without a path");
+
+  /* a FIFO is written into, not replaced */
+  const char *fifo = tpath("fifo");
+  CHECK(mkfifo(fifo, 0600) == 0, "mkfifo");
+  int rd = open(fifo, O_RDONLY | O_NONBLOCK);
+  CHECK(rd >= 0, "open the FIFO");
+  CHECK(rr_image_write(dev, &ids, fifo) == RR_OK, "ids to a FIFO: %s", rr_device_message(dev));
+  uint8_t buf[512];
+  ssize_t got = rd >= 0 ? read(rd, buf, sizeof buf) : -1;
+  CHECK(got > 16 && memcmp(buf, "\x93NUMPY", 6) == 0, "FIFO received %d bytes", (int)got);
+  if (rd >= 0) close(rd);
+  CHECK(stat(fifo, &st) == 0 && S_ISFIFO(st.st_mode), "the FIFO was replaced");
+  unlink(fifo);
+}
+
+static int count_entries(const char *path) {
+  DIR *d = opendir(path);
+  int n = 0;
+  for (struct dirent *e; d && (e = readdir(d)) != NULL;) n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
+  if (d) closedir(d);
+  return n;
+}
+
+/* A set whose last output fails leaves nothing, in a fresh directory. */
+static void test_output_sets(void) {
+  const char *sub = tpath("set");
+  CHECK(mkdir(sub, 0777) == 0, "mkdir set");
+  char a[600], b[600], c[600], d[600];
+  snprintf(a, sizeof a, "%s/a.png", sub);
+  snprintf(b, sizeof b, "%s/b.exr", sub);
+  snprintf(c, sizeof c, "%s/c.npy", sub);
+  snprintf(d, sizeof d, "%s/d.pfm", sub);
+  float v[12] = {0};
+  rr_image colour = {2, 2, 3, RR_PIXEL_F32, v, RR_IMAGE_COLOR};
+  uint32_t idv[4] = {1, 2, RR_MISS, 4};
+  rr_image ids = {2, 2, 1, RR_PIXEL_U32, idv, RR_IMAGE_AOV + RR_AOV_ID};
+  rr_image layers[2] = {colour, ids};
+
+  rr_output *set;
+  CHECK(rr_output_new(dev, &set) == RR_OK, "rr_output_new");
+  CHECK(rr_output_add(set, &colour, 1, a) == RR_OK && rr_output_add(set, layers, 2, b) == RR_OK &&
+            rr_output_add(set, &ids, 1, c) == RR_OK,
+        "adds: %s", rr_device_message(dev));
+  CHECK(!exists(a) && !exists(b) && !exists(c), "an output appeared before the commit");
+  CHECK(count_entries(sub) == 3, "%d temporaries for 3 outputs", count_entries(sub));
+  CHECK(rr_output_add(set, &ids, 1, d) == RR_ERROR_UNSUPPORTED, "ids with RR_MISS as PFM: %s", rr_device_message(dev));
+  CHECK(rr_output_add(set, &colour, 1, "-") == RR_OK && rr_output_add(set, &colour, 1, "png:-") == RR_ERROR_ARGUMENT,
+        "a second standard output: %s", rr_device_message(dev));
+  CHECK(rr_output_add(set, &colour, 1, a) == RR_ERROR_ARGUMENT, "a file twice: %s", rr_device_message(dev));
+  rr_output_release(set);
+  CHECK(count_entries(sub) == 0, "a failed set left %d files", count_entries(sub));
+
+  /* a rename that fails at the commit takes back the renames before it */
+  CHECK(rr_output_new(dev, &set) == RR_OK, "rr_output_new");
+  CHECK(rr_output_add(set, &colour, 1, a) == RR_OK && rr_output_add(set, &ids, 1, c) == RR_OK, "adds: %s",
+        rr_device_message(dev));
+  char inside[640];
+  snprintf(inside, sizeof inside, "%s/keep", c);
+  CHECK(mkdir(c, 0777) == 0 && put_file(inside, "x", 1), "a directory in c.npy's way");
+  CHECK(rr_output_commit(set) == RR_ERROR_IO && strstr(rr_device_message(dev), c), "commit onto a directory: %s",
+        rr_device_message(dev));
+  CHECK(rr_output_commit(set) == RR_ERROR_ARGUMENT, "a second commit");
+  rr_output_release(set);
+  CHECK(!exists(a), "a.png stayed after a failed commit");
+  CHECK(count_entries(sub) == 1, "%d files after a failed commit (the directory alone expected)", count_entries(sub));
+  unlink(inside);
+  rmdir(c);
+
+  /* a good set appears whole */
+  CHECK(rr_output_new(dev, &set) == RR_OK, "rr_output_new");
+  CHECK(rr_output_add(set, &colour, 1, a) == RR_OK && rr_output_add(set, layers, 2, b) == RR_OK &&
+            rr_output_add(set, &ids, 1, "npy:/dev/null") == RR_OK && rr_output_commit(set) == RR_OK,
+        "a good set: %s", rr_device_message(dev));
+  rr_output_release(set);
+  CHECK(exists(a) && exists(b) && count_entries(sub) == 2, "a good set wrote %d files", count_entries(sub));
+  unlink(a);
+  unlink(b);
+  rmdir(sub);
+}
+
 /* Removes the files of dir; counts those that look like leftover temporaries. */
 static int clean_dir(void) {
   int leftovers = 0;
@@ -556,6 +888,10 @@ int main(void) {
   test_exr();
   test_failures();
   test_textures();
+  test_exr_layers();
+  test_linear_colour();
+  test_streams();
+  test_output_sets();
   rr_device_release(dev);
   int leftovers = clean_dir();
   CHECK(leftovers == 0, "%d temporaries left behind", leftovers);

@@ -167,3 +167,27 @@ const char *test_write_file(const char *dir, const char *name, const char *text)
   if (f) fputs(text, f), fclose(f);
   return p;
 }
+
+bool test_exr_load(const char *path, test_exr_file *x) {
+  EXRVersion v;
+  const char *err = NULL;
+  InitEXRHeader(&x->h);
+  InitEXRImage(&x->img);
+  x->ok = ParseEXRVersionFromFile(&v, path) == TINYEXR_SUCCESS &&
+          ParseEXRHeaderFromFile(&x->h, &v, path, &err) == TINYEXR_SUCCESS &&
+          LoadEXRImageFromFile(&x->img, &x->h, path, &err) == TINYEXR_SUCCESS;
+  CHECK(x->ok, "tinyexr cannot read %s: %s", path, err ? err : "");
+  if (err) FreeEXRErrorMessage(err);
+  return x->ok;
+}
+
+void test_exr_free(test_exr_file *x) {
+  if (x->ok) FreeEXRImage(&x->img);
+  FreeEXRHeader(&x->h);
+}
+
+int test_exr_find(const test_exr_file *x, const char *name) {
+  for (int k = 0; k < x->h.num_channels; k++)
+    if (!strcmp(x->h.channels[k].name, name)) return k;
+  return -1;
+}

@@ -8,6 +8,8 @@
 #include "vis/vis.h"
 #include "io/io.h"
 
+#include <tinyexr.h>
+
 extern int test_passed, test_failed;
 
 #define CHECK(cond, ...)                                                   \
@@ -63,6 +65,17 @@ rr_camera test_random_view(const rr_scene *s, float dist_lo, float dist_hi, floa
  * buffers, so a few paths stay valid at once); a file that cannot be written is
  * left missing, for the test's load to report. */
 const char *test_write_file(const char *dir, const char *name, const char *text);
+/* An EXR file read through tinyexr itself rather than rastray's reader (ok: it
+ * loaded; a failure is CHECKed). test_exr_free releases it in either case. */
+typedef struct test_exr_file {
+  EXRHeader h;
+  EXRImage img;
+  bool ok;
+} test_exr_file;
+bool test_exr_load(const char *path, test_exr_file *x);
+void test_exr_free(test_exr_file *x);
+/* The index of the channel named `name`, -1 when absent. */
+int test_exr_find(const test_exr_file *x, const char *name);
 /* Deterministic random numbers for property tests. */
 unsigned test_rand(void);
 float test_randf(float lo, float hi);

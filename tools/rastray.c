@@ -1,20 +1,26 @@
 /* rastray: the command-line tool. Everything it does goes through rastray.h.
- * Exit codes: 0 success, 1 bad input (files, scenes), 2 bad usage (flags, values). */
-#include "rastray.h"
+ * Exit codes: 0 success, 1 bad input (files, scenes), 2 bad usage (flags, values).
+ * man/rastray.1 documents it; tests/test_cli_help.c keeps the two in step. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, mkstemp, fchmod, fdopen */
 
+#include "cli.h"
+#include "progress.h"
+
+#include <cjson/cJSON.h>
 #include <getopt.h>
 #include <math.h>
-#include <stdbool.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
-enum { EXIT_INPUT = 1, EXIT_USAGE = 2 };
+static int verbosity; /* -1: --quiet, 0, 1: --verbose */
 
-static void die(int code, const char *fmt, ...) __attribute__((noreturn, format(printf, 2, 3)));
-static void die(int code, const char *fmt, ...) {
+void die(int code, const char *fmt, ...) {
+  progress_stop();
   va_list ap;
   va_start(ap, fmt);
   fputs("rastray: ", stderr);
@@ -22,6 +28,33 @@ static void die(int code, const char *fmt, ...) {
   fputc('\n', stderr);
   va_end(ap);
   exit(code);
+}
+
+void note(int level, const char *fmt, ...) {
+  if (verbosity < level) return;
+  progress_clear();
+  va_list ap;
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+}
+
+double now_ms(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+static void output_failed(rr_device *dev, rr_output *set);
+
+void json_add(rr_device *dev, rr_output *set, const cJSON *root, const char *path) {
+  char *text = cJSON_Print(root);
+  if (!text) die(EXIT_INPUT, "out of memory writing '%s'", path);
+  size_t n = strlen(text);
+  text[n] = '\n'; /* over the terminating NUL: the bytes are counted */
+  rr_error e = rr_output_add_bytes(set, text, n + 1, path);
+  cJSON_free(text);
+  if (e) output_failed(dev, set);
 }
 
 #define STRING(x) #x
@@ -36,6 +69,7 @@ static void die(int code, const char *fmt, ...) {
 enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
+  OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS,
 };
 
 typedef struct cli_option {
@@ -55,11 +89,16 @@ struct cli_command {
   int (*run)(rr_device *dev, const cli_command *cmd, int argc, char **argv); /* argv[0]: the command's name */
 };
 
+#define HELP_OPTION {"help", 'h', NULL, "print this help and exit"}
 /* Every command's last options; next_option handles them. */
 #define COMMON_OPTIONS                                                                                    \
-  {"quiet", 'q', NULL, "print nothing on stderr but errors (and --stats when asked)"},                  \
-      {"verbose", 'v', NULL, "also print what was loaded, the BVH, the method and why, the outputs"},   \
-      {"help", 'h', NULL, "print this help and exit"}
+  {"progress", OPT_PROGRESS, NULL,                                                                      \
+   "show progress on stderr even when it is not a terminal (on a terminal it\n"                        \
+   "appears by itself once a command runs longer than a second)"},                                     \
+      {"quiet", 'q', NULL, "print nothing on stderr but errors (and --stats when asked)"},              \
+      {"verbose", 'v', NULL, "also print what was loaded, the BVH, the method and why, the outputs\n"   \
+                             "written and the time of each step"},                                      \
+      HELP_OPTION
 
 static const char scenes_note[] =
     "scenes: a file assimp reads (.obj .ply .gltf .glb .dae .3ds ...), or demo, plane[:N],\n"
@@ -81,14 +120,26 @@ static const cli_option render_options[] = {
     {"target", OPT_TARGET, "X,Y,Z", "the point the camera looks at (goes with --eye)"},
     {"up", OPT_UP, "X,Y,Z", "the camera's up direction (default 0,1,0)"},
     {"fov", OPT_FOV, "DEG", "vertical field of view (default 45; fisheye: the full angle, up to 360)"},
+    {"camera-file", OPT_CAMERA_FILE, "FILE",
+     "read the camera from a JSON file (as --save-camera writes, or a 4x4\n"
+     "camera-to-world \"matrix\" and \"fov\"); camera flags override its values"},
+    {"save-camera", OPT_SAVE_CAMERA, "FILE", "write the camera used (after automatic framing) as JSON"},
+    {"camera-from-file", OPT_CAMERA_FROM_FILE, "NAME|INDEX",
+     "look through a camera the scene file defines (see info); --camera may\nchange its projection"},
     {"shade", OPT_SHADE, "MODE", "lambert (default), id, normal, depth, heat-evals, heat-nodes"},
-    {"output", 'o', "PATH", "colour image: .png, .exr or .pfm (default rastray.png unless --aov is given)"},
-    {"aov", OPT_AOV, "NAME=PATH",
-     "write an AOV as .npy, .pfm or .exr; repeatable. NAME: depth, id (triangle),\n"
-     "mesh (geometry id), material (index), normal, bary, evals, nodes"},
-    {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default: all cores)"},
+    {"output", 'o', "PATH",
+     "colour image: .png (sRGB), .exr or .pfm (linear light); default rastray.png\n"
+     "unless --aov is given. PATH may be - (stdout, PNG), FMT:PATH (png:-, exr:-),\n"
+     "or a device or FIFO such as /dev/null"},
+    {"aov", OPT_AOV, "LIST=PATH",
+     "write AOVs as .npy, .pfm or .exr (stdout: - as NPY, or FMT:-); repeatable.\n"
+     "LIST: one NAME, NAME,NAME,... or all, as the layers of one EXR. NAME: color\n"
+     "(the shaded image), depth (EXR Z), normal (N.X N.Y N.Z), bary (bary.u bary.v),\n"
+     "id (triangle), mesh (geometry id), material (index) (ids: EXR UINT), evals,\n"
+     "nodes; all: every one (evals, nodes with heat). Outputs are all or nothing"},
+    {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default 0: all cores)"},
     {"repeat", OPT_REPEAT, "N", "run the visibility pass N times, report the median time"},
-    {"stats", OPT_STATS, NULL, "print key=value statistics to stderr"},
+    {"stats", OPT_STATS, NULL, "print key=value statistics to stderr, with the time of each step"},
     {"stats-json", OPT_STATS_JSON, "PATH", "write the statistics as one JSON object"},
     {"cull-backfaces", OPT_CULL_BACKFACES, NULL, "triangles seen from behind are invisible"},
     COMMON_OPTIONS,
@@ -96,20 +147,48 @@ static const cli_option render_options[] = {
 };
 
 static const cli_option info_options[] = {
+    {"threads", OPT_THREADS, "N", "threads building the BVH, at most " VALUE(RR_MAX_THREADS) " (default 0: all cores)"},
     COMMON_OPTIONS,
     {NULL, 0, NULL, NULL},
 };
 
 static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **argv);
 static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv);
+static int cmd_help(rr_device *dev, const cli_command *cmd, int argc, char **argv);
+
+static const cli_option help_options[] = {
+    HELP_OPTION,
+    {NULL, 0, NULL, NULL},
+};
 
 static const cli_command commands[] = {
     {"render", "[SCENE] [options]", "render SCENE (a mesh file or built-in name; default demo)", scenes_note,
      render_options, cmd_render},
     {"info", "SCENE [options]", "print the scene's triangles, geometries and BVH figures", scenes_note, info_options,
      cmd_info},
+    {"help", "[COMMAND]", "print the commands, or a command's options", NULL, help_options, cmd_help},
 };
 enum { NCOMMANDS = sizeof commands / sizeof commands[0] };
+
+/* The command named `name`; an unknown one ends the program with a usage error. */
+static const cli_command *find_command(const char *name) {
+  for (int c = 0; c < NCOMMANDS; c++)
+    if (strcmp(name, commands[c].name) == 0) return &commands[c];
+  char names[256] = "";
+  for (int c = 0; c < NCOMMANDS; c++)
+    snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", commands[c].name,
+             c == NCOMMANDS - 1 ? "" : c == NCOMMANDS - 2 ? " or " : ", ");
+  die(EXIT_USAGE, "unknown command '%s' (expected %s; see --help)", name, names);
+}
+
+/* The overview: the commands and where their options are. */
+static void print_overview(FILE *f) {
+  fputs("usage: rastray COMMAND [options]\n       rastray --help | --version\n\ncommands:\n", f);
+  for (int c = 0; c < NCOMMANDS; c++) fprintf(f, "  %-8s %s\n", commands[c].name, commands[c].summary);
+  fputs("\n'rastray COMMAND --help' or 'rastray help COMMAND' lists a command's options.\n"
+        "Exit status: 0 success, 1 bad input (files, scenes), 2 bad usage (options, values).\n",
+        f);
+}
 
 static void print_usage(FILE *f, const cli_command *cmd) {
   fprintf(f, "usage: rastray %s %s\n%s\n", cmd->name, cmd->operands, cmd->summary);
@@ -129,18 +208,8 @@ static void print_usage(FILE *f, const cli_command *cmd) {
   }
 }
 
-static char flag[64]; /* the option being handled, "--name", for messages */
-static int verbosity;  /* -1: --quiet, 0, 1: --verbose */
-
-/* A message on stderr when the verbosity is at least `level` (0: unless --quiet). */
-static void note(int level, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void note(int level, const char *fmt, ...) {
-  if (verbosity < level) return;
-  va_list ap;
-  va_start(ap, fmt);
-  vfprintf(stderr, fmt, ap);
-  va_end(ap);
-}
+static char option_name[64]; /* the option being handled, "--name", for messages */
+static bool force_progress; /* --progress */
 
 /* The next option of the command's argv (argv[0] is the command's name): its key,
  * its value in optarg; -1 after the last (the operands are then argv[optind..]).
@@ -165,8 +234,8 @@ static int next_option(const cli_command *cmd, int argc, char **argv) {
   /* getopt leaves the key of a known option that failed in optopt (0 for an unknown long one) */
   const cli_option *o = cmd->options;
   while (o->name && o->key != (key == '?' || key == ':' ? optopt : key)) o++;
-  if (o->name) snprintf(flag, sizeof flag, "--%s", o->name);
-  if (key == '?' && o->name) die(EXIT_USAGE, "%s takes no value (see --help)", flag);
+  if (o->name) snprintf(option_name, sizeof option_name, "--%s", o->name);
+  if (key == '?' && o->name) die(EXIT_USAGE, "%s takes no value (see --help)", option_name);
   if (key == '?' && optopt) die(EXIT_USAGE, "unknown option '-%c' (see --help)", optopt);
   if (key == '?') die(EXIT_USAGE, "unknown option '%s' (see --help)", argv[optind - 1]);
   if (key == ':') die(EXIT_USAGE, "%s needs a value (see --help)", argv[optind - 1]);
@@ -174,6 +243,7 @@ static int next_option(const cli_command *cmd, int argc, char **argv) {
   case 'h': print_usage(stdout, cmd), exit(0);
   case 'q': verbosity = -1; return next_option(cmd, argc, argv);
   case 'v': verbosity = 1; return next_option(cmd, argc, argv);
+  case OPT_PROGRESS: force_progress = true; return next_option(cmd, argc, argv);
   }
   return key;
 }
@@ -229,10 +299,35 @@ static void parse_size(const char *s, int *w, int *h) {
   *w = (int)a, *h = (int)b;
 }
 
+/* An --aov: the images written as one file (several: the layers of one EXR). */
+enum { COLOR_BIT = 1u << RR_AOV_COUNT }; /* the shaded image, beside AOV a's bit 1 << a */
 typedef struct {
-  rr_aov aov;
+  unsigned images; /* COLOR_BIT and AOV bits */
+  bool all;        /* `all`: resolved once heat is known */
   const char *path;
 } aov_out;
+
+/* Parses --aov LIST=PATH. */
+static aov_out parse_aov(const char *arg) {
+  const char *eq = strchr(arg, '=');
+  char list[256];
+  if (!eq || eq == arg || !eq[1] || (size_t)(eq - arg) >= sizeof list)
+    die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
+  memcpy(list, arg, eq - arg), list[eq - arg] = 0;
+  aov_out a = {0, false, eq + 1};
+  char *save = NULL;
+  for (char *name = strtok_r(list, ",", &save); name; name = strtok_r(NULL, ",", &save)) {
+    int k = rr_aov_from_name(name);
+    if (!strcmp(name, "all")) a.all = true;
+    else if (!strcmp(name, "color")) a.images |= COLOR_BIT;
+    else if (k >= 0) a.images |= 1u << k;
+    else
+      die(EXIT_USAGE,
+          "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes or all)", name);
+  }
+  if (!a.images && !a.all) die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
+  return a;
+}
 
 static int cmp_double(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
@@ -244,59 +339,117 @@ static double median(double *v, int n) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-static double now_ms(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-static rr_scene *load_scene(rr_device *dev, const char *name) {
+/* Loads a scene, its BVH built on `threads` threads; *load_ms is the time of the
+ * load without the build. Progress shows from here on: loading is the first long step. */
+static rr_scene *load_scene(rr_device *dev, const char *name, int threads, double *load_ms) {
+  if (verbosity >= 0) progress_start(dev, force_progress);
+  rr_build_options build;
+  rr_build_options_init(&build);
+  build.threads = threads;
+  rr_device_set_build_options(dev, &build);
+  double t0 = now_ms();
   rr_scene *scene;
   if (rr_scene_load(dev, name, &scene) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
   rr_scene_info in;
   rr_scene_get_info(scene, &in);
-  note(1, "loaded %s: %llu triangles (%llu skipped), %u geometries, %u materials\n", name,
-       (unsigned long long)in.triangles, (unsigned long long)in.skipped, in.geometries, in.materials);
+  *load_ms = now_ms() - t0 - in.bvh_build_ms;
+  note(1, "loaded %s: %llu triangles (%llu skipped), %u geometries, %u materials in %.1f ms\n", name,
+       (unsigned long long)in.triangles, (unsigned long long)in.skipped, in.geometries, in.materials, *load_ms);
   note(1, "bvh: %llu nodes, %llu leaves, depth %u, SAH cost %.3f, %.2f MiB, built in %.1f ms\n",
        (unsigned long long)in.bvh_nodes, (unsigned long long)in.bvh_leaves, in.bvh_depth, in.bvh_sah_cost,
        in.bvh_bytes / 1048576.0, in.bvh_build_ms);
+  if (in.textures_missing) /* rendered without them: say so, not only in info */
+    note(0, "rastray: warning: %u of %u textures missing or unreadable (rastray info '%s' lists them)\n",
+         in.textures_missing, in.textures, name);
   return scene;
 }
 
-static void write_image(rr_device *dev, rr_image *img, const char *path) {
-  rr_error e = rr_image_write(dev, img, path);
-  rr_image_free(img);
-  if (e) die(e == RR_ERROR_ARGUMENT ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
+/* Ends the run on a failed output (the set's device holds why); the set's temporaries go first. */
+static void output_failed(rr_device *dev, rr_output *set) {
+  rr_output_release(set);
+  die(rr_device_error(dev) == RR_ERROR_ARGUMENT ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
 }
 
-/* Cuts the six faces out of a cube camera's cross and writes DIR/<face>.png. */
-static void write_cube_faces(rr_device *dev, const rr_image *cross, const char *dir) {
+static void add_output(rr_device *dev, rr_output *set, const rr_image *images, int n, const char *path) {
+  rr_error e = rr_output_add(set, images, n, path);
+  if (e) output_failed(dev, set);
+}
+
+/* Cuts the six faces out of a cube camera's cross and adds DIR/<face>.png to the set. */
+static void add_cube_faces(rr_device *dev, rr_output *set, const rr_image *cross, const char *dir) {
   static const struct {
     const char *name;
     int col, row;
   } faces[6] = {{"front", 1, 1}, {"right", 2, 1}, {"back", 3, 1}, {"left", 0, 1}, {"top", 1, 0}, {"bottom", 1, 2}};
   int n = cross->height / 3;
   for (int f = 0; f < 6; f++) {
-    rr_image img = {n, n, 3, RR_PIXEL_F32, malloc((size_t)n * n * 3 * sizeof(float))};
-    if (!img.data) die(EXIT_INPUT, "out of memory");
+    rr_image img = {n, n, 3, RR_PIXEL_F32, malloc((size_t)n * n * 3 * sizeof(float)), cross->kind};
+    if (!img.data) {
+      rr_output_release(set);
+      die(EXIT_INPUT, "out of memory");
+    }
     for (int y = 0; y < n; y++)
       memcpy((float *)img.data + (size_t)y * n * 3,
              (const float *)cross->data + ((size_t)(faces[f].row * n + y) * cross->width + faces[f].col * n) * 3,
              (size_t)n * 3 * sizeof(float));
     char path[4096];
     snprintf(path, sizeof path, "%s/%s.png", dir, faces[f].name);
-    rr_error e = rr_image_write(dev, &img, path);
+    rr_error e = rr_output_add(set, &img, 1, path);
     free(img.data);
-    if (e) die(EXIT_INPUT, "%s", rr_device_message(dev));
+    if (e) output_failed(dev, set);
   }
 }
 
-static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
-  while (next_option(cmd, argc, argv) != -1) {
+/* The times of a render's steps, in milliseconds. */
+typedef struct {
+  double load, build, frame, cpu, shade, write, total;
+} timings;
+
+/* Adds the run's images to its output set. The colour image and each AOV are made
+ * once (shade_ms), whatever number of files hold them, and encoded (write_ms). */
+static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, const rr_camera *cam,
+                       const rr_frame *frame, int shade, const char *out, const char *cube_dir, const aov_out *aovs,
+                       int naov, timings *ms) {
+  unsigned need = out || cube_dir ? COLOR_BIT : 0;
+  for (int k = 0; k < naov; k++) need |= aovs[k].images;
+  rr_image images[RR_AOV_COUNT + 1] = {{0}}; /* AOV a at a, the colour last */
+  rr_image *colour = &images[RR_AOV_COUNT];
+  progress_stage("shading");
+  double t = now_ms();
+  for (int a = 0; a <= RR_AOV_COUNT; a++) {
+    if (!(need & 1u << a)) continue;
+    rr_error e = a == RR_AOV_COUNT ? rr_shade(dev, scene, cam, frame, (rr_shade_mode)shade, colour)
+                                   : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
+    if (e) {
+      rr_output_release(set);
+      die(EXIT_INPUT, "%s", rr_device_message(dev));
+    }
   }
+  ms->shade = now_ms() - t;
+  progress_stage("writing");
+  t = now_ms();
+  if (out) add_output(dev, set, colour, 1, out);
+  if (cube_dir) add_cube_faces(dev, set, colour, cube_dir);
+  for (int k = 0; k < naov; k++) {
+    rr_image layers[RR_AOV_COUNT + 1];
+    int n = 0;
+    for (int a = RR_AOV_COUNT; a >= 0; a--) /* the colour first, as in the help */
+      if (aovs[k].images & 1u << a) layers[n++] = images[a];
+    add_output(dev, set, layers, n, aovs[k].path);
+  }
+  ms->write = now_ms() - t;
+  for (int a = 0; a <= RR_AOV_COUNT; a++) rr_image_free(&images[a]);
+}
+
+static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
+  int threads = 0;
+  for (int key; (key = next_option(cmd, argc, argv)) != -1;)
+    if (key == OPT_THREADS) threads = (int)parse_int(option_name, optarg, 0, RR_MAX_THREADS);
   if (argc - optind != 1) die(EXIT_USAGE, "info takes one scene (see --help)");
   const char *scene_name = argv[optind];
-  rr_scene *scene = load_scene(dev, scene_name);
+  double load_ms;
+  rr_scene *scene = load_scene(dev, scene_name, threads, &load_ms);
+  progress_stop();
   rr_scene_info in;
   rr_scene_get_info(scene, &in);
   printf("scene        %s\n", scene_name);
@@ -311,6 +464,51 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
     printf("  %-4u %-24s %u %s%s, material %u\n", g, gi.name ? gi.name : "-", gi.count,
            rr_geometry_kind_name(gi.kind), gi.count == 1 ? "" : "s", gi.material);
   }
+  /* Materials with their textures, then every texture that is not there (even
+   * when the materials are too many to list). */
+  for (uint32_t m = 0; in.materials <= LISTED && m < in.materials; m++) {
+    rr_material_info mi;
+    rr_scene_get_material_info(scene, m, &mi);
+    printf("  material %-3u %-20s colour (%.3g, %.3g, %.3g)", m, mi.name ? mi.name : "-", mi.color[0], mi.color[1],
+           mi.color[2]);
+    if (mi.texture && mi.texture_width)
+      printf(", texture '%s' (%s, %dx%d)", mi.texture, rr_texture_status_name(mi.texture_status), mi.texture_width,
+             mi.texture_height);
+    else if (mi.texture) printf(", texture '%s' (%s)", mi.texture, rr_texture_status_name(mi.texture_status));
+    putchar('\n');
+  }
+  printf("textures     %u (%u missing or unreadable)\n", in.textures, in.textures_missing);
+  for (uint32_t m = 0; in.textures_missing && m < in.materials; m++) {
+    rr_material_info mi;
+    rr_scene_get_material_info(scene, m, &mi);
+    if (mi.texture_status == RR_TEXTURE_MISSING || mi.texture_status == RR_TEXTURE_UNREADABLE)
+      printf("  %-10s '%s' (material %u)\n", rr_texture_status_name(mi.texture_status), mi.texture, m);
+  }
+  printf("cameras      %u\n", in.cameras);
+  for (uint32_t c = 0; c < in.cameras; c++) {
+    rr_camera fc;
+    const char *name = rr_scene_camera_name(scene, c);
+    if (rr_scene_get_camera(dev, scene, c, 1, 1, &fc) != RR_OK) { /* a file's camera the library cannot use */
+      printf("  %-4u %-24s unusable: %s\n", c, name ? name : "-", rr_device_message(dev));
+      continue;
+    }
+    printf("  %-4u %-24s %s, eye (%g, %g, %g), looking along (%g, %g, %g)", c, name ? name : "-", rr_camera_name(fc.type),
+           fc.eye[0], fc.eye[1], fc.eye[2], fc.target[0] - fc.eye[0], fc.target[1] - fc.eye[1], fc.target[2] - fc.eye[2]);
+    if (fc.type == RR_CAMERA_PERSPECTIVE) printf(", %.1f° at 1:1", fc.fov_deg);
+    putchar('\n');
+  }
+  printf("lights       %u\n", in.lights);
+  for (uint32_t l = 0; l < in.lights; l++) {
+    rr_light_info li;
+    rr_scene_get_light(scene, l, &li);
+    printf("  %-4u %-24s %s, at (%g, %g, %g), towards (%g, %g, %g), colour (%g, %g, %g)", l, li.name ? li.name : "-",
+           rr_light_type_name(li.type), li.position[0], li.position[1], li.position[2], li.direction[0],
+           li.direction[1], li.direction[2], li.color[0], li.color[1], li.color[2]);
+    if (li.type == RR_LIGHT_SPOT) printf(", cone %.1f°..%.1f°", li.inner_cone_deg, li.outer_cone_deg);
+    putchar('\n');
+  }
+  printf("up, front    (%g, %g, %g), (%g, %g, %g)\n", in.up[0], in.up[1], in.up[2], in.front[0], in.front[1],
+         in.front[2]);
   printf("bounds       (%g, %g, %g) .. (%g, %g, %g)\n", in.bounds_min[0], in.bounds_min[1], in.bounds_min[2],
          in.bounds_max[0], in.bounds_max[1], in.bounds_max[2]);
   printf("bvh nodes    %llu\n", (unsigned long long)in.bvh_nodes);
@@ -323,6 +521,39 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
   return 0;
 }
 
+/* The fields of src named in `fields` (CAM_ bits) copied into dst. */
+static void camera_take(rr_camera *dst, const rr_camera *src, unsigned fields) {
+  if (fields & CAM_TYPE) dst->type = src->type;
+  if (fields & CAM_EYE) memcpy(dst->eye, src->eye, sizeof dst->eye);
+  if (fields & CAM_TARGET) memcpy(dst->target, src->target, sizeof dst->target);
+  if (fields & CAM_UP) memcpy(dst->up, src->up, sizeof dst->up);
+  if (fields & CAM_FOV) dst->fov_deg = src->fov_deg;
+  if (fields & CAM_ORTHO) dst->ortho_height = src->ortho_height;
+}
+
+/* --stats-json: the statistics as one JSON object. */
+static void add_stats_json(rr_device *dev, rr_output *set, const char *path, const char *scene_name, const rr_camera *cam, const rr_render_options *opt,
+                           int repeat, const rr_scene_info *info, const rr_stats *st, const timings *ms) {
+  cJSON *o = cJSON_CreateObject();
+  cJSON_AddStringToObject(o, "scene", scene_name);
+  cJSON_AddStringToObject(o, "method", rr_method_name(st->method));
+  cJSON_AddStringToObject(o, "camera", rr_camera_name(cam->type));
+  const struct {
+    const char *key;
+    double value;
+  } numbers[] = {{"triangles", (double)info->triangles}, {"skipped", (double)info->skipped},
+                 {"width", opt->width}, {"height", opt->height}, {"threads", st->threads}, {"repeat", repeat},
+                 {"load_ms", ms->load}, {"build_ms", ms->build}, {"frame_ms", ms->frame}, {"cpu_ms", ms->cpu},
+                 {"shade_ms", ms->shade}, {"write_ms", ms->write}, {"total_ms", ms->total},
+                 {"setups", (double)st->setups}, {"edge_evals", (double)st->edge_evals}, {"nodes", (double)st->nodes},
+                 {"bins", (double)st->bins}, {"bins_empty", (double)st->bins_empty}};
+  for (size_t k = 0; k < sizeof numbers / sizeof *numbers; k++) /* times to the microsecond */
+    cJSON_AddNumberToObject(o, numbers[k].key, round(numbers[k].value * 1000) / 1000);
+  cJSON_AddStringToObject(o, "auto", st->why);
+  json_add(dev, set, o, path);
+  cJSON_Delete(o);
+}
+
 static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
   double t_start = now_ms();
   rr_render_options opt;
@@ -330,8 +561,10 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   opt.method = RR_METHOD_AUTO;
   rr_camera cam;
   rr_camera_init(&cam);
-  const char *scene_name = NULL, *out = NULL, *json = NULL, *cube_dir = NULL;
-  bool have_eye = false, have_target = false, stats = false;
+  const char *scene_name = NULL, *out = NULL, *json = NULL, *cube_dir = NULL, *camera_file = NULL, *save_camera = NULL;
+  const char *file_cam = NULL; /* --camera-from-file */
+  unsigned given = 0;           /* the camera's fields set by flags */
+  bool stats = false;
   int shade = RR_SHADE_LAMBERT, repeat = 1, naov = 0;
   aov_out aovs[16];
   for (int key; (key = next_option(cmd, argc, argv)) != -1;) {
@@ -348,19 +581,20 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
       if (type < 0)
         die(EXIT_USAGE, "unknown camera '%s' (expected perspective, orthographic, parabolic, latlong, fisheye or cube)",
             optarg);
-      cam.type = (rr_camera_type)type;
+      cam.type = (rr_camera_type)type, given |= CAM_TYPE;
       break;
     }
     case OPT_ORTHO_HEIGHT:
-      cam.ortho_height = parse_float(flag, optarg);
+      cam.ortho_height = parse_float(option_name, optarg), given |= CAM_ORTHO;
       if (!(cam.ortho_height > 0)) die(EXIT_USAGE, "bad value '%s' for --ortho-height (expected > 0)", optarg);
       break;
     case OPT_CUBE_FACES: cube_dir = optarg; break;
-    case OPT_EYE: parse_vec(flag, optarg, cam.eye), have_eye = true; break;
-    case OPT_TARGET: parse_vec(flag, optarg, cam.target), have_target = true; break;
-    case OPT_UP: parse_vec(flag, optarg, cam.up); break;
+    case OPT_EYE: parse_vec(option_name, optarg, cam.eye), given |= CAM_EYE; break;
+    case OPT_TARGET: parse_vec(option_name, optarg, cam.target), given |= CAM_TARGET; break;
+    case OPT_UP: parse_vec(option_name, optarg, cam.up), given |= CAM_UP; break;
+    case OPT_CAMERA_FROM_FILE: file_cam = optarg; break;
     case OPT_FOV:
-      cam.fov_deg = parse_float(flag, optarg);
+      cam.fov_deg = parse_float(option_name, optarg), given |= CAM_FOV;
       if (!(cam.fov_deg > 0 && cam.fov_deg <= 360))
         die(EXIT_USAGE, "bad value '%s' for --fov (expected 0 < fov < 180, or up to 360 for fisheye)", optarg);
       break;
@@ -371,43 +605,56 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
             optarg);
       break;
     case 'o': out = optarg; break;
-    case OPT_AOV: {
-      const char *eq = strchr(optarg, '=');
-      char name[32];
-      if (!eq || eq == optarg || !eq[1] || (size_t)(eq - optarg) >= sizeof name)
-        die(EXIT_USAGE, "bad --aov '%s' (expected NAME=PATH)", optarg);
-      memcpy(name, optarg, eq - optarg), name[eq - optarg] = 0;
-      int k = rr_aov_from_name(name);
-      if (k < 0)
-        die(EXIT_USAGE, "unknown AOV '%s' (expected depth, id, mesh, material, normal, bary, evals or nodes)", name);
-      if (k == RR_AOV_EVALS || k == RR_AOV_NODES) opt.heat = 1;
+    case OPT_AOV:
       if (naov == 16) die(EXIT_USAGE, "too many --aov (at most 16)");
-      aovs[naov++] = (aov_out){(rr_aov)k, eq + 1};
+      aovs[naov++] = parse_aov(optarg);
       break;
-    }
-    case OPT_THREADS: opt.threads = (int)parse_int(flag, optarg, 1, RR_MAX_THREADS); break;
-    case OPT_REPEAT: repeat = (int)parse_int(flag, optarg, 1, 1000); break;
+    case OPT_THREADS: opt.threads = (int)parse_int(option_name, optarg, 0, RR_MAX_THREADS); break;
+    case OPT_REPEAT: repeat = (int)parse_int(option_name, optarg, 1, 1000); break;
     case OPT_STATS: stats = true; break;
     case OPT_STATS_JSON: json = optarg; break;
     case OPT_ORACLES: opt.oracles = optarg; break;
     case OPT_CULL_BACKFACES: opt.cull_backfaces = 1; break;
+    case OPT_CAMERA_FILE: camera_file = optarg; break;
+    case OPT_SAVE_CAMERA: save_camera = optarg; break;
     }
   }
   if (optind < argc) scene_name = argv[optind];
   if (argc - optind > 1) die(EXIT_USAGE, "more than one scene given ('%s' and '%s')", scene_name, argv[optind + 1]);
-  if (have_eye != have_target) die(EXIT_USAGE, "--eye and --target go together");
+  if (!(given & CAM_EYE) != !(given & CAM_TARGET)) die(EXIT_USAGE, "--eye and --target go together");
+  if (file_cam && (given & (CAM_EYE | CAM_TARGET | CAM_UP | CAM_FOV)))
+    die(EXIT_USAGE, "--camera-from-file takes the view from the file: no --eye, --target, --up or --fov with it");
+  if (file_cam && camera_file) die(EXIT_USAGE, "--camera-from-file and --camera-file exclude each other");
   if (!scene_name) scene_name = "demo";
   if (!out && naov == 0) out = "rastray.png";
   if (shade == RR_SHADE_HEAT_EVALS || shade == RR_SHADE_HEAT_NODES) opt.heat = 1;
+  const unsigned heat_aovs = 1u << RR_AOV_EVALS | 1u << RR_AOV_NODES;
+  for (int k = 0; k < naov; k++) opt.heat |= (aovs[k].images & heat_aovs) != 0;
+  for (int k = 0; k < naov; k++) /* all: every AOV the frame has */
+    if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~(opt.heat ? 0 : heat_aovs);
+  if (camera_file) { /* the file's values, where no flag gave one */
+    rr_camera from_file = cam;
+    unsigned fields = camera_file_read(camera_file, &from_file);
+    camera_take(&cam, &from_file, fields & ~given);
+    given |= fields;
+  }
 
-  rr_build_options build; /* the BVH is built on the render's threads too */
-  rr_build_options_init(&build);
-  build.threads = opt.threads;
-  rr_device_set_build_options(dev, &build);
-  rr_scene *scene = load_scene(dev, scene_name);
-  if (!have_eye && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK)
+  timings ms = {0};
+  rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load);
+  if (file_cam) { /* the file's camera; --camera may change its projection */
+    rr_camera_type type = cam.type;
+    uint32_t index;
+    if (rr_scene_find_camera(dev, scene, file_cam, &index) != RR_OK ||
+        rr_scene_get_camera(dev, scene, index, opt.width, opt.height, &cam) != RR_OK)
+      die(EXIT_INPUT, "%s", rr_device_message(dev));
+    if (given & CAM_TYPE) cam.type = type;
+  } else if (!(given & CAM_EYE) && rr_camera_frame(dev, scene, opt.width, opt.height, &cam) != RR_OK) {
     die(EXIT_INPUT, "%s", rr_device_message(dev));
-  if (rr_camera_check(dev, &cam) != RR_OK) die(EXIT_USAGE, "%s", rr_device_message(dev));
+  }
+  if (rr_camera_check(dev, &cam) != RR_OK) {
+    if (camera_file) die(EXIT_INPUT, "camera file '%s': %s", camera_file, rr_device_message(dev));
+    die(EXIT_USAGE, "%s", rr_device_message(dev));
+  }
   if (cube_dir && cam.type != RR_CAMERA_CUBE) die(EXIT_USAGE, "--cube-faces needs --camera cube");
 
   double *times = malloc(sizeof(double) * repeat), *cpus = malloc(sizeof(double) * repeat);
@@ -416,74 +663,70 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   opt.frames_hint = repeat; /* auto weighs a trial against the frames to come */
   for (int r = 0; r < repeat; r++) {
     rr_frame_release(frame);
+    progress_frame(r, repeat);
     rr_error e = rr_render(dev, scene, &cam, &opt, &frame);
     if (e) die(e == RR_ERROR_ARGUMENT || e == RR_ERROR_UNSUPPORTED ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
     rr_stats st;
     rr_frame_get_stats(frame, &st);
     times[r] = st.frame_ms, cpus[r] = st.cpu_ms;
   }
-  double frame_ms = median(times, repeat), cpu_ms = median(cpus, repeat);
+  ms.frame = median(times, repeat), ms.cpu = median(cpus, repeat);
   free(times), free(cpus);
-
-  if (out || cube_dir) {
-    rr_image img;
-    if (rr_shade(dev, scene, &cam, frame, (rr_shade_mode)shade, &img) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
-    if (cube_dir) write_cube_faces(dev, &img, cube_dir);
-    if (out) write_image(dev, &img, out);
-    else rr_image_free(&img);
-  }
-  for (int k = 0; k < naov; k++) {
-    rr_image img;
-    if (rr_frame_aov(dev, scene, &cam, frame, aovs[k].aov, &img) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
-    write_image(dev, &img, aovs[k].path);
-  }
-
   rr_stats st;
   rr_frame_get_stats(frame, &st);
+  const char *method = rr_method_name(st.method);
+  if (st.why[0]) note(1, "auto chose %s: %s\n", method, st.why);
+  else note(1, "method %s (as asked)\n", method);
+
+  /* Every file of the run goes into one output set: all of them appear, or none. */
+  rr_output *set;
+  if (rr_output_new(dev, &set) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+  add_images(dev, set, scene, &cam, frame, shade, out, cube_dir, aovs, naov, &ms);
+  if (save_camera) camera_file_add(dev, set, save_camera, &cam, opt.width, opt.height);
   rr_scene_info info;
   rr_scene_get_info(scene, &info);
-  double total_ms = now_ms() - t_start;
-  const char *method = rr_method_name(st.method);
-  int threads = st.threads;
+  ms.build = info.bvh_build_ms;
+  ms.total = now_ms() - t_start;
+  if (json) add_stats_json(dev, set, json, scene_name, &cam, &opt, repeat, &info, &st, &ms);
+  if (rr_output_commit(set) != RR_OK) output_failed(dev, set);
+  rr_output_release(set);
+  progress_stop();
   if (stats)
     fprintf(stderr,
-            "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f cpu_ms=%.3f total_ms=%.1f "
-            "setups=%llu edge_evals=%llu nodes=%llu bins=%llu bins_empty=%llu\n",
-            method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, threads, frame_ms, cpu_ms,
-            total_ms, (unsigned long long)st.setups, (unsigned long long)st.edge_evals, (unsigned long long)st.nodes,
-            (unsigned long long)st.bins, (unsigned long long)st.bins_empty);
-  if (stats && st.why[0]) fprintf(stderr, "auto chose %s: %s\n", method, st.why);
-  else if (st.why[0]) note(1, "auto chose %s: %s\n", method, st.why);
-  if (json) {
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s.tmp", json);
-    FILE *f = fopen(tmp, "w");
-    if (!f) die(EXIT_INPUT, "cannot write '%s'", json);
-    fprintf(f,
-            "{\"scene\": \"%s\", \"method\": \"%s\", \"camera\": \"%s\", \"triangles\": %llu, "
-            "\"skipped\": %llu, \"width\": %d, \"height\": %d, \"threads\": %d, \"repeat\": %d, "
-            "\"frame_ms\": %.3f, \"cpu_ms\": %.3f, \"total_ms\": %.3f, \"setups\": %llu, \"edge_evals\": %llu, \"nodes\": %llu, "
-            "\"bins\": %llu, \"bins_empty\": %llu, \"auto\": \"%s\"}\n",
-            scene_name, method, rr_camera_name(cam.type), (unsigned long long)info.triangles, (unsigned long long)info.skipped, opt.width,
-            opt.height, threads, repeat, frame_ms, cpu_ms, total_ms, (unsigned long long)st.setups,
+            "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f cpu_ms=%.3f load_ms=%.1f "
+            "build_ms=%.1f shade_ms=%.1f write_ms=%.1f total_ms=%.1f setups=%llu edge_evals=%llu nodes=%llu bins=%llu "
+            "bins_empty=%llu\n",
+            method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, st.threads,
+            ms.frame, ms.cpu, ms.load, ms.build, ms.shade, ms.write, ms.total, (unsigned long long)st.setups,
             (unsigned long long)st.edge_evals, (unsigned long long)st.nodes, (unsigned long long)st.bins,
-            (unsigned long long)st.bins_empty, st.why);
-    if (fclose(f) != 0 || rename(tmp, json) != 0) {
-      remove(tmp);
-      die(EXIT_INPUT, "cannot write '%s'", json);
-    }
-  }
-  if (out && !stats) note(0, "wrote %s (%dx%d, %s, %.1f ms)\n", out, opt.width, opt.height, method, frame_ms);
+            (unsigned long long)st.bins_empty);
+  if (stats && st.why[0]) fprintf(stderr, "auto chose %s: %s\n", method, st.why);
+  if (out) note(1, "wrote %s\n", out);
+  if (cube_dir) note(1, "wrote %s/{front,right,back,left,top,bottom}.png\n", cube_dir);
+  for (int k = 0; k < naov; k++) note(1, "wrote %s\n", aovs[k].path);
+  if (save_camera) note(1, "wrote %s\n", save_camera);
+  if (json) note(1, "wrote %s\n", json);
+  note(1, "times: load %.1f ms, build %.1f ms, visibility %.1f ms%s, shade %.1f ms, write %.1f ms, total %.1f ms\n",
+       ms.load, ms.build, ms.frame, repeat > 1 ? " (median)" : "", ms.shade, ms.write, ms.total);
+  if (out && !stats && verbosity == 0)
+    note(0, "wrote %s (%dx%d, %s, %.1f ms)\n", out, opt.width, opt.height, method, ms.frame);
   rr_frame_release(frame);
   rr_scene_release(scene);
   return 0;
 }
 
-/* The overview: commands and where their options are. */
-static void print_overview(FILE *f) {
-  fputs("usage: rastray COMMAND [options]\n\ncommands:\n", f);
-  for (int c = 0; c < NCOMMANDS; c++) fprintf(f, "  %-8s %s\n", commands[c].name, commands[c].summary);
-  fputs("\n'rastray COMMAND --help' lists a command's options; 'rastray --version' prints the version.\n", f);
+/* help [COMMAND]: the overview, or a command's usage. */
+static int cmd_help(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
+  (void)dev;
+  while (next_option(cmd, argc, argv) != -1) {
+  }
+  if (argc - optind > 1) die(EXIT_USAGE, "help takes at most one command");
+  if (argc - optind == 0) {
+    print_overview(stdout);
+    return 0;
+  }
+  print_usage(stdout, find_command(argv[optind]));
+  return 0;
 }
 
 int main(int argc, char **argv) {
@@ -495,10 +738,7 @@ int main(int argc, char **argv) {
     printf("rastray %s\n", RR_VERSION);
     return 0;
   }
-  const cli_command *cmd = NULL;
-  for (int c = 0; c < NCOMMANDS; c++)
-    if (strcmp(argv[1], commands[c].name) == 0) cmd = &commands[c];
-  if (!cmd) die(EXIT_USAGE, "unknown command '%s' (expected render or info; see --help)", argv[1]);
+  const cli_command *cmd = find_command(argv[1]);
   rr_device *dev = rr_device_new();
   if (!dev) die(EXIT_INPUT, "out of memory");
   int rc = cmd->run(dev, cmd, argc - 1, argv + 1); /* the command's name stands as getopt's argv[0] */

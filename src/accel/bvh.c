@@ -642,6 +642,11 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   split *splits = NULL;
   rr_error err = RR_OK;
   if (!bd.refs || !bd.scratch || !cb) goto oom;
+  /* Every level of the tree costs about the same: the fraction done is the levels
+   * done out of about log2(n / leaf size) + 1. */
+  progress_span progress = {s->dev, RR_PROGRESS_BUILD, 0, 1};
+  double levels = log2((double)n / bd.leaf_size) + 1, built = 0;
+  rr_progress(&progress, 0);
 
   ref_job rj = {s, bd.refs, cb};
   rr_parallel_for(nchunks, bd.threads, make_refs, &rj);
@@ -707,6 +712,8 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
     if (next.oom || small.oom) goto oom;
     task_vec tmp = frontier;
     frontier = next, next = tmp;
+    built = fmin(built + 1 / levels, 0.9);
+    rr_progress(&progress, built);
   }
 
   /* Small ranges: one subtree per task, in parallel. */
@@ -715,7 +722,8 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   depths = calloc(small.n, sizeof *depths);
   if (!local || !leaves || !depths) goto oom;
   sub_job sj = {&bd, top.v, small.v, local, leaves, depths};
-  rr_parallel_for((int)small.n, bd.threads, build_subtree, &sj);
+  progress_span subtrees = rr_progress_part(&progress, built, 1);
+  rr_parallel_for_progress((int)small.n, bd.threads, build_subtree, &sj, &subtrees);
 
   /* Assemble: the top, then each task's nodes with their child indices moved. */
   uint64_t total = top.n;
@@ -750,6 +758,7 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
              (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t));
   b->build_ms = rr_now_ms() - t0;
+  rr_progress(&progress, 1);
   *out = b;
   b = NULL;
   goto done;

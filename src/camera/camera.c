@@ -1,6 +1,7 @@
 /* Cameras: the ray direction of every sample, and bounds for rasterization. */
 #include "camera/camera.h"
 
+#include <stdio.h>
 #include <string.h>
 
 void rr_camera_init(rr_camera *cam) {
@@ -259,11 +260,12 @@ rr_error rr_camera_frame(rr_device *dev, const rr_scene *s, int width, int heigh
   vec3 centre = v3_scale(v3_add(s->bmin, s->bmax), 0.5f);
   float th = cam->fov_deg > 0 && cam->fov_deg < 180 ? tanf(cam->fov_deg * (float)RR_PI / 360.0f) : 0.41f;
   float tw = th * (float)width / (float)height, fill = 0.94f;
-  /* Look from the front and a little above; back off until every corner of the
-   * bounding box is inside the view: for a corner at offset o from the centre, at
-   * depth D - o·dir, |o·right| <= depth·tw and |o·up| <= depth·th. */
-  vec3 dir = v3_norm(v3(0.0f, 0.5f, 1.0f));
-  vec3 right = v3_norm(v3_cross(v3_neg(dir), v3(0, 1, 0))), up = v3_cross(right, v3_neg(dir));
+  /* Look at the model's front from a little above (for a Y-up file from +Z and
+   * +Y); back off until every corner of the bounding box is inside the view: for a
+   * corner at offset o from the centre, at depth D - o·dir, |o·right| <= depth·tw
+   * and |o·up| <= depth·th. */
+  vec3 dir = v3_norm(v3_add(s->front, v3_scale(s->up, 0.5f)));
+  vec3 right = v3_norm(v3_cross(v3_neg(dir), s->up)), up = v3_cross(right, v3_neg(dir));
   float dist = 0;
   for (int k = 0; k < 8; k++) {
     vec3 o = v3_sub(v3(k & 1 ? s->bmax.x : s->bmin.x, k & 2 ? s->bmax.y : s->bmin.y, k & 4 ? s->bmax.z : s->bmin.z),
@@ -277,8 +279,54 @@ rr_error rr_camera_frame(rr_device *dev, const rr_scene *s, int width, int heigh
   vec3 eye = v3_add(centre, v3_scale(dir, dist));
   cam->eye[0] = eye.x, cam->eye[1] = eye.y, cam->eye[2] = eye.z;
   cam->target[0] = centre.x, cam->target[1] = centre.y, cam->target[2] = centre.z;
-  cam->up[0] = 0, cam->up[1] = 1, cam->up[2] = 0;
+  v3_store(cam->up, s->up);
   return rr_ok(dev);
+}
+
+rr_error rr_scene_get_camera(rr_device *dev, const rr_scene *s, uint32_t index, int width, int height,
+                             rr_camera *cam) {
+  if (!s || !cam) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_scene_get_camera: NULL argument");
+  if (index >= s->ncameras)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "camera %u out of range (the scene has %u)", index, s->ncameras);
+  if (width < 1 || height < 1) return rr_fail(dev, RR_ERROR_ARGUMENT, "bad image size %dx%d", width, height);
+  const file_camera *c = &s->cameras[index];
+  rr_camera_init(cam);
+  vec3 target = v3_add(c->eye, c->fwd);
+  v3_store(cam->eye, c->eye), v3_store(cam->target, target), v3_store(cam->up, c->up);
+  float aspect = (float)width / (float)height;
+  if (c->ortho_width > 0) {
+    cam->type = RR_CAMERA_ORTHOGRAPHIC;
+    cam->ortho_height = c->ortho_width / aspect;
+  } else {
+    /* tan(fov_y / 2) = tan(fov_x / 2) / aspect: the file's width fills the image's */
+    cam->fov_deg = (c->fov_vertical ? c->fov : 2.0f * atanf(tanf(0.5f * c->fov) / aspect)) * 180.0f / (float)RR_PI;
+  }
+  return rr_camera_check(dev, cam);
+}
+
+const char *rr_scene_camera_name(const rr_scene *s, uint32_t index) {
+  return s && index < s->ncameras ? s->cameras[index].name : NULL;
+}
+
+rr_error rr_scene_find_camera(rr_device *dev, const rr_scene *s, const char *name, uint32_t *index) {
+  if (!s || !name || !index) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_scene_find_camera: NULL argument");
+  for (uint32_t i = 0; i < s->ncameras; i++)
+    if (s->cameras[i].name && strcmp(s->cameras[i].name, name) == 0) return *index = i, rr_ok(dev);
+  char *end;
+  unsigned long i = strtoul(name, &end, 10);
+  if (*name >= '0' && *name <= '9' && !*end && i < s->ncameras) return *index = (uint32_t)i, rr_ok(dev);
+  if (!s->ncameras) return rr_fail(dev, RR_ERROR_ARGUMENT, "no camera '%s': the scene defines no cameras", name);
+  /* one line naming them all (indices for the unnamed), cut short on a huge list */
+  char list[512] = "";
+  size_t len = 0;
+  for (uint32_t c = 0; c < s->ncameras && len < sizeof list; c++) {
+    const char *nm = s->cameras[c].name;
+    int n = nm ? snprintf(list + len, sizeof list - len, "%s'%s'", c ? ", " : "", nm)
+               : snprintf(list + len, sizeof list - len, "%s%u (unnamed)", c ? ", " : "", c);
+    len += n > 0 ? (size_t)n : 0;
+  }
+  return rr_fail(dev, RR_ERROR_ARGUMENT, "no camera '%s' (the scene's %u: %s%s)", name, s->ncameras, list,
+                 len >= sizeof list ? "..." : "");
 }
 
 void rr_cam_for_ray(const float org[3], const float dir[3], camera *out) {

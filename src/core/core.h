@@ -25,6 +25,9 @@ struct rr_device {
     int method;
     char why[256];
   } auto_choice;
+  rr_progress_fn progress; /* rr_device_set_progress; NULL: none */
+  void *progress_user;
+  double progress_ms;      /* when it was last told an inner fraction */
 };
 
 /* Records a failure in dev (when not NULL) and returns its code. */
@@ -33,11 +36,33 @@ rr_error rr_fail(rr_device *dev, rr_error code, const char *fmt, ...)
 /* Records success. */
 rr_error rr_ok(rr_device *dev);
 
+/* The part [lo, hi] of a stage's progress that a pass or loop covers; dev NULL,
+ * or a device without a progress function, takes no reports. */
+typedef struct progress_span {
+  rr_device *dev;
+  rr_progress_stage stage;
+  double lo, hi;
+} progress_span;
+/* Reports lo + (hi - lo)·fraction of the span's stage to its device's progress
+ * function: the stage's 0 and 1 always, inner fractions at most every
+ * RR_PROGRESS_MS. Only on the thread that called the library (its contract). */
+void rr_progress(const progress_span *span, double fraction);
+/* The part [a, b] of a span (fractions of it). */
+static inline progress_span rr_progress_part(const progress_span *span, double a, double b) {
+  progress_span p = *span;
+  p.lo = span->lo + (span->hi - span->lo) * a, p.hi = span->lo + (span->hi - span->lo) * b;
+  return p;
+}
+
 /* Runs fn(job, thread, arg) for job = 0..njobs-1, dealt out dynamically to
  * `threads` threads (the caller's thread is one of them; at most RR_MAX_THREADS,
  * which sizes every per-thread array, so thread < RR_MAX_THREADS). */
 typedef void (*rr_parallel_fn)(int job, int thread, void *arg);
 void rr_parallel_for(int njobs, int threads, rr_parallel_fn fn, void *arg);
+/* The same, reporting the share of jobs taken as the span's progress from the
+ * caller's thread (thread 0), which takes jobs like the others; span may be NULL.
+ * Call it from the thread that called the library, not from inside a job. */
+void rr_parallel_for_progress(int njobs, int threads, rr_parallel_fn fn, void *arg, const progress_span *span);
 /* Number of cores available. */
 int rr_cpu_count(void);
 /* Milliseconds on a monotonic clock. */

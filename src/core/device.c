@@ -30,3 +30,9 @@ rr_error rr_ok(rr_device *dev) {
   }
   return RR_OK;
 }
+
+rr_error rr_device_set_progress(rr_device *dev, rr_progress_fn fn, void *user) {
+  if (!dev) return RR_ERROR_ARGUMENT;
+  dev->progress = fn, dev->progress_user = user, dev->progress_ms = 0;
+  return rr_ok(dev);
+}

@@ -11,7 +11,8 @@
  * their own threads, so no device ever waits for another), everything else in it
  * is read and written under `mu`, and a caller leaves only when no worker is still
  * inside its loop, whose state lives on that caller's stack. A loop reaches no
- * caller data but through fn and arg. */
+ * caller data but through fn and arg, and its progress span, which only the
+ * caller's own thread (thread 0) reads: progress is reported from there alone. */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime, sysconf, pthreads */
 
 #include "core/core.h"
@@ -27,13 +28,31 @@ typedef struct {
   int njobs;
   rr_parallel_fn fn;
   void *arg;
+  const progress_span *span; /* reported by thread 0, the caller's */
 } loop;
+
+/* Beside the pool, whose caller makes the reports. */
+void rr_progress(const progress_span *span, double fraction) {
+  rr_device *dev = span->dev;
+  if (!dev || !dev->progress) return;
+  double f = span->lo + (span->hi - span->lo) * fraction;
+  if (f > 0 && f < 1) { /* an inner fraction: rarely enough not to matter */
+    double now = rr_now_ms();
+    if (now - dev->progress_ms < RR_PROGRESS_MS) return;
+    dev->progress_ms = now;
+  }
+  dev->progress(dev->progress_user, span->stage, f < 0 ? 0 : f > 1 ? 1 : f);
+}
 
 static void run_jobs(loop *l, int thread) {
   for (;;) {
     int job = atomic_fetch_add(&l->next, 1);
     if (job >= l->njobs) break;
     l->fn(job, thread, l->arg);
+    if (thread == 0 && l->span) { /* the share taken; the loop's end is its caller's to report */
+      int taken = atomic_load_explicit(&l->next, memory_order_relaxed);
+      if (taken < l->njobs) rr_progress(l->span, (double)taken / l->njobs);
+    }
   }
 }
 
@@ -108,10 +127,14 @@ static void run_own_threads(loop *l, int threads) {
 }
 
 void rr_parallel_for(int njobs, int threads, rr_parallel_fn fn, void *arg) {
+  rr_parallel_for_progress(njobs, threads, fn, arg, NULL);
+}
+
+void rr_parallel_for_progress(int njobs, int threads, rr_parallel_fn fn, void *arg, const progress_span *span) {
   if (threads > njobs) threads = njobs;
   if (threads < 1) threads = 1;
   if (threads > RR_MAX_THREADS) threads = RR_MAX_THREADS;
-  loop l = {.njobs = njobs, .fn = fn, .arg = arg};
+  loop l = {.njobs = njobs, .fn = fn, .arg = arg, .span = span && span->dev && span->dev->progress ? span : NULL};
   atomic_init(&l.next, 0);
   if (threads == 1) {
     run_jobs(&l, 0);

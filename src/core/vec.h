@@ -27,5 +27,6 @@ static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fminf(a.x, b.x), fminf(a.y
 static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
 static inline float v3_get(vec3 a, int axis) { return axis == 0 ? a.x : axis == 1 ? a.y : a.z; }
 static inline vec3 v3_load(const float *p) { return v3(p[0], p[1], p[2]); }
+static inline void v3_store(float *p, vec3 a) { p[0] = a.x, p[1] = a.y, p[2] = a.z; }
 
 #endif

@@ -7,6 +7,8 @@
  * sample test then leaves no cracks and counts no pixel twice along shared edges. */
 #include "io/io.h"
 
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* ---- name parsing -------------------------------------------------------------- */
@@ -252,7 +254,7 @@ static rr_error gen_ground(rr_scene *s) {
   const vec3 origin = v3(0, 0, 0), dir[4] = {v3(1, 0, 0), v3(0, 0, -1), v3(-1, 0, 0), v3(0, 0, 1)};
   for (int q = 0; q < 4; q++) {
     vec3 p[3] = {origin, dir[q], dir[(q + 1) % 4]};
-    rr_scene_push_inf(s, p, 6u, NULL, NULL, ground_m); /* corners 1 and 2 at infinity */
+    rr_scene_push_inf(s, p, 6u, NULL, NULL, NULL, ground_m); /* corners 1 and 2 at infinity */
   }
   e = gen_sphere(s, 24, v3(-1.5f, 1.05f, 0.5f), 1.0f, ball_m);
   uint32_t t0 = s->ntris;
@@ -492,15 +494,37 @@ static rr_error smooth_normals(rr_scene *s, uint32_t t0, uint32_t t1) {
   return RR_OK;
 }
 
-/* Loads a mesh file into s, names its geometries `name`, gives it smooth normals,
- * scales it uniformly by `size` divided by its largest extent, turns it by `yaw`
- * degrees about +y and stands the bottom centre of its bounds at (x, 0, z). Returns
- * the first material it added. */
-static rr_error place_file(rr_scene *s, const char *path, const char *name, float size, float yaw, float x,
+enum { DATA_PATH_MAX = 4096 };
+
+/* Finds one of the demo's data files in the first directory holding it: the
+ * environment's RASTRAY_DATA, then the installed share/rastray, then the source
+ * tree's data/ (a build that was never installed). */
+static rr_error find_data_file(rr_device *dev, const char *file, char path[static DATA_PATH_MAX]) {
+  const char *dirs[] = {getenv("RASTRAY_DATA"), RR_DATA_INSTALL_DIR, RR_DATA_DIR};
+  for (size_t i = 0; i < sizeof dirs / sizeof *dirs; i++) {
+    if (!dirs[i] || !*dirs[i]) continue;
+    int n = snprintf(path, DATA_PATH_MAX, "%s/%s", dirs[i], file);
+    FILE *f = n > 0 && n < DATA_PATH_MAX ? fopen(path, "rb") : NULL;
+    if (f) {
+      fclose(f);
+      return RR_OK;
+    }
+  }
+  return rr_fail(dev, RR_ERROR_IO, "demo file '%s' is in none of $RASTRAY_DATA, %s, %s", file,
+                 RR_DATA_INSTALL_DIR, RR_DATA_DIR);
+}
+
+/* Loads a data file's mesh into s, names its geometries `name`, gives it smooth
+ * normals, scales it uniformly by `size` divided by its largest extent, turns it by
+ * `yaw` degrees about +y and stands the bottom centre of its bounds at (x, 0, z).
+ * Returns the first material it added. */
+static rr_error place_file(rr_scene *s, const char *file, const char *name, float size, float yaw, float x,
                            float z, uint32_t *first_mat) {
   uint32_t t0 = s->ntris, g0 = s->ngeoms;
   *first_mat = s->nmaterials;
-  rr_error e = rr_scene_load_file(s, path);
+  char path[DATA_PATH_MAX];
+  rr_error e = find_data_file(s->dev, file, path);
+  if (!e) e = rr_scene_load_file(s, path);
   if (!e && s->ntris == t0) e = rr_fail(s->dev, RR_ERROR_EMPTY, "demo mesh '%s' has no triangles", path);
   for (uint32_t g = g0; !e && g < s->ngeoms; g++) e = rr_scene_name_geometry(s, g, name);
   if (!e) e = smooth_normals(s, t0, s->ntris);
@@ -545,12 +569,12 @@ static rr_error gen_demo(rr_scene *s) {
   push_quad(s, v3(-5.0f, fy, -3.0f), v3(-5.0f, fy, 3.0f), v3(5.0f, fy, 3.0f), v3(5.0f, fy, -3.0f),
             &up, floor_m);
 
-  e = place_file(s, RR_DATA_DIR "/teapot.obj", "teapot", 3.2f, -20.0f, -0.6f, -0.3f, &teapot_m);
+  e = place_file(s, "teapot.obj", "teapot", 3.2f, -20.0f, -0.6f, -0.3f, &teapot_m);
   if (e) return e;
   for (uint32_t m = teapot_m; m < s->nmaterials; m++) { /* the file has no colour of its own */
     s->materials[m].color[0] = 0.86f, s->materials[m].color[1] = 0.30f, s->materials[m].color[2] = 0.24f;
   }
-  e = place_file(s, RR_DATA_DIR "/spot.obj", "spot", 1.9f, 145.0f, 2.6f, 0.3f, &spot_m);
+  e = place_file(s, "spot.obj", "spot", 1.9f, 145.0f, 2.6f, 0.3f, &spot_m);
   if (!e) e = gen_sphere(s, 48, v3(-3.3f, 0.6f, 0.9f), 0.6f, blue_m);
   if (!e) e = gen_sphere(s, 32, v3(0.9f, 0.35f, 1.6f), 0.35f, gold_m);
   if (!e) e = gen_torus(s, 48, 24, 0.5f, 0.17f, v3(-1.6f, 0.17f, 1.7f), green_m);

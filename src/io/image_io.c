@@ -1,13 +1,17 @@
-/* Image files by extension: PNG (8-bit), PFM (float), NPY (any pixel type) and
- * OpenEXR (float or uint ids).
+/* Image files: PNG (8-bit), PFM (float), NPY (any pixel type) and OpenEXR (floats,
+ * uint ids, several AOVs as layers of one file).
  *
- * Writers encode into a temporary file next to the target and rename it over the
- * target only when everything succeeded, so a failure never leaves a partial file.
+ * Writing goes through an output set (rr_output): each file is encoded in memory,
+ * then written under a temporary name next to its target; only when every file of
+ * the set succeeded are the temporaries renamed over their targets, so a failure
+ * leaves no file behind. Standard output and other non-regular targets (devices,
+ * FIFOs) cannot be renamed onto: their bytes wait in memory and go out last.
  * Readers load the whole file into memory and check every size against its length
  * before touching pixels: a malformed file is an RR_ERROR_PARSE, never a crash. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "io/io.h"
+#include "core/color.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -27,6 +31,8 @@ static const uint8_t npy_magic[6] = {0x93, 'N', 'U', 'M', 'P', 'Y'};
 
 typedef enum image_format { FMT_UNKNOWN = 0, FMT_PNG, FMT_PFM, FMT_EXR, FMT_NPY } image_format;
 
+static const char *const format_names[] = {"", "png", "pfm", "exr", "npy"};
+
 /* The extension of the last path component, with its dot ("" when none). */
 static const char *path_ext(const char *path) {
   const char *slash = strrchr(path, '/');
@@ -36,10 +42,20 @@ static const char *path_ext(const char *path) {
 
 static image_format format_of(const char *path) {
   const char *ext = path_ext(path);
-  if (!strcasecmp(ext, ".png")) return FMT_PNG;
-  if (!strcasecmp(ext, ".pfm")) return FMT_PFM;
-  if (!strcasecmp(ext, ".exr")) return FMT_EXR;
-  if (!strcasecmp(ext, ".npy")) return FMT_NPY;
+  for (int f = FMT_PNG; f <= FMT_NPY; f++)
+    if (ext[0] == '.' && !strcasecmp(ext + 1, format_names[f])) return (image_format)f;
+  return FMT_UNKNOWN;
+}
+
+/* The format named by a "fmt:" prefix of spec (and *file past it), FMT_UNKNOWN when
+ * there is none (*file = spec). */
+static image_format format_prefix(const char *spec, const char **file) {
+  *file = spec;
+  for (int f = FMT_PNG; f <= FMT_NPY; f++)
+    if (!strncasecmp(spec, format_names[f], 3) && spec[3] == ':') {
+      *file = spec + 4;
+      return (image_format)f;
+    }
   return FMT_UNKNOWN;
 }
 
@@ -92,10 +108,19 @@ static float bits_float(uint32_t u) {
   return f;
 }
 
-/* Sample i (pixel-major, channels interleaved) of an image as a float. */
+/* Whether sample i of an image is a colour channel (of a colour image, alpha aside). */
+static bool is_color(const rr_image *img, size_t i) {
+  return img->kind == RR_IMAGE_COLOR && !(img->channels == 4 && i % 4 == 3);
+}
+
+/* Sample i (pixel-major, channels interleaved) as a float file holds it: 8-bit
+ * values as v / 255, decoded to linear light when colour; ids as their float. */
 static float sample_float(const rr_image *img, size_t i) {
   switch (img->type) {
-  case RR_PIXEL_U8: return ((const uint8_t *)img->data)[i] / 255.0f;
+  case RR_PIXEL_U8: {
+    float v = ((const uint8_t *)img->data)[i] / 255.0f;
+    return is_color(img, i) ? srgb_decode(v) : v;
+  }
   case RR_PIXEL_F32: return ((const float *)img->data)[i];
   default: return (float)((const uint32_t *)img->data)[i];
   }
@@ -108,6 +133,14 @@ static uint8_t to_u8(float v) {
   return (uint8_t)(v * 255.0f + 0.5f);
 }
 
+/* Sample i as an 8-bit file holds it: floats clamped and rounded, sRGB-encoded first
+ * when colour. */
+static uint8_t sample_u8(const rr_image *img, size_t i) {
+  if (img->type == RR_PIXEL_U8) return ((const uint8_t *)img->data)[i];
+  float v = ((const float *)img->data)[i]; /* check_fits keeps ids out of PNG */
+  return to_u8(is_color(img, i) ? srgb_encode(v) : v);
+}
+
 /* A library's message made one printable line (tinyexr's often end in '\n', stb's
  * may quote bytes of the file). */
 static const char *one_line(char *buf, size_t cap, const char *msg) {
@@ -118,135 +151,72 @@ static const char *one_line(char *buf, size_t cap, const char *msg) {
   for (size_t n = strlen(buf); n > 0 && buf[n - 1] == ' '; n--) buf[n - 1] = '\0';
   return buf;
 }
+/* ---- encoding into memory ------------------------------------------------------ */
 
-/* ---- writing through a temporary file ---------------------------------------- */
+typedef struct bytes {
+  uint8_t *p;
+  size_t n, cap;
+  bool nomem; /* an append failed: the buffer is incomplete */
+} bytes;
 
-typedef struct tmp_file {
-  const char *path; /* the target, for messages */
-  char *name;       /* the temporary */
-  FILE *f;
-} tmp_file;
-
-/* Creates path.tmp.XXXXXX exclusively. Not mkstemp: it makes the file 0600 and the
- * image would keep that mode; opening with 0666 lets the umask decide as for any
- * other output file. */
-static rr_error tmp_create(rr_device *dev, const char *path, tmp_file *t) {
-  size_t cap = strlen(path) + 32;
-  t->path = path;
-  t->f = NULL;
-  t->name = malloc(cap);
-  if (!t->name) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
-  struct timespec ts;
-  clock_gettime(CLOCK_REALTIME, &ts);
-  uint64_t seed = (uint64_t)ts.tv_nsec ^ (uint64_t)ts.tv_sec * 2654435761u ^
-                  (uint64_t)getpid() << 12 ^ (uint64_t)(uintptr_t)t;
-  int fd = -1;
-  for (int attempt = 0; attempt < 100; attempt++) {
-    seed = seed * 6364136223846793005ull + 1442695040888963407ull;
-    snprintf(t->name, cap, "%s.tmp.%06lx", path, (unsigned long)(seed >> 40) & 0xFFFFFFul);
-    fd = open(t->name, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0 || errno != EEXIST) break;
+static void bytes_put(bytes *b, const void *p, size_t n) {
+  if (b->nomem || n == 0) return;
+  if (n > b->cap - b->n) {
+    size_t cap = b->cap ? b->cap : 4096;
+    while (cap - b->n < n) cap *= 2;
+    uint8_t *q = realloc(b->p, cap);
+    if (!q) {
+      b->nomem = true;
+      return;
+    }
+    b->p = q;
+    b->cap = cap;
   }
-  if (fd < 0) {
-    int err = errno;
-    free(t->name);
-    t->name = NULL;
-    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", path, strerror(err));
-  }
-  t->f = fdopen(fd, "wb");
-  if (!t->f) {
-    int err = errno;
-    close(fd);
-    unlink(t->name);
-    free(t->name);
-    t->name = NULL;
-    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", path, strerror(err));
-  }
-  return RR_OK;
+  memcpy(b->p + b->n, p, n);
+  b->n += n;
 }
 
-/* Closes the temporary and, when status is RR_OK, renames it over the target;
- * otherwise (or when closing or renaming fails) removes it. */
-static rr_error tmp_finish(rr_device *dev, tmp_file *t, rr_error status) {
-  int err = 0;
-  if (status == RR_OK && fflush(t->f) != 0) err = errno;
-  if (fclose(t->f) != 0 && status == RR_OK && !err) err = errno;
-  if (status == RR_OK && !err && rename(t->name, t->path) != 0) err = errno;
-  if (status != RR_OK || err) unlink(t->name);
-  free(t->name);
-  t->name = NULL;
-  if (status == RR_OK && err)
-    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", t->path, strerror(err));
-  return status;
+static void bytes_free(bytes *b) {
+  free(b->p);
+  memset(b, 0, sizeof *b);
 }
 
-static rr_error put(rr_device *dev, tmp_file *t, const void *p, size_t n) {
-  errno = 0;
-  if (n && fwrite(p, 1, n, t->f) != n)
-    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", t->path,
-                   strerror(errno ? errno : EIO));
-  return RR_OK;
-}
-
-/* ---- PNG ---------------------------------------------------------------------- */
-
-typedef struct png_sink {
-  FILE *f;
-  int err; /* errno of the first failed write */
-} png_sink;
-
+/* PNG through stb, from a copy converted to 8 bits. */
 static void png_write_cb(void *ctx, void *data, int size) {
-  png_sink *s = ctx;
-  errno = 0;
-  if (!s->err && size > 0 && fwrite(data, 1, (size_t)size, s->f) != (size_t)size)
-    s->err = errno ? errno : EIO;
+  if (size > 0) bytes_put(ctx, data, (size_t)size);
 }
 
-static rr_error write_png(rr_device *dev, tmp_file *t, const rr_image *img) {
+static bool encode_png(const rr_image *img, bytes *out) {
   size_t n = (size_t)img->width * img->height * img->channels;
-  const uint8_t *px = img->data;
-  uint8_t *conv = NULL;
-  if (img->type == RR_PIXEL_F32) {
-    conv = malloc(n);
-    if (!conv) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", t->path);
-    for (size_t i = 0; i < n; i++) conv[i] = to_u8(((const float *)img->data)[i]);
-    px = conv;
-  }
-  png_sink sink = {t->f, 0};
-  int ok = stbi_write_png_to_func(png_write_cb, &sink, img->width, img->height, img->channels, px,
+  uint8_t *px = malloc(n);
+  if (!px) return false;
+  for (size_t i = 0; i < n; i++) px[i] = sample_u8(img, i);
+  int ok = stbi_write_png_to_func(png_write_cb, out, img->width, img->height, img->channels, px,
                                   img->width * img->channels);
-  free(conv);
-  if (!ok) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': PNG encoding failed", t->path);
-  if (sink.err)
-    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", t->path, strerror(sink.err));
-  return RR_OK;
+  free(px);
+  return ok && !out->nomem;
 }
-
-/* ---- PFM ---------------------------------------------------------------------- */
 
 /* PFM rows go bottom to top; a negative scale marks little-endian floats. 8-bit
- * values are written as v / 255, ids as their float (check_fits made sure it is exact). */
-static rr_error write_pfm(rr_device *dev, tmp_file *t, const rr_image *img) {
+ * values are written as sample_float gives them, ids as their float (check_fits made
+ * sure it is exact). */
+static bool encode_pfm(const rr_image *img, bytes *out) {
   char head[64];
   int len = snprintf(head, sizeof head, "%s\n%d %d\n-1.0\n", img->channels == 1 ? "Pf" : "PF",
                      img->width, img->height);
-  rr_error e = put(dev, t, head, (size_t)len);
+  bytes_put(out, head, (size_t)len);
   size_t row_samples = (size_t)img->width * img->channels;
-  uint8_t *row = malloc(row_samples * 4);
-  if (!row) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", t->path);
-  for (int y = img->height - 1; y >= 0 && e == RR_OK; y--) {
-    size_t base = (size_t)y * row_samples;
-    for (size_t i = 0; i < row_samples; i++)
-      store_le32(row + 4 * i, float_bits(sample_float(img, base + i)));
-    e = put(dev, t, row, row_samples * 4);
-  }
-  free(row);
-  return e;
+  for (int y = img->height - 1; y >= 0; y--)
+    for (size_t i = 0; i < row_samples; i++) {
+      uint8_t w[4];
+      store_le32(w, float_bits(sample_float(img, (size_t)y * row_samples + i)));
+      bytes_put(out, w, 4);
+    }
+  return !out->nomem;
 }
 
-/* ---- NPY ---------------------------------------------------------------------- */
-
-static rr_error write_npy(rr_device *dev, tmp_file *t, const rr_image *img) {
+/* NPY holds the samples as they are, in the image's own type. */
+static bool encode_npy(const rr_image *img, bytes *out) {
   const char *descr = img->type == RR_PIXEL_U8 ? "|u1" : img->type == RR_PIXEL_F32 ? "<f4" : "<u4";
   char dict[128];
   int n;
@@ -267,98 +237,171 @@ static rr_error write_npy(rr_device *dev, tmp_file *t, const rr_image *img) {
   memcpy(head + 10, dict, (size_t)n);
   memset(head + 10 + n, ' ', total - 10 - (size_t)n - 1);
   head[total - 1] = '\n';
-  rr_error e = put(dev, t, head, total);
-  if (e) return e;
-  size_t row_samples = (size_t)img->width * img->channels;
-  if (img->type == RR_PIXEL_U8) return put(dev, t, img->data, row_samples * img->height);
-  uint8_t *row = malloc(row_samples * 4);
-  if (!row) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", t->path);
-  const uint32_t *words = img->data; /* F32 and U32 are both 32-bit words */
-  for (int y = 0; y < img->height && e == RR_OK; y++) {
-    for (size_t i = 0; i < row_samples; i++)
-      store_le32(row + 4 * i, words[(size_t)y * row_samples + i]);
-    e = put(dev, t, row, row_samples * 4);
+  bytes_put(out, head, total);
+  size_t count = (size_t)img->width * img->height * img->channels;
+  if (img->type == RR_PIXEL_U8) {
+    bytes_put(out, img->data, count);
+  } else {
+    const uint32_t *words = img->data; /* F32 and U32 are both 32-bit words */
+    for (size_t i = 0; i < count; i++) {
+      uint8_t w[4];
+      store_le32(w, words[i]);
+      bytes_put(out, w, 4);
+    }
   }
-  free(row);
-  return e;
+  return !out->nomem;
 }
 
-/* ---- EXR ---------------------------------------------------------------------- */
+/* ---- EXR channel names ------------------------------------------------------------ */
 
-/* Channel names by channel count; 2 channels (e.g. barycentrics) are stored as R, G. */
-static const char *const exr_names[5][4] = {
+/* Values and colour by channel count, as OpenEXR names colour: R, G, B, A (Y alone). */
+static const char *const plain_channels[5][4] = {
     {0}, {"Y"}, {"R", "G"}, {"R", "G", "B"}, {"R", "G", "B", "A"}};
 
-/* Encodes an image as a ZIP-compressed scanline EXR in memory: floats as FLOAT
- * channels (8-bit values divided by 255), ids as UINT channels. */
-static rr_error encode_exr(rr_device *dev, const rr_image *img, const char *path,
-                           unsigned char **mem, size_t *size) {
-  int c = img->channels;
-  size_t npix = (size_t)img->width * img->height;
-  /* OpenEXR lists channels sorted by name, and the pixel data follows that order */
-  int order[4];
-  for (int i = 0; i < c; i++) {
-    int j = i;
-    for (; j > 0 && strcmp(exr_names[c][order[j - 1]], exr_names[c][i]) > 0; j--)
-      order[j] = order[j - 1];
-    order[j] = i;
+/* AOVs: depth in Z as OpenEXR's convention has it; vectors as named layers, which
+ * OpenImageIO, Nuke and Blender show as one layer (channels sorted by name read back
+ * in this order); ids by what they number. */
+static const struct {
+  int channels;
+  const char *names[3];
+} aov_channels[RR_AOV_COUNT] = {
+    [RR_AOV_DEPTH] = {1, {"Z"}},
+    [RR_AOV_ID] = {1, {"id"}},
+    [RR_AOV_NORMAL] = {3, {"N.X", "N.Y", "N.Z"}},
+    [RR_AOV_BARY] = {2, {"bary.u", "bary.v"}},
+    [RR_AOV_EVALS] = {1, {"evals"}},
+    [RR_AOV_NODES] = {1, {"nodes"}},
+    [RR_AOV_MESH] = {1, {"mesh"}},
+    [RR_AOV_MATERIAL] = {1, {"material"}},
+};
+
+static bool is_aov_kind(int kind) {
+  return kind >= RR_IMAGE_AOV && kind < RR_IMAGE_AOV + RR_AOV_COUNT;
+}
+
+/* The EXR name of channel ch of a checked image. */
+static const char *exr_channel(const rr_image *img, int ch) {
+  if (is_aov_kind(img->kind)) return aov_channels[img->kind - RR_IMAGE_AOV].names[ch];
+  return plain_channels[img->channels][ch];
+}
+
+typedef struct exr_channel_ref {
+  const char *name;
+  const rr_image *img;
+  int ch;
+} exr_channel_ref;
+
+static int cmp_channel(const void *a, const void *b) {
+  return strcmp(((const exr_channel_ref *)a)->name, ((const exr_channel_ref *)b)->name);
+}
+
+/* Encodes images of one size as the channels of one ZIP-compressed scanline EXR:
+ * floats as FLOAT channels (8-bit values as sample_float gives them), ids as UINT.
+ * Several images are the layers of one part, as multi-layer EXR files are. */
+static rr_error encode_exr(rr_device *dev, const rr_image *images, int n, const char *path,
+                           bytes *out) {
+  int c = 0;
+  for (int i = 0; i < n; i++) c += images[i].channels;
+  size_t npix = (size_t)images[0].width * images[0].height;
+  exr_channel_ref *refs = calloc((size_t)c, sizeof *refs);
+  EXRChannelInfo *info = calloc((size_t)c, sizeof *info);
+  int *types = calloc((size_t)c * 2, sizeof *types);
+  unsigned char **planes = calloc((size_t)c, sizeof *planes);
+  rr_error e = RR_OK;
+  if (!refs || !info || !types || !planes) {
+    e = rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
+    goto done;
   }
-  EXRChannelInfo info[4];
-  int pixel_types[4], requested[4];
-  unsigned char *planes[4] = {0};
-  int type = img->type == RR_PIXEL_U32 ? TINYEXR_PIXELTYPE_UINT : TINYEXR_PIXELTYPE_FLOAT;
-  memset(info, 0, sizeof info);
+  for (int i = 0, k = 0; i < n; i++)
+    for (int ch = 0; ch < images[i].channels; ch++, k++)
+      refs[k] = (exr_channel_ref){exr_channel(&images[i], ch), &images[i], ch};
+  /* OpenEXR lists channels sorted by name, and the pixel data follows that order */
+  qsort(refs, (size_t)c, sizeof *refs, cmp_channel);
   for (int k = 0; k < c; k++) {
-    int src = order[k];
-    snprintf(info[k].name, sizeof info[k].name, "%s", exr_names[c][src]);
+    if (k > 0 && !strcmp(refs[k].name, refs[k - 1].name)) {
+      e = rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': two layers have a channel '%s'", path,
+                  refs[k].name);
+      goto done;
+    }
+    const rr_image *img = refs[k].img;
+    int ic = img->channels;
+    snprintf(info[k].name, sizeof info[k].name, "%s", refs[k].name);
     info[k].x_sampling = info[k].y_sampling = 1;
-    pixel_types[k] = requested[k] = type;
+    types[k] = types[c + k] = img->type == RR_PIXEL_U32 ? TINYEXR_PIXELTYPE_UINT : TINYEXR_PIXELTYPE_FLOAT;
     planes[k] = malloc(npix * 4);
     if (!planes[k]) {
-      for (int i = 0; i < k; i++) free(planes[i]);
-      return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
+      e = rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
+      goto done;
     }
     if (img->type == RR_PIXEL_U32) {
       uint32_t *dst = (uint32_t *)planes[k];
-      for (size_t i = 0; i < npix; i++) dst[i] = ((const uint32_t *)img->data)[i * c + src];
+      for (size_t i = 0; i < npix; i++) dst[i] = ((const uint32_t *)img->data)[i * ic + refs[k].ch];
     } else {
       float *dst = (float *)planes[k];
-      for (size_t i = 0; i < npix; i++) dst[i] = sample_float(img, i * c + src);
+      for (size_t i = 0; i < npix; i++) dst[i] = sample_float(img, i * ic + refs[k].ch);
     }
   }
-  EXRHeader header;
-  InitEXRHeader(&header);
-  header.num_channels = c;
-  header.channels = info;
-  header.pixel_types = pixel_types;
-  header.requested_pixel_types = requested;
-  header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-  EXRImage image;
-  InitEXRImage(&image);
-  image.images = planes;
-  image.width = img->width;
-  image.height = img->height;
-  image.num_channels = c;
-  const char *err = NULL;
-  *mem = NULL;
-  *size = SaveEXRImageToMemory(&image, &header, mem, &err);
-  for (int k = 0; k < c; k++) free(planes[k]);
-  /* header and image point at our arrays: not for FreeEXRHeader/FreeEXRImage */
-  if (*size == 0) {
-    char buf[256];
-    rr_error e = rr_fail(dev, RR_ERROR_IO, "cannot write '%s': EXR encoding failed: %s", path,
-                         one_line(buf, sizeof buf, err));
-    if (err) FreeEXRErrorMessage(err);
-    free(*mem);
-    *mem = NULL;
-    return e;
+  {
+    EXRHeader header;
+    InitEXRHeader(&header);
+    header.num_channels = c;
+    header.channels = info;
+    header.pixel_types = types;
+    header.requested_pixel_types = types + c;
+    header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
+    EXRImage image;
+    InitEXRImage(&image);
+    image.images = planes;
+    image.width = images[0].width;
+    image.height = images[0].height;
+    image.num_channels = c;
+    const char *err = NULL;
+    unsigned char *mem = NULL;
+    size_t size = SaveEXRImageToMemory(&image, &header, &mem, &err);
+    /* header and image point at our arrays: not for FreeEXRHeader/FreeEXRImage */
+    if (size == 0) {
+      char buf[256];
+      e = rr_fail(dev, RR_ERROR_IO, "cannot write '%s': EXR encoding failed: %s", path,
+                  one_line(buf, sizeof buf, err));
+      if (err) FreeEXRErrorMessage(err);
+      free(mem);
+    } else {
+      *out = (bytes){mem, size, size, false};
+    }
   }
+done:
+  for (int k = 0; planes && k < c; k++) free(planes[k]);
+  free(planes);
+  free(types);
+  free(info);
+  free(refs);
+  return e;
+}
+
+/* ---- checks before anything is made ----------------------------------------------- */
+
+static rr_error check_image(rr_device *dev, const rr_image *img, const char *path) {
+  if (!img || !img->data)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no image data", path);
+  if (img->width < 1 || img->height < 1 || img->width > RR_MAX_SIZE || img->height > RR_MAX_SIZE)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad image size %dx%d", path,
+                   img->width, img->height);
+  if (img->channels < 1 || img->channels > 4)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad channel count %d", path,
+                   img->channels);
+  if (img->type != RR_PIXEL_U8 && img->type != RR_PIXEL_F32 && img->type != RR_PIXEL_U32)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad pixel type %d", path,
+                   (int)img->type);
+  if (img->kind < 0 || img->kind >= RR_IMAGE_AOV + RR_AOV_COUNT)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad image kind %d", path,
+                   img->kind);
+  if (is_aov_kind(img->kind) && img->channels != aov_channels[img->kind - RR_IMAGE_AOV].channels)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': an AOV image of %d channels, %d expected",
+                   path, img->channels, aov_channels[img->kind - RR_IMAGE_AOV].channels);
   return RR_OK;
 }
 
-/* ---- writer entry points ------------------------------------------------------ */
-
-/* Checks that the format can hold the image, before any file is made. */
+/* Checks that the format can hold the image. */
 static rr_error check_fits(rr_device *dev, image_format fmt, const rr_image *img,
                            const char *path) {
   int c = img->channels;
@@ -401,45 +444,267 @@ static rr_error check_fits(rr_device *dev, image_format fmt, const rr_image *img
   return RR_OK;
 }
 
-rr_error rr_image_write_file(rr_device *dev, const rr_image *img, const char *path) {
-  if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write an image: no path");
-  image_format fmt = format_of(path);
-  if (fmt == FMT_UNKNOWN) return unknown_format(dev, "write", path);
-  if (!img || !img->data)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no image data", path);
-  if (img->width < 1 || img->height < 1 || img->width > RR_MAX_SIZE || img->height > RR_MAX_SIZE)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad image size %dx%d", path,
-                   img->width, img->height);
-  if (img->channels < 1 || img->channels > 4)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad channel count %d", path,
-                   img->channels);
-  if (img->type != RR_PIXEL_U8 && img->type != RR_PIXEL_F32 && img->type != RR_PIXEL_U32)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad pixel type %d", path,
-                   (int)img->type);
-  rr_error e = check_fits(dev, fmt, img, path);
-  if (e) return e;
-
-  /* EXR is encoded in memory first so that an encoding failure makes no file */
-  unsigned char *exr = NULL;
-  size_t exr_size = 0;
-  if (fmt == FMT_EXR && (e = encode_exr(dev, img, path, &exr, &exr_size)) != RR_OK) return e;
-
-  tmp_file t;
-  e = tmp_create(dev, path, &t);
-  if (e) {
-    free(exr);
-    return e;
-  }
+/* Encodes n checked images (n > 1 only for EXR) in format fmt. */
+static rr_error encode(rr_device *dev, image_format fmt, const rr_image *images, int n,
+                       const char *path, bytes *out) {
+  bool ok = false;
   switch (fmt) {
-  case FMT_PNG: e = write_png(dev, &t, img); break;
-  case FMT_PFM: e = write_pfm(dev, &t, img); break;
-  case FMT_NPY: e = write_npy(dev, &t, img); break;
-  case FMT_EXR: e = put(dev, &t, exr, exr_size); break;
+  case FMT_EXR: return encode_exr(dev, images, n, path, out);
+  case FMT_PNG: ok = encode_png(images, out); break;
+  case FMT_PFM: ok = encode_pfm(images, out); break;
+  case FMT_NPY: ok = encode_npy(images, out); break;
   case FMT_UNKNOWN: break;
   }
-  free(exr);
-  e = tmp_finish(dev, &t, e);
-  return e ? e : rr_ok(dev);
+  if (ok) return RR_OK;
+  bytes_free(out);
+  return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
+}
+
+/* ---- output sets ------------------------------------------------------------------ */
+
+typedef struct output {
+  char *spec;      /* the path as given, with any format prefix (for messages) */
+  const char *file;/* the file itself, inside spec */
+  char *tmp;       /* a regular file's temporary; NULL for a stream and once renamed */
+  bytes data;      /* a stream's bytes, written at commit */
+  bool stream;     /* standard output or a non-regular file: written, not renamed onto */
+  bool is_stdout;
+} output;
+
+struct rr_output {
+  rr_device *dev;
+  output *v;
+  int n, cap;
+  bool committed;
+};
+
+/* Creates a temporary for file in its directory, exclusively: file.tmp.XXXXXX. Not
+ * mkstemp, which makes the file 0600 for good: opening with 0666 lets the umask
+ * decide, as for any other output; O_EXCL gives mkstemp's guarantee that two runs
+ * never share a temporary. */
+static int tmp_create(char *name, size_t cap, const char *file) {
+  struct timespec ts;
+  clock_gettime(CLOCK_REALTIME, &ts);
+  uint64_t seed = (uint64_t)ts.tv_nsec ^ (uint64_t)ts.tv_sec * 2654435761u ^
+                  (uint64_t)getpid() << 12 ^ (uint64_t)(uintptr_t)name;
+  int fd = -1;
+  for (int attempt = 0; attempt < 100; attempt++) {
+    seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+    snprintf(name, cap, "%s.tmp.%06lx", file, (unsigned long)(seed >> 40) & 0xFFFFFFul);
+    fd = open(name, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0 || errno != EEXIST) break;
+  }
+  return fd;
+}
+
+/* Writes all of b to fd; 0 or an errno. */
+static int write_all(int fd, const bytes *b) {
+  for (size_t done = 0; done < b->n;) {
+    ssize_t w = write(fd, b->p + done, b->n - done);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return w < 0 ? errno : EIO;
+    done += (size_t)w;
+  }
+  return 0;
+}
+
+/* Writes the encoded file to a new temporary for o->file (o->tmp). */
+static rr_error write_tmp(rr_device *dev, output *o, const bytes *b) {
+  size_t cap = strlen(o->file) + 32;
+  o->tmp = malloc(cap);
+  if (!o->tmp) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", o->spec);
+  int fd = tmp_create(o->tmp, cap, o->file);
+  int err = fd < 0 ? errno : write_all(fd, b);
+  if (fd >= 0 && close(fd) != 0 && !err) err = errno;
+  if (err) {
+    if (fd >= 0) unlink(o->tmp);
+    free(o->tmp);
+    o->tmp = NULL;
+    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", o->spec, strerror(err));
+  }
+  return RR_OK;
+}
+
+rr_error rr_output_new(rr_device *dev, rr_output **out) {
+  if (!out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_output_new: NULL argument");
+  *out = calloc(1, sizeof **out);
+  if (!*out) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for an output set");
+  (*out)->dev = dev;
+  return rr_ok(dev);
+}
+
+/* The format of an output that names none: what suits the images. */
+static image_format default_format(const rr_image *images, int n) {
+  if (n > 1) return FMT_EXR;
+  return images->kind == RR_IMAGE_COLOR || images->type == RR_PIXEL_U8 ? FMT_PNG : FMT_NPY;
+}
+
+/* Checks where an output goes (file inside path, after any format prefix) and
+ * starts its entry: a stream or a regular file, not written twice by one set. */
+static rr_error output_target(rr_output *set, const char *path, const char *file, output *o) {
+  rr_device *dev = set->dev;
+  struct stat st;
+  bool is_stdout = !strcmp(file, "-");
+  bool exists = !is_stdout && stat(file, &st) == 0;
+  bool stream = is_stdout || (exists && !S_ISREG(st.st_mode));
+  if (exists && S_ISDIR(st.st_mode))
+    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", path, strerror(EISDIR));
+  for (int i = 0; i < set->n; i++)
+    if ((is_stdout && set->v[i].is_stdout) || (!stream && !set->v[i].stream && !strcmp(set->v[i].file, file)))
+      return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': %s written twice", path,
+                     is_stdout ? "standard output" : "the file");
+  if (stream && !is_stdout && access(file, W_OK) != 0)
+    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", path, strerror(errno));
+  *o = (output){.stream = stream, .is_stdout = is_stdout};
+  return RR_OK;
+}
+
+/* Adds the output o of path with its bytes b, which it takes: a stream keeps them
+ * for the commit, a regular file is written to its temporary now. */
+static rr_error output_push(rr_output *set, output o, const char *path, const char *file, bytes *b) {
+  rr_device *dev = set->dev;
+  rr_error e = RR_OK;
+  if (set->n == set->cap) {
+    int cap = set->cap ? 2 * set->cap : 8;
+    output *v = realloc(set->v, (size_t)cap * sizeof *v);
+    if (!v) e = rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
+    else set->v = v, set->cap = cap;
+  }
+  if (!e && !(o.spec = strdup(path))) e = rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
+  if (!e) o.file = o.spec + (file - path);
+  if (!e && o.stream) o.data = *b, *b = (bytes){0}; /* kept for the commit */
+  else if (!e) e = write_tmp(dev, &o, b);
+  bytes_free(b);
+  if (e) {
+    free(o.spec);
+    return e;
+  }
+  set->v[set->n++] = o;
+  return rr_ok(dev);
+}
+
+rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char *path) {
+  if (!set) return RR_ERROR_ARGUMENT;
+  rr_device *dev = set->dev;
+  if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write an image: no path");
+  if (set->committed)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': the output set was committed", path);
+  if (n < 1 || !images) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no image data", path);
+  const char *file;
+  image_format fmt = format_prefix(path, &file);
+  if (!*file) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no path after the format", path);
+  output o;
+  rr_error e = output_target(set, path, file, &o);
+  if (e) return e;
+  if (fmt == FMT_UNKNOWN) fmt = format_of(file);
+  if (fmt == FMT_UNKNOWN && o.stream) fmt = default_format(images, n);
+  if (fmt == FMT_UNKNOWN) return unknown_format(dev, "write", path);
+  for (int i = 0; i < n && !e; i++) {
+    e = check_image(dev, &images[i], path);
+    if (!e && (images[i].width != images[0].width || images[i].height != images[0].height))
+      e = rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': layers of %dx%d and %dx%d pixels", path,
+                  images[0].width, images[0].height, images[i].width, images[i].height);
+  }
+  if (e) return e;
+  if (n > 1 && fmt != FMT_EXR)
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED, "cannot write '%s': only EXR holds several layers", path);
+  if ((e = check_fits(dev, fmt, images, path)) != RR_OK) return e;
+  bytes b = {0};
+  if ((e = encode(dev, fmt, images, n, path, &b)) != RR_OK) return e;
+  return output_push(set, o, path, file, &b);
+}
+
+rr_error rr_output_add_bytes(rr_output *set, const void *data, size_t size, const char *path) {
+  if (!set) return RR_ERROR_ARGUMENT;
+  rr_device *dev = set->dev;
+  if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write a file: no path");
+  if (set->committed)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': the output set was committed", path);
+  if (!data && size) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no data", path);
+  output o;
+  rr_error e = output_target(set, path, path, &o);
+  if (e) return e;
+  bytes b = {0};
+  bytes_put(&b, data, size);
+  if (b.nomem) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);
+  return output_push(set, o, path, path, &b);
+}
+
+/* Writes a stream's bytes: the target opened as it is (never created or renamed onto). */
+static int write_stream(const output *o) {
+  if (o->is_stdout) {
+    errno = 0;
+    if (fwrite(o->data.p, 1, o->data.n, stdout) != o->data.n || fflush(stdout) != 0)
+      return errno ? errno : EIO;
+    return 0;
+  }
+  int fd = open(o->file, O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return errno;
+  int err = write_all(fd, &o->data);
+  if (close(fd) != 0 && !err) err = errno;
+  return err;
+}
+
+rr_error rr_output_commit(rr_output *set) {
+  if (!set) return RR_ERROR_ARGUMENT;
+  rr_device *dev = set->dev;
+  if (set->committed) return rr_fail(dev, RR_ERROR_ARGUMENT, "an output set is committed once");
+  set->committed = true;
+  for (int i = 0; i < set->n; i++) {
+    output *o = &set->v[i];
+    if (!o->tmp) continue;
+    if (rename(o->tmp, o->file) == 0) {
+      free(o->tmp);
+      o->tmp = NULL;
+      continue;
+    }
+    int err = errno;
+    /* all or nothing: the files already in place go again; release removes the temporaries */
+    for (int j = 0; j < i; j++)
+      if (!set->v[j].stream) unlink(set->v[j].file);
+    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", o->spec, strerror(err));
+  }
+  /* streams after the files, standard output last: a reader gets data only once
+   * everything else is in place */
+  for (int pass = 0; pass < 2; pass++)
+    for (int i = 0; i < set->n; i++) {
+      output *o = &set->v[i];
+      if (!o->stream || o->is_stdout != (pass == 1)) continue;
+      int err = write_stream(o);
+      if (err) return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", o->spec, strerror(err));
+    }
+  return rr_ok(dev);
+}
+
+void rr_output_release(rr_output *set) {
+  if (!set) return;
+  for (int i = 0; i < set->n; i++) {
+    if (set->v[i].tmp) unlink(set->v[i].tmp);
+    free(set->v[i].tmp);
+    bytes_free(&set->v[i].data);
+    free(set->v[i].spec);
+  }
+  free(set->v);
+  free(set);
+}
+
+/* One call, one set. */
+static rr_error write_set(rr_device *dev, const rr_image *images, int n, const char *path) {
+  rr_output *set;
+  rr_error e = rr_output_new(dev, &set);
+  if (e) return e;
+  e = rr_output_add(set, images, n, path);
+  if (!e) e = rr_output_commit(set);
+  rr_output_release(set);
+  return e;
+}
+
+rr_error rr_image_write(rr_device *dev, const rr_image *img, const char *path) {
+  return write_set(dev, img, 1, path);
+}
+
+rr_error rr_image_write_layers(rr_device *dev, const rr_image *images, int n, const char *path) {
+  return write_set(dev, images, n, path);
 }
 
 /* ---- reading ------------------------------------------------------------------ */
@@ -856,6 +1121,13 @@ static rr_error read_exr(rr_device *dev, const char *path, const blob *b, rr_ima
   }
   e = alloc_image(dev, path, (int)w, (int)h, c, ids ? RR_PIXEL_U32 : RR_PIXEL_F32, out);
   if (e) goto done;
+  /* the kind the channel names say (sorted like aov_channels' names) */
+  out->kind = nrgba == c ? RR_IMAGE_COLOR : RR_IMAGE_VALUES;
+  for (int a = 0; a < RR_AOV_COUNT && nrgba == 0; a++) {
+    bool same = aov_channels[a].channels == c;
+    for (int k = 0; same && k < c; k++) same = !strcmp(header.channels[k].name, aov_channels[a].names[k]);
+    if (same) out->kind = RR_IMAGE_AOV + a;
+  }
   {
     size_t npix = (size_t)w * h;
     uint32_t *dst = out->data; /* 32-bit words, float or uint alike */
@@ -872,7 +1144,7 @@ done:
   return e;
 }
 
-rr_error rr_image_read_file(rr_device *dev, const char *path, rr_image *out) {
+rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out) {
   if (!out) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot read an image: no output image");
   memset(out, 0, sizeof *out);
   if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot read an image: no path");
@@ -896,15 +1168,7 @@ rr_error rr_image_read_file(rr_device *dev, const char *path, rr_image *out) {
   return rr_ok(dev);
 }
 
-/* ---- public API --------------------------------------------------------------- */
-
-rr_error rr_image_write(rr_device *dev, const rr_image *img, const char *path) {
-  return rr_image_write_file(dev, img, path);
-}
-
-rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out) {
-  return rr_image_read_file(dev, path, out);
-}
+/* ---- images ------------------------------------------------------------------ */
 
 void rr_image_free(rr_image *img) {
   if (!img) return;

@@ -9,11 +9,11 @@ rr_error rr_scene_load_file(rr_scene *s, const char *path);
 /* Returns RR_OK when `name` named a built-in scene (and fills s), RR_ERROR_UNSUPPORTED
  * when it is not a built-in name; other codes are real failures. */
 rr_error rr_scene_load_builtin(rr_scene *s, const char *name);
-/* Loads the textures named by the materials (missing files leave textures empty). */
+/* Loads the textures named by the materials that have none yet, from files found
+ * from base_dir; the materials' texture_status says what became of each. */
 void rr_scene_load_textures(rr_scene *s, const char *base_dir);
-
-/* Writers and readers by extension, in image_io.c. */
-rr_error rr_image_write_file(rr_device *dev, const rr_image *img, const char *path);
-rr_error rr_image_read_file(rr_device *dev, const char *path, rr_image *out);
+/* Decodes a compressed image in memory (PNG, JPEG, ... as stb_image reads) into tex;
+ * false (tex untouched) when it cannot. */
+bool rr_texture_decode(rr_texture *tex, const void *bytes, size_t len);
 
 #endif

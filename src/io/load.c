@@ -7,8 +7,11 @@ rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out) {
   rr_scene *s;
   rr_error e = rr_scene_new(dev, &s);
   if (e) return e;
+  progress_span progress = {dev, RR_PROGRESS_LOAD, 0, 1}; /* files give no fraction to report */
+  rr_progress(&progress, 0);
   e = rr_scene_load_builtin(s, path);
   if (e == RR_ERROR_UNSUPPORTED) e = rr_scene_load_file(s, path);
+  if (!e) rr_progress(&progress, 1);
   if (!e && s->ntris == 0)
     e = rr_fail(dev, RR_ERROR_EMPTY, "scene '%s' has no triangles%s", path,
                 s->skipped ? " (all were degenerate or non-finite)" : "");

@@ -1,4 +1,7 @@
-/* Scene storage: triangles in structure-of-arrays form, geometries, materials, bounds. */
+/* Scene storage: triangles in structure-of-arrays form, geometries, materials, bounds,
+ * and the cameras and lights of a file. */
+#define _POSIX_C_SOURCE 200809L /* strdup */
+
 #include "accel/bvh.h"
 
 #include <string.h>
@@ -11,6 +14,7 @@ rr_error rr_scene_new(rr_device *dev, rr_scene **out) {
   s->dev = dev;
   s->bmin = v3(INFINITY, INFINITY, INFINITY);
   s->bmax = v3(-INFINITY, -INFINITY, -INFINITY);
+  s->up = v3(0, 1, 0), s->front = v3(0, 0, 1);
   *out = s;
   return rr_ok(dev);
 }
@@ -18,18 +22,23 @@ rr_error rr_scene_new(rr_device *dev, rr_scene **out) {
 void rr_scene_release(rr_scene *s) {
   if (!s) return;
   for (int k = 0; k < 3; k++) {
-    for (int c = 0; c < 3; c++) free(s->p[k][c]), free(s->n[k][c]);
+    for (int c = 0; c < 3; c++) free(s->p[k][c]), free(s->n[k][c]), free(s->col[k][c]);
     for (int c = 0; c < 2; c++) free(s->uv[k][c]);
   }
   free(s->material);
   free(s->inf);
   for (uint32_t m = 0; m < s->nmaterials; m++) {
+    free(s->materials[m].name);
     free(s->materials[m].texture_path);
     free(s->materials[m].texture.rgb);
   }
   free(s->materials);
   free(s->geoms);
   free(s->names);
+  for (uint32_t c = 0; c < s->ncameras; c++) free(s->cameras[c].name);
+  free(s->cameras);
+  for (uint32_t l = 0; l < s->nlights; l++) free((char *)s->lights[l].name);
+  free(s->lights);
   rr_bvh_release(s->bvh);
   free(s);
 }
@@ -67,6 +76,21 @@ rr_error rr_scene_reserve_inf(rr_scene *s) {
   return s->inf ? RR_OK : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for corners at infinity");
 }
 
+rr_error rr_scene_reserve_colors(rr_scene *s) {
+  if (s->col[0][0]) return RR_OK;
+  size_t cap = s->cap ? s->cap : 1;
+  for (int k = 0; k < 3; k++)
+    for (int c = 0; c < 3; c++) {
+      s->col[k][c] = malloc(cap * sizeof(float));
+      if (!s->col[k][c]) {
+        for (int j = 0; j < 9; j++) free(s->col[j / 3][j % 3]), s->col[j / 3][j % 3] = NULL;
+        return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for vertex colours");
+      }
+      for (uint32_t i = 0; i < s->ntris; i++) s->col[k][c][i] = 1.0f; /* white changes nothing */
+    }
+  return RR_OK;
+}
+
 void rr_scene_trim(rr_scene *s) {
   if (s->ntris && s->ntris < s->cap) resize(s, s->ntris, false, false); /* on failure the arrays stay as they were */
 }
@@ -79,6 +103,7 @@ static bool resize(rr_scene *s, uint32_t cap, bool add_n, bool add_uv) {
   for (int k = 0; k < 3; k++) {
     for (int c = 0; c < 3; c++) {
       ok = ok && grow(&s->p[k][c], cap);
+      if (s->col[k][c]) ok = ok && grow(&s->col[k][c], cap);
       if (s->n[k][c] || add_n) {
         bool fresh = !s->n[k][c];
         ok = ok && grow(&s->n[k][c], cap);
@@ -130,10 +155,11 @@ vec3 rr_scene_tri_normal(const rr_scene *s, uint32_t i) {
 }
 
 bool rr_scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv)[2], uint32_t mat) {
-  return rr_scene_push_inf(s, p, 0, n, uv, mat);
+  return rr_scene_push_inf(s, p, 0, n, uv, NULL, mat);
 }
 
-bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, const float (*uv)[2], uint32_t mat) {
+bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, const float (*uv)[2],
+                       const vec3 *col, uint32_t mat) {
   /* A triangle with a non-finite coordinate or no area can never be hit
    * consistently; it is dropped and counted, not fatal. So is one whose three
    * corners are all at infinity (it lies on the plane at infinity). */
@@ -147,6 +173,7 @@ bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n
   if ((n && !s->n[0][0]) || (uv && !s->uv[0][0]))
     if (rr_scene_reserve(s, 0, n != NULL, uv != NULL) != RR_OK) return false;
   if (inf && rr_scene_reserve_inf(s) != RR_OK) return false;
+  if (col && rr_scene_reserve_colors(s) != RR_OK) return false;
   if (!s->ngeoms && rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, NULL) != RR_OK) return false;
   uint32_t i = s->ntris++;
   if (s->inf) s->inf[i] = (uint8_t)(inf & 7u);
@@ -159,6 +186,10 @@ bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n
     if (s->uv[0][0]) {
       s->uv[k][0][i] = uv ? uv[k][0] : 0;
       s->uv[k][1][i] = uv ? uv[k][1] : 0;
+    }
+    if (s->col[0][0]) {
+      vec3 ck = col ? col[k] : v3(1, 1, 1);
+      s->col[k][0][i] = ck.x, s->col[k][1][i] = ck.y, s->col[k][2][i] = ck.z;
     }
     if (inf >> k & 1u) continue;
     s->bmin = v3_min(s->bmin, p[k]);
@@ -181,6 +212,42 @@ uint32_t rr_scene_add_material(rr_scene *s, const float color[3], const char *te
     strcpy(mat->texture_path, texture_path);
   }
   return s->nmaterials++;
+}
+
+/* A malloc'd copy of name in *out (NULL for NULL or ""); false when out of memory. */
+static bool copy_name(const char *name, char **out) {
+  *out = NULL;
+  if (!name || !*name) return true;
+  *out = strdup(name);
+  return *out != NULL;
+}
+
+rr_error rr_scene_name_material(rr_scene *s, uint32_t m, const char *name) {
+  char *copy;
+  if (!copy_name(name, &copy)) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory naming a material");
+  free(s->materials[m].name);
+  s->materials[m].name = copy;
+  return RR_OK;
+}
+
+rr_error rr_scene_add_camera(rr_scene *s, const char *name, const file_camera *cam) {
+  file_camera *p = realloc(s->cameras, (s->ncameras + 1) * sizeof *p);
+  char *copy = NULL;
+  if (p) s->cameras = p;
+  if (!p || !copy_name(name, &copy)) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for the file's cameras");
+  p[s->ncameras] = *cam;
+  p[s->ncameras++].name = copy;
+  return RR_OK;
+}
+
+rr_error rr_scene_add_light(rr_scene *s, const rr_light_info *light) {
+  rr_light_info *p = realloc(s->lights, (s->nlights + 1) * sizeof *p);
+  char *name = NULL;
+  if (p) s->lights = p;
+  if (!p || !copy_name(light->name, &name)) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for the file's lights");
+  p[s->nlights] = *light;
+  p[s->nlights++].name = name;
+  return RR_OK;
 }
 
 /* Appends name to the name pool and gives its offset (NO_NAME for NULL or ""). */
@@ -289,10 +356,11 @@ void rr_scene_update_bounds(rr_scene *s) {
 }
 
 /* Appends an indexed mesh of `stride` floats per vertex: xyz, or xyzw where w = 0
- * is a point at infinity in direction xyz and other w are divided through. The
- * indices are checked first, so a bad mesh adds nothing. */
+ * is a point at infinity in direction xyz and other w are divided through, with
+ * optional linear RGB vertex colours. The indices are checked first, so a bad mesh
+ * adds nothing. */
 static rr_error add_mesh(rr_scene *s, const char *api, const float *pos, int stride, size_t nvert,
-                         const uint32_t *idx, size_t ntri, const float rgb[3]) {
+                         const uint32_t *idx, size_t ntri, const float rgb[3], const float *vrgb) {
   if (!s) return RR_ERROR_ARGUMENT;
   if ((!pos && nvert) || (!idx && ntri)) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: NULL positions or indices", api);
   if (ntri > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: too many triangles", api);
@@ -303,37 +371,46 @@ static rr_error add_mesh(rr_scene *s, const char *api, const float *pos, int str
                      idx[t], t / 3, nvert);
     inf = inf || (stride == 4 && pos[4 * (size_t)idx[t] + 3] == 0);
   }
-  float grey[3] = {SCENE_GREY, SCENE_GREY, SCENE_GREY};
-  uint32_t mat = rr_scene_add_material(s, rgb ? rgb : grey, NULL);
+  for (size_t c = 0; vrgb && c < 3 * nvert; c++)
+    if (!isfinite(vrgb[c])) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: vertex colour %zu is not finite", api, c / 3);
+  /* Vertex colours multiply into the base colour: white unless the caller says. */
+  float grey[3] = {SCENE_GREY, SCENE_GREY, SCENE_GREY}, white[3] = {1, 1, 1};
+  uint32_t mat = rr_scene_add_material(s, rgb ? rgb : vrgb ? white : grey, NULL);
   if (mat == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
   rr_error e = rr_scene_reserve(s, (uint32_t)ntri, false, false);
   if (!e && inf) e = rr_scene_reserve_inf(s);
+  if (!e && vrgb) e = rr_scene_reserve_colors(s);
   if (!e) e = rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, NULL);
   if (e) return e;
   for (size_t t = 0; t < ntri; t++) {
-    vec3 p[3];
+    vec3 p[3], col[3];
     unsigned inf = 0;
     for (int k = 0; k < 3; k++) {
       const float *v = pos + stride * (size_t)idx[3 * t + k];
+      if (vrgb) col[k] = v3_load(vrgb + 3 * (size_t)idx[3 * t + k]);
       float w = stride == 4 ? v[3] : 1.0f;
       if (w == 0) inf |= 1u << k, p[k] = v3(v[0], v[1], v[2]); /* a point at infinity: its direction */
       else p[k] = v3(v[0] / w, v[1] / w, v[2] / w); /* exact for w = 1 */
     }
-    rr_scene_push_inf(s, p, inf, NULL, NULL, mat);
+    rr_scene_push_inf(s, p, inf, NULL, NULL, vrgb ? col : NULL, mat);
   }
   return rr_ok(s->dev);
 }
 
 rr_error rr_scene_add_mesh(rr_scene *s, const float *pos, size_t nvert, const uint32_t *idx, size_t ntri,
                            const float rgb[3]) {
-  return add_mesh(s, "rr_scene_add_mesh", pos, 3, nvert, idx, ntri, rgb);
+  return add_mesh(s, "rr_scene_add_mesh", pos, 3, nvert, idx, ntri, rgb, NULL);
+}
+
+rr_error rr_scene_add_mesh_colors(rr_scene *s, const float *pos, size_t nvert, const uint32_t *idx, size_t ntri,
+                                  const float rgb[3], const float *vertex_rgb) {
+  return add_mesh(s, "rr_scene_add_mesh_colors", pos, 3, nvert, idx, ntri, rgb, vertex_rgb);
 }
 
 rr_error rr_scene_add_mesh4(rr_scene *s, const float *xyzw, size_t nvert, const uint32_t *idx, size_t ntri,
                             const float rgb[3]) {
-  return add_mesh(s, "rr_scene_add_mesh4", xyzw, 4, nvert, idx, ntri, rgb);
+  return add_mesh(s, "rr_scene_add_mesh4", xyzw, 4, nvert, idx, ntri, rgb, NULL);
 }
-
 
 rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
   if (!s || !info) return RR_ERROR_ARGUMENT;
@@ -344,8 +421,49 @@ rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
   info->geometries = s->ngeoms;
   info->bounds_min[0] = s->bmin.x, info->bounds_min[1] = s->bmin.y, info->bounds_min[2] = s->bmin.z;
   info->bounds_max[0] = s->bmax.x, info->bounds_max[1] = s->bmax.y, info->bounds_max[2] = s->bmax.z;
+  for (uint32_t m = 0; m < s->nmaterials; m++) {
+    rr_texture_status st = s->materials[m].texture_status;
+    info->textures += st != RR_TEXTURE_NONE;
+    info->textures_missing += st == RR_TEXTURE_MISSING || st == RR_TEXTURE_UNREADABLE;
+  }
+  info->cameras = s->ncameras, info->lights = s->nlights;
+  v3_store(info->up, s->up), v3_store(info->front, s->front);
   rr_bvh_fill_info(s->bvh, info);
   return RR_OK;
+}
+
+static const char *const texture_status_names[RR_TEXTURE_STATUS_COUNT] = {"none", "file", "embedded", "missing",
+                                                                          "unreadable"};
+
+const char *rr_texture_status_name(int status) {
+  return status >= 0 && status < RR_TEXTURE_STATUS_COUNT ? texture_status_names[status] : NULL;
+}
+
+rr_error rr_scene_get_material_info(const rr_scene *s, uint32_t material, rr_material_info *info) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if (!info) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_material_info: info is NULL");
+  if (material >= s->nmaterials)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_material_info: material %u out of range (%u in the scene)",
+                   material, s->nmaterials);
+  const rr_material *m = &s->materials[material];
+  *info = (rr_material_info){m->name, {m->color[0], m->color[1], m->color[2]}, m->texture_path, m->texture_status,
+                             m->texture.width, m->texture.height};
+  return rr_ok(s->dev);
+}
+
+static const char *const light_names[RR_LIGHT_TYPE_COUNT] = {"undefined", "directional", "point", "spot", "ambient",
+                                                             "area"};
+
+const char *rr_light_type_name(int type) { return type >= 0 && type < RR_LIGHT_TYPE_COUNT ? light_names[type] : NULL; }
+
+rr_error rr_scene_get_light(const rr_scene *s, uint32_t index, rr_light_info *info) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if (!info) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_light: info is NULL");
+  if (index >= s->nlights)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_light: light %u out of range (%u in the scene)", index,
+                   s->nlights);
+  *info = s->lights[index];
+  return rr_ok(s->dev);
 }
 
 /* The scene is complete: give back spare room and build the BVH with the device's options. */

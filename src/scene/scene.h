@@ -10,17 +10,31 @@ struct rr_bvh;
 
 /* The base colour of a mesh that names none (every channel). */
 #define SCENE_GREY 0.8f
-
 typedef struct rr_texture {
   int width, height; /* 0 when the file could not be read */
   uint8_t *rgb;      /* 3 bytes per texel, row 0 at the top */
 } rr_texture;
 
 typedef struct rr_material {
+  char *name;         /* NULL when the file gives none */
   float color[3];
   char *texture_path; /* NULL when the material names no texture */
   rr_texture texture;
+  rr_texture_status texture_status; /* where the texels came from, or why there are none */
 } rr_material;
+
+/* A camera of the file, in world space: it looks along fwd with up (both unit and
+ * orthogonal); fov is the full angle across the width (horizontal) or the height
+ * (vertical, glTF's yfov), ortho_width the full width of an orthographic view (0:
+ * perspective). */
+typedef struct file_camera {
+  char *name;
+  vec3 eye, fwd, up;
+  float fov; /* radians */
+  bool fov_vertical;
+  float ortho_width;
+} file_camera;
+
 
 /* A geometry: a run of primitives of one kind that a loader opened (a file's
  * node/mesh pair, an rr_scene_add_mesh call, a built-in object). Its primitives are
@@ -44,6 +58,7 @@ struct rr_scene {
   float *p[3][3];
   float *n[3][3];  /* optional vertex normals */
   float *uv[3][2]; /* optional texture coordinates */
+  float *col[3][3]; /* optional corner colours, linear RGB multiplied into the base colour */
   uint32_t *material; /* per triangle: its geometry's material, read per pixel by shading */
   rr_material *materials;
   uint32_t nmaterials;
@@ -56,6 +71,11 @@ struct rr_scene {
    * infinity (w = 0), whose p then holds its direction; NULL when there is none. */
   uint8_t *inf;
   vec3 bmin, bmax; /* of the finite corners */
+  vec3 up, front;  /* unit: the model's up and the side it faces (+Y, +Z unless the file says) */
+  file_camera *cameras;
+  uint32_t ncameras;
+  rr_light_info *lights; /* in world space; names are the scene's copies */
+  uint32_t nlights;
   struct rr_bvh *bvh; /* built by rr_scene_commit */
 };
 
@@ -80,14 +100,19 @@ rr_error rr_scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool wi
  * grow with the other arrays: after it, with room reserved, pushing such a triangle
  * cannot run out of memory. */
 rr_error rr_scene_reserve_inf(rr_scene *s);
+/* Starts the corner colours, which then grow with the other arrays; the corners
+ * so far are white (the colour that changes nothing). */
+rr_error rr_scene_reserve_colors(rr_scene *s);
 /* Gives back the room reserve doubled into (at commit: the scene is complete). */
 void rr_scene_trim(rr_scene *s);
 /* Appends one triangle (positions, optional corner normals/uvs); drops and counts
  * degenerate or non-finite ones. Returns true when kept. */
 bool rr_scene_push(rr_scene *s, const vec3 p[3], const vec3 *n, const float (*uv)[2], uint32_t mat);
-/* The same with corners at infinity (bit k of inf: p[k] is a direction); a triangle
- * with all three at infinity is dropped and counted. */
-bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, const float (*uv)[2], uint32_t mat);
+/* The same with corners at infinity (bit k of inf: p[k] is a direction; a triangle
+ * with all three at infinity is dropped and counted) and corner colours col (linear
+ * RGB, may be NULL: white where the scene has colours). */
+bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n, const float (*uv)[2],
+                       const vec3 *col, uint32_t mat);
 /* Opens a geometry: the primitives pushed from now on, until the next opens, are
  * its. name may be NULL or "" (none). A push into a scene without geometries opens
  * an unnamed one with the triangle's material. */
@@ -110,6 +135,11 @@ uint32_t rr_scene_geometry_of(const rr_scene *s, uint32_t prim);
 rr_hit rr_scene_hit(const rr_scene *s, uint32_t prim, float t, float l1, float l2);
 /* Adds a material and returns its index (UINT32_MAX when out of memory). */
 uint32_t rr_scene_add_material(rr_scene *s, const float color[3], const char *texture_path);
+/* Names material m (NULL or "": none). */
+rr_error rr_scene_name_material(rr_scene *s, uint32_t m, const char *name);
+/* Appends a camera or a light of a file (copied, names too; cam->name is ignored). */
+rr_error rr_scene_add_camera(rr_scene *s, const char *name, const file_camera *cam);
+rr_error rr_scene_add_light(rr_scene *s, const rr_light_info *light);
 /* Recomputes bounds. */
 void rr_scene_update_bounds(rr_scene *s);
 

@@ -1,6 +1,7 @@
 /* Deferred shading: reads only the visibility buffer (id, t, λ1, λ2) and the
  * scene, so it never knows which method made the frame. */
 #include "vis/vis.h"
+#include "core/color.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -10,10 +11,6 @@
 #pragma GCC diagnostic ignored "-Wunused-function"
 #include <stb_easy_font.h>
 #pragma GCC diagnostic pop
-
-/* Colours are shaded in linear light; textures and the output are encoded with this
- * power (sRGB, approximately). */
-#define GAMMA 2.2f
 
 typedef struct hit {
   bool valid, has_ray;
@@ -77,7 +74,7 @@ static void texel(const rr_texture *t, float u, float v, float rgb[3]) {
       for (int c = 0; c < 3; c++) rgb[c] += w * p[c] / 255.0f;
     }
   /* textures are sRGB-encoded; shading works in linear light */
-  for (int c = 0; c < 3; c++) rgb[c] = powf(rgb[c], GAMMA);
+  for (int c = 0; c < 3; c++) rgb[c] = srgb_decode(rgb[c]);
 }
 
 static void base_color(const rr_scene *s, const hit *h, float rgb[3]) {
@@ -93,6 +90,9 @@ static void base_color(const rr_scene *s, const hit *h, float rgb[3]) {
     texel(&m->texture, u, v, t);
     for (int c = 0; c < 3; c++) rgb[c] *= t[c];
   }
+  if (s->col[0][0]) /* vertex colours (linear) multiply in, like glTF's COLOR_0 */
+    for (int c = 0; c < 3; c++)
+      rgb[c] *= h->l0 * s->col[0][c][h->id] + h->l1 * s->col[1][c][h->id] + h->l2 * s->col[2][c][h->id];
 }
 
 static uint32_t hash32(uint32_t x) {
@@ -100,11 +100,9 @@ static uint32_t hash32(uint32_t x) {
   return x;
 }
 
-static float to_display(float linear) { return powf(fminf(fmaxf(linear, 0.0f), 1.0f), 1.0f / GAMMA); }
-
-static rr_error image_alloc(rr_device *dev, rr_image *img, int w, int h, int ch, rr_pixel_type type) {
+static rr_error image_alloc(rr_device *dev, rr_image *img, int w, int h, int ch, rr_pixel_type type, int kind) {
   size_t size = type == RR_PIXEL_U8 ? 1 : 4;
-  img->width = w, img->height = h, img->channels = ch, img->type = type;
+  img->width = w, img->height = h, img->channels = ch, img->type = type, img->kind = kind;
   img->data = calloc((size_t)w * h * ch, size);
   return img->data ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d image", w, h);
 }
@@ -182,8 +180,9 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp,
   const float *counts = mode == RR_SHADE_HEAT_EVALS ? f->heat_e : f->heat_n;
   if (heat && !counts)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "heat maps need per-pixel statistics (render with options.heat set)");
-  e = image_alloc(dev, out, vb->width, vb->height, 3, RR_PIXEL_F32);
+  e = image_alloc(dev, out, vb->width, vb->height, 3, RR_PIXEL_F32, RR_IMAGE_COLOR);
   if (e) return e;
+  float *px = out->data;
   if (heat) {
     e = shade_heat(dev, counts, out, mode == RR_SHADE_HEAT_EVALS ? "edge evaluations" : "BVH nodes");
     if (e) {
@@ -191,6 +190,8 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp,
       out->data = NULL;
       return e;
     }
+    /* drawn in display colours; the image holds linear light */
+    for (size_t i = 0; i < (size_t)vb->width * vb->height * 3; i++) px[i] = srgb_decode(px[i]);
     return rr_ok(dev);
   }
   float dmin = INFINITY, dmax = 0;
@@ -200,26 +201,24 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp,
         hit h = hit_at(s, &c, vb, x, y);
         if (h.valid) dmin = fminf(dmin, h.dist), dmax = fmaxf(dmax, h.dist);
       }
-  float *px = out->data;
   for (int y = 0; y < vb->height; y++)
     for (int x = 0; x < vb->width; x++) {
       float *o = px + 3 * ((size_t)y * vb->width + x);
       hit h = hit_at(s, &c, vb, x, y);
       if (!h.has_ray) continue; /* black where the camera has no ray */
+      if (h.valid && mode == RR_SHADE_LAMBERT) {
+        float rgb[3];
+        base_color(s, &h, rgb);
+        float lit = 0.12f + 0.88f * fmaxf(0.0f, -v3_dot(h.normal, h.dir));
+        for (int ch = 0; ch < 3; ch++) o[ch] = rgb[ch] * lit;
+        continue;
+      }
+      /* everything else is designed in display colours, decoded to linear light below */
       if (!h.valid) {
         /* a quiet vertical gradient behind the scene */
         float g = 0.16f + 0.10f * (1.0f - (float)y / vb->height);
         o[0] = g * 0.9f, o[1] = g, o[2] = g * 1.15f;
-        continue;
-      }
-      switch (mode) {
-      case RR_SHADE_LAMBERT: {
-        float rgb[3];
-        base_color(s, &h, rgb);
-        float lit = 0.12f + 0.88f * fmaxf(0.0f, -v3_dot(h.normal, h.dir));
-        for (int ch = 0; ch < 3; ch++) o[ch] = to_display(rgb[ch] * lit);
-        break;
-      }
+      } else switch (mode) {
       case RR_SHADE_ID: {
         uint32_t hsh = hash32(h.id + 1);
         for (int ch = 0; ch < 3; ch++) o[ch] = 0.2f + 0.8f * (float)((hsh >> (8 * ch)) & 255) / 255.0f;
@@ -236,6 +235,7 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp,
       default:
         break;
       }
+      for (int ch = 0; ch < 3; ch++) o[ch] = srgb_decode(o[ch]);
     }
   return rr_ok(dev);
 }
@@ -257,13 +257,14 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cp, c
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
     if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
-    e = image_alloc(dev, out, vb->width, vb->height, 1, RR_PIXEL_F32);
+    e = image_alloc(dev, out, vb->width, vb->height, 1, RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov);
     if (e) return e;
     memcpy(out->data, counts, (size_t)vb->width * vb->height * sizeof(float));
     return rr_ok(dev);
   }
   bool ints = aov == RR_AOV_ID || aov == RR_AOV_MESH || aov == RR_AOV_MATERIAL;
-  e = image_alloc(dev, out, vb->width, vb->height, channels[aov], ints ? RR_PIXEL_U32 : RR_PIXEL_F32);
+  e = image_alloc(dev, out, vb->width, vb->height, channels[aov], ints ? RR_PIXEL_U32 : RR_PIXEL_F32,
+                  RR_IMAGE_AOV + (int)aov);
   if (e) return e;
   for (int y = 0; y < vb->height; y++)
     for (int x = 0; x < vb->width; x++) {

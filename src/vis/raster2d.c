@@ -596,8 +596,8 @@ static void band_job(int b, int thread, void *arg) {
   }
 }
 
-static rr_error run2d(rr_device *dev, const rr_scene *s, const camera *c, bool cull, bool bin, int threads,
-                      target tg, rr_stats *stats) {
+static rr_error run2d(rr_device *dev, const progress_span *progress, const rr_scene *s, const camera *c, bool cull,
+                      bool bin, int threads, target tg, rr_stats *stats) {
   pipe2d pp;
   if (s->inf)
     return rr_fail(dev, RR_ERROR_UNSUPPORTED,
@@ -620,7 +620,8 @@ static rr_error run2d(rr_device *dev, const rr_scene *s, const camera *c, bool c
                    .out_max = MAX_SUB,
                    .setup = setup2d,
                    .rows = rows2d,
-                   .band = band_job};
+                   .band = band_job,
+                   .progress = progress};
   /* blocks of whole tiles, the largest bins and depth blocks */
   bool ok = rr_sortmiddle(&sm, s->ntris, c->height, block_size(LEVELS - 1), threads);
   for (int t = 0; t < RR_MAX_THREADS; t++) stats->setups += p->setups[t], stats->edge_evals += p->evals[t];
@@ -631,12 +632,12 @@ static rr_error run2d(rr_device *dev, const rr_scene *s, const camera *c, bool c
 
 rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx) {
   target tg = {.vb = ctx->vb, .heat = ctx->heat_e};
-  return run2d(dev, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, false, ctx->threads, tg, ctx->stats);
+  return run2d(dev, &ctx->progress, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, false, ctx->threads, tg, ctx->stats);
 }
 
 rr_error rr_vis_2dr_bin(rr_device *dev, render_ctx *ctx) {
   target tg = {.vb = ctx->vb, .heat = ctx->heat_e};
-  return run2d(dev, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, true, ctx->threads, tg, ctx->stats);
+  return run2d(dev, &ctx->progress, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, true, ctx->threads, tg, ctx->stats);
 }
 
 rr_error rr_raster2d_claims(const rr_scene *s, const camera *c, bool bin, int threads, uint8_t *front, uint8_t *back) {
@@ -645,7 +646,7 @@ rr_error rr_raster2d_claims(const rr_scene *s, const camera *c, bool bin, int th
   visbuf vb = {.width = c->width, .height = c->height};
   target tg = {.vb = &vb, .front = front, .back = back};
   rr_stats st = {0};
-  return run2d(NULL, s, c, false, bin, threads < 1 ? 1 : threads, tg, &st);
+  return run2d(NULL, NULL, s, c, false, bin, threads < 1 ? 1 : threads, tg, &st);
 }
 
 bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, double *sy) {

@@ -41,7 +41,7 @@ rr_error rr_vis_rc(rr_device *dev, render_ctx *ctx) {
     if (rr_tri_setup(s, i, ctx->cam, ctx->opt->cull_backfaces, &setup[n]) != SETUP_CULLED) ids[n++] = i;
   ctx->stats->setups += s->ntris;
   rc_job job = {.ctx = ctx, .setup = setup, .ids = ids, .n = n};
-  rr_parallel_for(ctx->vb->height, ctx->threads, rc_row, &job);
+  rr_parallel_for_progress(ctx->vb->height, ctx->threads, rc_row, &job, &ctx->progress);
   for (int t = 0; t < RR_MAX_THREADS; t++) ctx->stats->edge_evals += job.evals[t];
   free(setup), free(ids);
   return RR_OK;

@@ -421,7 +421,7 @@ static rr_error run_frame(rr_device *dev, render_ctx *ctx, rr_parallel_fn tile_f
   const visbuf *vb = ctx->vb;
   j->tiles_x = (vb->width + TILE - 1) / TILE;
   int tiles = j->tiles_x * ((vb->height + TILE - 1) / TILE);
-  rr_parallel_for(tiles, ctx->threads, tile_fn, j);
+  rr_parallel_for_progress(tiles, ctx->threads, tile_fn, j, &ctx->progress);
   if (j->fs.nloose) { /* the needles, over their rectangles, by bands of rows */
     j->band_rows = (vb->height + 4 * ctx->threads - 1) / (4 * ctx->threads);
     rr_parallel_for((vb->height + j->band_rows - 1) / j->band_rows, ctx->threads, loose_band, j);

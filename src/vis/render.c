@@ -287,10 +287,13 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   f->stats.threads = ctx.threads;
   f->stats.method = opt->method;
   double t0 = rr_now_ms(), c0 = rr_cpu_ms();
+  progress_span whole = {dev, RR_PROGRESS_RENDER, 0, 1};
+  rr_progress(&whole, 0);
   /* A pattern of N samples is N passes of the method, each with the camera of one
    * position writing its own layer: every method and camera takes the positions
    * as data. (A triangle is set up once per pass: S grows with N.) */
   for (int s = 0; s < opt->samples && !e; s++) {
+    ctx.progress = rr_progress_part(&whole, (double)s / opt->samples, (double)(s + 1) / opt->samples);
     if (s > 0) {
       rr_cam_release(&c);
       if ((e = rr_cam_setup_at(dev, cam, opt->width, opt->height, opt->sample_pos[s], &c))) break;
@@ -306,6 +309,7 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
     rr_frame_release(f);
     return e;
   }
+  rr_progress(&whole, 1);
   *out = f;
   return rr_ok(dev);
 }

@@ -33,7 +33,9 @@ bool rr_sortmiddle(sortmiddle *sm, uint32_t n, int height, int align, int thread
   for (uint32_t first = 0; ok && first < n; first += sm->batch) {
     sm->first = first, sm->count = n - first < sm->batch ? n - first : sm->batch;
     rr_parallel_for((int)((sm->count + sm->chunk - 1) / sm->chunk), threads, setup_chunk, sm);
-    rr_parallel_for(sm->bands, threads, sm->band, sm);
+    progress_span part = sm->progress ? rr_progress_part(sm->progress, (double)first / n, (double)(first + sm->count) / n)
+                                      : (progress_span){0};
+    rr_parallel_for_progress(sm->bands, threads, sm->band, sm, &part);
   }
   free(sm->prims), free(sm->span), free(sm->kept);
   sm->prims = NULL, sm->span = NULL, sm->kept = NULL;

@@ -36,6 +36,7 @@ struct sortmiddle {
   void (*rows)(const void *prim, int *y0, int *y1);
   /* Draws band `job` of the batch in this struct (arg), with sm_draw_band. */
   rr_parallel_fn band;
+  const progress_span *progress; /* the pass's, reported batch by batch and band by band; NULL: none */
   /* Filled by rr_sortmiddle: the blocks, and the batch being drawn. */
   int bands, block_rows, height;
   uint32_t first, count;

@@ -493,7 +493,8 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
                    .out_max = 1,
                    .setup = root_setup,
                    .rows = root_rows,
-                   .band = root_band};
+                   .band = root_band,
+                   .progress = &ctx->progress};
   /* blocks of whole top-level bins, else of 8 z tiles */
   const oracles *o = ctx->oracles;
   int align = o->binning && o->bin_size > HIZ ? (o->bin_size + HIZ - 1) / HIZ * HIZ : 8 * HIZ;
@@ -567,7 +568,8 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
                                 : (frustum < whole ? frustum : whole);
     tile = (tile + HIZ - 1) / HIZ * HIZ;
     tj->proto = proto, tj->tile = tile, tj->frustum = frustum, tj->tiles_x = (vb->width + tile - 1) / tile;
-    rr_parallel_for(tj->tiles_x * ((vb->height + tile - 1) / tile), ctx->threads, run_tile, tj);
+    rr_parallel_for_progress(tj->tiles_x * ((vb->height + tile - 1) / tile), ctx->threads, run_tile, tj,
+                             &ctx->progress);
     for (int i = 0; i < RR_MAX_THREADS; i++) add_stats(ctx->stats, &tj->st[i]);
     free(tj);
   }

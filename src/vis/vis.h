@@ -66,6 +66,7 @@ typedef struct render_ctx {
   rr_stats *stats;
   float *heat_e, *heat_n; /* optional per-pixel E and N charges */
   const struct oracles *oracles; /* the traversal's settings, for the 3dr methods */
+  progress_span progress;        /* this pass's share of the frame's progress: for its main loop */
 } render_ctx;
 
 /* The oracles of the continuum's traversal (paper Fig. 8), as settings. */
