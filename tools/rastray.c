@@ -107,7 +107,7 @@ static const char scenes_note[] =
 
 static const cli_option render_options[] = {
     {"method", OPT_METHOD, "NAME",
-     "visibility method: auto (default: the fastest exact one in a trial), rc,\n"
+     "visibility method: auto (default: chosen by a cost model of the view), rc,\n"
      "rc-bvh, rc-packet, 2dr-bb, 2dr-bin, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full"},
     {"oracles", OPT_ORACLES, "K=V,...",
      "override a 3dr method's traversal: frustum=N leaves=0|1 outside=0|1\n"
