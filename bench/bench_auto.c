@@ -25,14 +25,8 @@ enum { NCAND = sizeof cands / sizeof cands[0] };
 /* The view of a scene for a camera type: bench_table's view (a corner room of rooms
  * scenes seen from inside), the teapot grid from inside as in docs/cameras.md. */
 static void view(rr_device *dev, const char *name, const rr_scene *s, int type, int w, int h, rr_camera *cam) {
-  bench_camera(dev, s, w, h, cam);
-  if (strncmp(name, "rooms", 5) == 0) {
-    rr_scene_info in;
-    rr_scene_get_info(s, &in);
-    float eye[3] = {1.2f, 1.6f, 1.4f}, target[3] = {in.bounds_max[0], 1.2f, in.bounds_max[2] * 0.7f};
-    memcpy(cam->eye, eye, sizeof eye), memcpy(cam->target, target, sizeof target);
-    cam->fov_deg = 70;
-  } else if (strcmp(name, "grid:teapot.obj:7") == 0) {
+  bench_view(dev, name, s, w, h, cam);
+  if (strcmp(name, "grid:teapot.obj:7") == 0) {
     float eye[3] = {20.6f, 2.4f, 13.2f}, target[3] = {30, 1.2f, 20};
     memcpy(cam->eye, eye, sizeof eye), memcpy(cam->target, target, sizeof target);
     cam->fov_deg = 70;

@@ -85,17 +85,6 @@ static rr_render_options frame_options(int row, bool cull, int size, int threads
   return opt;
 }
 
-/* The view of a scene: auto-framed, or from inside a corner room of `rooms`. */
-static void scene_camera(rr_device *dev, const char *name, const rr_scene *s, int size, rr_camera *cam) {
-  bench_camera(dev, s, size, size, cam);
-  if (strncmp(name, "rooms", 5) == 0) {
-    rr_scene_info in;
-    rr_scene_get_info(s, &in);
-    float eye[3] = {1.2f, 1.6f, 1.4f}, target[3] = {in.bounds_max[0], 1.2f, in.bounds_max[2] * 0.7f};
-    memcpy(cam->eye, eye, sizeof eye), memcpy(cam->target, target, sizeof target);
-    cam->fov_deg = 70;
-  }
-}
 
 /* The fastest exact method of a pass (-1 when none ran). */
 static int fastest(const scene_result *res, int pass) {
@@ -224,7 +213,7 @@ static void run_scene(rr_device *dev, const options *o, int sc, scene_result *re
   rr_scene_get_info(s, &in);
   res->tris = in.triangles, res->build_rr = in.bvh_build_ms, res->bvh = (double)in.bvh_bytes;
   rr_camera cam;
-  scene_camera(dev, res->name, s, o->size, &cam);
+  bench_view(dev, res->name, s, o->size, o->size, &cam);
   fprintf(stderr, "%s: %llu triangles, BVH built in %.1f ms on %d thread%s\n", res->name,
           (unsigned long long)in.triangles, in.bvh_build_ms, o->threads, o->threads > 1 ? "s" : "");
   for (int pass = 0; pass < PASSES; pass++) run_pass(dev, s, &cam, o, pass, res);
@@ -248,7 +237,7 @@ static int count_main(const options *o) {
   for (int sc = 0; sc < o->nscenes; sc++) {
     rr_scene *s = bench_load(dev, o->scenes[sc], NULL);
     rr_camera cam;
-    scene_camera(dev, o->scenes[sc], s, o->size, &cam);
+    bench_view(dev, o->scenes[sc], s, o->size, o->size, &cam);
     fprintf(stderr, "counting instructions: %s\n", o->scenes[sc]);
     for (int r = 0; r < RR_METHOD_COUNT; r++) {
       if (!rastray_row(r, CULLED)) continue;

@@ -71,6 +71,17 @@ void bench_camera(rr_device *dev, const rr_scene *scene, int w, int h, rr_camera
   rr_camera_frame(dev, scene, w, h, cam);
 }
 
+void bench_view(rr_device *dev, const char *name, const rr_scene *s, int w, int h, rr_camera *cam) {
+  bench_camera(dev, s, w, h, cam);
+  if (strncmp(name, "rooms", 5) == 0) {
+    rr_scene_info in;
+    rr_scene_get_info(s, &in);
+    float eye[3] = {1.2f, 1.6f, 1.4f}, target[3] = {in.bounds_max[0], 1.2f, in.bounds_max[2] * 0.7f};
+    memcpy(cam->eye, eye, sizeof eye), memcpy(cam->target, target, sizeof target);
+    cam->fov_deg = 70;
+  }
+}
+
 static void check(rr_device *dev, rr_error e) {
   if (e == RR_OK) return;
   fprintf(stderr, "bench: %s\n", rr_device_message(dev));

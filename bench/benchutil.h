@@ -11,8 +11,10 @@
 const char *bench_scene_path(const char *name);
 /* Loads a scene or exits with a message. */
 rr_scene *bench_load(rr_device *dev, const char *name, double *load_ms);
-/* The benchmark view of a scene: auto-framed, or from inside for rooms scenes. */
+/* A scene auto-framed with a 50° field of view. */
 void bench_camera(rr_device *dev, const rr_scene *scene, int w, int h, rr_camera *cam);
+/* The benchmark view of scene `name`: auto-framed, or from inside a corner room of rooms scenes. */
+void bench_view(rr_device *dev, const char *name, const rr_scene *scene, int w, int h, rr_camera *cam);
 /* Renders `reps` times and returns the median frame time; *out keeps the last frame. */
 double bench_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
                     int reps, rr_frame **out);

@@ -235,16 +235,7 @@ static void test_aovs(rr_device *dev) {
   rr_scene_release(s);
 }
 
-/* Runs the CLI in dir; returns its exit code, its stdout in out. */
-static int run(const char *args, char *out, size_t size) {
-  char cmd[2048];
-  snprintf(cmd, sizeof cmd, "cd %s && %s %s 2>/dev/null", dir, RR_CLI, args);
-  FILE *p = popen(cmd, "r");
-  size_t n = p ? fread(out, 1, size - 1, p) : 0;
-  out[n] = 0;
-  int st = p ? pclose(p) : -1;
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
+static int run(const char *args, char *out, size_t size) { return test_run_cli(dir, args, false, out, size); }
 
 static rr_image read_u32(rr_device *dev, const char *name) {
   char path[600];

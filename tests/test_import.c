@@ -460,17 +460,7 @@ static void check_up_axis(rr_device *dev) {
   }
 }
 
-/* Runs the CLI with args in dir; its exit status, its stdout and stderr in out. */
-static int cli(const char *args, char *out, size_t cap) {
-  char cmd[1024];
-  snprintf(cmd, sizeof cmd, "cd %s && %s %s 2>&1", dir, RR_CLI, args);
-  FILE *p = popen(cmd, "r");
-  if (!p) return -1;
-  size_t n = fread(out, 1, cap - 1, p);
-  out[n] = 0;
-  int st = pclose(p);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
+static int cli(const char *args, char *out, size_t cap) { return test_run_cli(dir, args, true, out, cap); }
 
 /* `info` lists materials with their textures, the textures that are missing, the
  * cameras and lights; `render --camera-from-file` looks through a file's camera. */

@@ -1,7 +1,9 @@
 #include "testutil.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 int test_passed, test_failed;
@@ -190,4 +192,14 @@ int test_exr_find(const test_exr_file *x, const char *name) {
   for (int k = 0; k < x->h.num_channels; k++)
     if (!strcmp(x->h.channels[k].name, name)) return k;
   return -1;
+}
+
+int test_run_cli(const char *dir, const char *args, bool with_stderr, char *out, size_t cap) {
+  char cmd[4096];
+  snprintf(cmd, sizeof cmd, "cd '%s' && %s %s %s", dir, RR_CLI, args, with_stderr ? "2>&1" : "2>/dev/null");
+  FILE *p = popen(cmd, "r");
+  size_t n = p ? fread(out, 1, cap - 1, p) : 0;
+  out[n] = 0;
+  int st = p ? pclose(p) : -1;
+  return st != -1 && WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }

@@ -65,6 +65,9 @@ rr_camera test_random_view(const rr_scene *s, float dist_lo, float dist_hi, floa
  * buffers, so a few paths stay valid at once); a file that cannot be written is
  * left missing, for the test's load to report. */
 const char *test_write_file(const char *dir, const char *name, const char *text);
+/* Runs the CLI (RR_CLI) with args in directory dir: its exit status (-1 when it could not
+ * run or was killed), its stdout in out (with stderr too when with_stderr). */
+int test_run_cli(const char *dir, const char *args, bool with_stderr, char *out, size_t cap);
 /* An EXR file read through tinyexr itself rather than rastray's reader (ok: it
  * loaded; a failure is CHECKed). test_exr_free releases it in either case. */
 typedef struct test_exr_file {
