@@ -155,3 +155,75 @@ double peer_embree_cast(peer_embree *e, const camera *c, int width, int threads,
   rr_parallel_for(tiles, threads, width == 8 ? cast8_tile : cast1_tile, &j);
   return rr_now_ms() - t0;
 }
+
+enum { EMB_RAYS = 256 }; /* rays per job */
+
+typedef struct {
+  peer_embree *e;
+  const rr_ray *rays;
+  size_t n;
+  bool any;
+  uint32_t *ids;
+  float *t;
+} rays_job;
+
+static void rays1_chunk(int job, int thread, void *arg) {
+  (void)thread;
+  rays_job *j = arg;
+  struct RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  for (size_t i = (size_t)job * EMB_RAYS; i < j->n && i < (size_t)(job + 1) * EMB_RAYS; i++) {
+    const rr_ray *r = &j->rays[i];
+    struct RTCRayHit rh = {.ray = {.org_x = r->org[0], .org_y = r->org[1], .org_z = r->org[2], .tnear = r->tmin,
+                                   .dir_x = r->dir[0], .dir_y = r->dir[1], .dir_z = r->dir[2], .tfar = r->tmax,
+                                   .mask = 0xFFFFFFFFu},
+                           .hit = {.geomID = RTC_INVALID_GEOMETRY_ID, .primID = RTC_INVALID_GEOMETRY_ID}};
+    if (j->any) {
+      rtcOccluded1(j->e->scene, &ctx, &rh.ray);
+      j->ids[i] = rh.ray.tfar == -INFINITY ? 0 : RR_MISS; /* Embree marks an occluded ray so */
+      continue;
+    }
+    rtcIntersect1(j->e->scene, &ctx, &rh);
+    bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    j->ids[i] = hit ? rh.hit.primID : RR_MISS;
+    j->t[i] = hit ? rh.ray.tfar : INFINITY;
+  }
+}
+
+static void rays8_chunk(int job, int thread, void *arg) {
+  (void)thread;
+  rays_job *j = arg;
+  struct RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTC_ALIGN(32) struct RTCRayHit8 rh;
+  RTC_ALIGN(32) int valid[8];
+  for (size_t i0 = (size_t)job * EMB_RAYS; i0 < j->n && i0 < (size_t)(job + 1) * EMB_RAYS; i0 += 8) {
+    for (int l = 0; l < 8; l++) {
+      size_t i = i0 + l < j->n ? i0 + l : i0;
+      const rr_ray *r = &j->rays[i];
+      valid[l] = i0 + l < j->n ? -1 : 0;
+      rh.ray.org_x[l] = r->org[0], rh.ray.org_y[l] = r->org[1], rh.ray.org_z[l] = r->org[2];
+      rh.ray.dir_x[l] = r->dir[0], rh.ray.dir_y[l] = r->dir[1], rh.ray.dir_z[l] = r->dir[2];
+      rh.ray.tnear[l] = r->tmin, rh.ray.tfar[l] = r->tmax, rh.ray.time[l] = 0, rh.ray.mask[l] = 0xFFFFFFFFu;
+      rh.ray.id[l] = 0, rh.ray.flags[l] = 0;
+      rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID, rh.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
+    }
+    if (j->any)
+      rtcOccluded8(valid, j->e->scene, &ctx, &rh.ray);
+    else
+      rtcIntersect8(valid, j->e->scene, &ctx, &rh);
+    for (int l = 0; l < 8 && i0 + l < j->n; l++) {
+      bool hit = j->any ? rh.ray.tfar[l] == -INFINITY : rh.hit.geomID[l] != RTC_INVALID_GEOMETRY_ID;
+      j->ids[i0 + l] = !hit ? RR_MISS : j->any ? 0 : rh.hit.primID[l];
+      if (!j->any) j->t[i0 + l] = hit ? rh.ray.tfar[l] : INFINITY;
+    }
+  }
+}
+
+double peer_embree_rays(peer_embree *e, const rr_ray *rays, size_t n, bool any, int width, int threads, uint32_t *ids,
+                        float *t) {
+  rays_job j = {e, rays, n, any, ids, t};
+  double t0 = rr_now_ms();
+  rr_parallel_for((int)((n + EMB_RAYS - 1) / EMB_RAYS), threads, width == 8 ? rays8_chunk : rays1_chunk, &j);
+  return rr_now_ms() - t0;
+}

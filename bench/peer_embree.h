@@ -24,4 +24,11 @@ peer_embree_memory peer_embree_bytes(const peer_embree *e);
  * Writes ids (RR_MISS on a miss) and t (+inf on a miss) in rastray's layout and
  * returns the wall time in milliseconds. */
 double peer_embree_cast(peer_embree *e, const camera *c, int width, int threads, uint32_t *ids, float *t);
+/* Traces rays[0..n-1] (rastray's rr_ray: t along the unnormalised direction, as
+ * Embree's) in chunks dealt to `threads` threads: width 1 with rtcIntersect1 /
+ * rtcOccluded1 (any), width 8 with rtcIntersect8 / rtcOccluded8 on 8 consecutive
+ * rays. Writes ids (RR_MISS on a miss; any: 0 when occluded) and t (+inf on a
+ * miss; any: unused, may be NULL) and returns the wall time in milliseconds. */
+double peer_embree_rays(peer_embree *e, const rr_ray *rays, size_t n, bool any, int width, int threads, uint32_t *ids,
+                        float *t);
 #endif

@@ -201,6 +201,33 @@ RR_API rr_error rr_intersect(rr_device *dev, const rr_scene *scene, const rr_ray
  * dev as for rr_intersect. */
 RR_API rr_error rr_occluded(rr_device *dev, const rr_scene *scene, const rr_ray *ray, int *occluded);
 
+/* Many rays at once: a stream of `count` rays in either layout, described by
+ * where ray 0's components are and the bytes from one ray's component to the
+ * next's. An array of rr_ray: rr_ray_stream_aos(rays, count). Separate arrays
+ * (structure of arrays): {.count = n, .stride = sizeof(float), .org = {ox, oy, oz},
+ * .dir = {dx, dy, dz}, .tmin = tmin, .tmax = tmax}. */
+typedef struct rr_ray_stream {
+  size_t count;
+  size_t stride; /* a multiple of sizeof(float) */
+  const float *org[3], *dir[3], *tmin, *tmax;
+} rr_ray_stream;
+RR_API rr_ray_stream rr_ray_stream_aos(const rr_ray *rays, size_t count);
+
+/* rr_intersect and rr_occluded for every ray of a stream, on `threads` threads
+ * (0: all cores; at most RR_MAX_THREADS), into hits[i] / occluded[i]: each result
+ * is bit for bit the one rr_intersect / rr_occluded gives for that ray alone,
+ * whatever the thread count. A ray those would refuse (a non-finite origin or
+ * direction, a zero direction, a NaN range) is a miss (occluded 0) and the other
+ * rays are still traced; the call then returns RR_ERROR_ARGUMENT naming the
+ * lowest such ray. count 0 does nothing. Threading as for rr_intersect: any
+ * number of threads may run streams and single queries on one committed scene
+ * at once, each with its own device (or NULL); the threads a stream starts only
+ * read the scene and write their own rays' results. */
+RR_API rr_error rr_intersect_stream(rr_device *dev, const rr_scene *scene, const rr_ray_stream *rays, int threads,
+                                    rr_hit *hits);
+RR_API rr_error rr_occluded_stream(rr_device *dev, const rr_scene *scene, const rr_ray_stream *rays, int threads,
+                                   int *occluded);
+
 /* ---- cameras ------------------------------------------------------------- */
 
 /* With u = 2(x+0.5)/W - 1, v = 1 - 2(y+0.5)/H and the camera basis right, up, fwd: */

@@ -159,27 +159,12 @@ static rr_scene *random_scene(rr_device *dev, uint32_t n, float spread, float si
   return s;
 }
 
-/* Brute force: every triangle with the same sample test, the same tie rule on t. */
-static rr_hit brute(const rr_scene *s, const rr_ray *ray, int *any) {
-  camera rc;
-  rr_cam_for_ray(ray->org, ray->dir, &rc);
-  rr_hit h = rr_scene_hit(s, RR_MISS, INFINITY, 0, 0);
-  *any = 0;
-  for (uint32_t i = 0; i < s->ntris; i++) {
-    float t, l1, l2;
-    if (!rr_tri_ray_hit(s, i, &rc, false, ray->tmin, ray->tmax, &t, &l1, &l2)) continue;
-    *any = 1;
-    if (depth_wins(t, i, h.t, h.prim)) h = rr_scene_hit(s, i, t, l1, l2);
-  }
-  return h;
-}
-
 static int rays_checked, rays_hit;
 
 static void check_ray(const rr_scene *s, const rr_ray *ray, const char *name) {
   rr_hit h;
   int occ, any;
-  rr_hit ref = brute(s, ray, &any);
+  rr_hit ref = test_brute_ray(s, ray, &any);
   CHECK(rr_intersect(s->dev, s, ray, &h) == RR_OK, "%s: rr_intersect failed", name);
   CHECK(rr_occluded(s->dev, s, ray, &occ) == RR_OK, "%s: rr_occluded failed", name);
   bool same = h.prim == ref.prim && memcmp(&h.t, &ref.t, 4) == 0 && memcmp(&h.l1, &ref.l1, 4) == 0 &&

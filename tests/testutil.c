@@ -203,3 +203,17 @@ int test_run_cli(const char *dir, const char *args, bool with_stderr, char *out,
   int st = p ? pclose(p) : -1;
   return st != -1 && WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
+
+rr_hit test_brute_ray(const rr_scene *s, const rr_ray *ray, int *any) {
+  camera rc;
+  rr_cam_for_ray(ray->org, ray->dir, &rc);
+  rr_hit h = rr_scene_hit(s, RR_MISS, INFINITY, 0, 0);
+  *any = 0;
+  for (uint32_t i = 0; i < s->ntris; i++) {
+    float t, l1, l2;
+    if (!rr_tri_ray_hit(s, i, &rc, false, ray->tmin, ray->tmax, &t, &l1, &l2)) continue;
+    *any = 1;
+    if (depth_wins(t, i, h.t, h.prim)) h = rr_scene_hit(s, i, t, l1, l2);
+  }
+  return h;
+}

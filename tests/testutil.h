@@ -79,6 +79,10 @@ bool test_exr_load(const char *path, test_exr_file *x);
 void test_exr_free(test_exr_file *x);
 /* The index of the channel named `name`, -1 when absent. */
 int test_exr_find(const test_exr_file *x, const char *name);
+/* The reference of the ray queries: every triangle of s with the full setup and
+ * sample test of rc (rr_tri_ray_hit), ties in t to the lower id; *any: whether
+ * any triangle is hit in [tmin, tmax]. */
+rr_hit test_brute_ray(const rr_scene *s, const rr_ray *ray, int *any);
 /* Deterministic random numbers for property tests. */
 unsigned test_rand(void);
 float test_randf(float lo, float hi);

@@ -87,6 +87,58 @@ static inline bool sample_test(const float e[3], uint32_t tie, float vol, float 
 bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull_backfaces, float tmin, float tmax,
                  float *t, float *l1, float *l2);
 
+/* lex_less and lex_positive of triangle_setup_tmp.h for one lane, same NaN behaviour. */
+static inline bool tri_lex_less(vec3 a, vec3 b) {
+  return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+}
+static inline bool tri_lex_positive(float g1, float g2, float g3) {
+  return g1 > 0 || (g1 == 0 && (g2 > 0 || (g2 == 0 && g3 > 0)));
+}
+/* An edge normal as the setup computes it: h × (l − h) for the canonical order
+ * (l, h) of the edge's endpoints a → b, negated when the edge runs from h to l. */
+static inline vec3 tri_edge_normal(vec3 a, vec3 b) {
+  bool swap = tri_lex_less(b, a);
+  vec3 l = swap ? b : a, h = swap ? a : b, m = v3_cross(h, v3_sub(l, h));
+  return swap ? v3_neg(m) : m;
+}
+
+/* rr_tri_ray_hit, same bits, computing only what the ray's own sample needs: the
+ * queries test many triangles per ray and most fail on one edge. The setup of a
+ * finite triangle for a perspective camera (triangle_setup.c) gives edge value
+ * a_i = (σ n_i)·d0 (σ = ±1 turns the inside positive, σ n exactly ±n), and the
+ * sample (0, 0) evaluates a_i·1 + b_i·0 + c_i·0, which is negative or NaN
+ * whenever σ (n_i·d0) is: such an edge rejects the triangle before the other
+ * normals, b_i, c_i and the tie bits are computed. What passes is evaluated
+ * exactly as rr_tri_setup + tri_edges + sample_test would. Other triangles
+ * (corners at infinity) and cameras go through rr_tri_ray_hit. */
+static inline bool tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull, float tmin, float tmax,
+                               float *t, float *l1, float *l2) {
+  if (scene_inf(s, i) || ray->type != RR_CAMERA_PERSPECTIVE)
+    return rr_tri_ray_hit(s, i, ray, cull, tmin, tmax, t, l1, l2);
+  vec3 q[3];
+  for (int k = 0; k < 3; k++) q[k] = v3_sub(scene_vertex(s, k, i), ray->eye);
+  vec3 n[3];
+  n[0] = tri_edge_normal(q[1], q[2]);
+  float vol = v3_dot(q[0], n[0]);
+  if (!(vol != 0 && fabsf(vol) < INFINITY) || (cull && !(vol > 0))) return false; /* edge-on, culled */
+  const float sign = vol > 0 ? 1.0f : -1.0f;
+  if (!(sign * v3_dot(n[0], ray->d0) >= 0)) return false;
+  n[1] = tri_edge_normal(q[2], q[0]);
+  if (!(sign * v3_dot(n[1], ray->d0) >= 0)) return false;
+  n[2] = tri_edge_normal(q[0], q[1]);
+  if (!(sign * v3_dot(n[2], ray->d0) >= 0)) return false;
+  float e[3];
+  uint32_t tie = 0;
+  for (int k = 0; k < 3; k++) {
+    vec3 ne = v3_scale(n[k], sign);
+    float a = v3_dot(ne, ray->d0), b = v3_dot(ne, ray->dx), c = v3_dot(ne, ray->dy);
+    tie |= (uint32_t)tri_lex_positive(b, c, v3_dot(ne, ray->fwd)) << k;
+    e[k] = a * 1.0f + b * 0.0f + c * 0.0f;
+  }
+  if (!sample_test(e, tie, vol * sign, t, l1, l2)) return false;
+  return *t >= tmin && *t <= tmax;
+}
+
 /* The inclusive pixel rectangle a set-up triangle's samples may lie in; false when
  * none. For curved cameras it is the bounding box of the cells whose cone of
  * directions no edge plane excludes. */

@@ -11,8 +11,12 @@
  *
  * Thread safety: a query reads the scene and its BVH, keeps its state on its own
  * stack and writes only the caller's results and the caller's device (NULL: none),
- * so any number of threads may trace rays through one committed scene. */
+ * so any number of threads may trace rays through one committed scene. A stream
+ * (rr_intersect_stream, rr_occluded_stream) traces each ray the same way. */
 #include "vis/bvh_trace.h"
+
+#include <limits.h>
+#include <stdatomic.h>
 
 /* An arbitrary ray: its slab-test form, range, best hit and pseudo-camera. */
 typedef struct {
@@ -40,7 +44,7 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
   for (uint32_t i = first; i < first + count; i++) {
     uint32_t id = r->b->prims[i];
     float t, l1, l2;
-    if (!rr_tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
+    if (!tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
     if (any) return true;
     if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
   }
@@ -59,23 +63,51 @@ KERNEL bool query_leaf_any(void *q, uint32_t first, uint32_t count, uint64_t lan
 
 KERNEL float query_best(const void *q) { return ((const query_ray *)q)->t; }
 
+/* Why a ray cannot be traced, or NULL. */
+static const char *ray_problem(const float org[3], const float dir[3], float tmin, float tmax) {
+  for (int a = 0; a < 3; a++)
+    if (!isfinite(org[a]) || !isfinite(dir[a])) return "a non-finite origin or direction";
+  if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0) return "a zero direction";
+  if (isnan(tmin) || isnan(tmax)) return "a NaN range";
+  return NULL;
+}
+
+/* Prepares a valid ray against the scene's tree b (NULL: an empty scene). */
+static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const float org[3], const float dir[3],
+                       float tmin, float tmax) {
+  r->s = s, r->b = b;
+  rr_cam_for_ray(org, dir, &r->cam);
+  ray_q_init(&r->q, r->cam.eye, r->cam.d0);
+  r->tmin = tmin, r->t = tmax, r->id = RR_MISS, r->l1 = r->l2 = 0;
+}
+
+/* Traces a prepared ray: the nearest hit into r, or (any) whether there is one. */
+static bool query_trace(query_ray *r, bool any) {
+  if (!r->b) return false;
+  if (any) return bvh_trace(r->b, r, 1, query_node, query_leaf_any, query_best);
+  bvh_trace(r->b, r, 1, query_node, query_leaf_closest, query_best);
+  return r->id != RR_MISS;
+}
+
+/* The committed scene's tree (NULL for an empty scene) or an error in dev. */
+static rr_error query_scene(rr_device *dev, const char *fn, const rr_scene *s, const void *in, const void *out,
+                            const rr_bvh **b) {
+  if (!s || !in || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: NULL scene, ray or result", fn);
+  bool empty;
+  *b = rr_bvh_of(dev, s, &empty);
+  if (!*b && !empty) return RR_ERROR_ARGUMENT; /* a scene changed since its commit: rr_bvh_of said so */
+  return RR_OK;
+}
+
 /* Checks a query's arguments and prepares its ray; errors go to dev only. */
 static rr_error query_begin(rr_device *dev, const char *fn, const rr_scene *s, const rr_ray *ray, const void *out,
                             query_ray *r) {
-  if (!s || !ray || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: NULL scene, ray or result", fn);
-  for (int a = 0; a < 3; a++)
-    if (!isfinite(ray->org[a]) || !isfinite(ray->dir[a]))
-      return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray with a non-finite origin or direction", fn);
-  if (ray->dir[0] == 0 && ray->dir[1] == 0 && ray->dir[2] == 0)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray with a zero direction", fn);
-  if (isnan(ray->tmin) || isnan(ray->tmax)) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray with a NaN range", fn);
-  bool empty;
-  r->b = rr_bvh_of(dev, s, &empty);
-  if (!r->b && !empty) return RR_ERROR_ARGUMENT; /* a scene changed since its commit: rr_bvh_of said so */
-  r->s = s;
-  rr_cam_for_ray(ray->org, ray->dir, &r->cam);
-  ray_q_init(&r->q, r->cam.eye, r->cam.d0);
-  r->tmin = ray->tmin, r->t = ray->tmax, r->id = RR_MISS, r->l1 = r->l2 = 0;
+  const rr_bvh *b;
+  rr_error e = query_scene(dev, fn, s, ray, out, &b);
+  if (e) return e;
+  const char *why = ray_problem(ray->org, ray->dir, ray->tmin, ray->tmax);
+  if (why) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray with %s", fn, why);
+  query_init(r, s, b, ray->org, ray->dir, ray->tmin, ray->tmax);
   return RR_OK;
 }
 
@@ -84,8 +116,7 @@ rr_error rr_intersect(rr_device *dev, const rr_scene *scene, const rr_ray *ray, 
   query_ray r;
   rr_error e = query_begin(dev, "rr_intersect", scene, ray, hit, &r);
   if (e) return e;
-  if (r.b) bvh_trace(r.b, &r, 1, query_node, query_leaf_closest, query_best);
-  if (r.id != RR_MISS) *hit = rr_scene_hit(scene, r.id, r.t, r.l1, r.l2);
+  if (query_trace(&r, false)) *hit = rr_scene_hit(scene, r.id, r.t, r.l1, r.l2);
   return rr_ok(dev);
 }
 
@@ -94,6 +125,104 @@ rr_error rr_occluded(rr_device *dev, const rr_scene *scene, const rr_ray *ray, i
   query_ray r;
   rr_error e = query_begin(dev, "rr_occluded", scene, ray, occluded, &r);
   if (e) return e;
-  if (r.b) *occluded = bvh_trace(r.b, &r, 1, query_node, query_leaf_any, query_best);
+  *occluded = query_trace(&r, true);
   return rr_ok(dev);
+}
+
+/* ---- streams -------------------------------------------------------------
+ * A stream is cut into chunks of consecutive rays dealt to the thread pool; each
+ * ray is traced exactly as rr_intersect / rr_occluded trace it (so the results
+ * cannot depend on the chunking), with the scene checked once per call instead
+ * of once per ray. Packets (rc-packet's traversal) would pay only for coherent
+ * rays and are left for later: a stream does not know its rays are coherent. */
+
+rr_ray_stream rr_ray_stream_aos(const rr_ray *rays, size_t count) {
+  if (!rays) return (rr_ray_stream){.count = count, .stride = sizeof(rr_ray)};
+  return (rr_ray_stream){.count = count,
+                         .stride = sizeof(rr_ray),
+                         .org = {&rays->org[0], &rays->org[1], &rays->org[2]},
+                         .dir = {&rays->dir[0], &rays->dir[1], &rays->dir[2]},
+                         .tmin = &rays->tmin,
+                         .tmax = &rays->tmax};
+}
+
+enum { STREAM_CHUNK = 256 }; /* rays per job: a few tens of microseconds of work */
+
+typedef struct {
+  const rr_scene *s;
+  const rr_bvh *b;
+  const rr_ray_stream *rays;
+  size_t chunk;
+  rr_hit *hits;      /* closest hit, or */
+  int *occluded;     /* any hit */
+  atomic_size_t bad; /* the lowest invalid ray, SIZE_MAX when none */
+} stream_job;
+
+static float stream_at(const stream_job *j, const float *p, size_t i) {
+  return *(const float *)((const char *)p + i * j->rays->stride);
+}
+
+static void stream_chunk(int job, int thread, void *arg) {
+  (void)thread;
+  stream_job *j = arg;
+  const rr_ray_stream *rs = j->rays;
+  size_t lo = (size_t)job * j->chunk, hi = lo + j->chunk < rs->count ? lo + j->chunk : rs->count;
+  for (size_t i = lo; i < hi; i++) {
+    float org[3], dir[3], tmin = stream_at(j, rs->tmin, i), tmax = stream_at(j, rs->tmax, i);
+    for (int a = 0; a < 3; a++) org[a] = stream_at(j, rs->org[a], i), dir[a] = stream_at(j, rs->dir[a], i);
+    bool valid = !ray_problem(org, dir, tmin, tmax), hit = false;
+    query_ray r;
+    if (valid) {
+      query_init(&r, j->s, j->b, org, dir, tmin, tmax);
+      hit = query_trace(&r, j->occluded != NULL);
+    } else {
+      size_t bad = atomic_load(&j->bad);
+      while (i < bad && !atomic_compare_exchange_weak(&j->bad, &bad, i)) {
+      }
+    }
+    if (j->occluded)
+      j->occluded[i] = hit;
+    else
+      j->hits[i] = hit ? rr_scene_hit(j->s, r.id, r.t, r.l1, r.l2) : rr_scene_hit(j->s, RR_MISS, INFINITY, 0, 0);
+  }
+}
+
+static rr_error stream_run(rr_device *dev, const char *fn, const rr_scene *s, const rr_ray_stream *rs, int threads,
+                           rr_hit *hits, int *occluded) {
+  const rr_bvh *b;
+  rr_error e = query_scene(dev, fn, s, rs, hits ? (const void *)hits : (const void *)occluded, &b);
+  if (e) return e;
+  if (threads < 0 || threads > RR_MAX_THREADS)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: %d threads (0 for all cores, at most %d)", fn, threads,
+                   RR_MAX_THREADS);
+  if (rs->count == 0) return rr_ok(dev);
+  if (rs->stride % sizeof(float))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: a stride of %zu bytes, not a multiple of %zu", fn, rs->stride,
+                   sizeof(float));
+  bool null = !rs->tmin || !rs->tmax;
+  for (int a = 0; a < 3; a++) null |= !rs->org[a] || !rs->dir[a];
+  if (null) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: a NULL component array", fn);
+  /* jobs are ints: a stream of more than INT_MAX chunks gets longer chunks */
+  size_t chunk = rs->count / INT_MAX + 1 > STREAM_CHUNK ? rs->count / INT_MAX + 1 : STREAM_CHUNK;
+  stream_job j = {.s = s, .b = b, .rays = rs, .chunk = chunk, .hits = hits, .occluded = occluded};
+  atomic_init(&j.bad, SIZE_MAX);
+  rr_parallel_for((int)((rs->count + chunk - 1) / chunk), threads ? threads : rr_cpu_count(), stream_chunk, &j);
+  size_t bad = atomic_load(&j.bad);
+  if (bad != SIZE_MAX) {
+    float org[3], dir[3];
+    for (int a = 0; a < 3; a++) org[a] = stream_at(&j, rs->org[a], bad), dir[a] = stream_at(&j, rs->dir[a], bad);
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray %zu with %s (a miss)", fn, bad,
+                   ray_problem(org, dir, stream_at(&j, rs->tmin, bad), stream_at(&j, rs->tmax, bad)));
+  }
+  return rr_ok(dev);
+}
+
+rr_error rr_intersect_stream(rr_device *dev, const rr_scene *scene, const rr_ray_stream *rays, int threads,
+                             rr_hit *hits) {
+  return stream_run(dev, "rr_intersect_stream", scene, rays, threads, hits, NULL);
+}
+
+rr_error rr_occluded_stream(rr_device *dev, const rr_scene *scene, const rr_ray_stream *rays, int threads,
+                            int *occluded) {
+  return stream_run(dev, "rr_occluded_stream", scene, rays, threads, NULL, occluded);
 }
