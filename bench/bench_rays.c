@@ -13,7 +13,8 @@
  * --reps (default 5), Mrays/s, the ratio to Embree's width-1 call, agreement
  * with it (same hit/miss; closest hit: t within 1e-4 relative, same triangle), and whether the results
  * are bit-identical to the single calls'. --instructions: the instructions of
- * one pass of each rastray mode under callgrind (use fewer --rays). */
+ * one pass of each mode under callgrind (use fewer --rays), a measure that a busy
+ * machine does not blur. */
 #include "benchutil.h"
 #include "vis/vis.h"
 #ifdef RR_HAVE_EMBREE
@@ -131,9 +132,10 @@ static void bench_rays_set(rr_device *dev, const char *scene, const rr_scene *s,
     memset(modes[m].t, 0, n * sizeof(float));
   }
   if (o->count) {
-    for (int m = 0; m < M_EMB1; m++) {
+    for (int m = 0; m < nmodes; m++) {
       char part[256];
       snprintf(part, sizeof part, "%s %s %s", scene, any ? "shadow" : "ao", modes[m].name);
+      run_mode(dev, s, emb, m, any, rays, n, hits, occ, modes[m].ids, modes[m].t); /* warm-up, uncounted */
       bench_count_start();
       run_mode(dev, s, emb, m, any, rays, n, hits, occ, modes[m].ids, modes[m].t);
       bench_count_stop(part);
@@ -174,7 +176,7 @@ static void bench_rays_scene(rr_device *dev, const char *name, const bench_rays_
   void *emb = NULL;
 #ifdef RR_HAVE_EMBREE
   double build_ms;
-  if (!o->count) emb = peer_embree_new(s, 1, 1, &build_ms);
+  emb = peer_embree_new(s, 1, 1, &build_ms);
 #endif
   printf("%s: %u triangles\n", name, s->ntris);
   bench_rays_set(dev, name, s, emb, false, ao, o);
