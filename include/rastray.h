@@ -156,7 +156,7 @@ RR_API rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
  * and the triangles after it keep theirs. So the id of triangle t of a mesh (a
  * file's or an rr_scene_add_mesh call's) is first + t, and so are rr_frame_ids, the
  * id AOV, rr_hit.prim and the local index of rr_scene_get_geometry (= t).
- * rr_scene_info.triangles counts kept triangles, so ids may reach triangles + skipped. */
+ * rr_scene_info.triangles counts kept triangles: ids run from 0 to triangles + skipped - 1. */
 
 /* What a geometry is made of (like Embree's RTC_GEOMETRY_TYPE_*). */
 typedef enum rr_geometry_kind {
