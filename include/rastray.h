@@ -153,9 +153,9 @@ RR_API rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
  * (a face of n corners gives triangles (0, j, j+1), j = 1 .. n-2), counted over the
  * whole scene with geometries numbered in load order, whatever was skipped: a
  * skipped (degenerate or non-finite) triangle keeps its id, which no hit ever has,
- * and the triangles after it keep theirs. So the id of triangle t of a mesh (a
- * file's or an rr_scene_add_mesh call's) is first + t, and so are rr_frame_ids, the
- * id AOV, rr_hit.prim and the local index of rr_scene_get_geometry (= t).
+ * and the triangles after it keep theirs. So triangle t of a mesh (a file's or an
+ * rr_scene_add_mesh call's) has id first + t wherever an id appears (rr_frame_ids,
+ * the id AOV, rr_hit.prim) and local index t in rr_scene_get_geometry.
  * rr_scene_info.triangles counts kept triangles: ids run from 0 to triangles + skipped - 1. */
 
 /* What a geometry is made of (like Embree's RTC_GEOMETRY_TYPE_*). */
