@@ -91,7 +91,8 @@ RR_API rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out);
 RR_API rr_error rr_scene_new(rr_device *dev, rr_scene **out);
 /* Appends an indexed triangle mesh as one new geometry (numbered after the scene's
  * others) with a new material of base colour rgb (NULL: grey); 3 indices per
- * triangle. Degenerate and non-finite triangles are skipped and counted. */
+ * triangle. Degenerate and non-finite triangles are skipped and counted; they keep
+ * their ids (see "ids" below), so triangle t of the call has id first + t. */
 RR_API rr_error rr_scene_add_mesh(rr_scene *scene, const float *positions, size_t nvertices,
                                   const uint32_t *indices, size_t ntriangles, const float rgb[3]);
 /* The same with a colour per vertex (vertex_rgb: 3 floats each, linear RGB like
@@ -123,7 +124,7 @@ RR_API void rr_scene_release(rr_scene *scene);
 
 typedef struct rr_scene_info {
   uint64_t triangles;    /* triangles kept */
-  uint64_t skipped;      /* degenerate or non-finite triangles dropped at load */
+  uint64_t skipped;      /* degenerate or non-finite triangles dropped at load (never hit; their ids stay taken) */
   uint32_t materials;    /* materials */
   uint32_t geometries;   /* geometries (meshes), ids 0 .. geometries - 1 */
   float bounds_min[3], bounds_max[3];
@@ -147,7 +148,15 @@ RR_API rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
 /* A scene is a list of geometries, each a run of primitives of one kind: a mesh of a
  * file's node/mesh pair, one rr_scene_add_mesh call or one object of a built-in
  * scene, in the order they were added. Primitive ids (the visibility buffer's ids)
- * are global: geometry g holds ids [first, first + count). */
+ * are global: geometry g holds ids [first, first + count).
+ * Ids: a triangle's id is its face's index in load order after fan triangulation
+ * (a face of n corners gives triangles (0, j, j+1), j = 1 .. n-2), counted over the
+ * whole scene with geometries numbered in load order, whatever was skipped: a
+ * skipped (degenerate or non-finite) triangle keeps its id, which no hit ever has,
+ * and the triangles after it keep theirs. So triangle t of a mesh (a file's or an
+ * rr_scene_add_mesh call's) has id first + t wherever an id appears (rr_frame_ids,
+ * the id AOV, rr_hit.prim) and local index t in rr_scene_get_geometry.
+ * rr_scene_info.triangles counts kept triangles: ids run from 0 to triangles + skipped - 1. */
 
 /* What a geometry is made of (like Embree's RTC_GEOMETRY_TYPE_*). */
 typedef enum rr_geometry_kind {
@@ -160,13 +169,14 @@ RR_API const char *rr_geometry_kind_name(int kind);
 
 typedef struct rr_geometry_info {
   rr_geometry_kind kind;
-  uint32_t first, count; /* its primitives: global ids first .. first + count - 1 */
+  uint32_t first, count; /* its primitives: global ids first .. first + count - 1, skipped ones included */
   uint32_t material;     /* the material of all its primitives */
   const char *name;      /* the name the file gives it, NULL when none; valid until the scene changes */
 } rr_geometry_info;
 
-/* The geometry holding primitive `prim` and prim's index within it (*local = prim -
- * first); RR_MISS maps to RR_MISS in both. Either pointer may be NULL. */
+/* The geometry holding primitive id `prim` (a skipped one's too) and prim's index
+ * within it, its face's index in the mesh (*local = prim - first); RR_MISS maps to
+ * RR_MISS in both. Either pointer may be NULL. */
 RR_API rr_error rr_scene_get_geometry(const rr_scene *scene, uint32_t prim, uint32_t *geom, uint32_t *local);
 /* Fills what is known about geometry `geom` (0 .. rr_scene_info.geometries - 1). */
 RR_API rr_error rr_scene_get_geometry_info(const rr_scene *scene, uint32_t geom, rr_geometry_info *info);
@@ -180,7 +190,7 @@ typedef struct rr_ray {
 } rr_ray;
 
 typedef struct rr_hit {
-  uint32_t prim; /* triangle id, RR_MISS when nothing is hit */
+  uint32_t prim; /* triangle id (see "ids" above), RR_MISS when nothing is hit */
   float t;       /* ray parameter of the hit (+inf on a miss) */
   float l1, l2;  /* barycentrics of the hit: weights of the triangle's vertices 1 and 2 */
   uint32_t geom; /* the geometry holding prim (rr_scene_get_geometry), RR_MISS on a miss */
@@ -404,7 +414,7 @@ RR_API rr_error rr_frame_get_size(const rr_frame *frame, int *width, int *height
 /* Samples per pixel of the frame (options.samples). */
 RR_API rr_error rr_frame_get_samples(const rr_frame *frame, int *samples);
 /* Read-only views of the visibility buffer, row 0 at the top: primitive id
- * (RR_MISS on a miss), ray parameter t along the unnormalised camera ray
+ * (the triangle's id as under "geometries" above, RR_MISS on a miss), ray parameter t along the unnormalised camera ray
  * (+inf on a miss) and barycentrics λ1, λ2 of the hit. With several samples per
  * pixel they hold one width × height layer per sample, sample s at offset
  * s·width·height. */

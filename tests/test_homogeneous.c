@@ -142,8 +142,8 @@ static void check_views(rr_device *dev, const rr_scene *s, uint32_t nplane, cons
 }
 
 /* The reference for check_api's scene: the plane y = 0 (ids 0..3 by quadrant) and
- * triangle 4, the corner (1, 2, 3) with directions +x and -z: the quarter of the
- * plane y = 2 where x >= 1 and z <= 3. */
+ * triangle 5 (id 5: the skipped triangle 4 keeps its id), the corner (1, 2, 3) with
+ * directions +x and -z: the quarter of the plane y = 2 where x >= 1 and z <= 3. */
 static uint32_t reference_api(vec3 of, vec3 df, double *tbest) {
   double o[3] = {of.x, of.y, of.z}, d[3] = {df.x, df.y, df.z};
   uint32_t best = RR_MISS;
@@ -154,7 +154,7 @@ static uint32_t reference_api(vec3 of, vec3 df, double *tbest) {
     double x = o[0] + t * d[0], z = o[2] + t * d[2];
     *tbest = t, best = x > 0 ? (z < 0 ? 0 : 3) : (z < 0 ? 1 : 2);
   }
-  if (t2 > 0 && t2 < *tbest && o[0] + t2 * d[0] > 1 && o[2] + t2 * d[2] < 3) *tbest = t2, best = 4;
+  if (t2 > 0 && t2 < *tbest && o[0] + t2 * d[0] > 1 && o[2] + t2 * d[2] < 3) *tbest = t2, best = 5;
   return best;
 }
 

@@ -2,7 +2,8 @@
  *
  * Polygons are fan-triangulated here rather than by assimp, so primitive ids follow
  * the documented order: meshes in node order (file order), faces in file order,
- * face k of n corners giving triangles (0, j, j+1). Each node/mesh pair is one
+ * face k of n corners giving triangles (0, j, j+1), each counted whether kept or
+ * dropped as degenerate (the scene keeps dropped faces' ids). Each node/mesh pair is one
  * geometry, named after its node (an OBJ object or group, a glTF node), else after
  * its mesh; assimp splits an OBJ object by material into meshes of one node.
  * Besides triangles the file gives materials (with embedded textures), vertex

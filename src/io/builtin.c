@@ -279,8 +279,10 @@ static rr_error gen_ground(rr_scene *s) {
 /* grid:PATH:N — N×N copies of a mesh file on the XZ plane, copy k = j·N + i moved by
  * (i·1.25·sx, 0, j·1.25·sz). The copies are written straight into the arrays rather
  * than through rr_scene_push: a translated sliver could round to zero area and be
- * dropped, which would break the rule that copy k's triangle m has id k·T + m. Each
- * copy has its own geometries, like the file's, named as in the file. */
+ * dropped, which would break the rule that copy k's triangle m has index k·T + m and
+ * id k·F + (the file's id of m), F the file's faces, dropped ones included (ids as if
+ * the file were loaded N² times). Each copy has its own geometries, like the file's,
+ * named as in the file. */
 static rr_error load_grid(rr_scene *s, const char *name) {
   const char *rest = name + strlen("grid:");
   const char *colon = strrchr(rest, ':'); /* PATH may itself contain ':' */
@@ -296,17 +298,17 @@ static rr_error load_grid(rr_scene *s, const char *name) {
   memcpy(path, rest, len);
   path[len] = 0;
   uint32_t t0 = s->ntris, g0 = s->ngeoms;
-  uint64_t skipped0 = s->skipped;
+  uint64_t skipped0 = s->skipped, f0 = scene_faces(s);
   rr_error e = rr_scene_load_file(s, path);
   free(path);
   if (e) return e;
 
   uint32_t T = s->ntris - t0;
-  uint64_t copies = (uint64_t)n * (uint64_t)n, total = copies * T;
+  uint64_t F = scene_faces(s) - f0, copies = (uint64_t)n * (uint64_t)n, total = copies * T;
   if (T == 0 || n == 1) return RR_OK;
-  if (total > UINT32_MAX - 1 - (uint64_t)t0)
-    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "grid '%s' would hold %llu triangles (at most %u)", name,
-                   (unsigned long long)total, UINT32_MAX - 1 - t0);
+  if (copies * F > UINT32_MAX - 1 - f0) /* ids, dropped faces' too, stay below RR_MISS */
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "grid '%s' would hold %llu triangles (at most %llu)", name,
+                   (unsigned long long)(copies * F), (unsigned long long)(UINT32_MAX - 1 - f0));
 
   float xlo = INFINITY, xhi = -INFINITY, zlo = INFINITY, zhi = -INFINITY;
   for (int k = 0; k < 3; k++)
@@ -318,14 +320,17 @@ static rr_error load_grid(rr_scene *s, const char *name) {
   if (!isfinite((float)(n - 1) * 1.25f * sx) || !isfinite((float)(n - 1) * 1.25f * sz))
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "grid '%s': the mesh is too large to replicate", name);
 
+  s->skipped += (s->skipped - skipped0) * (copies - 1); /* as loading the file N² times would */
   e = rr_scene_reserve(s, (uint32_t)(total - T), false, false);
+  if (!e && F != T) e = rr_scene_reserve_ids(s); /* copies' ids differ from their indices */
   if (e) return e;
   uint32_t g1 = s->ngeoms;
   for (uint64_t copy = 1; copy < copies; copy++) {
     float ox = (float)(copy % n) * 1.25f * sx, oz = (float)(copy / n) * 1.25f * sz;
     size_t dst = t0 + copy * T;
     for (uint32_t g = g0; g < g1; g++) {
-      e = rr_scene_repeat_geometry(s, g, s->geoms[g].first + (uint32_t)(copy * T));
+      e = rr_scene_repeat_geometry(s, g, s->geoms[g].first + (uint32_t)(copy * T),
+                                   s->geoms[g].face + (uint32_t)(copy * F));
       if (e) return e;
     }
     for (int k = 0; k < 3; k++) {
@@ -340,10 +345,9 @@ static rr_error load_grid(rr_scene *s, const char *name) {
         if (s->uv[k][c]) memcpy(s->uv[k][c] + dst, s->uv[k][c] + t0, T * sizeof(float));
     }
     memcpy(s->material + dst, s->material + t0, T * sizeof(uint32_t));
+    for (uint32_t m = 0; s->file_id && m < T; m++) s->file_id[dst + m] = s->file_id[t0 + m] + (uint32_t)(copy * F);
   }
   s->ntris = (uint32_t)(t0 + total);
-  /* Count the file's dropped triangles once per copy, as loading it N² times would. */
-  s->skipped += (s->skipped - skipped0) * (copies - 1);
   rr_scene_update_bounds(s);
   return RR_OK;
 }

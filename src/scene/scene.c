@@ -26,6 +26,7 @@ void rr_scene_release(rr_scene *s) {
     for (int c = 0; c < 2; c++) free(s->uv[k][c]);
   }
   free(s->material);
+  free(s->file_id);
   free(s->inf);
   for (uint32_t m = 0; m < s->nmaterials; m++) {
     free(s->materials[m].name);
@@ -54,8 +55,9 @@ static bool grow(float **arr, uint32_t cap) {
 
 rr_error rr_scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_uvs) {
   uint64_t need = (uint64_t)s->ntris + more;
-  if (need > UINT32_MAX - 1)
-    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "scene too large: %llu triangles", (unsigned long long)need);
+  if (scene_faces(s) + more > UINT32_MAX - 1) /* every id, dropped faces' too, below RR_MISS */
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "scene too large: %llu triangles",
+                   (unsigned long long)(scene_faces(s) + more));
   /* Attribute arrays appear when the first mesh that has them arrives; earlier
    * triangles get zeros so the arrays stay aligned with the positions. */
   bool add_n = with_normals && !s->n[0][0], add_uv = with_uvs && !s->uv[0][0];
@@ -74,6 +76,14 @@ rr_error rr_scene_reserve_inf(rr_scene *s) {
   if (s->inf) return RR_OK;
   s->inf = calloc(s->cap ? s->cap : 1, 1); /* earlier triangles are finite */
   return s->inf ? RR_OK : rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for corners at infinity");
+}
+
+rr_error rr_scene_reserve_ids(rr_scene *s) {
+  if (s->file_id) return RR_OK;
+  s->file_id = malloc((s->cap ? s->cap : 1) * sizeof *s->file_id);
+  if (!s->file_id) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for the ids of %u triangles", s->ntris);
+  for (uint32_t i = 0; i < s->ntris; i++) s->file_id[i] = i; /* nothing was dropped before them */
+  return RR_OK;
 }
 
 rr_error rr_scene_reserve_colors(rr_scene *s) {
@@ -121,6 +131,11 @@ static bool resize(rr_scene *s, uint32_t cap, bool add_n, bool add_uv) {
   if (ok && s->inf && cap != s->cap) {
     uint8_t *f = realloc(s->inf, cap);
     if (f) s->inf = f;
+    ok = f != NULL;
+  }
+  if (ok && s->file_id && cap != s->cap) {
+    uint32_t *f = realloc(s->file_id, (size_t)cap * sizeof *f);
+    if (f) s->file_id = f;
     ok = f != NULL;
   }
   uint32_t *m = ok ? realloc(s->material, (size_t)cap * sizeof *m) : NULL;
@@ -174,8 +189,11 @@ bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n
     if (rr_scene_reserve(s, 0, n != NULL, uv != NULL) != RR_OK) return false;
   if (inf && rr_scene_reserve_inf(s) != RR_OK) return false;
   if (col && rr_scene_reserve_colors(s) != RR_OK) return false;
+  if (s->skipped && rr_scene_reserve_ids(s) != RR_OK) return false;
   if (!s->ngeoms && rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, NULL) != RR_OK) return false;
-  uint32_t i = s->ntris++;
+  uint32_t i = s->ntris;
+  if (s->file_id) s->file_id[i] = (uint32_t)scene_faces(s); /* reserve keeps ids below RR_MISS */
+  s->ntris++;
   if (s->inf) s->inf[i] = (uint8_t)(inf & 7u);
   for (int k = 0; k < 3; k++) {
     s->p[k][0][i] = p[k].x, s->p[k][1][i] = p[k].y, s->p[k][2][i] = p[k].z;
@@ -286,12 +304,12 @@ static rr_error append_geometry(rr_scene *s, scene_geometry g) {
 rr_error rr_scene_open_geometry(rr_scene *s, prim_kind kind, uint32_t material, const char *name) {
   uint32_t off;
   rr_error e = intern_name(s, name, &off);
-  return e ? e : append_geometry(s, (scene_geometry){s->ntris, material, kind, off});
+  return e ? e : append_geometry(s, (scene_geometry){s->ntris, (uint32_t)scene_faces(s), material, kind, off});
 }
 
-rr_error rr_scene_repeat_geometry(rr_scene *s, uint32_t g, uint32_t first) {
+rr_error rr_scene_repeat_geometry(rr_scene *s, uint32_t g, uint32_t first, uint32_t face) {
   scene_geometry copy = s->geoms[g]; /* by value: appending may move the table */
-  copy.first = first;
+  copy.first = first, copy.face = face;
   return append_geometry(s, copy);
 }
 
@@ -299,34 +317,40 @@ rr_error rr_scene_name_geometry(rr_scene *s, uint32_t g, const char *name) {
   return intern_name(s, name, &s->geoms[g].name);
 }
 
-uint32_t rr_scene_geometry_of(const rr_scene *s, uint32_t prim) {
-  if (prim >= s->ntris) return RR_MISS;
-  /* The last geometry starting at or before prim (geoms[0] starts at 0); an empty
-   * geometry starts where the next does, so the search passes over it. */
+/* The last geometry whose first index (by_id: first id) is at or below x. geoms[0]
+ * starts at 0 in both; an empty geometry starts where the next does (by index), so
+ * the search passes over it. */
+static uint32_t find_geometry(const rr_scene *s, uint32_t x, bool by_id) {
   uint32_t lo = 0, n = s->ngeoms;
   while (n > 1) {
     uint32_t half = n / 2;
-    if (s->geoms[lo + half].first <= prim) lo += half;
+    const scene_geometry *g = &s->geoms[lo + half];
+    if ((by_id ? g->face : g->first) <= x) lo += half;
     n -= half;
   }
   return lo;
 }
 
+uint32_t rr_scene_geometry_of(const rr_scene *s, uint32_t prim) {
+  return prim < s->ntris ? find_geometry(s, prim, false) : RR_MISS;
+}
+
 rr_hit rr_scene_hit(const rr_scene *s, uint32_t prim, float t, float l1, float l2) {
-  return (rr_hit){.prim = prim, .t = t, .l1 = l1, .l2 = l2,
-                  .geom = prim == RR_MISS ? RR_MISS : rr_scene_geometry_of(s, prim)};
+  if (prim == RR_MISS) return (rr_hit){.prim = RR_MISS, .t = t, .l1 = l1, .l2 = l2, .geom = RR_MISS};
+  return (rr_hit){.prim = scene_face_id(s, prim), .t = t, .l1 = l1, .l2 = l2, .geom = rr_scene_geometry_of(s, prim)};
 }
 
 const char *rr_geometry_kind_name(int kind) { return prim_kind_name(kind); }
 
 rr_error rr_scene_get_geometry(const rr_scene *s, uint32_t prim, uint32_t *geom, uint32_t *local) {
   if (!s) return RR_ERROR_ARGUMENT;
-  uint32_t g = rr_scene_geometry_of(s, prim);
+  /* prim is an id: dropped faces have ids too, in the geometry they were loaded into */
+  uint32_t g = prim < scene_faces(s) && s->ngeoms ? find_geometry(s, prim, true) : RR_MISS;
   if (geom) *geom = g;
-  if (local) *local = g == RR_MISS ? RR_MISS : prim - s->geoms[g].first;
+  if (local) *local = g == RR_MISS ? RR_MISS : prim - s->geoms[g].face;
   if (g == RR_MISS && prim != RR_MISS)
-    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_geometry: primitive %u out of range (%u in the scene)",
-                   prim, s->ntris);
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_geometry: primitive %u out of range (%llu in the scene)",
+                   prim, (unsigned long long)scene_faces(s));
   return RR_OK;
 }
 
@@ -337,7 +361,8 @@ rr_error rr_scene_get_geometry_info(const rr_scene *s, uint32_t geom, rr_geometr
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_geometry_info: geometry %u out of range (%u in the scene)",
                    geom, s->ngeoms);
   const scene_geometry *g = &s->geoms[geom];
-  *info = (rr_geometry_info){g->kind, g->first, scene_geometry_end(s, geom) - g->first, g->material,
+  uint32_t end = geom + 1 < s->ngeoms ? s->geoms[geom + 1].face : (uint32_t)scene_faces(s);
+  *info = (rr_geometry_info){g->kind, g->face, end - g->face, g->material,
                              g->name == NO_NAME ? NULL : s->names + g->name};
   return RR_OK;
 }

@@ -38,11 +38,13 @@ typedef struct file_camera {
 
 /* A geometry: a run of primitives of one kind that a loader opened (a file's
  * node/mesh pair, an rr_scene_add_mesh call, a built-in object). Its primitives are
- * the global ids from `first` up to the next geometry's first (the last one's up to
+ * the indices from `first` up to the next geometry's first (the last one's up to
  * ntris); the geometries tile [0, ntris) in order, and an empty one (every triangle
- * dropped) has the same first as the next. */
+ * dropped) has the same first as the next. Its faces (ids, below) likewise run
+ * from `face` to the next one's face (the last one's to scene_faces). */
 typedef struct scene_geometry {
   uint32_t first;
+  uint32_t face; /* the id of its first face: faces of the scene before it, dropped ones too */
   uint32_t material; /* the material of every primitive in it */
   prim_kind kind;
   uint32_t name; /* offset of its name in the scene's name pool, NO_NAME when none */
@@ -51,7 +53,17 @@ typedef struct scene_geometry {
 #define NO_NAME UINT32_MAX
 
 /* Triangles in structure-of-arrays form: component c of vertex k of triangle i is
- * p[k][c][i]. Normals and UVs are per triangle corner and may be NULL. */
+ * p[k][c][i]. Normals and UVs are per triangle corner and may be NULL.
+ *
+ * Indices and ids. The arrays hold the kept triangles only, at indices 0 .. ntris - 1,
+ * and everything inside the library (BVH, methods, the visibility buffer, shading)
+ * works with those indices. A triangle's id, the number users see, is its face's
+ * index in load order after fan triangulation, dropped faces counted: id =
+ * file_id[i] (i itself while nothing was dropped: file_id is NULL). The map only
+ * grows, so the order of ids is the order of indices and ties to the lower index
+ * are ties to the lower id. Ids leave the library through scene_face_id alone:
+ * rr_scene_hit (ray queries), the frame's ids and the id AOV and colours, and the
+ * geometry table (scene_geometry.face). */
 struct rr_scene {
   rr_device *dev;
   uint32_t ntris, cap;
@@ -66,7 +78,8 @@ struct rr_scene {
   uint32_t ngeoms, geoms_cap;
   char *names; /* the geometries' names, each ending in a NUL */
   size_t names_len, names_cap;
-  uint64_t skipped;
+  uint64_t skipped;   /* faces dropped (degenerate or non-finite); ids count them */
+  uint32_t *file_id;  /* per triangle: its id; NULL while none was dropped (id = index) */
   /* Homogeneous input: bit k of inf[i] set when corner k of triangle i is a point at
    * infinity (w = 0), whose p then holds its direction; NULL when there is none. */
   uint8_t *inf;
@@ -82,6 +95,13 @@ struct rr_scene {
 static inline vec3 scene_vertex(const rr_scene *s, int k, uint32_t i) {
   return v3(s->p[k][0][i], s->p[k][1][i], s->p[k][2][i]);
 }
+
+/* The id of triangle i (RR_MISS and other indices past the last stay as they are). */
+static inline uint32_t scene_face_id(const rr_scene *s, uint32_t i) {
+  return s->file_id && i < s->ntris ? s->file_id[i] : i;
+}
+/* Faces loaded so far, kept and dropped: ids run from 0 to this. */
+static inline uint64_t scene_faces(const rr_scene *s) { return s->ntris + s->skipped; }
 
 /* Which corners of triangle i lie at infinity (bit k: corner k); 0 for most. */
 static inline unsigned scene_inf(const rr_scene *s, uint32_t i) { return s->inf ? s->inf[i] : 0u; }
@@ -100,6 +120,9 @@ rr_error rr_scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool wi
  * grow with the other arrays: after it, with room reserved, pushing such a triangle
  * cannot run out of memory. */
 rr_error rr_scene_reserve_inf(rr_scene *s);
+/* Starts the map from triangle index to id (before it, every id was its index);
+ * it then grows with the other arrays. */
+rr_error rr_scene_reserve_ids(rr_scene *s);
 /* Starts the corner colours, which then grow with the other arrays; the corners
  * so far are white (the colour that changes nothing). */
 rr_error rr_scene_reserve_colors(rr_scene *s);
@@ -117,21 +140,17 @@ bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n
  * its. name may be NULL or "" (none). A push into a scene without geometries opens
  * an unnamed one with the triangle's material. */
 rr_error rr_scene_open_geometry(rr_scene *s, prim_kind kind, uint32_t material, const char *name);
-/* Opens a geometry like g (kind, material, name) whose primitives start at `first`,
- * for loaders that write primitives straight into the arrays (copies of a mesh);
- * first may not be below the last geometry's. */
-rr_error rr_scene_repeat_geometry(rr_scene *s, uint32_t g, uint32_t first);
+/* Opens a geometry like g (kind, material, name) whose primitives start at index
+ * `first` and id `face`, for loaders that write primitives straight into the arrays
+ * (copies of a mesh); neither may be below the last geometry's. */
+rr_error rr_scene_repeat_geometry(rr_scene *s, uint32_t g, uint32_t first, uint32_t face);
 /* Names geometry g (name NULL or "": none). */
 rr_error rr_scene_name_geometry(rr_scene *s, uint32_t g, const char *name);
-/* One past geometry g's last primitive id. */
-static inline uint32_t scene_geometry_end(const rr_scene *s, uint32_t g) {
-  return g + 1 < s->ngeoms ? s->geoms[g + 1].first : s->ntris;
-}
-/* The geometry of primitive id prim (binary search: shading asks per pixel);
+/* The geometry of triangle index prim (binary search: shading asks per pixel);
  * RR_MISS when prim is RR_MISS or out of range. */
 uint32_t rr_scene_geometry_of(const rr_scene *s, uint32_t prim);
-/* A ray query's answer for primitive prim (RR_MISS: a miss, s may then be NULL) hit
- * at t with barycentrics l1, l2: the rr_hit with prim's geometry filled in. */
+/* A ray query's answer for triangle index prim (RR_MISS: a miss, s may then be
+ * NULL) hit at t with barycentrics l1, l2: the rr_hit with prim's id and geometry. */
 rr_hit rr_scene_hit(const rr_scene *s, uint32_t prim, float t, float l1, float l2);
 /* Adds a material and returns its index (UINT32_MAX when out of memory). */
 uint32_t rr_scene_add_material(rr_scene *s, const float color[3], const char *texture_path);

@@ -220,7 +220,7 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp,
         o[0] = g * 0.9f, o[1] = g, o[2] = g * 1.15f;
       } else switch (mode) {
       case RR_SHADE_ID: {
-        uint32_t hsh = hash32(h.id + 1);
+        uint32_t hsh = hash32(scene_face_id(s, h.id) + 1); /* by id: the colour of a face whatever was dropped */
         for (int ch = 0; ch < 3; ch++) o[ch] = 0.2f + 0.8f * (float)((hsh >> (8 * ch)) & 255) / 255.0f;
         break;
       }
@@ -242,7 +242,7 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp,
 
 /* The value of an integer AOV (id, mesh, material) at a sample that saw primitive id. */
 static uint32_t id_aov(const rr_scene *s, rr_aov aov, uint32_t id) {
-  if (aov == RR_AOV_ID) return id;
+  if (aov == RR_AOV_ID) return scene_face_id(s, id);
   if (id >= s->ntris) return RR_MISS;
   return aov == RR_AOV_MESH ? rr_scene_geometry_of(s, id) : s->material[id];
 }

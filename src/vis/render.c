@@ -305,6 +305,14 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   }
   f->stats.frame_ms = rr_now_ms() - t0, f->stats.cpu_ms = rr_cpu_ms() - c0;
   rr_cam_release(&c);
+  /* The methods write triangle indices; users see ids (scene.h), which differ after
+   * a dropped face. Mapped once here, outside every method and the timed pass. */
+  if (!e && scene->file_id) {
+    size_t n = npix * opt->samples;
+    if (!(f->ids = malloc(n * sizeof *f->ids)))
+      e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d visibility buffer", opt->width, opt->height);
+    for (size_t k = 0; !e && k < n; k++) f->ids[k] = scene_face_id(scene, f->vb.id[k]);
+  }
   if (e) {
     rr_frame_release(f);
     return e;
@@ -317,6 +325,7 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
 void rr_frame_release(rr_frame *f) {
   if (!f) return;
   visbuf_free(&f->vb);
+  free(f->ids);
   free(f->heat_e), free(f->heat_n);
   free(f);
 }
@@ -339,7 +348,7 @@ rr_error rr_frame_get_samples(const rr_frame *f, int *samples) {
   return RR_OK;
 }
 
-const uint32_t *rr_frame_ids(const rr_frame *f) { return f ? f->vb.id : NULL; }
+const uint32_t *rr_frame_ids(const rr_frame *f) { return !f ? NULL : f->ids ? f->ids : f->vb.id; }
 const float *rr_frame_t(const rr_frame *f) { return f ? f->vb.t : NULL; }
 const float *rr_frame_bary1(const rr_frame *f) { return f ? f->vb.l1 : NULL; }
 const float *rr_frame_bary2(const rr_frame *f) { return f ? f->vb.l2 : NULL; }

@@ -49,7 +49,8 @@ KERNEL void heat_charge_corners(float *heat, int width, int x0, int y0, int x1, 
 }
 
 struct rr_frame {
-  visbuf vb;
+  visbuf vb; /* triangle indices (scene.h), which shading reads the scene's arrays by */
+  uint32_t *ids; /* vb's hits as ids, when the scene's ids differ from its indices (else NULL) */
   float *heat_e, *heat_n; /* per-pixel E and N, when options.heat was set */
   rr_stats stats;
   rr_method method;
