@@ -343,7 +343,10 @@ static rr_error load_grid(rr_scene *s, const char *name) {
         if (s->n[k][c]) memcpy(s->n[k][c] + dst, s->n[k][c] + t0, T * sizeof(float));
       for (int c = 0; c < 2; c++)
         if (s->uv[k][c]) memcpy(s->uv[k][c] + dst, s->uv[k][c] + t0, T * sizeof(float));
+      for (int c = 0; c < 3; c++)
+        if (s->col[k][c]) memcpy(s->col[k][c] + dst, s->col[k][c] + t0, T * sizeof(float));
     }
+    if (s->inf) memcpy(s->inf + dst, s->inf + t0, T);
     memcpy(s->material + dst, s->material + t0, T * sizeof(uint32_t));
     for (uint32_t m = 0; s->file_id && m < T; m++) s->file_id[dst + m] = s->file_id[t0 + m] + (uint32_t)(copy * F);
   }
