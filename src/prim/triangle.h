@@ -16,6 +16,15 @@ typedef struct tri_setup {
   float vol, vol_x, vol_y;
   uint32_t tie; /* bit i: a sample exactly on edge i belongs to this triangle */
   float w[3];   /* homogeneous w of vertex i (1, or 0 at infinity): the sum is Σ w_i V_i */
+  /* The depth from the plane: t = num / den with den = pa·w.x + pb·(w.y − cx) +
+   * pc·(w.z − cy) (= N·d, the plane normal N = Σ w_i n_i, sign-normalised like the
+   * edges) and num = num0 + (sx − cx)·num_x + (sy − cy)·num_y (= N·(p_f − o), p_f
+   * a finite corner, o the ray origin), see prim/triangle_setup.c. (cx, cy) is a
+   * sample near the triangle (planar cameras; 0 for curved ones), so that the terms
+   * the sample adds are small and den and num keep their accuracy at any angle. */
+  float pa, pb, pc;
+  float num0, num_x, num_y;
+  float cx, cy;
 } tri_setup;
 
 enum { SETUP_CULLED = 0, SETUP_FRONT = 1, SETUP_BACK = 2 };
@@ -44,6 +53,14 @@ static inline void tri_edges(const tri_setup *t, float sx, float sy, float e[3])
 static inline float tri_vol(const tri_setup *t, float sx, float sy) {
   return t->vol + sx * t->vol_x + sy * t->vol_y;
 }
+/* The depth's denominator N·d for evaluation vector w, and its numerator N·(p_f − o)
+ * at sample (sx, sy): the same order of operations as the edges and the volume. */
+static inline float tri_den_w(const tri_setup *t, vec3 w) {
+  return t->pa * w.x + t->pb * (w.y - t->cx) + t->pc * (w.z - t->cy);
+}
+static inline float tri_num(const tri_setup *t, float sx, float sy) {
+  return t->num0 + (sx - t->cx) * t->num_x + (sy - t->cy) * t->num_y;
+}
 
 /* The one sample test's two conditions, written once for a sample (floats, tie 0/1)
  * and for W samples (core/simd.h vectors, tie and results as lane masks), so every
@@ -52,15 +69,25 @@ static inline float tri_vol(const tri_setup *t, float sx, float sy) {
  * the hit counts when the sum Σw_iV_i and the volume are both positive. */
 #define TRI_EDGE_INSIDE(e, tie, zero) (((e) > (zero)) | (((e) == (zero)) & (tie)))
 #define TRI_HIT_AHEAD(sum, vol, zero) (((sum) > (zero)) & ((vol) > (zero)))
+/* The hit's t: from the plane, num / den, unless rounding left either not positive
+ * (a ray within a few ulps of the plane's direction), where V / Σ w_i V_i (= vol·inv)
+ * stays positive as the sign test requires. The plane form's relative error is a few
+ * ulps over the cosine between ray and plane: num is one rounding of a double, den
+ * an affine form of three rounded coefficients. V / Σ w_i V_i cancels instead: its
+ * edge values are of the size of distance × edge length, their sum of edge length². */
+#define TRI_DEPTH(num, den, vol, inv, zero, select) \
+  select(((num) > (zero)) & ((den) > (zero)), (num) / (den), (vol) * (inv))
 
 /* The one sample test (paper eq. 2 with the top-left rule of sect. 4.2).
  * e: sign-normalised edge values at the sample; tie: bit i set when the sample
  * belongs to this triangle if it lies exactly on edge i; vol: the sign-normalised
  * volume at the sample (positive when the hit lies ahead of the ray origin).
  * w: the vertices' homogeneous w (appendix eqs. 5–11: a vertex at infinity has
- * w = 0 and leaves the sum). On a hit returns true with t = V / Σw_iV_i and
- * λ_i = V_i / Σw_iV_i. */
-static inline bool sample_test_w(const float e[3], const float w[3], uint32_t tie, float vol,
+ * w = 0 and leaves the sum). num, den: the plane's numerator and denominator at
+ * the sample (tri_num, tri_den_w). On a hit returns true with t = num / den
+ * (TRI_DEPTH) and λ_i = V_i / Σw_iV_i. */
+static inline float tri_select_f(bool m, float a, float b) { return m ? a : b; }
+static inline bool sample_test_w(const float e[3], const float w[3], uint32_t tie, float vol, float num, float den,
                                  float *t, float *l1, float *l2) {
   if (!(TRI_EDGE_INSIDE(e[0], (tie & 1u) != 0, 0.0f) && TRI_EDGE_INSIDE(e[1], (tie & 2u) != 0, 0.0f) &&
         TRI_EDGE_INSIDE(e[2], (tie & 4u) != 0, 0.0f)))
@@ -71,15 +98,18 @@ static inline bool sample_test_w(const float e[3], const float w[3], uint32_t ti
   /* sum == 0: all three on their edges (a degenerate sliver) or a pixel with no ray */
   if (!TRI_HIT_AHEAD(sum, vol, 0.0f)) return false;
   float inv = 1.0f / sum;
-  *t = vol * inv;
+  *t = TRI_DEPTH(num, den, vol, inv, 0.0f, tri_select_f);
   *l1 = e[1] * inv;
   *l2 = e[2] * inv;
   return true;
 }
-/* The same for a triangle of finite vertices (every w = 1). */
-static inline bool sample_test(const float e[3], uint32_t tie, float vol, float *t, float *l1, float *l2) {
-  static const float ones[3] = {1.0f, 1.0f, 1.0f};
-  return sample_test_w(e, ones, tie, vol, t, l1, l2);
+
+/* The one sample test of set-up triangle ts at a planar camera's sample (sx, sy),
+ * whose edge values e come from tri_edges. */
+static inline bool sample_test(const tri_setup *ts, const float e[3], float sx, float sy, float *t, float *l1,
+                               float *l2) {
+  return sample_test_w(e, ts->w, ts->tie, tri_vol(ts, sx, sy), tri_num(ts, sx, sy), tri_den_w(ts, v3(1.0f, sx, sy)),
+                       t, l1, l2);
 }
 
 /* The one sample test for an arbitrary ray set up by rr_cam_for_ray(): true on a hit

@@ -23,7 +23,8 @@ static inline bool depth_wins(float t, uint32_t id, float best_t, uint32_t best_
 KERNEL int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, float sy, visbuf *vb, size_t k) {
   float e[3], t, l1, l2;
   tri_edges_w(ts, w, e);
-  if (!sample_test_w(e, ts->w, ts->tie, tri_vol(ts, sx, sy), &t, &l1, &l2)) return 0;
+  if (!sample_test_w(e, ts->w, ts->tie, tri_vol(ts, sx, sy), tri_num(ts, sx, sy), tri_den_w(ts, w), &t, &l1, &l2))
+    return 0;
   if (!depth_wins(t, id, vb->t[k], vb->id[k])) return 1;
   vb->t[k] = t;
   vb->id[k] = id;
