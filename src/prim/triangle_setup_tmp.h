@@ -18,8 +18,8 @@ typedef struct {
 typedef struct {
   VD x, y, z;
 } D3;
-#define TO_D(v) __builtin_convertvector((v), VD)
-#define TO_F(v) __builtin_convertvector((v), VF)
+#define TO_D(v) RR_CAT(RR_CAT(rr_vf, W), _to_double)(v)
+#define TO_F(v) RR_CAT(RR_CAT(rr_vd, W), _to_float)(v)
 #define TO_D3(v) ((D3){TO_D((v).x), TO_D((v).y), TO_D((v).z)})
 #define DSPLAT3(v) ((D3){(VD){0} + (double)(v).x, (VD){0} + (double)(v).y, (VD){0} + (double)(v).z})
 #define SPLAT3(v) ((V3){VF_(splat)((v).x), VF_(splat)((v).y), VF_(splat)((v).z)})
