@@ -204,63 +204,11 @@ int test_run_cli(const char *dir, const char *args, bool with_stderr, char *out,
   return st != -1 && WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
-/* ---- depth against the exact plane hit ---------------------------------------- */
-
-static int cmp_double(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return (x > y) - (x < y);
-}
-
 bool test_depth_errors(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
                        test_depth_stats *out) {
-  memset(out, 0, sizeof *out);
-  out->worst = -1;
   camera c;
   if (rr_cam_setup(dev, cam, f->vb.width, f->vb.height, &c) != RR_OK) return false;
-  bool ok = c.planar;
-  size_t npix = (size_t)f->vb.width * f->vb.height;
-  double *err = malloc(npix * sizeof *err);
-  int *where = malloc(npix * sizeof *where);
-  for (size_t k = 0; ok && err && where && k < npix; k++) {
-    uint32_t id = f->vb.id[k];
-    if (id == RR_MISS) continue;
-    double sx = (double)(k % f->vb.width) + c.sx0, sy = (double)(k / f->vb.width) + c.sy0, o[3], d[3];
-    float e[3] = {c.eye.x, c.eye.y, c.eye.z};
-    for (int a = 0; a < 3; a++) {
-      if (c.type == RR_CAMERA_ORTHOGRAPHIC) {
-        o[a] = (double)e[a] + (double)(&c.o0.x)[a] + sx * (&c.ox.x)[a] + sy * (&c.oy.x)[a];
-        d[a] = (&c.fwd.x)[a];
-      } else {
-        o[a] = e[a];
-        d[a] = (double)(&c.d0.x)[a] + sx * (&c.dx.x)[a] + sy * (&c.dy.x)[a];
-      }
-    }
-    /* the plane through finite corner pf, spanned by r1, r2 (a corner at infinity: its direction) */
-    unsigned inf = scene_inf(s, id);
-    int fc = !(inf & 1u) ? 0 : !(inf & 2u) ? 1 : 2;
-    double p[3][3], r[2][3], n[3];
-    for (int j = 0; j < 3; j++)
-      for (int a = 0; a < 3; a++) p[j][a] = s->p[j][a][id];
-    for (int j = 0; j < 2; j++) {
-      int kk = (fc + 1 + j) % 3;
-      for (int a = 0; a < 3; a++) r[j][a] = inf >> kk & 1u ? p[kk][a] : p[kk][a] - p[fc][a];
-    }
-    for (int a = 0; a < 3; a++) n[a] = r[0][(a + 1) % 3] * r[1][(a + 2) % 3] - r[0][(a + 2) % 3] * r[1][(a + 1) % 3];
-    double nd = 0, nq = 0, nn = 0, dd = 0;
-    for (int a = 0; a < 3; a++) nd += n[a] * d[a], nq += n[a] * (p[fc][a] - o[a]), nn += n[a] * n[a], dd += d[a] * d[a];
-    if (fabs(nd) < 1e-3 * sqrt(nn * dd)) continue; /* grazing */
-    double t = nq / nd;
-    where[out->n] = (int)k;
-    err[out->n++] = fabs((double)f->vb.t[k] - t) / fabs(t);
-  }
-  if (ok && err && where && out->n) {
-    for (int i = 0; i < out->n; i++)
-      if (err[i] > out->max) out->max = err[i], out->worst = where[i];
-    qsort(err, (size_t)out->n, sizeof *err, cmp_double);
-    out->p50 = err[out->n / 2];
-    out->p999 = err[(size_t)((out->n - 1) * 0.999)];
-  }
-  free(err), free(where);
+  bool ok = rr_depth_errors(s, &c, f->vb.id, f->vb.t, out);
   rr_cam_release(&c);
   return ok;
 }

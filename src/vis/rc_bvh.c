@@ -32,9 +32,10 @@
  * lower bound `tlo` of the t that sample_test() can compute for it at any sample
  * of the image; a node's tlo is the least of its triangles'. A primary ray prunes
  * a node only when the node's tlo is greater than its best t, which is exact:
- * box entry distances are not, because a triangle seen at a grazing angle can
- * compute a t well in front of its own box (measured: 2.4% at sin = 0.004 on the
- * ogre), and rc / 3dr-bb keep such hits. Box tests then only cull rays that miss. */
+ * box entry distances are not, because at a grazing angle the t a triangle
+ * computes may lie in front of its own box (rarely now that t comes from the plane,
+ * but unboundedly in TRI_DEPTH's fallback), and rc / 3dr-bb keep such hits. Box
+ * tests then only cull rays that miss. */
 /* A triangle's setup with its id (RR_MISS when culled for this camera): the one
  * stream of memory a leaf reads. */
 typedef struct {

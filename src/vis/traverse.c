@@ -20,12 +20,15 @@
 
 #define HIZ_SHIFT 3
 #define HIZ (1 << HIZ_SHIFT) /* hierarchical z-buffer tile size: frusta split down to it */
-/* Relative slack of the node occlusion test. The t that 3D rasterization computes
- * for a small far triangle seen at a grazing angle can lie percents in front of
- * its box (the edge values' sum cancels), and rc keeps such hits; early-z per
- * triangle uses a proven floor (computed_t_floor), but a node knows no triangle,
- * so it keeps this empirical slack: a hit more than 2% in front of its box is
- * still culled. */
+/* Relative slack of the node occlusion test. The t of TRI_DEPTH is num / den, both
+ * rounded from double-exact values (a few ulps) and den's terms about a sample
+ * near the triangle: a hit lies below its exact t, which its box bounds, by more
+ * than 2% only where den's rounding (about 4u of its terms' magnitudes, the
+ * magnitudes at most the triangle's screen extent times |pb|, |pc| beyond |den|)
+ * reaches 2% of den, i.e. rays within ~1e-5 of the plane of a large triangle, or
+ * in TRI_DEPTH's fallback (num or den not positive: rays within ulps of the plane).
+ * Early-z per triangle uses a proven floor (computed_t_floor); a node knows no
+ * triangle, so it keeps this slack. */
 #define DEPTH_MARGIN 2e-2f
 
 typedef struct tile_rect { int x0, y0, x1, y1; } tile_rect; /* samples [x0, x1) × [y0, y1) */
