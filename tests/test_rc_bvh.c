@@ -62,7 +62,7 @@ static void check_bound(rr_device *dev, const rr_scene *s, const rr_camera *cam,
       for (int x = 0; x < w; x++) {
         float e[3], t, l1, l2;
         tri_edges(&ts, (float)x + 0.5f, (float)y + 0.5f, e);
-        if (!sample_test(e, ts.tie, ts.vol, &t, &l1, &l2)) continue;
+        if (!sample_test(&ts, e, (float)x + 0.5f, (float)y + 0.5f, &t, &l1, &l2)) continue;
         checked++;
         float sx = (float)x + 0.5f, sy = (float)y + 0.5f;
         bool in = rect[0] <= sx && sx <= rect[2] && rect[1] <= sy && sy <= rect[3];

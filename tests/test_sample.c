@@ -58,7 +58,7 @@ int main(void) {
       bool hit = false;
       if (face != SETUP_CULLED) {
         tri_edges(&ts, sx, sy, ev);
-        hit = sample_test(ev, ts.tie, ts.vol, &ft, &l1, &l2);
+        hit = sample_test(&ts, ev, sx, sy, &ft, &l1, &l2);
       }
       CHECK(hit == ref_hit, "iter %d sample (%g,%g): hit %d, reference %d (margin %g, t %g)", iter, sx, sy, hit,
             ref_hit, margin, t);

@@ -28,7 +28,7 @@ static void count_claims(const rr_scene *s, const camera *c, bool use_bounds, ui
       for (int x = r[0]; x <= r[2]; x++) {
         float e[3], t, l1, l2;
         tri_edges(&ts, x + 0.5f, y + 0.5f, e);
-        if (!sample_test(e, ts.tie, ts.vol, &t, &l1, &l2)) continue;
+        if (!sample_test(&ts, e, x + 0.5f, y + 0.5f, &t, &l1, &l2)) continue;
         if (e[0] == 0 || e[1] == 0 || e[2] == 0) (*on_edge)++;
         (face == SETUP_FRONT ? front : back)[(size_t)y * c->width + x]++;
       }

@@ -217,3 +217,12 @@ rr_hit test_brute_ray(const rr_scene *s, const rr_ray *ray, int *any) {
   }
   return h;
 }
+
+bool test_depth_errors(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                       test_depth_stats *out) {
+  camera c;
+  if (rr_cam_setup(dev, cam, f->vb.width, f->vb.height, &c) != RR_OK) return false;
+  bool ok = rr_depth_errors(s, &c, f->vb.id, f->vb.t, out);
+  rr_cam_release(&c);
+  return ok;
+}

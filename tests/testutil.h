@@ -61,6 +61,11 @@ rr_frame *test_render_threads(rr_device *dev, const rr_scene *s, const rr_camera
  * view of fov_lo..fov_hi degrees; the rest as rr_camera_init (perspective, y up).
  * A range of one value (lo == hi) draws no random number. */
 rr_camera test_random_view(const rr_scene *s, float dist_lo, float dist_hi, float aim, float fov_lo, float fov_hi);
+/* rr_depth_errors (vis/vis.h) of a frame's depth for camera cam; false when the
+ * camera cannot be set up or is not planar. */
+typedef rr_depth_stats test_depth_stats;
+bool test_depth_errors(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                       test_depth_stats *out);
 /* Writes `text` to the file dir/name and returns its path (one of eight rotating
  * buffers, so a few paths stay valid at once); a file that cannot be written is
  * left missing, for the test's load to report. */

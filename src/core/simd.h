@@ -91,6 +91,10 @@ static inline rr_vi4 rr_vi4_trunc(rr_vf4 a) { return __builtin_convertvector(a, 
  * vectors through integer registers and the stack. */
 typedef rr_vf4 rr_vf1;
 typedef rr_vi4 rr_vi1;
+/* Doubles for a VF's lanes (setup's exact parts): conversions both ways. */
+typedef double rr_vd1 __attribute__((vector_size(16)));
+#define rr_vf1_to_double(a) ((rr_vd1){(a)[0]})
+#define rr_vd1_to_float(a) ((rr_vf1){(float)(a)[0]})
 
 static inline rr_vf1 rr_vf1_splat(float x) { return (rr_vf1){x}; }
 static inline rr_vi1 rr_vi1_splat(int32_t x) { return (rr_vi1){x}; }
@@ -131,6 +135,9 @@ static inline int rr_vi1_bits(rr_vi1 m) { return m[0] & 1; }
  * __builtin_cpu_supports("avx2"). Operators compile to the AVX2 instructions;
  * the helpers that have none in GCC's vector extension use the intrinsics. */
 #define RR_TARGET_AVX2 __attribute__((target("avx2")))
+typedef double rr_vd8 __attribute__((vector_size(64)));
+#define rr_vf8_to_double(a) __builtin_convertvector((a), rr_vd8)
+#define rr_vd8_to_float(a) __builtin_convertvector((a), rr_vf8)
 typedef float rr_vf8 __attribute__((vector_size(32)));
 typedef int32_t rr_vi8 __attribute__((vector_size(32)));
 

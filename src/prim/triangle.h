@@ -16,6 +16,15 @@ typedef struct tri_setup {
   float vol, vol_x, vol_y;
   uint32_t tie; /* bit i: a sample exactly on edge i belongs to this triangle */
   float w[3];   /* homogeneous w of vertex i (1, or 0 at infinity): the sum is Σ w_i V_i */
+  /* The depth from the plane: t = num / den with den = pa·w.x + pb·(w.y − cx) +
+   * pc·(w.z − cy) (= N·d, the plane normal N = Σ w_i n_i, sign-normalised like the
+   * edges) and num = num0 + (sx − cx)·num_x + (sy − cy)·num_y (= N·(p_f − o), p_f
+   * a finite corner, o the ray origin), see prim/triangle_setup.c. (cx, cy) is a
+   * sample near the triangle (planar cameras; 0 for curved ones), so that the terms
+   * the sample adds are small and den and num keep their accuracy at any angle. */
+  float pa, pb, pc;
+  float num0, num_x, num_y;
+  float cx, cy;
 } tri_setup;
 
 enum { SETUP_CULLED = 0, SETUP_FRONT = 1, SETUP_BACK = 2 };
@@ -44,6 +53,14 @@ static inline void tri_edges(const tri_setup *t, float sx, float sy, float e[3])
 static inline float tri_vol(const tri_setup *t, float sx, float sy) {
   return t->vol + sx * t->vol_x + sy * t->vol_y;
 }
+/* The depth's denominator N·d for evaluation vector w, and its numerator N·(p_f − o)
+ * at sample (sx, sy): the same order of operations as the edges and the volume. */
+static inline float tri_den_w(const tri_setup *t, vec3 w) {
+  return t->pa * w.x + t->pb * (w.y - t->cx) + t->pc * (w.z - t->cy);
+}
+static inline float tri_num(const tri_setup *t, float sx, float sy) {
+  return t->num0 + (sx - t->cx) * t->num_x + (sy - t->cy) * t->num_y;
+}
 
 /* The one sample test's two conditions, written once for a sample (floats, tie 0/1)
  * and for W samples (core/simd.h vectors, tie and results as lane masks), so every
@@ -52,15 +69,25 @@ static inline float tri_vol(const tri_setup *t, float sx, float sy) {
  * the hit counts when the sum Σw_iV_i and the volume are both positive. */
 #define TRI_EDGE_INSIDE(e, tie, zero) (((e) > (zero)) | (((e) == (zero)) & (tie)))
 #define TRI_HIT_AHEAD(sum, vol, zero) (((sum) > (zero)) & ((vol) > (zero)))
+/* The hit's t: from the plane, num / den, unless rounding left either not positive
+ * (a ray within a few ulps of the plane's direction), where V / Σ w_i V_i (= vol·inv)
+ * stays positive as the sign test requires. The plane form's relative error is a few
+ * ulps over the cosine between ray and plane: num is one rounding of a double, den
+ * an affine form of three rounded coefficients. V / Σ w_i V_i cancels instead: its
+ * edge values are of the size of distance × edge length, their sum of edge length². */
+#define TRI_DEPTH(num, den, vol, inv, zero, select) \
+  select(((num) > (zero)) & ((den) > (zero)), (num) / (den), (vol) * (inv))
 
 /* The one sample test (paper eq. 2 with the top-left rule of sect. 4.2).
  * e: sign-normalised edge values at the sample; tie: bit i set when the sample
  * belongs to this triangle if it lies exactly on edge i; vol: the sign-normalised
  * volume at the sample (positive when the hit lies ahead of the ray origin).
  * w: the vertices' homogeneous w (appendix eqs. 5–11: a vertex at infinity has
- * w = 0 and leaves the sum). On a hit returns true with t = V / Σw_iV_i and
- * λ_i = V_i / Σw_iV_i. */
-static inline bool sample_test_w(const float e[3], const float w[3], uint32_t tie, float vol,
+ * w = 0 and leaves the sum). num, den: the plane's numerator and denominator at
+ * the sample (tri_num, tri_den_w). On a hit returns true with t = num / den
+ * (TRI_DEPTH) and λ_i = V_i / Σw_iV_i. */
+static inline float tri_select_f(bool m, float a, float b) { return m ? a : b; }
+static inline bool sample_test_w(const float e[3], const float w[3], uint32_t tie, float vol, float num, float den,
                                  float *t, float *l1, float *l2) {
   if (!(TRI_EDGE_INSIDE(e[0], (tie & 1u) != 0, 0.0f) && TRI_EDGE_INSIDE(e[1], (tie & 2u) != 0, 0.0f) &&
         TRI_EDGE_INSIDE(e[2], (tie & 4u) != 0, 0.0f)))
@@ -71,15 +98,18 @@ static inline bool sample_test_w(const float e[3], const float w[3], uint32_t ti
   /* sum == 0: all three on their edges (a degenerate sliver) or a pixel with no ray */
   if (!TRI_HIT_AHEAD(sum, vol, 0.0f)) return false;
   float inv = 1.0f / sum;
-  *t = vol * inv;
+  *t = TRI_DEPTH(num, den, vol, inv, 0.0f, tri_select_f);
   *l1 = e[1] * inv;
   *l2 = e[2] * inv;
   return true;
 }
-/* The same for a triangle of finite vertices (every w = 1). */
-static inline bool sample_test(const float e[3], uint32_t tie, float vol, float *t, float *l1, float *l2) {
-  static const float ones[3] = {1.0f, 1.0f, 1.0f};
-  return sample_test_w(e, ones, tie, vol, t, l1, l2);
+
+/* The one sample test of set-up triangle ts at a planar camera's sample (sx, sy),
+ * whose edge values e come from tri_edges. */
+static inline bool sample_test(const tri_setup *ts, const float e[3], float sx, float sy, float *t, float *l1,
+                               float *l2) {
+  return sample_test_w(e, ts->w, ts->tie, tri_vol(ts, sx, sy), tri_num(ts, sx, sy), tri_den_w(ts, v3(1.0f, sx, sy)),
+                       t, l1, l2);
 }
 
 /* The one sample test for an arbitrary ray set up by rr_cam_for_ray(): true on a hit
@@ -90,9 +120,6 @@ bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull_
 /* lex_less and lex_positive of triangle_setup_tmp.h for one lane, same NaN behaviour. */
 static inline bool tri_lex_less(vec3 a, vec3 b) {
   return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
-}
-static inline bool tri_lex_positive(float g1, float g2, float g3) {
-  return g1 > 0 || (g1 == 0 && (g2 > 0 || (g2 == 0 && g3 > 0)));
 }
 /* An edge normal as the setup computes it: h × (l − h) for the canonical order
  * (l, h) of the edge's endpoints a → b, negated when the edge runs from h to l. */
@@ -108,9 +135,9 @@ static inline vec3 tri_edge_normal(vec3 a, vec3 b) {
  * a_i = (σ n_i)·d0 (σ = ±1 turns the inside positive, σ n exactly ±n), and the
  * sample (0, 0) evaluates a_i·1 + b_i·0 + c_i·0, which is negative or NaN
  * whenever σ (n_i·d0) is: such an edge rejects the triangle before the other
- * normals, b_i, c_i and the tie bits are computed. What passes is evaluated
- * exactly as rr_tri_setup + tri_edges + sample_test would. Other triangles
- * (corners at infinity) and cameras go through rr_tri_ray_hit. */
+ * normals and the depth's plane are computed. What passes (about three triangles
+ * a ray) goes through rr_tri_ray_hit, the full setup and sample test, as do
+ * triangles with corners at infinity and other cameras. */
 static inline bool tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull, float tmin, float tmax,
                                float *t, float *l1, float *l2) {
   if (scene_inf(s, i) || ray->type != RR_CAMERA_PERSPECTIVE)
@@ -127,16 +154,7 @@ static inline bool tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray,
   if (!(sign * v3_dot(n[1], ray->d0) >= 0)) return false;
   n[2] = tri_edge_normal(q[0], q[1]);
   if (!(sign * v3_dot(n[2], ray->d0) >= 0)) return false;
-  float e[3];
-  uint32_t tie = 0;
-  for (int k = 0; k < 3; k++) {
-    vec3 ne = v3_scale(n[k], sign);
-    float a = v3_dot(ne, ray->d0), b = v3_dot(ne, ray->dx), c = v3_dot(ne, ray->dy);
-    tie |= (uint32_t)tri_lex_positive(b, c, v3_dot(ne, ray->fwd)) << k;
-    e[k] = a * 1.0f + b * 0.0f + c * 0.0f;
-  }
-  if (!sample_test(e, tie, vol * sign, t, l1, l2)) return false;
-  return *t >= tmin && *t <= tmax;
+  return rr_tri_ray_hit(s, i, ray, cull, tmin, tmax, t, l1, l2); /* passed the edges: the full test */
 }
 
 /* The inclusive pixel rectangle a set-up triangle's samples may lie in; false when

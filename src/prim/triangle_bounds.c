@@ -122,7 +122,37 @@ uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t 
  * y1; the whole plane when P is unbounded or the camera curved). Double
  * arithmetic carries a relative slack far above its own rounding. Points at
  * infinity: sample_test sums w_i·e_i with w_i in {0, 1} and every e_i >= 0 on P,
- * so the plain sum bounds it too (curved cameras use |Σ w_i n_i|). */
+ * so the plain sum bounds it too (curved cameras use |Σ w_i n_i|).
+ *
+ * That floors V / Σ w_i V_i, the t of TRI_DEPTH's fallback; its usual t = num / den
+ * gets a floor of its own (plane_floor) and the bound is the lesser. */
+/* A floor under num / den wherever both are positive, over the samples of the
+ * rectangle [x0, x1] × [y0, y1] (planar cameras; curved ones: directions up to
+ * dmax long). num = num0 + X·num_x + Y·num_y and den = pa + X·pb + Y·pc with
+ * X = sx − cx, Y = sy − cy are evaluated in float with three roundings per term,
+ * within 4u of the sum of the terms' magnitudes; the least num and the largest
+ * den over the rectangle are at its corners (affine forms), and the quotient
+ * rounds once more. A floor of num at or below 0 floors t by 0; a largest den at
+ * or below 0 means TRI_DEPTH's fallback always applies (+inf: no floor needed). */
+static inline double lesser(double a, double b) { return a < b ? a : b; }
+static inline double greater(double a, double b) { return a > b ? a : b; }
+static double plane_floor(const tri_setup *ts, const camera *cam, double x0, double y0, double x1, double y1,
+                          double dmax) {
+  const double u = 0x1p-24;
+  x0 -= ts->cx, x1 -= ts->cx, y0 -= ts->cy, y1 -= ts->cy;
+  double mx = greater(fabs(x0), fabs(x1)), my = greater(fabs(y0), fabs(y1));
+  double n0 = ts->num0, nx = ts->num_x, ny = ts->num_y, a = ts->pa, b = ts->pb, c = ts->pc, dhi;
+  double nlo = n0 + lesser(x0 * nx, x1 * nx) + lesser(y0 * ny, y1 * ny) -
+               4 * u * (fabs(n0) + mx * fabs(nx) + my * fabs(ny));
+  if (cam->planar)
+    dhi = a + greater(x0 * b, x1 * b) + greater(y0 * c, y1 * c) + 4 * u * (fabs(a) + mx * fabs(b) + my * fabs(c));
+  else
+    dhi = (sqrt(a * a + b * b + c * c) * (1 + 1e-12) + 4 * u * (fabs(a) + fabs(b) + fabs(c))) * dmax;
+  if (!(dhi > 0)) return INFINITY;
+  if (!(nlo > 0)) return 0;
+  return nlo / dhi * (1 - 4 * u);
+}
+
 float rr_tri_bounds(const tri_setup *ts, const camera *cam, float rect[4]) {
   const double u = 0x1p-24, slack = 1e-12;
   int w = cam->width, h = cam->height;
@@ -221,6 +251,11 @@ float rr_tri_bounds(const tri_setup *ts, const camera *cam, float rect[4]) {
   }
   if (!(vmin > 0)) return 0;
   double t = vmin * (1 - u) * (1 - u) / (smax * (1 + u) * (1 + u)) * (1 - 1e-9);
+  /* the plane's floor over the samples of rect within the image */
+  double x0 = cam->sx0, x1 = w - 1 + x0, y0 = cam->sy0, y1 = h - 1 + y0;
+  double tp = plane_floor(ts, cam, greater(x0, rx0), greater(y0, ry0), lesser(x1, rx1), lesser(y1, ry1),
+                          (double)cam->dir_len_max * (1 + 1e-6));
+  t = lesser(t, tp);
   float f = (float)t;
   return (double)f > t ? nextafterf(f, 0) : f;
 }

@@ -37,6 +37,16 @@
  * screen derivatives (b and c; n·right and −n·up for curved views) and its value
  * along the view direction, so the two triangles of a shared edge never both own,
  * nor both refuse, its samples. */
+/* The depth from the plane (triangle.h: num, den). The plane normal Σ w_i n_i is
+ * the same for every point c the corners are taken relative to (q_k = p_k − w_k·c:
+ * the terms in c cancel), and with c = p_f, a finite corner, only the term of n_f
+ * remains: N = r_{f+2} × r_{f+1}, r_k = p_k − w_k·p_f, which is (p2 − p0) × (p1 − p0)
+ * for an ordinary triangle. It is computed from the world corners: its size is edge
+ * length², not the distance × edge length of the n_i whose sum cancels, and its
+ * rounding tilts the plane about p_f by about u·|p|/L radians, which moves a hit at
+ * most L from p_f by u·|p| (L: edge length). Then V = N·q_f (n_i·q_f = 0 for i ≠ f)
+ * and Σ w_i V_i = N·d, so num / den is, exactly, V / Σ w_i V_i; rounded, each is a
+ * dot product whose error is a few ulps over the cosine between N and q_f or d. */
 #define RR_TEMPLATE "prim/triangle_setup_tmp.h"
 #include "core/simd_widths.h"
 
@@ -61,8 +71,9 @@ bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull,
                  float *l1, float *l2) {
   tri_setup ts;
   if (rr_tri_setup(s, i, ray, cull, &ts) == SETUP_CULLED) return false;
+  /* sample (0, 0): the edge functions and the plane along the ray itself */
   float e[3];
-  tri_edges(&ts, 0.0f, 0.0f, e); /* = a[i]: the edge functions along the ray itself */
-  if (!sample_test_w(e, ts.w, ts.tie, ts.vol, t, l1, l2)) return false;
+  tri_edges(&ts, 0.0f, 0.0f, e);
+  if (!sample_test(&ts, e, 0.0f, 0.0f, t, l1, l2)) return false;
   return *t >= tmin && *t <= tmax;
 }

@@ -7,19 +7,33 @@
  * the operations are IEEE single floats in a fixed order (no FMA), so every width
  * gives the same bits. A culled triangle's out[l] is not written. */
 #define V3 RR_CAT(setup_v3_, W)
+#define D3 RR_CAT(setup_d3_, W)
+#define VD RR_CAT(rr_vd, W)
 
 /* W three-vectors, one per lane, and the vec3.h operations on them. */
 typedef struct {
   VF x, y, z;
 } V3;
+/* the same in double, for the plane */
+typedef struct {
+  VD x, y, z;
+} D3;
+#define TO_D(v) RR_CAT(RR_CAT(rr_vf, W), _to_double)(v)
+#define TO_F(v) RR_CAT(RR_CAT(rr_vd, W), _to_float)(v)
+#define TO_D3(v) ((D3){TO_D((v).x), TO_D((v).y), TO_D((v).z)})
+#define DSPLAT3(v) ((D3){(VD){0} + (double)(v).x, (VD){0} + (double)(v).y, (VD){0} + (double)(v).z})
 #define SPLAT3(v) ((V3){VF_(splat)((v).x), VF_(splat)((v).y), VF_(splat)((v).z)})
-#define SUB3(a, b) ((V3){(a).x - (b).x, (a).y - (b).y, (a).z - (b).z})
+/* SUB3, SCALE3, CROSS3 build a T: V3, or D3 for the plane's doubles */
+#define SUB3_T(T, a, b) ((T){(a).x - (b).x, (a).y - (b).y, (a).z - (b).z})
+#define SUB3(a, b) SUB3_T(V3, a, b)
 #define ADD3(a, b) ((V3){(a).x + (b).x, (a).y + (b).y, (a).z + (b).z})
 #define NEG3(a) ((V3){-(a).x, -(a).y, -(a).z})
-#define SCALE3(a, s) ((V3){(a).x * (s), (a).y * (s), (a).z * (s)})
+#define SCALE3_T(T, a, s) ((T){(a).x * (s), (a).y * (s), (a).z * (s)})
+#define SCALE3(a, s) SCALE3_T(V3, a, s)
 #define DOT3(a, b) ((a).x * (b).x + (a).y * (b).y + (a).z * (b).z)
-#define CROSS3(a, b) \
-  ((V3){(a).y * (b).z - (a).z * (b).y, (a).z * (b).x - (a).x * (b).z, (a).x * (b).y - (a).y * (b).x})
+#define CROSS3_T(T, a, b) \
+  ((T){(a).y * (b).z - (a).z * (b).y, (a).z * (b).x - (a).x * (b).z, (a).x * (b).y - (a).y * (b).x})
+#define CROSS3(a, b) CROSS3_T(V3, a, b)
 #define SELECT3(m, a, b) \
   ((V3){VF_(select)(m, (a).x, (b).x), VF_(select)(m, (a).y, (b).y), VF_(select)(m, (a).z, (b).z)})
 /* lex_less(a, b) and lex_positive(g1, g2, g3) as masks, with the scalar comparisons' NaN behaviour */
@@ -38,15 +52,15 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   const V3 zero3 = {zero, zero, zero};
   /* q: the corner relative to the eye, or its direction when it is at infinity */
-  V3 q[3];
+  V3 q[3], p[3];
   VI at_inf[3] = {VI_(splat)(0), VI_(splat)(0), VI_(splat)(0)};
 #pragma GCC unroll 3
   for (int k = 0; k < 3; k++) {
-    V3 p = {VF_(gather)(s->p[k][0], idx), VF_(gather)(s->p[k][1], idx), VF_(gather)(s->p[k][2], idx)};
-    q[k] = SUB3(p, SPLAT3(c->eye));
+    p[k] = (V3){VF_(gather)(s->p[k][0], idx), VF_(gather)(s->p[k][1], idx), VF_(gather)(s->p[k][2], idx)};
+    q[k] = SUB3(p[k], SPLAT3(c->eye));
     if (s->inf) {
       at_inf[k] = -((inf >> k) & 1);
-      q[k] = SELECT3(at_inf[k], p, q[k]);
+      q[k] = SELECT3(at_inf[k], p[k], q[k]);
     }
   }
   /* edge e runs from q[e+1] to q[e+2]: n_e = h × (l − h) in the canonical order (l, h) */
@@ -111,6 +125,58 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
     tie |= LEX_POSITIVE(g1, g2, DOT3(ne, fwd)) & (1 << e);
   }
   vol = vol * sign, vol_x = vol_x * sign, vol_y = vol_y * sign;
+  /* The plane (prim/triangle_setup.c) in double, rounded once to float:
+   * N = r_{f+2} × r_{f+1}, r_k = p_k − w_k·p_f for a finite corner f (0 unless it
+   * lies at infinity). Float corners subtract and multiply exactly in double. */
+  V3 pf = p[0], p1 = p[1], p2 = p[2];
+  VI inf1 = at_inf[1], inf2 = at_inf[2];
+  if (s->inf) {
+    const VI f1 = at_inf[0] & ~at_inf[1], f2 = at_inf[0] & at_inf[1]; /* f = 1, f = 2 */
+    pf = SELECT3(f1, p[1], SELECT3(f2, p[2], p[0]));
+    p1 = SELECT3(f1, p[2], SELECT3(f2, p[0], p[1]));
+    p2 = SELECT3(f1, p[0], SELECT3(f2, p[1], p[2]));
+    inf1 = VI_(select)(f1, at_inf[2], VI_(select)(f2, at_inf[0], at_inf[1]));
+    inf2 = VI_(select)(f1, at_inf[0], VI_(select)(f2, at_inf[1], at_inf[2]));
+  }
+  const V3 base1 = SELECT3(inf1, zero3, pf), base2 = SELECT3(inf2, zero3, pf); /* w_k·p_f */
+  const D3 r1 = SUB3_T(D3, TO_D3(p1), TO_D3(base1)), r2 = SUB3_T(D3, TO_D3(p2), TO_D3(base2));
+  const D3 nrm = SCALE3_T(D3, CROSS3_T(D3, r2, r1), TO_D(sign));
+  const D3 qf = SUB3_T(D3, TO_D3(pf), DSPLAT3(c->eye));
+  /* (cx, cy): the sample nearest to where p_f projects, within the image; the
+   * coordinates of q_f in the basis of the camera's (d0, dx, dy) or, orthographic,
+   * of q_f − o0 in (ox, oy, fwd), by the dual basis (the rows of its inverse). */
+  VF cx = zero, cy = zero;
+  if (c->planar) {
+    vec3 u = ortho ? c->ox : c->dx, v = ortho ? c->oy : c->dy, w0 = ortho ? c->fwd : c->d0;
+    V3 q = SUB3(pf, SPLAT3(c->eye));
+    if (ortho) q = SUB3(q, SPLAT3(c->o0));
+    /* perspective: q = λ·(d0 + sx·dx + sy·dy), sx = q·(dy × d0) / q·(dx × dy);
+     * orthographic: q = sx·ox + sy·oy + t·fwd, sx = q·(oy × fwd) / fwd·(ox × oy) */
+    const vec3 uv = v3_cross(u, v);
+    const VF depth = ortho ? VF_(splat)(v3_dot(w0, uv)) : DOT3(q, SPLAT3(uv));
+    const VF lo_x = VF_(splat)(c->sx0), hi_x = VF_(splat)((float)(c->width - 1) + c->sx0);
+    const VF lo_y = VF_(splat)(c->sy0), hi_y = VF_(splat)((float)(c->height - 1) + c->sy0);
+    /* NaN (a corner in the eye's plane) clamps to the far side: any sample is exact */
+    cx = VF_(max)(VF_(min)(DOT3(q, SPLAT3(v3_cross(v, w0))) / depth, hi_x), lo_x);
+    cy = VF_(max)(VF_(min)(DOT3(q, SPLAT3(v3_cross(w0, u))) / depth, hi_y), lo_y);
+    cx = VF_(floor)(cx - lo_x) + lo_x, cy = VF_(floor)(cy - lo_y) + lo_y;
+  }
+  const VD dcx = TO_D(cx), dcy = TO_D(cy);
+  VD pa, pb, pc, num0, num_x = TO_D(zero), num_y = num_x;
+  if (c->type == RR_CAMERA_PERSPECTIVE) {
+    pb = DOT3(nrm, DSPLAT3(c->dx)), pc = DOT3(nrm, DSPLAT3(c->dy));
+    pa = DOT3(nrm, DSPLAT3(c->d0)) + dcx * pb + dcy * pc;
+    num0 = DOT3(nrm, qf);
+  } else if (ortho) {
+    /* rays from eye + o0 + sx·ox + sy·oy along fwd */
+    pa = DOT3(nrm, DSPLAT3(c->fwd)), pb = num_x, pc = num_x;
+    num_x = -DOT3(nrm, DSPLAT3(c->ox)), num_y = -DOT3(nrm, DSPLAT3(c->oy));
+    num0 = DOT3(nrm, SUB3_T(D3, qf, DSPLAT3(c->o0))) + dcx * num_x + dcy * num_y;
+  } else {
+    pa = nrm.x, pb = nrm.y, pc = nrm.z;
+    num0 = DOT3(nrm, qf);
+  }
+  const VF fpa = TO_F(pa), fpb = TO_F(pb), fpc = TO_F(pc), fn0 = TO_F(num0), fnx = TO_F(num_x), fny = TO_F(num_y);
   VF w[3];
   for (int k = 0; k < 3; k++) w[k] = VF_(select)(at_inf[k], zero, one);
   for (int l = 0; l < count; l++) {
@@ -121,11 +187,17 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
     o->vol = vol[l], o->vol_x = vol_x[l], o->vol_y = vol_y[l];
     o->tie = (uint32_t)tie[l];
     for (int k = 0; k < 3; k++) o->w[k] = w[k][l];
+    o->pa = fpa[l], o->pb = fpb[l], o->pc = fpc[l];
+    o->num0 = fn0[l], o->num_x = fnx[l], o->num_y = fny[l];
+    o->cx = cx[l], o->cy = cy[l];
   }
 }
 
 #undef SPLAT3
 #undef SUB3
+#undef SUB3_T
+#undef SCALE3_T
+#undef CROSS3_T
 #undef ADD3
 #undef NEG3
 #undef SCALE3
@@ -135,3 +207,9 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
 #undef LEX_LESS3
 #undef LEX_POSITIVE
 #undef V3
+#undef D3
+#undef VD
+#undef TO_D
+#undef TO_F
+#undef TO_D3
+#undef DSPLAT3

@@ -4,7 +4,7 @@
  * Every sample of rectangle r against one set-up triangle, W samples of a row at
  * a time, columns then rows (the terms in sx are the same on every row). A lane is
  * the sample test of prim/triangle.h (sample_test_w) and the depth test of
- * vis/vis.h (depth_wins): the same operations in the same order on IEEE single
+ * vis/vis.h (depth_wins), with the depth of TRI_DEPTH: the same operations in the same order on IEEE single
  * floats (no FMA, a true division), so every width gives their bits. Lanes past
  * r[2] are masked off and touch no memory. */
 
@@ -19,6 +19,9 @@ TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32
   }
   const VF w0 = VF_(splat)(ts->w[0]), w1 = VF_(splat)(ts->w[1]), w2 = VF_(splat)(ts->w[2]);
   const VF vol = VF_(splat)(ts->vol), vol_x = VF_(splat)(ts->vol_x), vol_y = VF_(splat)(ts->vol_y);
+  const VF pa = VF_(splat)(ts->pa), pb = VF_(splat)(ts->pb), pc = VF_(splat)(ts->pc);
+  const VF num0 = VF_(splat)(ts->num0), num_x = VF_(splat)(ts->num_x), num_y = VF_(splat)(ts->num_y);
+  const VF cx = VF_(splat)(ts->cx), cy = VF_(splat)(ts->cy);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
   const VI idv = VI_(splat)((int32_t)id), bias = VI_(splat)(INT32_MIN), id_biased = idv ^ bias;
@@ -33,7 +36,7 @@ TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32
     VF ax[3]; /* planar: a·1 + b·sx, the part of each edge function that rows share */
 #pragma GCC unroll 3
     for (int e = 0; e < 3; e++) ax[e] = a[e] * one + b[e] * sx;
-    const VF vx = vol + sx * vol_x;
+    const VF vx = vol + sx * vol_x, px = pa * one + pb * (sx - cx), nx = num0 + (sx - cx) * num_x;
     for (int y = r[1]; y <= r[3]; y++) {
       const VF sy = VF_(splat)((float)y + c->sy0);
       const size_t k = (size_t)y * width + (size_t)x;
@@ -56,7 +59,8 @@ TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32
       int hit = VI_(bits)(in);
       if (!hit) continue;
       covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
-      const VF inv = one / sum, t = v * inv;
+      const VF den = planar ? px + pc * (sy - cy) : pa * wx + pb * (wy - cx) + pc * (wz - cy);
+      const VF inv = one / sum, t = TRI_DEPTH(nx + (sy - cy) * num_y, den, v, inv, zero, VF_(select));
       const VF bt = VF_(load_masked)(best_t + k, in);
       const VI bid = VI_(load_masked)(best_id + k, in);
       const VI wins = in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased)));

@@ -6,8 +6,10 @@
  *
  * Boxes are tested in 3D, widened by RAY_MARGIN relative to t (NaN slabs
  * ignored), and prune by box entry, which is exact but for triangles whose plane
- * passes within rounding of the ray's origin (their hits are numerical noise in
- * any method).
+ * passes within rounding of the ray's origin or direction: a ray's t is num / den
+ * (TRI_DEPTH) with num and den each one rounding of a double (den = pa at sample
+ * (0, 0), cx = cy = 0), within 2 ulps of the exact hit, far inside the margin,
+ * unless num or den rounds to zero or below (the fallback V / Σ w_i V_i).
  *
  * Thread safety: a query reads the scene and its BVH, keeps its state on its own
  * stack and writes only the caller's results and the caller's device (NULL: none),

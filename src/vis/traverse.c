@@ -20,12 +20,15 @@
 
 #define HIZ_SHIFT 3
 #define HIZ (1 << HIZ_SHIFT) /* hierarchical z-buffer tile size: frusta split down to it */
-/* Relative slack of the node occlusion test. The t that 3D rasterization computes
- * for a small far triangle seen at a grazing angle can lie percents in front of
- * its box (the edge values' sum cancels), and rc keeps such hits; early-z per
- * triangle uses a proven floor (computed_t_floor), but a node knows no triangle,
- * so it keeps this empirical slack: a hit more than 2% in front of its box is
- * still culled. */
+/* Relative slack of the node occlusion test. The t of TRI_DEPTH is num / den, both
+ * rounded from double-exact values (a few ulps) and den's terms about a sample
+ * near the triangle: a hit lies below its exact t, which its box bounds, by more
+ * than 2% only where den's rounding (about 4u of its terms' magnitudes, the
+ * magnitudes at most the triangle's screen extent times |pb|, |pc| beyond |den|)
+ * reaches 2% of den, i.e. rays within ~1e-5 of the plane of a large triangle, or
+ * in TRI_DEPTH's fallback (num or den not positive: rays within ulps of the plane).
+ * Early-z per triangle uses a proven floor (computed_t_floor); a node knows no
+ * triangle, so it keeps this slack. */
 #define DEPTH_MARGIN 2e-2f
 
 typedef struct tile_rect { int x0, y0, x1, y1; } tile_rect; /* samples [x0, x1) × [y0, y1) */
@@ -123,16 +126,22 @@ static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
   return covered;
 }
 
-/* A floor under the t that sample_test() computes for a triangle at any sample,
- * from the floor zmin of the exact t: the sum of the edge values carries an error
- * of at most ~5 ulps of `mag` (the sum of the terms' magnitudes), so the computed
- * t >= vol / (vol / zmin + err). Seen at a grazing angle the error can be large
- * (percents), and early-z must not drop a hit that rc keeps. */
+/* A floor under a t of the form num / den that sample_test() computes for a
+ * triangle at any sample, from the floor zmin of the exact t: den carries an error
+ * of at most ~5 ulps of `mag` (the sum of its terms' magnitudes) and num one or two
+ * ulps, so the computed t >= num / (num / zmin + err) less a few ulps. Seen at a
+ * grazing angle the error can be large, and early-z must not drop a hit that rc
+ * keeps. TRI_DEPTH computes t = num0 / (plane's den) or, where either is not
+ * positive, vol / Σ e_i: the floor is the lesser of the two (tri_t_floor). */
 static float computed_t_floor(float zmin, float mag, float vol) {
   if (!(zmin > 0) || !(vol > 0)) return 0;
   float err = 6.0f * FLT_EPSILON * mag;
   float floor_t = zmin / (1.0f + err * zmin / vol) * (1.0f - 8.0f * FLT_EPSILON);
   return floor_t > 0 && isfinite(floor_t) ? floor_t : 0;
+}
+/* mag, mag_p: the magnitudes of Σ e_i's and of den's terms */
+static float tri_t_floor(float zmin, float mag, float mag_p, const tri_setup *ts) {
+  return minf(computed_t_floor(zmin, mag, ts->vol), computed_t_floor(zmin, mag_p, ts->num0));
 }
 
 /* Completes a set-up triangle j with what binning and early-z need. */
@@ -153,7 +162,8 @@ static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
       j->slack[e] = 1e-5f * m;
       mag += m;
     }
-    j->zmin = c->type == RR_CAMERA_PERSPECTIVE ? computed_t_floor(zmin, mag, j->ts.vol) : 0;
+    float mag_p = fabsf(j->ts.pa) + W * fabsf(j->ts.pb) + H * fabsf(j->ts.pc);
+    j->zmin = c->type == RR_CAMERA_PERSPECTIVE ? tri_t_floor(zmin, mag, mag_p, &j->ts) : 0;
   } else {
     /* the distance to the triangle's plane bounds every hit's distance from below */
     unsigned inf = scene_inf(t->s, id);
@@ -163,7 +173,8 @@ static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
     float dist = fabsf(v3_dot(f == 0 ? q0 : f == 1 ? q1 : q2, nrm)) / v3_len(nrm);
     rr_tri_cone_setup(t->s, id, c, &j->ts, &j->cone);
     float mag = (j->cone.len[0] + j->cone.len[1] + j->cone.len[2]) * c->dir_len_max * 1.7321f;
-    j->zmin = dist > 0 && isfinite(dist) ? computed_t_floor(dist / c->dir_len_max, mag, j->ts.vol) : 0;
+    float mag_p = (fabsf(j->ts.pa) + fabsf(j->ts.pb) + fabsf(j->ts.pc)) * c->dir_len_max;
+    j->zmin = dist > 0 && isfinite(dist) ? tri_t_floor(dist / c->dir_len_max, mag, mag_p, &j->ts) : 0;
   }
 }
 
