@@ -583,19 +583,26 @@ static rr_error output_push(rr_output *set, output o, const char *path, const ch
   return rr_ok(dev);
 }
 
-rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char *path) {
+/* What every add checks first: a set, a path, and the set still open (what: the
+ * thing written, for the message). */
+static rr_error output_check(const rr_output *set, const char *path, const char *what) {
   if (!set) return RR_ERROR_ARGUMENT;
-  rr_device *dev = set->dev;
-  if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write an image: no path");
+  if (!path || !*path) return rr_fail(set->dev, RR_ERROR_ARGUMENT, "cannot write %s: no path", what);
   if (set->committed)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': the output set was committed", path);
+    return rr_fail(set->dev, RR_ERROR_ARGUMENT, "cannot write '%s': the output set was committed", path);
+  return RR_OK;
+}
+
+rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char *path) {
+  rr_error e = output_check(set, path, "an image");
+  if (e) return e;
+  rr_device *dev = set->dev;
   if (n < 1 || !images) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no image data", path);
   const char *file;
   image_format fmt = format_prefix(path, &file);
   if (!*file) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no path after the format", path);
   output o;
-  rr_error e = output_target(set, path, file, &o);
-  if (e) return e;
+  if ((e = output_target(set, path, file, &o)) != RR_OK) return e;
   if (fmt == FMT_UNKNOWN) fmt = format_of(file);
   if (fmt == FMT_UNKNOWN && o.stream) fmt = default_format(images, n);
   if (fmt == FMT_UNKNOWN) return unknown_format(dev, "write", path);
@@ -615,15 +622,12 @@ rr_error rr_output_add(rr_output *set, const rr_image *images, int n, const char
 }
 
 rr_error rr_output_add_bytes(rr_output *set, const void *data, size_t size, const char *path) {
-  if (!set) return RR_ERROR_ARGUMENT;
+  rr_error e = output_check(set, path, "a file");
+  if (e) return e;
   rr_device *dev = set->dev;
-  if (!path || !*path) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write a file: no path");
-  if (set->committed)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': the output set was committed", path);
   if (!data && size) return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': no data", path);
   output o;
-  rr_error e = output_target(set, path, path, &o);
-  if (e) return e;
+  if ((e = output_target(set, path, path, &o)) != RR_OK) return e;
   bytes b = {0};
   bytes_put(&b, data, size);
   if (b.nomem) return rr_fail(dev, RR_ERROR_MEMORY, "cannot write '%s': out of memory", path);

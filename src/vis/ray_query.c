@@ -160,8 +160,16 @@ typedef struct {
   atomic_size_t bad; /* the lowest invalid ray, SIZE_MAX when none */
 } stream_job;
 
-static float stream_at(const stream_job *j, const float *p, size_t i) {
-  return *(const float *)((const char *)p + i * j->rays->stride);
+static float stream_at(const rr_ray_stream *rs, const float *p, size_t i) {
+  return *(const float *)((const char *)p + i * rs->stride);
+}
+
+/* Ray i of a stream; why it cannot be traced, or NULL. */
+static const char *stream_ray(const rr_ray_stream *rs, size_t i, float org[3], float dir[3], float *tmin,
+                              float *tmax) {
+  for (int a = 0; a < 3; a++) org[a] = stream_at(rs, rs->org[a], i), dir[a] = stream_at(rs, rs->dir[a], i);
+  *tmin = stream_at(rs, rs->tmin, i), *tmax = stream_at(rs, rs->tmax, i);
+  return ray_problem(org, dir, *tmin, *tmax);
 }
 
 static void stream_chunk(int job, int thread, void *arg) {
@@ -170,9 +178,8 @@ static void stream_chunk(int job, int thread, void *arg) {
   const rr_ray_stream *rs = j->rays;
   size_t lo = (size_t)job * j->chunk, hi = lo + j->chunk < rs->count ? lo + j->chunk : rs->count;
   for (size_t i = lo; i < hi; i++) {
-    float org[3], dir[3], tmin = stream_at(j, rs->tmin, i), tmax = stream_at(j, rs->tmax, i);
-    for (int a = 0; a < 3; a++) org[a] = stream_at(j, rs->org[a], i), dir[a] = stream_at(j, rs->dir[a], i);
-    bool valid = !ray_problem(org, dir, tmin, tmax), hit = false;
+    float org[3], dir[3], tmin, tmax;
+    bool valid = !stream_ray(rs, i, org, dir, &tmin, &tmax), hit = false;
     query_ray r;
     if (valid) {
       query_init(&r, j->s, j->b, org, dir, tmin, tmax);
@@ -211,10 +218,9 @@ static rr_error stream_run(rr_device *dev, const char *fn, const rr_scene *s, co
   rr_parallel_for((int)((rs->count + chunk - 1) / chunk), threads ? threads : rr_cpu_count(), stream_chunk, &j);
   size_t bad = atomic_load(&j.bad);
   if (bad != SIZE_MAX) {
-    float org[3], dir[3];
-    for (int a = 0; a < 3; a++) org[a] = stream_at(&j, rs->org[a], bad), dir[a] = stream_at(&j, rs->dir[a], bad);
+    float org[3], dir[3], tmin, tmax;
     return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray %zu with %s (a miss)", fn, bad,
-                   ray_problem(org, dir, stream_at(&j, rs->tmin, bad), stream_at(&j, rs->tmax, bad)));
+                   stream_ray(rs, bad, org, dir, &tmin, &tmax));
   }
   return rr_ok(dev);
 }
