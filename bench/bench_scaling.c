@@ -11,10 +11,11 @@
  * frame by frame (--reps rounds, default 5) so that a change of load on a shared
  * machine hits them alike; the median counts. A mode whose frame is estimated to
  * take more than --cap-ms (default 5000) is skipped and its estimate reported:
- * the estimate is the smaller of two upper bounds, the last measured scene's
- * frame scaled by the triangle ratio (no method's frame grows faster than its
- * triangle count) and a frame at 1/16 of the width and height scaled by the pixel
- * ratio (nor faster than its sample count). A skipped mode stays skipped on
+ * the smaller of the last measured scene's frame scaled by the triangle ratio and
+ * a frame at 1/16 of the width and height scaled by the pixel ratio, both upper
+ * bounds while a frame grows no faster than its triangles or its samples (a method
+ * whose data outgrow the cache grows faster, and may run somewhat over the cap).
+ * A skipped mode stays skipped on
  * larger scenes. Writes PREFIX.csv (default docs/scaling-size) with one row per
  * mode, scene and thread count, and PREFIX.md with a table per thread count and
  * the ratio of the fastest exact method to Embree's best mode;

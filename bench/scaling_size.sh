@@ -4,7 +4,7 @@
 # Embree; 1 and 2 threads) into docs/scaling-size.csv and .md, plot_scaling.py
 # draws docs/scaling-size.svg (and a PNG when rsvg-convert is installed), and the
 # tables replace the part of docs/scaling.md between its two scaling_size.sh marks.
-# About 5 minutes at 1024x1024 on a quiet 2-core machine (longer under load).
+# 6 minutes at 1024x1024 on the 2-core machine at load average 9-15; less when quiet.
 #
 #   bench/scaling_size.sh [BUILD_DIR] [bench_scaling options, e.g. --size 512]
 #                                     (after scripts/build.sh; default build)
