@@ -15,11 +15,11 @@
  * a frame at 1/16 of the width and height scaled by the pixel ratio, both upper
  * bounds while a frame grows no faster than its triangles or its samples (a method
  * whose data outgrow the cache grows faster, and may run somewhat over the cap).
- * A skipped mode stays skipped on
- * larger scenes. Writes PREFIX.csv (default docs/scaling-size) with one row per
- * mode, scene and thread count, and PREFIX.md with a table per thread count and
- * the ratio of the fastest exact method to Embree's best mode;
- * bench/plot_scaling.py draws the CSV, bench/scaling_size.sh does all of it. */
+ * A skipped mode stays skipped on larger scenes. Writes PREFIX.csv (default
+ * docs/scaling-size) with one row per mode, scene and thread count, and PREFIX.md
+ * with a table per thread count and the ratio of the fastest exact method to
+ * Embree's best mode; bench/plot_scaling.py draws the CSV, bench/scaling_size.sh
+ * does all of it. */
 #include "benchutil.h"
 #include "vis/vis.h"
 #ifdef RR_HAVE_EMBREE
@@ -265,10 +265,10 @@ static int write_tables(const options *o, const scene_result *res, double load, 
   char day[32];
   time_t now = time(NULL);
   strftime(day, sizeof day, "%Y-%m-%d", gmtime(&now));
-  fprintf(md, "%dx%d, no backface culling, median of %d frames (modes taking turns); skipped: estimated above "
+  fprintf(md, "%dx%d, no backface culling, median of %d frame%s (modes taking turns); skipped: estimated above "
               "%.0f ms a frame. Embree at HIGH build quality. Made %s on %d cores, load average %.2f at the "
               "start, in %.1f minutes.\n",
-          o->size, o->size, o->reps, o->cap_ms, day, rr_cpu_count(), load, minutes);
+          o->size, o->size, o->reps, o->reps > 1 ? "s" : "", o->cap_ms, day, rr_cpu_count(), load, minutes);
   for (int ti = 0; ti < o->nthreads; ti++) md_table(md, o, res, ti);
   write_csv(csv, o, res);
   fclose(md), fclose(csv);

@@ -13,8 +13,8 @@ build=build
 case ${1:-} in -*|"") ;; *) build=$1; shift ;; esac
 out=docs/scaling-size doc=docs/scaling.md
 [ -x "$build/bench_scaling" ] || { echo "scaling_size.sh: no $build/bench_scaling (build first)" >&2; exit 1; }
-grep -q '^<!-- scaling_size.sh: from here -->$' "$doc" && grep -q '^<!-- scaling_size.sh: to here -->$' "$doc" ||
-  { echo "scaling_size.sh: $doc lacks the two scaling_size.sh marks" >&2; exit 1; }
+if ! grep -q '^<!-- scaling_size.sh: from here -->$' "$doc" || ! grep -q '^<!-- scaling_size.sh: to here -->$' "$doc"
+then echo "scaling_size.sh: $doc lacks the two scaling_size.sh marks" >&2; exit 1; fi
 
 "$build/bench_scaling" --out "$out" "$@"
 python3 "$(dirname "$0")/plot_scaling.py" "$out.csv" -o "$out.svg"
