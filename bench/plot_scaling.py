@@ -29,6 +29,7 @@ STYLE = {
     "embree rtcIntersect8": ("#000000", "3 3"),
 }
 SPARE = ["#393b79", "#637939", "#8c6d31", "#843c39", "#7b4173"]  # methods added later
+_spare_given = {}
 
 PANEL_W, PANEL_H = 430, 330           # plot area of one panel
 LEFT, TOP, GAP, BOTTOM = 70, 70, 60, 60
@@ -47,6 +48,8 @@ def read(path):
                 skipped[row["method"]] = min(est, skipped.get(row["method"], est))
                 continue
             tris, ms = int(row["triangles"]), float(row["frame_ms"])
+            if tris <= 0 or ms <= 0:
+                continue  # off a log axis (a frame under the CSV's 1 us resolution)
             data.setdefault(int(row["threads"]), {}).setdefault(row["method"], []).append((tris, ms))
             grid = re.fullmatch(r"grid:.*:(\d+)", row["scene"])
             labels[tris] = grid.group(1) + "²" if grid else row["scene"]
@@ -70,19 +73,19 @@ def ticks(rng):
     return decs, minor
 
 
-def fmt(e, unit=""):
+def fmt(e):
     """10**e as a short label: 0.1, 1, 10, 1k, 1M."""
     if e >= 6:
         return f"{10 ** (e - 6)}M"
     if e >= 3:
         return f"{10 ** (e - 3)}k"
-    return f"{10.0 ** e:g}{unit}"
+    return f"{10.0 ** e:g}"
 
 
-def style(method, spare={}):
+def style(method):
     if method in STYLE:
         return STYLE[method]
-    return spare.setdefault(method, (SPARE[len(spare) % len(SPARE)], "5 2"))
+    return _spare_given.setdefault(method, (SPARE[len(_spare_given) % len(SPARE)], "5 2"))
 
 
 def marker(method, x, y, colour):
