@@ -360,12 +360,13 @@ static bool centre_hits(const frustum *f, const bvh_node *b) {
   return t0 <= t1 * 1.0001f;
 }
 
-/* isOutside: the box lies wholly outside one side plane, behind the image plane,
- * or outside the cone of directions. */
-static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
+/* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
+ * the image plane, or outside the cone of directions. */
+static bool is_outside(const frustum *f, const bvh_node *b, const camera *c, float tmin) {
   /* A frustum of one sample is its ray: the classic ray-box test. */
   if (f->r.x1 - f->r.x0 == 1 && f->r.y1 - f->r.y0 == 1) return !centre_hits(f, b);
-  if (f->nplanes) return box_behind(b, c) || box_outside_sides(f, b);
+  /* (a box whose box_tmin is positive lies in front of the eye) */
+  if (f->nplanes) return (!(tmin > 0) && box_behind(b, c)) || box_outside_sides(f, b);
   if (f->has_cone <= 0) return f->has_cone < 0;
   /* the box's bounding sphere against the cone */
   vec3 lo = v3_load(b->lo), hi = v3_load(b->hi);
@@ -376,12 +377,9 @@ static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
   return phi > f->angle + beta + 1e-4f;
 }
 
-/* splitFrustum: the centre ray misses the node, or the node looks small in F. */
-static bool should_split(const trav *t, const frustum *f, const bvh_node *b, float z) {
-  const oracles *o = t->o;
-  int w = f->r.x1 - f->r.x0, h = f->r.y1 - f->r.y0;
-  if (!o->split_min || (w <= o->split_min && h <= o->split_min)) return false;
-  if (!centre_hits(f, b)) return true;
+/* Does box b (box_tmin z) look small in a frustum of `area` samples? Its size in
+ * pixels, squared, against split_ratio times the area. */
+static bool looks_small(const trav *t, const bvh_node *b, float z, float area) {
   const camera *c = t->c;
   float diag = v3_len(v3(b->hi[0] - b->lo[0], b->hi[1] - b->lo[1], b->hi[2] - b->lo[2])), px;
   if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
@@ -390,7 +388,21 @@ static bool should_split(const trav *t, const frustum *f, const bvh_node *b, flo
     if (!(z > 0)) return false;
     px = c->planar ? diag / (z * 2.0f * c->tan_half_h / (float)c->height) : diag / (z * c->lipschitz);
   }
-  return px * px < o->split_ratio * (float)w * (float)h; /* box size in pixels, squared */
+  return px * px < t->o->split_ratio * area;
+}
+
+/* Is f as small as splitting makes it? */
+static bool at_split_min(const trav *t, const frustum *f) {
+  int m = t->o->split_min;
+  return m && f->r.x1 - f->r.x0 <= m && f->r.y1 - f->r.y0 <= m;
+}
+
+static float frustum_area(const frustum *f) { return (float)(f->r.x1 - f->r.x0) * (float)(f->r.y1 - f->r.y0); }
+
+/* splitFrustum: the centre ray misses the node, or the node looks small in F. */
+static bool should_split(const trav *t, const frustum *f, const bvh_node *b, float z) {
+  if (!t->o->split_min || at_split_min(t, f)) return false;
+  return !centre_hits(f, b) || looks_small(t, b, z, frustum_area(f));
 }
 
 /* The depth in front of which a hit inside a box of box_tmin z may lie (0: anywhere). */
@@ -403,7 +415,7 @@ bool rr_oracle_occluded(const camera *c, const bvh_node *b, float farthest) {
 bool rr_oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bvh_node *b) {
   tile_rect r = {x0, y0, x1, y1};
   frustum f = make_frustum(c, r);
-  return is_outside(&f, b, c);
+  return is_outside(&f, b, c, box_tmin(b, c));
 }
 
 static void traverse(trav *t, const frustum *f, uint32_t node, float tmin);
@@ -454,13 +466,16 @@ static void traverse(trav *t, const frustum *f, uint32_t node, float tmin) {
   const oracles *o = t->o;
   t->st.nodes++;
   heat_charge(t->heat_n, t->vb->width, f->r.x0, f->r.y0, f->r.x1, f->r.y1, 1.0f);
-  if (o->cull_outside && is_outside(f, n, t->c)) return;
+  if (o->cull_outside && is_outside(f, n, t->c, tmin)) return;
   if (o->cull_occluded && hiz_nearer(t->hz, f->r.x0, f->r.y0, f->r.x1, f->r.y1, occlusion_depth(tmin))) return;
   if (should_split(t, f, n, tmin)) {
     split(t, f, node, tmin);
     return;
   }
-  if (n->count) {
+  /* generateSamples for a whole inner node too when it looks small in a frustum
+   * that cannot split any more: testing its descendants against F would cost more
+   * than bounding their triangles, which drops those beside F or between samples. */
+  if (n->count || (at_split_min(t, f) && looks_small(t, n, tmin, frustum_area(f)))) {
     generate(t, f, node);
     return;
   }
