@@ -217,18 +217,21 @@ static bool meets(const int bb[4], tile_rect r) {
 }
 
 /* Triangle setup: triangles ids[0..n-1] (first..first+n-1 when ids is NULL) into
- * out, keeping those that may cover a sample of r; returns how many. Planar
- * cameras bound the triangles from their corners first (into scratch, room for
- * n), so the many that fall between samples or beside r (a leaf's box reaches
- * into frusta its triangles do not) cost no setup; curved cameras bound a set-up
- * triangle by its cone. S counts the setups done. */
-static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, tile_rect r,
+ * out, keeping those that may cover a sample of *r (of the image when r is NULL);
+ * returns how many. Planar cameras bound the triangles from their corners first
+ * (into scratch, room for n), so the many that fall between samples or beside r (a
+ * leaf's box reaches into frusta its triangles do not) cost no setup; curved
+ * cameras bound a set-up triangle by its cone. S counts the setups done. */
+static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
                                 tri_bound *scratch, tri_job *out) {
   if (t->c->planar) {
     uint32_t nb = rr_tri_corner_bounds(t->s, first, ids, n, t->c, t->simd, scratch), kept = 0;
-    for (uint32_t k = 0; k < nb; k++)
-      if (meets(scratch[k].bb, r)) scratch[kept++] = scratch[k];
-    return setup_bounded(t, scratch, kept, out);
+    if (r) {
+      for (uint32_t k = 0; k < nb; k++)
+        if (meets(scratch[k].bb, *r)) scratch[kept++] = scratch[k];
+      nb = kept;
+    }
+    return setup_bounded(t, scratch, nb, out);
   }
   uint32_t kept = 0;
   t->st.setups += n;
@@ -236,7 +239,7 @@ static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, ui
     uint32_t id = ids ? ids[k] : first + k;
     tri_job *j = out + kept;
     if (rr_tri_setup(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED ||
-        !rr_tri_screen_bounds(t->s, id, t->c, &j->ts, j->bb) || !meets(j->bb, r))
+        !rr_tri_screen_bounds(t->s, id, t->c, &j->ts, j->bb) || (r && !meets(j->bb, *r)))
       continue;
     finish_setup(t, id, j);
     kept++;
@@ -439,7 +442,7 @@ static void split(trav *t, const frustum *f, uint32_t node, float tmin) {
 static void flush(trav *t) {
   tri_bound b[PEND_DRAW + BVH_MAX_LEAF];
   tri_job j[PEND_DRAW + BVH_MAX_LEAF];
-  uint32_t kept = setup_triangles(t, 0, t->pend, t->npend, t->pend_r, b, j);
+  uint32_t kept = setup_triangles(t, 0, t->pend, t->npend, &t->pend_r, b, j);
   for (uint32_t k = 0; k < kept; k++) draw(t, &j[k], t->pend_r);
   t->npend = 0;
 }
@@ -513,8 +516,7 @@ static uint32_t root_setup(void *arg, int thread, uint32_t first, uint32_t n, vo
   root_pass *rp = arg;
   trav t = rp->proto;
   tri_bound scratch[ROOT_CHUNK];
-  tile_rect all = {0, 0, t.vb->width, t.vb->height};
-  uint32_t kept = setup_triangles(&t, first, NULL, n, all, scratch, out);
+  uint32_t kept = setup_triangles(&t, first, NULL, n, NULL, scratch, out);
   add_stats(&rp->st[thread], &t.st);
   return kept;
 }
