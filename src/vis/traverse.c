@@ -12,6 +12,7 @@
  * Depth here is the ray parameter t along d(x, y) = d0 + x dx + y dy; for the
  * perspective camera d·fwd = 1, so t is also the distance along fwd. Culling
  * decisions keep a relative safety margin so they never remove a winning triangle. */
+#include "core/simd.h"
 #include "vis/hiz.h"
 #include "vis/sortmiddle.h"
 
@@ -210,15 +211,27 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
   return kept;
 }
 
+/* Does the inclusive rectangle bb meet the samples of r? */
+static bool meets(const int bb[4], tile_rect r) {
+  return bb[0] < r.x1 && bb[2] >= r.x0 && bb[1] < r.y1 && bb[3] >= r.y0;
+}
+
 /* Triangle setup: triangles ids[0..n-1] (first..first+n-1 when ids is NULL) into
- * out, keeping those that may cover a sample; returns how many. Planar cameras
- * bound the triangles from their corners first (into scratch, room for n), so the
- * many that fall between samples cost no setup; curved cameras bound a set-up
- * triangle by its cone. S counts the setups done. */
-static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, tri_bound *scratch,
-                                tri_job *out) {
+ * out, keeping those that may cover a sample of *r (of the image when r is NULL);
+ * returns how many. Planar cameras bound the triangles from their corners first
+ * (into scratch, room for n), so the many that fall between samples or beside r (a
+ * leaf's box reaches into frusta its triangles do not) cost no setup; curved
+ * cameras bound a set-up triangle by its cone. S counts the setups done. */
+static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
+                                tri_bound *scratch, tri_job *out) {
   if (t->c->planar) {
-    return setup_bounded(t, scratch, rr_tri_corner_bounds(t->s, first, ids, n, t->c, t->simd, scratch), out);
+    uint32_t nb = rr_tri_corner_bounds(t->s, first, ids, n, t->c, t->simd, scratch), kept = 0;
+    if (r) {
+      for (uint32_t k = 0; k < nb; k++)
+        if (meets(scratch[k].bb, *r)) scratch[kept++] = scratch[k];
+      nb = kept;
+    }
+    return setup_bounded(t, scratch, nb, out);
   }
   uint32_t kept = 0;
   t->st.setups += n;
@@ -226,7 +239,7 @@ static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, ui
     uint32_t id = ids ? ids[k] : first + k;
     tri_job *j = out + kept;
     if (rr_tri_setup(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED ||
-        !rr_tri_screen_bounds(t->s, id, t->c, &j->ts, j->bb))
+        !rr_tri_screen_bounds(t->s, id, t->c, &j->ts, j->bb) || (r && !meets(j->bb, *r)))
       continue;
     finish_setup(t, id, j);
     kept++;
@@ -248,13 +261,15 @@ KERNEL void draw(trav *t, const tri_job *j, tile_rect f) {
 typedef struct frustum {
   tile_rect r;
   int nplanes;       /* planar cameras: inward side planes n·p + off >= 0, */
-  float nx[4], ny[4], nz[4], off[4]; /* stored by component for the box test */
+  rr_vf4 nx, ny, nz, off; /* four at once, stored by component for the box test */
   int has_cone;      /* curved cameras: 1 with a cone of the frustum's directions, -1 without rays */
   vec3 axis;
   float angle;
-  bool has_ray;      /* the centre sample's ray */
-  vec3 origin, dir;
+  bool has_ray;      /* the centre sample's ray, and 1 / its direction (0 where it is 0) */
+  rr_vf4 origin, dir, inv;
 } frustum;
+
+static rr_vf4 vf4_v3(vec3 v) { return (rr_vf4){v.x, v.y, v.z, 0}; }
 
 static void set_plane(frustum *f, int i, vec3 n, vec3 point) {
   f->nx[i] = n.x, f->ny[i] = n.y, f->nz[i] = n.z, f->off[i] = -v3_dot(n, point);
@@ -262,7 +277,10 @@ static void set_plane(frustum *f, int i, vec3 n, vec3 point) {
 
 static frustum make_frustum(const camera *c, tile_rect r) {
   frustum f = {.r = r};
-  f.has_ray = rr_cam_ray(c, (r.x0 + r.x1 - 1) / 2, (r.y0 + r.y1 - 1) / 2, &f.origin, &f.dir);
+  vec3 o, d;
+  f.has_ray = rr_cam_ray(c, (r.x0 + r.x1 - 1) / 2, (r.y0 + r.y1 - 1) / 2, &o, &d);
+  f.origin = vf4_v3(o), f.dir = vf4_v3(d);
+  for (int a = 0; a < 3; a++) f.inv[a] = f.dir[a] != 0 ? 1.0f / f.dir[a] : 0;
   if (c->type == RR_CAMERA_PERSPECTIVE) {
     /* Planes through the eye and the outer pixel edges: half a pixel beyond the
      * outer sample centres, conservative for every sample. With rays
@@ -288,79 +306,70 @@ static frustum make_frustum(const camera *c, tile_rect r) {
   return f;
 }
 
-/* Largest value of n·p + off over the corners of a box, and a magnitude for slack. */
-static float box_max_plane(const bvh_node *b, vec3 n, float off, float *mag) {
-  float m = off, s = fabsf(off);
-  const float nn[3] = {n.x, n.y, n.z};
-  for (int a = 0; a < 3; a++) {
-    float lo = nn[a] * b->lo[a], hi = nn[a] * b->hi[a];
-    m += maxf(lo, hi);
-    s += fabsf(lo) + fabsf(hi);
-  }
-  *mag = s;
-  return m;
+/* A box's corners as vectors (lanes x, y, z; the fourth is not used). */
+static rr_vf4 box_lo(const bvh_node *b) { return rr_vf4_load(b->lo); }
+static rr_vf4 box_hi(const bvh_node *b) { return (rr_vf4){b->hi[0], b->hi[1], b->hi[2], 0}; }
+
+/* The sum of lanes x, y, z after `first`, in that order. */
+static float sum3(float first, rr_vf4 v) { return first + v[0] + v[1] + v[2]; }
+
+/* Is the box wholly behind the plane through the eye facing fwd (with slack)? */
+static bool box_behind(const bvh_node *b, const camera *c) {
+  rr_vf4 f = vf4_v3(c->fwd), lo = f * box_lo(b), hi = f * box_hi(b);
+  float off = -v3_dot(c->fwd, c->eye);
+  return sum3(off, rr_vf4_max(lo, hi)) <= -1e-6f * sum3(fabsf(off), rr_vf4_abs(lo) + rr_vf4_abs(hi));
 }
 
-/* box_max_plane for the four side planes at once (the loop vectorises): does the
- * box lie wholly outside one of them? */
+/* Does the box lie wholly outside one of the four side planes? Each plane's
+ * largest value over the box, n·p + off, four planes in the lanes, against a
+ * slack from the magnitudes of its terms. */
 static bool box_outside_sides(const frustum *f, const bvh_node *b) {
-  float m[4], s[4];
-  for (int i = 0; i < 4; i++) {
-    float lx = f->nx[i] * b->lo[0], hx = f->nx[i] * b->hi[0];
-    float ly = f->ny[i] * b->lo[1], hy = f->ny[i] * b->hi[1];
-    float lz = f->nz[i] * b->lo[2], hz = f->nz[i] * b->hi[2];
-    m[i] = f->off[i] + maxf(lx, hx) + maxf(ly, hy) + maxf(lz, hz);
-    s[i] = fabsf(f->off[i]) + (fabsf(lx) + fabsf(hx)) + (fabsf(ly) + fabsf(hy)) + (fabsf(lz) + fabsf(hz));
-  }
-  bool out = false;
-  for (int i = 0; i < 4; i++) out |= m[i] < -1e-5f * s[i];
-  return out;
+  rr_vf4 lx = f->nx * rr_vf4_splat(b->lo[0]), hx = f->nx * rr_vf4_splat(b->hi[0]);
+  rr_vf4 ly = f->ny * rr_vf4_splat(b->lo[1]), hy = f->ny * rr_vf4_splat(b->hi[1]);
+  rr_vf4 lz = f->nz * rr_vf4_splat(b->lo[2]), hz = f->nz * rr_vf4_splat(b->hi[2]);
+  rr_vf4 m = f->off + rr_vf4_max(lx, hx) + rr_vf4_max(ly, hy) + rr_vf4_max(lz, hz);
+  rr_vf4 s = rr_vf4_abs(f->off) + (rr_vf4_abs(lx) + rr_vf4_abs(hx)) + (rr_vf4_abs(ly) + rr_vf4_abs(hy)) +
+             (rr_vf4_abs(lz) + rr_vf4_abs(hz));
+  return rr_vi4_bits(m < rr_vf4_splat(-1e-5f) * s) != 0;
 }
 
 /* A lower bound of the ray parameter t of any hit inside the box, in the units of
  * the stored depths: the distance along fwd for planar cameras (d·fwd = 1), the
  * distance from the eye over the longest ray direction for curved ones. */
 static float box_tmin(const bvh_node *b, const camera *c) {
-  const float e[3] = {c->eye.x, c->eye.y, c->eye.z};
-  float m = 0;
+  rr_vf4 e = vf4_v3(c->eye), lo = box_lo(b) - e, hi = box_hi(b) - e;
   if (c->planar) {
-    const float f[3] = {c->fwd.x, c->fwd.y, c->fwd.z};
-    for (int a = 0; a < 3; a++) m += minf(f[a] * (b->lo[a] - e[a]), f[a] * (b->hi[a] - e[a]));
-    return m;
+    rr_vf4 f = vf4_v3(c->fwd);
+    return sum3(0, rr_vf4_min(f * lo, f * hi));
   }
-  for (int a = 0; a < 3; a++) {
-    float d = maxf(maxf(b->lo[a] - e[a], e[a] - b->hi[a]), 0.0f);
-    m += d * d;
-  }
-  return sqrtf(m) / c->dir_len_max;
+  rr_vf4 d = rr_vf4_max(rr_vf4_max(lo, -hi), rr_vf4_splat(0));
+  return sqrtf(sum3(0, d * d)) / c->dir_len_max;
 }
 
-/* The ray of the centre sample meets the box (slab test with slack)? */
+/* The ray of the centre sample meets the box (slab test with slack)? An axis the
+ * direction does not move along is a slab the origin must lie in. */
 static bool centre_hits(const frustum *f, const bvh_node *b) {
   if (!f->has_ray) return false;
-  float t0 = 0, t1 = INFINITY;
-  const float o[3] = {f->origin.x, f->origin.y, f->origin.z}, d[3] = {f->dir.x, f->dir.y, f->dir.z};
-  for (int a = 0; a < 3; a++) {
-    float pad = 1e-4f * (b->hi[a] - b->lo[a]) + 1e-6f * fabsf(o[a]);
-    if (d[a] == 0) {
-      if (o[a] < b->lo[a] - pad || o[a] > b->hi[a] + pad) return false;
-      continue;
-    }
-    float inv = 1.0f / d[a], ta = (b->lo[a] - pad - o[a]) * inv, tb = (b->hi[a] + pad - o[a]) * inv;
-    t0 = maxf(t0, minf(ta, tb));
-    t1 = minf(t1, maxf(ta, tb));
-  }
+  rr_vf4 lo = box_lo(b), hi = box_hi(b);
+  rr_vf4 pad = rr_vf4_splat(1e-4f) * (hi - lo) + rr_vf4_splat(1e-6f) * rr_vf4_abs(f->origin);
+  lo -= pad, hi += pad;
+  rr_vf4 ta = (lo - f->origin) * f->inv, tb = (hi - f->origin) * f->inv;
+  rr_vf4 near = rr_vf4_min(ta, tb), far = rr_vf4_max(ta, tb);
+  rr_vi4 flat = f->dir == rr_vf4_splat(0), in = (f->origin >= lo) & (f->origin <= hi);
+  near = rr_vf4_select(flat, rr_vf4_select(in, rr_vf4_splat(-INFINITY), rr_vf4_splat(INFINITY)), near);
+  far = rr_vf4_select(flat, rr_vf4_select(in, rr_vf4_splat(INFINITY), rr_vf4_splat(-INFINITY)), far);
+  float t0 = maxf(maxf(maxf(0, near[0]), near[1]), near[2]);
+  float t1 = minf(minf(minf(INFINITY, far[0]), far[1]), far[2]);
   return t0 <= t1 * 1.0001f;
 }
 
-/* isOutside: the box lies wholly outside one side plane, behind the image plane,
- * or outside the cone of directions. */
-static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
+/* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
+ * the image plane, or outside the cone of directions. */
+static bool is_outside(const frustum *f, const bvh_node *b, const camera *c, float tmin) {
   /* A frustum of one sample is its ray: the classic ray-box test. */
   if (f->r.x1 - f->r.x0 == 1 && f->r.y1 - f->r.y0 == 1) return !centre_hits(f, b);
-  float mag;
-  if (f->nplanes) return box_max_plane(b, c->fwd, -v3_dot(c->fwd, c->eye), &mag) <= -1e-6f * mag ||
-                        box_outside_sides(f, b);
+  /* (a box whose box_tmin is positive lies in front of the eye) */
+  if (f->nplanes) return (!(tmin > 0) && box_behind(b, c)) || box_outside_sides(f, b);
   if (f->has_cone <= 0) return f->has_cone < 0;
   /* the box's bounding sphere against the cone */
   vec3 lo = v3_load(b->lo), hi = v3_load(b->hi);
@@ -371,43 +380,50 @@ static bool is_outside(const frustum *f, const bvh_node *b, const camera *c) {
   return phi > f->angle + beta + 1e-4f;
 }
 
-/* splitFrustum: the centre ray misses the node, or the node looks small in F. */
-static bool should_split(const trav *t, const frustum *f, const bvh_node *b) {
-  const oracles *o = t->o;
-  int w = f->r.x1 - f->r.x0, h = f->r.y1 - f->r.y0;
-  if (!o->split_min || (w <= o->split_min && h <= o->split_min)) return false;
-  if (!centre_hits(f, b)) return true;
+/* Does box b (box_tmin z) look small in a frustum of `area` samples? Its size in
+ * pixels, squared, against split_ratio times the area. */
+static bool looks_small(const trav *t, const bvh_node *b, float z, float area) {
   const camera *c = t->c;
   float diag = v3_len(v3(b->hi[0] - b->lo[0], b->hi[1] - b->lo[1], b->hi[2] - b->lo[2])), px;
   if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
     px = diag / (2.0f * c->tan_half_h / (float)c->height);
   } else {
-    float z = box_tmin(b, c);
     if (!(z > 0)) return false;
     px = c->planar ? diag / (z * 2.0f * c->tan_half_h / (float)c->height) : diag / (z * c->lipschitz);
   }
-  return px * px < o->split_ratio * (float)w * (float)h; /* box size in pixels, squared */
+  return px * px < t->o->split_ratio * area;
 }
 
-/* The depth in front of which a hit inside box b may lie (0: anywhere). */
-static float occlusion_depth(const camera *c, const bvh_node *b) {
-  float z = box_tmin(b, c);
-  return z > 0 ? z * (1 - DEPTH_MARGIN) : 0;
+/* Is f as small as splitting makes it? */
+static bool at_split_min(const trav *t, const frustum *f) {
+  int m = t->o->split_min;
+  return m && f->r.x1 - f->r.x0 <= m && f->r.y1 - f->r.y0 <= m;
 }
+
+static float frustum_area(const frustum *f) { return (float)(f->r.x1 - f->r.x0) * (float)(f->r.y1 - f->r.y0); }
+
+/* splitFrustum: the centre ray misses the node, or the node looks small in F. */
+static bool should_split(const trav *t, const frustum *f, const bvh_node *b, float z) {
+  if (!t->o->split_min || at_split_min(t, f)) return false;
+  return !centre_hits(f, b) || looks_small(t, b, z, frustum_area(f));
+}
+
+/* The depth in front of which a hit inside a box of box_tmin z may lie (0: anywhere). */
+static float occlusion_depth(float z) { return z > 0 ? z * (1 - DEPTH_MARGIN) : 0; }
 
 bool rr_oracle_occluded(const camera *c, const bvh_node *b, float farthest) {
-  return farthest < occlusion_depth(c, b);
+  return farthest < occlusion_depth(box_tmin(b, c));
 }
 
 bool rr_oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bvh_node *b) {
   tile_rect r = {x0, y0, x1, y1};
   frustum f = make_frustum(c, r);
-  return is_outside(&f, b, c);
+  return is_outside(&f, b, c, box_tmin(b, c));
 }
 
-static void traverse(trav *t, const frustum *f, uint32_t node);
+static void traverse(trav *t, const frustum *f, uint32_t node, float tmin);
 
-static void split(trav *t, const frustum *f, uint32_t node) {
+static void split(trav *t, const frustum *f, uint32_t node, float tmin) {
   const tile_rect r = f->r;
   /* Quadrants aligned to the hierarchical z tiles. */
   int mx = r.x1 - r.x0 > t->o->split_min ? (r.x0 + (r.x1 - r.x0) / 2 + HIZ - 1) / HIZ * HIZ : r.x1;
@@ -418,7 +434,7 @@ static void split(trav *t, const frustum *f, uint32_t node) {
   for (int i = 0; i < 4; i++) {
     if (q[i].x0 >= q[i].x1 || q[i].y0 >= q[i].y1) continue;
     frustum sub = make_frustum(t->c, q[i]);
-    traverse(t, &sub, node);
+    traverse(t, &sub, node, tmin);
   }
 }
 
@@ -426,7 +442,7 @@ static void split(trav *t, const frustum *f, uint32_t node) {
 static void flush(trav *t) {
   tri_bound b[PEND_DRAW + BVH_MAX_LEAF];
   tri_job j[PEND_DRAW + BVH_MAX_LEAF];
-  uint32_t kept = setup_triangles(t, 0, t->pend, t->npend, b, j);
+  uint32_t kept = setup_triangles(t, 0, t->pend, t->npend, &t->pend_r, b, j);
   for (uint32_t k = 0; k < kept; k++) draw(t, &j[k], t->pend_r);
   t->npend = 0;
 }
@@ -446,27 +462,36 @@ static void generate(trav *t, const frustum *f, uint32_t node) {
   generate(t, f, n->first + 1);
 }
 
-static void traverse(trav *t, const frustum *f, uint32_t node) {
+/* tmin: the node's box_tmin, which its parent knew already */
+static void traverse(trav *t, const frustum *f, uint32_t node, float tmin) {
   const rr_bvh *bvh = t->s->bvh;
   const bvh_node *n = &bvh->nodes[node];
   const oracles *o = t->o;
   t->st.nodes++;
   heat_charge(t->heat_n, t->vb->width, f->r.x0, f->r.y0, f->r.x1, f->r.y1, 1.0f);
-  if (o->cull_outside && is_outside(f, n, t->c)) return;
-  if (o->cull_occluded && hiz_nearer(t->hz, f->r.x0, f->r.y0, f->r.x1, f->r.y1, occlusion_depth(t->c, n))) return;
-  if (should_split(t, f, n)) {
-    split(t, f, node);
+  if (o->cull_outside && is_outside(f, n, t->c, tmin)) return;
+  if (o->cull_occluded && hiz_nearer(t->hz, f->r.x0, f->r.y0, f->r.x1, f->r.y1, occlusion_depth(tmin))) return;
+  if (should_split(t, f, n, tmin)) {
+    split(t, f, node, tmin);
     return;
   }
-  if (n->count) {
+  /* generateSamples for a whole inner node too when it looks small in a frustum
+   * that cannot split any more: testing its descendants against F would cost more
+   * than bounding their triangles, which drops those beside F or between samples. */
+  if (n->count || (at_split_min(t, f) && looks_small(t, n, tmin, frustum_area(f)))) {
     generate(t, f, node);
     return;
   }
   /* Children front to back: nearer box first along the view direction. */
   uint32_t a = n->first, b = n->first + 1;
-  if (box_tmin(&bvh->nodes[b], t->c) < box_tmin(&bvh->nodes[a], t->c)) a = b, b = n->first;
-  traverse(t, f, a);
-  traverse(t, f, b);
+  float za = box_tmin(&bvh->nodes[a], t->c), zb = box_tmin(&bvh->nodes[b], t->c);
+  if (zb < za) {
+    traverse(t, f, b, zb);
+    traverse(t, f, a, za);
+  } else {
+    traverse(t, f, a, za);
+    traverse(t, f, b, zb);
+  }
 }
 
 /* ---- driving it ------------------------------------------------------------ */
@@ -491,7 +516,7 @@ static uint32_t root_setup(void *arg, int thread, uint32_t first, uint32_t n, vo
   root_pass *rp = arg;
   trav t = rp->proto;
   tri_bound scratch[ROOT_CHUNK];
-  uint32_t kept = setup_triangles(&t, first, NULL, n, scratch, out);
+  uint32_t kept = setup_triangles(&t, first, NULL, n, NULL, scratch, out);
   add_stats(&rp->st[thread], &t.st);
   return kept;
 }
@@ -554,7 +579,7 @@ static void run_tile(int job, int thread, void *arg) {
     for (int x = r.x0; x < r.x1; x += fs) {
       tile_rect q = {x, y, x + fs < r.x1 ? x + fs : r.x1, y + fs < r.y1 ? y + fs : r.y1};
       frustum f = make_frustum(t.c, q);
-      traverse(&t, &f, 0);
+      traverse(&t, &f, 0, box_tmin(&t.s->bvh->nodes[0], t.c));
     }
   if (t.npend) flush(&t);
   add_stats(&tj->st[thread], &t.st);
