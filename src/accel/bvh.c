@@ -122,10 +122,10 @@ static void bin_range(const pref *r, uint32_t n, const binmap *m, bins *b) {
     rr_vf4 lo, hi;
     ref_load(&r[i], &lo, &hi);
     rr_vi4 idx = bin_of(m, centroid(lo, hi));
-    for (int a = 0; a < 3; a++) {
-      box_grow(&b->box[a][idx[a]], lo, hi);
-      b->n[a][idx[a]]++;
-    }
+    int i0 = idx[0], i1 = idx[1], i2 = idx[2]; /* the three axes written out: no loop to run */
+    box_grow(&b->box[0][i0], lo, hi), b->n[0][i0]++;
+    box_grow(&b->box[1][i1], lo, hi), b->n[1][i1]++;
+    box_grow(&b->box[2][i2], lo, hi), b->n[2][i2]++;
   }
 }
 
@@ -183,11 +183,13 @@ static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, doub
   return found;
 }
 
-static inline int ref_bin(const pref *r, const binmap *m, int axis) {
+/* Whether a reference goes right of the split (bin >= pos on `axis`); *c is its centroid. */
+static inline bool ref_right(const pref *r, const binmap *m, int axis, int pos, rr_vf4 *c) {
   rr_vf4 lo, hi;
   ref_load(r, &lo, &hi);
-  rr_vi4 idx = bin_of(m, centroid(lo, hi));
-  return idx[axis];
+  *c = centroid(lo, hi);
+  rr_vi4 idx = bin_of(m, *c);
+  return idx[axis] >= pos;
 }
 
 /* Bounds and centroid bounds of a range. */
@@ -202,26 +204,21 @@ static void range_bounds(const pref *r, uint32_t n, box4 *box, box4 *cbox) {
   }
 }
 
-/* In-place partition of a small range (one thread): left = bin < pos. */
+/* In-place partition of a small range (one thread): left = bin < pos. Two-sided:
+ * each reference is looked at once, and only those on the wrong side move. */
 static uint32_t partition_small(pref *r, uint32_t n, const binmap *m, int axis, int pos, box4 cb[2]) {
   cb[0] = box_empty(), cb[1] = box_empty();
   uint32_t i = 0, j = n;
-  while (i < j) {
-    rr_vf4 lo, hi;
-    ref_load(&r[i], &lo, &hi);
-    rr_vf4 c = centroid(lo, hi);
-    rr_vi4 idx = bin_of(m, c);
-    if (idx[axis] < pos) {
-      box_grow(&cb[0], c, c);
-      i++;
-    } else {
-      box_grow(&cb[1], c, c);
-      pref t = r[i];
-      r[i] = r[--j];
-      r[j] = t;
-    }
+  for (;;) {
+    rr_vf4 ci = {0}, cj = {0}; /* set by the scans before use */
+    while (i < j && !ref_right(&r[i], m, axis, pos, &ci)) box_grow(&cb[0], ci, ci), i++;
+    while (i < j && ref_right(&r[j - 1], m, axis, pos, &cj)) box_grow(&cb[1], cj, cj), j--;
+    if (i == j) return i;
+    /* r[i] goes right and r[j - 1] left (j - 1 > i: r[i] stopped the left scan) */
+    pref tmp = r[i];
+    r[i++] = r[--j], r[j] = tmp;
+    box_grow(&cb[0], cj, cj), box_grow(&cb[1], ci, ci);
   }
-  return i;
 }
 
 /* ---- chunked work on big ranges (parallel, result independent of threads) -- */
@@ -250,7 +247,10 @@ static void chunk_count(int c, int thread, void *arg) {
   uint32_t s = (uint32_t)c * BVH_CHUNK, n = j->t->count - s < BVH_CHUNK ? j->t->count - s : BVH_CHUNK;
   const pref *r = j->bd->refs + j->t->start + s;
   uint32_t k = 0;
-  for (uint32_t i = 0; i < n; i++) k += ref_bin(&r[i], j->m, j->axis) < j->pos;
+  for (uint32_t i = 0; i < n; i++) {
+    rr_vf4 cen;
+    k += !ref_right(&r[i], j->m, j->axis, j->pos, &cen);
+  }
   j->nleft[c] = k;
 }
 
@@ -264,11 +264,8 @@ static void chunk_scatter(int c, int thread, void *arg) {
   uint32_t li = j->offset[c], ri = j->offset[nchunks + c];
   box4 cb[2] = {box_empty(), box_empty()};
   for (uint32_t i = 0; i < n; i++) {
-    rr_vf4 lo, hi;
-    ref_load(&r[i], &lo, &hi);
-    rr_vf4 cen = centroid(lo, hi);
-    rr_vi4 idx = bin_of(j->m, cen);
-    int side = idx[j->axis] >= j->pos;
+    rr_vf4 cen;
+    int side = ref_right(&r[i], j->m, j->axis, j->pos, &cen);
     box_grow(&cb[side], cen, cen);
     out[side ? ri++ : li++] = r[i];
   }
