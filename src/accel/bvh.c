@@ -122,10 +122,10 @@ static void bin_range(const pref *r, uint32_t n, const binmap *m, bins *b) {
     rr_vf4 lo, hi;
     ref_load(&r[i], &lo, &hi);
     rr_vi4 idx = bin_of(m, centroid(lo, hi));
-    for (int a = 0; a < 3; a++) {
-      box_grow(&b->box[a][idx[a]], lo, hi);
-      b->n[a][idx[a]]++;
-    }
+    int i0 = idx[0], i1 = idx[1], i2 = idx[2]; /* the three axes written out: no loop to run */
+    box_grow(&b->box[0][i0], lo, hi), b->n[0][i0]++;
+    box_grow(&b->box[1][i1], lo, hi), b->n[1][i1]++;
+    box_grow(&b->box[2][i2], lo, hi), b->n[2][i2]++;
   }
 }
 
@@ -134,9 +134,11 @@ static void bins_merge(bins *into, const bins *b, int nb) {
     for (int i = 0; i < nb; i++) box_merge(&into->box[a][i], b->box[a][i]), into->n[a][i] += b->n[a][i];
 }
 
-/* A range of references waiting to become a subtree rooted at `node`. */
+/* A range of references waiting to become a subtree rooted at `node`; they lie
+ * in bd->buf[buf] (a big range's split moves them to the other buffer). */
 typedef struct {
-  uint32_t start, count, node, depth;
+  uint32_t start, count, node;
+  uint16_t depth, buf;
   box4 box, cbox;
 } task;
 
@@ -148,7 +150,7 @@ typedef struct {
 } split;
 
 typedef struct {
-  pref *refs, *scratch;
+  pref *buf[2]; /* references, and room to partition big ranges into */
   int bins, leaf_size, threads;
   bool oom; /* an allocation failed (only the building thread splits big ranges, which allocate) */
 } builder;
@@ -183,11 +185,13 @@ static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, doub
   return found;
 }
 
-static inline int ref_bin(const pref *r, const binmap *m, int axis) {
+/* Whether a reference goes right of the split (bin >= pos on `axis`); *c is its centroid. */
+static inline bool ref_right(const pref *r, const binmap *m, int axis, int pos, rr_vf4 *c) {
   rr_vf4 lo, hi;
   ref_load(r, &lo, &hi);
-  rr_vi4 idx = bin_of(m, centroid(lo, hi));
-  return idx[axis];
+  *c = centroid(lo, hi);
+  rr_vi4 idx = bin_of(m, *c);
+  return idx[axis] >= pos;
 }
 
 /* Bounds and centroid bounds of a range. */
@@ -202,26 +206,21 @@ static void range_bounds(const pref *r, uint32_t n, box4 *box, box4 *cbox) {
   }
 }
 
-/* In-place partition of a small range (one thread): left = bin < pos. */
+/* In-place partition of a small range (one thread): left = bin < pos. Two-sided:
+ * each reference is looked at once, and only those on the wrong side move. */
 static uint32_t partition_small(pref *r, uint32_t n, const binmap *m, int axis, int pos, box4 cb[2]) {
   cb[0] = box_empty(), cb[1] = box_empty();
   uint32_t i = 0, j = n;
-  while (i < j) {
-    rr_vf4 lo, hi;
-    ref_load(&r[i], &lo, &hi);
-    rr_vf4 c = centroid(lo, hi);
-    rr_vi4 idx = bin_of(m, c);
-    if (idx[axis] < pos) {
-      box_grow(&cb[0], c, c);
-      i++;
-    } else {
-      box_grow(&cb[1], c, c);
-      pref t = r[i];
-      r[i] = r[--j];
-      r[j] = t;
-    }
+  for (;;) {
+    rr_vf4 ci = {0}, cj = {0}; /* set by the scans before use */
+    while (i < j && !ref_right(&r[i], m, axis, pos, &ci)) box_grow(&cb[0], ci, ci), i++;
+    while (i < j && ref_right(&r[j - 1], m, axis, pos, &cj)) box_grow(&cb[1], cj, cj), j--;
+    if (i == j) return i;
+    /* r[i] goes right and r[j - 1] left (j - 1 > i: r[i] stopped the left scan) */
+    pref tmp = r[i];
+    r[i++] = r[--j], r[j] = tmp;
+    box_grow(&cb[0], cj, cj), box_grow(&cb[1], ci, ci);
   }
-  return i;
 }
 
 /* ---- chunked work on big ranges (parallel, result independent of threads) -- */
@@ -241,16 +240,19 @@ static void chunk_bin(int c, int thread, void *arg) {
   (void)thread;
   chunk_job *j = arg;
   uint32_t s = (uint32_t)c * BVH_CHUNK, n = j->t->count - s < BVH_CHUNK ? j->t->count - s : BVH_CHUNK;
-  bin_range(j->bd->refs + j->t->start + s, n, j->m, &j->chunk_bins[c]);
+  bin_range(j->bd->buf[j->t->buf] + j->t->start + s, n, j->m, &j->chunk_bins[c]);
 }
 
 static void chunk_count(int c, int thread, void *arg) {
   (void)thread;
   chunk_job *j = arg;
   uint32_t s = (uint32_t)c * BVH_CHUNK, n = j->t->count - s < BVH_CHUNK ? j->t->count - s : BVH_CHUNK;
-  const pref *r = j->bd->refs + j->t->start + s;
+  const pref *r = j->bd->buf[j->t->buf] + j->t->start + s;
   uint32_t k = 0;
-  for (uint32_t i = 0; i < n; i++) k += ref_bin(&r[i], j->m, j->axis) < j->pos;
+  for (uint32_t i = 0; i < n; i++) {
+    rr_vf4 cen;
+    k += !ref_right(&r[i], j->m, j->axis, j->pos, &cen);
+  }
   j->nleft[c] = k;
 }
 
@@ -259,27 +261,17 @@ static void chunk_scatter(int c, int thread, void *arg) {
   chunk_job *j = arg;
   int nchunks = (int)((j->t->count + BVH_CHUNK - 1) / BVH_CHUNK);
   uint32_t s = (uint32_t)c * BVH_CHUNK, n = j->t->count - s < BVH_CHUNK ? j->t->count - s : BVH_CHUNK;
-  const pref *r = j->bd->refs + j->t->start + s;
-  pref *out = j->bd->scratch + j->t->start;
+  const pref *r = j->bd->buf[j->t->buf] + j->t->start + s;
+  pref *out = j->bd->buf[!j->t->buf] + j->t->start;
   uint32_t li = j->offset[c], ri = j->offset[nchunks + c];
   box4 cb[2] = {box_empty(), box_empty()};
   for (uint32_t i = 0; i < n; i++) {
-    rr_vf4 lo, hi;
-    ref_load(&r[i], &lo, &hi);
-    rr_vf4 cen = centroid(lo, hi);
-    rr_vi4 idx = bin_of(j->m, cen);
-    int side = idx[j->axis] >= j->pos;
+    rr_vf4 cen;
+    int side = ref_right(&r[i], j->m, j->axis, j->pos, &cen);
     box_grow(&cb[side], cen, cen);
     out[side ? ri++ : li++] = r[i];
   }
   j->ccb[2 * c] = cb[0], j->ccb[2 * c + 1] = cb[1];
-}
-
-static void chunk_copy(int c, int thread, void *arg) {
-  (void)thread;
-  chunk_job *j = arg;
-  uint32_t s = (uint32_t)c * BVH_CHUNK, n = j->t->count - s < BVH_CHUNK ? j->t->count - s : BVH_CHUNK;
-  memcpy(j->bd->refs + j->t->start + s, j->bd->scratch + j->t->start + s, n * sizeof(pref));
 }
 
 /* ---- splitting one range ---------------------------------------------------- */
@@ -292,8 +284,9 @@ static int bins_for(const builder *bd, uint32_t count) {
 
 static void median_split(builder *bd, const task *t, split *sp) {
   sp->mid = t->count / 2;
-  range_bounds(bd->refs + t->start, sp->mid, &sp->l.box, &sp->l.cbox);
-  range_bounds(bd->refs + t->start + sp->mid, t->count - sp->mid, &sp->r.box, &sp->r.cbox);
+  const pref *r = bd->buf[t->buf] + t->start;
+  range_bounds(r, sp->mid, &sp->l.box, &sp->l.cbox);
+  range_bounds(r + sp->mid, t->count - sp->mid, &sp->r.box, &sp->r.cbox);
 }
 
 /* Decides how to split t (or not) and partitions its references; `threads` only
@@ -301,6 +294,7 @@ static void median_split(builder *bd, const task *t, split *sp) {
  * and bd->oom is set. */
 static void split_task(builder *bd, const task *t, int threads, split *sp) {
   sp->mid = 0;
+  uint16_t buf = t->buf;
   if (t->count <= 1) return;
   bool big = t->count >= BVH_PAR_MIN;
   if (t->depth >= BVH_SAH_DEPTH) {
@@ -323,7 +317,7 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
     for (int c = 0; c < nchunks; c++) bins_merge(b, &job.chunk_bins[c], nb);
     free(job.chunk_bins);
   } else {
-    bin_range(bd->refs + t->start, t->count, &m, b);
+    bin_range(bd->buf[t->buf] + t->start, t->count, &m, b);
   }
   int axis = 0, pos = 0;
   double cost = 0;
@@ -359,15 +353,16 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
       job.offset[nchunks + c] = nr;
       nr += (c == nchunks - 1 ? t->count - (uint32_t)c * BVH_CHUNK : BVH_CHUNK) - job.nleft[c];
     }
+    /* Into the other buffer, where the children stay (no copy back). */
     rr_parallel_for(nchunks, threads, chunk_scatter, &job);
-    rr_parallel_for(nchunks, threads, chunk_copy, &job);
+    buf = !t->buf;
     sp->l.cbox = box_empty(), sp->r.cbox = box_empty();
     for (int c = 0; c < nchunks; c++) box_merge(&sp->l.cbox, job.ccb[2 * c]), box_merge(&sp->r.cbox, job.ccb[2 * c + 1]);
     sp->mid = nl;
     free(job.nleft), free(job.offset), free(job.ccb);
   } else {
     box4 cb[2];
-    sp->mid = partition_small(bd->refs + t->start, t->count, &m, axis, pos, cb);
+    sp->mid = partition_small(bd->buf[t->buf] + t->start, t->count, &m, axis, pos, cb);
     sp->l.cbox = cb[0], sp->r.cbox = cb[1];
   }
 children:
@@ -375,6 +370,7 @@ children:
   sp->l.start = t->start, sp->l.count = sp->mid;
   sp->r.start = t->start + sp->mid, sp->r.count = t->count - sp->mid;
   sp->l.depth = sp->r.depth = t->depth + 1;
+  sp->l.buf = sp->r.buf = buf;
 }
 
 static void store_box(bvh_node *n, box4 b) {
@@ -632,8 +628,8 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
     return RR_OK;
   }
   uint32_t n = s->ntris;
-  bd.refs = alloc_lines((size_t)n * sizeof(pref));
-  bd.scratch = alloc_lines((size_t)n * sizeof(pref));
+  bd.buf[0] = alloc_lines((size_t)n * sizeof(pref));
+  bd.buf[1] = alloc_lines((size_t)n * sizeof(pref));
   int nchunks = (int)((n + BVH_CHUNK - 1) / BVH_CHUNK);
   box4 *cb = malloc(sizeof(box4) * 2 * nchunks);
   task_vec frontier = {0}, next = {0}, small = {0};
@@ -641,14 +637,14 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   uint32_t *leaves = NULL, *depths = NULL;
   split *splits = NULL;
   rr_error err = RR_OK;
-  if (!bd.refs || !bd.scratch || !cb) goto oom;
+  if (!bd.buf[0] || !bd.buf[1] || !cb) goto oom;
   /* Every level of the tree costs about the same: the fraction done is the levels
    * done out of about log2(n / leaf size) + 1. */
   progress_span progress = {s->dev, RR_PROGRESS_BUILD, 0, 1};
   double levels = log2((double)n / bd.leaf_size) + 1, built = 0;
   rr_progress(&progress, 0);
 
-  ref_job rj = {s, bd.refs, cb};
+  ref_job rj = {s, bd.buf[0], cb};
   rr_parallel_for(nchunks, bd.threads, make_refs, &rj);
   task root = {.start = 0, .count = n, .node = 0, .depth = 0, .box = cb[0], .cbox = cb[1]};
   for (int c = 1; c < nchunks; c++) box_merge(&root.box, cb[2 * c]), box_merge(&root.cbox, cb[2 * c + 1]);
@@ -697,6 +693,7 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
       split *sp = &splits[i];
       store_box(&top.v[t->node], t->box);
       if (!sp->mid) { /* cannot happen for ranges this big, but stay correct */
+        if (t->buf) memcpy(bd.buf[0] + t->start, bd.buf[1] + t->start, t->count * sizeof(pref));
         top.v[t->node].first = t->start, top.v[t->node].count = t->count;
         top_leaves++;
         top_depth = t->depth > top_depth ? t->depth : top_depth;
@@ -752,7 +749,11 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
     b->depth = depths[i] > b->depth ? depths[i] : b->depth;
   }
   b->nnodes = (uint32_t)total;
-  for (uint32_t i = 0; i < n; i++) b->prims[i] = bd.refs[i].id;
+  /* Every range ends in a top leaf (in buffer 0) or a task's subtree (in its buffer). */
+  for (uint32_t i = 0; i < n; i++) b->prims[i] = bd.buf[0][i].id;
+  for (uint32_t i = 0; i < small.n; i++)
+    if (small.v[i].buf)
+      for (uint32_t k = small.v[i].start; k < small.v[i].start + small.v[i].count; k++) b->prims[k] = bd.buf[1][k].id;
   if (!collapse_wide(b)) goto oom;
   b->sah_cost = sah_cost(b);
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
@@ -768,7 +769,7 @@ done:
   for (uint32_t i = 0; local && i < small.n; i++) free(local[i].v);
   free(local), free(leaves), free(depths), free(splits);
   free(frontier.v), free(next.v), free(small.v), free(top.v);
-  free(bd.refs), free(bd.scratch), free(cb);
+  free(bd.buf[0]), free(bd.buf[1]), free(cb);
   rr_bvh_release(b);
   return err;
 }
