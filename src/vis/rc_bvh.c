@@ -27,6 +27,7 @@
  * exact bounds. */
 #include "vis/bvh_trace.h"
 
+#include <stdatomic.h>
 #include <string.h>
 
 /* ---- per-frame triangle setups and exact pruning bounds ------------------------ */
@@ -39,11 +40,14 @@
  * in front of its own box (rarely now that t comes from the plane, but unboundedly
  * in TRI_DEPTH's fallback), and rc / 3dr-bb keep such hits. Box tests then only
  * cull rays that miss. */
-/* A triangle's setup with its id (RR_MISS when culled for this camera, or when no
- * sample can reach it): the one stream of memory a leaf reads. */
+/* A triangle's setup with its id and the samples x0, y0, x1, y1 where it is
+ * tested: what a leaf reads. Kept only for the triangles a sample can reach, side
+ * by side (a batch of leaves takes its run of them), so the memory a frame
+ * touches follows those rather than the scene: on a detailed scene most are not. */
 typedef struct {
   tri_setup ts;
   uint32_t id;
+  float rect[4];
 } leaf_tri;
 
 /* Per wide node and slot: the screen rectangle (planar cameras) and the bound;
@@ -62,20 +66,21 @@ typedef struct {
   const rr_bvh *b;
   const camera *cam;
   bool cull, simd;
-  leaf_tri *ts;      /* by position in b->prims */
-  float (*trect)[4]; /* by position: the samples x0, y0, x1, y1 where the triangle is tested */
-  float *tlo;        /* by node */
-  float (*rect)[4];  /* by node */
+  leaf_tri *ts;      /* the live triangles, in runs of a batch */
+  atomic_uint nts;   /* how many ts holds */
+  uint32_t *slot;    /* by position in b->prims: its index in ts, or UINT32_MAX */
+  uint8_t *seen;     /* by triangle id (planar cameras): its corner rectangle holds a sample */
   wide_bounds *wb;   /* by wide node */
   thread_stats *st;  /* per thread: S */
 } frame_setups;
 
-enum { SETUP_CHUNK = 4096, BATCH = 2 * BVH_MAX_LEAF };
+enum { SETUP_CHUNK = 1024, SEEN_CHUNK = 1024, BATCH = 2 * BVH_MAX_LEAF };
 
-/* A batch of leaves' triangles: ids[k] at positions pos[k], and of the ones set up
- * (setup[k] >= 0: their index in ts/face) the pixel rectangle bb[k] (planar). */
+/* A batch of leaves (leaves[]: wide node · 4 + slot) and their triangles ids[k],
+ * and of the ones set up (setup[k] >= 0: their index in ts/face) the pixel
+ * rectangle bb[k] (planar). */
 typedef struct {
-  uint32_t ids[BATCH], pos[BATCH], sid[BATCH], leaves[BATCH];
+  uint32_t ids[BATCH], sid[BATCH], leaves[BATCH];
   int n, nl, setup[BATCH];
   int bb[BATCH][4];
   tri_setup ts[BATCH];
@@ -91,7 +96,10 @@ typedef struct {
 static void batch_setup(frame_setups *fs, leaf_batch *lb, int thread) {
   int ns = 0;
   if (fs->cam->planar) {
-    uint32_t nf = rr_tri_corner_bounds(fs->s, 0, lb->ids, (uint32_t)lb->n, fs->cam, fs->simd, lb->found);
+    uint32_t near[BATCH], nn = 0; /* seen_chunk's survivors, bounded again for their rectangles */
+    for (int k = 0; k < lb->n; k++)
+      if (fs->seen[lb->ids[k]]) near[nn++] = lb->ids[k];
+    uint32_t nf = rr_tri_corner_bounds(fs->s, 0, near, nn, fs->cam, fs->simd, lb->found);
     for (int k = 0, q = 0; k < lb->n; k++) {
       bool kept = q < (int)nf && lb->found[q].id == lb->ids[k]; /* in order; ids in a tree are distinct */
       lb->setup[k] = kept ? ns : -1;
@@ -104,104 +112,130 @@ static void batch_setup(frame_setups *fs, leaf_batch *lb, int thread) {
   fs->st[thread].setups += (uint64_t)ns;
 }
 
+/* Marks the triangles [job·chunk, (job+1)·chunk) whose corner rectangle holds a
+ * sample: in id order, the order of the vertex arrays, where leaf order would
+ * gather nine scattered floats a triangle. */
+static void seen_chunk(int job, int thread, void *arg) {
+  (void)thread;
+  frame_setups *fs = arg;
+  uint32_t i0 = (uint32_t)job * SEEN_CHUNK, n = fs->s->ntris - i0 < SEEN_CHUNK ? fs->s->ntris - i0 : SEEN_CHUNK;
+  tri_bound found[SEEN_CHUNK];
+  memset(fs->seen + i0, 0, n);
+  uint32_t nf = rr_tri_corner_bounds(fs->s, i0, NULL, n, fs->cam, fs->simd, found);
+  for (uint32_t q = 0; q < nf; q++) fs->seen[found[q].id] = 1;
+}
+
 /* Finishes the batch's leaves: each triangle's setup, id, rectangle and floor, each
- * leaf's least floor and rectangle. A planar camera's triangle is tested only at
+ * leaf's least floor and rectangle into its wide node's slot. A planar camera's triangle is tested only at
  * the samples of its corner rectangle (as 3dr-bb tests it), so its floor holds over
  * that rectangle; a curved camera's over the whole image. */
 static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
   const rr_bvh *b = fs->b;
   const camera *c = fs->cam;
+  leaf_tri out[BATCH];
+  int nout = 0, at[BATCH]; /* at[k]: triangle k's index in out, or -1 */
   for (int q = 0, k = 0; q < lb->nl; q++) {
-    const bvh_node *n = &b->nodes[lb->leaves[q]];
+    uint32_t w = lb->leaves[q] / 4, s = lb->leaves[q] % 4, first = b->wide[w].ref[s];
     float tlo = INFINITY, r[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-    for (uint32_t i = n->first; i < n->first + n->count; i++, k++) {
+    for (uint32_t i = first; i < first + b->wide[w].count[s]; i++, k++) {
       int j = lb->setup[k];
-      bool live = j >= 0 && lb->face[j] != SETUP_CULLED;
-      float *tr = fs->trect[i], t = INFINITY;
-      fs->ts[i].id = RR_MISS;
-      tr[0] = tr[1] = INFINITY, tr[2] = tr[3] = -INFINITY;
-      if (!live) continue;
-      fs->ts[i].ts = lb->ts[j];
+      at[k] = -1;
+      if (j < 0 || lb->face[j] == SETUP_CULLED) continue;
+      leaf_tri *lt = &out[nout];
+      lt->ts = lb->ts[j], lt->id = b->prims[i];
+      float t, *tr = lt->rect;
       if (c->planar) {
         /* the extreme samples, as the rays compute their coordinates */
         tr[0] = (float)lb->bb[k][0] + c->sx0, tr[1] = (float)lb->bb[k][1] + c->sy0;
         tr[2] = (float)lb->bb[k][2] + c->sx0, tr[3] = (float)lb->bb[k][3] + c->sy0;
-        t = rr_tri_rect_floor(&fs->ts[i].ts, c, tr);
+        t = rr_tri_rect_floor(&lt->ts, c, tr);
       } else {
-        t = rr_tri_bounds(&fs->ts[i].ts, c, tr);
+        t = rr_tri_bounds(&lt->ts, c, tr);
       }
-      if (t == INFINITY) { /* no sample can pass */
-        tr[0] = tr[1] = INFINITY, tr[2] = tr[3] = -INFINITY;
-        continue;
-      }
-      fs->ts[i].id = b->prims[i];
+      if (t == INFINITY) continue; /* no sample can pass */
+      at[k] = nout++;
       tlo = t < tlo ? t : tlo;
       r[0] = fminf(r[0], tr[0]), r[1] = fminf(r[1], tr[1]), r[2] = fmaxf(r[2], tr[2]), r[3] = fmaxf(r[3], tr[3]);
     }
-    fs->tlo[lb->leaves[q]] = tlo;
-    memcpy(fs->rect[lb->leaves[q]], r, sizeof r);
+    wide_bounds *wb = &fs->wb[w];
+    wb->tlo[s] = tlo, wb->x0[s] = r[0], wb->y0[s] = r[1], wb->x1[s] = r[2], wb->y1[s] = r[3];
+  }
+  /* Where the run lands depends on the threads' timing; what it holds does not. */
+  uint32_t base = atomic_fetch_add_explicit(&fs->nts, (unsigned)nout, memory_order_relaxed);
+  memcpy(fs->ts + base, out, (size_t)nout * sizeof *out);
+  for (int q = 0, k = 0; q < lb->nl; q++) {
+    uint32_t w = lb->leaves[q] / 4, s = lb->leaves[q] % 4, first = b->wide[w].ref[s];
+    for (uint32_t i = first; i < first + b->wide[w].count[s]; i++, k++)
+      fs->slot[i] = at[k] < 0 ? UINT32_MAX : base + (uint32_t)at[k];
   }
 }
 
-/* Sets up the triangles of the leaves among nodes [job·chunk, (job+1)·chunk).
- * Leaves hold a few triangles each, so those of several leaves are set up
- * together. */
+/* Sets up the triangles of the leaf slots of wide nodes [job·chunk, (job+1)·chunk)
+ * and gives their empty slots no samples. Leaves hold a few triangles each, so
+ * those of several leaves are set up together. */
 static void setup_leaves(int job, int thread, void *arg) {
   frame_setups *fs = arg;
   const rr_bvh *b = fs->b;
-  uint32_t n0 = (uint32_t)job * SETUP_CHUNK, n1 = n0 + SETUP_CHUNK < b->nnodes ? n0 + SETUP_CHUNK : b->nnodes;
+  uint32_t w0 = (uint32_t)job * SETUP_CHUNK, w1 = w0 + SETUP_CHUNK < b->nwide ? w0 + SETUP_CHUNK : b->nwide;
   leaf_batch lb;
   lb.n = lb.nl = 0;
-  for (uint32_t k = n0; k < n1; k++) {
-    const bvh_node *n = &b->nodes[k];
-    if (!n->count) continue;
-    if (lb.n + (int)n->count > BATCH) {
-      batch_setup(fs, &lb, thread), batch_finish(fs, &lb);
-      lb.n = lb.nl = 0;
+  for (uint32_t w = w0; w < w1; w++)
+    for (uint32_t i = 0; i < 4; i++) {
+      const bvh_wide *n = &b->wide[w];
+      if (n->ref[i] == UINT32_MAX) {
+        wide_bounds *wb = &fs->wb[w];
+        wb->tlo[i] = wb->x0[i] = wb->y0[i] = INFINITY, wb->x1[i] = wb->y1[i] = -INFINITY;
+      }
+      if (!n->count[i]) continue; /* empty, or an inner slot: wide_union's */
+      if (lb.n + (int)n->count[i] > BATCH) {
+        batch_setup(fs, &lb, thread), batch_finish(fs, &lb);
+        lb.n = lb.nl = 0;
+      }
+      memcpy(lb.ids + lb.n, b->prims + n->ref[i], n->count[i] * sizeof *lb.ids);
+      lb.n += (int)n->count[i], lb.leaves[lb.nl++] = 4 * w + i;
     }
-    memcpy(lb.ids + lb.n, b->prims + n->first, n->count * sizeof *lb.ids);
-    lb.n += (int)n->count, lb.leaves[lb.nl++] = k;
-  }
   batch_setup(fs, &lb, thread), batch_finish(fs, &lb);
 }
 
-static void setups_free(frame_setups *fs) {
-  free(fs->ts), free(fs->trect), free(fs->tlo), free(fs->rect), free(fs->wb);
+/* Fills the inner slots of wide node w from their children, bottom up, and returns
+ * the union of its slots: the least bound and the rectangle x0, y0, x1, y1. */
+static void wide_union(frame_setups *fs, uint32_t w, float u[5]) {
+  const bvh_wide *n = &fs->b->wide[w];
+  wide_bounds *wb = &fs->wb[w];
+  for (int i = 0; i < 4; i++) {
+    if (n->count[i] || n->ref[i] == UINT32_MAX) continue;
+    float c[5];
+    wide_union(fs, n->ref[i], c);
+    wb->tlo[i] = c[0], wb->x0[i] = c[1], wb->y0[i] = c[2], wb->x1[i] = c[3], wb->y1[i] = c[4];
+  }
+  u[0] = u[1] = u[2] = INFINITY, u[3] = u[4] = -INFINITY;
+  for (int i = 0; i < 4; i++) {
+    u[0] = fminf(u[0], wb->tlo[i]), u[1] = fminf(u[1], wb->x0[i]), u[2] = fminf(u[2], wb->y0[i]);
+    u[3] = fmaxf(u[3], wb->x1[i]), u[4] = fmaxf(u[4], wb->y1[i]);
+  }
 }
+
+static void setups_free(frame_setups *fs) { free(fs->ts), free(fs->slot), free(fs->seen), free(fs->wb); }
 
 static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *ctx, const rr_bvh *b,
                             thread_stats *st) {
   *fs = (frame_setups){.s = ctx->scene, .b = b, .cam = ctx->cam, .cull = ctx->opt->cull_backfaces != 0,
                         .simd = !ctx->opt->scalar, .st = st};
+  atomic_init(&fs->nts, 0);
   size_t n = b->nprims;
   fs->ts = malloc(n * sizeof *fs->ts + 1);
-  fs->trect = malloc(n * sizeof *fs->trect + 1);
-  fs->tlo = malloc((size_t)b->nnodes * sizeof *fs->tlo + 1);
-  fs->rect = malloc((size_t)b->nnodes * sizeof *fs->rect + 1);
+  fs->slot = malloc(n * sizeof *fs->slot + 1);
+  fs->seen = malloc((size_t)ctx->scene->ntris + 1);
   fs->wb = aligned_alloc(16, (size_t)b->nwide * sizeof *fs->wb);
-  if (!fs->ts || !fs->trect || !fs->tlo || !fs->rect || !fs->wb) {
+  if (!fs->ts || !fs->slot || !fs->seen || !fs->wb) {
     setups_free(fs);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %zu triangle setups", n);
   }
-  rr_parallel_for((int)((b->nnodes + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, fs);
-  /* Children come after their parent in the array: one backward pass. */
-  for (uint32_t k = b->nnodes; k-- > 0;) {
-    const bvh_node *nd = &b->nodes[k];
-    if (nd->count) continue;
-    uint32_t l = nd->first, r = nd->first + 1;
-    fs->tlo[k] = fminf(fs->tlo[l], fs->tlo[r]);
-    fs->rect[k][0] = fminf(fs->rect[l][0], fs->rect[r][0]), fs->rect[k][1] = fminf(fs->rect[l][1], fs->rect[r][1]);
-    fs->rect[k][2] = fmaxf(fs->rect[l][2], fs->rect[r][2]), fs->rect[k][3] = fmaxf(fs->rect[l][3], fs->rect[r][3]);
-  }
-  for (uint32_t w = 0; w < b->nwide; w++)
-    for (int i = 0; i < 4; i++) {
-      uint32_t k = b->wide_node[4 * (size_t)w + i];
-      wide_bounds *wb = &fs->wb[w];
-      bool e = k == UINT32_MAX;
-      wb->tlo[i] = e ? INFINITY : fs->tlo[k];
-      wb->x0[i] = e ? INFINITY : fs->rect[k][0], wb->y0[i] = e ? INFINITY : fs->rect[k][1];
-      wb->x1[i] = e ? -INFINITY : fs->rect[k][2], wb->y1[i] = e ? -INFINITY : fs->rect[k][3];
-    }
+  if (fs->cam->planar)
+    rr_parallel_for((int)((ctx->scene->ntris + SEEN_CHUNK - 1) / SEEN_CHUNK), ctx->threads, seen_chunk, fs);
+  rr_parallel_for((int)((b->nwide + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, fs);
+  float root[5];
+  wide_union(fs, 0, root);
   return RR_OK;
 }
 
@@ -261,9 +295,10 @@ KERNEL bool ray_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
   primary_ray *r = q;
   visbuf one = {1, 1, &r->id, &r->t, &r->l1, &r->l2};
   for (uint32_t i = first; i < first + count; i++) {
-    const leaf_tri *lt = &r->fs->ts[i];
-    const float *tr = r->fs->trect[i];
-    if (lt->id == RR_MISS || !(tr[0] <= r->sx && r->sx <= tr[2] && tr[1] <= r->sy && r->sy <= tr[3])) continue;
+    if (r->fs->slot[i] == UINT32_MAX) continue;
+    const leaf_tri *lt = &r->fs->ts[r->fs->slot[i]];
+    const float *tr = lt->rect;
+    if (!(tr[0] <= r->sx && r->sx <= tr[2] && tr[1] <= r->sy && r->sy <= tr[3])) continue;
     r->evals++;
     shade_sample_w(&lt->ts, lt->id, r->w, r->sx, r->sy, &one, 0);
   }
@@ -359,9 +394,9 @@ KERNEL bool packet_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes)
   const frame_setups *fs = p->fs;
   visbuf pvb = {PK, PK, p->id, p->t, p->l1, p->l2};
   for (uint32_t i = first; i < first + count; i++) {
-    const leaf_tri *lt = &fs->ts[i];
-    if (lt->id == RR_MISS) continue;
-    const float *tr = fs->trect[i];
+    if (fs->slot[i] == UINT32_MAX) continue;
+    const leaf_tri *lt = &fs->ts[fs->slot[i]];
+    const float *tr = lt->rect;
     uint64_t in = lanes & rect_lanes(p, tr[0], tr[1], tr[2], tr[3]);
     p->evals += (uint64_t)__builtin_popcountll(in);
     for (; in; in &= in - 1) {
