@@ -291,6 +291,7 @@ float rr_tri_rect_floor(const tri_setup *ts, const camera *cam, const float rect
   if (!(vmin > 0)) return 0;
   double t = vmin * (1 - u) * (1 - u) / (smax * (1 + u) * (1 + u)) * (1 - 1e-9);
   t = lesser(t, plane_floor(ts, cam, x0, y0, x1, y1, 0));
+  if (!(t >= 0)) return 0; /* NaN from infinite setup values: no floor */
   float f = (float)t;
   return (double)f > t ? nextafterf(f, 0) : f;
 }

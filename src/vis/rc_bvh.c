@@ -18,13 +18,20 @@
  *   rectangles;
  * - a ray skips a node whose rectangle does not hold its sample, or whose bound
  *   is greater than its best t (strictly: an equal t with a lower id still wins).
- * The price of exactness is that setup: every triangle a sample can reach, every
- * frame, and the corner bounds of every triangle. Box entry distances would not do
- * as bounds: a triangle seen at a grazing angle can compute a t in front of its own
- * box (t = num / den errs by a few ulps over the cosine to the plane, and TRI_DEPTH's
- * fallback without bound), and rc and 3dr-bb keep such hits. Curved cameras use 3D
- * box tests widened by RAY_MARGIN relative to t (NaN slabs ignored) besides the
- * exact bounds. */
+ * The price of exactness is that per-frame pass: the corner bounds of every
+ * triangle (in id order, streaming the vertex arrays), one index per triangle and
+ * the bounds of every wide node; setups, floors and the memory they take follow
+ * the triangles a sample reaches (on the 19² teapot grid at 512², 12% of them).
+ * So a frame still costs O(N), with a small constant, not O(log N). Box entry
+ * distances would remove it but are no proven bound: a triangle seen at a grazing
+ * angle computes t = num / den with a relative error of a few ulps over the cosine
+ * to its plane, after edge tests that pass rays up to a few ulps outside it, which
+ * puts the plane's hit a distance ~ ulps / sin² away along a plane of slope sin;
+ * TRI_DEPTH's fallback has no bound at all; rc and 3dr-bb keep such hits. A proof
+ * needs per node a floor on the sine between the eye's rays and its triangles'
+ * planes (normal cones in the tree), with per-frame exact floors kept for the
+ * nodes that fail it. Curved cameras use 3D box tests widened by RAY_MARGIN
+ * relative to t (NaN slabs ignored) besides the exact bounds. */
 #include "vis/bvh_trace.h"
 
 #include <stdatomic.h>
@@ -32,14 +39,8 @@
 
 /* ---- per-frame triangle setups and exact pruning bounds ------------------------ */
 
-/* Triangles are set up once per frame, in leaf order, each with a lower bound
- * `tlo` of the t that sample_test() can compute for it at the samples where it is
- * tested; a node's tlo is the least of its triangles'. A primary ray prunes a node
- * only when the node's tlo is greater than its best t, which is exact: box entry
- * distances are not, because at a grazing angle the t a triangle computes may lie
- * in front of its own box (rarely now that t comes from the plane, but unboundedly
- * in TRI_DEPTH's fallback), and rc / 3dr-bb keep such hits. Box tests then only
- * cull rays that miss. */
+/* A node's `tlo` is the least floor of its triangles (see the head comment): a
+ * primary ray prunes a node only when it is greater than its best t. */
 /* A triangle's setup with its id and the samples x0, y0, x1, y1 where it is
  * tested: what a leaf reads. Kept only for the triangles a sample can reach, side
  * by side (a batch of leaves takes its run of them), so the memory a frame
@@ -132,14 +133,20 @@ static void seen_chunk(int job, int thread, void *arg) {
 static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
   const rr_bvh *b = fs->b;
   const camera *c = fs->cam;
-  leaf_tri out[BATCH];
-  int nout = 0, at[BATCH]; /* at[k]: triangle k's index in out, or -1 */
+  /* The batch's run: room for every triangle set up and seen (one whose floor
+   * finds no sample stays an unused entry). Where the run lands depends on the
+   * threads' timing; what it holds does not. */
+  int nout = 0;
+  for (int k = 0; k < lb->n; k++) nout += lb->setup[k] >= 0 && lb->face[lb->setup[k]] != SETUP_CULLED;
+  uint32_t base = atomic_fetch_add_explicit(&fs->nts, (unsigned)nout, memory_order_relaxed);
+  leaf_tri *out = fs->ts + base;
+  nout = 0;
   for (int q = 0, k = 0; q < lb->nl; q++) {
     uint32_t w = lb->leaves[q] / 4, s = lb->leaves[q] % 4, first = b->wide[w].ref[s];
     float tlo = INFINITY, r[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
     for (uint32_t i = first; i < first + b->wide[w].count[s]; i++, k++) {
       int j = lb->setup[k];
-      at[k] = -1;
+      fs->slot[i] = UINT32_MAX;
       if (j < 0 || lb->face[j] == SETUP_CULLED) continue;
       leaf_tri *lt = &out[nout];
       lt->ts = lb->ts[j], lt->id = b->prims[i];
@@ -152,21 +159,14 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
       } else {
         t = rr_tri_bounds(&lt->ts, c, tr);
       }
-      if (t == INFINITY) continue; /* no sample can pass */
-      at[k] = nout++;
+      if (t != INFINITY) fs->slot[i] = base + (uint32_t)nout; /* else no sample can pass */
+      nout++;
+      if (t == INFINITY) continue;
       tlo = t < tlo ? t : tlo;
-      r[0] = fminf(r[0], tr[0]), r[1] = fminf(r[1], tr[1]), r[2] = fmaxf(r[2], tr[2]), r[3] = fmaxf(r[3], tr[3]);
+      r[0] = minf(r[0], tr[0]), r[1] = minf(r[1], tr[1]), r[2] = maxf(r[2], tr[2]), r[3] = maxf(r[3], tr[3]);
     }
     wide_bounds *wb = &fs->wb[w];
     wb->tlo[s] = tlo, wb->x0[s] = r[0], wb->y0[s] = r[1], wb->x1[s] = r[2], wb->y1[s] = r[3];
-  }
-  /* Where the run lands depends on the threads' timing; what it holds does not. */
-  uint32_t base = atomic_fetch_add_explicit(&fs->nts, (unsigned)nout, memory_order_relaxed);
-  memcpy(fs->ts + base, out, (size_t)nout * sizeof *out);
-  for (int q = 0, k = 0; q < lb->nl; q++) {
-    uint32_t w = lb->leaves[q] / 4, s = lb->leaves[q] % 4, first = b->wide[w].ref[s];
-    for (uint32_t i = first; i < first + b->wide[w].count[s]; i++, k++)
-      fs->slot[i] = at[k] < 0 ? UINT32_MAX : base + (uint32_t)at[k];
   }
 }
 
@@ -210,8 +210,8 @@ static void wide_union(frame_setups *fs, uint32_t w, float u[5]) {
   }
   u[0] = u[1] = u[2] = INFINITY, u[3] = u[4] = -INFINITY;
   for (int i = 0; i < 4; i++) {
-    u[0] = fminf(u[0], wb->tlo[i]), u[1] = fminf(u[1], wb->x0[i]), u[2] = fminf(u[2], wb->y0[i]);
-    u[3] = fmaxf(u[3], wb->x1[i]), u[4] = fmaxf(u[4], wb->y1[i]);
+    u[0] = minf(u[0], wb->tlo[i]), u[1] = minf(u[1], wb->x0[i]), u[2] = minf(u[2], wb->y0[i]);
+    u[3] = maxf(u[3], wb->x1[i]), u[4] = maxf(u[4], wb->y1[i]);
   }
 }
 
