@@ -185,6 +185,9 @@ bool rr_cone_excludes(const tri_cone *tc, const tri_setup *ts, vec3 axis, float 
  * camera c, and (planar cameras) a rectangle x0, y0, x1, y1 of sample coordinates
  * holding every sample where it can pass: the exact culling of rc-bvh, rc-packet. */
 float rr_tri_bounds(const tri_setup *ts, const camera *c, float rect[4]);
+/* The same least t over the samples of a given rectangle x0, y0, x1, y1 only
+ * (planar cameras): for a caller that tests the triangle nowhere else. */
+float rr_tri_rect_floor(const tri_setup *ts, const camera *c, const float rect[4]);
 
 /* A triangle with corners at infinity (homogeneous input) is unbounded: along an
  * axis it reaches from its finite corners towards each direction's sign. Its box

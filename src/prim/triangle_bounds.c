@@ -259,3 +259,39 @@ float rr_tri_bounds(const tri_setup *ts, const camera *cam, float rect[4]) {
   float f = (float)t;
   return (double)f > t ? nextafterf(f, 0) : f;
 }
+
+/* The least t that sample_test() can return for ts at the samples of rect (x0, y0,
+ * x1, y1 in sample coordinates; planar cameras), as rr_tri_bounds argues it but
+ * over a rectangle the caller tests only inside of (rc-bvh: the corner bounds), so
+ * no polygon is needed. At a passing sample every computed e_i = a_i + sx·b_i +
+ * sy·c_i is >= 0 and at most E_i + u_i, u_i = 4u·(|a_i| + mx·|b_i| + my·|c_i|)
+ * (mx, my: the rect's largest |sx|, |sy|), so the computed Σ w_i e_i is at most
+ * (1+u)^2 Σ w_i (E_i + u_i), an affine form whose maximum over the rect is at a
+ * corner; the volume's minimum likewise (its error 4u of its terms). That floors
+ * TRI_DEPTH's fallback vol·(1/sum); plane_floor floors num / den over the same
+ * rect. Double arithmetic keeps a relative slack far above its own rounding; a NaN
+ * or infinite sum gives no floor (0). */
+float rr_tri_rect_floor(const tri_setup *ts, const camera *cam, const float rect[4]) {
+  const double u = 0x1p-24, slack = 1e-12;
+  double x0 = rect[0], y0 = rect[1], x1 = rect[2], y1 = rect[3];
+  double mx = greater(fabs(x0), fabs(x1)), my = greater(fabs(y0), fabs(y1));
+  double A = 0, B = 0, C = 0, err = 0, mag = 0;
+  for (int i = 0; i < 3; i++) {
+    double w = ts->w[i], m = fabs(ts->a[i]) + mx * fabs(ts->b[i]) + my * fabs(ts->c[i]);
+    A += w * ts->a[i], B += w * ts->b[i], C += w * ts->c[i];
+    err += w * 4 * u * m, mag += w * m;
+  }
+  double smax = A + greater(B * x0, B * x1) + greater(C * y0, C * y1) + err + slack * mag;
+  if (smax <= 0) return INFINITY; /* no sample of the rect can pass */
+  if (!(smax < INFINITY)) return 0;
+  double v0 = ts->vol, vx = ts->vol_x, vy = ts->vol_y, vmin = v0; /* exact when vol_x = vol_y = 0 */
+  if (vx != 0 || vy != 0)
+    vmin = v0 + lesser(x0 * vx, x1 * vx) + lesser(y0 * vy, y1 * vy) -
+           (4 * u + slack) * (fabs(v0) + mx * fabs(vx) + my * fabs(vy));
+  if (!(vmin > 0)) return 0;
+  double t = vmin * (1 - u) * (1 - u) / (smax * (1 + u) * (1 + u)) * (1 - 1e-9);
+  t = lesser(t, plane_floor(ts, cam, x0, y0, x1, y1, 0));
+  if (!(t >= 0)) return 0; /* NaN from infinite setup values: no floor */
+  float f = (float)t;
+  return (double)f > t ? nextafterf(f, 0) : f;
+}

@@ -7,40 +7,48 @@
  * for the camera (once per frame, kept in leaf order) with shade_sample_w() at
  * its sample. Traversal only decides which (sample, triangle) pairs are visited,
  * and for primary rays it never skips the winner, by construction:
- * - each triangle gets, per frame, a lower bound of the t that sample_test() can
- *   compute for it and (planar cameras) a screen rectangle holding every sample
- *   where it can pass, both from the float error of the edge functions; nodes
- *   take the least bound and the union of rectangles;
+ * - planar cameras test a triangle only at the samples of its corner rectangle
+ *   (rr_tri_corner_bounds), exactly the samples 3dr-bb tests it at, so the two
+ *   choose among the same candidates; triangles whose rectangle holds no sample
+ *   (most of a detailed mesh's) are not set up;
+ * - each triangle set up gets, per frame, a lower bound of the t that
+ *   sample_test() can compute for it at those samples (rr_tri_rect_floor; curved
+ *   cameras: rr_tri_bounds over the image), from the float error of the edge
+ *   functions and of the plane; nodes take the least bound and the union of
+ *   rectangles;
  * - a ray skips a node whose rectangle does not hold its sample, or whose bound
- *   is greater than its best t (strictly: an equal t with a lower id still wins);
- * - needles (slivers whose rectangle reaches far beyond their projection) would
- *   widen every ancestor's rectangle: they are taken out of the tree for the frame
- *   and tested over their rectangles afterwards (the loose pass), merged by the
- *   same depth_wins().
- * The price of exactness is that setup: every triangle, every frame (S = T).
- * Box entry distances would not do: a triangle seen at a grazing angle can compute
- * a t well in front of its own box (measured: 2.4% at sin = 0.004 on the ogre), and
- * rc and 3dr-bb keep such hits. Curved cameras use 3D box tests widened by
- * RAY_MARGIN relative to t (NaN slabs ignored) besides the exact bounds. */
+ *   is greater than its best t (strictly: an equal t with a lower id still wins).
+ * The price of exactness is that per-frame pass: the corner bounds of every
+ * triangle (in id order, streaming the vertex arrays), one index per triangle and
+ * the bounds of every wide node; setups, floors and the memory they take follow
+ * the triangles a sample reaches (on the 19² teapot grid at 512², 12% of them).
+ * So a frame still costs O(N), with a small constant, not O(log N). Box entry
+ * distances would remove it but are no proven bound: a triangle seen at a grazing
+ * angle computes t = num / den with a relative error of a few ulps over the cosine
+ * to its plane, after edge tests that pass rays up to a few ulps outside it, which
+ * puts the plane's hit a distance ~ ulps / sin² away along a plane of slope sin;
+ * TRI_DEPTH's fallback has no bound at all; rc and 3dr-bb keep such hits. A proof
+ * needs per node a floor on the sine between the eye's rays and its triangles'
+ * planes (normal cones in the tree), with per-frame exact floors kept for the
+ * nodes that fail it. Curved cameras use 3D box tests widened by RAY_MARGIN
+ * relative to t (NaN slabs ignored) besides the exact bounds. */
 #include "vis/bvh_trace.h"
 
+#include <stdatomic.h>
 #include <string.h>
 
 /* ---- per-frame triangle setups and exact pruning bounds ------------------------ */
 
-/* Every triangle is set up once per frame (S = triangles), in leaf order, with a
- * lower bound `tlo` of the t that sample_test() can compute for it at any sample
- * of the image; a node's tlo is the least of its triangles'. A primary ray prunes
- * a node only when the node's tlo is greater than its best t, which is exact:
- * box entry distances are not, because at a grazing angle the t a triangle
- * computes may lie in front of its own box (rarely now that t comes from the plane,
- * but unboundedly in TRI_DEPTH's fallback), and rc / 3dr-bb keep such hits. Box
- * tests then only cull rays that miss. */
-/* A triangle's setup with its id (RR_MISS when culled for this camera): the one
- * stream of memory a leaf reads. */
+/* A node's `tlo` is the least floor of its triangles (see the head comment): a
+ * primary ray prunes a node only when it is greater than its best t. */
+/* A triangle's setup with its id and the samples x0, y0, x1, y1 where it is
+ * tested: what a leaf reads. Kept only for the triangles a sample can reach, side
+ * by side (a batch of leaves takes its run of them), so the memory a frame
+ * touches follows those rather than the scene: on a detailed scene most are not. */
 typedef struct {
   tri_setup ts;
   uint32_t id;
+  float rect[4];
 } leaf_tri;
 
 /* Per wide node and slot: the screen rectangle (planar cameras) and the bound;
@@ -50,152 +58,184 @@ typedef struct {
 } wide_bounds;
 
 typedef struct {
+  uint64_t evals, nodes, setups;
+  char pad[40]; /* one cache line per thread */
+} thread_stats;
+
+typedef struct {
   const rr_scene *s;
   const rr_bvh *b;
   const camera *cam;
   bool cull, simd;
-  leaf_tri *ts;      /* by position in b->prims */
-  float (*trect)[4]; /* by position: the triangle's rectangle x0, y0, x1, y1 */
-  float *tlo;        /* by node */
-  float (*rect)[4];  /* by node */
+  leaf_tri *ts;      /* the live triangles, in runs of a batch */
+  atomic_uint nts;   /* how many ts holds */
+  uint32_t *slot;    /* by position in b->prims: its index in ts, or UINT32_MAX */
+  uint8_t *seen;     /* by triangle id (planar cameras): its corner rectangle holds a sample */
   wide_bounds *wb;   /* by wide node */
-  uint8_t *loose;    /* by position: a needle left to the loose pass */
-  uint32_t *loose_pos, nloose;
-  leaf_tri *loose_ts;
+  thread_stats *st;  /* per thread: S */
 } frame_setups;
 
+enum { SETUP_CHUNK = 1024, SEEN_CHUNK = 1024, BATCH = 2 * BVH_MAX_LEAF };
+
+/* A batch of leaves (leaves[]: wide node · 4 + slot) and their triangles ids[k],
+ * and of the ones set up (setup[k] >= 0: their index in ts/face) the pixel
+ * rectangle bb[k] (planar). */
 typedef struct {
-  frame_setups *fs;
-  int chunk;
-} setup_job;
-
-enum { SETUP_CHUNK = 4096 };
-
-/* A needle: a sliver whose rectangle reaches far beyond its projection (the
- * enlarged lines of two nearly parallel edges meet far away). Kept in the tree it
- * would widen every ancestor's rectangle, so it goes to the loose pass instead. */
-static bool is_needle(const frame_setups *fs, uint32_t id, const float r[4]) {
-  float area = (r[2] - r[0]) * (r[3] - r[1]);
-  if (!(area > 256)) return false;
-  float x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  for (int k = 0; k < 3; k++) {
-    float sx, sy;
-    if (!rr_cam_project(fs->cam, scene_q(fs->s, k, id, fs->cam->eye), &sx, &sy)) return false;
-    x0 = fminf(x0, sx), y0 = fminf(y0, sy), x1 = fmaxf(x1, sx), y1 = fmaxf(y1, sy);
-  }
-  return area > 4 * (x1 - x0 + 2) * (y1 - y0 + 2);
-}
-
-/* Finishes leaves[0..nl-1], whose triangles ts/face hold in leaf order: each
- * triangle's setup, id and rectangle, each leaf's least t and rectangle. */
-static void finish_leaves(frame_setups *fs, const uint32_t *leaves, int nl, const tri_setup *ts, const int *face) {
-  const rr_bvh *b = fs->b;
-  for (int q = 0; q < nl; q++) {
-    const bvh_node *n = &b->nodes[leaves[q]];
-    float tlo = INFINITY, r[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-    for (uint32_t i = n->first; i < n->first + n->count; i++, ts++, face++) {
-      bool live = *face != SETUP_CULLED;
-      if (live) fs->ts[i].ts = *ts;
-      fs->ts[i].id = live ? b->prims[i] : RR_MISS;
-      fs->loose[i] = 0;
-      float *tr = fs->trect[i];
-      if (!live) {
-        tr[0] = tr[1] = INFINITY, tr[2] = tr[3] = -INFINITY;
-        continue;
-      }
-      float t = rr_tri_bounds(&fs->ts[i].ts, fs->cam, tr);
-      fs->loose[i] = fs->cam->planar && is_needle(fs, b->prims[i], tr);
-      if (fs->loose[i]) continue;
-      tlo = t < tlo ? t : tlo;
-      r[0] = fminf(r[0], tr[0]), r[1] = fminf(r[1], tr[1]), r[2] = fmaxf(r[2], tr[2]), r[3] = fmaxf(r[3], tr[3]);
-    }
-    fs->tlo[leaves[q]] = tlo;
-    memcpy(fs->rect[leaves[q]], r, sizeof r);
-  }
-}
-
-/* Sets up the triangles of the leaves among nodes [job·chunk, (job+1)·chunk).
- * Leaves hold a few triangles each, so those of several leaves are set up
- * together, eight lanes at a time where there is AVX2 (lanes never mix: the
- * same bits as one at a time). */
-static void setup_leaves(int job, int thread, void *arg) {
-  (void)thread;
-  frame_setups *fs = ((setup_job *)arg)->fs;
-  const rr_bvh *b = fs->b;
-  uint32_t n0 = (uint32_t)job * SETUP_CHUNK, n1 = n0 + SETUP_CHUNK < b->nnodes ? n0 + SETUP_CHUNK : b->nnodes;
-  enum { BATCH = 2 * BVH_MAX_LEAF };
+  uint32_t ids[BATCH], sid[BATCH], leaves[BATCH];
+  int n, nl, setup[BATCH];
+  int bb[BATCH][4];
   tri_setup ts[BATCH];
-  int face[BATCH], nids = 0, nl = 0;
-  uint32_t ids[BATCH], leaves[BATCH];
-  for (uint32_t k = n0; k < n1; k++) {
-    const bvh_node *n = &b->nodes[k];
-    if (!n->count) continue;
-    if (nids + (int)n->count > BATCH) {
-      rr_tri_setup_run(fs->s, ids, nids, fs->cam, fs->cull, fs->simd, ts, face);
-      finish_leaves(fs, leaves, nl, ts, face);
-      nids = nl = 0;
+  int face[BATCH];
+  tri_bound found[BATCH];
+} leaf_batch;
+
+/* Sets up the batch's triangles that can be seen, eight lanes at a time where
+ * there is AVX2 (lanes never mix: the same bits as one at a time). Planar cameras
+ * first bound each triangle by its corners (rr_tri_corner_bounds, the rectangles
+ * 3dr-bb tests it over): most triangles of a detailed mesh fall between samples
+ * and cost no setup. */
+static void batch_setup(frame_setups *fs, leaf_batch *lb, int thread) {
+  int ns = 0;
+  if (fs->cam->planar) {
+    uint32_t near[BATCH], nn = 0; /* seen_chunk's survivors, bounded again for their rectangles */
+    for (int k = 0; k < lb->n; k++)
+      if (fs->seen[lb->ids[k]]) near[nn++] = lb->ids[k];
+    uint32_t nf = rr_tri_corner_bounds(fs->s, 0, near, nn, fs->cam, fs->simd, lb->found);
+    for (int k = 0, q = 0; k < lb->n; k++) {
+      bool kept = q < (int)nf && lb->found[q].id == lb->ids[k]; /* in order; ids in a tree are distinct */
+      lb->setup[k] = kept ? ns : -1;
+      if (kept) memcpy(lb->bb[k], lb->found[q++].bb, sizeof lb->bb[k]), lb->sid[ns++] = lb->ids[k];
     }
-    memcpy(ids + nids, b->prims + n->first, n->count * sizeof *ids);
-    nids += (int)n->count, leaves[nl++] = k;
+  } else {
+    for (int k = 0; k < lb->n; k++) lb->setup[k] = ns, lb->sid[ns++] = lb->ids[k];
   }
-  rr_tri_setup_run(fs->s, ids, nids, fs->cam, fs->cull, fs->simd, ts, face);
-  finish_leaves(fs, leaves, nl, ts, face);
+  rr_tri_setup_run(fs->s, lb->sid, ns, fs->cam, fs->cull, fs->simd, lb->ts, lb->face);
+  fs->st[thread].setups += (uint64_t)ns;
 }
 
-static void setups_free(frame_setups *fs) {
-  free(fs->ts), free(fs->trect), free(fs->tlo), free(fs->rect), free(fs->wb), free(fs->loose);
-  free(fs->loose_pos), free(fs->loose_ts);
+/* Marks the triangles [job·chunk, (job+1)·chunk) whose corner rectangle holds a
+ * sample: in id order, the order of the vertex arrays, where leaf order would
+ * gather nine scattered floats a triangle. */
+static void seen_chunk(int job, int thread, void *arg) {
+  (void)thread;
+  frame_setups *fs = arg;
+  uint32_t i0 = (uint32_t)job * SEEN_CHUNK, n = fs->s->ntris - i0 < SEEN_CHUNK ? fs->s->ntris - i0 : SEEN_CHUNK;
+  tri_bound found[SEEN_CHUNK];
+  memset(fs->seen + i0, 0, n);
+  uint32_t nf = rr_tri_corner_bounds(fs->s, i0, NULL, n, fs->cam, fs->simd, found);
+  for (uint32_t q = 0; q < nf; q++) fs->seen[found[q].id] = 1;
 }
 
-static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *ctx, const rr_bvh *b) {
+/* Finishes the batch's leaves: each triangle's setup, id, rectangle and floor, each
+ * leaf's least floor and rectangle into its wide node's slot. A planar camera's triangle is tested only at
+ * the samples of its corner rectangle (as 3dr-bb tests it), so its floor holds over
+ * that rectangle; a curved camera's over the whole image. */
+static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
+  const rr_bvh *b = fs->b;
+  const camera *c = fs->cam;
+  /* The batch's run: room for every triangle set up and seen (one whose floor
+   * finds no sample stays an unused entry). Where the run lands depends on the
+   * threads' timing; what it holds does not. */
+  int nout = 0;
+  for (int k = 0; k < lb->n; k++) nout += lb->setup[k] >= 0 && lb->face[lb->setup[k]] != SETUP_CULLED;
+  uint32_t base = atomic_fetch_add_explicit(&fs->nts, (unsigned)nout, memory_order_relaxed);
+  leaf_tri *out = fs->ts + base;
+  nout = 0;
+  for (int q = 0, k = 0; q < lb->nl; q++) {
+    uint32_t w = lb->leaves[q] / 4, s = lb->leaves[q] % 4, first = b->wide[w].ref[s];
+    float tlo = INFINITY, r[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = first; i < first + b->wide[w].count[s]; i++, k++) {
+      int j = lb->setup[k];
+      fs->slot[i] = UINT32_MAX;
+      if (j < 0 || lb->face[j] == SETUP_CULLED) continue;
+      leaf_tri *lt = &out[nout];
+      lt->ts = lb->ts[j], lt->id = b->prims[i];
+      float t, *tr = lt->rect;
+      if (c->planar) {
+        /* the extreme samples, as the rays compute their coordinates */
+        tr[0] = (float)lb->bb[k][0] + c->sx0, tr[1] = (float)lb->bb[k][1] + c->sy0;
+        tr[2] = (float)lb->bb[k][2] + c->sx0, tr[3] = (float)lb->bb[k][3] + c->sy0;
+        t = rr_tri_rect_floor(&lt->ts, c, tr);
+      } else {
+        t = rr_tri_bounds(&lt->ts, c, tr);
+      }
+      if (t != INFINITY) fs->slot[i] = base + (uint32_t)nout; /* else no sample can pass */
+      nout++;
+      if (t == INFINITY) continue;
+      tlo = t < tlo ? t : tlo;
+      r[0] = minf(r[0], tr[0]), r[1] = minf(r[1], tr[1]), r[2] = maxf(r[2], tr[2]), r[3] = maxf(r[3], tr[3]);
+    }
+    wide_bounds *wb = &fs->wb[w];
+    wb->tlo[s] = tlo, wb->x0[s] = r[0], wb->y0[s] = r[1], wb->x1[s] = r[2], wb->y1[s] = r[3];
+  }
+}
+
+/* Sets up the triangles of the leaf slots of wide nodes [job·chunk, (job+1)·chunk)
+ * and gives their empty slots no samples. Leaves hold a few triangles each, so
+ * those of several leaves are set up together. */
+static void setup_leaves(int job, int thread, void *arg) {
+  frame_setups *fs = arg;
+  const rr_bvh *b = fs->b;
+  uint32_t w0 = (uint32_t)job * SETUP_CHUNK, w1 = w0 + SETUP_CHUNK < b->nwide ? w0 + SETUP_CHUNK : b->nwide;
+  leaf_batch lb;
+  lb.n = lb.nl = 0;
+  for (uint32_t w = w0; w < w1; w++)
+    for (uint32_t i = 0; i < 4; i++) {
+      const bvh_wide *n = &b->wide[w];
+      if (n->ref[i] == UINT32_MAX) {
+        wide_bounds *wb = &fs->wb[w];
+        wb->tlo[i] = wb->x0[i] = wb->y0[i] = INFINITY, wb->x1[i] = wb->y1[i] = -INFINITY;
+      }
+      if (!n->count[i]) continue; /* empty, or an inner slot: wide_union's */
+      if (lb.n + (int)n->count[i] > BATCH) {
+        batch_setup(fs, &lb, thread), batch_finish(fs, &lb);
+        lb.n = lb.nl = 0;
+      }
+      memcpy(lb.ids + lb.n, b->prims + n->ref[i], n->count[i] * sizeof *lb.ids);
+      lb.n += (int)n->count[i], lb.leaves[lb.nl++] = 4 * w + i;
+    }
+  batch_setup(fs, &lb, thread), batch_finish(fs, &lb);
+}
+
+/* Fills the inner slots of wide node w from their children, bottom up, and returns
+ * the union of its slots: the least bound and the rectangle x0, y0, x1, y1. */
+static void wide_union(frame_setups *fs, uint32_t w, float u[5]) {
+  const bvh_wide *n = &fs->b->wide[w];
+  wide_bounds *wb = &fs->wb[w];
+  for (int i = 0; i < 4; i++) {
+    if (n->count[i] || n->ref[i] == UINT32_MAX) continue;
+    float c[5];
+    wide_union(fs, n->ref[i], c);
+    wb->tlo[i] = c[0], wb->x0[i] = c[1], wb->y0[i] = c[2], wb->x1[i] = c[3], wb->y1[i] = c[4];
+  }
+  u[0] = u[1] = u[2] = INFINITY, u[3] = u[4] = -INFINITY;
+  for (int i = 0; i < 4; i++) {
+    u[0] = minf(u[0], wb->tlo[i]), u[1] = minf(u[1], wb->x0[i]), u[2] = minf(u[2], wb->y0[i]);
+    u[3] = maxf(u[3], wb->x1[i]), u[4] = maxf(u[4], wb->y1[i]);
+  }
+}
+
+static void setups_free(frame_setups *fs) { free(fs->ts), free(fs->slot), free(fs->seen), free(fs->wb); }
+
+static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *ctx, const rr_bvh *b,
+                            thread_stats *st) {
   *fs = (frame_setups){.s = ctx->scene, .b = b, .cam = ctx->cam, .cull = ctx->opt->cull_backfaces != 0,
-                        .simd = !ctx->opt->scalar};
+                        .simd = !ctx->opt->scalar, .st = st};
+  atomic_init(&fs->nts, 0);
   size_t n = b->nprims;
   fs->ts = malloc(n * sizeof *fs->ts + 1);
-  fs->trect = malloc(n * sizeof *fs->trect + 1);
-  fs->tlo = malloc((size_t)b->nnodes * sizeof *fs->tlo + 1);
-  fs->rect = malloc((size_t)b->nnodes * sizeof *fs->rect + 1);
+  fs->slot = malloc(n * sizeof *fs->slot + 1);
+  fs->seen = malloc((size_t)ctx->scene->ntris + 1);
   fs->wb = aligned_alloc(16, (size_t)b->nwide * sizeof *fs->wb);
-  fs->loose = malloc(n + 1);
-  if (!fs->ts || !fs->trect || !fs->tlo || !fs->rect || !fs->wb || !fs->loose) {
-    free(fs->ts), free(fs->trect), free(fs->tlo), free(fs->rect), free(fs->wb), free(fs->loose);
-    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %zu triangle setups", n);
-  }
-  setup_job sj = {fs, SETUP_CHUNK};
-  rr_parallel_for((int)((b->nnodes + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, &sj);
-  /* Needles leave the tree for the loose pass (in leaf order: deterministic). */
-  uint32_t nl = 0;
-  for (size_t i = 0; i < n; i++) nl += fs->loose[i];
-  fs->loose_pos = malloc((size_t)nl * sizeof *fs->loose_pos + 1);
-  fs->loose_ts = malloc((size_t)nl * sizeof *fs->loose_ts + 1);
-  if (!fs->loose_pos || !fs->loose_ts) {
+  if (!fs->ts || !fs->slot || !fs->seen || !fs->wb) {
     setups_free(fs);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %zu triangle setups", n);
   }
-  for (size_t i = 0; i < n; i++)
-    if (fs->loose[i]) {
-      fs->loose_pos[fs->nloose] = (uint32_t)i, fs->loose_ts[fs->nloose++] = fs->ts[i];
-      fs->ts[i].id = RR_MISS;
-    }
-  /* Children come after their parent in the array: one backward pass. */
-  for (uint32_t k = b->nnodes; k-- > 0;) {
-    const bvh_node *nd = &b->nodes[k];
-    if (nd->count) continue;
-    uint32_t l = nd->first, r = nd->first + 1;
-    fs->tlo[k] = fminf(fs->tlo[l], fs->tlo[r]);
-    fs->rect[k][0] = fminf(fs->rect[l][0], fs->rect[r][0]), fs->rect[k][1] = fminf(fs->rect[l][1], fs->rect[r][1]);
-    fs->rect[k][2] = fmaxf(fs->rect[l][2], fs->rect[r][2]), fs->rect[k][3] = fmaxf(fs->rect[l][3], fs->rect[r][3]);
-  }
-  for (uint32_t w = 0; w < b->nwide; w++)
-    for (int i = 0; i < 4; i++) {
-      uint32_t k = b->wide_node[4 * (size_t)w + i];
-      wide_bounds *wb = &fs->wb[w];
-      bool e = k == UINT32_MAX;
-      wb->tlo[i] = e ? INFINITY : fs->tlo[k];
-      wb->x0[i] = e ? INFINITY : fs->rect[k][0], wb->y0[i] = e ? INFINITY : fs->rect[k][1];
-      wb->x1[i] = e ? -INFINITY : fs->rect[k][2], wb->y1[i] = e ? -INFINITY : fs->rect[k][3];
-    }
-  ctx->stats->setups += n;
+  if (fs->cam->planar)
+    rr_parallel_for((int)((ctx->scene->ntris + SEEN_CHUNK - 1) / SEEN_CHUNK), ctx->threads, seen_chunk, fs);
+  rr_parallel_for((int)((b->nwide + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, fs);
+  float root[5];
+  wide_union(fs, 0, root);
   return RR_OK;
 }
 
@@ -204,15 +244,10 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
 enum { TILE = 32, PK = 8, PN = PK * PK };
 
 typedef struct {
-  uint64_t evals, nodes;
-  char pad[48]; /* one cache line per thread */
-} thread_stats;
-
-typedef struct {
   render_ctx *ctx;
   const rr_bvh *b;
   frame_setups fs;
-  int tiles_x, band_rows;
+  int tiles_x;
   thread_stats st[RR_MAX_THREADS];
 } frame_job;
 
@@ -253,14 +288,17 @@ KERNEL int ray_node_curved(void *q, const bvh_wide *w, uint32_t ref, uint64_t la
   return wide_test(w, &r->q, 0, s->key, r->t, &s->order);
 }
 
-/* Tests the leaf's triangles, set up for the frame, at the ray's sample. */
+/* Tests the leaf's triangles, set up for the frame, at the ray's sample where it
+ * lies in their rectangle (their floor holds there; curved cameras: everywhere). */
 KERNEL bool ray_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
   (void)lanes;
   primary_ray *r = q;
   visbuf one = {1, 1, &r->id, &r->t, &r->l1, &r->l2};
   for (uint32_t i = first; i < first + count; i++) {
-    const leaf_tri *lt = &r->fs->ts[i];
-    if (lt->id == RR_MISS) continue;
+    if (r->fs->slot[i] == UINT32_MAX) continue;
+    const leaf_tri *lt = &r->fs->ts[r->fs->slot[i]];
+    const float *tr = lt->rect;
+    if (!(tr[0] <= r->sx && r->sx <= tr[2] && tr[1] <= r->sy && r->sy <= tr[3])) continue;
     r->evals++;
     shade_sample_w(&lt->ts, lt->id, r->w, r->sx, r->sy, &one, 0);
   }
@@ -356,9 +394,9 @@ KERNEL bool packet_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes)
   const frame_setups *fs = p->fs;
   visbuf pvb = {PK, PK, p->id, p->t, p->l1, p->l2};
   for (uint32_t i = first; i < first + count; i++) {
-    const leaf_tri *lt = &fs->ts[i];
-    if (lt->id == RR_MISS) continue;
-    const float *tr = fs->trect[i];
+    if (fs->slot[i] == UINT32_MAX) continue;
+    const leaf_tri *lt = &fs->ts[fs->slot[i]];
+    const float *tr = lt->rect;
     uint64_t in = lanes & rect_lanes(p, tr[0], tr[1], tr[2], tr[3]);
     p->evals += (uint64_t)__builtin_popcountll(in);
     for (; in; in &= in - 1) {
@@ -404,33 +442,6 @@ static void rc_packet_tile(int job, int thread, void *arg) {
   st->evals += p->evals, st->nodes += p->nodes;
 }
 
-/* The loose pass: every sample of a needle's rectangle in one band of rows, with
- * the same sample test; depth_wins() merges it with what the rays found. */
-static void loose_band(int band, int thread, void *arg) {
-  frame_job *j = arg;
-  visbuf *vb = j->ctx->vb;
-  const camera *c = j->ctx->cam;
-  int y0 = band * j->band_rows, y1 = y0 + j->band_rows < vb->height ? y0 + j->band_rows : vb->height;
-  uint64_t e = 0;
-  for (uint32_t q = 0; q < j->fs.nloose; q++) {
-    const float *r = j->fs.trect[j->fs.loose_pos[q]];
-    const leaf_tri *lt = &j->fs.loose_ts[q];
-    /* Samples x + sx0 in [r0, r2]: x from ceil(r0 - sx0) to floor(r2 - sx0), clipped. */
-    float fx0 = fmaxf(ceilf(r[0] - c->sx0), 0), fx1 = fminf(floorf(r[2] - c->sx0), (float)(vb->width - 1));
-    float fy0 = fmaxf(ceilf(r[1] - c->sy0), (float)y0), fy1 = fminf(floorf(r[3] - c->sy0), (float)(y1 - 1));
-    if (!(fx0 <= fx1 && fy0 <= fy1)) continue;
-    for (int y = (int)fy0; y <= (int)fy1; y++)
-      for (int x = (int)fx0; x <= (int)fx1; x++) {
-        float sx = (float)x + c->sx0, sy = (float)y + c->sy0;
-        size_t k = (size_t)y * vb->width + x;
-        shade_sample_w(&lt->ts, lt->id, v3(1.0f, sx, sy), sx, sy, vb, k);
-        e++;
-        if (j->ctx->heat_e) j->ctx->heat_e[k] += 1;
-      }
-  }
-  j->st[thread].evals += e;
-}
-
 static rr_error run_frame(rr_device *dev, render_ctx *ctx, rr_parallel_fn tile_fn) {
   /* Packets work on screen rectangles: curved cameras cast one ray per sample. */
   if (tile_fn == rc_packet_tile && !ctx->cam->planar) tile_fn = rc_bvh_tile;
@@ -441,7 +452,7 @@ static rr_error run_frame(rr_device *dev, render_ctx *ctx, rr_parallel_fn tile_f
   frame_job *j = calloc(1, sizeof *j);
   if (!j) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory");
   j->ctx = ctx, j->b = b;
-  rr_error e = setups_init(dev, &j->fs, ctx, b);
+  rr_error e = setups_init(dev, &j->fs, ctx, b, j->st);
   if (e) {
     free(j);
     return e;
@@ -450,13 +461,10 @@ static rr_error run_frame(rr_device *dev, render_ctx *ctx, rr_parallel_fn tile_f
   j->tiles_x = (vb->width + TILE - 1) / TILE;
   int tiles = j->tiles_x * ((vb->height + TILE - 1) / TILE);
   rr_parallel_for_progress(tiles, ctx->threads, tile_fn, j, &ctx->progress);
-  if (j->fs.nloose) { /* the needles, over their rectangles, by bands of rows */
-    j->band_rows = (vb->height + 4 * ctx->threads - 1) / (4 * ctx->threads);
-    rr_parallel_for((vb->height + j->band_rows - 1) / j->band_rows, ctx->threads, loose_band, j);
-  }
   for (int t = 0; t < RR_MAX_THREADS; t++) {
     ctx->stats->edge_evals += j->st[t].evals;
     ctx->stats->nodes += j->st[t].nodes;
+    ctx->stats->setups += j->st[t].setups;
   }
   setups_free(&j->fs);
   free(j);
