@@ -31,6 +31,7 @@ typedef struct {
   uint32_t id;
   const rr_scene *s;
   const rr_bvh *b; /* NULL for an empty scene: every ray misses */
+  bool cam_ready;  /* cam is made for the first full test: many rays need none */
   camera cam;
 } query_ray;
 
@@ -46,6 +47,7 @@ KERNEL int query_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, 
   query_ray *r = q;
   const char *base = (const char *)w;
   rr_vf4 t0 = r->tlo, t1 = rr_vf4_splat(r->t);
+#pragma GCC unroll 3
   for (int a = 0; a < 3; a++) {
     t0 = rr_vf4_max((rr_vf4_load_aligned((const float *)(base + r->q.wn[a])) - r->q.o[a]) * r->q.inv[a], t0);
     t1 = rr_vf4_min((rr_vf4_load_aligned((const float *)(base + r->q.wf[a])) - r->q.o[a]) * r->inv_far[a], t1);
@@ -69,6 +71,11 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
     for (; may; may &= may - 1) {
       uint32_t id = r->b->prims[first + j + (uint32_t)__builtin_ctz(may)];
       float t, l1, l2;
+      if (!r->cam_ready) {
+        float org[3] = {r->q.o[0][0], r->q.o[1][0], r->q.o[2][0]}, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
+        rr_cam_for_ray(org, dir, &r->cam);
+        r->cam_ready = true;
+      }
       if (!rr_tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
       if (any) return true;
       if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
@@ -101,9 +108,8 @@ static const char *ray_problem(const float org[3], const float dir[3], float tmi
 /* Prepares a valid ray against the scene's tree b (NULL: an empty scene). */
 static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const float org[3], const float dir[3],
                        float tmin, float tmax) {
-  r->s = s, r->b = b;
-  rr_cam_for_ray(org, dir, &r->cam);
-  ray_q_init(&r->q, r->cam.eye, r->cam.d0);
+  r->s = s, r->b = b, r->cam_ready = false;
+  ray_q_init(&r->q, v3_load(org), v3_load(dir));
   for (int a = 0; a < 3; a++) {
     r->inv_far[a] = r->q.inv[a] * rr_vf4_splat(1 + RAY_MARGIN);
     r->q.inv[a] = r->q.inv[a] * rr_vf4_splat(1 - RAY_MARGIN);
