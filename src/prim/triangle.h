@@ -148,28 +148,34 @@ typedef struct {
 static inline tri_v4 tri_v4_sub(tri_v4 a, tri_v4 b) { return (tri_v4){a.x - b.x, a.y - b.y, a.z - b.z}; }
 static inline rr_vf4 tri_v4_dot(tri_v4 a, tri_v4 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 static inline rr_vi4 tri_vi4_select(rr_vi4 m, rr_vi4 a, rr_vi4 b) { return (m & a) | (~m & b); }
-/* tri_edge_normal lane by lane */
-KERNEL tri_v4 tri_v4_edge_normal(tri_v4 a, tri_v4 b) {
+/* tri_edge_normal lane by lane, as h × (l − h) and, in *neg, the sign bits that
+ * turn it into the normal (set where the edge runs from h to l). */
+KERNEL tri_v4 tri_v4_edge_cross(tri_v4 a, tri_v4 b, rr_vi4 *neg) {
   rr_vi4 swap = tri_vi4_select(b.x != a.x, b.x < a.x, tri_vi4_select(b.y != a.y, b.y < a.y, b.z < a.z));
   tri_v4 l = {rr_vf4_select(swap, b.x, a.x), rr_vf4_select(swap, b.y, a.y), rr_vf4_select(swap, b.z, a.z)};
   tri_v4 h = {rr_vf4_select(swap, a.x, b.x), rr_vf4_select(swap, a.y, b.y), rr_vf4_select(swap, a.z, b.z)};
   tri_v4 e = tri_v4_sub(l, h);
-  rr_vi4 neg = swap & (rr_vi4)rr_vf4_splat(-0.0f); /* -x flips the sign bit */
-  return (tri_v4){(rr_vf4)((rr_vi4)(h.y * e.z - h.z * e.y) ^ neg), (rr_vf4)((rr_vi4)(h.z * e.x - h.x * e.z) ^ neg),
-                  (rr_vf4)((rr_vi4)(h.x * e.y - h.y * e.x) ^ neg)};
+  *neg = swap & (rr_vi4)rr_vf4_splat(-0.0f);
+  return (tri_v4){h.y * e.z - h.z * e.y, h.z * e.x - h.x * e.z, h.x * e.y - h.y * e.x};
 }
+/* Negation is exact and rounding symmetric, so x·(−m) is −(x·m) up to the sign of
+ * a zero, which no test below tells apart: the signs (the edge's and σ) are
+ * applied to the dot products as sign bits. */
 KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3]) {
   tri_v4 q[3];
   for (int k = 0; k < 3; k++)
     q[k] = (tri_v4){rr_vf4_load(v + (3 * k) * stride) - eye[0], rr_vf4_load(v + (3 * k + 1) * stride) - eye[1],
                     rr_vf4_load(v + (3 * k + 2) * stride) - eye[2]};
   tri_v4 dv = {d[0], d[1], d[2]};
-  tri_v4 n0 = tri_v4_edge_normal(q[1], q[2]), n1 = tri_v4_edge_normal(q[2], q[0]),
-         n2 = tri_v4_edge_normal(q[0], q[1]);
-  rr_vf4 vol = tri_v4_dot(q[0], n0);
-  rr_vf4 sign = rr_vf4_select(vol > 0, rr_vf4_splat(1.0f), rr_vf4_splat(-1.0f));
-  rr_vi4 may = (vol != 0) & (rr_vf4_abs(vol) < INFINITY) & (sign * tri_v4_dot(n0, dv) >= 0) &
-               (sign * tri_v4_dot(n1, dv) >= 0) & (sign * tri_v4_dot(n2, dv) >= 0);
+  rr_vi4 neg[3];
+  tri_v4 m0 = tri_v4_edge_cross(q[1], q[2], &neg[0]), m1 = tri_v4_edge_cross(q[2], q[0], &neg[1]),
+         m2 = tri_v4_edge_cross(q[0], q[1], &neg[2]);
+  rr_vf4 vol = (rr_vf4)((rr_vi4)tri_v4_dot(q[0], m0) ^ neg[0]);
+  rr_vi4 sigma = (rr_vi4)vol & (rr_vi4)rr_vf4_splat(-0.0f); /* σ = −1 where the volume is negative */
+  rr_vf4 a0 = (rr_vf4)((rr_vi4)tri_v4_dot(m0, dv) ^ neg[0] ^ sigma),
+         a1 = (rr_vf4)((rr_vi4)tri_v4_dot(m1, dv) ^ neg[1] ^ sigma),
+         a2 = (rr_vf4)((rr_vi4)tri_v4_dot(m2, dv) ^ neg[2] ^ sigma);
+  rr_vi4 may = (vol != 0) & (rr_vf4_abs(vol) < INFINITY) & (a0 >= 0) & (a1 >= 0) & (a2 >= 0);
   return rr_vi4_bits(may);
 }
 
