@@ -1,8 +1,10 @@
 /* The public ray queries rr_intersect and rr_occluded: one arbitrary ray through
  * the committed scene's BVH, by the traversal of every ray caster
- * (vis/bvh_trace.h). Each triangle a leaf holds is set up for the ray (a
- * pseudo-camera at its origin, rr_cam_for_ray) and tested with the project's one
- * sample test, so a ray through a shared edge hits exactly one triangle.
+ * (vis/bvh_trace.h). A leaf's triangles, whose corners the tree keeps in leaf
+ * order (rr_bvh.leaf_v), go four at a time through the edge signs of their setup
+ * (tri_ray_may_hit4); those that pass are set up for the ray (a pseudo-camera at
+ * its origin, rr_cam_for_ray) and tested with the project's one sample test, so a
+ * ray through a shared edge hits exactly one triangle.
  *
  * Boxes are tested in 3D, widened by RAY_MARGIN relative to t (NaN slabs
  * ignored), and prune by box entry, which is exact but for triangles whose plane
