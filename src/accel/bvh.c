@@ -768,7 +768,8 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   }
   b->nnodes = (uint32_t)total;
   for (uint32_t i = 0; i < n; i++) b->prims[i] = bd.refs[i].id;
-  if (!collapse_wide(b) || !copy_leaf_corners(b, s)) goto oom;
+  if (!collapse_wide(b)) goto oom;
+  if (!copy_leaf_corners(b, s)) goto oom;
   b->sah_cost = sah_cost(b);
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
              (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) + ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
