@@ -2,7 +2,8 @@
  * bits of rr_intersect / rr_occluded, which give those of brute force over every
  * triangle with the setup and sample test of rc (rr_tri_ray_hit) — on random rays
  * (some with tmin/tmax cutting hits), rays through the shared edges and vertices
- * of plane:8, rays from the bunny's surface, in both layouts, on 1, 2 and 8
+ * of plane:8, rays from the bunny's surface, rays through leaves of up to
+ * 13 triangles and through a ground with corners at infinity, in both layouts, on 1, 2 and 8
  * threads; and bad input: NaN/inf components (a miss and an error naming the
  * ray), count 0, bad strides, thread counts and NULL arrays. */
 #include "vis/vis.h"
@@ -226,6 +227,40 @@ int main(void) {
   } else {
     CHECK(0, "built-in scene: %s", rr_device_message(dev));
   }
+  /* leaves of up to 13 triangles (several groups of four, one part full): a fan of
+   * triangles through one axis, whose boxes overlap so that no split pays; and a
+   * scene with corners at infinity, which the leaves' pre-test leaves to the full test */
+  rr_build_options opt;
+  rr_build_options_init(&opt);
+  opt.leaf_size = 13;
+  rr_device_set_build_options(dev, &opt);
+  enum { FAN = 40 };
+  float fan[FAN * 9];
+  uint32_t idx[FAN * 3];
+  for (int i = 0; i < FAN; i++) {
+    float a = 3.14159265f * (float)i / FAN, c = cosf(a), sn = sinf(a);
+    const float v[9] = {-c, -1, -sn, c, -1, sn, 0.1f * c, 1, 0.1f * sn};
+    memcpy(&fan[9 * i], v, sizeof v);
+    for (int k = 0; k < 3; k++) idx[3 * i + k] = (uint32_t)(3 * i + k);
+  }
+  for (int k = 0; k < 2; k++) {
+    rr_error e = k ? rr_scene_load(dev, "ground", &s) : rr_scene_new(dev, &s);
+    if (!k && !e) e = rr_scene_add_mesh(s, fan, 3 * FAN, idx, FAN, NULL);
+    if (!k && !e) e = rr_scene_commit(s);
+    if (e) {
+      CHECK(0, "%s: %s", k ? "ground" : "fan", rr_device_message(dev));
+      continue;
+    }
+    uint32_t widest = 0;
+    for (uint32_t i = 0; i < s->bvh->nnodes; i++) widest = s->bvh->nodes[i].count > widest ? s->bvh->nodes[i].count : widest;
+    CHECK(k || widest > 4, "fan: no leaf beyond four triangles (at most %u)", widest);
+    rr_ray *rays = random_rays(s, 500);
+    check_rays(dev, s, rays, 500, 1, k ? "ground (corners at infinity)" : "fan, leaves of up to 13");
+    free(rays);
+    rr_scene_release(s);
+  }
+  rr_build_options_init(&opt);
+  rr_device_set_build_options(dev, &opt);
   plane_rays(dev);
   bad_input(dev);
   bunny_rays(dev);

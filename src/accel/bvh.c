@@ -550,6 +550,21 @@ static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
   }
 }
 
+/* The corners of the leaves' triangles, leaf by leaf (rr_bvh.leaf_v). */
+static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
+  size_t n = (size_t)9 * b->nprims;
+  b->leaf_v = alloc_lines((n + BVH_LEAF_PAD) * sizeof(float));
+  if (!b->leaf_v) return false;
+  memset(b->leaf_v + n, 0, BVH_LEAF_PAD * sizeof(float));
+  for (uint32_t i = 0; i < b->nnodes; i++) {
+    const bvh_node *nd = &b->nodes[i];
+    float *v = b->leaf_v + (size_t)9 * nd->first;
+    for (uint32_t m = 0; nd->count && m < 9; m++)
+      for (uint32_t j = 0; j < nd->count; j++) v[m * nd->count + j] = s->p[m / 3][m % 3][b->prims[nd->first + j]];
+  }
+  return true;
+}
+
 static bool collapse_wide(rr_bvh *b) {
   /* At most one wide node per inner binary node (plus a leaf root). */
   uint32_t cap = (b->nnodes - 1) / 2 + 1;
@@ -575,7 +590,7 @@ static bool collapse_wide(rr_bvh *b) {
 
 void rr_bvh_release(rr_bvh *b) {
   if (!b) return;
-  free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node);
+  free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node), free(b->leaf_v);
   free(b);
 }
 
@@ -755,9 +770,10 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
     if (small.v[i].buf)
       for (uint32_t k = small.v[i].start; k < small.v[i].start + small.v[i].count; k++) b->prims[k] = bd.buf[1][k].id;
   if (!collapse_wide(b)) goto oom;
+  if (!copy_leaf_corners(b, s)) goto oom;
   b->sah_cost = sah_cost(b);
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
-             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t));
+             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) + ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
   b->build_ms = rr_now_ms() - t0;
   rr_progress(&progress, 1);
   *out = b;

@@ -24,6 +24,11 @@ typedef struct rr_bvh {
   struct bvh_wide *wide; /* the same tree collapsed to 4 children per node, for single rays */
   uint32_t *wide_node;   /* per wide node, per slot: the node of `nodes` it is (UINT32_MAX: empty) */
   uint32_t nwide;
+  /* The triangles' corners in leaf order, for the ray queries' leaf tests: a leaf
+   * holding prims [first, first + count) has corner k's axis x of its j-th triangle
+   * at leaf_v[9·first + (3k + x)·count + j], then BVH_LEAF_PAD zeros at the end, so
+   * that four lanes may be loaded from any triangle. */
+  float *leaf_v;
 } rr_bvh;
 
 /* A 4-wide node: up to four of the binary tree's nodes side by side, bounds as
@@ -34,7 +39,7 @@ typedef struct bvh_wide {
   uint32_t ref[4], count[4];
 } bvh_wide;
 
-enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK = 128 };
+enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK = 128, BVH_LEAF_PAD = 8 };
 
 /* Builds a binned-SAH BVH over the scene's triangles (accel/bvh.c); the tree is the
  * same for any opt->threads. An empty scene gets NULL. */

@@ -3,6 +3,7 @@
 #define RR_TRIANGLE_H
 
 #include "camera/camera.h"
+#include "core/simd.h"
 
 /* A triangle set up for a camera (paper eqs. 1–3 and appendix). Its edge functions
  * at a sample are V_i = a[i]·w.x + b[i]·w.y + c[i]·w.z for the camera's w
@@ -129,32 +130,53 @@ static inline vec3 tri_edge_normal(vec3 a, vec3 b) {
   return swap ? v3_neg(m) : m;
 }
 
-/* rr_tri_ray_hit, same bits, computing only what the ray's own sample needs: the
- * queries test many triangles per ray and most fail on one edge. The setup of a
- * finite triangle for a perspective camera (triangle_setup.c) gives edge value
- * a_i = (σ n_i)·d0 (σ = ±1 turns the inside positive, σ n exactly ±n), and the
- * sample (0, 0) evaluates a_i·1 + b_i·0 + c_i·0, which is negative or NaN
- * whenever σ (n_i·d0) is: such an edge rejects the triangle before the other
- * normals and the depth's plane are computed. What passes (about three triangles
- * a ray) goes through rr_tri_ray_hit, the full setup and sample test, as do
- * triangles with corners at infinity and other cameras. */
-static inline bool tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull, float tmin, float tmax,
-                               float *t, float *l1, float *l2) {
-  if (scene_inf(s, i) || ray->type != RR_CAMERA_PERSPECTIVE)
-    return rr_tri_ray_hit(s, i, ray, cull, tmin, tmax, t, l1, l2);
-  vec3 q[3];
-  for (int k = 0; k < 3; k++) q[k] = v3_sub(scene_vertex(s, k, i), ray->eye);
-  vec3 n[3];
-  n[0] = tri_edge_normal(q[1], q[2]);
-  float vol = v3_dot(q[0], n[0]);
-  if (!(vol != 0 && fabsf(vol) < INFINITY) || (cull && !(vol > 0))) return false; /* edge-on, culled */
-  const float sign = vol > 0 ? 1.0f : -1.0f;
-  if (!(sign * v3_dot(n[0], ray->d0) >= 0)) return false;
-  n[1] = tri_edge_normal(q[2], q[0]);
-  if (!(sign * v3_dot(n[1], ray->d0) >= 0)) return false;
-  n[2] = tri_edge_normal(q[0], q[1]);
-  if (!(sign * v3_dot(n[2], ray->d0) >= 0)) return false;
-  return rr_tri_ray_hit(s, i, ray, cull, tmin, tmax, t, l1, l2); /* passed the edges: the full test */
+/* Which of four triangles may hit a ray: the rest fail rr_tri_ray_hit, whose
+ * work this skips. The setup of a finite triangle for a perspective camera
+ * (triangle_setup.c) gives edge value a_i = (σ n_i)·d0 (σ = ±1 turns the inside
+ * positive, σ n exactly ±n), and the sample (0, 0) evaluates a_i·1 + b_i·0 +
+ * c_i·0, which is negative or NaN whenever σ (n_i·d0) is, and rejects an edge-on
+ * triangle (volume 0 or not finite). Computed here in the setup's own operations
+ * (q_k = p_k − eye, tri_edge_normal, the dot products), lane by lane, so a lane
+ * is rejected only where the full test would reject it. What passes (a few
+ * triangles a ray) goes through rr_tri_ray_hit, the full setup and sample test.
+ * Not for triangles with corners at infinity (their corners are directions).
+ * Corner k's axis x of lane j is v[(3k + x)·stride + j]; eye and d are the ray's
+ * origin and direction broadcast. Bit j of the result: lane j may hit. */
+typedef struct {
+  rr_vf4 x, y, z;
+} tri_v4;
+static inline tri_v4 tri_v4_sub(tri_v4 a, tri_v4 b) { return (tri_v4){a.x - b.x, a.y - b.y, a.z - b.z}; }
+static inline rr_vf4 tri_v4_dot(tri_v4 a, tri_v4 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline rr_vi4 tri_vi4_select(rr_vi4 m, rr_vi4 a, rr_vi4 b) { return (m & a) | (~m & b); }
+/* tri_edge_normal lane by lane, as h × (l − h) and, in *neg, the sign bits that
+ * turn it into the normal (set where the edge runs from h to l). */
+KERNEL tri_v4 tri_v4_edge_cross(tri_v4 a, tri_v4 b, rr_vi4 *neg) {
+  rr_vi4 swap = tri_vi4_select(b.x != a.x, b.x < a.x, tri_vi4_select(b.y != a.y, b.y < a.y, b.z < a.z));
+  tri_v4 l = {rr_vf4_select(swap, b.x, a.x), rr_vf4_select(swap, b.y, a.y), rr_vf4_select(swap, b.z, a.z)};
+  tri_v4 h = {rr_vf4_select(swap, a.x, b.x), rr_vf4_select(swap, a.y, b.y), rr_vf4_select(swap, a.z, b.z)};
+  tri_v4 e = tri_v4_sub(l, h);
+  *neg = swap & (rr_vi4)rr_vf4_splat(-0.0f);
+  return (tri_v4){h.y * e.z - h.z * e.y, h.z * e.x - h.x * e.z, h.x * e.y - h.y * e.x};
+}
+/* Negation is exact and rounding symmetric, so x·(−m) is −(x·m) up to the sign of
+ * a zero, which no test below tells apart: the signs (the edge's and σ) are
+ * applied to the dot products as sign bits. */
+KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3]) {
+  tri_v4 q[3];
+  for (int k = 0; k < 3; k++)
+    q[k] = (tri_v4){rr_vf4_load(v + (3 * k) * stride) - eye[0], rr_vf4_load(v + (3 * k + 1) * stride) - eye[1],
+                    rr_vf4_load(v + (3 * k + 2) * stride) - eye[2]};
+  tri_v4 dv = {d[0], d[1], d[2]};
+  rr_vi4 neg[3];
+  tri_v4 m0 = tri_v4_edge_cross(q[1], q[2], &neg[0]), m1 = tri_v4_edge_cross(q[2], q[0], &neg[1]),
+         m2 = tri_v4_edge_cross(q[0], q[1], &neg[2]);
+  rr_vf4 vol = (rr_vf4)((rr_vi4)tri_v4_dot(q[0], m0) ^ neg[0]);
+  rr_vi4 sigma = (rr_vi4)vol & (rr_vi4)rr_vf4_splat(-0.0f); /* σ = −1 where the volume is negative */
+  rr_vf4 a0 = (rr_vf4)((rr_vi4)tri_v4_dot(m0, dv) ^ neg[0] ^ sigma),
+         a1 = (rr_vf4)((rr_vi4)tri_v4_dot(m1, dv) ^ neg[1] ^ sigma),
+         a2 = (rr_vf4)((rr_vi4)tri_v4_dot(m2, dv) ^ neg[2] ^ sigma);
+  rr_vi4 may = (vol != 0) & (rr_vf4_abs(vol) < INFINITY) & (a0 >= 0) & (a1 >= 0) & (a2 >= 0);
+  return rr_vi4_bits(may);
 }
 
 /* The inclusive pixel rectangle a set-up triangle's samples may lie in; false when

@@ -104,18 +104,26 @@ KERNEL bool bvh_trace(const rr_bvh *b, void *q, uint64_t lanes, trace_node_fn no
       trace_slots s = {.lanes = {lanes, lanes, lanes, lanes}};
       int hits = node(q, w, ref, lanes, &s);
       if (hits) {
-        int order[4], n = 0;
-        for (int h = hits; h; h &= h - 1) {
-          int i = __builtin_ctz(h), j = n++;
-          for (; j > 0 && s.order[order[j - 1]] < s.order[i]; j--) order[j] = order[j - 1]; /* farthest first */
-          order[j] = i;
+        int i = __builtin_ctz(hits), rest = hits & (hits - 1);
+        if (rest && !(rest & (rest - 1))) { /* two (the common case): the nearer entered, the other stacked */
+          int k = __builtin_ctz(rest), far = s.order[i] < s.order[k] ? k : i;
+          i ^= k ^ far;
+          stack[sp].ref = w->ref[far], stack[sp].count = w->count[far], stack[sp].key = s.key[far];
+          stack_lanes[sp++] = s.lanes[far];
+        } else if (rest) { /* more: the nearest entered, the others stacked farthest first */
+          int order[4], n = 0;
+          for (int h = hits; h; h &= h - 1) {
+            int k = __builtin_ctz(h), j = n++;
+            for (; j > 0 && s.order[order[j - 1]] < s.order[k]; j--) order[j] = order[j - 1];
+            order[j] = k;
+          }
+          for (int j = 0; j < n - 1; j++) {
+            int k = order[j];
+            stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp].key = s.key[k];
+            stack_lanes[sp++] = s.lanes[k];
+          }
+          i = order[n - 1];
         }
-        for (int j = 0; j < n - 1; j++) {
-          int i = order[j];
-          stack[sp].ref = w->ref[i], stack[sp].count = w->count[i], stack[sp].key = s.key[i];
-          stack_lanes[sp++] = s.lanes[i];
-        }
-        int i = order[n - 1];
         ref = w->ref[i], count = w->count[i], lanes = s.lanes[i];
         continue;
       }

@@ -1,8 +1,10 @@
 /* The public ray queries rr_intersect and rr_occluded: one arbitrary ray through
  * the committed scene's BVH, by the traversal of every ray caster
- * (vis/bvh_trace.h). Each triangle a leaf holds is set up for the ray (a
- * pseudo-camera at its origin, rr_cam_for_ray) and tested with the project's one
- * sample test, so a ray through a shared edge hits exactly one triangle.
+ * (vis/bvh_trace.h). A leaf's triangles, whose corners the tree keeps in leaf
+ * order (rr_bvh.leaf_v), go four at a time through the edge signs of their setup
+ * (tri_ray_may_hit4); those that pass are set up for the ray (a pseudo-camera at
+ * its origin, rr_cam_for_ray) and tested with the project's one sample test, so a
+ * ray through a shared edge hits exactly one triangle.
  *
  * Boxes are tested in 3D, widened by RAY_MARGIN relative to t (NaN slabs
  * ignored), and prune by box entry, which is exact but for triangles whose plane
@@ -22,33 +24,64 @@
 
 /* An arbitrary ray: its slab-test form, range, best hit and pseudo-camera. */
 typedef struct {
-  ray_q q;
+  ray_q q;            /* q.inv rounded towards zero by RAY_MARGIN: the near planes' factor */
+  rr_vf4 inv_far[3];  /* the inverse direction away from zero by RAY_MARGIN: the far planes' */
+  rr_vf4 d[3];        /* the direction, broadcast (the leaf test) */
+  rr_vf4 tlo;         /* max(tmin, 0) broadcast: every hit has t > 0 */
   float tmin;
   float t, l1, l2; /* best hit so far; t starts at tmax */
   uint32_t id;
   const rr_scene *s;
   const rr_bvh *b; /* NULL for an empty scene: every ray misses */
+  bool cam_ready;  /* cam is made for the first full test: many rays need none */
   camera cam;
 } query_ray;
 
-/* The slots whose box the ray meets within [tmin, best t], nearest entry first;
- * the entry is also the key that drops a stacked slot. */
+/* The slots whose box the ray meets within [max(tmin, 0), best t], nearest entry
+ * first; the entry is also the key that drops a stacked slot. The margin is in the
+ * inverse direction: a slab's entry shrinks towards 0 and its exit grows by a
+ * factor 1 ∓ RAY_MARGIN (the box's interval beyond 0 widened relatively, as
+ * wide_test widens it, for one multiplication fewer a plane); a negative entry
+ * loses to tlo, a negative exit misses either way. NaN slabs are ignored as in
+ * wide_test. */
 KERNEL int query_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s) {
   (void)ref, (void)lanes;
   query_ray *r = q;
-  int hits = wide_test(w, &r->q, r->tmin, rr_vf4_splat(0), INFINITY, &s->order);
-  s->key = s->order;
-  return hits & rr_vi4_bits(s->order <= rr_vf4_splat(r->t));
+  const char *base = (const char *)w;
+  rr_vf4 t0 = r->tlo, t1 = rr_vf4_splat(r->t);
+#pragma GCC unroll 3
+  for (int a = 0; a < 3; a++) {
+    t0 = rr_vf4_max((rr_vf4_load_aligned((const float *)(base + r->q.wn[a])) - r->q.o[a]) * r->q.inv[a], t0);
+    t1 = rr_vf4_min((rr_vf4_load_aligned((const float *)(base + r->q.wf[a])) - r->q.o[a]) * r->inv_far[a], t1);
+  }
+  s->order = s->key = t0;
+  return rr_vi4_bits(t0 <= t1);
 }
 
-/* Tests a leaf's triangles, keeping the nearest hit; `any`: stops at the first. */
+/* Tests a leaf's triangles, keeping the nearest hit; `any`: stops at the first.
+ * Four at a time through the edge pre-test, then the full test for the lanes
+ * that pass it (and for triangles with corners at infinity, which it cannot
+ * judge). The same triangles pass whatever the order, and depth_wins keeps the
+ * nearest, lower id on a tie, so the hit does not depend on the order. */
 KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool any) {
-  for (uint32_t i = first; i < first + count; i++) {
-    uint32_t id = r->b->prims[i];
-    float t, l1, l2;
-    if (!tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
-    if (any) return true;
-    if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
+  const float *v = r->b->leaf_v + (size_t)9 * first;
+  for (uint32_t j = 0; j < count; j += 4) {
+    uint32_t n = count - j < 4 ? count - j : 4;
+    int may = tri_ray_may_hit4(v + j, count, r->q.o, r->d) & ((1 << n) - 1);
+    if (r->s->inf)
+      for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, r->b->prims[first + j + k]) != 0) << k;
+    for (; may; may &= may - 1) {
+      uint32_t id = r->b->prims[first + j + (uint32_t)__builtin_ctz(may)];
+      float t, l1, l2;
+      if (!r->cam_ready) {
+        float org[3] = {r->q.o[0][0], r->q.o[1][0], r->q.o[2][0]}, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
+        rr_cam_for_ray(org, dir, &r->cam);
+        r->cam_ready = true;
+      }
+      if (!rr_tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
+      if (any) return true;
+      if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
+    }
   }
   return false;
 }
@@ -77,18 +110,36 @@ static const char *ray_problem(const float org[3], const float dir[3], float tmi
 /* Prepares a valid ray against the scene's tree b (NULL: an empty scene). */
 static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const float org[3], const float dir[3],
                        float tmin, float tmax) {
-  r->s = s, r->b = b;
-  rr_cam_for_ray(org, dir, &r->cam);
-  ray_q_init(&r->q, r->cam.eye, r->cam.d0);
+  r->s = s, r->b = b, r->cam_ready = false;
+  ray_q_init(&r->q, v3_load(org), v3_load(dir));
+  for (int a = 0; a < 3; a++) {
+    r->inv_far[a] = r->q.inv[a] * rr_vf4_splat(1 + RAY_MARGIN);
+    r->q.inv[a] = r->q.inv[a] * rr_vf4_splat(1 - RAY_MARGIN);
+    r->d[a] = rr_vf4_splat(dir[a]);
+  }
+  r->tlo = rr_vf4_splat(tmin > 0 ? tmin : 0);
   r->tmin = tmin, r->t = tmax, r->id = RR_MISS, r->l1 = r->l2 = 0;
 }
 
 /* Traces a prepared ray: the nearest hit into r, or (any) whether there is one. */
-static bool query_trace(query_ray *r, bool any) {
+KERNEL bool query_trace_body(query_ray *r, bool any) {
   if (!r->b) return false;
   if (any) return bvh_trace(r->b, r, 1, query_node, query_leaf_any, query_best);
   bvh_trace(r->b, r, 1, query_node, query_leaf_closest, query_best);
   return r->id != RR_MISS;
+}
+
+#ifdef RR_SIMD_X86
+/* The same code with AVX2's encodings (three operands, blends): the four-lane
+ * tests take fewer instructions, with the same lane operations and bits. */
+RR_TARGET_AVX2 static bool query_trace_avx2(query_ray *r, bool any) { return query_trace_body(r, any); }
+#endif
+
+static bool query_trace(query_ray *r, bool any) {
+#ifdef RR_SIMD_X86
+  if (__builtin_cpu_supports("avx2")) return query_trace_avx2(r, any);
+#endif
+  return query_trace_body(r, any);
 }
 
 /* The committed scene's tree (NULL for an empty scene) or an error in dev. */
