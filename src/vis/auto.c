@@ -1,8 +1,10 @@
-/* auto's cost model: each candidate method's time for a view, predicted from counts
- * that are cheap to know before rendering (render.c chooses, and runs a trial when
- * the model is unsure and the frames to come repay it). */
+/* auto's model and choice: each candidate method's time for a view, predicted from
+ * counts that are cheap to know before rendering; the fastest, or, where the model is
+ * unsure and the frames to come repay it, the candidates of a trial (render.c runs
+ * it). The costs come from `bench_auto --calibrate` (docs/auto.md). */
 #include "vis/vis.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -57,47 +59,115 @@ static rr_error measure_view(rr_device *dev, const rr_scene *s, const rr_camera 
   return RR_OK;
 }
 
-/* Predicted milliseconds of a method for a view: counts times costs in ns, least-
- * squares fits (on relative error) to the CPU times of 72 planar views on one thread
- * of this machine: bench_table's scenes and the teapot grid from inside, perspective
- * and orthographic, 256² to 1024², culling on and off (docs/auto.md). Rays pay per
- * sample, a curved camera's rays four times as much (incoherent packets); the 3dr
- * methods set every triangle up against a curved camera's cells at some 5 µs a
- * triangle. Every method gained 1.55–2× from a second thread, none clearly more. */
-static double predict(rr_method m, const view_figures *v) {
-  double T = v->tris, S = v->setups, A = v->area, R = v->edges, P = v->samples, ns;
-  double UP = v->whole * P; /* whole-image rectangles: their samples are mostly skipped, ~0.3 ns each */
+const char *const rr_auto_fig_names[AUTO_NFIG] = {"T", "S", "A", "R", "UP", "P", "PlogT"};
+
+/* The costs: ns per unit of each figure on one thread, for planar and curved
+ * cameras, and what each further thread adds to one thread's speed. Written by
+ * `bench_auto --calibrate --threads 2 --out src/vis/auto_costs.h` (docs/auto.md):
+ * re-derive them when a method's speed changes. */
+#include "vis/auto_costs.h"
+
+#define FIG(f) (1u << AUTO_##f)
+unsigned rr_auto_uses(rr_method m, bool planar) {
   bool rays = m == RR_METHOD_RC_PACKET || m == RR_METHOD_RC_BVH;
-  /* single rays: twice rc-packet's time on planar views, 0.8–1.0× on curved ones */
-  if (rays) ns = (171 * T + (v->planar ? 15 : 100) * P) * (m == RR_METHOD_RC_BVH ? (v->planar ? 2 : 0.9) : 1);
-  else if (!v->planar) ns = (5000 * T + 300 * P) * (m == RR_METHOD_3DR_FC ? 1.3 : m == RR_METHOD_3DR_FULL ? 1.2 : 1);
-  else if (m == RR_METHOD_3DR_BB) ns = 10 * T + 65 * S + 2.0 * A + 0.28 * UP + 0.14 * P;
-  else if (m == RR_METHOD_3DR_BIN) ns = 5 * T + 76 * S + 0.43 * A + 14 * R + 1.3 * P;
-  /* what fc and full save is occlusion, which no count here shows: their fits miss
-   * by up to 3×, so they must be predicted 1.5× faster than bin to be chosen */
-  else if (m == RR_METHOD_3DR_FC) ns = 1.5 * (23 * T + 350 * S + 0.84 * A + 3.4 * P);
-  else ns = 1.5 * (130 * S + 6.6 * R + 9.4 * P);
-  return ns * 1e-6 * v->passes / (1 + 0.75 * (v->threads - 1));
+  /* rays: a setup of every triangle (T) or of what traversal reaches (P·log T) */
+  if (rays) return FIG(T) | FIG(P) | FIG(PLOGT);
+  if (!planar) return FIG(T) | FIG(P);
+  switch (m) {
+  case RR_METHOD_3DR_BB: return FIG(T) | FIG(S) | FIG(A) | FIG(UP) | FIG(P);
+  case RR_METHOD_3DR_BIN: return FIG(T) | FIG(S) | FIG(A) | FIG(R) | FIG(P);
+  case RR_METHOD_3DR_FC: return FIG(T) | FIG(S) | FIG(A) | FIG(P);
+  default: return FIG(S) | FIG(R) | FIG(P);
+  }
+}
+
+/* Predicted milliseconds of a method for a view. What 3dr-fc and 3dr-full save is
+ * occlusion, which no figure shows: their fits miss single views by up to 3× (on
+ * curved views too: rooms:8 against the meshes), so they must be predicted 1.5×
+ * faster than the others to be chosen. */
+static double predict(rr_method m, const view_figures *v, const double fig[AUTO_NFIG]) {
+  const double *c = (v->planar ? cost_planar : cost_curved)[m];
+  double ns = 0;
+  for (int f = 0; f < AUTO_NFIG; f++) ns += c[f] * fig[f];
+  if (m == RR_METHOD_3DR_FC || m == RR_METHOD_3DR_FULL) ns *= 1.5;
+  return ns * 1e-6 * v->passes / (1 + thread_gain[m] * (v->threads - 1));
 }
 
 /* The candidates: exact methods (bit-identical to ray casting; the 2D pipeline's
  * snapped vertices are for comparison) that win somewhere; 3dr-bb's screen
- * rectangles only on planar views. On a tie the earlier one is kept. */
-static const rr_method planar[AUTO_NCAND] = {RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL,
-                                   RR_METHOD_RC_PACKET};
-static const rr_method curved[AUTO_NCAND] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC,
-                                   RR_METHOD_3DR_FULL};
+ * rectangles only on planar views, single rays (2× rc-packet there) only on curved
+ * ones. On a tie the earlier one is kept. */
+static const rr_method planar[AUTO_NCAND] = {RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC,
+                                             RR_METHOD_3DR_FULL, RR_METHOD_RC_PACKET};
+static const rr_method curved[AUTO_NCAND] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_METHOD_3DR_BIN,
+                                             RR_METHOD_3DR_FC, RR_METHOD_3DR_FULL};
 
 rr_error rr_auto_predict(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
                          auto_prediction *out) {
   view_figures v;
   rr_error e = measure_view(dev, scene, cam, opt, &v);
   if (e) return e;
+  double *fig = out->fig;
+  fig[AUTO_T] = v.tris, fig[AUTO_S] = v.setups, fig[AUTO_A] = v.area, fig[AUTO_R] = v.edges;
+  fig[AUTO_UP] = v.whole * v.samples, fig[AUTO_P] = v.samples, fig[AUTO_PLOGT] = v.samples * log2(v.tris + 1);
+  out->planar = v.planar;
   for (int i = 0; i < AUTO_NCAND; i++) {
     out->method[i] = (v.planar ? planar : curved)[i];
-    out->ms[i] = predict(out->method[i], &v);
+    out->ms[i] = predict(out->method[i], &v, fig);
   }
   snprintf(out->figures, sizeof out->figures, "T=%.0f S=%.0f A=%.0f R=%.0f U=%.0f", v.tris, v.setups, v.area,
            v.edges, v.whole);
   return RR_OK;
 }
+
+/* ---- the choice ----------------------------------------------------------- */
+
+/* The model is unsure when another candidate is predicted within this factor of the
+ * best: its predictions miss by up to ±50% on the views it was fitted to. */
+#define AUTO_MARGIN 1.5
+
+/* The options of a trial: half the resolution in each direction (a cube map keeps
+ * its 4:3 faces), no extras. */
+rr_render_options rr_auto_trial_options(const rr_camera *cam, const rr_render_options *opt) {
+  rr_render_options t = *opt;
+  t.width = opt->width > 1 ? opt->width / 2 : 1, t.height = opt->height > 1 ? opt->height / 2 : 1;
+  if (cam->type == RR_CAMERA_CUBE) t.width = t.height / 3 * 4, t.height = t.height / 3 * 3;
+  if (t.height < 3) t = *opt;
+  t.heat = 0, t.oracles = NULL, t.frames_hint = 1;
+  return t;
+}
+
+rr_error rr_auto_choose(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
+                        auto_prediction *pred, rr_method near[AUTO_NCAND], int *close, bool *repays) {
+  rr_error e = rr_auto_predict(dev, scene, cam, opt, pred);
+  if (e) return e;
+  const auto_prediction p = *pred;
+  int b = 0;
+  for (int i = 1; i < AUTO_NCAND; i++)
+    if (p.ms[i] < p.ms[b]) b = i;
+  /* A candidate predicted r times the best may really be faster, by up to
+   * best · (1 − r / margin) a frame: the most a trial can save. It costs its rounds
+   * of every close candidate at the trial's size, predicted by the same model. */
+  near[0] = p.method[b], *close = 1;
+  double save = 0;
+  for (int i = 0; i < AUTO_NCAND; i++) {
+    double gain = p.ms[b] * (1 - p.ms[i] / (AUTO_MARGIN * p.ms[b]));
+    if (i == b || !(gain > 0)) continue;
+    near[(*close)++] = p.method[i];
+    if (gain > save) save = gain;
+  }
+  *repays = false;
+  int frames = opt->frames_hint > 1 ? opt->frames_hint : 1;
+  if (*close > 1 && frames > 1) {
+    rr_render_options t = rr_auto_trial_options(cam, opt);
+    auto_prediction small;
+    if ((e = rr_auto_predict(dev, scene, cam, &t, &small))) return e;
+    double cost = 0;
+    for (int i = 0; i < AUTO_NCAND; i++)
+      for (int k = 0; k < *close; k++)
+        if (small.method[i] == near[k]) cost += AUTO_TRIAL_ROUNDS * small.ms[i];
+    *repays = frames * save > cost;
+  }
+  return RR_OK;
+}
+

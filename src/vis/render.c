@@ -4,6 +4,7 @@
 #include "vis/vis.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* ---- names ---------------------------------------------------------------- */
@@ -126,50 +127,49 @@ static bool visbuf_alloc(visbuf *vb, int w, int h, int samples) {
   return true;
 }
 
-/* auto: the method the cost model (vis/auto.c) predicts fastest; where it is unsure
- * and the frames to come repay it, the fastest of the close candidates in a short
- * trial, a verdict the device keeps for the same view. */
-enum { RR_WHY = sizeof ((rr_stats *)0)->why };
-
-/* The model is unsure when another candidate is predicted within this factor of the
- * best: its predictions miss by up to ±50% on the views it was fitted to. */
-#define AUTO_MARGIN 1.5
-
+/* auto: the method its model (vis/auto.c) predicts fastest; where the model is unsure
+ * and the frames to come repay it, the fastest of the close candidates in a trial, a
+ * verdict the device keeps for the same view. */
 static bool same_view(const struct auto_choice *a, const struct auto_choice *b) {
   return a->scene == b->scene && a->bvh == b->bvh && a->ntris == b->ntris &&
          memcmp(&a->cam, &b->cam, sizeof a->cam) == 0 && a->width == b->width && a->height == b->height &&
          a->threads == b->threads && a->cull == b->cull && a->scalar == b->scalar;
 }
 
-/* Renders the view with each of cand[0..n-1] at half the resolution in each
- * direction, twice (the first round also warms the caches; a candidate more than
- * twice as slow as the best so far gets no second); *best is the fastest. Writes
- * "trial: <ms of each> ms at WxH; " and then `model` to why. */
-static rr_error trial(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
-                      const rr_method *cand, int n, const char *model, int *best, char why[RR_WHY]) {
-  rr_render_options t = *opt;
-  t.width = opt->width > 1 ? opt->width / 2 : 1, t.height = opt->height > 1 ? opt->height / 2 : 1;
-  if (cam->type == RR_CAMERA_CUBE) t.width = t.height / 3 * 4, t.height = t.height / 3 * 3;
-  if (t.height < 3) t = *opt;
-  t.heat = 0, t.oracles = NULL;
-  double best_ms = INFINITY;
-  char got[96] = "";
-  *best = -1;
-  for (int i = 0; i < n; i++) {
-    t.method = cand[i];
-    double ms = INFINITY;
-    for (int round = 0; round < 2 && (round == 0 || !(ms > 2 * best_ms)); round++) {
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* Renders the view with cand[0..n-1] in AUTO_TRIAL_ROUNDS interleaved rounds (each round
+ * renders every candidate once, in turn, so that a change of load hits them alike);
+ * the lowest median decides. One thread is timed by the process's CPU time, which
+ * another process's load does not inflate; more threads by the wall clock (CPU time
+ * would hide a method's serial parts). Writes "trial: <median ms of each> ms at WxH;
+ * " and then `model` to why. */
+static rr_error trial(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *t,
+                      const rr_method *cand, int n, const char *model, int *best, char why[AUTO_WHY]) {
+  rr_render_options o = *t;
+  double ms[AUTO_NCAND][AUTO_TRIAL_ROUNDS];
+  for (int r = 0; r < AUTO_TRIAL_ROUNDS; r++)
+    for (int i = 0; i < n; i++) {
       rr_frame *f;
-      rr_error e = rr_render(dev, scene, cam, &t, &f);
+      o.method = cand[i];
+      rr_error e = rr_render(dev, scene, cam, &o, &f);
       if (e) return e;
-      ms = f->stats.frame_ms < ms ? f->stats.frame_ms : ms;
+      ms[i][r] = f->stats.threads == 1 ? f->stats.cpu_ms : f->stats.frame_ms;
       rr_frame_release(f);
     }
+  double best_ms = INFINITY;
+  char got[96] = "";
+  for (int i = 0; i < n; i++) {
+    qsort(ms[i], AUTO_TRIAL_ROUNDS, sizeof ms[i][0], cmp_double);
+    double med = ms[i][AUTO_TRIAL_ROUNDS / 2];
     size_t len = strlen(got);
-    snprintf(got + len, sizeof got - len, "%s%s %.3g", i ? ", " : "", rr_method_name(cand[i]), ms);
-    if (ms < best_ms) best_ms = ms, *best = cand[i];
+    snprintf(got + len, sizeof got - len, "%s%s %.3g", i ? ", " : "", rr_method_name(cand[i]), med);
+    if (med < best_ms) best_ms = med, *best = cand[i];
   }
-  snprintf(why, RR_WHY, "trial: %s ms at %dx%d; %.140s", got, t.width, t.height, model);
+  snprintf(why, AUTO_WHY, "trial: %s ms at %dx%d; %.140s", got, t->width, t->height, model);
   return RR_OK;
 }
 
@@ -182,40 +182,28 @@ static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_came
                             .cull = opt->cull_backfaces != 0, .scalar = opt->scalar != 0};
   struct auto_choice *last = dev ? &dev->auto_choice : NULL;
   rr_render_options t = *opt;
-  char why[RR_WHY];
+  char why[AUTO_WHY];
   if (last && last->scene && same_view(last, &key)) { /* a trial's verdict for this view */
     t.method = (rr_method)last->method;
     snprintf(why, sizeof why, "%s", last->why);
   } else {
+    rr_method near[AUTO_NCAND];
+    int close;
+    bool repays;
     auto_prediction p;
-    rr_error e = rr_auto_predict(dev, scene, cam, opt, &p);
+    rr_error e = rr_auto_choose(dev, scene, cam, opt, &p, near, &close, &repays);
     if (e) return e;
-    double best_ms = INFINITY;
-    for (int i = 0; i < AUTO_NCAND; i++)
-      if (p.ms[i] < best_ms) best_ms = p.ms[i], t.method = p.method[i];
-    /* the close candidates, the best first, and what a trial among them would cost */
-    rr_method near[AUTO_NCAND] = {t.method};
-    int close = 1;
-    double trial_ms = 0;
-    for (int i = 0; i < AUTO_NCAND; i++) {
-      if (!(p.ms[i] <= AUTO_MARGIN * best_ms)) continue;
-      trial_ms += 0.5 * p.ms[i];
-      if (p.method[i] != t.method) near[close++] = p.method[i];
-    }
-    int frames = opt->frames_hint > 1 ? opt->frames_hint : 1;
     int w = snprintf(why, sizeof why, "model:");
     for (int i = 0; i < AUTO_NCAND && w >= 0 && (size_t)w < sizeof why; i++)
       w += snprintf(why + w, sizeof why - w, "%s %s %.3g", i ? "," : "", rr_method_name(p.method[i]), p.ms[i]);
     if (w >= 0 && (size_t)w < sizeof why) snprintf(why + w, sizeof why - w, " ms predicted (%s)", p.figures);
-    /* A wrong pick among close candidates costs up to the margin on every frame; a
-     * trial costs about a quarter frame per close candidate and round (two rounds):
-     * never worth it for one frame, worth it for a few when two are close. */
-    if (close > 1 && frames * (AUTO_MARGIN - 1) * best_ms > trial_ms) {
-      int best;
-      char model[RR_WHY];
+    t.method = near[0];
+    if (repays) {
+      int best = near[0];
+      char model[AUTO_WHY];
       memcpy(model, why, sizeof model);
-      e = trial(dev, scene, cam, opt, near, close, model, &best, why);
-      if (e) return e;
+      rr_render_options small = rr_auto_trial_options(cam, opt);
+      if ((e = trial(dev, scene, cam, &small, near, close, model, &best, why))) return e;
       t.method = (rr_method)best;
       if (last) {
         key.method = best;

@@ -92,16 +92,31 @@ bool rr_oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bv
 /* isOccluded: may the box be culled when the farthest depth stored in a frustum is `farthest`? */
 bool rr_oracle_occluded(const camera *c, const bvh_node *box, float farthest);
 
-/* auto's cost model (vis/auto.c): the candidate methods for a view (exact, able to
- * draw its camera) and each one's predicted milliseconds, with the counts behind them. */
+/* The model itself, for bench_auto: the candidate methods for a view (exact, able to
+ * draw its camera), each one's predicted milliseconds, and the figures behind them
+ * (per sample position; predicted ns = sum of figure × cost, see auto.c). */
 enum { AUTO_NCAND = 5 };
+enum { AUTO_T, AUTO_S, AUTO_A, AUTO_R, AUTO_UP, AUTO_P, AUTO_PLOGT, AUTO_NFIG };
 typedef struct auto_prediction {
   rr_method method[AUTO_NCAND];
   double ms[AUTO_NCAND];
+  double fig[AUTO_NFIG];
+  bool planar;
   char figures[96]; /* "T=... S=... A=... R=... U=..." */
 } auto_prediction;
 rr_error rr_auto_predict(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
                          auto_prediction *out);
+/* Which figures a method's cost may use (bit f for figure f), for fitting the costs. */
+unsigned rr_auto_uses(rr_method m, bool planar);
+/* auto's choice for a view (render.c renders it): near[0] the model's pick, near[1..
+ * *close-1] the candidates it is unsure of; *repays whether a trial among them
+ * (AUTO_TRIAL_ROUNDS interleaved rounds at rr_auto_trial_options' size) repays its
+ * cost over opt->frames_hint frames; *pred the predictions behind it. */
+enum { AUTO_WHY = sizeof ((rr_stats *)0)->why, AUTO_TRIAL_ROUNDS = 3 /* the median of three ignores one spoiled round */ };
+rr_error rr_auto_choose(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
+                        auto_prediction *pred, rr_method near[AUTO_NCAND], int *close, bool *repays);
+rr_render_options rr_auto_trial_options(const rr_camera *cam, const rr_render_options *opt);
+extern const char *const rr_auto_fig_names[AUTO_NFIG];
 
 typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
 
