@@ -117,6 +117,10 @@ static inline bool sample_test(const tri_setup *ts, const float e[3], float sx, 
  * with t in [tmin, tmax] (t along the unnormalised direction). */
 bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull_backfaces, float tmin, float tmax,
                  float *t, float *l1, float *l2);
+/* The same for a triangle without corners at infinity and no culling, with the same
+ * bits and a fraction of the work: only what the ray's one sample reads. */
+bool rr_tri_ray_hit1(const rr_scene *s, uint32_t i, const camera *ray, float tmin, float tmax, float *t, float *l1,
+                     float *l2);
 
 /* lex_less and lex_positive of triangle_setup_tmp.h for one lane, same NaN behaviour. */
 static inline bool tri_lex_less(vec3 a, vec3 b) {

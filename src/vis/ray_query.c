@@ -78,7 +78,9 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
         rr_cam_for_ray(org, dir, &r->cam);
         r->cam_ready = true;
       }
-      if (!rr_tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
+      bool hit = r->s->inf && scene_inf(r->s, id) ? rr_tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2)
+                                                   : rr_tri_ray_hit1(r->s, id, &r->cam, r->tmin, r->t, &t, &l1, &l2);
+      if (!hit) continue;
       if (any) return true;
       if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
     }
