@@ -34,6 +34,7 @@ typedef struct {
   const rr_scene *s;
   const rr_bvh *b; /* NULL for an empty scene: every ray misses */
   bool cam_ready;  /* cam is made for the first full test: many rays need none */
+  bool small;      /* the scene and direction keep the setup's b_i, c_i finite (query_leaf) */
   camera cam;
 } query_ray;
 
@@ -67,19 +68,28 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
   const float *v = r->b->leaf_v + (size_t)9 * first;
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;
-    int may = tri_ray_may_hit4(v + j, count, r->q.o, r->d) & ((1 << n) - 1);
+    rr_vf4 pre[4];
+    int may = tri_ray_may_hit4(v + j, count, r->q.o, r->d, pre) & ((1 << n) - 1);
     if (r->s->inf)
       for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, r->b->prims[first + j + k]) != 0) << k;
     for (; may; may &= may - 1) {
-      uint32_t id = r->b->prims[first + j + (uint32_t)__builtin_ctz(may)];
+      uint32_t lane = (uint32_t)__builtin_ctz(may), id = r->b->prims[first + j + lane];
       float t, l1, l2;
       if (!r->cam_ready) {
         float org[3] = {r->q.o[0][0], r->q.o[1][0], r->q.o[2][0]}, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
         rr_cam_for_ray(org, dir, &r->cam);
         r->cam_ready = true;
       }
-      bool hit = r->s->inf && scene_inf(r->s, id) ? rr_tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2)
-                                                   : rr_tri_ray_hit1(r->s, id, &r->cam, r->tmin, r->t, &t, &l1, &l2);
+      /* Edge values all positive are the sample test's (tri_ray_may_hit4): no tie,
+       * no sign of a zero to settle, only the plane left to compute. */
+      const float e[3] = {pre[0][lane], pre[1][lane], pre[2][lane]};
+      bool hit;
+      if (r->s->inf && scene_inf(r->s, id))
+        hit = rr_tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2);
+      else if (r->small && e[0] > 0 && e[1] > 0 && e[2] > 0)
+        hit = rr_tri_ray_finish(r->s, id, &r->cam, e, 0, pre[3][lane], r->tmin, r->t, &t, &l1, &l2);
+      else
+        hit = rr_tri_ray_hit1(r->s, id, &r->cam, r->tmin, r->t, &t, &l1, &l2);
       if (!hit) continue;
       if (any) return true;
       if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
@@ -113,6 +123,18 @@ static const char *ray_problem(const float org[3], const float dir[3], float tmi
 static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const float org[3], const float dir[3],
                        float tmin, float tmax) {
   r->s = s, r->b = b, r->cam_ready = false;
+  /* The setup's b_i, c_i are n_i·dx, n_i·dy with |n_i| ≤ 4Q² for corners within Q
+   * of the origin (per axis) and dx, dy of rr_cam_for_ray within D = max(|d|,
+   * 2|d|²): finite, with room for rounding, while 12·Q²·D stays below FLT_MAX. */
+  const float lo[3] = {s->bmin.x, s->bmin.y, s->bmin.z}, hi[3] = {s->bmax.x, s->bmax.y, s->bmax.z};
+  double big_q = 0, big_d = 0;
+  for (int a = 0; a < 3; a++) {
+    const double ql = fabs((double)lo[a] - org[a]), qh = fabs((double)hi[a] - org[a]), da = fabs((double)dir[a]);
+    if (!(ql <= big_q)) big_q = ql; /* NaN stays NaN: not small */
+    if (!(qh <= big_q)) big_q = qh;
+    if (!(da <= big_d)) big_d = da;
+  }
+  r->small = big_q * big_q * fmax(big_d, 2.01 * big_d * big_d) < 1e37;
   ray_q_init(&r->q, v3_load(org), v3_load(dir));
   for (int a = 0; a < 3; a++) {
     r->inv_far[a] = r->q.inv[a] * rr_vf4_splat(1 + RAY_MARGIN);
