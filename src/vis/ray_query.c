@@ -2,9 +2,12 @@
  * the committed scene's BVH, by the traversal of every ray caster
  * (vis/bvh_trace.h). A leaf's triangles, whose corners the tree keeps in leaf
  * order (rr_bvh.leaf_v), go four at a time through the edge signs of their setup
- * (tri_ray_may_hit4); those that pass are set up for the ray (a pseudo-camera at
- * its origin, rr_cam_for_ray) and tested with the project's one sample test, so a
- * ray through a shared edge hits exactly one triangle.
+ * (tri_ray_may_hit4); those that pass are tested with the project's one sample
+ * test for the ray (a pseudo-camera at its origin, rr_cam_for_ray), so a ray
+ * through a shared edge hits exactly one triangle: with the pre-test's edge values
+ * where all are positive (rr_tri_ray_finish), else with the part of the setup the
+ * ray's one sample reads (rr_tri_ray_hit1), or, for corners at infinity, the full
+ * setup (rr_tri_ray_hit) — the same bits each way.
  *
  * Boxes are tested in 3D, widened by RAY_MARGIN relative to t (NaN slabs
  * ignored), and prune by box entry, which is exact but for triangles whose plane
@@ -59,6 +62,20 @@ KERNEL int query_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, 
   return rr_vi4_bits(t0 <= t1);
 }
 
+/* Whether the setup's b_i, c_i (n_i·dx, n_i·dy) are finite for every finite
+ * triangle of s: |n_i| ≤ 4Q² (per axis, up to rounding) for corners within Q of the
+ * origin, so |b_i|, |c_i| ≤ 12·Q²·D for dx, dy within D, far below FLT_MAX for
+ * Q, D < 1e12. NaN (no finite corner) is not small. */
+static bool query_small(const rr_scene *s, const float org[3], const camera *c) {
+  const float lo[3] = {s->bmin.x, s->bmin.y, s->bmin.z}, hi[3] = {s->bmax.x, s->bmax.y, s->bmax.z};
+  const float dx[3] = {c->dx.x, c->dx.y, c->dx.z}, dy[3] = {c->dy.x, c->dy.y, c->dy.z};
+  bool small = true;
+  for (int a = 0; a < 3; a++)
+    small &= fabsf(lo[a] - org[a]) < 1e12f && fabsf(hi[a] - org[a]) < 1e12f && fabsf(dx[a]) < 1e12f &&
+             fabsf(dy[a]) < 1e12f;
+  return small;
+}
+
 /* Tests a leaf's triangles, keeping the nearest hit; `any`: stops at the first.
  * Four at a time through the edge pre-test, then the full test for the lanes
  * that pass it (and for triangles with corners at infinity, which it cannot
@@ -79,6 +96,7 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
         float org[3] = {r->q.o[0][0], r->q.o[1][0], r->q.o[2][0]}, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
         rr_cam_for_ray(org, dir, &r->cam);
         r->cam_ready = true;
+        r->small = query_small(r->s, org, &r->cam);
       }
       /* Edge values all positive are the sample test's (tri_ray_may_hit4): no tie,
        * no sign of a zero to settle, only the plane left to compute. */
@@ -123,18 +141,6 @@ static const char *ray_problem(const float org[3], const float dir[3], float tmi
 static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const float org[3], const float dir[3],
                        float tmin, float tmax) {
   r->s = s, r->b = b, r->cam_ready = false;
-  /* The setup's b_i, c_i are n_i·dx, n_i·dy with |n_i| ≤ 4Q² for corners within Q
-   * of the origin (per axis) and dx, dy of rr_cam_for_ray within D = max(|d|,
-   * 2|d|²): finite, with room for rounding, while 12·Q²·D stays below FLT_MAX. */
-  const float lo[3] = {s->bmin.x, s->bmin.y, s->bmin.z}, hi[3] = {s->bmax.x, s->bmax.y, s->bmax.z};
-  double big_q = 0, big_d = 0;
-  for (int a = 0; a < 3; a++) {
-    const double ql = fabs((double)lo[a] - org[a]), qh = fabs((double)hi[a] - org[a]), da = fabs((double)dir[a]);
-    if (!(ql <= big_q)) big_q = ql; /* NaN stays NaN: not small */
-    if (!(qh <= big_q)) big_q = qh;
-    if (!(da <= big_d)) big_d = da;
-  }
-  r->small = big_q * big_q * fmax(big_d, 2.01 * big_d * big_d) < 1e37;
   ray_q_init(&r->q, v3_load(org), v3_load(dir));
   for (int a = 0; a < 3; a++) {
     r->inv_far[a] = r->q.inv[a] * rr_vf4_splat(1 + RAY_MARGIN);
