@@ -14,6 +14,30 @@
 
 static bool same_hit(const rr_hit *a, const rr_hit *b) { return memcmp(a, b, sizeof *a) == 0; }
 
+/* The single-ray path's cut setup (rr_tri_ray_hit1) against the full one
+ * (rr_tri_ray_hit) on every finite triangle of s for every ray: the same verdict
+ * and, on a hit, the same bits of t and barycentrics. */
+static void check_tri_paths(const rr_scene *s, const rr_ray *rays, size_t n, const char *what) {
+  size_t bad = 0, hits = 0;
+  for (size_t r = 0; r < n; r++) {
+    camera rc;
+    rr_cam_for_ray(rays[r].org, rays[r].dir, &rc);
+    for (uint32_t i = 0; i < s->ntris; i++) {
+      if (scene_inf(s, i)) continue;
+      float t[2] = {0, 0}, l1[2] = {0, 0}, l2[2] = {0, 0};
+      bool a = rr_tri_ray_hit(s, i, &rc, false, rays[r].tmin, rays[r].tmax, &t[0], &l1[0], &l2[0]);
+      bool b = rr_tri_ray_hit1(s, i, &rc, rays[r].tmin, rays[r].tmax, &t[1], &l1[1], &l2[1]);
+      hits += a;
+      bool same = a == b && (!a || (memcmp(&t[0], &t[1], sizeof t[0]) == 0 && memcmp(&l1[0], &l1[1], sizeof l1[0]) == 0 &&
+                                    memcmp(&l2[0], &l2[1], sizeof l2[0]) == 0));
+      if (!same && bad++ < 4)
+        CHECK(0, "%s: ray %zu, triangle %u: full setup %d t %a l %a %a, ray setup %d t %a l %a %a", what, r, i, a,
+              t[0], l1[0], l2[0], b, t[1], l1[1], l2[1]);
+    }
+  }
+  CHECK(bad == 0 && hits > 0, "%s: %zu of the triangle tests differ (%zu hits)", what, bad, hits);
+}
+
 /* The rays as separate arrays (structure of arrays). */
 typedef struct {
   float *c[8]; /* ox oy oz dx dy dz tmin tmax */
@@ -114,6 +138,7 @@ static void plane_rays(rr_device *dev) {
           rays[n++] = r;
         }
   check_rays(dev, s, rays, n, 1, "plane:8 edges and vertices");
+  check_tri_paths(s, rays, n, "plane:8 edges and vertices");
   rr_hit hit;
   for (size_t i = 0; i < n; i++) {
     rr_intersect(dev, s, &rays[i], &hit);
@@ -211,6 +236,7 @@ static void bunny_rays(rr_device *dev) {
     rays[r] = (rr_ray){{p.x, p.y, p.z}, {d.x, d.y, d.z}, r % 3 ? 1e-4f : 0, r % 2 ? INFINITY : 1.0f};
   }
   check_rays(dev, s, rays, n, test_quick() ? 30 : 100, "bunny surface");
+  check_tri_paths(s, rays, test_quick() ? 4 : 16, "bunny surface"); /* every triangle: a few rays */
   free(rays);
   rr_scene_release(s);
 }
@@ -222,6 +248,7 @@ int main(void) {
     size_t n = test_quick() ? 500 : 3000;
     rr_ray *rays = random_rays(s, n);
     check_rays(dev, s, rays, n, 1, "random rays");
+    check_tri_paths(s, rays, n, "random rays");
     free(rays);
     rr_scene_release(s);
   } else {

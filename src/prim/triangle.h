@@ -117,6 +117,15 @@ static inline bool sample_test(const tri_setup *ts, const float e[3], float sx, 
  * with t in [tmin, tmax] (t along the unnormalised direction). */
 bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull_backfaces, float tmin, float tmax,
                  float *t, float *l1, float *l2);
+/* The same for a triangle without corners at infinity and no culling, with the same
+ * bits and a fraction of the work: only what the ray's one sample reads. */
+bool rr_tri_ray_hit1(const rr_scene *s, uint32_t i, const camera *ray, float tmin, float tmax, float *t, float *l1,
+                     float *l2);
+/* The rest of rr_tri_ray_hit1 (the plane, the sample test, the range) for edge
+ * values e that are inside, their tie bits, and the volume q0·n0 before the sign
+ * turns it positive (not 0, finite). */
+bool rr_tri_ray_finish(const rr_scene *s, uint32_t i, const camera *ray, const float e[3], uint32_t tie, float vol,
+                       float tmin, float tmax, float *t, float *l1, float *l2);
 
 /* lex_less and lex_positive of triangle_setup_tmp.h for one lane, same NaN behaviour. */
 static inline bool tri_lex_less(vec3 a, vec3 b) {
@@ -141,7 +150,11 @@ static inline vec3 tri_edge_normal(vec3 a, vec3 b) {
  * triangles a ray) goes through rr_tri_ray_hit, the full setup and sample test.
  * Not for triangles with corners at infinity (their corners are directions).
  * Corner k's axis x of lane j is v[(3k + x)·stride + j]; eye and d are the ray's
- * origin and direction broadcast. Bit j of the result: lane j may hit. */
+ * origin and direction broadcast. Bit j of the result: lane j may hit. Into
+ * out[0..2] the edge values a_i at (0, 0) and into out[3] the volume q0·n0: where
+ * they are not 0, the setup's values exactly (negation is exact, rounding
+ * symmetric), and where every a_i is positive and finite and so are the setup's
+ * b_i, c_i, the edge values of the sample test. */
 typedef struct {
   rr_vf4 x, y, z;
 } tri_v4;
@@ -161,7 +174,7 @@ KERNEL tri_v4 tri_v4_edge_cross(tri_v4 a, tri_v4 b, rr_vi4 *neg) {
 /* Negation is exact and rounding symmetric, so x·(−m) is −(x·m) up to the sign of
  * a zero, which no test below tells apart: the signs (the edge's and σ) are
  * applied to the dot products as sign bits. */
-KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3]) {
+KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3], rr_vf4 out[4]) {
   tri_v4 q[3];
   for (int k = 0; k < 3; k++)
     q[k] = (tri_v4){rr_vf4_load(v + (3 * k) * stride) - eye[0], rr_vf4_load(v + (3 * k + 1) * stride) - eye[1],
@@ -175,6 +188,7 @@ KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], 
   rr_vf4 a0 = (rr_vf4)((rr_vi4)tri_v4_dot(m0, dv) ^ neg[0] ^ sigma),
          a1 = (rr_vf4)((rr_vi4)tri_v4_dot(m1, dv) ^ neg[1] ^ sigma),
          a2 = (rr_vf4)((rr_vi4)tri_v4_dot(m2, dv) ^ neg[2] ^ sigma);
+  out[0] = a0, out[1] = a1, out[2] = a2, out[3] = vol;
   rr_vi4 may = (vol != 0) & (rr_vf4_abs(vol) < INFINITY) & (a0 >= 0) & (a1 >= 0) & (a2 >= 0);
   return rr_vi4_bits(may);
 }

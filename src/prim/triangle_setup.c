@@ -77,3 +77,59 @@ bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull,
   if (!sample_test(&ts, e, 0.0f, 0.0f, t, l1, l2)) return false;
   return *t >= tmin && *t <= tmax;
 }
+
+/* Double three-vectors for the plane of rr_tri_ray_hit1: the template's D3 operations. */
+typedef struct {
+  double x, y, z;
+} dvec3;
+static inline dvec3 dv3(vec3 a) { return (dvec3){a.x, a.y, a.z}; }
+/* DSPLAT3: 0 + x, whose zeros are +0 */
+static inline dvec3 dv3_splat(vec3 a) { return (dvec3){0.0 + a.x, 0.0 + a.y, 0.0 + a.z}; }
+static inline dvec3 dv3_sub(dvec3 a, dvec3 b) { return (dvec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
+static inline double dv3_dot(dvec3 a, dvec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+/* The plane and the sample test of rr_tri_ray_hit1 once the edge values e, their
+ * tie bits and the unturned volume vol (= q0·n0, not 0, finite) are known. */
+bool rr_tri_ray_finish(const rr_scene *s, uint32_t i, const camera *ray, const float e[3], uint32_t tie, float vol,
+                       float tmin, float tmax, float *t, float *l1, float *l2) {
+  const float sign = vol > 0.0f ? 1.0f : -1.0f;
+  tri_setup ts = {.vol = vol * sign, .vol_x = 0.0f * sign, .vol_y = 0.0f * sign, .tie = tie, .w = {1.0f, 1.0f, 1.0f}};
+  /* the plane: N = (p2 − p0) × (p1 − p0), exact in double, turned like the edges */
+  const dvec3 p0 = dv3(scene_vertex(s, 0, i)), r1 = dv3_sub(dv3(scene_vertex(s, 1, i)), p0),
+              r2 = dv3_sub(dv3(scene_vertex(s, 2, i)), p0);
+  const double dsign = sign;
+  const dvec3 nrm = {(r2.y * r1.z - r2.z * r1.y) * dsign, (r2.z * r1.x - r2.x * r1.z) * dsign,
+                     (r2.x * r1.y - r2.y * r1.x) * dsign};
+  const double pb = dv3_dot(nrm, dv3_splat(ray->dx)), pc = dv3_dot(nrm, dv3_splat(ray->dy));
+  ts.pa = (float)(dv3_dot(nrm, dv3_splat(ray->d0)) + 0.0 * pb + 0.0 * pc), ts.pb = (float)pb, ts.pc = (float)pc;
+  ts.num0 = (float)dv3_dot(nrm, dv3_sub(p0, dv3_splat(ray->eye)));
+  ts.num_x = ts.num_y = (float)0.0;
+  if (!sample_test(&ts, e, 0.0f, 0.0f, t, l1, l2)) return false;
+  return *t >= tmin && *t <= tmax;
+}
+
+/* rr_tri_ray_hit's setup_lanes1 for one finite triangle and a camera of
+ * rr_cam_for_ray (perspective, not planar: cx = cy = 0), cut to what the sample
+ * (0, 0) reads, in the template's operations and order (vec.h's dot and cross are
+ * its DOT3 and CROSS3, tri_edge_normal its canonical normal), so the bits are its
+ * bits; tests/test_rays compares the two on every triangle of many rays. The plane
+ * (in double) is computed only once the edges pass. */
+bool rr_tri_ray_hit1(const rr_scene *s, uint32_t i, const camera *ray, float tmin, float tmax, float *t, float *l1,
+                     float *l2) {
+  vec3 q[3], n[3];
+  for (int k = 0; k < 3; k++) q[k] = v3_sub(scene_vertex(s, k, i), ray->eye);
+  for (int e = 0; e < 3; e++) n[e] = tri_edge_normal(q[(e + 1) % 3], q[(e + 2) % 3]);
+  float vol = v3_dot(q[0], n[0]);
+  if (!(vol != 0.0f && fabsf(vol) < INFINITY)) return false; /* edge-on or not finite: SETUP_CULLED */
+  const float sign = vol > 0.0f ? 1.0f : -1.0f;
+  float e[3];
+  uint32_t tie = 0;
+  for (int k = 0; k < 3; k++) {
+    vec3 ne = v3_scale(n[k], sign);
+    float a = v3_dot(ne, ray->d0), b = v3_dot(ne, ray->dx), c = v3_dot(ne, ray->dy), f = v3_dot(ne, ray->fwd);
+    tie |= (b > 0.0f || (b == 0.0f && (c > 0.0f || (c == 0.0f && f > 0.0f)))) ? 1u << k : 0u; /* LEX_POSITIVE */
+    e[k] = a * 1.0f + b * 0.0f + c * 0.0f; /* tri_edges at (0, 0) */
+    if (!TRI_EDGE_INSIDE(e[k], (tie >> k & 1u) != 0, 0.0f)) return false;
+  }
+  return rr_tri_ray_finish(s, i, ray, e, tie, vol, tmin, tmax, t, l1, l2);
+}

@@ -2,9 +2,12 @@
  * the committed scene's BVH, by the traversal of every ray caster
  * (vis/bvh_trace.h). A leaf's triangles, whose corners the tree keeps in leaf
  * order (rr_bvh.leaf_v), go four at a time through the edge signs of their setup
- * (tri_ray_may_hit4); those that pass are set up for the ray (a pseudo-camera at
- * its origin, rr_cam_for_ray) and tested with the project's one sample test, so a
- * ray through a shared edge hits exactly one triangle.
+ * (tri_ray_may_hit4); those that pass are tested with the project's one sample
+ * test for the ray (a pseudo-camera at its origin, rr_cam_for_ray), so a ray
+ * through a shared edge hits exactly one triangle: with the pre-test's edge values
+ * where all are positive (rr_tri_ray_finish), else with the part of the setup the
+ * ray's one sample reads (rr_tri_ray_hit1), or, for corners at infinity, the full
+ * setup (rr_tri_ray_hit) — the same bits each way.
  *
  * Boxes are tested in 3D, widened by RAY_MARGIN relative to t (NaN slabs
  * ignored), and prune by box entry, which is exact but for triangles whose plane
@@ -34,6 +37,7 @@ typedef struct {
   const rr_scene *s;
   const rr_bvh *b; /* NULL for an empty scene: every ray misses */
   bool cam_ready;  /* cam is made for the first full test: many rays need none */
+  bool small;      /* the scene and direction keep the setup's b_i, c_i finite (query_leaf) */
   camera cam;
 } query_ray;
 
@@ -58,6 +62,20 @@ KERNEL int query_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, 
   return rr_vi4_bits(t0 <= t1);
 }
 
+/* Whether the setup's b_i, c_i (n_i·dx, n_i·dy) are finite for every finite
+ * triangle of s: |n_i| ≤ 4Q² (per axis, up to rounding) for corners within Q of the
+ * origin, so |b_i|, |c_i| ≤ 12·Q²·D for dx, dy within D, far below FLT_MAX for
+ * Q, D < 1e12. NaN (no finite corner) is not small. */
+static bool query_small(const rr_scene *s, const float org[3], const camera *c) {
+  const float lo[3] = {s->bmin.x, s->bmin.y, s->bmin.z}, hi[3] = {s->bmax.x, s->bmax.y, s->bmax.z};
+  const float dx[3] = {c->dx.x, c->dx.y, c->dx.z}, dy[3] = {c->dy.x, c->dy.y, c->dy.z};
+  bool small = true;
+  for (int a = 0; a < 3; a++)
+    small &= fabsf(lo[a] - org[a]) < 1e12f && fabsf(hi[a] - org[a]) < 1e12f && fabsf(dx[a]) < 1e12f &&
+             fabsf(dy[a]) < 1e12f;
+  return small;
+}
+
 /* Tests a leaf's triangles, keeping the nearest hit; `any`: stops at the first.
  * Four at a time through the edge pre-test, then the full test for the lanes
  * that pass it (and for triangles with corners at infinity, which it cannot
@@ -67,18 +85,30 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
   const float *v = r->b->leaf_v + (size_t)9 * first;
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;
-    int may = tri_ray_may_hit4(v + j, count, r->q.o, r->d) & ((1 << n) - 1);
+    rr_vf4 pre[4];
+    int may = tri_ray_may_hit4(v + j, count, r->q.o, r->d, pre) & ((1 << n) - 1);
     if (r->s->inf)
       for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, r->b->prims[first + j + k]) != 0) << k;
     for (; may; may &= may - 1) {
-      uint32_t id = r->b->prims[first + j + (uint32_t)__builtin_ctz(may)];
+      uint32_t lane = (uint32_t)__builtin_ctz(may), id = r->b->prims[first + j + lane];
       float t, l1, l2;
       if (!r->cam_ready) {
         float org[3] = {r->q.o[0][0], r->q.o[1][0], r->q.o[2][0]}, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
         rr_cam_for_ray(org, dir, &r->cam);
         r->cam_ready = true;
+        r->small = query_small(r->s, org, &r->cam);
       }
-      if (!rr_tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2)) continue;
+      /* Edge values all positive are the sample test's (tri_ray_may_hit4): no tie,
+       * no sign of a zero to settle, only the plane left to compute. */
+      const float e[3] = {pre[0][lane], pre[1][lane], pre[2][lane]};
+      bool hit;
+      if (r->s->inf && scene_inf(r->s, id))
+        hit = rr_tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2);
+      else if (r->small && e[0] > 0 && e[1] > 0 && e[2] > 0)
+        hit = rr_tri_ray_finish(r->s, id, &r->cam, e, 0, pre[3][lane], r->tmin, r->t, &t, &l1, &l2);
+      else
+        hit = rr_tri_ray_hit1(r->s, id, &r->cam, r->tmin, r->t, &t, &l1, &l2);
+      if (!hit) continue;
       if (any) return true;
       if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
     }
