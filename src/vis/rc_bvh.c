@@ -9,7 +9,9 @@
  * and for primary rays it never skips the winner, by construction:
  * - planar cameras test a triangle only at the samples of its corner rectangle
  *   (rr_tri_corner_bounds), exactly the samples 3dr-bb tests it at, so the two
- *   choose among the same candidates; triangles whose rectangle holds no sample
+ *   choose among the same candidates (where that rectangle is the whole image, only
+ *   its part inside the polygon bounds of rr_tri_bounds, which hold every sample
+ *   where the triangle can pass as well); triangles whose rectangle holds no sample
  *   (most of a detailed mesh's) are not set up;
  * - each triangle set up gets, per frame, a lower bound of the t that
  *   sample_test() can compute for it at those samples (rr_tri_rect_floor; curved
@@ -155,7 +157,20 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
         /* the extreme samples, as the rays compute their coordinates */
         tr[0] = (float)lb->bb[k][0] + c->sx0, tr[1] = (float)lb->bb[k][1] + c->sy0;
         tr[2] = (float)lb->bb[k][2] + c->sx0, tr[3] = (float)lb->bb[k][3] + c->sy0;
-        t = rr_tri_rect_floor(&lt->ts, c, tr);
+        if (lb->bb[k][0] > 0 || lb->bb[k][1] > 0 || lb->bb[k][2] < c->width - 1 || lb->bb[k][3] < c->height - 1) {
+          t = rr_tri_rect_floor(&lt->ts, c, tr);
+        } else {
+          /* A corner rectangle of the whole image (mostly a triangle crossing the
+           * eye's plane) would give every ancestor the whole image and a floor near
+           * 0: inside a scene, every ray would test all such triangles. The
+           * polygon's bounds hold every sample where it can pass too, so the
+           * triangle is tested only where both rectangles meet, with their floor (a NaN
+           * bound leaves the corner rectangle as it is). */
+          float pr[4];
+          t = rr_tri_bounds(&lt->ts, c, pr);
+          tr[0] = maxf(pr[0], tr[0]), tr[1] = maxf(pr[1], tr[1]), tr[2] = minf(pr[2], tr[2]), tr[3] = minf(pr[3], tr[3]);
+          if (!(tr[0] <= tr[2] && tr[1] <= tr[3])) t = INFINITY;
+        }
       } else {
         t = rr_tri_bounds(&lt->ts, c, tr);
       }
