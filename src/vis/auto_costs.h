@@ -1,26 +1,26 @@
 
-/* auto's costs: written by `bench_auto --calibrate` (112 views, median of 3);
+/* auto's costs: written by `bench_auto --calibrate --threads 2` (112 views, median of 5);
  * see vis/auto.c and docs/auto.md. Figures: T, S, A, R, UP, P, PlogT. */
 static const double cost_planar[RR_METHOD_COUNT][AUTO_NFIG] = {
-    [RR_METHOD_3DR_BB] = {5.33, 91.57, 1.883, 0, 0.3219, 0.1969, 0},
-    [RR_METHOD_3DR_BIN] = {4.387, 93.93, 0, 14.19, 0, 1.362, 0},
-    [RR_METHOD_3DR_FC] = {21.6, 248.3, 0.641, 0, 0, 2.781, 0},
-    [RR_METHOD_3DR_FULL] = {0, 250.6, 0, 0, 0, 7.331, 0},
-    [RR_METHOD_RC_PACKET] = {163.1, 0, 0, 0, 0, 0, 0.9623},
-    [RR_METHOD_RC_BVH] = {185.7, 0, 0, 0, 0, 0, 2.437},
+    [RR_METHOD_3DR_BB] = {4.208, 85.06, 1.367, 0, 0.3261, 0.4095, 0},
+    [RR_METHOD_3DR_BIN] = {4.299, 82.35, 0, 12.51, 0, 1.967, 0},
+    [RR_METHOD_3DR_FC] = {19.38, 212, 0.5459, 0, 0, 3.029, 0},
+    [RR_METHOD_3DR_FULL] = {0, 195.3, 0, 0, 0, 6.835, 0},
+    [RR_METHOD_RC_PACKET] = {94.27, 0, 0, 0, 0, 0, 0.8084},
+    [RR_METHOD_RC_BVH] = {107.1, 0, 0, 0, 0, 0, 1.211},
 };
 static const double cost_curved[RR_METHOD_COUNT][AUTO_NFIG] = {
-    [RR_METHOD_3DR_BIN] = {3845, 0, 0, 0, 0, 15.16, 0},
-    [RR_METHOD_3DR_FC] = {4455, 0, 0, 0, 0, 17.56, 0},
-    [RR_METHOD_3DR_FULL] = {2844, 0, 0, 0, 0, 11.21, 0},
-    [RR_METHOD_RC_PACKET] = {101.9, 0, 0, 0, 0, 71.37, 0},
-    [RR_METHOD_RC_BVH] = {97.25, 0, 0, 0, 0, 69.3, 0},
+    [RR_METHOD_3DR_BIN] = {3541, 0, 0, 0, 0, 21.65, 0},
+    [RR_METHOD_3DR_FC] = {3820, 0, 0, 0, 0, 23.35, 0},
+    [RR_METHOD_3DR_FULL] = {3005, 0, 0, 0, 0, 18.37, 0},
+    [RR_METHOD_RC_PACKET] = {83.13, 0, 0, 0, 0, 62.69, 0},
+    [RR_METHOD_RC_BVH] = {83.39, 0, 0, 0, 0, 62.31, 0},
 };
 static const double thread_gain[RR_METHOD_COUNT] = {
-    [RR_METHOD_3DR_BB] = 0.75,
-    [RR_METHOD_3DR_BIN] = 0.75,
-    [RR_METHOD_3DR_FC] = 0.75,
-    [RR_METHOD_3DR_FULL] = 0.75,
-    [RR_METHOD_RC_PACKET] = 0.75,
-    [RR_METHOD_RC_BVH] = 0.75,
+    [RR_METHOD_3DR_BB] = 0.357,
+    [RR_METHOD_3DR_BIN] = 0.387,
+    [RR_METHOD_3DR_FC] = 0.54,
+    [RR_METHOD_3DR_FULL] = 0.52,
+    [RR_METHOD_RC_PACKET] = 0.52,
+    [RR_METHOD_RC_BVH] = 0.589,
 };
