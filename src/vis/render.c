@@ -11,11 +11,13 @@
 
 /* The 3D rasterization methods are configurations of one traversal (paper
  * sect. 5); the others have loops of their own around the same sample test.
- * A method without either is one this build does not have yet. */
+ * A method without either is one this build does not have yet. all_samples: it
+ * draws every sample position of a pattern in one pass (render_ctx). */
 static const struct {
   const char *name;
   vis_method_fn fn;
   oracles o;
+  bool all_samples;
 } methods[RR_METHOD_COUNT] = {
     [RR_METHOD_RC] = {"rc", rr_vis_rc, {0}},
     [RR_METHOD_RC_BVH] = {"rc-bvh", rr_vis_rc_bvh, {0}},
@@ -250,21 +252,30 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                    "method '%s' projects onto a plane and cannot render a %s camera; the 3D methods can (rc, rc-bvh, "
                    "rc-packet, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full)",
                    methods[opt->method].name, rr_camera_name(cam->type));
-  camera c;
-  rr_error e = rr_cam_setup_at(dev, cam, opt->width, opt->height, opt->sample_pos[0], &c);
-  if (e) return e;
-  rr_frame *f = calloc(1, sizeof *f);
+  /* One camera per sample position: a method that takes them all at once gets
+   * them together, any other runs once per position (render_ctx in vis.h). */
+  camera cams[RR_MAX_SAMPLES];
+  int ncams = 0;
+  rr_error e = RR_OK;
+  for (; ncams < opt->samples && !e; ncams++)
+    e = rr_cam_setup_at(dev, cam, opt->width, opt->height, opt->sample_pos[ncams], &cams[ncams]);
+  if (e) ncams--;
+  rr_frame *f = e ? NULL : calloc(1, sizeof *f);
   size_t npix = (size_t)opt->width * opt->height;
-  if (!f || !visbuf_alloc(&f->vb, opt->width, opt->height, opt->samples) ||
-      (opt->heat && (!(f->heat_e = calloc(npix, sizeof(float))) || !(f->heat_n = calloc(npix, sizeof(float)))))) {
+  if (!e && (!f || !visbuf_alloc(&f->vb, opt->width, opt->height, opt->samples) ||
+             (opt->heat && (!(f->heat_e = calloc(npix, sizeof(float))) || !(f->heat_n = calloc(npix, sizeof(float)))))))
+    e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d visibility buffer", opt->width, opt->height);
+  if (e) {
     rr_frame_release(f);
-    rr_cam_release(&c);
-    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d visibility buffer", opt->width, opt->height);
+    while (ncams > 0) rr_cam_release(&cams[--ncams]);
+    return e;
   }
   f->method = opt->method;
   f->samples = opt->samples;
   render_ctx ctx = {.scene = scene,
-                    .cam = &c,
+                    .cam = &cams[0],
+                    .cams = cams,
+                    .samples = opt->samples,
                     .opt = opt,
                     .threads = opt->threads ? opt->threads : rr_cpu_count(),
                     .vb = &f->vb,
@@ -277,22 +288,21 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   double t0 = rr_now_ms(), c0 = rr_cpu_ms();
   progress_span whole = {dev, RR_PROGRESS_RENDER, 0, 1};
   rr_progress(&whole, 0);
-  /* A pattern of N samples is N passes of the method, each with the camera of one
-   * position writing its own layer: every method and camera takes the positions
-   * as data. (A triangle is set up once per pass: S grows with N.) */
-  for (int s = 0; s < opt->samples && !e; s++) {
-    ctx.progress = rr_progress_part(&whole, (double)s / opt->samples, (double)(s + 1) / opt->samples);
-    if (s > 0) {
-      rr_cam_release(&c);
-      if ((e = rr_cam_setup_at(dev, cam, opt->width, opt->height, opt->sample_pos[s], &c))) break;
-    }
-    visbuf layer = {opt->width, opt->height, f->vb.id + s * npix, f->vb.t + s * npix, f->vb.l1 + s * npix,
-                    f->vb.l2 + s * npix};
-    ctx.vb = &layer;
+  if (methods[opt->method].all_samples) {
+    ctx.progress = whole;
     e = methods[opt->method].fn(dev, &ctx);
-  }
+  } else /* one pass per position, each writing its own layer (S grows with N) */
+    for (int s = 0; s < opt->samples && !e; s++) {
+      ctx.progress = rr_progress_part(&whole, (double)s / opt->samples, (double)(s + 1) / opt->samples);
+      visbuf layer = {opt->width, opt->height, f->vb.id + s * npix, f->vb.t + s * npix, f->vb.l1 + s * npix,
+                      f->vb.l2 + s * npix};
+      ctx.cam = ctx.cams = &cams[s];
+      ctx.samples = 1;
+      ctx.vb = &layer;
+      e = methods[opt->method].fn(dev, &ctx);
+    }
   f->stats.frame_ms = rr_now_ms() - t0, f->stats.cpu_ms = rr_cpu_ms() - c0;
-  rr_cam_release(&c);
+  while (ncams > 0) rr_cam_release(&cams[--ncams]);
   /* The methods write triangle indices; users see ids (scene.h), which differ after
    * a dropped face. Mapped once here, outside every method and the timed pass. */
   if (!e && scene->file_id) {

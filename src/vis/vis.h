@@ -5,6 +5,9 @@
 #include "accel/bvh.h"
 #include "prim/triangle.h"
 
+/* Per sample: the hit's triangle index, t and barycentrics. A buffer of several
+ * samples per pixel holds one width × height layer per sample position: sample s
+ * of pixel k at s·width·height + k. */
 typedef struct visbuf {
   int width, height;
   uint32_t *id;
@@ -58,10 +61,15 @@ struct rr_frame {
   int samples; /* vb holds this many layers of vb.width × vb.height */
 };
 
-/* A pass of a method: fills vb (cleared to misses) and adds to stats. */
+/* A pass of a method: fills vb (cleared to misses) and adds to stats. A method that
+ * takes every sample position in one pass (all_samples in render.c's table) gets
+ * samples > 1 cameras, cams[s] resolved for position s, and writes layer s of vb;
+ * any other method runs once per position with samples = 1 and vb that layer. */
 typedef struct render_ctx {
   const rr_scene *scene;
-  const camera *cam;
+  const camera *cam;  /* cams[0] */
+  const camera *cams; /* one per sample position */
+  int samples;
   const rr_render_options *opt;
   int threads;
   visbuf *vb;
