@@ -100,7 +100,7 @@ static void check_claims(const rr_scene *s, const camera *c, int mode, const cha
   for (int run = 0; run < 3; run++) {
     bool bin = run > 0;
     int threads = run == 2 ? 3 : 1;
-    rr_error e = rr_raster2d_claims(s, c, bin, threads, front, back);
+    rr_error e = rr_raster2d_claims(s, c, 1, bin, threads, front, back);
     CHECK(e == RR_OK, "claims: %s", rr_device_message(dev));
     int holes = 0, doubles = 0, unequal = 0;
     for (size_t k = 0; k < n; k++) {

@@ -8,6 +8,11 @@
  *   raster        2dr-bb: every sample of the bounding box; 2dr-bin: 64² tiles,
  *                 16² and 4² blocks rejected or accepted whole by their corner
  *                 samples, early-z against per-block farthest depths
+ *   samples       a pattern of N positions in one pass: every triangle is
+ *                 projected, clipped and set up once, then rasterized at each
+ *                 position into its layer (the snapped vertices moved by the
+ *                 position's shift are a translation: the edge coefficients stay,
+ *                 the constants move by integers)
  *   sample        coverage from the integer edge values; depth and barycentrics
  *                 perspective-correct from the planes of 1/w, t/w and λ/w given by
  *                 the inverse of the matrix of homogeneous vertices (Olano & Greer,
@@ -46,11 +51,13 @@ typedef struct pipe2d {
   bool depth_is_w;   /* pinhole: t = w_c, so the vertex stage skips the depth row */
   int width, height;
   bool cull;
-  /* The kernels test samples at sub-pixel SUBPIX/2 of each pixel; the pattern's
-   * sample (sx0, sy0), snapped to sub-pixels like the vertices, is reached by
+  /* The kernels test samples at sub-pixel SUBPIX/2 of each pixel; position s of
+   * the pattern (sx0, sy0), snapped to sub-pixels like the vertices, is reached by
    * moving the snapped vertices by `shift` (0 for the centre). */
-  int64_t shift_x, shift_y;
-  double sx0, sy0;
+  int samples;
+  int64_t shift_x[RR_MAX_SAMPLES], shift_y[RR_MAX_SAMPLES];
+  int64_t shift_lo[2], shift_hi[2]; /* their range in x and y */
+  double sx0[RR_MAX_SAMPLES], sy0[RR_MAX_SAMPLES];
 } pipe2d;
 
 static void mat4_mul(double r[4][4], const double a[4][4], const double b[4][4]) {
@@ -94,11 +101,19 @@ static bool inverse3(const double a[3], const double b[3], const double c[3], do
  *                 and w = 1.
  * Clip space is OpenGL's for x and y (x/w, y/w in [-1, 1] on screen, y up); the near
  * plane is z_c = t − near ≥ 0. */
-static bool pipe_setup(pipe2d *pp, const rr_scene *s, const camera *c, bool cull) {
+static bool pipe_setup(pipe2d *pp, const rr_scene *s, const camera *cams, int samples, bool cull) {
+  const camera *c = cams; /* the cameras of a pattern differ in (sx0, sy0) only */
   bool ortho = c->type == RR_CAMERA_ORTHOGRAPHIC;
   if (c->type != RR_CAMERA_PERSPECTIVE && !ortho) return false; /* curved views have no projection */
-  pp->shift_x = SUBPIX / 2 - (int64_t)lround(c->sx0 * SUBPIX), pp->shift_y = SUBPIX / 2 - (int64_t)lround(c->sy0 * SUBPIX);
-  pp->sx0 = (double)(SUBPIX / 2 - pp->shift_x) / SUBPIX, pp->sy0 = (double)(SUBPIX / 2 - pp->shift_y) / SUBPIX;
+  pp->samples = samples;
+  pp->shift_lo[0] = pp->shift_lo[1] = INT64_MAX, pp->shift_hi[0] = pp->shift_hi[1] = INT64_MIN;
+  for (int k = 0; k < samples; k++) {
+    int64_t x = SUBPIX / 2 - (int64_t)lround(cams[k].sx0 * SUBPIX), y = SUBPIX / 2 - (int64_t)lround(cams[k].sy0 * SUBPIX);
+    pp->shift_x[k] = x, pp->shift_y[k] = y;
+    pp->sx0[k] = (double)(SUBPIX / 2 - x) / SUBPIX, pp->sy0[k] = (double)(SUBPIX / 2 - y) / SUBPIX;
+    pp->shift_lo[0] = x < pp->shift_lo[0] ? x : pp->shift_lo[0], pp->shift_hi[0] = x > pp->shift_hi[0] ? x : pp->shift_hi[0];
+    pp->shift_lo[1] = y < pp->shift_lo[1] ? y : pp->shift_lo[1], pp->shift_hi[1] = y > pp->shift_hi[1] ? y : pp->shift_hi[1];
+  }
   vec3 axis[3] = {c->right, c->up, c->fwd};
   double view[4][4] = {{0}}, proj[4][4] = {{0}};
   for (int r = 0; r < 3; r++) {
@@ -177,7 +192,7 @@ static double plane_dist(const pipe2d *pp, int plane, const double *v) {
   }
 }
 
-static unsigned outcode(const pipe2d *pp, const cvert *v) {
+KERNEL unsigned outcode(const pipe2d *pp, const cvert *v) {
   double x = v->v[CX], y = v->v[CY], w = v->v[CW], gx = pp->kx * w, gy = pp->ky * w;
   return (unsigned)(v->v[CZ] < 0) << P_NEAR | (unsigned)(gx + x < 0) << P_GUARD_L |
          (unsigned)(gx - x < 0) << P_GUARD_R | (unsigned)(gy - y < 0) << P_GUARD_T |
@@ -232,7 +247,7 @@ typedef struct planes {
   double w[3], t[3], l1[3], l2[3];
 } planes;
 
-static bool interpolation_planes(const pipe2d *pp, const cvert v[3], planes *pl) {
+KERNEL bool interpolation_planes(const pipe2d *pp, const cvert v[3], planes *pl) {
   double col[3][3];
   for (int k = 0; k < 3; k++) {
     col[k][0] = (v[k].v[CX] + v[k].v[CW]) * pp->hw;
@@ -264,45 +279,88 @@ static void plane_at(const double p[3], double sx, double sy, float out[3]) {
   out[1] = (float)p[0], out[2] = (float)p[1];
 }
 
+/* The planes of t at its reference sample: that of pixel (rect[0], rect[1]) at
+ * position s. */
+KERNEL void planes_at(const pipe2d *pp, tri2d *t, const planes *pl, int s) {
+  double sx = t->rect[0] + pp->sx0[s], sy = t->rect[1] + pp->sy0[s];
+  plane_at(pl->w, sx, sy, t->pw);
+  plane_at(pl->t, sx, sy, t->pt);
+  plane_at(pl->l1, sx, sy, t->p1);
+  plane_at(pl->l2, sx, sy, t->p2);
+}
+
+/* A (sub-)triangle set up for every position of a pattern: t's edges are those of
+ * the unshifted vertices and its rectangle the union of the positions' (which the
+ * bands are sorted by); each position's tri2d follows from the snapped vertices'
+ * bounds and the planes (tri_at). */
+typedef struct tri2dm {
+  tri2d t;
+  int32_t box[4]; /* x0, y0, x1, y1 of the snapped vertices, in sub-pixels */
+  planes pl;
+} tri2dm;
+
 static int64_t floor_div(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
 /* Viewport transform and snapping to 8 sub-pixel bits (round half away from zero). */
-static void snap(const pipe2d *pp, const cvert *c, int64_t *x, int64_t *y) {
+KERNEL void snap(const pipe2d *pp, const cvert *c, int64_t *x, int64_t *y) {
   double iw = 1.0 / c->v[CW];
   double sx = (c->v[CX] * iw * pp->hw + pp->hw) * SUBPIX, sy = (pp->hh - c->v[CY] * iw * pp->hh) * SUBPIX;
-  *x = (int64_t)(sx >= 0 ? sx + 0.5 : sx - 0.5) + pp->shift_x;
-  *y = (int64_t)(sy >= 0 ? sy + 0.5 : sy - 0.5) + pp->shift_y;
+  *x = (int64_t)(sx >= 0 ? sx + 0.5 : sx - 0.5);
+  *y = (int64_t)(sy >= 0 ? sy + 0.5 : sy - 0.5);
 }
 
-/* Sets up the coverage of one (sub-)triangle of snapped vertices; false when it
- * covers no sample (degenerate after snapping, culled, or between sample centres). */
-static bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], tri2d *t) {
+/* The samples (x + 0.5, y + 0.5) inside the snapped vertices' bounds `box` moved by
+ * lo (its low sides) and hi (its high sides), on screen; false when there are none. */
+KERNEL bool sample_rect(const pipe2d *pp, const int32_t box[4], const int64_t lo[2], const int64_t hi[2],
+                     int16_t rect[4]) {
+  int64_t x0 = -floor_div(SUBPIX / 2 - (box[0] + lo[0]), SUBPIX), y0 = -floor_div(SUBPIX / 2 - (box[1] + lo[1]), SUBPIX);
+  int64_t x1 = floor_div(box[2] + hi[0] - SUBPIX / 2, SUBPIX), y1 = floor_div(box[3] + hi[1] - SUBPIX / 2, SUBPIX);
+  if (x0 < 0) x0 = 0;
+  if (y0 < 0) y0 = 0;
+  if (x1 > pp->width - 1) x1 = pp->width - 1;
+  if (y1 > pp->height - 1) y1 = pp->height - 1;
+  if (x0 > x1 || y0 > y1) return false;
+  rect[0] = (int16_t)x0, rect[1] = (int16_t)y0, rect[2] = (int16_t)x1, rect[3] = (int16_t)y1;
+  return true;
+}
+
+/* Position s of a pattern's triangle m: its vertices moved by the position's shift,
+ * which moves the edge constants by exact integers. False when it covers no sample. */
+static bool tri_at(const pipe2d *pp, const tri2dm *m, int s, tri2d *t) {
+  const int64_t shift[2] = {pp->shift_x[s], pp->shift_y[s]};
+  *t = m->t;
+  if (!sample_rect(pp, m->box, shift, shift, t->rect)) return false;
+  for (int i = 0; i < 3; i++) t->c[i] -= t->a[i] * shift[0] + t->b[i] * shift[1];
+  planes_at(pp, t, &m->pl, s);
+  return true;
+}
+
+/* Sets up the coverage of one (sub-)triangle of snapped vertices, and their bounds
+ * in box; false when it covers no sample of the pattern (degenerate after snapping,
+ * culled, or between sample positions). One position: t is that position's; more:
+ * t's edges are the unshifted vertices' and its rectangle the positions' union. */
+KERNEL bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], tri2d *t, int32_t box[4], const bool all) {
   /* Twice the signed area, y down: negative for a triangle that is counter-clockwise
    * as the viewer sees it, the front face (as rr_tri_setup decides it). */
   int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
   if (area == 0) return false;
   t->back = area > 0;
   if (t->back && pp->cull) return false;
-  /* The samples (x + 0.5, y + 0.5) inside the snapped (shifted) vertices' bounds. */
   int64_t x0 = X[0], x1 = X[0], y0 = Y[0], y1 = Y[0];
   for (int k = 1; k < 3; k++) {
     x0 = X[k] < x0 ? X[k] : x0, x1 = X[k] > x1 ? X[k] : x1;
     y0 = Y[k] < y0 ? Y[k] : y0, y1 = Y[k] > y1 ? Y[k] : y1;
   }
-  x0 = -floor_div(SUBPIX / 2 - x0, SUBPIX), y0 = -floor_div(SUBPIX / 2 - y0, SUBPIX);
-  x1 = floor_div(x1 - SUBPIX / 2, SUBPIX), y1 = floor_div(y1 - SUBPIX / 2, SUBPIX);
-  if (x0 < 0) x0 = 0;
-  if (y0 < 0) y0 = 0;
-  if (x1 > pp->width - 1) x1 = pp->width - 1;
-  if (y1 > pp->height - 1) y1 = pp->height - 1;
-  if (x0 > x1 || y0 > y1) return false;
-  t->rect[0] = (int16_t)x0, t->rect[1] = (int16_t)y0, t->rect[2] = (int16_t)x1, t->rect[3] = (int16_t)y1;
+  box[0] = (int32_t)x0, box[1] = (int32_t)y0, box[2] = (int32_t)x1, box[3] = (int32_t)y1;
+  const int64_t shift[2] = {pp->shift_x[0], pp->shift_y[0]};
+  if (!sample_rect(pp, box, all ? pp->shift_lo : shift, all ? pp->shift_hi : shift, t->rect)) return false;
+  int64_t shx = all ? 0 : shift[0], shy = all ? 0 : shift[1];
   int64_t sign = area > 0 ? 1 : -1;
   for (int i = 0; i < 3; i++) {
     int p = (i + 1) % 3, q = (i + 2) % 3;
     int64_t a = -(Y[q] - Y[p]) * sign, b = (X[q] - X[p]) * sign;
     t->a[i] = (int32_t)a, t->b[i] = (int32_t)b;
-    t->c[i] = -(a * X[p] + b * Y[p]);
+    t->c[i] = -(a * (X[p] + shx) + b * (Y[p] + shy));
     /* Top-left rule: a sample on the edge belongs to the triangle whose inside
      * lies to its right (a > 0), or below for a horizontal edge (b > 0). */
     if (!(a > 0 || (a == 0 && b > 0))) t->c[i] -= 1;
@@ -310,13 +368,17 @@ static bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], 
   return true;
 }
 
-/* Sets up the interpolation of a (sub-)triangle that covers samples. */
-static void setup_interp(const pipe2d *pp, tri2d *t, const planes *pl, const double depth[3], uint32_t id) {
-  double sx = t->rect[0] + pp->sx0, sy = t->rect[1] + pp->sy0; /* the reference sample */
-  plane_at(pl->w, sx, sy, t->pw);
-  plane_at(pl->t, sx, sy, t->pt);
-  plane_at(pl->l1, sx, sy, t->p1);
-  plane_at(pl->l2, sx, sy, t->p2);
+/* Sets up the interpolation of a (sub-)triangle that covers samples: its planes
+ * for one position, or kept whole for tri_at (a tri2dm). */
+KERNEL void setup_interp(const pipe2d *pp, tri2d *t, const planes *pl, const int32_t box[4], const double depth[3],
+                     uint32_t id, const bool all) {
+  if (!all) {
+    planes_at(pp, t, pl, 0);
+  } else {
+    tri2dm *m = (tri2dm *)t;
+    memcpy(m->box, box, sizeof m->box);
+    m->pl = *pl;
+  }
   /* Depth is linear on the triangle, so its range is that of the vertices. The
    * clamp also makes early-z exact: no sample of the triangle is nearer than tmin. */
   double lo = depth[0] < depth[1] ? depth[0] : depth[1], hi = depth[0] > depth[1] ? depth[0] : depth[1];
@@ -325,10 +387,13 @@ static void setup_interp(const pipe2d *pp, tri2d *t, const planes *pl, const dou
   t->id = id;
 }
 
+/* The bytes of a set-up triangle: a tri2d for one position, a tri2dm for more. */
+static size_t prim_size(const pipe2d *pp) { return pp->samples == 1 ? sizeof(tri2d) : sizeof(tri2dm); }
+
 /* Vertex stage, clipping and setup of scene triangle i; appends up to MAX_SUB
- * set-up triangles to out and returns their number. *setups counts the triangles
- * that reached setup. */
-static int setup_scene_tri(const pipe2d *pp, const rr_scene *s, uint32_t i, tri2d *out, uint64_t *setups) {
+ * set-up triangles (prim_size bytes each) to out and returns their number.
+ * *setups counts the triangles that reached setup. */
+KERNEL int setup_scene_tri(const pipe2d *pp, const rr_scene *s, uint32_t i, char *out, uint64_t *setups, const bool pattern) {
   cvert poly[2][MAX_POLY];
   unsigned all = ~0u, any = 0;
   for (int k = 0; k < 3; k++) {
@@ -358,10 +423,13 @@ static int setup_scene_tri(const pipe2d *pp, const rr_scene *s, uint32_t i, tri2
   for (int k = 1; k + 1 < n; k++) {
     int64_t tx[3] = {X[0], X[k], X[k + 1]}, ty[3] = {Y[0], Y[k], Y[k + 1]};
     ++*setups;
-    if (!setup_tri(pp, tx, ty, &out[m])) continue;
+    tri2d *t = (tri2d *)(out + m * (pattern ? sizeof(tri2dm) : sizeof(tri2d)));
+    int32_t box[4];
+    if (!setup_tri(pp, tx, ty, t, box, pattern)) continue;
     if (!have_planes && !(have_planes = interpolation_planes(pp, orig, &pl))) return 0;
     double depth[3] = {poly[cur][0].v[CT], poly[cur][k].v[CT], poly[cur][k + 1].v[CT]};
-    setup_interp(pp, &out[m++], &pl, depth, i);
+    setup_interp(pp, t, &pl, box, depth, i, pattern);
+    m++;
   }
   return m;
 }
@@ -448,6 +516,7 @@ typedef struct bin_ctx {
   const target *tg;
   hiz *hz; /* NULL in claims mode */
   uint64_t evals;
+  const struct pass2d *pass;
 } bin_ctx;
 
 /* One block of `level` with top-left sample (bx, by): skipped when the triangle is
@@ -537,23 +606,27 @@ typedef struct pass2d {
   const rr_scene *scene;
   const pipe2d *pp;
   bool bin;
-  target tg;
-  hiz *hz; /* NULL unless 2dr-bin tests depths */
+  visbuf layer[RR_MAX_SAMPLES]; /* position s's layer of the buffer */
+  target tg[RR_MAX_SAMPLES];    /* and where its samples go */
+  hiz *hz;                      /* one per position; NULL unless 2dr-bin tests depths */
   uint64_t setups[RR_MAX_THREADS], evals[RR_MAX_THREADS];
 } pass2d;
 
 static uint32_t setup2d(void *arg, int thread, uint32_t first, uint32_t n, void *out) {
   pass2d *p = arg;
-  tri2d *t = out;
+  char *t = out;
   uint32_t m = 0;
   uint64_t setups = 0;
-  for (uint32_t i = first; i < first + n; i++) m += setup_scene_tri(p->pp, p->scene, i, t + m, &setups);
+  if (p->pp->samples > 1) /* each with its own inlined setup */
+    for (uint32_t i = first; i < first + n; i++) m += setup_scene_tri(p->pp, p->scene, i, t + m * sizeof(tri2dm), &setups, true);
+  else
+    for (uint32_t i = first; i < first + n; i++) m += setup_scene_tri(p->pp, p->scene, i, t + m * sizeof(tri2d), &setups, false);
   p->setups[thread] += setups;
   return m;
 }
 
 static void rows2d(const void *prim, int *y0, int *y1) {
-  const tri2d *t = prim;
+  const tri2d *t = prim; /* a tri2dm starts with its tri2d, whose rows are the pattern's */
   *y0 = t->rect[1], *y1 = t->rect[3];
 }
 
@@ -570,88 +643,115 @@ KERNEL void draw2d(bin_ctx *bc, const tri2d *t, int y0, int y1, const bool bin, 
     heat_charge(bc->tg->heat, bc->tg->vb->width, t->rect[0], ry0, t->rect[2] + 1, ry1 + 1, (float)n);
 }
 
-/* draw2d for each mode, as the band loop takes them */
-KERNEL void draw_bb_z(void *bc, const void *t, int y0, int y1) { draw2d(bc, t, y0, y1, false, false); }
-KERNEL void draw_bb_claims(void *bc, const void *t, int y0, int y1) { draw2d(bc, t, y0, y1, false, true); }
-KERNEL void draw_bin_z(void *bc, const void *t, int y0, int y1) { draw2d(bc, t, y0, y1, true, false); }
-KERNEL void draw_bin_claims(void *bc, const void *t, int y0, int y1) { draw2d(bc, t, y0, y1, true, true); }
-
-KERNEL void band2d(const sortmiddle *sm, int b, int thread, const bool bin, const bool count) {
-  pass2d *p = sm->arg;
-  bin_ctx bc = {.tg = &p->tg, .hz = p->hz};
-  sm_draw_band(sm, b, &bc, bin ? (count ? draw_bin_claims : draw_bin_z) : count ? draw_bb_claims : draw_bb_z);
-  p->evals[thread] += bc.evals;
-}
-
-static void band_job(int b, int thread, void *arg) {
-  const sortmiddle *sm = arg;
-  const pass2d *p = sm->arg;
-  bool count = p->tg.front != NULL;
-  if (p->bin) {
-    if (count) band2d(sm, b, thread, true, true);
-    else band2d(sm, b, thread, true, false);
-  } else {
-    if (count) band2d(sm, b, thread, false, true);
-    else band2d(sm, b, thread, false, false);
+/* The same at every position of a pattern, each into its layer (and its depth blocks). */
+KERNEL void draw2d_all(bin_ctx *bc, const tri2dm *m, int y0, int y1, const bool bin, const bool count) {
+  const pass2d *p = bc->pass;
+  for (int s = 0; s < p->pp->samples; s++) {
+    tri2d t;
+    if (!tri_at(p->pp, m, s, &t)) continue;
+    bc->tg = &p->tg[s], bc->hz = p->hz ? &p->hz[s] : NULL;
+    draw2d(bc, &t, y0, y1, bin, count);
   }
 }
 
-static rr_error run2d(rr_device *dev, const progress_span *progress, const rr_scene *s, const camera *c, bool cull,
-                      bool bin, int threads, target tg, rr_stats *stats) {
+/* draw2d for each mode, as the band loop takes them */
+#define DRAW2D(name, bin, count)                                                                                      \
+  KERNEL void name(void *bc, const void *t, int y0, int y1) { draw2d(bc, t, y0, y1, bin, count); }                  \
+  KERNEL void name##_all(void *bc, const void *t, int y0, int y1) { draw2d_all(bc, t, y0, y1, bin, count); }
+DRAW2D(draw_bb_z, false, false)
+DRAW2D(draw_bb_claims, false, true)
+DRAW2D(draw_bin_z, true, false)
+DRAW2D(draw_bin_claims, true, true)
+
+KERNEL void band2d(const sortmiddle *sm, int b, int thread, void (*draw)(void *, const void *, int, int)) {
+  pass2d *p = sm->arg;
+  bin_ctx bc = {.tg = &p->tg[0], .hz = p->hz, .pass = p};
+  sm_draw_band(sm, b, &bc, draw);
+  p->evals[thread] += bc.evals;
+}
+
+/* The band job of one position or of a pattern, each mode with its own inlined draw. */
+KERNEL void band_jobs(int b, int thread, void *arg, const bool all) {
+  const sortmiddle *sm = arg;
+  const pass2d *p = sm->arg;
+  switch (p->bin << 1 | (p->tg[0].front != NULL)) {
+  case 0: band2d(sm, b, thread, all ? draw_bb_z_all : draw_bb_z); break;
+  case 1: band2d(sm, b, thread, all ? draw_bb_claims_all : draw_bb_claims); break;
+  case 2: band2d(sm, b, thread, all ? draw_bin_z_all : draw_bin_z); break;
+  default: band2d(sm, b, thread, all ? draw_bin_claims_all : draw_bin_claims); break;
+  }
+}
+static void band_job(int b, int thread, void *arg) { band_jobs(b, thread, arg, false); }
+static void band_job_all(int b, int thread, void *arg) { band_jobs(b, thread, arg, true); }
+
+/* A pattern of `samples` positions (cams[s] for position s) in one pass; tg's
+ * buffers (the visibility buffer, or the claim counts) hold a layer per position. */
+static rr_error run2d(rr_device *dev, const progress_span *progress, const rr_scene *s, const camera *cams, int samples,
+                      bool cull, bool bin, int threads, target tg, rr_stats *stats) {
   pipe2d pp;
   if (s->inf)
     return rr_fail(dev, RR_ERROR_UNSUPPORTED,
                    "2D rasterization does not take vertices at infinity (w = 0); use a 3D method "
                    "(rc, rc-bvh, rc-packet, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs, 3dr-full)");
-  if (!pipe_setup(&pp, s, c, cull))
+  if (!pipe_setup(&pp, s, cams, samples, cull))
     return rr_fail(dev, RR_ERROR_UNSUPPORTED, "2D rasterization needs a planar camera (perspective or orthographic)");
   pass2d *p = calloc(1, sizeof *p);
-  hiz hz = {0};
   bool need_hiz = bin && !tg.front;
-  if (!p || (need_hiz && !rr_hiz_init(&hz, tg.vb, block_shift(0), LEVELS))) {
-    free(p);
-    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for 2D rasterization");
+  hiz *hz = need_hiz ? calloc((size_t)samples, sizeof *hz) : NULL;
+  bool ok = p && (!need_hiz || hz);
+  if (ok) {
+    *p = (pass2d){.scene = s, .pp = &pp, .bin = bin, .hz = hz};
+    size_t npix = (size_t)tg.vb->width * tg.vb->height;
+    const visbuf *vb = tg.vb;
+    for (int k = 0; k < samples; k++) { /* layer k of each buffer the target has */
+      size_t o = (size_t)k * npix;
+      p->layer[k] = (visbuf){vb->width, vb->height, vb->id ? vb->id + o : NULL, vb->t ? vb->t + o : NULL,
+                             vb->l1 ? vb->l1 + o : NULL, vb->l2 ? vb->l2 + o : NULL};
+      p->tg[k] = (target){&p->layer[k], tg.front ? tg.front + o : NULL, tg.back ? tg.back + o : NULL, tg.heat};
+      if (need_hiz) ok &= rr_hiz_init(&hz[k], &p->layer[k], block_shift(0), LEVELS);
+    }
   }
-  *p = (pass2d){.scene = s, .pp = &pp, .bin = bin, .tg = tg, .hz = need_hiz ? &hz : NULL};
-  sortmiddle sm = {.arg = p,
-                   .size = sizeof(tri2d),
-                   .batch = BATCH,
-                   .chunk = CHUNK,
-                   .out_max = MAX_SUB,
-                   .setup = setup2d,
-                   .rows = rows2d,
-                   .band = band_job,
-                   .progress = progress};
-  /* blocks of whole tiles, the largest bins and depth blocks */
-  bool ok = rr_sortmiddle(&sm, s->ntris, c->height, block_size(LEVELS - 1), threads);
-  for (int t = 0; t < RR_MAX_THREADS; t++) stats->setups += p->setups[t], stats->edge_evals += p->evals[t];
-  rr_hiz_free(&hz);
-  free(p);
+  if (ok) {
+    sortmiddle sm = {.arg = p,
+                     .size = prim_size(&pp),
+                     .batch = BATCH,
+                     .chunk = CHUNK,
+                     .out_max = MAX_SUB,
+                     .setup = setup2d,
+                     .rows = rows2d,
+                     .band = samples > 1 ? band_job_all : band_job,
+                     .progress = progress};
+    /* blocks of whole tiles, the largest bins and depth blocks */
+    ok = rr_sortmiddle(&sm, s->ntris, pp.height, block_size(LEVELS - 1), threads);
+    for (int t = 0; t < RR_MAX_THREADS; t++) stats->setups += p->setups[t], stats->edge_evals += p->evals[t];
+  }
+  for (int k = 0; hz && k < samples; k++) rr_hiz_free(&hz[k]);
+  free(hz), free(p);
   return ok ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for 2D rasterization");
 }
 
-rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx) {
+static rr_error render2d(rr_device *dev, render_ctx *ctx, bool bin) {
   target tg = {.vb = ctx->vb, .heat = ctx->heat_e};
-  return run2d(dev, &ctx->progress, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, false, ctx->threads, tg, ctx->stats);
+  return run2d(dev, &ctx->progress, ctx->scene, ctx->cams, ctx->samples, ctx->opt->cull_backfaces, bin, ctx->threads,
+               tg, ctx->stats);
 }
 
-rr_error rr_vis_2dr_bin(rr_device *dev, render_ctx *ctx) {
-  target tg = {.vb = ctx->vb, .heat = ctx->heat_e};
-  return run2d(dev, &ctx->progress, ctx->scene, ctx->cam, ctx->opt->cull_backfaces, true, ctx->threads, tg, ctx->stats);
-}
+rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx) { return render2d(dev, ctx, false); }
+rr_error rr_vis_2dr_bin(rr_device *dev, render_ctx *ctx) { return render2d(dev, ctx, true); }
 
-rr_error rr_raster2d_claims(const rr_scene *s, const camera *c, bool bin, int threads, uint8_t *front, uint8_t *back) {
-  size_t n = (size_t)c->width * c->height;
+rr_error rr_raster2d_claims(const rr_scene *s, const camera *cams, int samples, bool bin, int threads, uint8_t *front,
+                            uint8_t *back) {
+  size_t n = (size_t)cams->width * cams->height * samples;
   memset(front, 0, n), memset(back, 0, n);
-  visbuf vb = {.width = c->width, .height = c->height};
+  visbuf vb = {.width = cams->width, .height = cams->height};
   target tg = {.vb = &vb, .front = front, .back = back};
   rr_stats st = {0};
-  return run2d(NULL, NULL, s, c, false, bin, threads < 1 ? 1 : threads, tg, &st);
+  return run2d(NULL, NULL, s, cams, samples, false, bin, threads < 1 ? 1 : threads, tg, &st);
 }
 
 bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, double *sy) {
   pipe2d pp;
-  if (!pipe_setup(&pp, s, c, false)) return false;
+  if (!pipe_setup(&pp, s, c, 1, false)) return false;
   cvert v;
   vertex_stage(&pp, p, &v);
   if (v.v[CZ] < 0) return false;

@@ -135,9 +135,11 @@ rr_error rr_vis_rc_packet(rr_device *dev, render_ctx *ctx);
 /* 2dr-bb and 2dr-bin: projection, clipping, fixed-point 2D edge functions (vis/raster2d.c). */
 rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx);
 rr_error rr_vis_2dr_bin(rr_device *dev, render_ctx *ctx);
-/* Test hook: runs the 2D pipeline (binning when `bin`) over every triangle but, instead
- * of the z test, counts in front[k] / back[k] every triangle that claims sample k. */
-rr_error rr_raster2d_claims(const rr_scene *s, const camera *c, bool bin, int threads, uint8_t *front, uint8_t *back);
+/* Test hook: runs the 2D pipeline (binning when `bin`) over every triangle at the
+ * `samples` positions of cams[] but, instead of the z test, counts in front[k] /
+ * back[k] every triangle that claims sample k (layered like the visibility buffer). */
+rr_error rr_raster2d_claims(const rr_scene *s, const camera *cams, int samples, bool bin, int threads, uint8_t *front,
+                            uint8_t *back);
 /* Test hook: where the 2D pipeline's vertex stage puts world point p on the screen;
  * false when p is behind its near plane. */
 bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, double *sy);
