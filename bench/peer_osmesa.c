@@ -18,15 +18,24 @@ struct osmesa_peer {
   uint8_t *rgba; /* the colour buffer, row 0 at the bottom */
   uint32_t *ids; /* row 0 at the top */
   GLuint vbo[2]; /* positions, colours */
+  GLuint fbo, rb[2]; /* the multisample target (colour, depth) when samples > 1 */
+  int samples;
+  double resolve_ms;
   GLsizei nverts;
   vec3 bmin, bmax;
 };
 
 static double now(void) { return rr_now_ms(); }
 
+
 static int cmp_double(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
   return (x > y) - (x < y);
+}
+
+static double median(double *t, int n) {
+  qsort(t, n, sizeof *t, cmp_double);
+  return n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]);
 }
 
 osmesa_peer *osmesa_new(int w, int h, int threads) {
@@ -59,12 +68,14 @@ osmesa_peer *osmesa_new(int w, int h, int threads) {
   glMatrixMode(GL_MODELVIEW);
   glLoadIdentity();
   glGenBuffers(2, p->vbo);
+  p->samples = 1;
   return p;
 }
 
 void osmesa_release(osmesa_peer *p) {
   if (!p) return;
   if (p->ctx) {
+    osmesa_set_samples(p, 1);
     glDeleteBuffers(2, p->vbo);
     OSMesaDestroyContext(p->ctx);
   }
@@ -76,6 +87,44 @@ const char *osmesa_renderer(const osmesa_peer *p) {
   const GLubyte *s = glGetString(GL_RENDERER);
   return s ? (const char *)s : "unknown";
 }
+
+int osmesa_set_samples(osmesa_peer *p, int samples) {
+  if (p->fbo) {
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &p->fbo);
+    glDeleteRenderbuffers(2, p->rb);
+    p->fbo = 0;
+  }
+  p->samples = 1;
+  if (samples <= 1) return 1;
+  GLint max = 0;
+  glGetIntegerv(GL_MAX_SAMPLES, &max);
+  if (samples > max) {
+    fprintf(stderr, "osmesa: %d samples asked, GL_MAX_SAMPLES is %d\n", samples, max);
+    return 0;
+  }
+  glGenFramebuffers(1, &p->fbo);
+  glGenRenderbuffers(2, p->rb);
+  glBindRenderbuffer(GL_RENDERBUFFER, p->rb[0]);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, p->w, p->h);
+  glBindRenderbuffer(GL_RENDERBUFFER, p->rb[1]);
+  /* as deep as OSMesa's own depth buffer is at best, so both targets test alike */
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT32F, p->w, p->h);
+  GLint got = 0;
+  glGetRenderbufferParameteriv(GL_RENDERBUFFER, GL_RENDERBUFFER_SAMPLES, &got);
+  glBindFramebuffer(GL_FRAMEBUFFER, p->fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, p->rb[0]);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, p->rb[1]);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE || glGetError() != GL_NO_ERROR) {
+    fprintf(stderr, "osmesa: no framebuffer of %d samples\n", samples);
+    osmesa_set_samples(p, 1);
+    return 0;
+  }
+  p->samples = got > 1 ? got : samples;
+  return p->samples;
+}
+
+double osmesa_resolve_ms(const osmesa_peer *p) { return p->resolve_ms; }
 
 int osmesa_load(osmesa_peer *p, const rr_scene *s) {
   if (s->ntris >= 0xFFFFFFu) {
@@ -169,7 +218,7 @@ double osmesa_render(osmesa_peer *p, const rr_camera *cam, int cull, int reps) {
   } else {
     glDisable(GL_CULL_FACE);
   }
-  double t[64];
+  double t[64], res[64] = {0};
   if (reps < 1) reps = 1;
   if (reps > 64) reps = 64;
   for (int r = 0; r < reps; r++) {
@@ -179,9 +228,17 @@ double osmesa_render(osmesa_peer *p, const rr_camera *cam, int cull, int reps) {
     glDrawArrays(GL_TRIANGLES, 0, p->nverts);
     glFinish();
     t[r] = now() - t0;
+    if (p->fbo) { /* the resolve into OSMesa's buffer, timed apart */
+      t0 = now();
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+      glBlitFramebuffer(0, 0, p->w, p->h, 0, 0, p->w, p->h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+      glFinish();
+      res[r] = now() - t0;
+      glBindFramebuffer(GL_FRAMEBUFFER, p->fbo);
+    }
   }
-  qsort(t, reps, sizeof *t, cmp_double);
-  return reps % 2 ? t[reps / 2] : 0.5 * (t[reps / 2 - 1] + t[reps / 2]);
+  p->resolve_ms = median(res, reps);
+  return median(t, reps);
 }
 
 const uint32_t *osmesa_ids(osmesa_peer *p) {

@@ -21,10 +21,19 @@ const char *osmesa_renderer(const osmesa_peer *p);
 /* Uploads a scene's triangles to a vertex buffer, each triangle coloured by its id.
  * Returns 0 on success. */
 int osmesa_load(osmesa_peer *p, const rr_scene *scene);
+/* Where the following renderings go: 1, OSMesa's own buffer (the default); more, a
+ * framebuffer object of that many samples per pixel (colour and depth renderbuffers
+ * from glRenderbufferStorageMultisample), resolved into OSMesa's buffer by
+ * glBlitFramebuffer after each frame. Returns the samples GL granted (it may round
+ * up), or 0, with a message on stderr, when it cannot (llvmpipe offers 4). */
+int osmesa_set_samples(osmesa_peer *p, int samples);
 /* Renders the loaded scene from cam `reps` times (depth test GL_LESS, flat colour,
  * back faces culled when `cull`) and returns the median milliseconds of the draw
  * and glFinish; the clear is finished before the clock starts. */
 double osmesa_render(osmesa_peer *p, const rr_camera *cam, int cull, int reps);
+/* The median milliseconds of the last osmesa_render's resolves (glBlitFramebuffer
+ * and glFinish, after each timed draw); 0 with one sample. */
+double osmesa_resolve_ms(const osmesa_peer *p);
 /* The ids of the last rendering, row 0 at the top (RR_MISS where nothing was
  * drawn); owned by the peer. */
 const uint32_t *osmesa_ids(osmesa_peer *p);

@@ -82,18 +82,54 @@ static void check_positions(rr_device *dev, const rr_scene *s, const rr_camera *
   rr_frame_release(a), rr_frame_release(b), rr_frame_release(c);
 }
 
-/* The 2D pipeline at the same positions agrees with 3D rasterization on ids. */
-static void check_2d(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h) {
-  rr_render_options o = pattern_options(RR_METHOD_3DR_BB, w, h, 4, rgss);
-  rr_frame *a = test_render_opt(dev, s, cam, &o);
-  o.method = RR_METHOD_2DR_BIN;
-  rr_frame *b = test_render_opt(dev, s, cam, &o);
-  if (a && b) {
-    int n = 4 * w * h, agree = 0;
-    for (int k = 0; k < n; k++) agree += a->vb.id[k] == b->vb.id[k];
-    CHECK(agree >= n * 995 / 1000, "2dr-bin agrees with 3dr-bb on %d of %d ids", agree, n);
+/* A 4x4 grid rotated by atan(1/4), all positions in [0, 1), none at the centre; its
+ * projections on both axes are 16 distinct sixteenths. */
+static void rotated_grid16(float pos[16][2]) {
+  for (int k = 0; k < 16; k++) {
+    int i = k % 4, j = k / 4;
+    pos[k][0] = (float)(4 * i + j) / 16 + 1.0f / 32, pos[k][1] = (float)(4 * j + 3 - i) / 16 + 1.0f / 32;
   }
-  rr_frame_release(a), rr_frame_release(b);
+}
+
+/* The 2D pipeline at the same positions agrees with 3D rasterization on ids, and
+ * each of its layers (all positions drawn in one pass) is its frame of one sample
+ * at that position, bit for bit. */
+static void check_2d_pattern(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h, int n,
+                             const float (*pos)[2]) {
+  rr_render_options o = pattern_options(RR_METHOD_3DR_BB, w, h, n, pos);
+  rr_frame *a = test_render_opt(dev, s, cam, &o);
+  size_t npix = (size_t)w * h;
+  for (int m = 0; m < 2; m++) {
+    o.method = m ? RR_METHOD_2DR_BIN : RR_METHOD_2DR_BB;
+    rr_frame *b = test_render_opt(dev, s, cam, &o);
+    if (a && b) {
+      int all = n * w * h, agree = 0;
+      for (int k = 0; k < all; k++) agree += a->vb.id[k] == b->vb.id[k];
+      CHECK(agree >= all * 995 / 1000, "%s agrees with 3dr-bb on %d of %d ids at %d positions", rr_method_name(o.method),
+            agree, all, n);
+    }
+    for (int k = 0; b && k < n; k++) {
+      rr_render_options one = pattern_options(o.method, w, h, 1, &pos[k]);
+      rr_frame *f = test_render_opt(dev, s, cam, &one);
+      if (!f) continue;
+      bool same = memcmp(f->vb.id, b->vb.id + k * npix, npix * 4) == 0 &&
+                  memcmp(f->vb.t, b->vb.t + k * npix, npix * 4) == 0 &&
+                  memcmp(f->vb.l1, b->vb.l1 + k * npix, npix * 4) == 0 &&
+                  memcmp(f->vb.l2, b->vb.l2 + k * npix, npix * 4) == 0;
+      CHECK(same, "%s: layer %d of %d is not the frame of one sample at (%g, %g)", rr_method_name(o.method), k, n,
+            pos[k][0], pos[k][1]);
+      rr_frame_release(f);
+    }
+    rr_frame_release(b);
+  }
+  rr_frame_release(a);
+}
+
+static void check_2d(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h) {
+  check_2d_pattern(dev, s, cam, w, h, 4, rgss);
+  float grid16[16][2];
+  rotated_grid16(grid16);
+  check_2d_pattern(dev, s, cam, w, h, 16, grid16);
 }
 
 static void check_bad(rr_device *dev, const rr_scene *s, const rr_camera *cam) {

@@ -372,9 +372,8 @@ KERNEL bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], 
  * for one position, or kept whole for tri_at (a tri2dm). */
 KERNEL void setup_interp(const pipe2d *pp, tri2d *t, const planes *pl, const int32_t box[4], const double depth[3],
                      uint32_t id, const bool all) {
-  if (!all) {
-    planes_at(pp, t, pl, 0);
-  } else {
+  planes_at(pp, t, pl, 0); /* a pattern's slopes are its positions' too */
+  if (all) {
     tri2dm *m = (tri2dm *)t;
     memcpy(m->box, box, sizeof m->box);
     m->pl = *pl;
@@ -517,6 +516,7 @@ typedef struct bin_ctx {
   hiz *hz; /* NULL in claims mode */
   uint64_t evals;
   const struct pass2d *pass;
+  int sample; /* the position of a pattern being drawn */
 } bin_ctx;
 
 /* One block of `level` with top-left sample (bx, by): skipped when the triangle is
@@ -643,15 +643,80 @@ KERNEL void draw2d(bin_ctx *bc, const tri2d *t, int y0, int y1, const bool bin, 
     heat_charge(bc->tg->heat, bc->tg->vb->width, t->rect[0], ry0, t->rect[2] + 1, ry1 + 1, (float)n);
 }
 
-/* The same at every position of a pattern, each into its layer (and its depth blocks). */
-KERNEL void draw2d_all(bin_ctx *bc, const tri2dm *m, int y0, int y1, const bool bin, const bool count) {
-  const pass2d *p = bc->pass;
-  for (int s = 0; s < p->pp->samples; s++) {
-    tri2d t;
-    if (!tri_at(p->pp, m, s, &t)) continue;
-    bc->tg = &p->tg[s], bc->hz = p->hz ? &p->hz[s] : NULL;
-    draw2d(bc, &t, y0, y1, bin, count);
+/* Bit s: position s (of n) is covered, every edge value e_i + off[i][s] >= 0. Two
+ * positions a step where x86 has SIMD: the sign bits of the OR of their edge values. */
+KERNEL uint32_t covered_mask(int64_t e0, int64_t e1, int64_t e2, const int64_t off[3][RR_MAX_SAMPLES], int n) {
+  uint32_t out = 0;
+#ifdef RR_SIMD_X86
+  __m128i v0 = _mm_set1_epi64x(e0), v1 = _mm_set1_epi64x(e1), v2 = _mm_set1_epi64x(e2);
+  for (int s = 0; s < n; s += 2) {
+    __m128i o = _mm_or_si128(_mm_or_si128(_mm_add_epi64(v0, _mm_load_si128((const __m128i *)&off[0][s])),
+                                          _mm_add_epi64(v1, _mm_load_si128((const __m128i *)&off[1][s]))),
+                             _mm_add_epi64(v2, _mm_load_si128((const __m128i *)&off[2][s])));
+    out |= (uint32_t)_mm_movemask_pd(_mm_castsi128_pd(o)) << s;
   }
+  return ~out & ((2u << (n - 1)) - 1);
+#else
+  for (int s = 0; s < n; s++) out |= (uint32_t)(((e0 + off[0][s]) | (e1 + off[1][s]) | (e2 + off[2][s])) >= 0) << s;
+  return out;
+#endif
+}
+
+/* 2dr-bb at every position of a pattern at once: rows y0..y1 of the positions'
+ * union rectangle, each pixel's edge values computed once and moved by each
+ * position's constant offset, a bit mask of the positions covered; a covered
+ * sample is shaded as raster_row shades it at that position (its planes referenced
+ * to its own rectangle, made when the position is first covered), so each layer
+ * gets the bits of its one-position frame. */
+KERNEL void raster_bb_all(const tri2dm *m, int y0, int y1, bin_ctx *bc, const bool count) {
+  const pass2d *p = bc->pass;
+  const pipe2d *pp = p->pp;
+  const tri2d *t = &m->t;
+  int n = pp->samples;
+  /* position s's edge values are the pixel's plus off[i][s]; an odd pattern's last
+   * pair is padded with a position no edge value reaches */
+  int64_t off[3][RR_MAX_SAMPLES] __attribute__((aligned(16)));
+  for (int s = 0; s < n; s++)
+    for (int i = 0; i < 3; i++) off[i][s] = -(t->a[i] * pp->shift_x[s] + t->b[i] * pp->shift_y[s]);
+  if (n & 1)
+    for (int i = 0; i < 3; i++) off[i][n] = INT64_MIN / 2;
+  tri2d at[RR_MAX_SAMPLES]; /* position s's triangle, once bit s of `made` is set */
+  uint32_t made = 0;
+  int64_t s0 = (int64_t)t->a[0] * SUBPIX, s1 = (int64_t)t->a[1] * SUBPIX, s2 = (int64_t)t->a[2] * SUBPIX;
+  int x0 = t->rect[0], x1 = t->rect[2], width = pp->width;
+  for (int y = y0; y <= y1; y++) {
+    int64_t px = (int64_t)x0 * SUBPIX + SUBPIX / 2, py = (int64_t)y * SUBPIX + SUBPIX / 2;
+    int64_t e0 = t->a[0] * px + t->b[0] * py + t->c[0];
+    int64_t e1 = t->a[1] * px + t->b[1] * py + t->c[1];
+    int64_t e2 = t->a[2] * px + t->b[2] * py + t->c[2];
+    for (int x = x0; x <= x1; x++, e0 += s0, e1 += s1, e2 += s2) {
+      uint32_t mask = covered_mask(e0, e1, e2, off, n);
+      for (; mask; mask &= mask - 1) {
+        int s = __builtin_ctz(mask);
+        tri2d *ts = &at[s];
+        if (!(made >> s & 1)) made |= 1u << s, tri_at(pp, m, s, ts); /* covered: its rectangle is not empty */
+        float dy = (float)(y - ts->rect[1]);
+        float qr = ts->pw[0] + dy * ts->pw[2], tr = ts->pt[0] + dy * ts->pt[2];
+        float r1 = ts->p1[0] + dy * ts->p1[2], r2 = ts->p2[0] + dy * ts->p2[2];
+        shade2d(ts, (float)(x - ts->rect[0]), qr, tr, r1, r2, &p->tg[s], (size_t)y * width + x, count);
+      }
+    }
+  }
+  uint64_t evals = (uint64_t)(x1 - x0 + 1) * (uint64_t)(y1 - y0 + 1) * (uint64_t)n;
+  bc->evals += evals;
+  heat_charge(p->tg[0].heat, width, x0, y0, x1 + 1, y1 + 1, (float)evals);
+}
+
+/* The same at position bc->sample of a pattern's triangle (2dr-bin), or at all of
+ * them (2dr-bb). */
+KERNEL void draw2d_all(bin_ctx *bc, const tri2dm *m, int y0, int y1, const bool bin, const bool count) {
+  if (!bin) {
+    int ry0 = y0 > m->t.rect[1] ? y0 : m->t.rect[1], ry1 = y1 - 1 < m->t.rect[3] ? y1 - 1 : m->t.rect[3];
+    raster_bb_all(m, ry0, ry1, bc, count);
+    return;
+  }
+  tri2d t;
+  if (tri_at(bc->pass->pp, m, bc->sample, &t)) draw2d(bc, &t, y0, y1, bin, count);
 }
 
 /* draw2d for each mode, as the band loop takes them */
@@ -663,10 +728,16 @@ DRAW2D(draw_bb_claims, false, true)
 DRAW2D(draw_bin_z, true, false)
 DRAW2D(draw_bin_claims, true, true)
 
+/* A pattern's band is drawn by 2dr-bin one position after the other, each into its
+ * own layer and depth blocks (a position's samples of the band stay in cache while
+ * the batch streams past). */
 KERNEL void band2d(const sortmiddle *sm, int b, int thread, void (*draw)(void *, const void *, int, int)) {
   pass2d *p = sm->arg;
-  bin_ctx bc = {.tg = &p->tg[0], .hz = p->hz, .pass = p};
-  sm_draw_band(sm, b, &bc, draw);
+  bin_ctx bc = {.pass = p};
+  for (int s = 0; s < (p->bin ? p->pp->samples : 1); s++) { /* 2dr-bb takes all positions at once */
+    bc.tg = &p->tg[s], bc.hz = p->hz ? &p->hz[s] : NULL, bc.sample = s;
+    sm_draw_band(sm, b, &bc, draw);
+  }
   p->evals[thread] += bc.evals;
 }
 
