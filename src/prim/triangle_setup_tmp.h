@@ -165,18 +165,22 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
     cx = VF_(floor)(cx - lo_x) + lo_x, cy = VF_(floor)(cy - lo_y) + lo_y;
   }
   const VD dcx = TO_D(cx), dcy = TO_D(cy);
-  VD pa, pb, pc, num0, num_x = TO_D(zero), num_y = num_x, base = num_x;
+  VD pa, pb, pc, num0, num_x = TO_D(zero), num_y = num_x, base;
   if (c->type == RR_CAMERA_PERSPECTIVE) {
     pb = DOT3(nrm, DSPLAT3(c->dx)), pc = DOT3(nrm, DSPLAT3(c->dy));
     base = DOT3(nrm, DSPLAT3(c->d0));
     pa = base + dcx * pb + dcy * pc;
     num0 = DOT3(nrm, qf);
+    if (pl)
+      for (int l = 0; l < count; l++) pl[l].base = base[l], pl[l].u = pb[l], pl[l].v = pc[l];
   } else if (ortho) {
     /* rays from eye + o0 + sx·ox + sy·oy along fwd */
     pa = DOT3(nrm, DSPLAT3(c->fwd)), pb = num_x, pc = num_x;
     num_x = -DOT3(nrm, DSPLAT3(c->ox)), num_y = -DOT3(nrm, DSPLAT3(c->oy));
     base = DOT3(nrm, SUB3_T(D3, qf, DSPLAT3(c->o0)));
     num0 = base + dcx * num_x + dcy * num_y;
+    if (pl)
+      for (int l = 0; l < count; l++) pl[l].base = base[l], pl[l].u = num_x[l], pl[l].v = num_y[l];
   } else {
     pa = nrm.x, pb = nrm.y, pc = nrm.z;
     num0 = DOT3(nrm, qf);
@@ -195,11 +199,8 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
     o->pa = fpa[l], o->pb = fpb[l], o->pc = fpc[l];
     o->num0 = fn0[l], o->num_x = fnx[l], o->num_y = fny[l];
     o->cx = cx[l], o->cy = cy[l];
-    if (pl && c->planar) {
-      bool persp = c->type == RR_CAMERA_PERSPECTIVE;
-      pl[l].base = base[l], pl[l].u = persp ? pb[l] : num_x[l], pl[l].v = persp ? pc[l] : num_y[l];
-    }
   }
+
 }
 
 #undef SPLAT3

@@ -11,7 +11,7 @@
  * floats (no FMA, a true division), so every width gives their bits. Lanes past
  * r[2] are masked off and touch no memory. */
 
-TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at *at, uint32_t id,
+TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at *at, uint32_t id,
                                                      const int r[4], const camera *cams, int ns, visbuf *vb,
                                                      const bool planar) {
   VF a[3], b[3], cc[3];
@@ -80,4 +80,17 @@ TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const 
   }
   }
   return covered;
+}
+
+/* One position (the usual frame) and several: the loop above inlined into each,
+ * so the one-position frame pays nothing for the loop over positions. */
+TARGET static uint64_t RR_CAT(raster_one, W)(const tri_setup *ts, uint32_t id, const int r[4], const camera *c,
+                                             visbuf *vb, const bool planar) {
+  return planar ? RR_CAT(raster_loop, W)(ts, NULL, id, r, c, 1, vb, true)
+                : RR_CAT(raster_loop, W)(ts, NULL, id, r, c, 1, vb, false);
+}
+TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_at *at, uint32_t id, const int r[4],
+                                              const camera *cams, int ns, visbuf *vb, const bool planar) {
+  return planar ? RR_CAT(raster_loop, W)(ts, at, id, r, cams, ns, vb, true)
+                : RR_CAT(raster_loop, W)(ts, at, id, r, cams, ns, vb, false);
 }

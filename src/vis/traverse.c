@@ -81,8 +81,10 @@ typedef struct tri_job {
 KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_at *at, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
-  t->st.edge_evals += rr_raster_rect_samples(&j->ts, at, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
-  heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0) * t->ns));
+  t->st.edge_evals += !at ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
+                           : rr_raster_rect_samples(&j->ts, at, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
+  if (t->heat_e)
+    heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0) * t->ns));
   if (t->hiz_used) hiz_mark(t->hz, r.x0, r.y0, r.x1, r.y1);
   return covered;
 }
@@ -172,6 +174,17 @@ static float tri_t_floor(float zmin, float mag, float mag_p, const tri_setup *ts
   return minf(computed_t_floor(zmin, mag, ts->vol), computed_t_floor(zmin, mag_p, ts->num0));
 }
 
+/* The largest |pa| of a planar setup over the positions: the size of den's terms. */
+static float max_pa(const trav *t, const tri_job *j) {
+  float pa = fabsf(j->ts.pa);
+  for (int s = 1; s < t->ns; s++) {
+    tri_setup at;
+    rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &at);
+    pa = maxf(pa, fabsf(at.pa));
+  }
+  return pa;
+}
+
 /* Completes a set-up triangle j with what binning and early-z need. */
 static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
   const camera *c = t->c;
@@ -190,13 +203,7 @@ static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
       j->slack[e] = 1e-5f * m;
       mag += m;
     }
-    float pa = fabsf(j->ts.pa); /* the largest of the positions' pa */
-    for (int s = 1; s < t->ns; s++) {
-      tri_setup at;
-      rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &at);
-      pa = maxf(pa, fabsf(at.pa));
-    }
-    float mag_p = pa + W * fabsf(j->ts.pb) + H * fabsf(j->ts.pc);
+    float mag_p = (t->ns > 1 ? max_pa(t, j) : fabsf(j->ts.pa)) + W * fabsf(j->ts.pb) + H * fabsf(j->ts.pc);
     j->zmin = c->type == RR_CAMERA_PERSPECTIVE ? tri_t_floor(zmin, mag, mag_p, &j->ts) : 0;
   } else {
     /* the distance to the triangle's plane bounds every hit's distance from below */
@@ -221,14 +228,14 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
     int m = nb - q < 8 ? (int)(nb - q) : 8, face[8];
     uint32_t ids[8];
     tri_setup ts[8];
-    tri_plane pl[8];
+    tri_plane pls[8], *pl = t->ns > 1 ? pls : NULL;
     for (int l = 0; l < m; l++) ids[l] = b[q + l].id;
-    rr_tri_setup_planes(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face, t->ns > 1 ? pl : NULL);
+    rr_tri_setup_planes(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face, pl);
     for (int l = 0; l < m; l++) {
       if (face[l] == SETUP_CULLED) continue;
       tri_job *j = out + kept++;
       j->ts = ts[l];
-      if (t->ns > 1) j->pl = pl[l];
+      if (pl) j->pl = pl[l];
       memcpy(j->bb, b[q + l].bb, sizeof j->bb);
       finish_setup(t, ids[l], j);
     }
@@ -287,21 +294,31 @@ static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, ui
   return kept;
 }
 
-/* Rasterizes a prepared triangle into the samples of f it may cover, at every
- * position: the setup is moved to each once here, not per bin. */
-KERNEL void draw(trav *t, const tri_job *j, tile_rect f) {
-  tile_rect r = {j->bb[0] > f.x0 ? j->bb[0] : f.x0, j->bb[1] > f.y0 ? j->bb[1] : f.y0,
-                 j->bb[2] + 1 < f.x1 ? j->bb[2] + 1 : f.x1, j->bb[3] + 1 < f.y1 ? j->bb[3] + 1 : f.y1};
-  if (r.x0 >= r.x1 || r.y0 >= r.y1) return;
+/* Rasterizes a prepared triangle into the samples r, with its setup moved to
+ * each position (at; NULL for one position). */
+KERNEL void draw_rect(trav *t, const tri_job *j, const tri_at *at, tile_rect r) {
+  if (t->o->binning) bin_raster(t, j, at, r, t->o->bin_size);
+  else raster_samples(t, j, at, r);
+}
+
+/* Several positions: the setup moved to each once per draw, not per bin. */
+static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
   tri_at at[RR_MAX_SAMPLES];
-  for (int s = 0; s < t->ns && t->ns > 1; s++) {
+  for (int s = 0; s < t->ns; s++) {
     tri_setup m;
     rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &m);
     at[s] = (tri_at){m.pa, m.num0, m.cx, m.cy};
   }
-  const tri_at *pat = t->ns > 1 ? at : NULL;
-  if (t->o->binning) bin_raster(t, j, pat, r, t->o->bin_size);
-  else raster_samples(t, j, pat, r);
+  draw_rect(t, j, at, r);
+}
+
+/* Rasterizes a prepared triangle into the samples of f it may cover. */
+KERNEL void draw(trav *t, const tri_job *j, tile_rect f) {
+  tile_rect r = {j->bb[0] > f.x0 ? j->bb[0] : f.x0, j->bb[1] > f.y0 ? j->bb[1] : f.y0,
+                 j->bb[2] + 1 < f.x1 ? j->bb[2] + 1 : f.x1, j->bb[3] + 1 < f.y1 ? j->bb[3] + 1 : f.y1};
+  if (r.x0 >= r.x1 || r.y0 >= r.y1) return;
+  if (t->ns > 1) draw_moved(t, j, r);
+  else draw_rect(t, j, NULL, r);
 }
 
 /* ---- frusta against boxes ---------------------------------------------- */
