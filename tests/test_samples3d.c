@@ -218,8 +218,8 @@ int main(void) {
     CHECK(0, "load: %s", rr_device_message(dev));
     return test_done();
   }
-  rr_scene *demo = NULL; /* curved views bound triangles coarsely: a lighter scene keeps them quick */
-  if (rr_scene_load(dev, "demo", &demo) != RR_OK) {
+  rr_scene *light = NULL; /* curved views bound triangles coarsely: a lighter scene keeps them quick */
+  if (rr_scene_load(dev, "sphere:32", &light) != RR_OK) {
     CHECK(0, "load: %s", rr_device_message(dev));
     return test_done();
   }
@@ -231,7 +231,7 @@ int main(void) {
     int w = curved ? 32 : 48, h = curved ? 24 : 36;
     for (int v = 0; v <= views; v++) {
       /* v = 0: inside the bounds, looking around; then random views from outside */
-      const rr_scene *sc = curved ? demo : s;
+      const rr_scene *sc = curved ? light : s;
       rr_camera cam = v == 0 ? test_random_view(sc, 0.2f, 0.2f, 1, 90, 90) : test_random_view(sc, 1.2f, 3, 0.4f, 30, 80);
       cam.type = (rr_camera_type)type;
       if (type == RR_CAMERA_FISHEYE && v == 0) cam.fov_deg = 200;
@@ -245,7 +245,7 @@ int main(void) {
   rr_camera_init(&cam);
   rr_camera_frame(dev, s, 48, 36, &cam);
   check_stats(dev, s, &cam);
-  rr_scene_release(s), rr_scene_release(demo);
+  rr_scene_release(s), rr_scene_release(light);
   rr_device_release(dev);
   return test_done();
 }
