@@ -136,8 +136,8 @@ static void check_moves(rr_device *dev, const rr_scene *s) {
  * x + sx0 lies on world x = x + sx0 - 32, inside the plane's [-33, 33], so the
  * positions (0, 0), (0.5, 0), (0, 0.5) and (0.5, 0.5) fall on the vertices, on the
  * edges along either axis and on the cells' centres, which their diagonals cross.
- * Every claim is counted, as rc's loop and 3dr-bb's bounds over the pattern's
- * extent visit: each (pixel, position) exactly once; then the methods render it. */
+ * Every claim is counted, as rc's loop and 3dr-bb's bounds over the positions
+ * visit: each (pixel, position) exactly once; then the methods render it. */
 static void check_watertight(rr_device *dev) {
   rr_scene *plane;
   if (rr_scene_load(dev, "plane:66", &plane) != RR_OK) {
@@ -156,7 +156,6 @@ static void check_watertight(rr_device *dev) {
   CHECK(cams[0].tan_half_h == 1.0f, "tan(45°) rounds to %.9g", cams[0].tan_half_h);
   static uint8_t claims[2][4][N * N];
   memset(claims, 0, sizeof claims);
-  const float span[4] = {0, 0, 0.5f, 0.5f};
   int on_edge = 0;
   for (uint32_t i = 0; i < plane->ntris; i++) {
     tri_setup ts;
@@ -165,8 +164,8 @@ static void check_watertight(rr_device *dev) {
     rr_tri_setup_planes(plane, &i, 1, &cams[0], false, false, &ts, &face, &pl);
     if (face == SETUP_CULLED) continue;
     tri_bound b = {0, {0, 0, N - 1, N - 1}};
-    for (int m = 0; m < 2; m++) { /* m = 0: every pixel (rc); 1: the bounds over the extent */
-      if (m == 1 && !rr_tri_corner_bounds_span(plane, i, NULL, 1, &cams[0], span, false, &b)) continue;
+    for (int m = 0; m < 2; m++) { /* m = 0: every pixel (rc); 1: the bounds over the positions */
+      if (m == 1 && !rr_tri_corner_bounds_at(plane, i, NULL, 1, &cams[0], 4, on, false, &b)) continue;
       for (int k = 0; k < 4; k++) {
         tri_setup at;
         rr_tri_setup_at(&ts, &pl, &cams[k], &at);
@@ -186,7 +185,7 @@ static void check_watertight(rr_device *dev) {
     for (int k = 0; k < 4; k++)
       for (int p = 0; p < N * N; p++) holes += claims[m][k][p] == 0, doubles += claims[m][k][p] > 1;
     CHECK(holes == 0 && doubles == 0, "plane at sample level (%s): %d holes, %d double claims",
-          m ? "bounds over the extent" : "every pixel", holes, doubles);
+          m ? "bounds over the positions" : "every pixel", holes, doubles);
   }
   CHECK(on_edge >= 3 * N * N, "only %d of %d samples fell on an edge or vertex", on_edge, 4 * N * N);
   printf("plane: %d of %d samples decided on an edge or vertex\n", on_edge, 4 * N * N);

@@ -222,11 +222,11 @@ typedef struct tri_bound {
 } tri_bound;
 uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
                            bool simd, tri_bound *out);
-/* The same for every sample position (sx0, sy0) in span[0..1] .. span[2..3] (the
- * extent of a pattern; c's own position is not read): the rectangle of pixels
- * that may hold a sample of any of them. */
-uint32_t rr_tri_corner_bounds_span(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n,
-                                   const camera *c, const float span[4], bool simd, tri_bound *out);
+/* The same for the npos sample positions pos[k] (sx0, sy0 of each; c's own is
+ * not read): the union of the rectangles of the positions whose samples may
+ * meet the triangle, which is kept when one does. */
+uint32_t rr_tri_corner_bounds_at(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
+                                 int npos, const float (*pos)[2], bool simd, tri_bound *out);
 /* Curved cameras: what bounds a triangle's directions from the eye. */
 typedef struct tri_cone {
   float len[4];      /* lengths of the three edge normals and of their sum */

@@ -42,6 +42,7 @@ typedef struct trav {
   const camera *cams; /* one per sample position, ns of them (render_ctx) */
   int ns;
   float span[4];      /* the positions' extent: x0, y0, x1, y1 of their (sx0, sy0) */
+  float pos[RR_MAX_SAMPLES][2]; /* the positions: (sx0, sy0) of each camera */
   const oracles *o;
   visbuf *vb;
   bool cull_back, simd;
@@ -272,7 +273,7 @@ static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, int b
 static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
                                 tri_bound *scratch, tri_job *out) {
   if (t->c->planar) {
-    uint32_t nb = rr_tri_corner_bounds_span(t->s, first, ids, n, t->c, t->span, t->simd, scratch), kept = 0;
+    uint32_t nb = rr_tri_corner_bounds_at(t->s, first, ids, n, t->c, t->ns, t->pos, t->simd, scratch), kept = 0;
     if (r) {
       for (uint32_t k = 0; k < nb; k++)
         if (meets(scratch[k].bb, *r)) scratch[kept++] = scratch[k];
@@ -688,6 +689,7 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
                 .heat_e = ctx->heat_e,
                 .heat_n = ctx->heat_n};
   proto.span[0] = proto.span[2] = ctx->cams[0].sx0, proto.span[1] = proto.span[3] = ctx->cams[0].sy0;
+  for (int s = 0; s < ctx->samples; s++) proto.pos[s][0] = ctx->cams[s].sx0, proto.pos[s][1] = ctx->cams[s].sy0;
   for (int s = 1; s < ctx->samples; s++) {
     proto.span[0] = minf(proto.span[0], ctx->cams[s].sx0), proto.span[1] = minf(proto.span[1], ctx->cams[s].sy0);
     proto.span[2] = maxf(proto.span[2], ctx->cams[s].sx0), proto.span[3] = maxf(proto.span[3], ctx->cams[s].sy0);
