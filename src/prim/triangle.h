@@ -39,6 +39,21 @@ int rr_tri_setup(const rr_scene *s, uint32_t i, const camera *c, bool cull_backf
 void rr_tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces, bool simd,
                    tri_setup *out, int *face);
 
+/* What a setup for one sample position needs to become the setup for another
+ * (planar cameras): only the sample (cx, cy) near the triangle moves with the
+ * position, and with it the one coefficient of the depth that depends on it, pa
+ * (perspective) or num0 (orthographic) = base + cx·u + cy·v rounded once from
+ * double. The edges, the volume and the tie bits do not depend on the position. */
+typedef struct tri_plane {
+  float px, py;       /* where the finite corner projects, before the clamp to the image */
+  double base, u, v;
+} tri_plane;
+/* rr_tri_setup_run that also writes each kept triangle's tri_plane to pl[k]. */
+void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces,
+                         bool simd, tri_setup *out, int *face, tri_plane *pl);
+/* The setup ts (from rr_tri_setup_planes with a camera that differs from c only in
+ * its sample position) for camera c: the bits rr_tri_setup gives for c. */
+void rr_tri_setup_at(const tri_setup *ts, const tri_plane *pl, const camera *c, tri_setup *out);
 /* The three edge functions of a set-up triangle for evaluation vector w. The
  * order of operations is fixed (the build uses -ffp-contract=off: a fused
  * multiply-add would change the bits) so every method computes the same values
@@ -207,6 +222,11 @@ typedef struct tri_bound {
 } tri_bound;
 uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
                            bool simd, tri_bound *out);
+/* The same for the npos sample positions pos[k] (sx0, sy0 of each; c's own is
+ * not read): the union of the rectangles of the positions whose samples may
+ * meet the triangle, which is kept when one does. */
+uint32_t rr_tri_corner_bounds_at(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
+                                 int npos, const float (*pos)[2], bool simd, tri_bound *out);
 /* Curved cameras: what bounds a triangle's directions from the eye. */
 typedef struct tri_cone {
   float len[4];      /* lengths of the three edge normals and of their sum */

@@ -79,7 +79,8 @@ static bool curved_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
 bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int r[4]) {
   if (c->planar) {
     tri_bound b;
-    if (!corner_bounds1(s, i, NULL, 1, c, &b)) return false;
+    const float pos[1][2] = {{c->sx0, c->sy0}};
+    if (!corner_bounds1(s, i, NULL, 1, c, 1, pos, &b)) return false;
     memcpy(r, b.bb, sizeof b.bb);
     return true;
   }
@@ -91,17 +92,23 @@ bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
   return curved_bounds(s, i, c, ts, r);
 }
 
-uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
-                              bool simd, tri_bound *out) {
+uint32_t rr_tri_corner_bounds_at(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
+                                 int npos, const float (*pos)[2], bool simd, tri_bound *out) {
   uint32_t kept = 0, k = 0;
 #ifdef RR_SIMD_X86
   if (simd && __builtin_cpu_supports("avx2"))
     for (; k < n; k += 8)
-      kept += corner_bounds8(s, first + k, ids ? ids + k : NULL, n - k < 8 ? (int)(n - k) : 8, c, out + kept);
+      kept += corner_bounds8(s, first + k, ids ? ids + k : NULL, n - k < 8 ? (int)(n - k) : 8, c, npos, pos, out + kept);
 #endif
   (void)simd;
-  for (; k < n; k++) kept += corner_bounds1(s, first + k, ids ? ids + k : NULL, 1, c, out + kept);
+  for (; k < n; k++) kept += corner_bounds1(s, first + k, ids ? ids + k : NULL, 1, c, npos, pos, out + kept);
   return kept;
+}
+
+uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
+                              bool simd, tri_bound *out) {
+  const float pos[1][2] = {{c->sx0, c->sy0}};
+  return rr_tri_corner_bounds_at(s, first, ids, n, c, 1, pos, simd, out);
 }
 
 /* The least t that sample_test() can return for ts at any sample of camera c.

@@ -4,12 +4,14 @@
  * The pixel rectangles of triangles ids[0..n-1] (first..first+n-1 when ids is
  * NULL; n <= W, the padding lanes repeat the last one) for a planar camera, from
  * their projected corners, as rr_tri_screen_bounds defines them (the comments
- * there): the same operations in the same order (no FMA, true divisions), lane by
+ * there) for the npos sample positions pos (the union of their rectangles): the
+ * same operations in the same order (no FMA, true divisions), lane by
  * lane, so every width gives the same rectangles. Writes the triangles whose
  * rectangle holds a sample to out, in order; returns how many. */
 
 TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
-                                                       const camera *c, tri_bound *out) {
+                                                       const camera *c, int npos, const float (*pos)[2],
+                                                       tri_bound *out) {
   int32_t lane_id[W], lane_inf[W] = {0};
   for (int l = 0; l < W; l++)
     lane_id[l] = (int32_t)(ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1));
@@ -57,10 +59,29 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
   const VI bounded = c->type == RR_CAMERA_ORTHOGRAPHIC ? projected & (inf == 0) : projected;
   const VF big = VF_(max)(VF_(max)(VF_(abs)(x0), VF_(abs)(x1)), VF_(max)(VF_(abs)(y0), VF_(abs)(y1)));
   const VF m = VF_(splat)(1.0f / 64) + VF_(splat)(1e-5f) * big;
-  const VF ox = VF_(splat)(c->sx0), oy = VF_(splat)(c->sy0); /* the sample's position in the pixel */
-  VF lx = VF_(max)(VF_(ceil)(x0 - ox - m), zero), hx = VF_(min)(VF_(floor)(x1 - ox + m), last_x);
+  /* the rectangle of pixels whose sample at position (ox, oy) may lie in the hull;
+   * with several positions, the union of those that hold one */
+#define POS_RECT(ox, oy)                                                                                    \
+  VF lx = VF_(max)(VF_(ceil)(x0 - ox - m), zero), hx = VF_(min)(VF_(floor)(x1 - ox + m), last_x);        \
   VF ly = VF_(max)(VF_(ceil)(y0 - oy - m), zero), hy = VF_(min)(VF_(floor)(y1 - oy + m), last_y);
-  const VI empty = (lx > hx) | (ly > hy);
+  POS_RECT(VF_(splat)(pos[0][0]), VF_(splat)(pos[0][1]))
+  VI empty = (lx > hx) | (ly > hy);
+  for (int p = 1; p < npos; p++) {
+    VF ux = lx, uy = ly, vx = hx, vy = hy;
+    VI was = empty;
+    {
+      POS_RECT(VF_(splat)(pos[p][0]), VF_(splat)(pos[p][1]))
+      const VI none = (lx > hx) | (ly > hy);
+      /* empty so far: this position's rectangle; else the union with it unless it is empty */
+      ux = VF_(select)(was, lx, VF_(select)(none, ux, VF_(min)(ux, lx)));
+      uy = VF_(select)(was, ly, VF_(select)(none, uy, VF_(min)(uy, ly)));
+      vx = VF_(select)(was, hx, VF_(select)(none, vx, VF_(max)(vx, hx)));
+      vy = VF_(select)(was, hy, VF_(select)(none, vy, VF_(max)(vy, hy)));
+      empty = was & none;
+    }
+    lx = ux, ly = uy, hx = vx, hy = vy;
+  }
+#undef POS_RECT
   const int keep = VI_(bits)(ahead_any & ~(bounded & empty)) & ((1 << n) - 1);
   if (!keep) return 0;
   /* not bounded: the whole screen */

@@ -52,19 +52,41 @@
 
 int rr_tri_setup(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces, tri_setup *out) {
   int face;
-  setup_lanes1(s, &i, 1, c, cull_backfaces, out, &face);
+  setup_lanes1(s, &i, 1, c, cull_backfaces, out, &face, NULL);
   return face;
+}
+
+void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces,
+                         bool simd, tri_setup *out, int *face, tri_plane *pl) {
+  int k = 0;
+#ifdef RR_SIMD_X86
+  if (simd && __builtin_cpu_supports("avx2"))
+    for (; k < n; k += 8)
+      setup_lanes8(s, ids + k, n - k < 8 ? n - k : 8, c, cull_backfaces, out + k, face + k, pl ? pl + k : NULL);
+#endif
+  (void)simd;
+  for (; k < n; k++) setup_lanes1(s, ids + k, 1, c, cull_backfaces, out + k, face + k, pl ? pl + k : NULL);
 }
 
 void rr_tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces, bool simd,
                       tri_setup *out, int *face) {
-  int k = 0;
-#ifdef RR_SIMD_X86
-  if (simd && __builtin_cpu_supports("avx2"))
-    for (; k < n; k += 8) setup_lanes8(s, ids + k, n - k < 8 ? n - k : 8, c, cull_backfaces, out + k, face + k);
-#endif
-  (void)simd;
-  for (; k < n; k++) setup_lanes1(s, ids + k, 1, c, cull_backfaces, out + k, face + k);
+  rr_tri_setup_planes(s, ids, n, c, cull_backfaces, simd, out, face, NULL);
+}
+
+void rr_tri_setup_at(const tri_setup *ts, const tri_plane *pl, const camera *c, tri_setup *out) {
+  *out = *ts;
+  if (!c->planar) return; /* (cx, cy) = (0, 0) at every position */
+  /* the template's clamp (min, max as minps, maxps: a NaN gives the bound) and floor */
+  const float lo_x = c->sx0, hi_x = (float)(c->width - 1) + c->sx0;
+  const float lo_y = c->sy0, hi_y = (float)(c->height - 1) + c->sy0;
+  float cx = pl->px < hi_x ? pl->px : hi_x, cy = pl->py < hi_y ? pl->py : hi_y;
+  cx = cx > lo_x ? cx : lo_x, cy = cy > lo_y ? cy : lo_y;
+  cx = floorf(cx - lo_x) + lo_x, cy = floorf(cy - lo_y) + lo_y;
+  const double dcx = cx, dcy = cy;
+  const float p = (float)(pl->base + dcx * pl->u + dcy * pl->v);
+  out->cx = cx, out->cy = cy;
+  if (c->type == RR_CAMERA_PERSPECTIVE) out->pa = p;
+  else out->num0 = p;
 }
 
 bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull, float tmin, float tmax, float *t,

@@ -43,7 +43,7 @@ typedef struct {
   (((g1) > zero) | (((g1) == zero) & (((g2) > zero) | (((g2) == zero) & ((g3) > zero)))))
 
 TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32_t *ids, int count, const camera *c,
-                                                 bool cull, tri_setup *out, int *face) {
+                                                 bool cull, tri_setup *out, int *face, tri_plane *pl) {
   int32_t lane_id[W], lane_inf[W] = {0};
   for (int l = 0; l < W; l++) lane_id[l] = (int32_t)ids[l < count ? l : count - 1];
   if (s->inf)
@@ -156,22 +156,31 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
     const VF depth = ortho ? VF_(splat)(v3_dot(w0, uv)) : DOT3(q, SPLAT3(uv));
     const VF lo_x = VF_(splat)(c->sx0), hi_x = VF_(splat)((float)(c->width - 1) + c->sx0);
     const VF lo_y = VF_(splat)(c->sy0), hi_y = VF_(splat)((float)(c->height - 1) + c->sy0);
-    /* NaN (a corner in the eye's plane) clamps to the far side: any sample is exact */
-    cx = VF_(max)(VF_(min)(DOT3(q, SPLAT3(v3_cross(v, w0))) / depth, hi_x), lo_x);
-    cy = VF_(max)(VF_(min)(DOT3(q, SPLAT3(v3_cross(w0, u))) / depth, hi_y), lo_y);
+    cx = DOT3(q, SPLAT3(v3_cross(v, w0))) / depth, cy = DOT3(q, SPLAT3(v3_cross(w0, u))) / depth;
+    if (pl)
+      for (int l = 0; l < count; l++) pl[l].px = cx[l], pl[l].py = cy[l];
+    /* NaN (a corner in the eye's plane) clamps to the far side: any sample is exact
+     * (tri_setup_at repeats these operations for another position) */
+    cx = VF_(max)(VF_(min)(cx, hi_x), lo_x), cy = VF_(max)(VF_(min)(cy, hi_y), lo_y);
     cx = VF_(floor)(cx - lo_x) + lo_x, cy = VF_(floor)(cy - lo_y) + lo_y;
   }
   const VD dcx = TO_D(cx), dcy = TO_D(cy);
-  VD pa, pb, pc, num0, num_x = TO_D(zero), num_y = num_x;
+  VD pa, pb, pc, num0, num_x = TO_D(zero), num_y = num_x, base;
   if (c->type == RR_CAMERA_PERSPECTIVE) {
     pb = DOT3(nrm, DSPLAT3(c->dx)), pc = DOT3(nrm, DSPLAT3(c->dy));
-    pa = DOT3(nrm, DSPLAT3(c->d0)) + dcx * pb + dcy * pc;
+    base = DOT3(nrm, DSPLAT3(c->d0));
+    pa = base + dcx * pb + dcy * pc;
     num0 = DOT3(nrm, qf);
+    if (pl)
+      for (int l = 0; l < count; l++) pl[l].base = base[l], pl[l].u = pb[l], pl[l].v = pc[l];
   } else if (ortho) {
     /* rays from eye + o0 + sx·ox + sy·oy along fwd */
     pa = DOT3(nrm, DSPLAT3(c->fwd)), pb = num_x, pc = num_x;
     num_x = -DOT3(nrm, DSPLAT3(c->ox)), num_y = -DOT3(nrm, DSPLAT3(c->oy));
-    num0 = DOT3(nrm, SUB3_T(D3, qf, DSPLAT3(c->o0))) + dcx * num_x + dcy * num_y;
+    base = DOT3(nrm, SUB3_T(D3, qf, DSPLAT3(c->o0)));
+    num0 = base + dcx * num_x + dcy * num_y;
+    if (pl)
+      for (int l = 0; l < count; l++) pl[l].base = base[l], pl[l].u = num_x[l], pl[l].v = num_y[l];
   } else {
     pa = nrm.x, pb = nrm.y, pc = nrm.z;
     num0 = DOT3(nrm, qf);
@@ -191,6 +200,7 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
     o->num0 = fn0[l], o->num_x = fnx[l], o->num_y = fny[l];
     o->cx = cx[l], o->cy = cy[l];
   }
+
 }
 
 #undef SPLAT3

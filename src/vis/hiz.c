@@ -10,7 +10,7 @@ void rr_hiz_free(hiz *h) {
 
 bool rr_hiz_init(hiz *h, const visbuf *vb, int shift, int levels) {
   memset(h, 0, sizeof *h);
-  h->vb = vb, h->shift = shift, h->levels = levels;
+  h->vb = vb, h->layers = 1, h->shift = shift, h->levels = levels;
   for (int l = 0; l < levels; l++) {
     int s = 1 << (shift + 2 * l);
     h->w[l] = (vb->width + s - 1) / s, h->h[l] = (vb->height + s - 1) / s;

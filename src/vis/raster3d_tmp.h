@@ -2,14 +2,18 @@
  * that raster3d.c instantiates per width through core/simd_widths.h.
  *
  * Every sample of rectangle r against one set-up triangle, W samples of a row at
- * a time, columns then rows (the terms in sx are the same on every row). A lane is
+ * a time, columns then rows (the terms in sx are the same on every row), for each
+ * of the ns sample positions in turn (cams[s], layer s of vb): the triangle's
+ * constants are loaded once, and at[s] (NULL for one position: ts's own) gives
+ * the four setup values that move with the position. A lane is
  * the sample test of prim/triangle.h (sample_test_w) and the depth test of
  * vis/vis.h (depth_wins), with the depth of TRI_DEPTH: the same operations in the same order on IEEE single
  * floats (no FMA, a true division), so every width gives their bits. Lanes past
  * r[2] are masked off and touch no memory. */
 
-TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32_t id, const int r[4],
-                                                     const camera *c, visbuf *vb, const bool planar) {
+TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at *at, uint32_t id,
+                                                     const int r[4], const camera *cams, int ns, visbuf *vb,
+                                                     const bool planar) {
   VF a[3], b[3], cc[3];
   VI tie[3];
 #pragma GCC unroll 3
@@ -19,17 +23,20 @@ TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32
   }
   const VF w0 = VF_(splat)(ts->w[0]), w1 = VF_(splat)(ts->w[1]), w2 = VF_(splat)(ts->w[2]);
   const VF vol = VF_(splat)(ts->vol), vol_x = VF_(splat)(ts->vol_x), vol_y = VF_(splat)(ts->vol_y);
-  const VF pa = VF_(splat)(ts->pa), pb = VF_(splat)(ts->pb), pc = VF_(splat)(ts->pc);
-  const VF num0 = VF_(splat)(ts->num0), num_x = VF_(splat)(ts->num_x), num_y = VF_(splat)(ts->num_y);
-  const VF cx = VF_(splat)(ts->cx), cy = VF_(splat)(ts->cy);
+  const VF pb = VF_(splat)(ts->pb), pc = VF_(splat)(ts->pc);
+  const VF num_x = VF_(splat)(ts->num_x), num_y = VF_(splat)(ts->num_y);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
   const VI idv = VI_(splat)((int32_t)id), bias = VI_(splat)(INT32_MIN), id_biased = idv ^ bias;
   const VI end = VI_(splat)(r[2] + 1);
-  float *best_t = vb->t, *l1 = vb->l1, *l2 = vb->l2;
-  int32_t *best_id = (int32_t *)vb->id;
-  const size_t width = (size_t)vb->width;
+  const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
   uint64_t covered = 0;
+  for (int s = 0; s < ns; s++) {
+  const camera *c = &cams[s];
+  const tri_at p = at ? at[s] : (tri_at){ts->pa, ts->num0, ts->cx, ts->cy};
+  const VF pa = VF_(splat)(p.pa), num0 = VF_(splat)(p.num0), cx = VF_(splat)(p.cx), cy = VF_(splat)(p.cy);
+  float *best_t = vb->t + s * layer, *l1 = vb->l1 + s * layer, *l2 = vb->l2 + s * layer;
+  int32_t *best_id = (int32_t *)vb->id + s * layer;
   for (int x = r[0]; x <= r[2]; x += W) {
     const VI xi = VI_(splat)(x) + VI_(lanes)(), valid = end > xi;
     const VF sx = VF_(from_int)(xi) + VF_(splat)(c->sx0);
@@ -71,5 +78,19 @@ TARGET static inline uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, uint32
       VF_(store_masked)(l2 + k, wins, ev[2] * inv);
     }
   }
+  }
   return covered;
+}
+
+/* One position (the usual frame) and several: the loop above inlined into each,
+ * so the one-position frame pays nothing for the loop over positions. */
+TARGET static uint64_t RR_CAT(raster_one, W)(const tri_setup *ts, uint32_t id, const int r[4], const camera *c,
+                                             visbuf *vb, const bool planar) {
+  return planar ? RR_CAT(raster_loop, W)(ts, NULL, id, r, c, 1, vb, true)
+                : RR_CAT(raster_loop, W)(ts, NULL, id, r, c, 1, vb, false);
+}
+TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_at *at, uint32_t id, const int r[4],
+                                              const camera *cams, int ns, visbuf *vb, const bool planar) {
+  return planar ? RR_CAT(raster_loop, W)(ts, at, id, r, cams, ns, vb, true)
+                : RR_CAT(raster_loop, W)(ts, at, id, r, cams, ns, vb, false);
 }

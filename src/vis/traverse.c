@@ -38,7 +38,11 @@ enum { PEND_DRAW = 16 }; /* see trav.pend */
 
 typedef struct trav {
   const rr_scene *s;
-  const camera *c;
+  const camera *c;    /* cams[0]: what does not depend on the sample position */
+  const camera *cams; /* one per sample position, ns of them (render_ctx) */
+  int ns;
+  float span[4];      /* the positions' extent: x0, y0, x1, y1 of their (sx0, sy0) */
+  float pos[RR_MAX_SAMPLES][2]; /* the positions: (sx0, sy0) of each camera */
   const oracles *o;
   visbuf *vb;
   bool cull_back, simd;
@@ -69,39 +73,66 @@ typedef struct tri_job {
     float slack[3];  /* planar: how far below zero a rounded corner value may fall for an inside sample */
     tri_cone cone;   /* curved: what bounds the triangle's directions */
   };
+  tri_plane pl;      /* planar, several positions: how ts moves to each (rr_tri_setup_at) */
 } tri_job;
 
-/* Tests every sample of r; the one kernel every generateSamples path ends in.
- * Returns the samples the triangle covers. */
-KERNEL uint64_t raster_samples(trav *t, const tri_job *j, tile_rect r) {
+/* Tests every sample of r at every position (at: the setup moved to each, NULL
+ * for one); the one kernel every generateSamples path ends in. Returns the
+ * samples the triangle covers. */
+KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_at *at, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
-  t->st.edge_evals += rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd);
-  heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
+  t->st.edge_evals += !at ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
+                           : rr_raster_rect_samples(&j->ts, at, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
+  if (t->heat_e)
+    heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0) * t->ns));
   if (t->hiz_used) hiz_mark(t->hz, r.x0, r.y0, r.x1, r.y1);
   return covered;
 }
 
+/* Curved views bend edges into arcs, so corners prove nothing. Bound the bin's
+ * rays by a cone instead: edge e rejects the bin when its plane leaves the whole
+ * cone on the outside, n·axis < -|n| sin(angle) (paper sect. 4.1 does the same for
+ * the parabolic map by shifting the corners); with several positions, every
+ * position's cone. 1: rejected, 0: kept, -1: no rays there. */
+static int cone_rejects(trav *t, const tri_job *j, tile_rect b) {
+  int rays = 0;
+  for (int s = 0; s < t->ns; s++) {
+    vec3 axis;
+    float angle;
+    int cone = rr_cam_rect_cone(&t->cams[s], b.x0, b.y0, b.x1, b.y1, &axis, &angle);
+    if (cone < 0) continue;
+    rays = 1;
+    if (!(cone > 0 && angle < CAMERA_NO_CONE)) return 0;
+    t->st.edge_evals += 1;
+    int cx = (b.x0 + b.x1) / 2, cy = (b.y0 + b.y1) / 2;
+    heat_charge(t->heat_e, t->vb->width, cx, cy, cx + 1, cy + 1, 1.0f);
+    if (!rr_cone_excludes(&j->cone, &j->ts, axis, angle)) return 0;
+  }
+  return rays ? 1 : -1;
+}
+
 /* Hierarchical binning: a bin is rejected when one edge function is negative at
- * all four corner samples (the edges are linear in the sample position for planar
- * cameras) or when early-z shows it is hidden; otherwise it is refined by 4 in each
- * direction down to single samples. Accepted samples still go through the sample
- * test, which keeps the result bit-identical. */
-static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
+ * all four corners of its samples (the edges are linear in the sample position
+ * for planar cameras; with several positions, the corners of their extent) or when
+ * early-z shows it is hidden; otherwise it is refined by 4 in each direction down
+ * to single pixels. Accepted samples still go through the sample test, which keeps
+ * the result bit-identical. */
+static uint64_t bin_raster(trav *t, const tri_job *j, const tri_at *at, tile_rect r, int size) {
   uint64_t covered = 0;
   for (int by = r.y0 - r.y0 % size; by < r.y1; by += size)
     for (int bx = r.x0 - r.x0 % size; bx < r.x1; bx += size) {
       tile_rect b = {bx > r.x0 ? bx : r.x0, by > r.y0 ? by : r.y0, bx + size < r.x1 ? bx + size : r.x1,
                      by + size < r.y1 ? by + size : r.y1};
       if (size <= t->o->bin_min || (b.x1 - b.x0) * (b.y1 - b.y0) <= 4) {
-        covered += raster_samples(t, j, b);
+        covered += raster_samples(t, j, at, b);
         continue;
       }
       bool out = false;
       if (t->c->planar) {
-        /* the bin's corner samples */
-        float xs[2] = {(float)b.x0 + t->c->sx0, (float)(b.x1 - 1) + t->c->sx0};
-        float ys[2] = {(float)b.y0 + t->c->sy0, (float)(b.y1 - 1) + t->c->sy0};
+        /* the corners of the bin's samples */
+        float xs[2] = {(float)b.x0 + t->span[0], (float)(b.x1 - 1) + t->span[2]};
+        float ys[2] = {(float)b.y0 + t->span[1], (float)(b.y1 - 1) + t->span[3]};
         for (int e = 0; e < 3 && !out; e++) {
           bool all_out = true;
           for (int k = 0; k < 4 && all_out; k++)
@@ -111,25 +142,14 @@ static uint64_t bin_raster(trav *t, const tri_job *j, tile_rect r, int size) {
         t->st.edge_evals += 4;
         heat_charge_corners(t->heat_e, t->vb->width, b.x0, b.y0, b.x1, b.y1);
       } else {
-        /* Curved views bend edges into arcs, so corners prove nothing. Bound the bin's
-         * rays by a cone instead: edge e rejects the bin when its plane leaves the
-         * whole cone on the outside, n·axis < -|n| sin(angle) (paper sect. 4.1 does
-         * the same for the parabolic map by shifting the corners). */
-        vec3 axis;
-        float angle;
-        int cone = rr_cam_rect_cone(t->c, b.x0, b.y0, b.x1, b.y1, &axis, &angle);
-        if (cone < 0) continue; /* no rays here: nothing to refine */
-        if (cone > 0 && angle < CAMERA_NO_CONE) {
-          out = rr_cone_excludes(&j->cone, &j->ts, axis, angle);
-          t->st.edge_evals += 1;
-          int cx = (b.x0 + b.x1) / 2, cy = (b.y0 + b.y1) / 2;
-          heat_charge(t->heat_e, t->vb->width, cx, cy, cx + 1, cy + 1, 1.0f);
-        }
+        int rejects = cone_rejects(t, j, b);
+        if (rejects < 0) continue; /* no rays here: nothing to refine */
+        out = rejects > 0;
       }
       if (out) continue;
       if (t->o->early_z && hiz_nearer(t->hz, b.x0, b.y0, b.x1, b.y1, j->zmin)) continue;
       /* refined: count the bins that turn out to hold none of the triangle */
-      uint64_t in = bin_raster(t, j, b, size / 4 > 1 ? size / 4 : 1);
+      uint64_t in = bin_raster(t, j, at, b, size / 4 > 1 ? size / 4 : 1);
       t->st.bins++;
       t->st.bins_empty += in == 0;
       covered += in;
@@ -155,6 +175,17 @@ static float tri_t_floor(float zmin, float mag, float mag_p, const tri_setup *ts
   return minf(computed_t_floor(zmin, mag, ts->vol), computed_t_floor(zmin, mag_p, ts->num0));
 }
 
+/* The largest |pa| of a planar setup over the positions: the size of den's terms. */
+static float max_pa(const trav *t, const tri_job *j) {
+  float pa = fabsf(j->ts.pa);
+  for (int s = 1; s < t->ns; s++) {
+    tri_setup at;
+    rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &at);
+    pa = maxf(pa, fabsf(at.pa));
+  }
+  return pa;
+}
+
 /* Completes a set-up triangle j with what binning and early-z need. */
 static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
   const camera *c = t->c;
@@ -173,7 +204,7 @@ static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
       j->slack[e] = 1e-5f * m;
       mag += m;
     }
-    float mag_p = fabsf(j->ts.pa) + W * fabsf(j->ts.pb) + H * fabsf(j->ts.pc);
+    float mag_p = (t->ns > 1 ? max_pa(t, j) : fabsf(j->ts.pa)) + W * fabsf(j->ts.pb) + H * fabsf(j->ts.pc);
     j->zmin = c->type == RR_CAMERA_PERSPECTIVE ? tri_t_floor(zmin, mag, mag_p, &j->ts) : 0;
   } else {
     /* the distance to the triangle's plane bounds every hit's distance from below */
@@ -198,12 +229,14 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
     int m = nb - q < 8 ? (int)(nb - q) : 8, face[8];
     uint32_t ids[8];
     tri_setup ts[8];
+    tri_plane pls[8], *pl = t->ns > 1 ? pls : NULL;
     for (int l = 0; l < m; l++) ids[l] = b[q + l].id;
-    rr_tri_setup_run(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face);
+    rr_tri_setup_planes(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face, pl);
     for (int l = 0; l < m; l++) {
       if (face[l] == SETUP_CULLED) continue;
       tri_job *j = out + kept++;
       j->ts = ts[l];
+      if (pl) j->pl = pl[l];
       memcpy(j->bb, b[q + l].bb, sizeof j->bb);
       finish_setup(t, ids[l], j);
     }
@@ -216,6 +249,21 @@ static bool meets(const int bb[4], tile_rect r) {
   return bb[0] < r.x1 && bb[2] >= r.x0 && bb[1] < r.y1 && bb[3] >= r.y0;
 }
 
+/* A curved camera's screen bounds of a set-up triangle, over every position's
+ * rays (their cones differ); false when none may see it. */
+static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, int bb[4]) {
+  bool any = false;
+  for (int s = 0; s < t->ns; s++) {
+    int r[4];
+    if (!rr_tri_screen_bounds(t->s, id, &t->cams[s], ts, r)) continue;
+    if (!any) memcpy(bb, r, sizeof r);
+    bb[0] = r[0] < bb[0] ? r[0] : bb[0], bb[1] = r[1] < bb[1] ? r[1] : bb[1];
+    bb[2] = r[2] > bb[2] ? r[2] : bb[2], bb[3] = r[3] > bb[3] ? r[3] : bb[3];
+    any = true;
+  }
+  return any;
+}
+
 /* Triangle setup: triangles ids[0..n-1] (first..first+n-1 when ids is NULL) into
  * out, keeping those that may cover a sample of *r (of the image when r is NULL);
  * returns how many. Planar cameras bound the triangles from their corners first
@@ -225,7 +273,7 @@ static bool meets(const int bb[4], tile_rect r) {
 static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
                                 tri_bound *scratch, tri_job *out) {
   if (t->c->planar) {
-    uint32_t nb = rr_tri_corner_bounds(t->s, first, ids, n, t->c, t->simd, scratch), kept = 0;
+    uint32_t nb = rr_tri_corner_bounds_at(t->s, first, ids, n, t->c, t->ns, t->pos, t->simd, scratch), kept = 0;
     if (r) {
       for (uint32_t k = 0; k < nb; k++)
         if (meets(scratch[k].bb, *r)) scratch[kept++] = scratch[k];
@@ -238,8 +286,8 @@ static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, ui
   for (uint32_t k = 0; k < n; k++) {
     uint32_t id = ids ? ids[k] : first + k;
     tri_job *j = out + kept;
-    if (rr_tri_setup(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED ||
-        !rr_tri_screen_bounds(t->s, id, t->c, &j->ts, j->bb) || (r && !meets(j->bb, *r)))
+    if (rr_tri_setup(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED || !curved_bounds(t, id, &j->ts, j->bb) ||
+        (r && !meets(j->bb, *r)))
       continue;
     finish_setup(t, id, j);
     kept++;
@@ -247,13 +295,31 @@ static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, ui
   return kept;
 }
 
+/* Rasterizes a prepared triangle into the samples r, with its setup moved to
+ * each position (at; NULL for one position). */
+KERNEL void draw_rect(trav *t, const tri_job *j, const tri_at *at, tile_rect r) {
+  if (t->o->binning) bin_raster(t, j, at, r, t->o->bin_size);
+  else raster_samples(t, j, at, r);
+}
+
+/* Several positions: the setup moved to each once per draw, not per bin. */
+static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
+  tri_at at[RR_MAX_SAMPLES];
+  for (int s = 0; s < t->ns; s++) {
+    tri_setup m;
+    rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &m);
+    at[s] = (tri_at){m.pa, m.num0, m.cx, m.cy};
+  }
+  draw_rect(t, j, at, r);
+}
+
 /* Rasterizes a prepared triangle into the samples of f it may cover. */
 KERNEL void draw(trav *t, const tri_job *j, tile_rect f) {
   tile_rect r = {j->bb[0] > f.x0 ? j->bb[0] : f.x0, j->bb[1] > f.y0 ? j->bb[1] : f.y0,
                  j->bb[2] + 1 < f.x1 ? j->bb[2] + 1 : f.x1, j->bb[3] + 1 < f.y1 ? j->bb[3] + 1 : f.y1};
   if (r.x0 >= r.x1 || r.y0 >= r.y1) return;
-  if (t->o->binning) bin_raster(t, j, r, t->o->bin_size);
-  else raster_samples(t, j, r);
+  if (t->ns > 1) draw_moved(t, j, r);
+  else draw_rect(t, j, NULL, r);
 }
 
 /* ---- frusta against boxes ---------------------------------------------- */
@@ -266,6 +332,7 @@ typedef struct frustum {
   vec3 axis;
   float angle;
   bool has_ray;      /* the centre sample's ray, and 1 / its direction (0 where it is 0) */
+  bool one_ray;      /* one sample: the frustum is that ray */
   rr_vf4 origin, dir, inv;
 } frustum;
 
@@ -275,8 +342,8 @@ static void set_plane(frustum *f, int i, vec3 n, vec3 point) {
   f->nx[i] = n.x, f->ny[i] = n.y, f->nz[i] = n.z, f->off[i] = -v3_dot(n, point);
 }
 
-static frustum make_frustum(const camera *c, tile_rect r) {
-  frustum f = {.r = r};
+static frustum make_frustum(const camera *c, int ns, tile_rect r) {
+  frustum f = {.r = r, .one_ray = ns == 1 && r.x1 - r.x0 == 1 && r.y1 - r.y0 == 1};
   vec3 o, d;
   f.has_ray = rr_cam_ray(c, (r.x0 + r.x1 - 1) / 2, (r.y0 + r.y1 - 1) / 2, &o, &d);
   f.origin = vf4_v3(o), f.dir = vf4_v3(d);
@@ -363,21 +430,35 @@ static bool centre_hits(const frustum *f, const bvh_node *b) {
   return t0 <= t1 * 1.0001f;
 }
 
-/* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
- * the image plane, or outside the cone of directions. */
-static bool is_outside(const frustum *f, const bvh_node *b, const camera *c, float tmin) {
-  /* A frustum of one sample is its ray: the classic ray-box test. */
-  if (f->r.x1 - f->r.x0 == 1 && f->r.y1 - f->r.y0 == 1) return !centre_hits(f, b);
-  /* (a box whose box_tmin is positive lies in front of the eye) */
-  if (f->nplanes) return (!(tmin > 0) && box_behind(b, c)) || box_outside_sides(f, b);
-  if (f->has_cone <= 0) return f->has_cone < 0;
-  /* the box's bounding sphere against the cone */
+/* Is the box outside a cone of directions from the eye (rr_cam_rect_cone's
+ * has_cone, axis, angle)? Its bounding sphere against the cone. */
+static bool outside_cone(int has_cone, vec3 axis, float angle, const bvh_node *b, const camera *c) {
+  if (has_cone <= 0) return has_cone < 0;
   vec3 lo = v3_load(b->lo), hi = v3_load(b->hi);
   vec3 v = v3_sub(v3_scale(v3_add(lo, hi), 0.5f), c->eye);
   float rad = 0.5f * v3_len(v3_sub(hi, lo)) * 1.0001f, dist = v3_len(v);
   if (dist <= rad || !(dist > 0)) return false;
-  float beta = asinf(rad / dist), phi = acosf(maxf(-1.0f, minf(1.0f, v3_dot(v, f->axis) / dist)));
-  return phi > f->angle + beta + 1e-4f;
+  float beta = asinf(rad / dist), phi = acosf(maxf(-1.0f, minf(1.0f, v3_dot(v, axis) / dist)));
+  return phi > angle + beta + 1e-4f;
+}
+
+/* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
+ * the image plane, or outside the cone of directions (of every one of the ns
+ * positions of cams; the side planes run along pixel edges, which hold any). */
+static bool is_outside(const frustum *f, const bvh_node *b, const camera *cams, int ns, float tmin) {
+  const camera *c = cams;
+  /* A frustum of one sample is its ray: the classic ray-box test. */
+  if (f->one_ray) return !centre_hits(f, b);
+  /* (a box whose box_tmin is positive lies in front of the eye) */
+  if (f->nplanes) return (!(tmin > 0) && box_behind(b, c)) || box_outside_sides(f, b);
+  if (!outside_cone(f->has_cone, f->axis, f->angle, b, c)) return false;
+  for (int s = 1; s < ns; s++) {
+    vec3 axis = v3(0, 0, 0);
+    float angle = 0;
+    int has = rr_cam_rect_cone(&cams[s], f->r.x0, f->r.y0, f->r.x1, f->r.y1, &axis, &angle);
+    if (!outside_cone(has, axis, angle, b, c)) return false;
+  }
+  return true;
 }
 
 /* Does box b (box_tmin z) look small in a frustum of `area` samples? Its size in
@@ -417,8 +498,8 @@ bool rr_oracle_occluded(const camera *c, const bvh_node *b, float farthest) {
 
 bool rr_oracle_outside(const camera *c, int x0, int y0, int x1, int y1, const bvh_node *b) {
   tile_rect r = {x0, y0, x1, y1};
-  frustum f = make_frustum(c, r);
-  return is_outside(&f, b, c, box_tmin(b, c));
+  frustum f = make_frustum(c, 1, r);
+  return is_outside(&f, b, c, 1, box_tmin(b, c));
 }
 
 static void traverse(trav *t, const frustum *f, uint32_t node, float tmin);
@@ -433,7 +514,7 @@ static void split(trav *t, const frustum *f, uint32_t node, float tmin) {
   tile_rect q[4] = {{r.x0, r.y0, mx, my}, {mx, r.y0, r.x1, my}, {r.x0, my, mx, r.y1}, {mx, my, r.x1, r.y1}};
   for (int i = 0; i < 4; i++) {
     if (q[i].x0 >= q[i].x1 || q[i].y0 >= q[i].y1) continue;
-    frustum sub = make_frustum(t->c, q[i]);
+    frustum sub = make_frustum(t->c, t->ns, q[i]);
     traverse(t, &sub, node, tmin);
   }
 }
@@ -469,7 +550,7 @@ static void traverse(trav *t, const frustum *f, uint32_t node, float tmin) {
   const oracles *o = t->o;
   t->st.nodes++;
   heat_charge(t->heat_n, t->vb->width, f->r.x0, f->r.y0, f->r.x1, f->r.y1, 1.0f);
-  if (o->cull_outside && is_outside(f, n, t->c, tmin)) return;
+  if (o->cull_outside && is_outside(f, n, t->cams, t->ns, tmin)) return;
   if (o->cull_occluded && hiz_nearer(t->hz, f->r.x0, f->r.y0, f->r.x1, f->r.y1, occlusion_depth(tmin))) return;
   if (should_split(t, f, n, tmin)) {
     split(t, f, node, tmin);
@@ -578,7 +659,7 @@ static void run_tile(int job, int thread, void *arg) {
   for (int y = r.y0; y < r.y1; y += fs)
     for (int x = r.x0; x < r.x1; x += fs) {
       tile_rect q = {x, y, x + fs < r.x1 ? x + fs : r.x1, y + fs < r.y1 ? y + fs : r.y1};
-      frustum f = make_frustum(t.c, q);
+      frustum f = make_frustum(t.c, t.ns, q);
       traverse(&t, &f, 0, box_tmin(&t.s->bvh->nodes[0], t.c));
     }
   if (t.npend) flush(&t);
@@ -594,8 +675,11 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
   hiz hz;
   if (!rr_hiz_init(&hz, vb, HIZ_SHIFT, 1))
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the hierarchical z-buffer");
+  hz.layers = ctx->samples; /* a tile's farthest depth over every position */
   trav proto = {.s = ctx->scene,
                 .c = ctx->cam,
+                .cams = ctx->cams,
+                .ns = ctx->samples,
                 .o = o,
                 .vb = ctx->vb,
                 .cull_back = ctx->opt->cull_backfaces != 0,
@@ -604,6 +688,12 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
                 .hz = &hz,
                 .heat_e = ctx->heat_e,
                 .heat_n = ctx->heat_n};
+  proto.span[0] = proto.span[2] = ctx->cams[0].sx0, proto.span[1] = proto.span[3] = ctx->cams[0].sy0;
+  for (int s = 0; s < ctx->samples; s++) proto.pos[s][0] = ctx->cams[s].sx0, proto.pos[s][1] = ctx->cams[s].sy0;
+  for (int s = 1; s < ctx->samples; s++) {
+    proto.span[0] = minf(proto.span[0], ctx->cams[s].sx0), proto.span[1] = minf(proto.span[1], ctx->cams[s].sy0);
+    proto.span[2] = maxf(proto.span[2], ctx->cams[s].sx0), proto.span[3] = maxf(proto.span[3], ctx->cams[s].sy0);
+  }
   rr_error err = RR_OK;
   if (!o->leaves) {
     err = rasterize_root(dev, ctx, &proto);

@@ -149,6 +149,16 @@ bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx,
 uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb,
                         uint64_t *covered, bool simd);
 
+/* The setup values that move with the sample position (rr_tri_setup_at). */
+typedef struct tri_at {
+  float pa, num0, cx, cy;
+} tri_at;
+/* rr_raster_rect at ns sample positions at once: cams[s] and layer s of vb (of
+ * vb->width × vb->height each), with ts's values moved to position s by at[s] (at
+ * NULL when ns is 1). Returns the evaluations, ns per sample of the rectangle. */
+uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_at *at, uint32_t id, const int rect[4],
+                                const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd);
+
 /* Test and benchmark hook: the relative error of depths t (one per sample of the
  * planar camera c's image; ids: the hit triangle, RR_MISS for none) against the
  * exact hit of each sample's ray (from c's own d0, dx, dy or o0, ox, oy, in double)
