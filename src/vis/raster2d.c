@@ -292,7 +292,7 @@ KERNEL void planes_at(const pipe2d *pp, tri2d *t, const planes *pl, int s) {
 /* A (sub-)triangle set up for every position of a pattern: t's edges are those of
  * the unshifted vertices and its rectangle the union of the positions' (which the
  * bands are sorted by); each position's tri2d follows from the snapped vertices'
- * bounds and the planes (tri_at). */
+ * bounds and the planes (tri2d_at). */
 typedef struct tri2dm {
   tri2d t;
   int32_t box[4]; /* x0, y0, x1, y1 of the snapped vertices, in sub-pixels */
@@ -326,7 +326,7 @@ KERNEL bool sample_rect(const pipe2d *pp, const int32_t box[4], const int64_t lo
 
 /* Position s of a pattern's triangle m: its vertices moved by the position's shift,
  * which moves the edge constants by exact integers. False when it covers no sample. */
-static bool tri_at(const pipe2d *pp, const tri2dm *m, int s, tri2d *t) {
+static bool tri2d_at(const pipe2d *pp, const tri2dm *m, int s, tri2d *t) {
   const int64_t shift[2] = {pp->shift_x[s], pp->shift_y[s]};
   *t = m->t;
   if (!sample_rect(pp, m->box, shift, shift, t->rect)) return false;
@@ -369,7 +369,7 @@ KERNEL bool setup_tri(const pipe2d *pp, const int64_t X[3], const int64_t Y[3], 
 }
 
 /* Sets up the interpolation of a (sub-)triangle that covers samples: its planes
- * for one position, or kept whole for tri_at (a tri2dm). */
+ * for one position, or kept whole for tri2d_at (a tri2dm). */
 KERNEL void setup_interp(const pipe2d *pp, tri2d *t, const planes *pl, const int32_t box[4], const double depth[3],
                      uint32_t id, const bool all) {
   planes_at(pp, t, pl, 0); /* a pattern's slopes are its positions' too */
@@ -694,7 +694,7 @@ KERNEL void raster_bb_all(const tri2dm *m, int y0, int y1, bin_ctx *bc, const bo
       for (; mask; mask &= mask - 1) {
         int s = __builtin_ctz(mask);
         tri2d *ts = &at[s];
-        if (!(made >> s & 1)) made |= 1u << s, tri_at(pp, m, s, ts); /* covered: its rectangle is not empty */
+        if (!(made >> s & 1)) made |= 1u << s, tri2d_at(pp, m, s, ts); /* covered: its rectangle is not empty */
         float dy = (float)(y - ts->rect[1]);
         float qr = ts->pw[0] + dy * ts->pw[2], tr = ts->pt[0] + dy * ts->pt[2];
         float r1 = ts->p1[0] + dy * ts->p1[2], r2 = ts->p2[0] + dy * ts->p2[2];
@@ -716,7 +716,7 @@ KERNEL void draw2d_all(bin_ctx *bc, const tri2dm *m, int y0, int y1, const bool 
     return;
   }
   tri2d t;
-  if (tri_at(bc->pass->pp, m, bc->sample, &t)) draw2d(bc, &t, y0, y1, bin, count);
+  if (tri2d_at(bc->pass->pp, m, bc->sample, &t)) draw2d(bc, &t, y0, y1, bin, count);
 }
 
 /* draw2d for each mode, as the band loop takes them */
