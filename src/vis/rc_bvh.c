@@ -225,16 +225,17 @@ static void slot_empty(wide_bounds *wb, int i) {
  * sample, from the box alone (perspective cameras). A triangle is tested only at
  * the samples of its corner rectangle (rr_tri_corner_bounds: the float
  * projections of its corners, widened by 1/64 + 1e-5·|coordinate| pixels). When
- * every corner of the box is ahead of the eye within the cone z >= |q|/8 (convex,
- * so the whole box is), the box, and each triangle in it, projects inside the
- * bounding box of its corners' projections (a perspective map keeps convex sets
- * convex); in that cone a float projection errs by less than 200u·W/tan_w + 3u·|sx|
- * (u = 2^-24: q, z and the dot products err by 5u·|q|, and |qr| / (z·tan_w) <= 8 /
- * tan_w), both the box's here and the triangle corners' there, so the box's
- * rectangle widened by 1/32 + 2e-5·|coordinate| + 512u·(W/tan_w + H/tan_h) holds
- * every sample any of its triangles is tested at. A box without a sample in that
- * rectangle holds no triangle that a frame would set up; a box reaching behind or
- * near the eye's plane may hold any. */
+ * every corner of the box is ahead of the eye (z > 0: convex, so the whole box
+ * is), the box, and each triangle in it, projects inside the bounding box of its
+ * corners' projections (a perspective map keeps convex sets convex). With R the
+ * largest |q| / z of the box's corners (>= that of any point in it), a float
+ * projection errs by less than 4u·R·(1 + R)·W / tan_w + 3u·|sx| (u = 2^-24: q, z
+ * and the dot products err by 5u·|q|, and |qr| / (z·tan_w) <= R / tan_w), both the
+ * box's here and the triangle corners' there, so the box's rectangle widened by
+ * 1/32 + 2e-5·|coordinate| + 16u·R·(1 + R)·(W / tan_w + H / tan_h) holds every
+ * sample any of its triangles is tested at. A box without a sample in that
+ * rectangle holds no triangle that a frame would set up; a box reaching the eye's
+ * plane may hold any. */
 static int box_reach(const camera *c, const bvh_wide *n) {
   const rr_vf4 zero = rr_vf4_splat(0), one = rr_vf4_splat(1), half = rr_vf4_splat(0.5f);
   const rr_vf4 tw = rr_vf4_splat(c->tan_half_w), th = rr_vf4_splat(c->tan_half_h);
@@ -243,6 +244,7 @@ static int box_reach(const camera *c, const bvh_wide *n) {
   const float right[3] = {c->right.x, c->right.y, c->right.z}, up[3] = {c->up.x, c->up.y, c->up.z};
   rr_vf4 x0 = rr_vf4_splat(INFINITY), y0 = x0, x1 = -x0, y1 = -x0;
   rr_vi4 front = (rr_vi4){-1, -1, -1, -1};
+  rr_vf4 r2 = zero; /* the largest (|q| / z)² */
   for (int k = 0; k < 8; k++) {
     rr_vf4 z = zero, qr = zero, qu = zero, len2 = zero;
     for (int a = 0; a < 3; a++) {
@@ -250,21 +252,22 @@ static int box_reach(const camera *c, const bvh_wide *n) {
       z = z + q * rr_vf4_splat(fwd[a]), qr = qr + q * rr_vf4_splat(right[a]), qu = qu + q * rr_vf4_splat(up[a]);
       len2 = len2 + q * q;
     }
-    /* 60 rather than 64: room for the rounding of this test */
-    front &= (z > zero) & (z * z * rr_vf4_splat(60) >= len2);
+    front &= z > zero;
+    r2 = rr_vf4_max(r2, len2 / (z * z));
     rr_vf4 sx = (qr / (z * tw) + one) * half * W, sy = (one - qu / (z * th)) * half * H;
     x0 = rr_vf4_min(x0, sx), x1 = rr_vf4_max(x1, sx), y0 = rr_vf4_min(y0, sy), y1 = rr_vf4_max(y1, sy);
   }
-  const float u = 0x1p-24f, m0 = 1.0f / 32 + 512 * u * ((float)c->width / c->tan_half_w + (float)c->height / c->tan_half_h);
+  const float u = 0x1p-24f, wh = (float)c->width / c->tan_half_w + (float)c->height / c->tan_half_h;
   int reach = 0;
   for (int i = 0; i < 4; i++) {
     if (n->ref[i] == UINT32_MAX) continue;
     float big = fmaxf(fmaxf(fabsf(x0[i]), fabsf(x1[i])), fmaxf(fabsf(y0[i]), fabsf(y1[i])));
-    float m = m0 + 2e-5f * big;
+    float R = sqrtf(r2[i]) * 1.01f; /* rounded up past this computation's own error */
+    float m = 1.0f / 32 + 2e-5f * big + 16 * u * R * (1 + R) * wh;
     /* the first and last pixel whose sample lies in the widened rectangle */
     float lx = fmaxf(ceilf(x0[i] - m - c->sx0), 0), hx = fminf(floorf(x1[i] + m - c->sx0), (float)(c->width - 1));
     float ly = fmaxf(ceilf(y0[i] - m - c->sy0), 0), hy = fminf(floorf(y1[i] + m - c->sy0), (float)(c->height - 1));
-    if (!front[i] || (lx <= hx && ly <= hy)) reach |= 1 << i;
+    if (!front[i] || !(m < INFINITY) || (lx <= hx && ly <= hy)) reach |= 1 << i;
   }
   return reach;
 }
