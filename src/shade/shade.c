@@ -236,6 +236,7 @@ static void shade_rows(int job, int thread, void *arg) {
   const rr_scene *s = p->s;
   size_t npix = (size_t)vb->width * vb->height;
   int n = p->samples, K = p->stored;
+  bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
   uint64_t shades = 0;
   for (int y = job * SHADE_ROWS; y < vb->height && y < (job + 1) * SHADE_ROWS; y++) {
     float bg[3];
@@ -248,61 +249,95 @@ static void shade_rows(int job, int thread, void *arg) {
       /* Each stored sample not yet coloured starts a group: the samples that saw its
        * primitive. ssaa and none: every sample its own group. msaa, csaa: shaded once,
        * at the group's mean barycentrics and ray parameter along its first sample's ray. */
+      float w[RR_MAX_SAMPLES] = {0};
       for (int i = 0; i < K; i++) {
         if (done[i]) continue;
-        float col[3] = {0, 0, 0}, l1 = 0, l2 = 0, t = 0;
-        int members = 0;
-        bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
-        for (int m = i; m < (grouped ? n : i + 1); m++)
-          if (ids[m] == ids[i]) {
-            size_t e = m * npix + k;
-            l1 += vb->l1[e], l2 += vb->l2[e], t += vb->t[e], members++;
-          }
+        uint32_t id = ids[i];
+        int last = grouped ? n : i + 1;
+        float col[3] = {0, 0, 0};
         vec3 o, d;
-        if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
-          float inv = 1.0f / (float)members;
-          hit h = hit_make(s, ids[i], l1 * inv, l2 * inv, t * inv, d);
-          if (h.valid) shade_hit(s, &h, p->mode, p->dmin, p->dmax, col), shades++;
-          else memcpy(col, bg, sizeof col);
+        if (id < s->ntris) {
+          float l1 = 0, l2 = 0, t = 0;
+          int members = 0;
+          for (int m = i; m < last; m++)
+            if (ids[m] == id) {
+              size_t e = m * npix + k;
+              l1 += vb->l1[e], l2 += vb->l2[e], t += vb->t[e], members++;
+            }
+          if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
+            float inv = 1.0f / (float)members;
+            hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, d);
+            shade_hit(s, &h, p->mode, p->dmin, p->dmax, col);
+            shades++;
+          }
+        } else if (p->cams[i].planar || rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
+          memcpy(col, bg, sizeof col);
         }
-        for (int m = i; m < (grouped ? K : i + 1); m++)
-          if (ids[m] == ids[i]) {
+        for (int m = i; m < (last < K ? last : K); m++)
+          if (ids[m] == id) {
             memcpy(p->rgb + 3 * (m * npix + k), col, sizeof col);
-            done[m] = true;
-            if (p->weight) p->weight[m * npix + k] = 1.0f;
+            done[m] = true, w[m] = 1.0f;
           }
       }
-      /* csaa: a coverage sample votes for the nearest stored sample of its primitive */
+      /* csaa: a coverage sample votes for the nearest stored sample of its primitive;
+       * its own colour counts for nothing */
       for (int c = K; c < n; c++) {
-        for (int j = 0; j < K; j++) {
-          int st = p->nearest[c][j];
-          if (ids[st] == ids[c]) {
-            p->weight[st * npix + k] += 1.0f;
+        for (int j = 0; j < K; j++)
+          if (ids[p->nearest[c][j]] == ids[c]) {
+            w[p->nearest[c][j]] += 1.0f;
             break;
           }
-        }
-        p->weight[c * npix + k] = 0.0f;
         memset(p->rgb + 3 * (c * npix + k), 0, 3 * sizeof(float));
       }
+      if (p->weight)
+        for (int i = 0; i < n; i++) p->weight[i * npix + k] = w[i];
     }
   }
   p->shades[thread] += shades;
 }
 
 /* A box filter over each pixel's samples, weighted: the stand-in for the resolve
- * filters (resolve.h), with the same input. */
-static void resolve_box(const resolve_input *in, float *out) {
+ * filters (resolve.h), with the same input. Rows in parallel, layer by layer so
+ * that the loops run over contiguous floats. */
+typedef struct box_job {
+  const resolve_input *in;
+  float *out;
+} box_job;
+
+enum { RESOLVE_ROWS = 8 };
+
+static void resolve_box_rows(int job, int thread, void *arg) {
+  (void)thread;
+  const box_job *b = arg;
+  const resolve_input *in = b->in;
   size_t npix = (size_t)in->width * in->height;
-  for (size_t k = 0; k < npix; k++) {
-    float sum[3] = {0, 0, 0}, wsum = 0;
-    for (int i = 0; i < in->samples; i++) {
-      size_t e = i * npix + k;
-      float w = in->weight ? in->weight[e] : 1.0f;
-      for (int ch = 0; ch < 3; ch++) sum[ch] += w * in->rgb[3 * e + ch];
-      wsum += w;
+  int y0 = job * RESOLVE_ROWS, y1 = y0 + RESOLVE_ROWS < in->height ? y0 + RESOLVE_ROWS : in->height;
+  size_t k0 = (size_t)y0 * in->width, n = (size_t)(y1 - y0) * in->width;
+  float *acc = b->out + 3 * k0;
+  memset(acc, 0, 3 * n * sizeof *acc);
+  for (int i = 0; i < in->samples; i++) {
+    const float *rgb = in->rgb + 3 * (i * npix + k0);
+    if (!in->weight) {
+      for (size_t j = 0; j < 3 * n; j++) acc[j] += rgb[j];
+      continue;
     }
-    for (int ch = 0; ch < 3; ch++) out[3 * k + ch] = wsum > 0 ? sum[ch] / wsum : 0.0f;
+    const float *w = in->weight + i * npix + k0;
+    for (size_t k = 0; k < n; k++)
+      for (int ch = 0; ch < 3; ch++) acc[3 * k + ch] += w[k] * rgb[3 * k + ch];
   }
+  for (size_t k = 0; k < n; k++) {
+    float total = (float)in->samples;
+    if (in->weight) {
+      total = 0;
+      for (int i = 0; i < in->samples; i++) total += in->weight[i * npix + k0 + k];
+    }
+    for (int ch = 0; ch < 3; ch++) acc[3 * k + ch] = total > 0 ? acc[3 * k + ch] / total : 0.0f;
+  }
+}
+
+static void resolve_box(const resolve_input *in, float *out, int threads) {
+  box_job b = {in, out};
+  rr_parallel_for((in->height + RESOLVE_ROWS - 1) / RESOLVE_ROWS, threads, resolve_box_rows, &b);
 }
 
 /* The frame's range of eye distances over every shaded sample (the depth mode's scale). */
@@ -375,7 +410,7 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cam
     rr_parallel_for((vb->height + SHADE_ROWS - 1) / SHADE_ROWS, threads, shade_rows, p);
     double t1 = rr_now_ms();
     resolve_input in = {vb->width, vb->height, p->samples, (const float (*)[2])f->pos, p->rgb, p->weight};
-    resolve_box(&in, out->data); /* aa-resolve's filters take over here */
+    resolve_box(&in, out->data, threads); /* the resolve filters (resolve.h) take over here */
     if (st) {
       *st = (rr_shade_stats){.shade_ms = t1 - t0, .resolve_ms = rr_now_ms() - t1};
       for (int t = 0; t < RR_MAX_THREADS; t++) st->shades += p->shades[t];
