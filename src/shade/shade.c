@@ -237,6 +237,10 @@ static void shade_rows(int job, int thread, void *arg) {
   size_t npix = (size_t)vb->width * vb->height;
   int n = p->samples, K = p->stored;
   bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
+  /* locals: the stores to rgb would otherwise reload every pointer (floats may alias) */
+  const uint32_t *vid = vb->id;
+  const float *vl1 = vb->l1, *vl2 = vb->l2, *vt = vb->t;
+  float *rgb = p->rgb, *weight = p->weight;
   uint64_t shades = 0;
   for (int y = job * SHADE_ROWS; y < vb->height && y < (job + 1) * SHADE_ROWS; y++) {
     float bg[3];
@@ -245,7 +249,7 @@ static void shade_rows(int job, int thread, void *arg) {
       size_t k = (size_t)y * vb->width + x;
       uint32_t ids[RR_MAX_SAMPLES];
       bool done[RR_MAX_SAMPLES] = {false};
-      for (int i = 0; i < n; i++) ids[i] = vb->id[i * npix + k];
+      for (int i = 0; i < n; i++) ids[i] = vid[i * npix + k];
       /* Each stored sample not yet coloured starts a group: the samples that saw its
        * primitive. ssaa and none: every sample its own group. msaa, csaa: shaded once,
        * at the group's mean barycentrics and ray parameter along its first sample's ray. */
@@ -262,7 +266,7 @@ static void shade_rows(int job, int thread, void *arg) {
           for (int m = i; m < last; m++)
             if (ids[m] == id) {
               size_t e = m * npix + k;
-              l1 += vb->l1[e], l2 += vb->l2[e], t += vb->t[e], members++;
+              l1 += vl1[e], l2 += vl2[e], t += vt[e], members++;
             }
           if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
             float inv = 1.0f / (float)members;
@@ -275,7 +279,7 @@ static void shade_rows(int job, int thread, void *arg) {
         }
         for (int m = i; m < (last < K ? last : K); m++)
           if (ids[m] == id) {
-            memcpy(p->rgb + 3 * (m * npix + k), col, sizeof col);
+            memcpy(rgb + 3 * (m * npix + k), col, sizeof col);
             done[m] = true, w[m] = 1.0f;
           }
       }
@@ -287,10 +291,10 @@ static void shade_rows(int job, int thread, void *arg) {
             w[p->nearest[c][j]] += 1.0f;
             break;
           }
-        memset(p->rgb + 3 * (c * npix + k), 0, 3 * sizeof(float));
+        memset(rgb + 3 * (c * npix + k), 0, 3 * sizeof(float));
       }
-      if (p->weight)
-        for (int i = 0; i < n; i++) p->weight[i * npix + k] = w[i];
+      if (weight)
+        for (int i = 0; i < n; i++) weight[i * npix + k] = w[i];
     }
   }
   p->shades[thread] += shades;
