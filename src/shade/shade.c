@@ -1,11 +1,13 @@
 /* Deferred shading: reads only the visibility buffer (id, t, λ1, λ2) and the
  * scene, so it never knows which method made the frame. */
+#define _DEFAULT_SOURCE /* madvise */
 #include "vis/vis.h"
 #include "core/color.h"
 #include "shade/resolve.h"
 
 #include <stdio.h>
 #include <string.h>
+#include <sys/mman.h>
 
 /* stb_easy_font is header-only with static functions; only some are used. */
 #pragma GCC diagnostic push
@@ -219,6 +221,7 @@ typedef struct shade_pass {
   signed char nearest[RR_MAX_SAMPLES][RR_MAX_SAMPLES]; /* csaa: coverage sample c's stored samples, nearest first */
   float *rgb, *weight;                                  /* the resolve's input (resolve.h); weight NULL: all 1 */
   uint64_t shades[RR_MAX_THREADS];
+  bool failed; /* a job found no memory */
 } shade_pass;
 
 enum { SHADE_ROWS = 8 }; /* rows per job */
@@ -230,73 +233,98 @@ static void background(int y, int height, float o[3]) {
   o[0] = srgb_decode(g * 0.9f), o[1] = srgb_decode(g), o[2] = srgb_decode(g * 1.15f);
 }
 
+/* A run of pixels of one row, every layer copied side by side: the layers lie a
+ * power of two apart, so reading a pixel's samples in place would map them all to
+ * the same cache sets. */
+enum { RUN = 64 };
+typedef struct sample_run {
+  uint32_t id[RR_MAX_SAMPLES][RUN];
+  float l1[RR_MAX_SAMPLES][RUN], l2[RR_MAX_SAMPLES][RUN], t[RR_MAX_SAMPLES][RUN];
+  float rgb[RR_MAX_SAMPLES][3 * RUN], w[RR_MAX_SAMPLES][RUN];
+} sample_run;
+
+/* Shades pixel (x, y), run entry j: see rr_aa_mode for what each mode does. */
+static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, int y, const float bg[3]) {
+  const rr_scene *s = p->s;
+  int n = p->samples, K = p->stored;
+  bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
+  bool done[RR_MAX_SAMPLES] = {false};
+  uint64_t shades = 0;
+  /* Each stored sample not yet coloured starts a group: the samples that saw its
+   * primitive. ssaa and none: every sample its own group. msaa, csaa: shaded once,
+   * at the group's mean barycentrics and ray parameter along its first sample's ray. */
+  for (int i = 0; i < K; i++) {
+    if (done[i]) continue;
+    uint32_t id = r->id[i][j];
+    int last = grouped ? n : i + 1;
+    float col[3] = {0, 0, 0};
+    vec3 o, d;
+    if (id < s->ntris) {
+      float l1 = 0, l2 = 0, t = 0;
+      int members = 0;
+      for (int m = i; m < last; m++)
+        if (r->id[m][j] == id) l1 += r->l1[m][j], l2 += r->l2[m][j], t += r->t[m][j], members++;
+      if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
+        float inv = 1.0f / (float)members;
+        hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, d);
+        shade_hit(s, &h, p->mode, p->dmin, p->dmax, col);
+        shades++;
+      }
+    } else if (p->cams[i].planar || rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
+      memcpy(col, bg, sizeof col);
+    }
+    for (int m = i; m < (last < K ? last : K); m++)
+      if (r->id[m][j] == id) {
+        memcpy(&r->rgb[m][3 * j], col, sizeof col);
+        done[m] = true, r->w[m][j] = 1.0f;
+      }
+  }
+  /* csaa: a coverage sample votes for the nearest stored sample of its primitive;
+   * its own colour counts for nothing */
+  for (int c = K; c < n; c++) {
+    for (int v = 0; v < K; v++)
+      if (r->id[p->nearest[c][v]][j] == r->id[c][j]) {
+        r->w[p->nearest[c][v]][j] += 1.0f;
+        break;
+      }
+    r->w[c][j] = 0.0f;
+    memset(&r->rgb[c][3 * j], 0, 3 * sizeof(float));
+  }
+  return shades;
+}
+
 static void shade_rows(int job, int thread, void *arg) {
   shade_pass *p = arg;
   const visbuf *vb = p->vb;
-  const rr_scene *s = p->s;
   size_t npix = (size_t)vb->width * vb->height;
-  int n = p->samples, K = p->stored;
-  bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
-  /* locals: the stores to rgb would otherwise reload every pointer (floats may alias) */
-  const uint32_t *vid = vb->id;
-  const float *vl1 = vb->l1, *vl2 = vb->l2, *vt = vb->t;
-  float *rgb = p->rgb, *weight = p->weight;
+  int n = p->samples;
   uint64_t shades = 0;
+  sample_run *r = malloc(sizeof *r);
+  if (!r) { /* a job without room leaves its rows for shade_frame to report */
+    p->failed = true;
+    return;
+  }
   for (int y = job * SHADE_ROWS; y < vb->height && y < (job + 1) * SHADE_ROWS; y++) {
     float bg[3];
     background(y, vb->height, bg);
-    for (int x = 0; x < vb->width; x++) {
-      size_t k = (size_t)y * vb->width + x;
-      uint32_t ids[RR_MAX_SAMPLES];
-      bool done[RR_MAX_SAMPLES] = {false};
-      for (int i = 0; i < n; i++) ids[i] = vid[i * npix + k];
-      /* Each stored sample not yet coloured starts a group: the samples that saw its
-       * primitive. ssaa and none: every sample its own group. msaa, csaa: shaded once,
-       * at the group's mean barycentrics and ray parameter along its first sample's ray. */
-      float w[RR_MAX_SAMPLES] = {0};
-      for (int i = 0; i < K; i++) {
-        if (done[i]) continue;
-        uint32_t id = ids[i];
-        int last = grouped ? n : i + 1;
-        float col[3] = {0, 0, 0};
-        vec3 o, d;
-        if (id < s->ntris) {
-          float l1 = 0, l2 = 0, t = 0;
-          int members = 0;
-          for (int m = i; m < last; m++)
-            if (ids[m] == id) {
-              size_t e = m * npix + k;
-              l1 += vl1[e], l2 += vl2[e], t += vt[e], members++;
-            }
-          if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
-            float inv = 1.0f / (float)members;
-            hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, d);
-            shade_hit(s, &h, p->mode, p->dmin, p->dmax, col);
-            shades++;
-          }
-        } else if (p->cams[i].planar || rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
-          memcpy(col, bg, sizeof col);
-        }
-        for (int m = i; m < (last < K ? last : K); m++)
-          if (ids[m] == id) {
-            memcpy(rgb + 3 * (m * npix + k), col, sizeof col);
-            done[m] = true, w[m] = 1.0f;
-          }
+    for (int x0 = 0; x0 < vb->width; x0 += RUN) {
+      int len = vb->width - x0 < RUN ? vb->width - x0 : RUN;
+      size_t k0 = (size_t)y * vb->width + x0;
+      for (int i = 0; i < n; i++) {
+        size_t e = i * npix + k0;
+        memcpy(r->id[i], vb->id + e, len * sizeof(uint32_t));
+        memcpy(r->l1[i], vb->l1 + e, len * sizeof(float));
+        memcpy(r->l2[i], vb->l2 + e, len * sizeof(float));
+        memcpy(r->t[i], vb->t + e, len * sizeof(float));
       }
-      /* csaa: a coverage sample votes for the nearest stored sample of its primitive;
-       * its own colour counts for nothing */
-      for (int c = K; c < n; c++) {
-        for (int j = 0; j < K; j++)
-          if (ids[p->nearest[c][j]] == ids[c]) {
-            w[p->nearest[c][j]] += 1.0f;
-            break;
-          }
-        memset(rgb + 3 * (c * npix + k), 0, 3 * sizeof(float));
+      for (int j = 0; j < len; j++) shades += shade_pixel(p, r, j, x0 + j, y, bg);
+      for (int i = 0; i < n; i++) {
+        memcpy(p->rgb + 3 * (i * npix + k0), r->rgb[i], 3 * len * sizeof(float));
+        if (p->weight) memcpy(p->weight + i * npix + k0, r->w[i], len * sizeof(float));
       }
-      if (weight)
-        for (int i = 0; i < n; i++) weight[i * npix + k] = w[i];
     }
   }
+  free(r);
   p->shades[thread] += shades;
 }
 
@@ -374,6 +402,20 @@ static rr_error shade_heat_frame(rr_device *dev, const rr_frame *f, rr_shade_mod
   return rr_ok(dev);
 }
 
+/* A large buffer of per-sample values, in huge pages where the system offers them
+ * on request: a fresh 4 KiB page costs a fault each, and a 1024² frame of 16
+ * samples is 200 MB of colour (free() releases it). */
+static void *sample_alloc(size_t bytes) {
+  enum { HUGE_PAGE = 2 << 20 };
+  if (bytes < HUGE_PAGE) return malloc(bytes);
+  void *p = NULL;
+  if (posix_memalign(&p, HUGE_PAGE, bytes)) return NULL;
+#ifdef MADV_HUGEPAGE
+  madvise(p, bytes, MADV_HUGEPAGE); /* advice: without it the pages are small */
+#endif
+  return p;
+}
+
 /* Shades the samples as the frame's AA mode says (cams: one per sample position),
  * then resolves them into out. */
 static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f,
@@ -398,8 +440,8 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cam
       }
   }
   size_t nsamp = (size_t)p->samples * npix;
-  p->rgb = malloc(nsamp * 3 * sizeof(float));
-  p->weight = f->aa == RR_AA_CSAA ? malloc(nsamp * sizeof(float)) : NULL;
+  p->rgb = sample_alloc(nsamp * 3 * sizeof(float));
+  p->weight = f->aa == RR_AA_CSAA ? sample_alloc(nsamp * sizeof(float)) : NULL;
   rr_error e = image_alloc(dev, out, vb->width, vb->height, 3, RR_PIXEL_F32, RR_IMAGE_COLOR);
   if (!e && (!p->rgb || (f->aa == RR_AA_CSAA && !p->weight))) {
     free(out->data);
@@ -414,10 +456,15 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cam
     rr_parallel_for((vb->height + SHADE_ROWS - 1) / SHADE_ROWS, threads, shade_rows, p);
     double t1 = rr_now_ms();
     resolve_input in = {vb->width, vb->height, p->samples, (const float (*)[2])f->pos, p->rgb, p->weight};
-    resolve_box(&in, out->data, threads); /* the resolve filters (resolve.h) take over here */
+    if (!p->failed) resolve_box(&in, out->data, threads); /* the resolve filters (resolve.h) take over here */
     if (st) {
       *st = (rr_shade_stats){.shade_ms = t1 - t0, .resolve_ms = rr_now_ms() - t1};
       for (int t = 0; t < RR_MAX_THREADS; t++) st->shades += p->shades[t];
+    }
+    if (p->failed) {
+      free(out->data);
+      out->data = NULL;
+      e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading");
     }
   }
   free(p->rgb), free(p->weight), free(p);
