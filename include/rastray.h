@@ -365,6 +365,44 @@ RR_API int rr_method_from_name(const char *name);
 /* The name of a method ("rc", ...), NULL when out of range. */
 RR_API const char *rr_method_name(int method);
 
+/* Anti-aliasing: how shading turns a pixel's visibility samples into colour. The
+ * samples themselves are options.samples and options.sample_pos; the modes differ
+ * only in shading (rr_shade), never in visibility. */
+typedef enum rr_aa_mode {
+  RR_AA_NONE = 0, /* one colour per pixel, from sample 0 (today's one sample at the centre) */
+  RR_AA_SSAA,     /* supersampling: every sample shaded */
+  RR_AA_MSAA,     /* multisampling: shaded once per pixel per primitive covering any of its samples,
+                     at the mean barycentrics of the covered samples (a point inside the triangle:
+                     triangles are convex), the colour shared by the samples it covers */
+  RR_AA_CSAA,     /* coverage sampling: visibility at every sample; the first aa_stored samples
+                     carry colour as in msaa; every other sample adds its vote (weight 1) to the
+                     stored sample nearest to it that saw the same primitive (or the same miss),
+                     and to none when no stored sample did */
+  RR_AA_MODE_COUNT
+} rr_aa_mode;
+
+/* Sample patterns (positions inside the pixel, each in [0, 1)). */
+typedef enum rr_aa_pattern {
+  RR_AA_STANDARD = 0, /* Direct3D's and Vulkan's standard positions, as offsets from the pixel centre
+                         in 1/16 pixel, y down: 1: (0,0); 2: (4,4) (-4,-4); 4: (-2,-6) (6,-2) (-6,2)
+                         (2,6); 8: (1,-3) (-1,3) (5,1) (-3,-5) (-5,5) (-7,-1) (3,7) (7,-7); 16: (1,1)
+                         (-1,-3) (-3,2) (4,-1) (-5,-2) (2,5) (5,3) (3,-5) (-2,6) (0,-7) (-4,-6) (-6,4)
+                         (-8,0) (7,-4) (6,7) (-7,-8) */
+  RR_AA_ROTATED,      /* a grid of c × r cells (1×1, 2×1, 2×2, 4×2, 4×4) at the cells' centres, rotated
+                         by atan(1/2) about the pixel centre and scaled by √5/2 (offset (u, v) becomes
+                         (u - v/2, u/2 + v), so 4 samples are the classic RGSS), wrapped into the pixel */
+  RR_AA_JITTER,       /* the same c × r cells, one uniformly random position in each, from a seed */
+  RR_AA_PATTERN_COUNT
+} rr_aa_pattern;
+
+/* Fills pos[0 .. n-1] with the n positions (n: 1, 2, 4, 8 or 16) of a pattern;
+ * seed matters to RR_AA_JITTER alone (the same seed, the same positions). */
+RR_API rr_error rr_aa_positions(rr_aa_pattern pattern, int n, uint32_t seed, float pos[][2]);
+/* The name of a mode ("none", "ssaa", "msaa", "csaa") or pattern ("standard",
+ * "rotated", "jitter"), NULL when out of range. */
+RR_API const char *rr_aa_mode_name(int mode);
+RR_API const char *rr_aa_pattern_name(int pattern);
+
 typedef struct rr_render_options {
   rr_method method;
   int width, height;  /* image size in pixels */
@@ -372,6 +410,9 @@ typedef struct rr_render_options {
   float sample_pos[RR_MAX_SAMPLES][2]; /* sample s at (x + sample_pos[s][0], y + sample_pos[s][1]) in pixel
                                           (x, y); each in [0, 1) (default: one sample at the centre) */
   int threads;        /* 0: all cores; at most RR_MAX_THREADS */
+  rr_aa_mode aa;      /* how shading uses the samples (default RR_AA_NONE); rr_render_options_set_aa
+                         sets it with samples and sample_pos */
+  int aa_stored;      /* csaa: K, the samples that carry colour: sample_pos[0 .. K-1] (1..samples) */
   int cull_backfaces; /* nonzero: triangles seen from behind are invisible */
   int heat;           /* nonzero: also record E and N charged to each pixel (AOVs evals, nodes) */
   int scalar;         /* nonzero: no SIMD kernels (for comparison; results are the same bits) */
@@ -388,6 +429,14 @@ typedef struct rr_render_options {
 /* Fills options with defaults: 3dr-bb, 1024x768, one sample at each pixel's centre,
  * all cores, no culling. */
 RR_API void rr_render_options_init(rr_render_options *opt);
+/* Sets options.aa, samples, aa_stored and sample_pos for an AA mode: none (samples
+ * must be 1: the pixel's centre), ssaa:N and msaa:N (N positions of the pattern),
+ * csaa:K/N (stored = K ≤ N): the K stored samples first, at the positions of the
+ * pattern of K (where msaa:K samples), then the N - K positions of the pattern of N
+ * left after taking, for each stored sample in turn, the one nearest to it (ties: the
+ * lower index). N and K are 1, 2, 4, 8 or 16. */
+RR_API rr_error rr_render_options_set_aa(rr_device *dev, rr_render_options *opt, rr_aa_mode mode, int samples,
+                                         int stored, rr_aa_pattern pattern, uint32_t seed);
 
 typedef struct rr_stats {
   uint64_t setups;     /* S: triangle setups computed */
@@ -483,6 +532,21 @@ typedef struct rr_image {
  * picture in linear light. */
 RR_API rr_error rr_shade(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                          const rr_frame *frame, rr_shade_mode mode, rr_image *out);
+/* The statistics of a shading pass. */
+typedef struct rr_shade_stats {
+  uint64_t shades;   /* shading invocations: one per shaded point of a primitive (the background
+                        behind misses is not counted) */
+  double shade_ms;   /* wall time turning samples into linear colours */
+  double resolve_ms; /* wall time of the resolve: per-sample colours to pixels */
+} rr_shade_stats;
+
+/* rr_shade, with the statistics of the pass in *stats (stats may be NULL). Under
+ * anti-aliasing (the frame's options.aa) the samples are shaded as the mode says,
+ * each in linear light, then resolved to one colour per pixel. Heat maps count per
+ * pixel whatever the samples. */
+RR_API rr_error rr_shade_with_stats(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                                    const rr_frame *frame, rr_shade_mode mode, rr_image *out,
+                                    rr_shade_stats *stats);
 /* Extracts an AOV of a frame into a new image of kind RR_IMAGE_AOV + aov. */
 RR_API rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                              const rr_frame *frame, rr_aov aov, rr_image *out);

@@ -236,6 +236,11 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
       return rr_fail(dev, RR_ERROR_ARGUMENT, "bad position (%g, %g) of sample %d (each in [0, 1))", (double)p[0],
                      (double)p[1], s);
   }
+  if ((int)opt->aa < 0 || opt->aa >= RR_AA_MODE_COUNT)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AA mode %d", (int)opt->aa);
+  if (opt->aa == RR_AA_CSAA && (opt->aa_stored < 1 || opt->aa_stored > opt->samples))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad stored sample count %d for csaa (1..%d, the samples)", opt->aa_stored,
+                   opt->samples);
   if (opt->method == RR_METHOD_AUTO) return render_auto(dev, scene, cam, opt, out);
   oracles o = methods[opt->method].o;
   if (opt->oracles && *opt->oracles) {
@@ -272,6 +277,8 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   }
   f->method = opt->method;
   f->samples = opt->samples;
+  memcpy(f->pos, opt->sample_pos, sizeof f->pos);
+  f->aa = opt->aa, f->aa_stored = opt->aa == RR_AA_CSAA ? opt->aa_stored : 0;
   render_ctx ctx = {.scene = scene,
                     .cam = &cams[0],
                     .cams = cams,
