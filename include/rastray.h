@@ -413,6 +413,8 @@ RR_API rr_error rr_frame_get_stats(const rr_frame *frame, rr_stats *stats);
 RR_API rr_error rr_frame_get_size(const rr_frame *frame, int *width, int *height);
 /* Samples per pixel of the frame (options.samples). */
 RR_API rr_error rr_frame_get_samples(const rr_frame *frame, int *samples);
+/* The frame's sample positions (options.sample_pos): pos[s] for s < samples. */
+RR_API rr_error rr_frame_get_sample_pos(const rr_frame *frame, float pos[RR_MAX_SAMPLES][2]);
 /* Read-only views of the visibility buffer, row 0 at the top: primitive id
  * (the triangle's id as under "geometries" above, RR_MISS on a miss), ray parameter t along the unnormalised camera ray
  * (+inf on a miss) and barycentrics λ1, λ2 of the hit. With several samples per
@@ -447,11 +449,20 @@ typedef enum rr_aov {
   RR_AOV_NODES,     /* 1 float: BVH nodes visited charged to the pixel (needs options.heat) */
   RR_AOV_MESH,      /* 1 uint32: geometry id (segmentation by mesh), RR_MISS on a miss */
   RR_AOV_MATERIAL,  /* 1 uint32: material index (segmentation by material), RR_MISS on a miss */
+  RR_AOV_COVERAGE,  /* 1 float: the fraction of the pixel's samples that hit (plain count, no filter) */
+  RR_AOV_SAMPLE_ID,    /* N uint32 (N = samples): the id of each sample, channel s = sample s */
+  RR_AOV_SAMPLE_DEPTH, /* N floats: the depth of each sample (+inf on a miss) */
+  RR_AOV_SAMPLE_MESH,  /* N uint32: the geometry id of each sample */
   RR_AOV_COUNT
 } rr_aov;
+/* With several samples per pixel the per-pixel AOVs follow one rule each: id, mesh,
+ * material, normal and bary are those of the sample nearest the pixel's centre (the
+ * lowest such s on a tie; the same s in every pixel), so they belong to one
+ * surface; depth is the nearest depth among all the pixel's samples; evals and
+ * nodes sum over the samples. The sample-* AOVs give every sample. */
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
- * "material"); -1 when unknown. */
+ * "material", "coverage", "sample-id", "sample-depth", "sample-mesh"); -1 when unknown. */
 RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
@@ -465,7 +476,8 @@ typedef enum rr_image_kind {
                           colour to sRGB, EXR and PFM decode 8-bit colour to linear light */
   RR_IMAGE_AOV         /* RR_IMAGE_AOV + a: AOV a of rr_frame_aov, values as they are, EXR channels
                           depth Z, normal N.X N.Y N.Z, bary bary.u bary.v (λ1, λ2), id, mesh and
-                          material (32-bit UINT), evals, nodes */
+                          material (32-bit UINT), evals, nodes, coverage; per sample s (2 digits):
+                          id.sNN, Z.sNN, mesh.sNN */
 } rr_image_kind;
 
 /* An image owned by the caller or by rastray (rr_image_free). */
@@ -483,6 +495,42 @@ typedef struct rr_image {
  * picture in linear light. */
 RR_API rr_error rr_shade(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                          const rr_frame *frame, rr_shade_mode mode, rr_image *out);
+/* Resolve filters: how a pixel's colour is made from the samples' colours (in linear
+ * light). Each weighs a sample by its offset (dx, dy) from the pixel's centre as
+ * f(dx)·f(dy), over |dx|, |dy| < radius, and the weights are normalised per pixel. */
+typedef enum rr_filter {
+  RR_FILTER_BOX = 0,         /* the mean of the pixel's own samples (radius 0.5) */
+  RR_FILTER_MITCHELL,        /* Mitchell–Netravali, B = C = 1/3 (default radius 2): sharper, with
+                                negative lobes; results below zero are clamped to zero */
+  RR_FILTER_BLACKMAN_HARRIS, /* the 4-term Blackman–Harris window (default radius 1.5): smooth, positive */
+  RR_FILTER_COUNT
+} rr_filter;
+
+/* The filter named `name` ("box", "mitchell", "blackman-harris"); -1 when unknown. */
+RR_API int rr_filter_from_name(const char *name);
+/* The name of a filter, NULL when out of range. */
+RR_API const char *rr_filter_name(int filter);
+
+#define RR_FILTER_MAX_RADIUS 4.0f /* widest filter radius, in pixels */
+
+typedef struct rr_resolve_options {
+  rr_filter filter;
+  float radius; /* in pixels, 0.5 .. RR_FILTER_MAX_RADIUS; 0: the filter's default */
+  int alpha;    /* nonzero: a 4th channel, alpha = the filtered coverage of the pixel's samples;
+                   the colour is then straight (not premultiplied): the filtered mean of the
+                   samples that hit, weighted by their coverage (0 where nothing hit) */
+} rr_resolve_options;
+
+/* Fills options with defaults: box filter, no alpha. */
+RR_API void rr_resolve_options_init(rr_resolve_options *opt);
+
+/* Shades a frame like rr_shade, every sample of a pixel, and resolves them to one colour
+ * per pixel with the given filter (NULL: defaults; rr_shade is this with NULL). One
+ * sample per pixel and the box filter give rr_shade's image. Heat maps are per pixel:
+ * neither filtered nor given alpha. */
+RR_API rr_error rr_shade_resolved(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                                  const rr_frame *frame, rr_shade_mode mode, const rr_resolve_options *resolve,
+                                  rr_image *out);
 /* Extracts an AOV of a frame into a new image of kind RR_IMAGE_AOV + aov. */
 RR_API rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                              const rr_frame *frame, rr_aov aov, rr_image *out);

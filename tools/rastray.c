@@ -69,7 +69,7 @@ void json_add(rr_device *dev, rr_output *set, const cJSON *root, const char *pat
 enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
-  OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS,
+  OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA_FILTER, OPT_ALPHA,
 };
 
 typedef struct cli_option {
@@ -127,6 +127,13 @@ static const cli_option render_options[] = {
     {"camera-from-file", OPT_CAMERA_FROM_FILE, "NAME|INDEX",
      "look through a camera the scene file defines (see info); --camera may\nchange its projection"},
     {"shade", OPT_SHADE, "MODE", "lambert (default), id, normal, depth, heat-evals, heat-nodes"},
+    {"aa-filter", OPT_AA_FILTER, "NAME[:R]",
+     "resolve filter of a pixel's samples: box (default: the mean of its own),\n"
+     "mitchell (B=C=1/3, radius R default 2), blackman-harris (R default 1.5);\n"
+     "R in pixels, 0.5..4; wide filters read the neighbours' samples too"},
+    {"alpha", OPT_ALPHA, NULL,
+     "give the colour image an alpha channel: the coverage of the pixel's samples\n"
+     "(filtered), colour straight (PNG RGBA, EXR R G B A)"},
     {"output", 'o', "PATH",
      "colour image: .png (sRGB), .exr or .pfm (linear light); default rastray.png\n"
      "unless --aov is given. PATH may be - (stdout, PNG), FMT:PATH (png:-, exr:-),\n"
@@ -136,7 +143,11 @@ static const cli_option render_options[] = {
      "LIST: one NAME, NAME,NAME,... or all, as the layers of one EXR. NAME: color\n"
      "(the shaded image), depth (EXR Z), normal (N.X N.Y N.Z), bary (bary.u bary.v),\n"
      "id (triangle), mesh (geometry id), material (index) (ids: EXR UINT), evals,\n"
-     "nodes; all: every one (evals, nodes with heat). Outputs are all or nothing"},
+     "nodes, coverage (fraction of samples hit), sample-id, sample-depth,\n"
+     "sample-mesh (H×W×N, one per sample: EXR id.s00.., Z.s00.., mesh.s00..); all:\n"
+     "color to nodes (evals, nodes with heat). With several samples id, mesh,\n"
+     "material, normal, bary are the sample nearest the centre's, depth the nearest.\n"
+     "Outputs are all or nothing"},
     {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default 0: all cores)"},
     {"repeat", OPT_REPEAT, "N", "run the visibility pass N times, report the median time"},
     {"stats", OPT_STATS, NULL, "print key=value statistics to stderr, with the time of each step"},
@@ -323,10 +334,31 @@ static aov_out parse_aov(const char *arg) {
     else if (k >= 0) a.images |= 1u << k;
     else
       die(EXIT_USAGE,
-          "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes or all)", name);
+          "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes, coverage, "
+          "sample-id, sample-depth, sample-mesh or all)",
+          name);
   }
   if (!a.images && !a.all) die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
   return a;
+}
+
+/* Parses --aa-filter NAME[:RADIUS]. */
+static void parse_filter(const char *arg, rr_resolve_options *ro) {
+  char name[32];
+  const char *colon = strchr(arg, ':');
+  size_t len = colon ? (size_t)(colon - arg) : strlen(arg);
+  int f = -1;
+  if (len < sizeof name) {
+    memcpy(name, arg, len), name[len] = 0;
+    f = rr_filter_from_name(name);
+  }
+  if (f < 0) die(EXIT_USAGE, "unknown filter '%s' for --aa-filter (expected box, mitchell or blackman-harris)", arg);
+  ro->filter = (rr_filter)f;
+  if (!colon) return;
+  ro->radius = parse_float(option_name, colon + 1);
+  if (!(ro->radius >= 0.5f && ro->radius <= RR_FILTER_MAX_RADIUS))
+    die(EXIT_USAGE, "bad radius '%s' for --aa-filter (expected 0.5..%g pixels)", colon + 1,
+        (double)RR_FILTER_MAX_RADIUS);
 }
 
 static int cmp_double(const void *a, const void *b) {
@@ -408,8 +440,8 @@ typedef struct {
 /* Adds the run's images to its output set. The colour image and each AOV are made
  * once (shade_ms), whatever number of files hold them, and encoded (write_ms). */
 static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, const rr_camera *cam,
-                       const rr_frame *frame, int shade, const char *out, const char *cube_dir, const aov_out *aovs,
-                       int naov, timings *ms) {
+                       const rr_frame *frame, int shade, const rr_resolve_options *resolve, const char *out,
+                       const char *cube_dir, const aov_out *aovs, int naov, timings *ms) {
   unsigned need = out || cube_dir ? COLOR_BIT : 0;
   for (int k = 0; k < naov; k++) need |= aovs[k].images;
   rr_image images[RR_AOV_COUNT + 1] = {{0}}; /* AOV a at a, the colour last */
@@ -418,7 +450,7 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
   double t = now_ms();
   for (int a = 0; a <= RR_AOV_COUNT; a++) {
     if (!(need & 1u << a)) continue;
-    rr_error e = a == RR_AOV_COUNT ? rr_shade(dev, scene, cam, frame, (rr_shade_mode)shade, colour)
+    rr_error e = a == RR_AOV_COUNT ? rr_shade_resolved(dev, scene, cam, frame, (rr_shade_mode)shade, resolve, colour)
                                    : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
     if (e) {
       rr_output_release(set);
@@ -567,6 +599,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   bool stats = false;
   int shade = RR_SHADE_LAMBERT, repeat = 1, naov = 0;
   aov_out aovs[16];
+  rr_resolve_options resolve;
+  rr_resolve_options_init(&resolve);
   for (int key; (key = next_option(cmd, argc, argv)) != -1;) {
     switch (key) {
     case OPT_METHOD: {
@@ -615,6 +649,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_STATS_JSON: json = optarg; break;
     case OPT_ORACLES: opt.oracles = optarg; break;
     case OPT_CULL_BACKFACES: opt.cull_backfaces = 1; break;
+    case OPT_AA_FILTER: parse_filter(optarg, &resolve); break;
+    case OPT_ALPHA: resolve.alpha = 1; break;
     case OPT_CAMERA_FILE: camera_file = optarg; break;
     case OPT_SAVE_CAMERA: save_camera = optarg; break;
     }
@@ -630,8 +666,10 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   if (shade == RR_SHADE_HEAT_EVALS || shade == RR_SHADE_HEAT_NODES) opt.heat = 1;
   const unsigned heat_aovs = 1u << RR_AOV_EVALS | 1u << RR_AOV_NODES;
   for (int k = 0; k < naov; k++) opt.heat |= (aovs[k].images & heat_aovs) != 0;
-  for (int k = 0; k < naov; k++) /* all: every AOV the frame has */
-    if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~(opt.heat ? 0 : heat_aovs);
+  const unsigned by_name = 1u << RR_AOV_COVERAGE | 1u << RR_AOV_SAMPLE_ID | 1u << RR_AOV_SAMPLE_DEPTH |
+                           1u << RR_AOV_SAMPLE_MESH; /* the AA outputs: asked for by name */
+  for (int k = 0; k < naov; k++) /* all: every per-pixel AOV of the visibility the frame has */
+    if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~by_name & ~(opt.heat ? 0 : heat_aovs);
   if (camera_file) { /* the file's values, where no flag gave one */
     rr_camera from_file = cam;
     unsigned fields = camera_file_read(camera_file, &from_file);
@@ -681,7 +719,7 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   /* Every file of the run goes into one output set: all of them appear, or none. */
   rr_output *set;
   if (rr_output_new(dev, &set) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
-  add_images(dev, set, scene, &cam, frame, shade, out, cube_dir, aovs, naov, &ms);
+  add_images(dev, set, scene, &cam, frame, shade, &resolve, out, cube_dir, aovs, naov, &ms);
   if (save_camera) camera_file_add(dev, set, save_camera, &cam, opt.width, opt.height);
   rr_scene_info info;
   rr_scene_get_info(scene, &info);

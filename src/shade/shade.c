@@ -2,6 +2,7 @@
  * scene, so it never knows which method made the frame. */
 #include "vis/vis.h"
 #include "core/color.h"
+#include "shade/resolve.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -171,36 +172,21 @@ static rr_error shade_heat(rr_device *dev, const float *heat, rr_image *img, con
   return RR_OK;
 }
 
-static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp, const rr_frame *f,
-                            rr_shade_mode mode, rr_image *out) {
-  const camera c = *cp;
-  const visbuf *vb = &f->vb;
-  rr_error e;
-  bool heat = mode == RR_SHADE_HEAT_EVALS || mode == RR_SHADE_HEAT_NODES;
-  const float *counts = mode == RR_SHADE_HEAT_EVALS ? f->heat_e : f->heat_n;
-  if (heat && !counts)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "heat maps need per-pixel statistics (render with options.heat set)");
-  e = image_alloc(dev, out, vb->width, vb->height, 3, RR_PIXEL_F32, RR_IMAGE_COLOR);
-  if (e) return e;
-  float *px = out->data;
-  if (heat) {
-    e = shade_heat(dev, counts, out, mode == RR_SHADE_HEAT_EVALS ? "edge evaluations" : "BVH nodes");
-    if (e) {
-      free(out->data);
-      out->data = NULL;
-      return e;
+/* The eye distances of a layer's hits widen [*dmin, *dmax]. */
+static void depth_range(const rr_scene *s, const camera *c, const visbuf *vb, float *dmin, float *dmax) {
+  for (int y = 0; y < vb->height; y++)
+    for (int x = 0; x < vb->width; x++) {
+      hit h = hit_at(s, c, vb, x, y);
+      if (h.valid) *dmin = fminf(*dmin, h.dist), *dmax = fmaxf(*dmax, h.dist);
     }
-    /* drawn in display colours; the image holds linear light */
-    for (size_t i = 0; i < (size_t)vb->width * vb->height * 3; i++) px[i] = srgb_decode(px[i]);
-    return rr_ok(dev);
-  }
-  float dmin = INFINITY, dmax = 0;
-  if (mode == RR_SHADE_DEPTH)
-    for (int y = 0; y < vb->height; y++)
-      for (int x = 0; x < vb->width; x++) {
-        hit h = hit_at(s, &c, vb, x, y);
-        if (h.valid) dmin = fminf(dmin, h.dist), dmax = fmaxf(dmax, h.dist);
-      }
+}
+
+/* Shades one layer of samples (one sample per pixel, camera c at its position) into
+ * px, 3 floats per pixel, left alone where the camera has no ray; depth shades
+ * [dmin, dmax] from bright to dark. */
+static void shade_layer(const rr_scene *s, const camera *cp, const visbuf *vb, rr_shade_mode mode, float dmin,
+                        float dmax, float *px) {
+  const camera c = *cp;
   for (int y = 0; y < vb->height; y++)
     for (int x = 0; x < vb->width; x++) {
       float *o = px + 3 * ((size_t)y * vb->width + x);
@@ -237,7 +223,70 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp,
       }
       for (int ch = 0; ch < 3; ch++) o[ch] = srgb_decode(o[ch]);
     }
+}
+
+/* Heat maps: per pixel, drawn in display colours and stored in linear light. */
+static rr_error shade_heat_frame(rr_device *dev, const rr_frame *f, rr_shade_mode mode, rr_image *out) {
+  const float *counts = mode == RR_SHADE_HEAT_EVALS ? f->heat_e : f->heat_n;
+  if (!counts)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "heat maps need per-pixel statistics (render with options.heat set)");
+  rr_error e = image_alloc(dev, out, f->vb.width, f->vb.height, 3, RR_PIXEL_F32, RR_IMAGE_COLOR);
+  if (!e) e = shade_heat(dev, counts, out, mode == RR_SHADE_HEAT_EVALS ? "edge evaluations" : "BVH nodes");
+  if (e) {
+    free(out->data);
+    out->data = NULL;
+    return e;
+  }
+  float *px = out->data;
+  for (size_t i = 0; i < (size_t)f->vb.width * f->vb.height * 3; i++) px[i] = srgb_decode(px[i]);
   return rr_ok(dev);
+}
+
+/* Layer s of a frame's visibility buffer: sample s of every pixel. */
+static visbuf frame_layer(const rr_frame *f, int s) {
+  size_t off = (size_t)s * f->vb.width * f->vb.height;
+  return (visbuf){f->vb.width, f->vb.height, f->vb.id + off, f->vb.t + off, f->vb.l1 + off, f->vb.l2 + off};
+}
+
+/* Resolves the frame's cameras, one per sample position; on failure none is left. */
+static rr_error frame_cameras(rr_device *dev, const rr_camera *cam, const rr_frame *f, camera *cams) {
+  for (int s = 0; s < f->samples; s++) {
+    rr_error e = rr_cam_setup_at(dev, cam, f->vb.width, f->vb.height, f->sample_pos[s], &cams[s]);
+    if (e) {
+      while (s > 0) rr_cam_release(&cams[--s]);
+      return e;
+    }
+  }
+  return RR_OK;
+}
+
+/* Shades every sample of the frame (layer by layer, each at its own position) and
+ * resolves them with the filter. */
+static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f,
+                            rr_shade_mode mode, const rr_resolve_options *ropt, rr_image *out) {
+  size_t npix = (size_t)f->vb.width * f->vb.height, n = npix * f->samples;
+  bool alpha = ropt && ropt->alpha;
+  float *rgb = calloc(n * 3, sizeof *rgb), *cover = alpha ? malloc(n * sizeof *cover) : NULL;
+  if (!rgb || (alpha && !cover)) {
+    free(rgb), free(cover);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %d samples of a %dx%d image", f->samples, f->vb.width,
+                   f->vb.height);
+  }
+  float dmin = INFINITY, dmax = 0;
+  if (mode == RR_SHADE_DEPTH)
+    for (int k = 0; k < f->samples; k++) {
+      visbuf layer = frame_layer(f, k);
+      depth_range(s, &cams[k], &layer, &dmin, &dmax);
+    }
+  for (int k = 0; k < f->samples; k++) {
+    visbuf layer = frame_layer(f, k);
+    shade_layer(s, &cams[k], &layer, mode, dmin, dmax, rgb + 3 * npix * k);
+  }
+  for (size_t i = 0; cover && i < n; i++) cover[i] = f->vb.id[i] < s->ntris ? 1.0f : 0.0f;
+  resolve_input in = {f->vb.width, f->vb.height, f->samples, (const float(*)[2])f->sample_pos, rgb, NULL, cover};
+  rr_error e = rr_resolve_image(dev, &in, ropt, f->stats.threads, out);
+  free(rgb), free(cover);
+  return e ? e : rr_ok(dev);
 }
 
 /* The value of an integer AOV (id, mesh, material) at a sample that saw primitive id. */
@@ -247,13 +296,36 @@ static uint32_t id_aov(const rr_scene *s, rr_aov aov, uint32_t id) {
   return aov == RR_AOV_MESH ? rr_scene_geometry_of(s, id) : s->material[id];
 }
 
-static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cp, const rr_frame *f, rr_aov aov,
+/* The sample nearest the pixel's centre (the lowest index on a tie): the same in
+ * every pixel, as every pixel has the frame's pattern. */
+static int centre_sample(const rr_frame *f) {
+  int best = 0;
+  float best_d = INFINITY;
+  for (int s = 0; s < f->samples; s++) {
+    float dx = f->sample_pos[s][0] - 0.5f, dy = f->sample_pos[s][1] - 0.5f, d = dx * dx + dy * dy;
+    if (d < best_d) best = s, best_d = d;
+  }
+  return best;
+}
+
+/* The AOV a per-sample AOV gives for each sample; the AOV itself otherwise. */
+static rr_aov per_sample_base(rr_aov aov) {
+  switch (aov) {
+  case RR_AOV_SAMPLE_ID: return RR_AOV_ID;
+  case RR_AOV_SAMPLE_DEPTH: return RR_AOV_DEPTH;
+  case RR_AOV_SAMPLE_MESH: return RR_AOV_MESH;
+  default: return aov;
+  }
+}
+
+/* Fills an AOV from the frame's layers, by the rules of several samples per pixel
+ * (rastray.h): a per-sample AOV takes every layer as a channel; coverage counts the
+ * layers' hits; depth keeps the nearest; the others read the centre's layer. */
+static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f, rr_aov aov,
                           rr_image *out) {
-  const camera c = *cp;
   const visbuf *vb = &f->vb;
   rr_error e;
-  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1, 1, 1};
-  if ((int)aov < 0 || aov >= RR_AOV_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AOV %d", (int)aov);
+  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1, 1, 1, 1};
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
     if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
@@ -262,44 +334,67 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cp, c
     memcpy(out->data, counts, (size_t)vb->width * vb->height * sizeof(float));
     return rr_ok(dev);
   }
-  bool ints = aov == RR_AOV_ID || aov == RR_AOV_MESH || aov == RR_AOV_MATERIAL;
-  e = image_alloc(dev, out, vb->width, vb->height, channels[aov], ints ? RR_PIXEL_U32 : RR_PIXEL_F32,
-                  RR_IMAGE_AOV + (int)aov);
+  rr_aov base = per_sample_base(aov);
+  bool per_sample = base != aov, ints = base == RR_AOV_ID || base == RR_AOV_MESH || base == RR_AOV_MATERIAL;
+  int ch = per_sample ? f->samples : channels[aov], centre = centre_sample(f);
+  e = image_alloc(dev, out, vb->width, vb->height, ch, ints ? RR_PIXEL_U32 : RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov);
   if (e) return e;
-  for (int y = 0; y < vb->height; y++)
-    for (int x = 0; x < vb->width; x++) {
-      size_t k = (size_t)y * vb->width + x;
-      if (ints) {
-        ((uint32_t *)out->data)[k] = id_aov(s, aov, vb->id[k]);
-        continue;
+  size_t npix = (size_t)vb->width * vb->height;
+  float *o = out->data;
+  if (base == RR_AOV_DEPTH && !per_sample)
+    for (size_t k = 0; k < npix; k++) o[k] = INFINITY;
+  for (int smp = 0; smp < f->samples; smp++) {
+    if (!per_sample && base != RR_AOV_DEPTH && aov != RR_AOV_COVERAGE && smp != centre) continue;
+    visbuf layer = frame_layer(f, smp);
+    int c0 = per_sample ? smp : 0; /* this layer's channel */
+    for (int y = 0; y < vb->height; y++)
+      for (int x = 0; x < vb->width; x++) {
+        size_t k = (size_t)y * vb->width + x;
+        if (ints) {
+          ((uint32_t *)out->data)[k * ch + c0] = id_aov(s, base, layer.id[k]);
+          continue;
+        }
+        if (aov == RR_AOV_COVERAGE) {
+          o[k] += layer.id[k] < s->ntris ? 1.0f / f->samples : 0.0f;
+          continue;
+        }
+        hit h = hit_at(s, &cams[smp], &layer, x, y);
+        float *p = o + k * ch + c0;
+        if (base == RR_AOV_DEPTH) *p = fminf(*p, h.valid ? h.dist : INFINITY);
+        else if (base == RR_AOV_NORMAL && h.valid) p[0] = h.normal.x, p[1] = h.normal.y, p[2] = h.normal.z;
+        else if (base == RR_AOV_BARY && h.valid) p[0] = h.l1, p[1] = h.l2;
       }
-      float *o = (float *)out->data + channels[aov] * k;
-      hit h = hit_at(s, &c, vb, x, y);
-      if (aov == RR_AOV_DEPTH) o[0] = h.valid ? h.dist : INFINITY;
-      else if (aov == RR_AOV_NORMAL && h.valid) o[0] = h.normal.x, o[1] = h.normal.y, o[2] = h.normal.z;
-      else if (aov == RR_AOV_BARY && h.valid) o[0] = h.l1, o[1] = h.l2;
-    }
+  }
   return rr_ok(dev);
 }
 
-/* The public entry points resolve the camera for the frame's size around the work. */
-rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_shade_mode mode,
-                  rr_image *out) {
+/* The public entry points resolve the frame's cameras, one per sample position, around the work. */
+rr_error rr_shade_resolved(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                           rr_shade_mode mode, const rr_resolve_options *resolve, rr_image *out) {
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
   if ((int)mode < 0 || mode >= RR_SHADE_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shade mode %d", (int)mode);
-  camera c;
-  rr_error e = rr_cam_setup(dev, cam, f->vb.width, f->vb.height, &c);
-  if (!e) e = shade_frame(dev, s, &c, f, mode, out);
-  rr_cam_release(&c);
+  if (mode == RR_SHADE_HEAT_EVALS || mode == RR_SHADE_HEAT_NODES) return shade_heat_frame(dev, f, mode, out);
+  camera cams[RR_MAX_SAMPLES];
+  rr_error e = frame_cameras(dev, cam, f, cams);
+  if (e) return e;
+  e = shade_frame(dev, s, cams, f, mode, resolve, out);
+  for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
   return e;
+}
+
+rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_shade_mode mode,
+                  rr_image *out) {
+  return rr_shade_resolved(dev, s, cam, f, mode, NULL, out);
 }
 
 rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_aov aov,
                       rr_image *out) {
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_frame_aov: NULL argument");
-  camera c;
-  rr_error e = rr_cam_setup(dev, cam, f->vb.width, f->vb.height, &c);
-  if (!e) e = frame_aov(dev, s, &c, f, aov, out);
-  rr_cam_release(&c);
+  if ((int)aov < 0 || aov >= RR_AOV_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AOV %d", (int)aov);
+  camera cams[RR_MAX_SAMPLES];
+  rr_error e = frame_cameras(dev, cam, f, cams);
+  if (e) return e;
+  e = frame_aov(dev, s, cams, f, aov, out);
+  for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
   return e;
 }

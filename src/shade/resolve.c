@@ -1,0 +1,128 @@
+/* Resolve: a filter over every sample near a pixel's centre, in linear light. The
+ * weight of a sample depends only on its position in its pixel and that pixel's
+ * offset from the one resolved, the same for every pixel: it is tabulated once per
+ * frame as taps (pixel offset, sample, weight), and a pixel is a sum over the taps
+ * that land inside the image, normalised by the weights it met (so the border needs
+ * no special case and a constant image stays constant). */
+#include "shade/resolve.h"
+#include "core/vec.h"
+
+#include <math.h>
+#include <string.h>
+
+static const char *const filter_names[RR_FILTER_COUNT] = {"box", "mitchell", "blackman-harris"};
+static const float default_radius[RR_FILTER_COUNT] = {0.5f, 2.0f, 1.5f};
+
+int rr_filter_from_name(const char *name) {
+  for (int i = 0; name && i < RR_FILTER_COUNT; i++)
+    if (!strcmp(name, filter_names[i])) return i;
+  return -1;
+}
+
+const char *rr_filter_name(int filter) {
+  return filter >= 0 && filter < RR_FILTER_COUNT ? filter_names[filter] : NULL;
+}
+
+void rr_resolve_options_init(rr_resolve_options *opt) {
+  *opt = (rr_resolve_options){.filter = RR_FILTER_BOX, .radius = 0, .alpha = 0};
+}
+
+/* Mitchell–Netravali's cubic at |x| in [0, 2), B = C = 1/3 (their recommendation). */
+static double mitchell(double x) {
+  const double B = 1.0 / 3, C = 1.0 / 3;
+  x = fabs(x);
+  if (x < 1) return ((12 - 9 * B - 6 * C) * x * x * x + (-18 + 12 * B + 6 * C) * x * x + (6 - 2 * B)) / 6;
+  if (x < 2) return ((-B - 6 * C) * x * x * x + (6 * B + 30 * C) * x * x + (-12 * B - 48 * C) * x + (8 * B + 24 * C)) / 6;
+  return 0;
+}
+
+/* The filter's 1D weight at offset x from the centre, radius r. Half-open support
+ * [-r, r): with the box's r = 0.5 a pixel takes exactly its own samples. */
+static double filter_1d(rr_filter f, double x, double r) {
+  if (!(x >= -r && x < r)) return 0;
+  switch (f) {
+  case RR_FILTER_MITCHELL: return mitchell(2 * x / r);
+  case RR_FILTER_BLACKMAN_HARRIS: { /* the window over [-r, r], centred */
+    const double a0 = 0.35875, a1 = 0.48829, a2 = 0.14128, a3 = 0.01168, p = RR_PI * x / r;
+    return a0 + a1 * cos(p) + a2 * cos(2 * p) + a3 * cos(3 * p);
+  }
+  default: return 1;
+  }
+}
+
+typedef struct tap {
+  int dx, dy, s;
+  double f;
+} tap;
+
+typedef struct resolve_job {
+  const resolve_input *in;
+  const tap *taps;
+  int ntaps;
+  float *out;
+  int channels;
+} resolve_job;
+
+enum { ROWS_PER_JOB = 16 };
+
+static void resolve_rows(int job, int thread, void *arg) {
+  (void)thread;
+  const resolve_job *j = arg;
+  const resolve_input *in = j->in;
+  int w = in->width, h = in->height;
+  size_t npix = (size_t)w * h;
+  int y1 = (job + 1) * ROWS_PER_JOB < h ? (job + 1) * ROWS_PER_JOB : h;
+  for (int y = job * ROWS_PER_JOB; y < y1; y++)
+    for (int x = 0; x < w; x++) {
+      double rgb[3] = {0, 0, 0}, wsum = 0, asum = 0; /* double: sums of up to ~2000 taps stay exact enough */
+      for (int t = 0; t < j->ntaps; t++) {
+        const tap *tp = &j->taps[t];
+        int xx = x + tp->dx, yy = y + tp->dy;
+        if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+        size_t k = (size_t)tp->s * npix + (size_t)yy * w + xx;
+        double wt = in->weight ? tp->f * in->weight[k] : tp->f;
+        double wa = in->alpha ? wt * in->alpha[k] : wt;
+        wsum += wt, asum += wa;
+        for (int c = 0; c < 3; c++) rgb[c] += wa * in->rgb[3 * k + c];
+      }
+      float *o = j->out + (size_t)j->channels * ((size_t)y * w + x);
+      for (int c = 0; c < 3; c++) o[c] = asum > 0 ? (float)fmax(rgb[c] / asum, 0) : 0.0f;
+      if (j->channels == 4) o[3] = wsum > 0 ? (float)fmin(fmax(asum / wsum, 0), 1) : 0.0f;
+    }
+}
+
+rr_error rr_resolve_image(rr_device *dev, const resolve_input *in, const rr_resolve_options *opt, int threads,
+                       rr_image *out) {
+  rr_resolve_options def;
+  if (!opt) rr_resolve_options_init(&def), opt = &def;
+  if ((int)opt->filter < 0 || opt->filter >= RR_FILTER_COUNT)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown resolve filter %d", (int)opt->filter);
+  double r = opt->radius == 0 ? default_radius[opt->filter] : opt->radius;
+  if (!(r >= 0.5 && r <= RR_FILTER_MAX_RADIUS))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad filter radius %g (0.5 .. %g pixels, 0 for the filter's own)",
+                   (double)opt->radius, (double)RR_FILTER_MAX_RADIUS);
+  /* a sample at p in a pixel dx away sits dx + p - 0.5 from the centre: |dx| <= R */
+  int R = (int)ceil(r + 0.5), side = 2 * R + 1;
+  tap *taps = malloc(sizeof *taps * side * side * in->samples);
+  int channels = in->alpha ? 4 : 3;
+  out->width = in->width, out->height = in->height, out->channels = channels;
+  out->type = RR_PIXEL_F32, out->kind = RR_IMAGE_COLOR;
+  out->data = taps ? malloc(sizeof(float) * channels * in->width * in->height) : NULL;
+  if (!out->data) {
+    free(taps);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory resolving a %dx%d image", in->width, in->height);
+  }
+  int ntaps = 0;
+  for (int dy = -R; dy <= R; dy++)
+    for (int dx = -R; dx <= R; dx++)
+      for (int s = 0; s < in->samples; s++) {
+        double f = filter_1d(opt->filter, dx + (double)in->pos[s][0] - 0.5, r) *
+                   filter_1d(opt->filter, dy + (double)in->pos[s][1] - 0.5, r);
+        if (f != 0) taps[ntaps++] = (tap){dx, dy, s, f};
+      }
+  resolve_job job = {in, taps, ntaps, out->data, channels};
+  rr_parallel_for((in->height + ROWS_PER_JOB - 1) / ROWS_PER_JOB, threads ? threads : rr_cpu_count(), resolve_rows,
+                  &job);
+  free(taps);
+  return RR_OK;
+}
