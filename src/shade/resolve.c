@@ -57,7 +57,7 @@ typedef struct tap {
 
 typedef struct resolve_job {
   const resolve_input *in;
-  const tap *taps;
+  const tap *taps, *own; /* the filter's; the box of the pixel's own samples */
   int ntaps;
   float *out;
   int channels;
@@ -65,29 +65,39 @@ typedef struct resolve_job {
 
 enum { ROWS_PER_JOB = 16 };
 
+/* The sums of pixel (x, y) over the taps inside the image: Σ f·w·a·rgb in sum[0..2],
+ * Σ f·w·a in sum[3], Σ f·w in sum[4]; in double, so a constant stays one. */
+static void pixel_sums(const resolve_input *in, const tap *taps, int ntaps, int x, int y, double sum[5]) {
+  int w = in->width, h = in->height;
+  size_t npix = (size_t)w * h;
+  for (int c = 0; c < 5; c++) sum[c] = 0;
+  for (int t = 0; t < ntaps; t++) {
+    const tap *tp = &taps[t];
+    int xx = x + tp->dx, yy = y + tp->dy;
+    if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+    size_t k = (size_t)tp->s * npix + (size_t)yy * w + xx;
+    double wt = in->weight ? tp->f * in->weight[k] : tp->f;
+    double wa = in->alpha ? wt * in->alpha[k] : wt;
+    for (int c = 0; c < 3; c++) sum[c] += wa * in->rgb[3 * k + c];
+    sum[3] += wa, sum[4] += wt;
+  }
+}
+
 static void resolve_rows(int job, int thread, void *arg) {
   (void)thread;
   const resolve_job *j = arg;
   const resolve_input *in = j->in;
-  int w = in->width, h = in->height;
-  size_t npix = (size_t)w * h;
-  int y1 = (job + 1) * ROWS_PER_JOB < h ? (job + 1) * ROWS_PER_JOB : h;
+  int y1 = (job + 1) * ROWS_PER_JOB < in->height ? (job + 1) * ROWS_PER_JOB : in->height;
   for (int y = job * ROWS_PER_JOB; y < y1; y++)
-    for (int x = 0; x < w; x++) {
-      double rgb[3] = {0, 0, 0}, wsum = 0, asum = 0; /* double: sums of up to ~2000 taps stay exact enough */
-      for (int t = 0; t < j->ntaps; t++) {
-        const tap *tp = &j->taps[t];
-        int xx = x + tp->dx, yy = y + tp->dy;
-        if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-        size_t k = (size_t)tp->s * npix + (size_t)yy * w + xx;
-        double wt = in->weight ? tp->f * in->weight[k] : tp->f;
-        double wa = in->alpha ? wt * in->alpha[k] : wt;
-        wsum += wt, asum += wa;
-        for (int c = 0; c < 3; c++) rgb[c] += wa * in->rgb[3 * k + c];
-      }
-      float *o = j->out + (size_t)j->channels * ((size_t)y * w + x);
-      for (int c = 0; c < 3; c++) o[c] = asum > 0 ? (float)fmax(rgb[c] / asum, 0) : 0.0f;
-      if (j->channels == 4) o[3] = wsum > 0 ? (float)fmin(fmax(asum / wsum, 0), 1) : 0.0f;
+    for (int x = 0; x < in->width; x++) {
+      double sum[5];
+      pixel_sums(in, j->taps, j->ntaps, x, y, sum);
+      /* negative lobes over sparse weights may leave nothing positive to divide by:
+       * the pixel's own samples then decide, as the box would */
+      if (!(sum[3] > 0 && sum[4] > 0)) pixel_sums(in, j->own, in->samples, x, y, sum);
+      float *o = j->out + (size_t)j->channels * ((size_t)y * in->width + x);
+      for (int c = 0; c < 3; c++) o[c] = sum[3] > 0 ? (float)fmax(sum[c] / sum[3], 0) : 0.0f;
+      if (j->channels == 4) o[3] = sum[4] > 0 ? (float)fmin(fmax(sum[3] / sum[4], 0), 1) : 0.0f;
     }
 }
 
@@ -103,7 +113,7 @@ rr_error rr_resolve_image(rr_device *dev, const resolve_input *in, const rr_reso
                    (double)opt->radius, (double)RR_FILTER_MAX_RADIUS);
   /* a sample at p in a pixel dx away sits dx + p - 0.5 from the centre: |dx| <= R */
   int R = (int)ceil(r + 0.5), side = 2 * R + 1;
-  tap *taps = malloc(sizeof *taps * side * side * in->samples);
+  tap *taps = malloc(sizeof *taps * (side * side + 1) * in->samples), *own = taps + side * side * in->samples;
   int channels = in->alpha ? 4 : 3;
   out->width = in->width, out->height = in->height, out->channels = channels;
   out->type = RR_PIXEL_F32, out->kind = RR_IMAGE_COLOR;
@@ -120,7 +130,8 @@ rr_error rr_resolve_image(rr_device *dev, const resolve_input *in, const rr_reso
                    filter_1d(opt->filter, dy + (double)in->pos[s][1] - 0.5, r);
         if (f != 0) taps[ntaps++] = (tap){dx, dy, s, f};
       }
-  resolve_job job = {in, taps, ntaps, out->data, channels};
+  for (int s = 0; s < in->samples; s++) own[s] = (tap){0, 0, s, 1};
+  resolve_job job = {in, taps, own, ntaps, out->data, channels};
   rr_parallel_for((in->height + ROWS_PER_JOB - 1) / ROWS_PER_JOB, threads ? threads : rr_cpu_count(), resolve_rows,
                   &job);
   free(taps);

@@ -21,7 +21,9 @@ typedef struct resolve_input {
  * 4 with alpha), on `threads` threads (0: all cores). A pixel's colour is
  * Σ f·w·a·rgb / Σ f·w·a over the samples the filter reaches (f its weight, w the
  * input's, a the alpha, 1 without), clamped at 0; alpha is Σ f·w·a / Σ f·w in [0, 1].
- * A pixel whose sums are not positive is 0. opt NULL: the defaults. */
+ * Where the filter leaves no positive sum (negative lobes over sparse weights), the
+ * pixel's own samples are averaged instead, as by the box; where they too sum to 0,
+ * the pixel is 0. opt NULL: the defaults. */
 rr_error rr_resolve_image(rr_device *dev, const resolve_input *in, const rr_resolve_options *opt, int threads,
                        rr_image *out);
 

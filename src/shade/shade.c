@@ -341,8 +341,8 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
   if (e) return e;
   size_t npix = (size_t)vb->width * vb->height;
   float *o = out->data;
-  if (base == RR_AOV_DEPTH && !per_sample)
-    for (size_t k = 0; k < npix; k++) o[k] = INFINITY;
+  if (base == RR_AOV_DEPTH) /* a miss everywhere, until a sample sees nearer */
+    for (size_t k = 0; k < npix * ch; k++) o[k] = INFINITY;
   for (int smp = 0; smp < f->samples; smp++) {
     if (!per_sample && base != RR_AOV_DEPTH && aov != RR_AOV_COVERAGE && smp != centre) continue;
     visbuf layer = frame_layer(f, smp);
