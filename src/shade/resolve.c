@@ -8,6 +8,7 @@
 #include "core/vec.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 static const char *const filter_names[RR_FILTER_COUNT] = {"box", "mitchell", "blackman-harris"};
@@ -51,14 +52,15 @@ static double filter_1d(rr_filter f, double x, double r) {
 }
 
 typedef struct tap {
-  int dx, dy, s;
+  int dx, dy;
+  ptrdiff_t off; /* of the sample from the pixel's, in samples: s·width·height + dy·width + dx */
   double f;
 } tap;
 
 typedef struct resolve_job {
   const resolve_input *in;
   const tap *taps, *own; /* the filter's; the box of the pixel's own samples */
-  int ntaps;
+  int ntaps, reach; /* reach: the farthest tap, in pixels */
   float *out;
   int channels;
 } resolve_job;
@@ -67,20 +69,33 @@ enum { ROWS_PER_JOB = 16 };
 
 /* The sums of pixel (x, y) over the taps inside the image: Σ f·w·a·rgb in sum[0..2],
  * Σ f·w·a in sum[3], Σ f·w in sum[4]; in double, so a constant stays one. */
-static void pixel_sums(const resolve_input *in, const tap *taps, int ntaps, int x, int y, double sum[5]) {
+static inline void sums_of(const resolve_input *in, const tap *taps, int ntaps, int x, int y, bool clip,
+                           bool weighed, double sum[5]) {
   int w = in->width, h = in->height;
-  size_t npix = (size_t)w * h;
-  for (int c = 0; c < 5; c++) sum[c] = 0;
-  for (int t = 0; t < ntaps; t++) {
-    const tap *tp = &taps[t];
-    int xx = x + tp->dx, yy = y + tp->dy;
-    if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-    size_t k = (size_t)tp->s * npix + (size_t)yy * w + xx;
-    double wt = in->weight ? tp->f * in->weight[k] : tp->f;
-    double wa = in->alpha ? wt * in->alpha[k] : wt;
-    for (int c = 0; c < 3; c++) sum[c] += wa * in->rgb[3 * k + c];
-    sum[3] += wa, sum[4] += wt;
+  ptrdiff_t k0 = (ptrdiff_t)y * w + x;
+  double r = 0, g = 0, b = 0, wa = 0, wt = 0;
+  for (const tap *tp = taps; tp < taps + ntaps; tp++) {
+    if (clip && ((unsigned)(x + tp->dx) >= (unsigned)w || (unsigned)(y + tp->dy) >= (unsigned)h)) continue;
+    ptrdiff_t k = k0 + tp->off;
+    double f = tp->f, fa = f;
+    if (weighed) {
+      if (in->weight) f *= in->weight[k];
+      fa = in->alpha ? f * in->alpha[k] : f;
+    }
+    const float *c = in->rgb + 3 * k;
+    r += fa * c[0], g += fa * c[1], b += fa * c[2], wa += fa, wt += f;
   }
+  sum[0] = r, sum[1] = g, sum[2] = b, sum[3] = wa, sum[4] = wt;
+}
+
+/* The same, specialised: taps may fall outside the image only near its border
+ * (reach: how far they go), and most inputs have neither weights nor alpha. */
+static void pixel_sums(const resolve_input *in, const tap *taps, int ntaps, int reach, int x, int y, double sum[5]) {
+  bool clip = x < reach || y < reach || x >= in->width - reach || y >= in->height - reach;
+  bool weighed = in->weight || in->alpha;
+  if (clip) sums_of(in, taps, ntaps, x, y, true, weighed, sum);
+  else if (weighed) sums_of(in, taps, ntaps, x, y, false, true, sum);
+  else sums_of(in, taps, ntaps, x, y, false, false, sum);
 }
 
 static void resolve_rows(int job, int thread, void *arg) {
@@ -91,10 +106,10 @@ static void resolve_rows(int job, int thread, void *arg) {
   for (int y = job * ROWS_PER_JOB; y < y1; y++)
     for (int x = 0; x < in->width; x++) {
       double sum[5];
-      pixel_sums(in, j->taps, j->ntaps, x, y, sum);
+      pixel_sums(in, j->taps, j->ntaps, j->reach, x, y, sum);
       /* negative lobes over sparse weights may leave nothing positive to divide by:
        * the pixel's own samples then decide, as the box would */
-      if (!(sum[3] > 0 && sum[4] > 0)) pixel_sums(in, j->own, in->samples, x, y, sum);
+      if (!(sum[3] > 0 && sum[4] > 0)) pixel_sums(in, j->own, in->samples, 0, x, y, sum);
       float *o = j->out + (size_t)j->channels * ((size_t)y * in->width + x);
       for (int c = 0; c < 3; c++) o[c] = sum[3] > 0 ? (float)fmax(sum[c] / sum[3], 0) : 0.0f;
       if (j->channels == 4) o[3] = sum[4] > 0 ? (float)fmin(fmax(sum[3] / sum[4], 0), 1) : 0.0f;
@@ -123,15 +138,16 @@ rr_error rr_resolve_image(rr_device *dev, const resolve_input *in, const rr_reso
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory resolving a %dx%d image", in->width, in->height);
   }
   int ntaps = 0;
-  for (int dy = -R; dy <= R; dy++)
-    for (int dx = -R; dx <= R; dx++)
-      for (int s = 0; s < in->samples; s++) {
+  ptrdiff_t w = in->width, layer = w * in->height;
+  for (int s = 0; s < in->samples; s++) /* in memory order, layer by layer, row by row */
+    for (int dy = -R; dy <= R; dy++)
+      for (int dx = -R; dx <= R; dx++) {
         double f = filter_1d(opt->filter, dx + (double)in->pos[s][0] - 0.5, r) *
                    filter_1d(opt->filter, dy + (double)in->pos[s][1] - 0.5, r);
-        if (f != 0) taps[ntaps++] = (tap){dx, dy, s, f};
+        if (f != 0) taps[ntaps++] = (tap){dx, dy, s * layer + dy * w + dx, f};
       }
-  for (int s = 0; s < in->samples; s++) own[s] = (tap){0, 0, s, 1};
-  resolve_job job = {in, taps, own, ntaps, out->data, channels};
+  for (int s = 0; s < in->samples; s++) own[s] = (tap){0, 0, s * layer, 1};
+  resolve_job job = {in, taps, own, ntaps, R, out->data, channels};
   rr_parallel_for((in->height + ROWS_PER_JOB - 1) / ROWS_PER_JOB, threads ? threads : rr_cpu_count(), resolve_rows,
                   &job);
   free(taps);
