@@ -492,7 +492,8 @@ typedef struct rr_image {
  * lambert is the lit colour itself; the visualisations (id, normal, depth, heat maps,
  * the background) are display colours stored decoded from sRGB, so that every file
  * shows them as designed: a PNG holds exactly the display values, an EXR the same
- * picture in linear light. */
+ * picture in linear light. With several samples per pixel each is shaded and their
+ * mean taken (rr_shade_resolved with the box filter). */
 RR_API rr_error rr_shade(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                          const rr_frame *frame, rr_shade_mode mode, rr_image *out);
 /* Resolve filters: how a pixel's colour is made from the samples' colours (in linear
