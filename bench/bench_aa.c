@@ -35,7 +35,7 @@ static void frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const
   rr_image img;
   rr_shade_stats st;
   if (rr_render(dev, s, cam, opt, &f) != RR_OK ||
-      rr_shade_with_stats(dev, s, cam, f, RR_SHADE_LAMBERT, &img, &st) != RR_OK) {
+      rr_shade_frame(dev, s, cam, f, NULL, &img, &st) /* Lambert, box */ != RR_OK) {
     fprintf(stderr, "bench_aa: %s\n", rr_device_message(dev));
     exit(1);
   }

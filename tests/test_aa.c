@@ -102,7 +102,10 @@ static float *render_aa(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   if (!f) return NULL;
   rr_image img = {0};
   rr_shade_stats local;
-  rr_error e = rr_shade_with_stats(dev, s, cam, f, mode, &img, st ? st : &local);
+  rr_shade_options so;
+  rr_shade_options_init(&so);
+  so.mode = mode;
+  rr_error e = rr_shade_frame(dev, s, cam, f, &so, &img, st ? st : &local);
   CHECK(e == RR_OK, "shading %s:%d: %s", rr_aa_mode_name(m), n, rr_device_message(dev));
   rr_frame_release(f);
   if (e) return NULL;

@@ -69,7 +69,8 @@ void json_add(rr_device *dev, rr_output *set, const cJSON *root, const char *pat
 enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
-  OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA, OPT_AA_PATTERN,
+  OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA, OPT_AA_PATTERN, OPT_AA_FILTER,
+  OPT_ALPHA,
 };
 
 typedef struct cli_option {
@@ -127,6 +128,20 @@ static const cli_option render_options[] = {
     {"camera-from-file", OPT_CAMERA_FROM_FILE, "NAME|INDEX",
      "look through a camera the scene file defines (see info); --camera may\nchange its projection"},
     {"shade", OPT_SHADE, "MODE", "lambert (default), id, normal, depth, heat-evals, heat-nodes"},
+    {"aa", OPT_AA, "MODE",
+     "anti-aliasing: none (default), ssaa:N (N samples, each shaded), msaa:N (shaded\n"
+     "once per pixel per primitive), csaa:K/N (N coverage samples, K with colour);\n"
+     "N, K: 1, 2, 4, 8 or 16"},
+    {"aa-pattern", OPT_AA_PATTERN, "NAME",
+     "sample positions: standard (default: Direct3D's and Vulkan's), rotated (a\n"
+     "rotated grid), jitter[:SEED] (one random position per cell; seed default 1)"},
+    {"aa-filter", OPT_AA_FILTER, "NAME[:R]",
+     "resolve filter of a pixel's samples: box (default: the mean of its own),\n"
+     "mitchell (B=C=1/3, radius R default 2), blackman-harris (R default 1.5);\n"
+     "R in pixels, 0.5..4; wide filters read the neighbours' samples too"},
+    {"alpha", OPT_ALPHA, NULL,
+     "give the colour image an alpha channel: the coverage of the pixel's samples\n"
+     "(filtered), colour straight (PNG RGBA, EXR R G B A)"},
     {"output", 'o', "PATH",
      "colour image: .png (sRGB), .exr or .pfm (linear light); default rastray.png\n"
      "unless --aov is given. PATH may be - (stdout, PNG), FMT:PATH (png:-, exr:-),\n"
@@ -136,14 +151,11 @@ static const cli_option render_options[] = {
      "LIST: one NAME, NAME,NAME,... or all, as the layers of one EXR. NAME: color\n"
      "(the shaded image), depth (EXR Z), normal (N.X N.Y N.Z), bary (bary.u bary.v),\n"
      "id (triangle), mesh (geometry id), material (index) (ids: EXR UINT), evals,\n"
-     "nodes; all: every one (evals, nodes with heat). Outputs are all or nothing"},
-    {"aa", OPT_AA, "MODE",
-     "anti-aliasing: none (default), ssaa:N (N samples, each shaded), msaa:N (shaded\n"
-     "once per pixel per primitive), csaa:K/N (N coverage samples, K with colour);\n"
-     "N, K: 1, 2, 4, 8 or 16"},
-    {"aa-pattern", OPT_AA_PATTERN, "NAME",
-     "sample positions: standard (default: Direct3D's and Vulkan's), rotated (a\n"
-     "rotated grid), jitter[:SEED] (one random position per cell; seed default 1)"},
+     "nodes, coverage (fraction of samples hit), sample-id, sample-depth,\n"
+     "sample-mesh (H×W×N, one per sample: EXR id.s00.., Z.s00.., mesh.s00..); all:\n"
+     "color to nodes (evals, nodes with heat). With several samples id, mesh,\n"
+     "material, normal, bary are the sample nearest the centre's, depth the nearest.\n"
+     "Outputs are all or nothing"},
     {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default 0: all cores)"},
     {"repeat", OPT_REPEAT, "N", "run the visibility pass N times, report the median time"},
     {"stats", OPT_STATS, NULL, "print key=value statistics to stderr, with the time of each step"},
@@ -373,10 +385,31 @@ static aov_out parse_aov(const char *arg) {
     else if (k >= 0) a.images |= 1u << k;
     else
       die(EXIT_USAGE,
-          "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes or all)", name);
+          "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes, coverage, "
+          "sample-id, sample-depth, sample-mesh or all)",
+          name);
   }
   if (!a.images && !a.all) die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
   return a;
+}
+
+/* Parses --aa-filter NAME[:RADIUS]. */
+static void parse_filter(const char *arg, rr_shade_options *ro) {
+  char name[32];
+  const char *colon = strchr(arg, ':');
+  size_t len = colon ? (size_t)(colon - arg) : strlen(arg);
+  int f = -1;
+  if (len < sizeof name) {
+    memcpy(name, arg, len), name[len] = 0;
+    f = rr_filter_from_name(name);
+  }
+  if (f < 0) die(EXIT_USAGE, "unknown filter '%s' for --aa-filter (expected box, mitchell or blackman-harris)", arg);
+  ro->filter = (rr_filter)f;
+  if (!colon) return;
+  ro->radius = parse_float(option_name, colon + 1);
+  if (!(ro->radius >= 0.5f && ro->radius <= RR_FILTER_MAX_RADIUS))
+    die(EXIT_USAGE, "bad radius '%s' for --aa-filter (expected 0.5..%g pixels)", colon + 1,
+        (double)RR_FILTER_MAX_RADIUS);
 }
 
 static int cmp_double(const void *a, const void *b) {
@@ -459,8 +492,8 @@ typedef struct {
 /* Adds the run's images to its output set. The colour image and each AOV are made
  * once (shade_ms), whatever number of files hold them, and encoded (write_ms). */
 static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, const rr_camera *cam,
-                       const rr_frame *frame, int shade, const char *out, const char *cube_dir, const aov_out *aovs,
-                       int naov, timings *ms) {
+                       const rr_frame *frame, const rr_shade_options *shading, const char *out,
+                       const char *cube_dir, const aov_out *aovs, int naov, timings *ms) {
   unsigned need = out || cube_dir ? COLOR_BIT : 0;
   for (int k = 0; k < naov; k++) need |= aovs[k].images;
   rr_image images[RR_AOV_COUNT + 1] = {{0}}; /* AOV a at a, the colour last */
@@ -470,7 +503,7 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
   for (int a = 0; a <= RR_AOV_COUNT; a++) {
     if (!(need & 1u << a)) continue;
     rr_shade_stats st = {0};
-    rr_error e = a == RR_AOV_COUNT ? rr_shade_with_stats(dev, scene, cam, frame, (rr_shade_mode)shade, colour, &st)
+    rr_error e = a == RR_AOV_COUNT ? rr_shade_frame(dev, scene, cam, frame, shading, colour, &st)
                                    : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
     ms->resolve += st.resolve_ms, ms->shades += st.shades;
     if (e) {
@@ -626,6 +659,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   uint32_t seed = 1;
   bool pattern_given = false;
   aov_out aovs[16];
+  rr_shade_options shading;
+  rr_shade_options_init(&shading);
   for (int key; (key = next_option(cmd, argc, argv)) != -1;) {
     switch (key) {
     case OPT_METHOD: {
@@ -676,6 +711,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_CULL_BACKFACES: opt.cull_backfaces = 1; break;
     case OPT_AA: aa = parse_aa(optarg); break;
     case OPT_AA_PATTERN: pattern = parse_aa_pattern(optarg, &seed), pattern_given = true; break;
+    case OPT_AA_FILTER: parse_filter(optarg, &shading); break;
+    case OPT_ALPHA: shading.alpha = 1; break;
     case OPT_CAMERA_FILE: camera_file = optarg; break;
     case OPT_SAVE_CAMERA: save_camera = optarg; break;
     }
@@ -694,8 +731,10 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   if (shade == RR_SHADE_HEAT_EVALS || shade == RR_SHADE_HEAT_NODES) opt.heat = 1;
   const unsigned heat_aovs = 1u << RR_AOV_EVALS | 1u << RR_AOV_NODES;
   for (int k = 0; k < naov; k++) opt.heat |= (aovs[k].images & heat_aovs) != 0;
-  for (int k = 0; k < naov; k++) /* all: every AOV the frame has */
-    if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~(opt.heat ? 0 : heat_aovs);
+  const unsigned by_name = 1u << RR_AOV_COVERAGE | 1u << RR_AOV_SAMPLE_ID | 1u << RR_AOV_SAMPLE_DEPTH |
+                           1u << RR_AOV_SAMPLE_MESH; /* the AA outputs: asked for by name */
+  for (int k = 0; k < naov; k++) /* all: every per-pixel AOV of the visibility the frame has */
+    if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~by_name & ~(opt.heat ? 0 : heat_aovs);
   if (camera_file) { /* the file's values, where no flag gave one */
     rr_camera from_file = cam;
     unsigned fields = camera_file_read(camera_file, &from_file);
@@ -745,7 +784,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   /* Every file of the run goes into one output set: all of them appear, or none. */
   rr_output *set;
   if (rr_output_new(dev, &set) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
-  add_images(dev, set, scene, &cam, frame, shade, out, cube_dir, aovs, naov, &ms);
+  shading.mode = (rr_shade_mode)shade;
+  add_images(dev, set, scene, &cam, frame, &shading, out, cube_dir, aovs, naov, &ms);
   if (save_camera) camera_file_add(dev, set, save_camera, &cam, opt.width, opt.height);
   rr_scene_info info;
   rr_scene_get_info(scene, &info);

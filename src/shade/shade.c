@@ -216,10 +216,10 @@ typedef struct shade_pass {
   const visbuf *vb;
   rr_shade_mode mode;
   rr_aa_mode aa;
-  int samples, stored; /* samples shaded (none: 1) and those carrying colour (csaa: K; else all) */
+  int samples, stored; /* samples shaded and those carrying colour (csaa: K; else all) */
   float dmin, dmax;
   signed char nearest[RR_MAX_SAMPLES][RR_MAX_SAMPLES]; /* csaa: coverage sample c's stored samples, nearest first */
-  float *rgb, *weight;                                  /* the resolve's input (resolve.h); weight NULL: all 1 */
+  float *rgb, *weight, *alpha; /* the resolve's input (resolve.h); weight NULL: all 1; alpha NULL: opaque */
   uint64_t shades[RR_MAX_THREADS];
   bool failed; /* a job found no memory */
 } shade_pass;
@@ -321,55 +321,13 @@ static void shade_rows(int job, int thread, void *arg) {
       for (int i = 0; i < n; i++) {
         memcpy(p->rgb + 3 * (i * npix + k0), r->rgb[i], 3 * len * sizeof(float));
         if (p->weight) memcpy(p->weight + i * npix + k0, r->w[i], len * sizeof(float));
+        if (p->alpha)
+          for (int j = 0; j < len; j++) p->alpha[i * npix + k0 + j] = r->id[i][j] < p->s->ntris ? 1.0f : 0.0f;
       }
     }
   }
   free(r);
   p->shades[thread] += shades;
-}
-
-/* A box filter over each pixel's samples, weighted: the stand-in for the resolve
- * filters (resolve.h), with the same input. Rows in parallel, layer by layer so
- * that the loops run over contiguous floats. */
-typedef struct box_job {
-  const resolve_input *in;
-  float *out;
-} box_job;
-
-enum { RESOLVE_ROWS = 8 };
-
-static void resolve_box_rows(int job, int thread, void *arg) {
-  (void)thread;
-  const box_job *b = arg;
-  const resolve_input *in = b->in;
-  size_t npix = (size_t)in->width * in->height;
-  int y0 = job * RESOLVE_ROWS, y1 = y0 + RESOLVE_ROWS < in->height ? y0 + RESOLVE_ROWS : in->height;
-  size_t k0 = (size_t)y0 * in->width, n = (size_t)(y1 - y0) * in->width;
-  float *acc = b->out + 3 * k0;
-  memset(acc, 0, 3 * n * sizeof *acc);
-  for (int i = 0; i < in->samples; i++) {
-    const float *rgb = in->rgb + 3 * (i * npix + k0);
-    if (!in->weight) {
-      for (size_t j = 0; j < 3 * n; j++) acc[j] += rgb[j];
-      continue;
-    }
-    const float *w = in->weight + i * npix + k0;
-    for (size_t k = 0; k < n; k++)
-      for (int ch = 0; ch < 3; ch++) acc[3 * k + ch] += w[k] * rgb[3 * k + ch];
-  }
-  for (size_t k = 0; k < n; k++) {
-    float total = (float)in->samples;
-    if (in->weight) {
-      total = 0;
-      for (int i = 0; i < in->samples; i++) total += in->weight[i * npix + k0 + k];
-    }
-    for (int ch = 0; ch < 3; ch++) acc[3 * k + ch] = total > 0 ? acc[3 * k + ch] / total : 0.0f;
-  }
-}
-
-static void resolve_box(const resolve_input *in, float *out, int threads) {
-  box_job b = {in, out};
-  rr_parallel_for((in->height + RESOLVE_ROWS - 1) / RESOLVE_ROWS, threads, resolve_box_rows, &b);
 }
 
 /* The frame's range of eye distances over every shaded sample (the depth mode's scale). */
@@ -417,24 +375,24 @@ static void *sample_alloc(size_t bytes) {
 }
 
 /* Shades the samples as the frame's AA mode says (cams: one per sample position),
- * then resolves them into out. */
-static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f,
-                            rr_shade_mode mode, rr_image *out, rr_shade_stats *st) {
+ * then resolves them into out with the options' filter. */
+static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f,
+                              const rr_shade_options *opt, rr_image *out, rr_shade_stats *st) {
   const visbuf *vb = &f->vb;
   size_t npix = (size_t)vb->width * vb->height;
   shade_pass *p = calloc(1, sizeof *p);
   if (!p) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading");
-  *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = mode, .aa = f->aa,
-                    .samples = f->aa == RR_AA_NONE ? 1 : f->samples};
+  *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = opt->mode, .aa = f->aa, .samples = f->samples};
   p->stored = f->aa == RR_AA_CSAA ? f->aa_stored : p->samples;
+  const float(*pos)[2] = (const float(*)[2])f->sample_pos;
   /* coverage samples' stored samples by distance (ties: the lower index) */
   for (int c = p->stored; c < p->samples; c++) {
     for (int j = 0; j < p->stored; j++) p->nearest[c][j] = (signed char)j;
     for (int a = 1; a < p->stored; a++) /* insertion sort: stable */
       for (int b = a; b > 0; b--) {
         int u = p->nearest[c][b - 1], v = p->nearest[c][b];
-        float du = hypotf(f->pos[u][0] - f->pos[c][0], f->pos[u][1] - f->pos[c][1]);
-        float dv = hypotf(f->pos[v][0] - f->pos[c][0], f->pos[v][1] - f->pos[c][1]);
+        float du = hypotf(pos[u][0] - pos[c][0], pos[u][1] - pos[c][1]);
+        float dv = hypotf(pos[v][0] - pos[c][0], pos[v][1] - pos[c][1]);
         if (dv >= du) break;
         p->nearest[c][b - 1] = (signed char)v, p->nearest[c][b] = (signed char)u;
       }
@@ -442,33 +400,46 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cam
   size_t nsamp = (size_t)p->samples * npix;
   p->rgb = sample_alloc(nsamp * 3 * sizeof(float));
   p->weight = f->aa == RR_AA_CSAA ? sample_alloc(nsamp * sizeof(float)) : NULL;
-  rr_error e = image_alloc(dev, out, vb->width, vb->height, 3, RR_PIXEL_F32, RR_IMAGE_COLOR);
-  if (!e && (!p->rgb || (f->aa == RR_AA_CSAA && !p->weight))) {
-    free(out->data);
-    out->data = NULL;
+  p->alpha = opt->alpha ? sample_alloc(nsamp * sizeof(float)) : NULL;
+  rr_error e = RR_OK;
+  if (!p->rgb || (f->aa == RR_AA_CSAA && !p->weight) || (opt->alpha && !p->alpha))
     e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %dx%d pixels of %d samples", vb->width, vb->height,
                 p->samples);
-  }
   if (!e) {
     double t0 = rr_now_ms();
-    if (mode == RR_SHADE_DEPTH) depth_range(p, &p->dmin, &p->dmax);
+    if (opt->mode == RR_SHADE_DEPTH) depth_range(p, &p->dmin, &p->dmax);
     int threads = f->stats.threads > 0 ? f->stats.threads : 1;
     rr_parallel_for((vb->height + SHADE_ROWS - 1) / SHADE_ROWS, threads, shade_rows, p);
     double t1 = rr_now_ms();
-    resolve_input in = {vb->width, vb->height, p->samples, (const float (*)[2])f->pos, p->rgb, p->weight};
-    if (!p->failed) resolve_box(&in, out->data, threads); /* the resolve filters (resolve.h) take over here */
+    resolve_input in = {vb->width, vb->height, p->samples, pos, p->rgb, p->weight, p->alpha};
+    e = p->failed ? rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading")
+                  : rr_resolve_image(dev, &in, opt, threads, out);
     if (st) {
       *st = (rr_shade_stats){.shade_ms = t1 - t0, .resolve_ms = rr_now_ms() - t1};
       for (int t = 0; t < RR_MAX_THREADS; t++) st->shades += p->shades[t];
     }
-    if (p->failed) {
-      free(out->data);
-      out->data = NULL;
-      e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading");
+  }
+  free(p->rgb), free(p->weight), free(p->alpha), free(p);
+  return e ? e : rr_ok(dev);
+}
+
+/* The value of an integer AOV (id, mesh, material) at a sample that saw primitive id. */
+/* Layer s of a frame's visibility buffer: sample s of every pixel. */
+static visbuf frame_layer(const rr_frame *f, int s) {
+  size_t off = (size_t)s * f->vb.width * f->vb.height;
+  return (visbuf){f->vb.width, f->vb.height, f->vb.id + off, f->vb.t + off, f->vb.l1 + off, f->vb.l2 + off};
+}
+
+/* Resolves the frame's cameras, one per sample position; on failure none is left. */
+static rr_error frame_cameras(rr_device *dev, const rr_camera *cam, const rr_frame *f, camera *cams) {
+  for (int s = 0; s < f->samples; s++) {
+    rr_error e = rr_cam_setup_at(dev, cam, f->vb.width, f->vb.height, f->sample_pos[s], &cams[s]);
+    if (e) {
+      while (s > 0) rr_cam_release(&cams[--s]);
+      return e;
     }
   }
-  free(p->rgb), free(p->weight), free(p);
-  return e ? e : rr_ok(dev);
+  return RR_OK;
 }
 
 /* The value of an integer AOV (id, mesh, material) at a sample that saw primitive id. */
@@ -478,13 +449,36 @@ static uint32_t id_aov(const rr_scene *s, rr_aov aov, uint32_t id) {
   return aov == RR_AOV_MESH ? rr_scene_geometry_of(s, id) : s->material[id];
 }
 
-static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cp, const rr_frame *f, rr_aov aov,
+/* The sample nearest the pixel's centre (the lowest index on a tie): the same in
+ * every pixel, as every pixel has the frame's pattern. */
+static int centre_sample(const rr_frame *f) {
+  int best = 0;
+  float best_d = INFINITY;
+  for (int s = 0; s < f->samples; s++) {
+    float dx = f->sample_pos[s][0] - 0.5f, dy = f->sample_pos[s][1] - 0.5f, d = dx * dx + dy * dy;
+    if (d < best_d) best = s, best_d = d;
+  }
+  return best;
+}
+
+/* The AOV a per-sample AOV gives for each sample; the AOV itself otherwise. */
+static rr_aov per_sample_base(rr_aov aov) {
+  switch (aov) {
+  case RR_AOV_SAMPLE_ID: return RR_AOV_ID;
+  case RR_AOV_SAMPLE_DEPTH: return RR_AOV_DEPTH;
+  case RR_AOV_SAMPLE_MESH: return RR_AOV_MESH;
+  default: return aov;
+  }
+}
+
+/* Fills an AOV from the frame's layers, by the rules of several samples per pixel
+ * (rastray.h): a per-sample AOV takes every layer as a channel; coverage counts the
+ * layers' hits; depth keeps the nearest; the others read the centre's layer. */
+static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f, rr_aov aov,
                           rr_image *out) {
-  const camera c = *cp;
   const visbuf *vb = &f->vb;
   rr_error e;
-  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1, 1, 1};
-  if ((int)aov < 0 || aov >= RR_AOV_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AOV %d", (int)aov);
+  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1, 1, 1, 1};
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
     if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
@@ -493,60 +487,83 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cp, c
     memcpy(out->data, counts, (size_t)vb->width * vb->height * sizeof(float));
     return rr_ok(dev);
   }
-  bool ints = aov == RR_AOV_ID || aov == RR_AOV_MESH || aov == RR_AOV_MATERIAL;
-  e = image_alloc(dev, out, vb->width, vb->height, channels[aov], ints ? RR_PIXEL_U32 : RR_PIXEL_F32,
-                  RR_IMAGE_AOV + (int)aov);
+  rr_aov base = per_sample_base(aov);
+  bool per_sample = base != aov, ints = base == RR_AOV_ID || base == RR_AOV_MESH || base == RR_AOV_MATERIAL;
+  int ch = per_sample ? f->samples : channels[aov], centre = centre_sample(f);
+  e = image_alloc(dev, out, vb->width, vb->height, ch, ints ? RR_PIXEL_U32 : RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov);
   if (e) return e;
-  for (int y = 0; y < vb->height; y++)
-    for (int x = 0; x < vb->width; x++) {
-      size_t k = (size_t)y * vb->width + x;
-      if (ints) {
-        ((uint32_t *)out->data)[k] = id_aov(s, aov, vb->id[k]);
-        continue;
+  size_t npix = (size_t)vb->width * vb->height;
+  float *o = out->data;
+  if (base == RR_AOV_DEPTH) /* a miss everywhere, until a sample sees nearer */
+    for (size_t k = 0; k < npix * ch; k++) o[k] = INFINITY;
+  for (int smp = 0; smp < f->samples; smp++) {
+    if (!per_sample && base != RR_AOV_DEPTH && aov != RR_AOV_COVERAGE && smp != centre) continue;
+    visbuf layer = frame_layer(f, smp);
+    int c0 = per_sample ? smp : 0; /* this layer's channel */
+    for (int y = 0; y < vb->height; y++)
+      for (int x = 0; x < vb->width; x++) {
+        size_t k = (size_t)y * vb->width + x;
+        if (ints) {
+          ((uint32_t *)out->data)[k * ch + c0] = id_aov(s, base, layer.id[k]);
+          continue;
+        }
+        if (aov == RR_AOV_COVERAGE) {
+          o[k] += layer.id[k] < s->ntris ? 1.0f / f->samples : 0.0f;
+          continue;
+        }
+        hit h = hit_at(s, &cams[smp], &layer, x, y);
+        float *p = o + k * ch + c0;
+        if (base == RR_AOV_DEPTH) *p = fminf(*p, h.valid ? h.dist : INFINITY);
+        else if (base == RR_AOV_NORMAL && h.valid) p[0] = h.normal.x, p[1] = h.normal.y, p[2] = h.normal.z;
+        else if (base == RR_AOV_BARY && h.valid) p[0] = h.l1, p[1] = h.l2;
       }
-      float *o = (float *)out->data + channels[aov] * k;
-      hit h = hit_at(s, &c, vb, x, y);
-      if (aov == RR_AOV_DEPTH) o[0] = h.valid ? h.dist : INFINITY;
-      else if (aov == RR_AOV_NORMAL && h.valid) o[0] = h.normal.x, o[1] = h.normal.y, o[2] = h.normal.z;
-      else if (aov == RR_AOV_BARY && h.valid) o[0] = h.l1, o[1] = h.l2;
-    }
+  }
   return rr_ok(dev);
 }
 
-/* The public entry points resolve the camera for the frame's size around the work
- * (shading: one camera per sample position). */
-rr_error rr_shade_with_stats(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
-                             rr_shade_mode mode, rr_image *out, rr_shade_stats *stats) {
+/* The public entry points resolve the frame's cameras, one per sample position, around the work. */
+void rr_shade_options_init(rr_shade_options *opt) {
+  *opt = (rr_shade_options){.mode = RR_SHADE_LAMBERT, .filter = RR_FILTER_BOX, .radius = 0, .alpha = 0};
+}
+
+rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                        const rr_shade_options *opt, rr_image *out, rr_shade_stats *stats) {
+  rr_shade_options def;
+  if (!opt) rr_shade_options_init(&def), opt = &def;
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
-  if ((int)mode < 0 || mode >= RR_SHADE_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shade mode %d", (int)mode);
+  if ((int)opt->mode < 0 || opt->mode >= RR_SHADE_COUNT)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shade mode %d", (int)opt->mode);
   if (stats) *stats = (rr_shade_stats){0};
-  if (mode == RR_SHADE_HEAT_EVALS || mode == RR_SHADE_HEAT_NODES) {
+  if (opt->mode == RR_SHADE_HEAT_EVALS || opt->mode == RR_SHADE_HEAT_NODES) {
     double t0 = rr_now_ms();
-    rr_error e = shade_heat_frame(dev, f, mode, out);
+    rr_error e = shade_heat_frame(dev, f, opt->mode, out);
     if (stats) stats->shade_ms = rr_now_ms() - t0;
     return e;
   }
   camera cams[RR_MAX_SAMPLES];
-  int n = 0, need = f->aa == RR_AA_NONE ? 1 : f->samples;
-  rr_error e = RR_OK;
-  for (; n < need && !e; n++) e = rr_cam_setup_at(dev, cam, f->vb.width, f->vb.height, f->pos[n], &cams[n]);
-  if (e) n--;
-  if (!e) e = shade_frame(dev, s, cams, f, mode, out, stats);
-  while (n > 0) rr_cam_release(&cams[--n]);
+  rr_error e = frame_cameras(dev, cam, f, cams);
+  if (e) return e;
+  e = shade_samples(dev, s, cams, f, opt, out, stats);
+  for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
   return e;
 }
 
 rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_shade_mode mode,
                   rr_image *out) {
-  return rr_shade_with_stats(dev, s, cam, f, mode, out, NULL);
+  rr_shade_options opt;
+  rr_shade_options_init(&opt);
+  opt.mode = mode;
+  return rr_shade_frame(dev, s, cam, f, &opt, out, NULL);
 }
 
 rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_aov aov,
                       rr_image *out) {
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_frame_aov: NULL argument");
-  camera c;
-  rr_error e = rr_cam_setup(dev, cam, f->vb.width, f->vb.height, &c);
-  if (!e) e = frame_aov(dev, s, &c, f, aov, out);
-  rr_cam_release(&c);
+  if ((int)aov < 0 || aov >= RR_AOV_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AOV %d", (int)aov);
+  camera cams[RR_MAX_SAMPLES];
+  rr_error e = frame_cameras(dev, cam, f, cams);
+  if (e) return e;
+  e = frame_aov(dev, s, cams, f, aov, out);
+  for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
   return e;
 }
