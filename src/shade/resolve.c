@@ -96,10 +96,15 @@ static void pixel_sums(const resolve_input *in, const tap *taps, int ntaps, int 
   else sums_of(in, taps, ntaps, x, y, false, false, sum);
 }
 
+/* x clamped to [0, hi] (NaN to 0); comparisons, not fmax/fmin, which are library calls. */
+static inline double clamp0(double x, double hi) {
+  return x > 0 ? (x < hi ? x : hi) : 0;
+}
+
 /* A pixel's colour (and alpha) from its sums. */
-static void finish(const double sum[5], float *o, int channels) {
-  for (int c = 0; c < 3; c++) o[c] = sum[3] > 0 ? (float)fmax(sum[c] / sum[3], 0) : 0.0f;
-  if (channels == 4) o[3] = sum[4] > 0 ? (float)fmin(fmax(sum[3] / sum[4], 0), 1) : 0.0f;
+static inline void finish(const double sum[5], float *o, int channels) {
+  for (int c = 0; c < 3; c++) o[c] = sum[3] > 0 ? (float)clamp0(sum[c] / sum[3], INFINITY) : 0.0f;
+  if (channels == 4) o[3] = sum[4] > 0 ? (float)clamp0(sum[3] / sum[4], 1) : 0.0f;
 }
 
 static void resolve_rows(int job, int thread, void *arg) {
@@ -123,36 +128,41 @@ static void resolve_rows(int job, int thread, void *arg) {
  * streams contiguous floats (a pixel's samples lie a power of two apart). */
 static void resolve_box_rows(int job, int thread, void *arg) {
   (void)thread;
-  const resolve_job *j = arg;
+  resolve_job *j = arg;
   const resolve_input *in = j->in;
   size_t w = (size_t)in->width, layer = w * in->height;
-  double *acc = malloc(5 * w * sizeof *acc); /* Σ a·w·rgb (3 per pixel); Σ a·w; Σ w */
+  bool weighed = in->weight || in->alpha;
+  double *acc = malloc((weighed ? 5 : 3) * w * sizeof *acc); /* Σ f·a·rgb (3 per pixel); Σ f·a; Σ f */
   if (!acc) {
-    ((resolve_job *)arg)->failed = true;
+    j->failed = true;
     return;
   }
+  double *wa = acc + 3 * w, *wt = acc + 4 * w;
   int y1 = (job + 1) * ROWS_PER_JOB < in->height ? (job + 1) * ROWS_PER_JOB : in->height;
   for (int y = job * ROWS_PER_JOB; y < y1; y++) {
-    memset(acc, 0, 5 * w * sizeof *acc);
-    double *wa = acc + 3 * w, *wt = acc + 4 * w;
     for (int s = 0; s < in->samples; s++) {
       size_t k0 = s * layer + (size_t)y * w;
       const float *rgb = in->rgb + 3 * k0;
-      if (!in->weight && !in->alpha) { /* the common case: plain sums */
-        for (size_t i = 0; i < 3 * w; i++) acc[i] += rgb[i];
+      if (!weighed) { /* the common case: plain sums, the first sample their start; a pixel
+                         per step (a loop over 3·w floats costs 3 times the loop's overhead) */
+        double *a = acc;
+        if (s == 0)
+          for (const float *c = rgb; c < rgb + 3 * w; c += 3, a += 3) a[0] = c[0], a[1] = c[1], a[2] = c[2];
+        else
+          for (const float *c = rgb; c < rgb + 3 * w; c += 3, a += 3) a[0] += c[0], a[1] += c[1], a[2] += c[2];
         continue;
       }
       for (size_t x = 0; x < w; x++) {
         double f = in->weight ? in->weight[k0 + x] : 1.0, fa = in->alpha ? f * in->alpha[k0 + x] : f;
-        for (int c = 0; c < 3; c++) acc[3 * x + c] += fa * rgb[3 * x + c];
-        wa[x] += fa, wt[x] += f;
+        double *a = acc + 3 * x;
+        if (s == 0) a[0] = fa * rgb[3 * x], a[1] = fa * rgb[3 * x + 1], a[2] = fa * rgb[3 * x + 2], wa[x] = fa, wt[x] = f;
+        else a[0] += fa * rgb[3 * x], a[1] += fa * rgb[3 * x + 1], a[2] += fa * rgb[3 * x + 2], wa[x] += fa, wt[x] += f;
       }
     }
     float *o = j->out + (size_t)j->channels * y * w;
+    double n = in->samples;
     for (size_t x = 0; x < w; x++) {
-      double n = in->samples;
-      double sum[5] = {acc[3 * x], acc[3 * x + 1], acc[3 * x + 2], in->weight || in->alpha ? wa[x] : n,
-                       in->weight || in->alpha ? wt[x] : n};
+      double sum[5] = {acc[3 * x], acc[3 * x + 1], acc[3 * x + 2], weighed ? wa[x] : n, weighed ? wt[x] : n};
       finish(sum, o + j->channels * x, j->channels);
     }
   }
