@@ -241,6 +241,28 @@ static void test_frame_outputs(void) {
     worst = fmax(worst, fabs(((float *)c.data)[i] - mean / N));
   }
   CHECK(ok && worst < 1e-6, "resolved colour off the mean of the samples by %g", worst);
+
+  /* the one shading call: NULL options are rr_shade's Lambert; options and stats */
+  rr_image c2 = {0};
+  rr_shade_stats st;
+  CHECK(rr_shade_frame(dev, s, &cam, f, NULL, &c2, &st) == RR_OK && c.data && c2.channels == 3 &&
+            !memcmp(c.data, c2.data, npix * 3 * sizeof(float)),
+        "rr_shade_frame(NULL options) differs from rr_shade: %s", rr_device_message(dev));
+  CHECK(st.shades > 0 && st.shades <= N * npix && st.shade_ms >= 0 && st.resolve_ms >= 0, "stats: %llu shades",
+        (unsigned long long)st.shades);
+  rr_image_free(&c2);
+  rr_shade_options so;
+  rr_shade_options_init(&so);
+  so.mode = RR_SHADE_NORMAL, so.filter = RR_FILTER_MITCHELL, so.alpha = 1;
+  CHECK(rr_shade_frame(dev, s, &cam, f, &so, &c2, NULL) == RR_OK && c2.channels == 4 && c2.kind == RR_IMAGE_COLOR,
+        "normal, mitchell, alpha: %s", rr_device_message(dev));
+  rr_image_free(&c2);
+  so.radius = 9;
+  CHECK(rr_shade_frame(dev, s, &cam, f, &so, &c2, NULL) == RR_ERROR_ARGUMENT && !c2.data &&
+            strstr(rr_device_message(dev), "radius"),
+        "radius 9 accepted: %s", rr_device_message(dev));
+  so.radius = 0, so.mode = (rr_shade_mode)99;
+  CHECK(rr_shade_frame(dev, s, &cam, f, &so, &c2, NULL) == RR_ERROR_ARGUMENT && !c2.data, "shade mode 99 accepted");
   rr_image_free(&c);
   for (int k = 0; k < N; k++) rr_image_free(&ci[k]);
 
