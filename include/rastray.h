@@ -365,6 +365,45 @@ RR_API int rr_method_from_name(const char *name);
 /* The name of a method ("rc", ...), NULL when out of range. */
 RR_API const char *rr_method_name(int method);
 
+/* Anti-aliasing: how shading turns a pixel's visibility samples into colour. The
+ * samples themselves are options.samples and options.sample_pos; the modes differ
+ * only in shading (rr_shade), never in visibility. */
+typedef enum rr_aa_mode {
+  RR_AA_NONE = 0, /* no AA mode: every sample shaded, as ssaa (rr_render_options_set_aa's none is one
+                     sample at the centre, the image as without AA) */
+  RR_AA_SSAA,     /* supersampling: every sample shaded */
+  RR_AA_MSAA,     /* multisampling: shaded once per pixel per primitive covering any of its samples,
+                     at the mean barycentrics of the covered samples (a point inside the triangle:
+                     triangles are convex), the colour shared by the samples it covers */
+  RR_AA_CSAA,     /* coverage sampling: visibility at every sample; the first aa_stored samples
+                     carry colour as in msaa; every other sample adds its vote (weight 1) to the
+                     stored sample nearest to it that saw the same primitive (or the same miss),
+                     and to none when no stored sample did */
+  RR_AA_MODE_COUNT
+} rr_aa_mode;
+
+/* Sample patterns (positions inside the pixel, each in [0, 1)). */
+typedef enum rr_aa_pattern {
+  RR_AA_STANDARD = 0, /* Direct3D's and Vulkan's standard positions, as offsets from the pixel centre
+                         in 1/16 pixel, y down: 1: (0,0); 2: (4,4) (-4,-4); 4: (-2,-6) (6,-2) (-6,2)
+                         (2,6); 8: (1,-3) (-1,3) (5,1) (-3,-5) (-5,5) (-7,-1) (3,7) (7,-7); 16: (1,1)
+                         (-1,-3) (-3,2) (4,-1) (-5,-2) (2,5) (5,3) (3,-5) (-2,6) (0,-7) (-4,-6) (-6,4)
+                         (-8,0) (7,-4) (6,7) (-7,-8) */
+  RR_AA_ROTATED,      /* a grid of c × r cells (1×1, 2×1, 2×2, 4×2, 4×4) at the cells' centres, rotated
+                         by atan(1/2) about the pixel centre and scaled by √5/2 (offset (u, v) becomes
+                         (u - v/2, u/2 + v), so 4 samples are the classic RGSS), wrapped into the pixel */
+  RR_AA_JITTER,       /* the same c × r cells, one uniformly random position in each, from a seed */
+  RR_AA_PATTERN_COUNT
+} rr_aa_pattern;
+
+/* Fills pos[0 .. n-1] with the n positions (n: 1, 2, 4, 8 or 16) of a pattern;
+ * seed matters to RR_AA_JITTER alone (the same seed, the same positions). */
+RR_API rr_error rr_aa_positions(rr_aa_pattern pattern, int n, uint32_t seed, float pos[][2]);
+/* The name of a mode ("none", "ssaa", "msaa", "csaa") or pattern ("standard",
+ * "rotated", "jitter"), NULL when out of range. */
+RR_API const char *rr_aa_mode_name(int mode);
+RR_API const char *rr_aa_pattern_name(int pattern);
+
 typedef struct rr_render_options {
   rr_method method;
   int width, height;  /* image size in pixels */
@@ -372,6 +411,9 @@ typedef struct rr_render_options {
   float sample_pos[RR_MAX_SAMPLES][2]; /* sample s at (x + sample_pos[s][0], y + sample_pos[s][1]) in pixel
                                           (x, y); each in [0, 1) (default: one sample at the centre) */
   int threads;        /* 0: all cores; at most RR_MAX_THREADS */
+  rr_aa_mode aa;      /* how shading uses the samples (default RR_AA_NONE); rr_render_options_set_aa
+                         sets it with samples and sample_pos */
+  int aa_stored;      /* csaa: K, the samples that carry colour: sample_pos[0 .. K-1] (1..samples) */
   int cull_backfaces; /* nonzero: triangles seen from behind are invisible */
   int heat;           /* nonzero: also record E and N charged to each pixel (AOVs evals, nodes) */
   int scalar;         /* nonzero: no SIMD kernels (for comparison; results are the same bits) */
@@ -388,6 +430,14 @@ typedef struct rr_render_options {
 /* Fills options with defaults: 3dr-bb, 1024x768, one sample at each pixel's centre,
  * all cores, no culling. */
 RR_API void rr_render_options_init(rr_render_options *opt);
+/* Sets options.aa, samples, aa_stored and sample_pos for an AA mode: none (samples
+ * must be 1: the pixel's centre), ssaa:N and msaa:N (N positions of the pattern),
+ * csaa:K/N (stored = K ≤ N): the K stored samples first, at the positions of the
+ * pattern of K (where msaa:K samples), then the N - K positions of the pattern of N
+ * left after taking, for each stored sample in turn, the one nearest to it (ties: the
+ * lower index). N and K are 1, 2, 4, 8 or 16. */
+RR_API rr_error rr_render_options_set_aa(rr_device *dev, rr_render_options *opt, rr_aa_mode mode, int samples,
+                                         int stored, rr_aa_pattern pattern, uint32_t seed);
 
 typedef struct rr_stats {
   uint64_t setups;     /* S: triangle setups computed */
@@ -413,6 +463,8 @@ RR_API rr_error rr_frame_get_stats(const rr_frame *frame, rr_stats *stats);
 RR_API rr_error rr_frame_get_size(const rr_frame *frame, int *width, int *height);
 /* Samples per pixel of the frame (options.samples). */
 RR_API rr_error rr_frame_get_samples(const rr_frame *frame, int *samples);
+/* The frame's sample positions (options.sample_pos): pos[s] for s < samples. */
+RR_API rr_error rr_frame_get_sample_pos(const rr_frame *frame, float pos[RR_MAX_SAMPLES][2]);
 /* Read-only views of the visibility buffer, row 0 at the top: primitive id
  * (the triangle's id as under "geometries" above, RR_MISS on a miss), ray parameter t along the unnormalised camera ray
  * (+inf on a miss) and barycentrics λ1, λ2 of the hit. With several samples per
@@ -447,11 +499,20 @@ typedef enum rr_aov {
   RR_AOV_NODES,     /* 1 float: BVH nodes visited charged to the pixel (needs options.heat) */
   RR_AOV_MESH,      /* 1 uint32: geometry id (segmentation by mesh), RR_MISS on a miss */
   RR_AOV_MATERIAL,  /* 1 uint32: material index (segmentation by material), RR_MISS on a miss */
+  RR_AOV_COVERAGE,  /* 1 float: the fraction of the pixel's samples that hit (plain count, no filter) */
+  RR_AOV_SAMPLE_ID,    /* N uint32 (N = samples): the id of each sample, channel s = sample s */
+  RR_AOV_SAMPLE_DEPTH, /* N floats: the depth of each sample (+inf on a miss) */
+  RR_AOV_SAMPLE_MESH,  /* N uint32: the geometry id of each sample */
   RR_AOV_COUNT
 } rr_aov;
+/* With several samples per pixel the per-pixel AOVs follow one rule each: id, mesh,
+ * material, normal and bary are those of the sample nearest the pixel's centre (the
+ * lowest such s on a tie; the same s in every pixel), so they belong to one
+ * surface; depth is the nearest depth among all the pixel's samples; evals and
+ * nodes sum over the samples. The sample-* AOVs give every sample. */
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
- * "material"); -1 when unknown. */
+ * "material", "coverage", "sample-id", "sample-depth", "sample-mesh"); -1 when unknown. */
 RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
@@ -465,7 +526,8 @@ typedef enum rr_image_kind {
                           colour to sRGB, EXR and PFM decode 8-bit colour to linear light */
   RR_IMAGE_AOV         /* RR_IMAGE_AOV + a: AOV a of rr_frame_aov, values as they are, EXR channels
                           depth Z, normal N.X N.Y N.Z, bary bary.u bary.v (λ1, λ2), id, mesh and
-                          material (32-bit UINT), evals, nodes */
+                          material (32-bit UINT), evals, nodes, coverage; per sample s (2 digits):
+                          id.sNN, Z.sNN, mesh.sNN */
 } rr_image_kind;
 
 /* An image owned by the caller or by rastray (rr_image_free). */
@@ -480,9 +542,60 @@ typedef struct rr_image {
  * lambert is the lit colour itself; the visualisations (id, normal, depth, heat maps,
  * the background) are display colours stored decoded from sRGB, so that every file
  * shows them as designed: a PNG holds exactly the display values, an EXR the same
- * picture in linear light. */
+ * picture in linear light. The samples are shaded as the frame's AA mode says and
+ * their mean taken: rr_shade_frame with the defaults and this mode. */
 RR_API rr_error rr_shade(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                          const rr_frame *frame, rr_shade_mode mode, rr_image *out);
+/* Resolve filters: how a pixel's colour is made from the samples' colours (in linear
+ * light). Each weighs a sample by its offset (dx, dy) from the pixel's centre as
+ * f(dx)·f(dy), over |dx|, |dy| < radius, and the weights are normalised per pixel. */
+typedef enum rr_filter {
+  RR_FILTER_BOX = 0,         /* the mean of the pixel's own samples (radius 0.5) */
+  RR_FILTER_MITCHELL,        /* Mitchell–Netravali, B = C = 1/3 (default radius 2): sharper, with
+                                negative lobes; results below zero are clamped to zero */
+  RR_FILTER_BLACKMAN_HARRIS, /* the 4-term Blackman–Harris window (default radius 1.5): smooth, positive */
+  RR_FILTER_COUNT
+} rr_filter;
+
+/* The filter named `name` ("box", "mitchell", "blackman-harris"); -1 when unknown. */
+RR_API int rr_filter_from_name(const char *name);
+/* The name of a filter, NULL when out of range. */
+RR_API const char *rr_filter_name(int filter);
+
+#define RR_FILTER_MAX_RADIUS 4.0f /* widest filter radius, in pixels */
+
+/* How rr_shade_frame shades and resolves a frame. The AA mode (which samples are
+ * shaded) is the frame's own, from rr_render_options; these say what is drawn and
+ * how the samples' colours become pixels. */
+typedef struct rr_shade_options {
+  rr_shade_mode mode; /* what to draw (default RR_SHADE_LAMBERT) */
+  rr_filter filter;   /* resolve filter (default RR_FILTER_BOX) */
+  float radius;       /* in pixels, 0.5 .. RR_FILTER_MAX_RADIUS; 0: the filter's default */
+  int alpha;          /* nonzero: a 4th channel, alpha = the filtered coverage of the pixel's samples;
+                         the colour is then straight (not premultiplied): the filtered mean of the
+                         samples that hit, weighted by their coverage (0 where nothing hit) */
+} rr_shade_options;
+
+/* Fills options with defaults: Lambert, box filter, no alpha. */
+RR_API void rr_shade_options_init(rr_shade_options *opt);
+
+/* The statistics of a shading pass. */
+typedef struct rr_shade_stats {
+  uint64_t shades;   /* shading invocations: one per shaded point of a primitive (the background
+                        behind misses is not counted) */
+  double shade_ms;   /* wall time turning samples into linear colours */
+  double resolve_ms; /* wall time of the resolve: per-sample colours to pixels */
+} rr_shade_stats;
+
+/* Shades a frame and resolves its samples to one colour per pixel (opt NULL: the
+ * defaults; rr_shade is this with mode alone). The samples are shaded as the frame's
+ * AA mode says (options.aa), each in linear light, then filtered. One sample per
+ * pixel and the box filter give one shade per pixel, as is. Heat maps are per pixel:
+ * neither filtered nor given alpha. stats, when not NULL, receives the pass's
+ * statistics. */
+RR_API rr_error rr_shade_frame(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                               const rr_frame *frame, const rr_shade_options *opt, rr_image *out,
+                               rr_shade_stats *stats);
 /* Extracts an AOV of a frame into a new image of kind RR_IMAGE_AOV + aov. */
 RR_API rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                              const rr_frame *frame, rr_aov aov, rr_image *out);

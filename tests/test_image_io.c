@@ -576,7 +576,9 @@ static void test_exr_layers(void) {
       {"B", "G", "R"}, [1 + RR_AOV_DEPTH] = {"Z"}, [1 + RR_AOV_ID] = {"id"},
       [1 + RR_AOV_NORMAL] = {"N.X", "N.Y", "N.Z"}, [1 + RR_AOV_BARY] = {"bary.u", "bary.v"},
       [1 + RR_AOV_EVALS] = {"evals"}, [1 + RR_AOV_NODES] = {"nodes"}, [1 + RR_AOV_MESH] = {"mesh"},
-      [1 + RR_AOV_MATERIAL] = {"material"}};
+      [1 + RR_AOV_MATERIAL] = {"material"}, [1 + RR_AOV_COVERAGE] = {"coverage"},
+      [1 + RR_AOV_SAMPLE_ID] = {"id.s00"}, [1 + RR_AOV_SAMPLE_DEPTH] = {"Z.s00"},
+      [1 + RR_AOV_SAMPLE_MESH] = {"mesh.s00"}};
   rr_scene *s = colour_scene(rgb);
   rr_image images[1 + RR_AOV_COUNT];
   memset(images, 0, sizeof images);

@@ -69,7 +69,8 @@ void json_add(rr_device *dev, rr_output *set, const cJSON *root, const char *pat
 enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
-  OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS,
+  OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA, OPT_AA_PATTERN, OPT_AA_FILTER,
+  OPT_ALPHA,
 };
 
 typedef struct cli_option {
@@ -127,6 +128,20 @@ static const cli_option render_options[] = {
     {"camera-from-file", OPT_CAMERA_FROM_FILE, "NAME|INDEX",
      "look through a camera the scene file defines (see info); --camera may\nchange its projection"},
     {"shade", OPT_SHADE, "MODE", "lambert (default), id, normal, depth, heat-evals, heat-nodes"},
+    {"aa", OPT_AA, "MODE",
+     "anti-aliasing: none (default), ssaa:N (N samples, each shaded), msaa:N (shaded\n"
+     "once per pixel per primitive), csaa:K/N (N coverage samples, K with colour);\n"
+     "N, K: 1, 2, 4, 8 or 16"},
+    {"aa-pattern", OPT_AA_PATTERN, "NAME",
+     "sample positions: standard (default: Direct3D's and Vulkan's), rotated (a\n"
+     "rotated grid), jitter[:SEED] (one random position per cell; seed default 1)"},
+    {"aa-filter", OPT_AA_FILTER, "NAME[:R]",
+     "resolve filter of a pixel's samples: box (default: the mean of its own),\n"
+     "mitchell (B=C=1/3, radius R default 2), blackman-harris (R default 1.5);\n"
+     "R in pixels, 0.5..4; wide filters read the neighbours' samples too"},
+    {"alpha", OPT_ALPHA, NULL,
+     "give the colour image an alpha channel: the coverage of the pixel's samples\n"
+     "(filtered), colour straight (PNG RGBA, EXR R G B A)"},
     {"output", 'o', "PATH",
      "colour image: .png (sRGB), .exr or .pfm (linear light); default rastray.png\n"
      "unless --aov is given. PATH may be - (stdout, PNG), FMT:PATH (png:-, exr:-),\n"
@@ -136,7 +151,11 @@ static const cli_option render_options[] = {
      "LIST: one NAME, NAME,NAME,... or all, as the layers of one EXR. NAME: color\n"
      "(the shaded image), depth (EXR Z), normal (N.X N.Y N.Z), bary (bary.u bary.v),\n"
      "id (triangle), mesh (geometry id), material (index) (ids: EXR UINT), evals,\n"
-     "nodes; all: every one (evals, nodes with heat). Outputs are all or nothing"},
+     "nodes, coverage (fraction of samples hit), sample-id, sample-depth,\n"
+     "sample-mesh (H×W×N, one per sample: EXR id.s00.., Z.s00.., mesh.s00..); all:\n"
+     "color to nodes (evals, nodes with heat). With several samples id, mesh,\n"
+     "material, normal, bary are the sample nearest the centre's, depth the nearest.\n"
+     "Outputs are all or nothing"},
     {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default 0: all cores)"},
     {"repeat", OPT_REPEAT, "N", "run the visibility pass N times, report the median time"},
     {"stats", OPT_STATS, NULL, "print key=value statistics to stderr, with the time of each step"},
@@ -299,6 +318,49 @@ static void parse_size(const char *s, int *w, int *h) {
   *w = (int)a, *h = (int)b;
 }
 
+/* An --aa MODE: the mode, its samples N and (csaa) stored samples K. */
+typedef struct {
+  rr_aa_mode mode;
+  int samples, stored;
+} aa_spec;
+
+/* A sample count of --aa: 1, 2, 4, 8 or 16, the whole of s. */
+static bool parse_count(const char *s, char **end, int *n) {
+  long v = strtol(s, end, 10);
+  *n = (int)v;
+  return *end != s && (v == 1 || v == 2 || v == 4 || v == 8 || v == 16);
+}
+
+static aa_spec parse_aa(const char *arg) {
+  aa_spec a = {RR_AA_NONE, 1, 0};
+  char *end = NULL;
+  bool ok;
+  if (!strcmp(arg, "none")) return a;
+  if (!strncmp(arg, "ssaa:", 5) || !strncmp(arg, "msaa:", 5)) {
+    a.mode = arg[0] == 's' ? RR_AA_SSAA : RR_AA_MSAA;
+    ok = parse_count(arg + 5, &end, &a.samples) && !*end;
+  } else if (!strncmp(arg, "csaa:", 5)) {
+    a.mode = RR_AA_CSAA;
+    ok = parse_count(arg + 5, &end, &a.stored) && *end == '/' && parse_count(end + 1, &end, &a.samples) && !*end &&
+         a.stored <= a.samples;
+  } else {
+    die(EXIT_USAGE, "unknown --aa '%s' (expected none, ssaa:N, msaa:N or csaa:K/N)", arg);
+  }
+  if (!ok) die(EXIT_USAGE, "bad --aa '%s' (N and K: 1, 2, 4, 8 or 16, K at most N)", arg);
+  return a;
+}
+
+static rr_aa_pattern parse_aa_pattern(const char *arg, uint32_t *seed) {
+  if (!strcmp(arg, "standard")) return RR_AA_STANDARD;
+  if (!strcmp(arg, "rotated")) return RR_AA_ROTATED;
+  if (!strcmp(arg, "jitter")) return RR_AA_JITTER;
+  if (!strncmp(arg, "jitter:", 7)) {
+    *seed = (uint32_t)parse_int("--aa-pattern's seed", arg + 7, 0, UINT32_MAX);
+    return RR_AA_JITTER;
+  }
+  die(EXIT_USAGE, "unknown --aa-pattern '%s' (expected standard, rotated or jitter[:SEED])", arg);
+}
+
 /* An --aov: the images written as one file (several: the layers of one EXR). */
 enum { COLOR_BIT = 1u << RR_AOV_COUNT }; /* the shaded image, beside AOV a's bit 1 << a */
 typedef struct {
@@ -323,10 +385,31 @@ static aov_out parse_aov(const char *arg) {
     else if (k >= 0) a.images |= 1u << k;
     else
       die(EXIT_USAGE,
-          "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes or all)", name);
+          "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes, coverage, "
+          "sample-id, sample-depth, sample-mesh or all)",
+          name);
   }
   if (!a.images && !a.all) die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
   return a;
+}
+
+/* Parses --aa-filter NAME[:RADIUS]. */
+static void parse_filter(const char *arg, rr_shade_options *ro) {
+  char name[32];
+  const char *colon = strchr(arg, ':');
+  size_t len = colon ? (size_t)(colon - arg) : strlen(arg);
+  int f = -1;
+  if (len < sizeof name) {
+    memcpy(name, arg, len), name[len] = 0;
+    f = rr_filter_from_name(name);
+  }
+  if (f < 0) die(EXIT_USAGE, "unknown filter '%s' for --aa-filter (expected box, mitchell or blackman-harris)", arg);
+  ro->filter = (rr_filter)f;
+  if (!colon) return;
+  ro->radius = parse_float(option_name, colon + 1);
+  if (!(ro->radius >= 0.5f && ro->radius <= RR_FILTER_MAX_RADIUS))
+    die(EXIT_USAGE, "bad radius '%s' for --aa-filter (expected 0.5..%g pixels)", colon + 1,
+        (double)RR_FILTER_MAX_RADIUS);
 }
 
 static int cmp_double(const void *a, const void *b) {
@@ -402,14 +485,15 @@ static void add_cube_faces(rr_device *dev, rr_output *set, const rr_image *cross
 
 /* The times of a render's steps, in milliseconds. */
 typedef struct {
-  double load, build, frame, cpu, shade, write, total;
+  double load, build, frame, cpu, shade, resolve, write, total;
+  uint64_t shades; /* shading invocations of the colour image */
 } timings;
 
 /* Adds the run's images to its output set. The colour image and each AOV are made
  * once (shade_ms), whatever number of files hold them, and encoded (write_ms). */
 static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, const rr_camera *cam,
-                       const rr_frame *frame, int shade, const char *out, const char *cube_dir, const aov_out *aovs,
-                       int naov, timings *ms) {
+                       const rr_frame *frame, const rr_shade_options *shading, const char *out,
+                       const char *cube_dir, const aov_out *aovs, int naov, timings *ms) {
   unsigned need = out || cube_dir ? COLOR_BIT : 0;
   for (int k = 0; k < naov; k++) need |= aovs[k].images;
   rr_image images[RR_AOV_COUNT + 1] = {{0}}; /* AOV a at a, the colour last */
@@ -418,14 +502,16 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
   double t = now_ms();
   for (int a = 0; a <= RR_AOV_COUNT; a++) {
     if (!(need & 1u << a)) continue;
-    rr_error e = a == RR_AOV_COUNT ? rr_shade(dev, scene, cam, frame, (rr_shade_mode)shade, colour)
+    rr_shade_stats st = {0};
+    rr_error e = a == RR_AOV_COUNT ? rr_shade_frame(dev, scene, cam, frame, shading, colour, &st)
                                    : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
+    ms->resolve += st.resolve_ms, ms->shades += st.shades;
     if (e) {
       rr_output_release(set);
       die(EXIT_INPUT, "%s", rr_device_message(dev));
     }
   }
-  ms->shade = now_ms() - t;
+  ms->shade = now_ms() - t - ms->resolve; /* shading the samples and the AOVs */
   progress_stage("writing");
   t = now_ms();
   if (out) add_output(dev, set, colour, 1, out);
@@ -538,13 +624,15 @@ static void add_stats_json(rr_device *dev, rr_output *set, const char *path, con
   cJSON_AddStringToObject(o, "scene", scene_name);
   cJSON_AddStringToObject(o, "method", rr_method_name(st->method));
   cJSON_AddStringToObject(o, "camera", rr_camera_name(cam->type));
+  cJSON_AddStringToObject(o, "aa", rr_aa_mode_name(opt->aa));
   const struct {
     const char *key;
     double value;
   } numbers[] = {{"triangles", (double)info->triangles}, {"skipped", (double)info->skipped},
                  {"width", opt->width}, {"height", opt->height}, {"threads", st->threads}, {"repeat", repeat},
-                 {"load_ms", ms->load}, {"build_ms", ms->build}, {"frame_ms", ms->frame}, {"cpu_ms", ms->cpu},
-                 {"shade_ms", ms->shade}, {"write_ms", ms->write}, {"total_ms", ms->total},
+                 {"samples", opt->samples}, {"load_ms", ms->load}, {"build_ms", ms->build}, {"frame_ms", ms->frame},
+                 {"vis_ms", ms->frame}, {"cpu_ms", ms->cpu}, {"shade_ms", ms->shade}, {"resolve_ms", ms->resolve},
+                 {"write_ms", ms->write}, {"total_ms", ms->total}, {"shades", (double)ms->shades},
                  {"setups", (double)st->setups}, {"edge_evals", (double)st->edge_evals}, {"nodes", (double)st->nodes},
                  {"bins", (double)st->bins}, {"bins_empty", (double)st->bins_empty}};
   for (size_t k = 0; k < sizeof numbers / sizeof *numbers; k++) /* times to the microsecond */
@@ -566,7 +654,13 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   unsigned given = 0;           /* the camera's fields set by flags */
   bool stats = false;
   int shade = RR_SHADE_LAMBERT, repeat = 1, naov = 0;
+  aa_spec aa = {RR_AA_NONE, 1, 0};
+  rr_aa_pattern pattern = RR_AA_STANDARD;
+  uint32_t seed = 1;
+  bool pattern_given = false;
   aov_out aovs[16];
+  rr_shade_options shading;
+  rr_shade_options_init(&shading);
   for (int key; (key = next_option(cmd, argc, argv)) != -1;) {
     switch (key) {
     case OPT_METHOD: {
@@ -615,6 +709,10 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_STATS_JSON: json = optarg; break;
     case OPT_ORACLES: opt.oracles = optarg; break;
     case OPT_CULL_BACKFACES: opt.cull_backfaces = 1; break;
+    case OPT_AA: aa = parse_aa(optarg); break;
+    case OPT_AA_PATTERN: pattern = parse_aa_pattern(optarg, &seed), pattern_given = true; break;
+    case OPT_AA_FILTER: parse_filter(optarg, &shading); break;
+    case OPT_ALPHA: shading.alpha = 1; break;
     case OPT_CAMERA_FILE: camera_file = optarg; break;
     case OPT_SAVE_CAMERA: save_camera = optarg; break;
     }
@@ -626,12 +724,17 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     die(EXIT_USAGE, "--camera-from-file takes the view from the file: no --eye, --target, --up or --fov with it");
   if (file_cam && camera_file) die(EXIT_USAGE, "--camera-from-file and --camera-file exclude each other");
   if (!scene_name) scene_name = "demo";
+  if (pattern_given && aa.mode == RR_AA_NONE) die(EXIT_USAGE, "--aa-pattern needs --aa other than none");
+  if (rr_render_options_set_aa(dev, &opt, aa.mode, aa.samples, aa.stored, pattern, seed) != RR_OK)
+    die(EXIT_USAGE, "%s", rr_device_message(dev));
   if (!out && naov == 0) out = "rastray.png";
   if (shade == RR_SHADE_HEAT_EVALS || shade == RR_SHADE_HEAT_NODES) opt.heat = 1;
   const unsigned heat_aovs = 1u << RR_AOV_EVALS | 1u << RR_AOV_NODES;
   for (int k = 0; k < naov; k++) opt.heat |= (aovs[k].images & heat_aovs) != 0;
-  for (int k = 0; k < naov; k++) /* all: every AOV the frame has */
-    if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~(opt.heat ? 0 : heat_aovs);
+  const unsigned by_name = 1u << RR_AOV_COVERAGE | 1u << RR_AOV_SAMPLE_ID | 1u << RR_AOV_SAMPLE_DEPTH |
+                           1u << RR_AOV_SAMPLE_MESH; /* the AA outputs: asked for by name */
+  for (int k = 0; k < naov; k++) /* all: every per-pixel AOV of the visibility the frame has */
+    if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~by_name & ~(opt.heat ? 0 : heat_aovs);
   if (camera_file) { /* the file's values, where no flag gave one */
     rr_camera from_file = cam;
     unsigned fields = camera_file_read(camera_file, &from_file);
@@ -681,7 +784,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   /* Every file of the run goes into one output set: all of them appear, or none. */
   rr_output *set;
   if (rr_output_new(dev, &set) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
-  add_images(dev, set, scene, &cam, frame, shade, out, cube_dir, aovs, naov, &ms);
+  shading.mode = (rr_shade_mode)shade;
+  add_images(dev, set, scene, &cam, frame, &shading, out, cube_dir, aovs, naov, &ms);
   if (save_camera) camera_file_add(dev, set, save_camera, &cam, opt.width, opt.height);
   rr_scene_info info;
   rr_scene_get_info(scene, &info);
@@ -693,11 +797,12 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   progress_stop();
   if (stats)
     fprintf(stderr,
-            "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d frame_ms=%.3f cpu_ms=%.3f load_ms=%.1f "
-            "build_ms=%.1f shade_ms=%.1f write_ms=%.1f total_ms=%.1f setups=%llu edge_evals=%llu nodes=%llu bins=%llu "
-            "bins_empty=%llu\n",
+            "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d aa=%s samples=%d frame_ms=%.3f "
+            "vis_ms=%.3f cpu_ms=%.3f load_ms=%.1f build_ms=%.1f shade_ms=%.1f resolve_ms=%.1f write_ms=%.1f "
+            "total_ms=%.1f shades=%llu setups=%llu edge_evals=%llu nodes=%llu bins=%llu bins_empty=%llu\n",
             method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, st.threads,
-            ms.frame, ms.cpu, ms.load, ms.build, ms.shade, ms.write, ms.total, (unsigned long long)st.setups,
+            rr_aa_mode_name(opt.aa), opt.samples, ms.frame, ms.frame, ms.cpu, ms.load, ms.build, ms.shade, ms.resolve,
+            ms.write, ms.total, (unsigned long long)ms.shades, (unsigned long long)st.setups,
             (unsigned long long)st.edge_evals, (unsigned long long)st.nodes, (unsigned long long)st.bins,
             (unsigned long long)st.bins_empty);
   if (stats && st.why[0]) fprintf(stderr, "auto chose %s: %s\n", method, st.why);
@@ -706,8 +811,10 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   for (int k = 0; k < naov; k++) note(1, "wrote %s\n", aovs[k].path);
   if (save_camera) note(1, "wrote %s\n", save_camera);
   if (json) note(1, "wrote %s\n", json);
-  note(1, "times: load %.1f ms, build %.1f ms, visibility %.1f ms%s, shade %.1f ms, write %.1f ms, total %.1f ms\n",
-       ms.load, ms.build, ms.frame, repeat > 1 ? " (median)" : "", ms.shade, ms.write, ms.total);
+  note(1,
+       "times: load %.1f ms, build %.1f ms, visibility %.1f ms%s, shade %.1f ms, resolve %.1f ms, write %.1f ms, "
+       "total %.1f ms\n",
+       ms.load, ms.build, ms.frame, repeat > 1 ? " (median)" : "", ms.shade, ms.resolve, ms.write, ms.total);
   if (out && !stats && verbosity == 0)
     note(0, "wrote %s (%dx%d, %s, %.1f ms)\n", out, opt.width, opt.height, method, ms.frame);
   rr_frame_release(frame);

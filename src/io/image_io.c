@@ -215,12 +215,15 @@ static bool encode_pfm(const rr_image *img, bytes *out) {
   return !out->nomem;
 }
 
-/* NPY holds the samples as they are, in the image's own type. */
+static bool per_sample_kind(int kind);
+
+/* NPY holds the samples as they are, in the image's own type: (H, W) or (H, W, C); a
+ * per-sample AOV is always (H, W, N). */
 static bool encode_npy(const rr_image *img, bytes *out) {
   const char *descr = img->type == RR_PIXEL_U8 ? "|u1" : img->type == RR_PIXEL_F32 ? "<f4" : "<u4";
   char dict[128];
   int n;
-  if (img->channels == 1)
+  if (img->channels == 1 && !per_sample_kind(img->kind))
     n = snprintf(dict, sizeof dict, "{'descr': '%s', 'fortran_order': False, 'shape': (%d, %d), }",
                  descr, img->height, img->width);
   else
@@ -261,9 +264,12 @@ static const char *const plain_channels[5][4] = {
 /* AOVs: depth in Z as OpenEXR's convention has it; vectors as named layers, which
  * OpenImageIO, Nuke and Blender show as one layer (channels sorted by name read back
  * in this order); ids by what they number. */
+#define PER_SAMPLE(p)                                                                                        \
+  {0, {p "00", p "01", p "02", p "03", p "04", p "05", p "06", p "07", p "08", p "09", p "10", p "11", p "12", \
+       p "13", p "14", p "15"}}
 static const struct {
-  int channels;
-  const char *names[3];
+  int channels; /* 0: one per sample, 1 .. RR_MAX_SAMPLES */
+  const char *names[RR_MAX_SAMPLES];
 } aov_channels[RR_AOV_COUNT] = {
     [RR_AOV_DEPTH] = {1, {"Z"}},
     [RR_AOV_ID] = {1, {"id"}},
@@ -273,10 +279,28 @@ static const struct {
     [RR_AOV_NODES] = {1, {"nodes"}},
     [RR_AOV_MESH] = {1, {"mesh"}},
     [RR_AOV_MATERIAL] = {1, {"material"}},
+    [RR_AOV_COVERAGE] = {1, {"coverage"}},
+    /* a sample per channel, numbered so that sorting by name keeps their order */
+    [RR_AOV_SAMPLE_ID] = PER_SAMPLE("id.s"),
+    [RR_AOV_SAMPLE_DEPTH] = PER_SAMPLE("Z.s"),
+    [RR_AOV_SAMPLE_MESH] = PER_SAMPLE("mesh.s"),
 };
+_Static_assert(RR_MAX_SAMPLES == 16, "PER_SAMPLE names 16 samples");
 
 static bool is_aov_kind(int kind) {
   return kind >= RR_IMAGE_AOV && kind < RR_IMAGE_AOV + RR_AOV_COUNT;
+}
+
+/* Whether images of kind `kind` have a channel per sample (the sample-* AOVs). */
+static bool per_sample_kind(int kind) {
+  return is_aov_kind(kind) && !aov_channels[kind - RR_IMAGE_AOV].channels;
+}
+
+/* Whether an image of kind `kind` may have c channels. */
+static bool channels_fit(int kind, int c) {
+  if (kind < RR_IMAGE_AOV) return c >= 1 && c <= 4;
+  int want = aov_channels[kind - RR_IMAGE_AOV].channels;
+  return want ? c == want : c >= 1 && c <= RR_MAX_SAMPLES;
 }
 
 /* The EXR name of channel ch of a checked image. */
@@ -386,7 +410,7 @@ static rr_error check_image(rr_device *dev, const rr_image *img, const char *pat
   if (img->width < 1 || img->height < 1 || img->width > RR_MAX_SIZE || img->height > RR_MAX_SIZE)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad image size %dx%d", path,
                    img->width, img->height);
-  if (img->channels < 1 || img->channels > 4)
+  if (img->channels < 1 || img->channels > RR_MAX_SAMPLES)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad channel count %d", path,
                    img->channels);
   if (img->type != RR_PIXEL_U8 && img->type != RR_PIXEL_F32 && img->type != RR_PIXEL_U32)
@@ -395,9 +419,13 @@ static rr_error check_image(rr_device *dev, const rr_image *img, const char *pat
   if (img->kind < 0 || img->kind >= RR_IMAGE_AOV + RR_AOV_COUNT)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad image kind %d", path,
                    img->kind);
-  if (is_aov_kind(img->kind) && img->channels != aov_channels[img->kind - RR_IMAGE_AOV].channels)
+  if (!channels_fit(img->kind, img->channels)) {
+    if (!is_aov_kind(img->kind) || per_sample_kind(img->kind))
+      return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': bad channel count %d", path,
+                     img->channels);
     return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': an AOV image of %d channels, %d expected",
                    path, img->channels, aov_channels[img->kind - RR_IMAGE_AOV].channels);
+  }
   return RR_OK;
 }
 
@@ -411,10 +439,10 @@ static rr_error check_fits(rr_device *dev, image_format fmt, const rr_image *img
       return rr_fail(dev, RR_ERROR_UNSUPPORTED,
                      "cannot write '%s': PNG holds 8-bit values, not uint32 ids (use .npy or .exr)",
                      path);
-    if (c == 2)
+    if (c == 2 || c > 4)
       return rr_fail(dev, RR_ERROR_UNSUPPORTED,
-                     "cannot write '%s': PNG holds 1, 3 or 4 channels, not 2 (use .npy or .exr)",
-                     path);
+                     "cannot write '%s': PNG holds 1, 3 or 4 channels, not %d (use .npy or .exr)",
+                     path, c);
     return RR_OK;
   case FMT_PFM:
     if (c != 1 && c != 3)
@@ -1128,7 +1156,7 @@ static rr_error read_exr(rr_device *dev, const char *path, const blob *b, rr_ima
   /* the kind the channel names say (sorted like aov_channels' names) */
   out->kind = nrgba == c ? RR_IMAGE_COLOR : RR_IMAGE_VALUES;
   for (int a = 0; a < RR_AOV_COUNT && nrgba == 0; a++) {
-    bool same = aov_channels[a].channels == c;
+    bool same = channels_fit(RR_IMAGE_AOV + a, c);
     for (int k = 0; same && k < c; k++) same = !strcmp(header.channels[k].name, aov_channels[a].names[k]);
     if (same) out->kind = RR_IMAGE_AOV + a;
   }

@@ -1,10 +1,13 @@
 /* Deferred shading: reads only the visibility buffer (id, t, λ1, λ2) and the
  * scene, so it never knows which method made the frame. */
+#define _DEFAULT_SOURCE /* madvise */
 #include "vis/vis.h"
 #include "core/color.h"
+#include "shade/resolve.h"
 
 #include <stdio.h>
 #include <string.h>
+#include <sys/mman.h>
 
 /* stb_easy_font is header-only with static functions; only some are used. */
 #pragma GCC diagnostic push
@@ -27,28 +30,22 @@ static vec3 geometric_normal(const rr_scene *s, uint32_t i) {
   return v3_norm(v3_cross(v3_sub(scene_vertex(s, 1, i), p0), v3_sub(scene_vertex(s, 2, i), p0)));
 }
 
-static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, int y) {
-  hit h = {0};
-  size_t k = (size_t)y * vb->width + x;
-  vec3 o, d;
-  h.has_ray = rr_cam_ray(c, x, y, &o, &d);
-  h.id = vb->id[k];
-  if (h.id == RR_MISS || h.id >= s->ntris) return h;
+/* The shading inputs of triangle `id` at barycentrics (l1, l2), seen along the
+ * (unnormalised) ray direction d at parameter t; not valid on a miss. */
+static hit hit_make(const rr_scene *s, uint32_t id, float l1, float l2, float t, vec3 d) {
+  hit h = {.has_ray = true, .id = id};
+  if (id == RR_MISS || id >= s->ntris) return h;
   h.valid = true;
-  if (!h.has_ray) {
-    h.valid = false;
-    return h;
-  }
   float len = v3_len(d);
   h.dir = v3_scale(d, 1.0f / len);
-  h.dist = vb->t[k] * len;
-  h.l1 = vb->l1[k], h.l2 = vb->l2[k], h.l0 = 1.0f - h.l1 - h.l2;
-  vec3 n = geometric_normal(s, h.id);
+  h.dist = t * len;
+  h.l1 = l1, h.l2 = l2, h.l0 = 1.0f - l1 - l2;
+  vec3 n = geometric_normal(s, id);
   if (s->n[0][0]) {
     vec3 sn = v3(0, 0, 0);
     float w[3] = {h.l0, h.l1, h.l2};
     for (int v = 0; v < 3; v++)
-      sn = v3_add(sn, v3_scale(v3(s->n[v][0][h.id], s->n[v][1][h.id], s->n[v][2][h.id]), w[v]));
+      sn = v3_add(sn, v3_scale(v3(s->n[v][0][id], s->n[v][1][id], s->n[v][2][id]), w[v]));
     if (v3_dot(sn, sn) > 1e-12f) {
       sn = v3_norm(sn);
       /* keep interpolated normals on the geometric normal's side */
@@ -57,6 +54,18 @@ static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, i
   }
   h.normal = v3_dot(n, h.dir) > 0 ? v3_neg(n) : n;
   return h;
+}
+
+/* The hit of entry i of the visibility buffer (a sample of pixel (x, y)) seen by c. */
+static hit sample_hit(const rr_scene *s, const camera *c, const visbuf *vb, size_t i, int x, int y) {
+  vec3 o, d;
+  if (!rr_cam_ray(c, x, y, &o, &d)) return (hit){.id = vb->id[i]};
+  return hit_make(s, vb->id[i], vb->l1[i], vb->l2[i], vb->t[i], d);
+}
+
+/* Sample 0 of pixel (x, y). */
+static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, int y) {
+  return sample_hit(s, c, vb, (size_t)y * vb->width + x, x, y);
 }
 
 static void texel(const rr_texture *t, float u, float v, float rgb[3]) {
@@ -171,73 +180,266 @@ static rr_error shade_heat(rr_device *dev, const float *heat, rr_image *img, con
   return RR_OK;
 }
 
-static rr_error shade_frame(rr_device *dev, const rr_scene *s, const camera *cp, const rr_frame *f,
-                            rr_shade_mode mode, rr_image *out) {
-  const camera c = *cp;
-  const visbuf *vb = &f->vb;
-  rr_error e;
-  bool heat = mode == RR_SHADE_HEAT_EVALS || mode == RR_SHADE_HEAT_NODES;
-  const float *counts = mode == RR_SHADE_HEAT_EVALS ? f->heat_e : f->heat_n;
-  if (heat && !counts)
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "heat maps need per-pixel statistics (render with options.heat set)");
-  e = image_alloc(dev, out, vb->width, vb->height, 3, RR_PIXEL_F32, RR_IMAGE_COLOR);
-  if (e) return e;
-  float *px = out->data;
-  if (heat) {
-    e = shade_heat(dev, counts, out, mode == RR_SHADE_HEAT_EVALS ? "edge evaluations" : "BVH nodes");
-    if (e) {
-      free(out->data);
-      out->data = NULL;
-      return e;
-    }
-    /* drawn in display colours; the image holds linear light */
-    for (size_t i = 0; i < (size_t)vb->width * vb->height * 3; i++) px[i] = srgb_decode(px[i]);
-    return rr_ok(dev);
+/* The linear colour of a valid hit under a shade mode other than the heat maps;
+ * [dmin, dmax]: the frame's range of distances (depth). */
+static void shade_hit(const rr_scene *s, const hit *h, rr_shade_mode mode, float dmin, float dmax, float o[3]) {
+  if (mode == RR_SHADE_LAMBERT) {
+    float rgb[3];
+    base_color(s, h, rgb);
+    float lit = 0.12f + 0.88f * fmaxf(0.0f, -v3_dot(h->normal, h->dir));
+    for (int ch = 0; ch < 3; ch++) o[ch] = rgb[ch] * lit;
+    return;
   }
-  float dmin = INFINITY, dmax = 0;
-  if (mode == RR_SHADE_DEPTH)
+  /* the visualisations are designed in display colours, decoded to linear light */
+  switch (mode) {
+  case RR_SHADE_ID: {
+    uint32_t hsh = hash32(scene_face_id(s, h->id) + 1); /* by id: the colour of a face whatever was dropped */
+    for (int ch = 0; ch < 3; ch++) o[ch] = 0.2f + 0.8f * (float)((hsh >> (8 * ch)) & 255) / 255.0f;
+    break;
+  }
+  case RR_SHADE_NORMAL:
+    o[0] = 0.5f + 0.5f * h->normal.x, o[1] = 0.5f + 0.5f * h->normal.y, o[2] = 0.5f + 0.5f * h->normal.z;
+    break;
+  default: { /* depth */
+    float g = dmax > dmin ? 1.0f - 0.85f * (h->dist - dmin) / (dmax - dmin) : 1.0f;
+    o[0] = o[1] = o[2] = g;
+    break;
+  }
+  }
+  for (int ch = 0; ch < 3; ch++) o[ch] = srgb_decode(o[ch]);
+}
+
+/* One shading pass over the samples of a frame (rows dealt out in jobs). */
+typedef struct shade_pass {
+  const rr_scene *s;
+  const camera *cams; /* cams[s] resolved at sample s's position */
+  const visbuf *vb;
+  rr_shade_mode mode;
+  rr_aa_mode aa;
+  int samples, stored; /* samples shaded and those carrying colour (csaa: K; else all) */
+  float dmin, dmax;
+  signed char nearest[RR_MAX_SAMPLES][RR_MAX_SAMPLES]; /* csaa: coverage sample c's stored samples, nearest first */
+  float *rgb, *weight, *alpha; /* the resolve's input (resolve.h); weight NULL: all 1; alpha NULL: opaque */
+  uint64_t shades[RR_MAX_THREADS];
+  bool failed; /* a job found no memory */
+} shade_pass;
+
+enum { SHADE_ROWS = 8 }; /* rows per job */
+
+/* Behind misses: a quiet vertical gradient in display colours, as linear light;
+ * black where the camera has no ray. */
+static void background(int y, int height, float o[3]) {
+  float g = 0.16f + 0.10f * (1.0f - (float)y / height);
+  o[0] = srgb_decode(g * 0.9f), o[1] = srgb_decode(g), o[2] = srgb_decode(g * 1.15f);
+}
+
+/* A run of pixels of one row, every layer copied side by side: the layers lie a
+ * power of two apart, so reading a pixel's samples in place would map them all to
+ * the same cache sets. */
+enum { RUN = 64 };
+typedef struct sample_run {
+  uint32_t id[RR_MAX_SAMPLES][RUN];
+  float l1[RR_MAX_SAMPLES][RUN], l2[RR_MAX_SAMPLES][RUN], t[RR_MAX_SAMPLES][RUN];
+  float rgb[RR_MAX_SAMPLES][3 * RUN], w[RR_MAX_SAMPLES][RUN];
+} sample_run;
+
+/* Shades pixel (x, y), run entry j: see rr_aa_mode for what each mode does. */
+static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, int y, const float bg[3]) {
+  const rr_scene *s = p->s;
+  int n = p->samples, K = p->stored;
+  bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
+  bool done[RR_MAX_SAMPLES] = {false};
+  uint64_t shades = 0;
+  /* Each stored sample not yet coloured starts a group: the samples that saw its
+   * primitive. ssaa and none: every sample its own group. msaa, csaa: shaded once,
+   * at the group's mean barycentrics and ray parameter along its first sample's ray. */
+  for (int i = 0; i < K; i++) {
+    if (done[i]) continue;
+    uint32_t id = r->id[i][j];
+    int last = grouped ? n : i + 1;
+    float col[3] = {0, 0, 0};
+    vec3 o, d;
+    if (id < s->ntris) {
+      float l1 = 0, l2 = 0, t = 0;
+      int members = 0;
+      for (int m = i; m < last; m++)
+        if (r->id[m][j] == id) l1 += r->l1[m][j], l2 += r->l2[m][j], t += r->t[m][j], members++;
+      if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
+        float inv = 1.0f / (float)members;
+        hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, d);
+        shade_hit(s, &h, p->mode, p->dmin, p->dmax, col);
+        shades++;
+      }
+    } else if (p->cams[i].planar || rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
+      memcpy(col, bg, sizeof col);
+    }
+    for (int m = i; m < (last < K ? last : K); m++)
+      if (r->id[m][j] == id) {
+        memcpy(&r->rgb[m][3 * j], col, sizeof col);
+        done[m] = true, r->w[m][j] = 1.0f;
+      }
+  }
+  /* csaa: a coverage sample votes for the nearest stored sample of its primitive;
+   * its own colour counts for nothing */
+  for (int c = K; c < n; c++) {
+    for (int v = 0; v < K; v++)
+      if (r->id[p->nearest[c][v]][j] == r->id[c][j]) {
+        r->w[p->nearest[c][v]][j] += 1.0f;
+        break;
+      }
+    r->w[c][j] = 0.0f;
+    memset(&r->rgb[c][3 * j], 0, 3 * sizeof(float));
+  }
+  return shades;
+}
+
+static void shade_rows(int job, int thread, void *arg) {
+  shade_pass *p = arg;
+  const visbuf *vb = p->vb;
+  size_t npix = (size_t)vb->width * vb->height;
+  int n = p->samples;
+  uint64_t shades = 0;
+  sample_run *r = malloc(sizeof *r);
+  if (!r) { /* a job without room leaves its rows for shade_frame to report */
+    p->failed = true;
+    return;
+  }
+  for (int y = job * SHADE_ROWS; y < vb->height && y < (job + 1) * SHADE_ROWS; y++) {
+    float bg[3];
+    background(y, vb->height, bg);
+    for (int x0 = 0; x0 < vb->width; x0 += RUN) {
+      int len = vb->width - x0 < RUN ? vb->width - x0 : RUN;
+      size_t k0 = (size_t)y * vb->width + x0;
+      for (int i = 0; i < n; i++) {
+        size_t e = i * npix + k0;
+        memcpy(r->id[i], vb->id + e, len * sizeof(uint32_t));
+        memcpy(r->l1[i], vb->l1 + e, len * sizeof(float));
+        memcpy(r->l2[i], vb->l2 + e, len * sizeof(float));
+        memcpy(r->t[i], vb->t + e, len * sizeof(float));
+      }
+      for (int j = 0; j < len; j++) shades += shade_pixel(p, r, j, x0 + j, y, bg);
+      for (int i = 0; i < n; i++) {
+        memcpy(p->rgb + 3 * (i * npix + k0), r->rgb[i], 3 * len * sizeof(float));
+        if (p->weight) memcpy(p->weight + i * npix + k0, r->w[i], len * sizeof(float));
+        if (p->alpha)
+          for (int j = 0; j < len; j++) p->alpha[i * npix + k0 + j] = r->id[i][j] < p->s->ntris ? 1.0f : 0.0f;
+      }
+    }
+  }
+  free(r);
+  p->shades[thread] += shades;
+}
+
+/* The frame's range of eye distances over every shaded sample (the depth mode's scale). */
+static void depth_range(const shade_pass *p, float *dmin, float *dmax) {
+  const visbuf *vb = p->vb;
+  size_t npix = (size_t)vb->width * vb->height;
+  *dmin = INFINITY, *dmax = 0;
+  for (int i = 0; i < p->samples; i++)
     for (int y = 0; y < vb->height; y++)
       for (int x = 0; x < vb->width; x++) {
-        hit h = hit_at(s, &c, vb, x, y);
-        if (h.valid) dmin = fminf(dmin, h.dist), dmax = fmaxf(dmax, h.dist);
+        hit h = sample_hit(p->s, &p->cams[i], vb, i * npix + (size_t)y * vb->width + x, x, y);
+        if (h.valid) *dmin = fminf(*dmin, h.dist), *dmax = fmaxf(*dmax, h.dist);
       }
-  for (int y = 0; y < vb->height; y++)
-    for (int x = 0; x < vb->width; x++) {
-      float *o = px + 3 * ((size_t)y * vb->width + x);
-      hit h = hit_at(s, &c, vb, x, y);
-      if (!h.has_ray) continue; /* black where the camera has no ray */
-      if (h.valid && mode == RR_SHADE_LAMBERT) {
-        float rgb[3];
-        base_color(s, &h, rgb);
-        float lit = 0.12f + 0.88f * fmaxf(0.0f, -v3_dot(h.normal, h.dir));
-        for (int ch = 0; ch < 3; ch++) o[ch] = rgb[ch] * lit;
-        continue;
-      }
-      /* everything else is designed in display colours, decoded to linear light below */
-      if (!h.valid) {
-        /* a quiet vertical gradient behind the scene */
-        float g = 0.16f + 0.10f * (1.0f - (float)y / vb->height);
-        o[0] = g * 0.9f, o[1] = g, o[2] = g * 1.15f;
-      } else switch (mode) {
-      case RR_SHADE_ID: {
-        uint32_t hsh = hash32(scene_face_id(s, h.id) + 1); /* by id: the colour of a face whatever was dropped */
-        for (int ch = 0; ch < 3; ch++) o[ch] = 0.2f + 0.8f * (float)((hsh >> (8 * ch)) & 255) / 255.0f;
-        break;
-      }
-      case RR_SHADE_NORMAL:
-        o[0] = 0.5f + 0.5f * h.normal.x, o[1] = 0.5f + 0.5f * h.normal.y, o[2] = 0.5f + 0.5f * h.normal.z;
-        break;
-      case RR_SHADE_DEPTH: {
-        float g = dmax > dmin ? 1.0f - 0.85f * (h.dist - dmin) / (dmax - dmin) : 1.0f;
-        o[0] = o[1] = o[2] = g;
-        break;
-      }
-      default:
-        break;
-      }
-      for (int ch = 0; ch < 3; ch++) o[ch] = srgb_decode(o[ch]);
-    }
+}
+
+static rr_error shade_heat_frame(rr_device *dev, const rr_frame *f, rr_shade_mode mode, rr_image *out) {
+  const float *counts = mode == RR_SHADE_HEAT_EVALS ? f->heat_e : f->heat_n;
+  if (!counts)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "heat maps need per-pixel statistics (render with options.heat set)");
+  rr_error e = image_alloc(dev, out, f->vb.width, f->vb.height, 3, RR_PIXEL_F32, RR_IMAGE_COLOR);
+  if (!e) e = shade_heat(dev, counts, out, mode == RR_SHADE_HEAT_EVALS ? "edge evaluations" : "BVH nodes");
+  if (e) {
+    free(out->data);
+    out->data = NULL;
+    return e;
+  }
+  /* drawn in display colours; the image holds linear light */
+  float *px = out->data;
+  for (size_t i = 0; i < (size_t)f->vb.width * f->vb.height * 3; i++) px[i] = srgb_decode(px[i]);
   return rr_ok(dev);
+}
+
+/* A large buffer of per-sample values, in huge pages where the system offers them
+ * on request: a fresh 4 KiB page costs a fault each, and a 1024² frame of 16
+ * samples is 200 MB of colour (free() releases it). */
+static void *sample_alloc(size_t bytes) {
+  enum { HUGE_PAGE = 2 << 20 };
+  if (bytes < HUGE_PAGE) return malloc(bytes);
+  void *p = NULL;
+  if (posix_memalign(&p, HUGE_PAGE, bytes)) return NULL;
+#ifdef MADV_HUGEPAGE
+  madvise(p, bytes, MADV_HUGEPAGE); /* advice: without it the pages are small */
+#endif
+  return p;
+}
+
+/* Shades the samples as the frame's AA mode says (cams: one per sample position),
+ * then resolves them into out with the options' filter. */
+static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f,
+                              const rr_shade_options *opt, rr_image *out, rr_shade_stats *st) {
+  const visbuf *vb = &f->vb;
+  size_t npix = (size_t)vb->width * vb->height;
+  shade_pass *p = calloc(1, sizeof *p);
+  if (!p) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading");
+  *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = opt->mode, .aa = f->aa, .samples = f->samples};
+  p->stored = f->aa == RR_AA_CSAA ? f->aa_stored : p->samples;
+  const float(*pos)[2] = (const float(*)[2])f->sample_pos;
+  /* coverage samples' stored samples by distance (ties: the lower index) */
+  for (int c = p->stored; c < p->samples; c++) {
+    for (int j = 0; j < p->stored; j++) p->nearest[c][j] = (signed char)j;
+    for (int a = 1; a < p->stored; a++) /* insertion sort: stable */
+      for (int b = a; b > 0; b--) {
+        int u = p->nearest[c][b - 1], v = p->nearest[c][b];
+        float du = hypotf(pos[u][0] - pos[c][0], pos[u][1] - pos[c][1]);
+        float dv = hypotf(pos[v][0] - pos[c][0], pos[v][1] - pos[c][1]);
+        if (dv >= du) break;
+        p->nearest[c][b - 1] = (signed char)v, p->nearest[c][b] = (signed char)u;
+      }
+  }
+  size_t nsamp = (size_t)p->samples * npix;
+  p->rgb = sample_alloc(nsamp * 3 * sizeof(float));
+  p->weight = f->aa == RR_AA_CSAA ? sample_alloc(nsamp * sizeof(float)) : NULL;
+  p->alpha = opt->alpha ? sample_alloc(nsamp * sizeof(float)) : NULL;
+  rr_error e = RR_OK;
+  if (!p->rgb || (f->aa == RR_AA_CSAA && !p->weight) || (opt->alpha && !p->alpha))
+    e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %dx%d pixels of %d samples", vb->width, vb->height,
+                p->samples);
+  if (!e) {
+    double t0 = rr_now_ms();
+    if (opt->mode == RR_SHADE_DEPTH) depth_range(p, &p->dmin, &p->dmax);
+    int threads = f->stats.threads > 0 ? f->stats.threads : 1;
+    rr_parallel_for((vb->height + SHADE_ROWS - 1) / SHADE_ROWS, threads, shade_rows, p);
+    double t1 = rr_now_ms();
+    resolve_input in = {vb->width, vb->height, p->samples, pos, p->rgb, p->weight, p->alpha};
+    e = p->failed ? rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading")
+                  : rr_resolve_image(dev, &in, opt, threads, out);
+    if (st) {
+      *st = (rr_shade_stats){.shade_ms = t1 - t0, .resolve_ms = rr_now_ms() - t1};
+      for (int t = 0; t < RR_MAX_THREADS; t++) st->shades += p->shades[t];
+    }
+  }
+  free(p->rgb), free(p->weight), free(p->alpha), free(p);
+  return e ? e : rr_ok(dev);
+}
+
+/* The value of an integer AOV (id, mesh, material) at a sample that saw primitive id. */
+/* Layer s of a frame's visibility buffer: sample s of every pixel. */
+static visbuf frame_layer(const rr_frame *f, int s) {
+  size_t off = (size_t)s * f->vb.width * f->vb.height;
+  return (visbuf){f->vb.width, f->vb.height, f->vb.id + off, f->vb.t + off, f->vb.l1 + off, f->vb.l2 + off};
+}
+
+/* Resolves the frame's cameras, one per sample position; on failure none is left. */
+static rr_error frame_cameras(rr_device *dev, const rr_camera *cam, const rr_frame *f, camera *cams) {
+  for (int s = 0; s < f->samples; s++) {
+    rr_error e = rr_cam_setup_at(dev, cam, f->vb.width, f->vb.height, f->sample_pos[s], &cams[s]);
+    if (e) {
+      while (s > 0) rr_cam_release(&cams[--s]);
+      return e;
+    }
+  }
+  return RR_OK;
 }
 
 /* The value of an integer AOV (id, mesh, material) at a sample that saw primitive id. */
@@ -247,13 +449,36 @@ static uint32_t id_aov(const rr_scene *s, rr_aov aov, uint32_t id) {
   return aov == RR_AOV_MESH ? rr_scene_geometry_of(s, id) : s->material[id];
 }
 
-static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cp, const rr_frame *f, rr_aov aov,
+/* The sample nearest the pixel's centre (the lowest index on a tie): the same in
+ * every pixel, as every pixel has the frame's pattern. */
+static int centre_sample(const rr_frame *f) {
+  int best = 0;
+  float best_d = INFINITY;
+  for (int s = 0; s < f->samples; s++) {
+    float dx = f->sample_pos[s][0] - 0.5f, dy = f->sample_pos[s][1] - 0.5f, d = dx * dx + dy * dy;
+    if (d < best_d) best = s, best_d = d;
+  }
+  return best;
+}
+
+/* The AOV a per-sample AOV gives for each sample; the AOV itself otherwise. */
+static rr_aov per_sample_base(rr_aov aov) {
+  switch (aov) {
+  case RR_AOV_SAMPLE_ID: return RR_AOV_ID;
+  case RR_AOV_SAMPLE_DEPTH: return RR_AOV_DEPTH;
+  case RR_AOV_SAMPLE_MESH: return RR_AOV_MESH;
+  default: return aov;
+  }
+}
+
+/* Fills an AOV from the frame's layers, by the rules of several samples per pixel
+ * (rastray.h): a per-sample AOV takes every layer as a channel; coverage counts the
+ * layers' hits; depth keeps the nearest; the others read the centre's layer. */
+static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f, rr_aov aov,
                           rr_image *out) {
-  const camera c = *cp;
   const visbuf *vb = &f->vb;
   rr_error e;
-  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1, 1, 1};
-  if ((int)aov < 0 || aov >= RR_AOV_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AOV %d", (int)aov);
+  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1, 1, 1, 1};
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
     if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
@@ -262,44 +487,83 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cp, c
     memcpy(out->data, counts, (size_t)vb->width * vb->height * sizeof(float));
     return rr_ok(dev);
   }
-  bool ints = aov == RR_AOV_ID || aov == RR_AOV_MESH || aov == RR_AOV_MATERIAL;
-  e = image_alloc(dev, out, vb->width, vb->height, channels[aov], ints ? RR_PIXEL_U32 : RR_PIXEL_F32,
-                  RR_IMAGE_AOV + (int)aov);
+  rr_aov base = per_sample_base(aov);
+  bool per_sample = base != aov, ints = base == RR_AOV_ID || base == RR_AOV_MESH || base == RR_AOV_MATERIAL;
+  int ch = per_sample ? f->samples : channels[aov], centre = centre_sample(f);
+  e = image_alloc(dev, out, vb->width, vb->height, ch, ints ? RR_PIXEL_U32 : RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov);
   if (e) return e;
-  for (int y = 0; y < vb->height; y++)
-    for (int x = 0; x < vb->width; x++) {
-      size_t k = (size_t)y * vb->width + x;
-      if (ints) {
-        ((uint32_t *)out->data)[k] = id_aov(s, aov, vb->id[k]);
-        continue;
+  size_t npix = (size_t)vb->width * vb->height;
+  float *o = out->data;
+  if (base == RR_AOV_DEPTH) /* a miss everywhere, until a sample sees nearer */
+    for (size_t k = 0; k < npix * ch; k++) o[k] = INFINITY;
+  for (int smp = 0; smp < f->samples; smp++) {
+    if (!per_sample && base != RR_AOV_DEPTH && aov != RR_AOV_COVERAGE && smp != centre) continue;
+    visbuf layer = frame_layer(f, smp);
+    int c0 = per_sample ? smp : 0; /* this layer's channel */
+    for (int y = 0; y < vb->height; y++)
+      for (int x = 0; x < vb->width; x++) {
+        size_t k = (size_t)y * vb->width + x;
+        if (ints) {
+          ((uint32_t *)out->data)[k * ch + c0] = id_aov(s, base, layer.id[k]);
+          continue;
+        }
+        if (aov == RR_AOV_COVERAGE) {
+          o[k] += layer.id[k] < s->ntris ? 1.0f / f->samples : 0.0f;
+          continue;
+        }
+        hit h = hit_at(s, &cams[smp], &layer, x, y);
+        float *p = o + k * ch + c0;
+        if (base == RR_AOV_DEPTH) *p = fminf(*p, h.valid ? h.dist : INFINITY);
+        else if (base == RR_AOV_NORMAL && h.valid) p[0] = h.normal.x, p[1] = h.normal.y, p[2] = h.normal.z;
+        else if (base == RR_AOV_BARY && h.valid) p[0] = h.l1, p[1] = h.l2;
       }
-      float *o = (float *)out->data + channels[aov] * k;
-      hit h = hit_at(s, &c, vb, x, y);
-      if (aov == RR_AOV_DEPTH) o[0] = h.valid ? h.dist : INFINITY;
-      else if (aov == RR_AOV_NORMAL && h.valid) o[0] = h.normal.x, o[1] = h.normal.y, o[2] = h.normal.z;
-      else if (aov == RR_AOV_BARY && h.valid) o[0] = h.l1, o[1] = h.l2;
-    }
+  }
   return rr_ok(dev);
 }
 
-/* The public entry points resolve the camera for the frame's size around the work. */
+/* The public entry points resolve the frame's cameras, one per sample position, around the work. */
+void rr_shade_options_init(rr_shade_options *opt) {
+  *opt = (rr_shade_options){.mode = RR_SHADE_LAMBERT, .filter = RR_FILTER_BOX, .radius = 0, .alpha = 0};
+}
+
+rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                        const rr_shade_options *opt, rr_image *out, rr_shade_stats *stats) {
+  rr_shade_options def;
+  if (!opt) rr_shade_options_init(&def), opt = &def;
+  if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
+  if ((int)opt->mode < 0 || opt->mode >= RR_SHADE_COUNT)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shade mode %d", (int)opt->mode);
+  if (stats) *stats = (rr_shade_stats){0};
+  if (opt->mode == RR_SHADE_HEAT_EVALS || opt->mode == RR_SHADE_HEAT_NODES) {
+    double t0 = rr_now_ms();
+    rr_error e = shade_heat_frame(dev, f, opt->mode, out);
+    if (stats) stats->shade_ms = rr_now_ms() - t0;
+    return e;
+  }
+  camera cams[RR_MAX_SAMPLES];
+  rr_error e = frame_cameras(dev, cam, f, cams);
+  if (e) return e;
+  e = shade_samples(dev, s, cams, f, opt, out, stats);
+  for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
+  return e;
+}
+
 rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_shade_mode mode,
                   rr_image *out) {
-  if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
-  if ((int)mode < 0 || mode >= RR_SHADE_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shade mode %d", (int)mode);
-  camera c;
-  rr_error e = rr_cam_setup(dev, cam, f->vb.width, f->vb.height, &c);
-  if (!e) e = shade_frame(dev, s, &c, f, mode, out);
-  rr_cam_release(&c);
-  return e;
+  rr_shade_options opt;
+  rr_shade_options_init(&opt);
+  opt.mode = mode;
+  return rr_shade_frame(dev, s, cam, f, &opt, out, NULL);
 }
 
 rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_aov aov,
                       rr_image *out) {
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_frame_aov: NULL argument");
-  camera c;
-  rr_error e = rr_cam_setup(dev, cam, f->vb.width, f->vb.height, &c);
-  if (!e) e = frame_aov(dev, s, &c, f, aov, out);
-  rr_cam_release(&c);
+  if ((int)aov < 0 || aov >= RR_AOV_COUNT) return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AOV %d", (int)aov);
+  camera cams[RR_MAX_SAMPLES];
+  rr_error e = frame_cameras(dev, cam, f, cams);
+  if (e) return e;
+  e = frame_aov(dev, s, cams, f, aov, out);
+  for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
   return e;
 }

@@ -98,8 +98,8 @@ int rr_shade_from_name(const char *name) {
 }
 
 int rr_aov_from_name(const char *name) {
-  static const char *const names[RR_AOV_COUNT] = {"depth", "id", "normal", "bary",
-                                                  "evals", "nodes", "mesh", "material"};
+  static const char *const names[RR_AOV_COUNT] = {"depth", "id",       "normal",    "bary",         "evals",      "nodes",
+                                                  "mesh",  "material", "coverage", "sample-id", "sample-depth", "sample-mesh"};
   return name_index(names, RR_AOV_COUNT, name);
 }
 
@@ -239,6 +239,11 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
       return rr_fail(dev, RR_ERROR_ARGUMENT, "bad position (%g, %g) of sample %d (each in [0, 1))", (double)p[0],
                      (double)p[1], s);
   }
+  if ((int)opt->aa < 0 || opt->aa >= RR_AA_MODE_COUNT)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown AA mode %d", (int)opt->aa);
+  if (opt->aa == RR_AA_CSAA && (opt->aa_stored < 1 || opt->aa_stored > opt->samples))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad stored sample count %d for csaa (1..%d, the samples)", opt->aa_stored,
+                   opt->samples);
   if (opt->method == RR_METHOD_AUTO) return render_auto(dev, scene, cam, opt, out);
   oracles o = methods[opt->method].o;
   if (opt->oracles && *opt->oracles) {
@@ -275,6 +280,8 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   }
   f->method = opt->method;
   f->samples = opt->samples;
+  memcpy(f->sample_pos, opt->sample_pos, sizeof f->sample_pos);
+  f->aa = opt->aa, f->aa_stored = opt->aa == RR_AA_CSAA ? opt->aa_stored : 0;
   render_ctx ctx = {.scene = scene,
                     .cam = &cams[0],
                     .cams = cams,
@@ -340,6 +347,12 @@ rr_error rr_frame_get_stats(const rr_frame *f, rr_stats *stats) {
 rr_error rr_frame_get_size(const rr_frame *f, int *w, int *h) {
   if (!f || !w || !h) return RR_ERROR_ARGUMENT;
   *w = f->vb.width, *h = f->vb.height;
+  return RR_OK;
+}
+
+rr_error rr_frame_get_sample_pos(const rr_frame *f, float pos[RR_MAX_SAMPLES][2]) {
+  if (!f || !pos) return RR_ERROR_ARGUMENT;
+  memcpy(pos, f->sample_pos, sizeof f->sample_pos);
   return RR_OK;
 }
 

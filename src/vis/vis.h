@@ -59,6 +59,9 @@ struct rr_frame {
   rr_stats stats;
   rr_method method;
   int samples; /* vb holds this many layers of vb.width × vb.height */
+  float sample_pos[RR_MAX_SAMPLES][2]; /* options.sample_pos: where layer s sampled each pixel */
+  rr_aa_mode aa;                       /* how shading uses them (options.aa, aa_stored) */
+  int aa_stored;
 };
 
 /* A pass of a method: fills vb (cleared to misses) and adds to stats. A method that
