@@ -96,17 +96,6 @@ static void pixel_sums(const resolve_input *in, const tap *taps, int ntaps, int 
   else sums_of(in, taps, ntaps, x, y, false, false, sum);
 }
 
-/* x clamped to [0, hi] (NaN to 0); comparisons, not fmax/fmin, which are library calls. */
-static inline double clamp0(double x, double hi) {
-  return x > 0 ? (x < hi ? x : hi) : 0;
-}
-
-/* A pixel's colour (and alpha) from its sums. */
-static inline void finish(const double sum[5], float *o, int channels) {
-  for (int c = 0; c < 3; c++) o[c] = sum[3] > 0 ? (float)clamp0(sum[c] / sum[3], INFINITY) : 0.0f;
-  if (channels == 4) o[3] = sum[4] > 0 ? (float)clamp0(sum[3] / sum[4], 1) : 0.0f;
-}
-
 static void resolve_rows(int job, int thread, void *arg) {
   (void)thread;
   const resolve_job *j = arg;
@@ -119,7 +108,7 @@ static void resolve_rows(int job, int thread, void *arg) {
       /* negative lobes over sparse weights may leave nothing positive to divide by:
        * the pixel's own samples then decide, as the box would */
       if (!(sum[3] > 0 && sum[4] > 0)) pixel_sums(in, j->own, in->samples, 0, x, y, sum);
-      finish(sum, j->out + (size_t)j->channels * ((size_t)y * in->width + x), j->channels);
+      resolve_finish(sum, j->out + (size_t)j->channels * ((size_t)y * in->width + x), j->channels);
     }
 }
 
@@ -163,20 +152,37 @@ static void resolve_box_rows(int job, int thread, void *arg) {
     double n = in->samples;
     for (size_t x = 0; x < w; x++) {
       double sum[5] = {acc[3 * x], acc[3 * x + 1], acc[3 * x + 2], weighed ? wa[x] : n, weighed ? wt[x] : n};
-      finish(sum, o + j->channels * x, j->channels);
+      resolve_finish(sum, o + j->channels * x, j->channels);
     }
   }
   free(acc);
 }
 
-rr_error rr_resolve_image(rr_device *dev, const resolve_input *in, const rr_shade_options *opt, int threads,
-                          rr_image *out) {
+/* The radius opt asks for, or a message when it or the filter is bad. */
+static rr_error filter_radius(rr_device *dev, const rr_shade_options *opt, double *r) {
   if ((int)opt->filter < 0 || opt->filter >= RR_FILTER_COUNT)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown resolve filter %d", (int)opt->filter);
-  double r = opt->radius == 0 ? default_radius[opt->filter] : opt->radius;
-  if (!(r >= 0.5 && r <= RR_FILTER_MAX_RADIUS))
+  *r = opt->radius == 0 ? default_radius[opt->filter] : opt->radius;
+  if (!(*r >= 0.5 && *r <= RR_FILTER_MAX_RADIUS))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad filter radius %g (0.5 .. %g pixels, 0 for the filter's own)",
                    (double)opt->radius, (double)RR_FILTER_MAX_RADIUS);
+  return RR_OK;
+}
+
+/* Half-open support: the box of radius 0.5 weighs a sample at p in [0, 1) of its own
+ * pixel 1 and one in a neighbour (|dx + p - 0.5| >= 0.5) 0. */
+rr_error rr_resolve_check(rr_device *dev, const rr_shade_options *opt, bool *own) {
+  double r = 0;
+  rr_error e = filter_radius(dev, opt, &r);
+  *own = !e && opt->filter == RR_FILTER_BOX && r == 0.5;
+  return e;
+}
+
+rr_error rr_resolve_image(rr_device *dev, const resolve_input *in, const rr_shade_options *opt, int threads,
+                          rr_image *out) {
+  double r = 0;
+  rr_error e = filter_radius(dev, opt, &r);
+  if (e) return e;
   /* a sample at p in a pixel dx away sits dx + p - 0.5 from the centre: |dx| <= R */
   int R = (int)ceil(r + 0.5), side = 2 * R + 1;
   tap *taps = malloc(sizeof *taps * (side * side + 1) * in->samples), *own = taps + side * side * in->samples;

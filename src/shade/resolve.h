@@ -6,6 +6,8 @@
 
 #include "core/core.h"
 
+#include <math.h>
+
 typedef struct resolve_input {
   int width, height, samples;
   const float (*pos)[2]; /* sample s of pixel (x, y) at (x + pos[s][0], y + pos[s][1]) */
@@ -26,5 +28,34 @@ typedef struct resolve_input {
  * the pixel is 0. opt: the filter and radius (its mode and alpha are not read). */
 rr_error rr_resolve_image(rr_device *dev, const resolve_input *in, const rr_shade_options *opt, int threads,
                           rr_image *out);
+/* Checks opt's filter and radius; *own: the filter takes each pixel's own samples at
+ * weight 1 and nothing else (the box of radius 0.5), so shading may resolve a pixel
+ * as soon as its samples are shaded (resolve_own) and keep no per-sample colours. */
+rr_error rr_resolve_check(rr_device *dev, const rr_shade_options *opt, bool *own);
+
+/* x clamped to [0, hi] (NaN to 0); comparisons, not fmax/fmin, which are library calls. */
+static inline double resolve_clamp0(double x, double hi) {
+  return x > 0 ? (x < hi ? x : hi) : 0;
+}
+
+/* A pixel's colour (and alpha, channels 4) from its sums Σ f·w·a·rgb, Σ f·w·a, Σ f·w. */
+static inline void resolve_finish(const double sum[5], float *o, int channels) {
+  for (int c = 0; c < 3; c++) o[c] = sum[3] > 0 ? (float)resolve_clamp0(sum[c] / sum[3], INFINITY) : 0.0f;
+  if (channels == 4) o[3] = sum[4] > 0 ? (float)resolve_clamp0(sum[3] / sum[4], 1) : 0.0f;
+}
+
+/* The box of one pixel's own n samples, as rr_resolve_image computes it (the same
+ * sums in the same order, so the same bits): sample s's colour at rgb + s·rgb_step,
+ * its weight w[s·step] and alpha a[s·step] (NULL: 1). */
+static inline void resolve_own(int n, const float *rgb, size_t rgb_step, const float *w, const float *a, size_t step,
+                               int channels, float *o) {
+  double sum[5] = {0, 0, 0, 0, 0};
+  for (int s = 0; s < n; s++) {
+    double f = w ? w[s * step] : 1.0, fa = a ? f * a[s * step] : f;
+    const float *c = rgb + s * rgb_step;
+    sum[0] += fa * c[0], sum[1] += fa * c[1], sum[2] += fa * c[2], sum[3] += fa, sum[4] += f;
+  }
+  resolve_finish(sum, o, channels);
+}
 
 #endif

@@ -220,6 +220,8 @@ typedef struct shade_pass {
   float dmin, dmax;
   signed char nearest[RR_MAX_SAMPLES][RR_MAX_SAMPLES]; /* csaa: coverage sample c's stored samples, nearest first */
   float *rgb, *weight, *alpha; /* the resolve's input (resolve.h); weight NULL: all 1; alpha NULL: opaque */
+  bool has_alpha;
+  float *out; /* a filter of each pixel's own samples: the image, resolved as shading goes (no rgb kept) */
   uint64_t shades[RR_MAX_THREADS];
   bool failed; /* a job found no memory */
 } shade_pass;
@@ -240,7 +242,7 @@ enum { RUN = 64 };
 typedef struct sample_run {
   uint32_t id[RR_MAX_SAMPLES][RUN];
   float l1[RR_MAX_SAMPLES][RUN], l2[RR_MAX_SAMPLES][RUN], t[RR_MAX_SAMPLES][RUN];
-  float rgb[RR_MAX_SAMPLES][3 * RUN], w[RR_MAX_SAMPLES][RUN];
+  float rgb[RR_MAX_SAMPLES][3 * RUN], w[RR_MAX_SAMPLES][RUN], a[RR_MAX_SAMPLES][RUN];
 } sample_run;
 
 /* Shades pixel (x, y), run entry j: see rr_aa_mode for what each mode does. */
@@ -318,11 +320,20 @@ static void shade_rows(int job, int thread, void *arg) {
         memcpy(r->t[i], vb->t + e, len * sizeof(float));
       }
       for (int j = 0; j < len; j++) shades += shade_pixel(p, r, j, x0 + j, y, bg);
+      for (int i = 0; p->has_alpha && i < n; i++)
+        for (int j = 0; j < len; j++) r->a[i][j] = r->id[i][j] < p->s->ntris ? 1.0f : 0.0f;
+      const float *w = p->aa == RR_AA_CSAA ? r->w[0] : NULL, *a = p->has_alpha ? r->a[0] : NULL;
+      if (p->out) { /* resolved here: the box of the pixel's own samples */
+        int ch = p->has_alpha ? 4 : 3;
+        for (int j = 0; j < len; j++)
+          resolve_own(n, &r->rgb[0][3 * j], 3 * RUN, w ? w + j : NULL, a ? a + j : NULL, RUN, ch,
+                      p->out + ch * (k0 + j));
+        continue;
+      }
       for (int i = 0; i < n; i++) {
         memcpy(p->rgb + 3 * (i * npix + k0), r->rgb[i], 3 * len * sizeof(float));
-        if (p->weight) memcpy(p->weight + i * npix + k0, r->w[i], len * sizeof(float));
-        if (p->alpha)
-          for (int j = 0; j < len; j++) p->alpha[i * npix + k0 + j] = r->id[i][j] < p->s->ntris ? 1.0f : 0.0f;
+        if (w) memcpy(p->weight + i * npix + k0, r->w[i], len * sizeof(float));
+        if (a) memcpy(p->alpha + i * npix + k0, r->a[i], len * sizeof(float));
       }
     }
   }
@@ -397,14 +408,22 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
         p->nearest[c][b - 1] = (signed char)v, p->nearest[c][b] = (signed char)u;
       }
   }
-  size_t nsamp = (size_t)p->samples * npix;
-  p->rgb = sample_alloc(nsamp * 3 * sizeof(float));
-  p->weight = f->aa == RR_AA_CSAA ? sample_alloc(nsamp * sizeof(float)) : NULL;
-  p->alpha = opt->alpha ? sample_alloc(nsamp * sizeof(float)) : NULL;
-  rr_error e = RR_OK;
-  if (!p->rgb || (f->aa == RR_AA_CSAA && !p->weight) || (opt->alpha && !p->alpha))
-    e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %dx%d pixels of %d samples", vb->width, vb->height,
-                p->samples);
+  bool own;
+  rr_error e = rr_resolve_check(dev, opt, &own);
+  size_t nsamp = own ? 0 : (size_t)p->samples * npix;
+  p->has_alpha = opt->alpha != 0;
+  if (!e && own) { /* resolved as shading goes: no per-sample colours */
+    int ch = opt->alpha ? 4 : 3;
+    *out = (rr_image){vb->width, vb->height, ch, RR_PIXEL_F32, malloc(sizeof(float) * ch * npix), RR_IMAGE_COLOR};
+    if (!(p->out = out->data)) e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d image", vb->width, vb->height);
+  } else if (!e) {
+    p->rgb = sample_alloc(nsamp * 3 * sizeof(float));
+    p->weight = f->aa == RR_AA_CSAA ? sample_alloc(nsamp * sizeof(float)) : NULL;
+    p->alpha = opt->alpha ? sample_alloc(nsamp * sizeof(float)) : NULL;
+    if (!p->rgb || (f->aa == RR_AA_CSAA && !p->weight) || (opt->alpha && !p->alpha))
+      e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %dx%d pixels of %d samples", vb->width, vb->height,
+                  p->samples);
+  }
   if (!e) {
     double t0 = rr_now_ms();
     if (opt->mode == RR_SHADE_DEPTH) depth_range(p, &p->dmin, &p->dmax);
@@ -413,7 +432,9 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
     double t1 = rr_now_ms();
     resolve_input in = {vb->width, vb->height, p->samples, pos, p->rgb, p->weight, p->alpha};
     e = p->failed ? rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading")
+        : own     ? RR_OK
                   : rr_resolve_image(dev, &in, opt, threads, out);
+    if (e && own) free(out->data), out->data = NULL;
     if (st) {
       *st = (rr_shade_stats){.shade_ms = t1 - t0, .resolve_ms = rr_now_ms() - t1};
       for (int t = 0; t < RR_MAX_THREADS; t++) st->shades += p->shades[t];
