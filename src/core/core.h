@@ -63,6 +63,9 @@ void rr_parallel_for(int njobs, int threads, rr_parallel_fn fn, void *arg);
  * caller's thread (thread 0), which takes jobs like the others; span may be NULL.
  * Call it from the thread that called the library, not from inside a job. */
 void rr_parallel_for_progress(int njobs, int threads, rr_parallel_fn fn, void *arg, const progress_span *span);
+/* malloc for buffers of many megabytes: in huge pages where the system offers them
+ * (fewer page faults); free() releases it. */
+void *rr_alloc_large(size_t bytes);
 /* Number of cores available. */
 int rr_cpu_count(void);
 /* Milliseconds on a monotonic clock. */

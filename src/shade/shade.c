@@ -1,13 +1,11 @@
 /* Deferred shading: reads only the visibility buffer (id, t, λ1, λ2) and the
  * scene, so it never knows which method made the frame. */
-#define _DEFAULT_SOURCE /* madvise */
 #include "vis/vis.h"
 #include "core/color.h"
 #include "shade/resolve.h"
 
 #include <stdio.h>
 #include <string.h>
-#include <sys/mman.h>
 
 /* stb_easy_font is header-only with static functions; only some are used. */
 #pragma GCC diagnostic push
@@ -371,20 +369,6 @@ static rr_error shade_heat_frame(rr_device *dev, const rr_frame *f, rr_shade_mod
   return rr_ok(dev);
 }
 
-/* A large buffer of per-sample values, in huge pages where the system offers them
- * on request: a fresh 4 KiB page costs a fault each, and a 1024² frame of 16
- * samples is 200 MB of colour (free() releases it). */
-static void *sample_alloc(size_t bytes) {
-  enum { HUGE_PAGE = 2 << 20 };
-  if (bytes < HUGE_PAGE) return malloc(bytes);
-  void *p = NULL;
-  if (posix_memalign(&p, HUGE_PAGE, bytes)) return NULL;
-#ifdef MADV_HUGEPAGE
-  madvise(p, bytes, MADV_HUGEPAGE); /* advice: without it the pages are small */
-#endif
-  return p;
-}
-
 /* Shades the samples as the frame's AA mode says (cams: one per sample position),
  * then resolves them into out with the options' filter. */
 static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f,
@@ -417,9 +401,9 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
     *out = (rr_image){vb->width, vb->height, ch, RR_PIXEL_F32, malloc(sizeof(float) * ch * npix), RR_IMAGE_COLOR};
     if (!(p->out = out->data)) e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d image", vb->width, vb->height);
   } else if (!e) {
-    p->rgb = sample_alloc(nsamp * 3 * sizeof(float));
-    p->weight = f->aa == RR_AA_CSAA ? sample_alloc(nsamp * sizeof(float)) : NULL;
-    p->alpha = opt->alpha ? sample_alloc(nsamp * sizeof(float)) : NULL;
+    p->rgb = rr_alloc_large(nsamp * 3 * sizeof(float));
+    p->weight = f->aa == RR_AA_CSAA ? rr_alloc_large(nsamp * sizeof(float)) : NULL;
+    p->alpha = opt->alpha ? rr_alloc_large(nsamp * sizeof(float)) : NULL;
     if (!p->rgb || (f->aa == RR_AA_CSAA && !p->weight) || (opt->alpha && !p->alpha))
       e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %dx%d pixels of %d samples", vb->width, vb->height,
                   p->samples);

@@ -120,10 +120,10 @@ static void visbuf_free(visbuf *vb) {
 static bool visbuf_alloc(visbuf *vb, int w, int h, int samples) {
   size_t n = (size_t)w * h * samples;
   vb->width = w, vb->height = h;
-  vb->id = malloc(n * sizeof *vb->id);
-  vb->t = malloc(n * sizeof *vb->t);
-  vb->l1 = malloc(n * sizeof *vb->l1);
-  vb->l2 = malloc(n * sizeof *vb->l2);
+  vb->id = rr_alloc_large(n * sizeof *vb->id);
+  vb->t = rr_alloc_large(n * sizeof *vb->t);
+  vb->l1 = rr_alloc_large(n * sizeof *vb->l1);
+  vb->l2 = rr_alloc_large(n * sizeof *vb->l2);
   if (!vb->id || !vb->t || !vb->l1 || !vb->l2) {
     visbuf_free(vb);
     return false;
