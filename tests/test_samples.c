@@ -40,14 +40,11 @@ static void check_methods(rr_device *dev, const rr_scene *s, const rr_camera *ca
     CHECK(d == 0, "%s: %s differs from rc-bvh in %d of %d samples", what, rr_method_name(ms[i]), d, 4 * w * h);
     rr_frame_release(f);
   }
-  size_t npix = (size_t)w * h;
   for (int k = 0; k < 4; k++) {
     rr_render_options one = pattern_options(RR_METHOD_3DR_BIN, w, h, 1, &rgss[k]);
     rr_frame *f = test_render_opt(dev, s, cam, &one);
     if (!f) continue;
-    bool same = memcmp(f->vb.id, ref->vb.id + k * npix, npix * 4) == 0 &&
-                memcmp(f->vb.t, ref->vb.t + k * npix, npix * 4) == 0 &&
-                memcmp(f->vb.l1, ref->vb.l1 + k * npix, npix * 4) == 0;
+    bool same = test_frame_is_layer(f, ref, k);
     CHECK(same, "%s: layer %d is not the frame of one sample at (%g, %g)", what, k, rgss[k][0], rgss[k][1]);
     rr_frame_release(f);
   }
@@ -98,7 +95,6 @@ static void check_2d_pattern(rr_device *dev, const rr_scene *s, const rr_camera 
                              const float (*pos)[2]) {
   rr_render_options o = pattern_options(RR_METHOD_3DR_BB, w, h, n, pos);
   rr_frame *a = test_render_opt(dev, s, cam, &o);
-  size_t npix = (size_t)w * h;
   for (int m = 0; m < 2; m++) {
     o.method = m ? RR_METHOD_2DR_BIN : RR_METHOD_2DR_BB;
     rr_frame *b = test_render_opt(dev, s, cam, &o);
@@ -112,10 +108,7 @@ static void check_2d_pattern(rr_device *dev, const rr_scene *s, const rr_camera 
       rr_render_options one = pattern_options(o.method, w, h, 1, &pos[k]);
       rr_frame *f = test_render_opt(dev, s, cam, &one);
       if (!f) continue;
-      bool same = memcmp(f->vb.id, b->vb.id + k * npix, npix * 4) == 0 &&
-                  memcmp(f->vb.t, b->vb.t + k * npix, npix * 4) == 0 &&
-                  memcmp(f->vb.l1, b->vb.l1 + k * npix, npix * 4) == 0 &&
-                  memcmp(f->vb.l2, b->vb.l2 + k * npix, npix * 4) == 0;
+      bool same = test_frame_is_layer(f, b, k);
       CHECK(same, "%s: layer %d of %d is not the frame of one sample at (%g, %g)", rr_method_name(o.method), k, n,
             pos[k][0], pos[k][1]);
       rr_frame_release(f);

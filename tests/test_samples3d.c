@@ -56,15 +56,11 @@ static void check_view(rr_device *dev, const rr_scene *s, const rr_camera *cam, 
     if (methods3d[i] == RR_METHOD_3DR_FULL) full = f;
     else rr_frame_release(f);
   }
-  size_t npix = (size_t)w * h;
   for (int k = 0; layers && full && k < 16; k++) {
     rr_render_options one = pattern(RR_METHOD_3DR_BB, w, h, threads, 1, (const float (*)[2]) & rg16[k]);
     rr_frame *f = test_render_opt(dev, s, cam, &one);
     if (!f) continue;
-    bool same = memcmp(f->vb.id, full->vb.id + k * npix, npix * 4) == 0 &&
-                memcmp(f->vb.t, full->vb.t + k * npix, npix * 4) == 0 &&
-                memcmp(f->vb.l1, full->vb.l1 + k * npix, npix * 4) == 0 &&
-                memcmp(f->vb.l2, full->vb.l2 + k * npix, npix * 4) == 0;
+    bool same = test_frame_is_layer(f, full, k);
     CHECK(same, "%s: layer %d is not the one-sample frame at (%g, %g)", what, k, rg16[k][0], rg16[k][1]);
     rr_frame_release(f);
   }

@@ -58,6 +58,12 @@ int test_frames_differ(const rr_frame *a, const rr_frame *b) {
   return d;
 }
 
+bool test_frame_is_layer(const rr_frame *one, const rr_frame *multi, int layer) {
+  size_t npix = (size_t)one->vb.width * one->vb.height, off = (size_t)layer * npix;
+  return memcmp(one->vb.id, multi->vb.id + off, npix * 4) == 0 && memcmp(one->vb.t, multi->vb.t + off, npix * 4) == 0 &&
+         memcmp(one->vb.l1, multi->vb.l1 + off, npix * 4) == 0 && memcmp(one->vb.l2, multi->vb.l2 + off, npix * 4) == 0;
+}
+
 int test_frame_hits(const rr_frame *f) {
   size_t n = (size_t)f->vb.width * f->vb.height * f->samples;
   int hits = 0;

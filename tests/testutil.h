@@ -36,6 +36,9 @@ bool test_quick(void);
 /* Samples where two visibility buffers differ in any byte of id, t, λ1 or λ2 (every
  * sample layer; frames of different sample counts differ everywhere). */
 int test_frames_differ(const rr_frame *a, const rr_frame *b);
+/* Whether a one-sample frame is, byte for byte (id, t, λ1, λ2), layer `layer` of a
+ * frame of several samples. */
+bool test_frame_is_layer(const rr_frame *one, const rr_frame *multi, int layer);
 /* Samples of a frame that hit a triangle. */
 int test_frame_hits(const rr_frame *f);
 /* Renders w×h with method m on `threads` threads (cull: back faces culled) and
