@@ -583,8 +583,10 @@ RR_API void rr_shade_options_init(rr_shade_options *opt);
 typedef struct rr_shade_stats {
   uint64_t shades;   /* shading invocations: one per shaded point of a primitive (the background
                         behind misses is not counted) */
-  double shade_ms;   /* wall time turning samples into linear colours */
-  double resolve_ms; /* wall time of the resolve: per-sample colours to pixels */
+  double shade_ms;   /* wall time turning samples into linear colours (with the box filter of radius
+                        0.5 each pixel is resolved as its samples are shaded: that time is here) */
+  double resolve_ms; /* wall time of a separate resolve, per-sample colours to pixels (the wide filters;
+                        about 0 for the box) */
 } rr_shade_stats;
 
 /* Shades a frame and resolves its samples to one colour per pixel (opt NULL: the
