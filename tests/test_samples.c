@@ -11,19 +11,11 @@
 /* Rotated-grid positions, none at the centre. */
 static const float rgss[4][2] = {{0.375f, 0.125f}, {0.875f, 0.375f}, {0.125f, 0.625f}, {0.625f, 0.875f}};
 
-static rr_render_options pattern_options(rr_method m, int w, int h, int n, const float (*pos)[2]) {
-  rr_render_options o;
-  rr_render_options_init(&o);
-  o.method = m, o.width = w, o.height = h, o.threads = 2, o.samples = n;
-  memcpy(o.sample_pos, pos, (size_t)n * sizeof o.sample_pos[0]);
-  return o;
-}
-
 /* Every exact method against rc-bvh over all layers, and each layer against a
  * one-sample frame at its position. */
 static void check_methods(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h, const char *what) {
   bool planar = cam->type == RR_CAMERA_PERSPECTIVE || cam->type == RR_CAMERA_ORTHOGRAPHIC;
-  rr_render_options o = pattern_options(RR_METHOD_RC_BVH, w, h, 4, rgss);
+  rr_render_options o = test_pattern(RR_METHOD_RC_BVH, w, h, 2, 4, rgss);
   rr_frame *ref = test_render_opt(dev, s, cam, &o);
   if (!ref) return;
   CHECK(ref->samples == 4, "%s: %d layers", what, ref->samples);
@@ -40,14 +32,7 @@ static void check_methods(rr_device *dev, const rr_scene *s, const rr_camera *ca
     CHECK(d == 0, "%s: %s differs from rc-bvh in %d of %d samples", what, rr_method_name(ms[i]), d, 4 * w * h);
     rr_frame_release(f);
   }
-  for (int k = 0; k < 4; k++) {
-    rr_render_options one = pattern_options(RR_METHOD_3DR_BIN, w, h, 1, &rgss[k]);
-    rr_frame *f = test_render_opt(dev, s, cam, &one);
-    if (!f) continue;
-    bool same = test_frame_is_layer(f, ref, k);
-    CHECK(same, "%s: layer %d is not the frame of one sample at (%g, %g)", what, k, rgss[k][0], rgss[k][1]);
-    rr_frame_release(f);
-  }
+  test_check_layers(dev, s, cam, &o, RR_METHOD_3DR_BIN, ref, what);
   rr_frame_release(ref);
 }
 
@@ -55,12 +40,12 @@ static void check_methods(rr_device *dev, const rr_scene *s, const rr_camera *ca
  * rounding of the directions, so nearly every id agrees. */
 static void check_positions(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h) {
   const float grid[4][2] = {{0.25f, 0.25f}, {0.75f, 0.25f}, {0.25f, 0.75f}, {0.75f, 0.75f}};
-  rr_render_options o = pattern_options(RR_METHOD_3DR_BB, w, h, 4, grid);
+  rr_render_options o = test_pattern(RR_METHOD_3DR_BB, w, h, 2, 4, grid);
   rr_frame *a = test_render_opt(dev, s, cam, &o);
-  rr_render_options big = pattern_options(RR_METHOD_3DR_BB, 2 * w, 2 * h, 1, grid);
+  rr_render_options big = test_pattern(RR_METHOD_3DR_BB, 2 * w, 2 * h, 2, 1, grid);
   big.sample_pos[0][0] = big.sample_pos[0][1] = 0.5f;
   rr_frame *b = test_render_opt(dev, s, cam, &big);
-  rr_render_options mid = pattern_options(RR_METHOD_3DR_BB, w, h, 1, grid);
+  rr_render_options mid = test_pattern(RR_METHOD_3DR_BB, w, h, 2, 1, grid);
   mid.sample_pos[0][0] = mid.sample_pos[0][1] = 0.5f;
   rr_frame *c = test_render_opt(dev, s, cam, &mid);
   if (a && b && c) {
@@ -93,7 +78,7 @@ static void rotated_grid16(float pos[16][2]) {
  * at that position, bit for bit. */
 static void check_2d_pattern(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h, int n,
                              const float (*pos)[2]) {
-  rr_render_options o = pattern_options(RR_METHOD_3DR_BB, w, h, n, pos);
+  rr_render_options o = test_pattern(RR_METHOD_3DR_BB, w, h, 2, n, pos);
   rr_frame *a = test_render_opt(dev, s, cam, &o);
   for (int m = 0; m < 2; m++) {
     o.method = m ? RR_METHOD_2DR_BIN : RR_METHOD_2DR_BB;
@@ -104,15 +89,7 @@ static void check_2d_pattern(rr_device *dev, const rr_scene *s, const rr_camera 
       CHECK(agree >= all * 995 / 1000, "%s agrees with 3dr-bb on %d of %d ids at %d positions", rr_method_name(o.method),
             agree, all, n);
     }
-    for (int k = 0; b && k < n; k++) {
-      rr_render_options one = pattern_options(o.method, w, h, 1, &pos[k]);
-      rr_frame *f = test_render_opt(dev, s, cam, &one);
-      if (!f) continue;
-      bool same = test_frame_is_layer(f, b, k);
-      CHECK(same, "%s: layer %d of %d is not the frame of one sample at (%g, %g)", rr_method_name(o.method), k, n,
-            pos[k][0], pos[k][1]);
-      rr_frame_release(f);
-    }
+    if (b) test_check_layers(dev, s, cam, &o, o.method, b, rr_method_name(o.method));
     rr_frame_release(b);
   }
   rr_frame_release(a);
@@ -126,7 +103,7 @@ static void check_2d(rr_device *dev, const rr_scene *s, const rr_camera *cam, in
 }
 
 static void check_bad(rr_device *dev, const rr_scene *s, const rr_camera *cam) {
-  rr_render_options o = pattern_options(RR_METHOD_3DR_BB, 8, 8, 4, rgss);
+  rr_render_options o = test_pattern(RR_METHOD_3DR_BB, 8, 8, 2, 4, rgss);
   const float bad[][2] = {{1.0f, 0.5f}, {-0.1f, 0.5f}, {0.5f, NAN}, {0.5f, INFINITY}};
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
     rr_render_options b = o;

@@ -23,14 +23,6 @@ static void make_rg16(void) {
   }
 }
 
-static rr_render_options pattern(rr_method m, int w, int h, int threads, int n, const float (*pos)[2]) {
-  rr_render_options o;
-  rr_render_options_init(&o);
-  o.method = m, o.width = w, o.height = h, o.threads = threads, o.samples = n;
-  memcpy(o.sample_pos, pos, (size_t)n * sizeof o.sample_pos[0]);
-  return o;
-}
-
 static const rr_method methods3d[] = {RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FS,
                                       RR_METHOD_3DR_FULL};
 enum { NMETHODS3D = sizeof methods3d / sizeof methods3d[0] };
@@ -39,7 +31,7 @@ enum { NMETHODS3D = sizeof methods3d / sizeof methods3d[0] };
  * 3dr-full against a one-sample 3dr-bb frame at its position too. */
 static void check_view(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h, int threads,
                        bool layers, const char *what) {
-  rr_render_options o = pattern(RR_METHOD_RC_BVH, w, h, threads, 16, (const float (*)[2])rg16);
+  rr_render_options o = test_pattern(RR_METHOD_RC_BVH, w, h, threads, 16, (const float (*)[2])rg16);
   rr_frame *ref = test_render_opt(dev, s, cam, &o);
   if (!ref) return;
   rr_frame *full = NULL;
@@ -56,14 +48,7 @@ static void check_view(rr_device *dev, const rr_scene *s, const rr_camera *cam, 
     if (methods3d[i] == RR_METHOD_3DR_FULL) full = f;
     else rr_frame_release(f);
   }
-  for (int k = 0; layers && full && k < 16; k++) {
-    rr_render_options one = pattern(RR_METHOD_3DR_BB, w, h, threads, 1, (const float (*)[2]) & rg16[k]);
-    rr_frame *f = test_render_opt(dev, s, cam, &one);
-    if (!f) continue;
-    bool same = test_frame_is_layer(f, full, k);
-    CHECK(same, "%s: layer %d is not the one-sample frame at (%g, %g)", what, k, rg16[k][0], rg16[k][1]);
-    rr_frame_release(f);
-  }
+  if (layers && full) test_check_layers(dev, s, cam, &o, RR_METHOD_3DR_BB, full, what);
   rr_frame_release(full);
   rr_frame_release(ref);
 }
@@ -72,12 +57,12 @@ static void check_view(rr_device *dev, const rr_scene *s, const rr_camera *cam, 
  * the 16 one-position frames together; E counts every sample evaluation. */
 static void check_stats(rr_device *dev, const rr_scene *s, const rr_camera *cam) {
   for (int i = 0; i < NMETHODS3D; i++) {
-    rr_render_options o16 = pattern(methods3d[i], 128, 96, 1, 16, (const float (*)[2])rg16);
+    rr_render_options o16 = test_pattern(methods3d[i], 128, 96, 1, 16, (const float (*)[2])rg16);
     rr_frame *b = test_render_opt(dev, s, cam, &o16);
     if (!b) continue;
     uint64_t setups = 0, evals = 0;
     for (int k = 0; k < 16; k++) {
-      rr_render_options o1 = pattern(methods3d[i], 128, 96, 1, 1, (const float (*)[2]) & rg16[k]);
+      rr_render_options o1 = test_pattern(methods3d[i], 128, 96, 1, 1, (const float (*)[2]) & rg16[k]);
       rr_frame *a = test_render_opt(dev, s, cam, &o1);
       if (!a) continue;
       rr_stats sa;
@@ -187,7 +172,7 @@ static void check_watertight(rr_device *dev) {
   printf("plane: %d of %d samples decided on an edge or vertex\n", on_edge, 4 * N * N);
   for (int k = 0; k < 4; k++) rr_cam_release(&cams[k]);
   /* the methods: no sample misses the plane, and all agree */
-  rr_render_options o = pattern(RR_METHOD_RC_BVH, N, N, 2, 4, on);
+  rr_render_options o = test_pattern(RR_METHOD_RC_BVH, N, N, 2, 4, on);
   rr_frame *ref = test_render_opt(dev, plane, &rc, &o);
   if (ref) {
     CHECK(test_frame_hits(ref) == 4 * N * N, "rc-bvh: %d of %d samples hit the plane", test_frame_hits(ref), 4 * N * N);

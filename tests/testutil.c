@@ -58,10 +58,29 @@ int test_frames_differ(const rr_frame *a, const rr_frame *b) {
   return d;
 }
 
-bool test_frame_is_layer(const rr_frame *one, const rr_frame *multi, int layer) {
-  size_t npix = (size_t)one->vb.width * one->vb.height, off = (size_t)layer * npix;
-  return memcmp(one->vb.id, multi->vb.id + off, npix * 4) == 0 && memcmp(one->vb.t, multi->vb.t + off, npix * 4) == 0 &&
-         memcmp(one->vb.l1, multi->vb.l1 + off, npix * 4) == 0 && memcmp(one->vb.l2, multi->vb.l2 + off, npix * 4) == 0;
+rr_render_options test_pattern(rr_method m, int w, int h, int threads, int n, const float (*pos)[2]) {
+  rr_render_options o;
+  rr_render_options_init(&o);
+  o.method = m, o.width = w, o.height = h, o.threads = threads, o.samples = n;
+  memcpy(o.sample_pos, pos, (size_t)n * sizeof o.sample_pos[0]);
+  return o;
+}
+
+void test_check_layers(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_render_options *o,
+                       rr_method one, const rr_frame *multi, const char *what) {
+  size_t npix = (size_t)o->width * o->height;
+  for (int k = 0; k < o->samples; k++) {
+    rr_render_options o1 = test_pattern(one, o->width, o->height, o->threads, 1, &o->sample_pos[k]);
+    rr_frame *f = test_render_opt(dev, s, cam, &o1);
+    if (!f) continue;
+    size_t off = (size_t)k * npix;
+    bool same = memcmp(f->vb.id, multi->vb.id + off, npix * 4) == 0 &&
+                memcmp(f->vb.t, multi->vb.t + off, npix * 4) == 0 &&
+                memcmp(f->vb.l1, multi->vb.l1 + off, npix * 4) == 0 && memcmp(f->vb.l2, multi->vb.l2 + off, npix * 4) == 0;
+    CHECK(same, "%s: layer %d of %d is not %s's frame of one sample at (%g, %g)", what, k, o->samples,
+          rr_method_name(one), o->sample_pos[k][0], o->sample_pos[k][1]);
+    rr_frame_release(f);
+  }
 }
 
 int test_frame_hits(const rr_frame *f) {

@@ -36,9 +36,12 @@ bool test_quick(void);
 /* Samples where two visibility buffers differ in any byte of id, t, λ1 or λ2 (every
  * sample layer; frames of different sample counts differ everywhere). */
 int test_frames_differ(const rr_frame *a, const rr_frame *b);
-/* Whether a one-sample frame is, byte for byte (id, t, λ1, λ2), layer `layer` of a
- * frame of several samples. */
-bool test_frame_is_layer(const rr_frame *one, const rr_frame *multi, int layer);
+/* Options for method m at w×h on `threads` threads with the n sample positions pos. */
+rr_render_options test_pattern(rr_method m, int w, int h, int threads, int n, const float (*pos)[2]);
+/* Checks that every layer k of `multi` (rendered with options o) is, byte for byte
+ * (id, t, λ1, λ2), the frame of one sample at o's position k drawn by method one. */
+void test_check_layers(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_render_options *o,
+                       rr_method one, const rr_frame *multi, const char *what);
 /* Samples of a frame that hit a triangle. */
 int test_frame_hits(const rr_frame *f);
 /* Renders w×h with method m on `threads` threads (cull: back faces culled) and
