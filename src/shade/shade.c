@@ -428,13 +428,6 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
   return e ? e : rr_ok(dev);
 }
 
-/* The value of an integer AOV (id, mesh, material) at a sample that saw primitive id. */
-/* Layer s of a frame's visibility buffer: sample s of every pixel. */
-static visbuf frame_layer(const rr_frame *f, int s) {
-  size_t off = (size_t)s * f->vb.width * f->vb.height;
-  return (visbuf){f->vb.width, f->vb.height, f->vb.id + off, f->vb.t + off, f->vb.l1 + off, f->vb.l2 + off};
-}
-
 /* Resolves the frame's cameras, one per sample position; on failure none is left. */
 static rr_error frame_cameras(rr_device *dev, const rr_camera *cam, const rr_frame *f, camera *cams) {
   for (int s = 0; s < f->samples; s++) {
@@ -503,7 +496,7 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
     for (size_t k = 0; k < npix * ch; k++) o[k] = INFINITY;
   for (int smp = 0; smp < f->samples; smp++) {
     if (!per_sample && base != RR_AOV_DEPTH && aov != RR_AOV_COVERAGE && smp != centre) continue;
-    visbuf layer = frame_layer(f, smp);
+    visbuf layer = visbuf_layer(&f->vb, smp);
     int c0 = per_sample ? smp : 0; /* this layer's channel */
     for (int y = 0; y < vb->height; y++)
       for (int x = 0; x < vb->width; x++) {

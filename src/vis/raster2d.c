@@ -776,8 +776,7 @@ static rr_error run2d(rr_device *dev, const progress_span *progress, const rr_sc
     const visbuf *vb = tg.vb;
     for (int k = 0; k < samples; k++) { /* layer k of each buffer the target has */
       size_t o = (size_t)k * npix;
-      p->layer[k] = (visbuf){vb->width, vb->height, vb->id ? vb->id + o : NULL, vb->t ? vb->t + o : NULL,
-                             vb->l1 ? vb->l1 + o : NULL, vb->l2 ? vb->l2 + o : NULL};
+      p->layer[k] = visbuf_layer(vb, k);
       p->tg[k] = (target){&p->layer[k], tg.front ? tg.front + o : NULL, tg.back ? tg.back + o : NULL, tg.heat};
       if (need_hiz) ok &= rr_hiz_init(&hz[k], &p->layer[k], block_shift(0), LEVELS);
     }

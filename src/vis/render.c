@@ -304,8 +304,7 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   } else /* one pass per position, each writing its own layer (S grows with N) */
     for (int s = 0; s < opt->samples && !e; s++) {
       ctx.progress = rr_progress_part(&whole, (double)s / opt->samples, (double)(s + 1) / opt->samples);
-      visbuf layer = {opt->width, opt->height, f->vb.id + s * npix, f->vb.t + s * npix, f->vb.l1 + s * npix,
-                      f->vb.l2 + s * npix};
+      visbuf layer = visbuf_layer(&f->vb, s);
       ctx.cam = ctx.cams = &cams[s];
       ctx.samples = 1;
       ctx.vb = &layer;

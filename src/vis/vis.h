@@ -14,6 +14,14 @@ typedef struct visbuf {
   float *t, *l1, *l2;
 } visbuf;
 
+/* Layer s of a buffer of several samples: sample s of every pixel (arrays the
+ * buffer lacks stay NULL). */
+static inline visbuf visbuf_layer(const visbuf *vb, int s) {
+  size_t o = (size_t)s * vb->width * vb->height;
+  return (visbuf){vb->width, vb->height, vb->id ? vb->id + o : NULL, vb->t ? vb->t + o : NULL,
+                  vb->l1 ? vb->l1 + o : NULL, vb->l2 ? vb->l2 + o : NULL};
+}
+
 /* The depth test shared by every method: nearer wins; on equal t the lower id wins,
  * so the result does not depend on the order in which triangles are visited. */
 static inline bool depth_wins(float t, uint32_t id, float best_t, uint32_t best_id) {
