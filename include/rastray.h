@@ -564,6 +564,25 @@ RR_API const char *rr_filter_name(int filter);
 
 #define RR_FILTER_MAX_RADIUS 4.0f /* widest filter radius, in pixels */
 
+/* How a texture is read over a sample's footprint (its pixel's extent in texture
+ * space, from exact derivatives of the texture coordinates). */
+typedef enum rr_texture_filter {
+  RR_TEXTURE_NEAREST = 0, /* the texel under the sample, level 0 (aliases) */
+  RR_TEXTURE_BILINEAR,    /* 2×2 texels, level 0 (aliases when minified) */
+  RR_TEXTURE_TRILINEAR,   /* bilinear in the two MIP levels around the footprint's size */
+  RR_TEXTURE_ANISO,       /* up to `aniso` trilinear probes along the footprint's major axis */
+  RR_TEXTURE_EWA,         /* an elliptical Gaussian over the footprint */
+  RR_TEXTURE_FILTER_COUNT
+} rr_texture_filter;
+
+/* How a texture repeats outside [0, 1] (from the material). */
+typedef enum rr_texture_wrap {
+  RR_WRAP_REPEAT = 0,
+  RR_WRAP_CLAMP,  /* clamp to edge */
+  RR_WRAP_MIRROR, /* mirrored repeat */
+  RR_WRAP_COUNT
+} rr_texture_wrap;
+
 /* How rr_shade_frame shades and resolves a frame. The AA mode (which samples are
  * shaded) is the frame's own, from rr_render_options; these say what is drawn and
  * how the samples' colours become pixels. */
@@ -574,9 +593,12 @@ typedef struct rr_shade_options {
   int alpha;          /* nonzero: a 4th channel, alpha = the filtered coverage of the pixel's samples;
                          the colour is then straight (not premultiplied): the filtered mean of the
                          samples that hit, weighted by their coverage (0 where nothing hit) */
+  rr_texture_filter texture_filter; /* default RR_TEXTURE_ANISO */
+  int aniso;                        /* most probes of RR_TEXTURE_ANISO, 1 .. 16 (default 16) */
+  float lod_bias;                   /* added to the MIP level, in levels (default 0) */
 } rr_shade_options;
 
-/* Fills options with defaults: Lambert, box filter, no alpha. */
+/* Fills options with defaults: Lambert, box filter, no alpha, aniso:16 textures. */
 RR_API void rr_shade_options_init(rr_shade_options *opt);
 
 /* The statistics of a shading pass. */

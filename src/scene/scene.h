@@ -13,6 +13,7 @@ struct rr_bvh;
 typedef struct rr_texture {
   int width, height; /* 0 when the file could not be read */
   uint8_t *rgb;      /* 3 bytes per texel, row 0 at the top */
+  rr_texture_wrap wrap[2]; /* in u, in v */
 } rr_texture;
 
 typedef struct rr_material {

@@ -3,6 +3,7 @@
 #include "vis/vis.h"
 #include "core/color.h"
 #include "shade/resolve.h"
+#include "shade/texture.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -66,25 +67,7 @@ static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, i
   return sample_hit(s, c, vb, (size_t)y * vb->width + x, x, y);
 }
 
-static void texel(const rr_texture *t, float u, float v, float rgb[3]) {
-  /* Wrap, bilinear; v points up in the file's convention, rows run down. */
-  u -= floorf(u), v -= floorf(v);
-  float fx = u * t->width - 0.5f, fy = (1.0f - v) * t->height - 0.5f;
-  int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
-  float ax = fx - x0, ay = fy - y0;
-  for (int c = 0; c < 3; c++) rgb[c] = 0;
-  for (int j = 0; j < 2; j++)
-    for (int i = 0; i < 2; i++) {
-      int xx = ((x0 + i) % t->width + t->width) % t->width, yy = ((y0 + j) % t->height + t->height) % t->height;
-      float w = (i ? ax : 1 - ax) * (j ? ay : 1 - ay);
-      const uint8_t *p = t->rgb + 3 * ((size_t)yy * t->width + xx);
-      for (int c = 0; c < 3; c++) rgb[c] += w * p[c] / 255.0f;
-    }
-  /* textures are sRGB-encoded; shading works in linear light */
-  for (int c = 0; c < 3; c++) rgb[c] = srgb_decode(rgb[c]);
-}
-
-static void base_color(const rr_scene *s, const hit *h, float rgb[3]) {
+static void base_color(const rr_scene *s, const hit *h, const tex_filter *tf, float rgb[3]) {
   const rr_material *m = s->nmaterials ? &s->materials[s->material[h->id] % s->nmaterials] : NULL;
   rgb[0] = rgb[1] = rgb[2] = SCENE_GREY;
   if (!m) return;
@@ -93,8 +76,10 @@ static void base_color(const rr_scene *s, const hit *h, float rgb[3]) {
     uint32_t i = h->id;
     float u = h->l0 * s->uv[0][0][i] + h->l1 * s->uv[1][0][i] + h->l2 * s->uv[2][0][i];
     float v = h->l0 * s->uv[0][1][i] + h->l1 * s->uv[1][1][i] + h->l2 * s->uv[2][1][i];
-    float t[3];
-    texel(&m->texture, u, v, t);
+    /* TODO(issue 15): the footprint from exact derivatives */
+    tex_coord tc = {u, v, 0, 0, 0, 0};
+    float t[4];
+    rr_texture_sample(&m->texture, &tc, tf, t);
     for (int c = 0; c < 3; c++) rgb[c] *= t[c];
   }
   if (s->col[0][0]) /* vertex colours (linear) multiply in, like glTF's COLOR_0 */
@@ -180,10 +165,11 @@ static rr_error shade_heat(rr_device *dev, const float *heat, rr_image *img, con
 
 /* The linear colour of a valid hit under a shade mode other than the heat maps;
  * [dmin, dmax]: the frame's range of distances (depth). */
-static void shade_hit(const rr_scene *s, const hit *h, rr_shade_mode mode, float dmin, float dmax, float o[3]) {
+static void shade_hit(const rr_scene *s, const hit *h, rr_shade_mode mode, const tex_filter *tf, float dmin,
+                      float dmax, float o[3]) {
   if (mode == RR_SHADE_LAMBERT) {
     float rgb[3];
-    base_color(s, h, rgb);
+    base_color(s, h, tf, rgb);
     float lit = 0.12f + 0.88f * fmaxf(0.0f, -v3_dot(h->normal, h->dir));
     for (int ch = 0; ch < 3; ch++) o[ch] = rgb[ch] * lit;
     return;
@@ -213,6 +199,7 @@ typedef struct shade_pass {
   const camera *cams; /* cams[s] resolved at sample s's position */
   const visbuf *vb;
   rr_shade_mode mode;
+  tex_filter tex;
   rr_aa_mode aa;
   int samples, stored; /* samples shaded and those carrying colour (csaa: K; else all) */
   float dmin, dmax;
@@ -267,7 +254,7 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, in
       if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
         float inv = 1.0f / (float)members;
         hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, d);
-        shade_hit(s, &h, p->mode, p->dmin, p->dmax, col);
+        shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
         shades++;
       }
     } else if (p->cams[i].planar || rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
@@ -377,7 +364,8 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
   size_t npix = (size_t)vb->width * vb->height;
   shade_pass *p = calloc(1, sizeof *p);
   if (!p) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading");
-  *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = opt->mode, .aa = f->aa, .samples = f->samples};
+  *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = opt->mode, .aa = f->aa, .samples = f->samples,
+                      .tex = {opt->texture_filter, opt->aniso, opt->lod_bias}};
   p->stored = f->aa == RR_AA_CSAA ? f->aa_stored : p->samples;
   const float(*pos)[2] = (const float(*)[2])f->sample_pos;
   /* coverage samples' stored samples by distance (ties: the lower index) */
@@ -521,7 +509,8 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
 
 /* The public entry points resolve the frame's cameras, one per sample position, around the work. */
 void rr_shade_options_init(rr_shade_options *opt) {
-  *opt = (rr_shade_options){.mode = RR_SHADE_LAMBERT, .filter = RR_FILTER_BOX, .radius = 0, .alpha = 0};
+  *opt = (rr_shade_options){.mode = RR_SHADE_LAMBERT, .filter = RR_FILTER_BOX, .radius = 0, .alpha = 0,
+                              .texture_filter = RR_TEXTURE_ANISO, .aniso = 16, .lod_bias = 0};
 }
 
 rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
