@@ -51,28 +51,50 @@ rr_error rr_camera_check(rr_device *dev, const rr_camera *c) {
   return rr_ok(dev);
 }
 
-/* The direction of pixel (x, y) of a curved camera; zero where it has no ray. */
-static vec3 curved_dir(const camera *c, const rr_camera *in, int x, int y) {
+/* The direction of pixel (x, y) of a curved camera; zero where it has no ray.
+ * With dd, also its derivatives with respect to the sample position, per pixel
+ * step in x (dd[0]) and y (dd[1]): each mapping differentiated in closed form. */
+static vec3 curved_dir(const camera *c, int x, int y, vec3 *dd) {
   double W = c->width, H = c->height, sx = x + (double)c->sx0, sy = y + (double)c->sy0;
-  double u = 2 * sx / W - 1, v = 1 - 2 * sy / H;
+  double u = 2 * sx / W - 1, v = 1 - 2 * sy / H, du = 2 / W, dv = -2 / H; /* du/dsx, dv/dsy */
   vec3 r = c->right, up = c->up, f = c->fwd;
   switch (c->type) {
   case RR_CAMERA_PARABOLIC: {
     double rr = u * u + v * v;
     if (rr > 1) return v3(0, 0, 0);
+    if (dd) { /* ∂d/∂u = right − u·fwd, ∂d/∂v = up − v·fwd */
+      dd[0] = v3_scale(v3_sub(r, v3_scale(f, (float)u)), (float)du);
+      dd[1] = v3_scale(v3_sub(up, v3_scale(f, (float)v)), (float)dv);
+    }
     return v3_add(v3_add(v3_scale(r, (float)u), v3_scale(up, (float)v)), v3_scale(f, (float)(0.5 - 0.5 * rr)));
   }
   case RR_CAMERA_LATLONG: {
     double phi = 2 * RR_PI * sx / W - RR_PI, theta = RR_PI * sy / H;
-    return v3_add(v3_scale(v3_add(v3_scale(r, (float)sin(phi)), v3_scale(f, (float)cos(phi))), (float)sin(theta)),
-                  v3_scale(up, (float)cos(theta)));
+    vec3 horiz = v3_add(v3_scale(r, (float)sin(phi)), v3_scale(f, (float)cos(phi)));
+    if (dd) { /* ∂d/∂φ = sin θ (cos φ right − sin φ fwd), ∂d/∂θ = cos θ horiz − sin θ up */
+      vec3 dphi = v3_sub(v3_scale(r, (float)cos(phi)), v3_scale(f, (float)sin(phi)));
+      dd[0] = v3_scale(dphi, (float)(sin(theta) * 2 * RR_PI / W));
+      dd[1] = v3_scale(v3_sub(v3_scale(horiz, (float)cos(theta)), v3_scale(up, (float)sin(theta))),
+                       (float)(RR_PI / H));
+    }
+    return v3_add(v3_scale(horiz, (float)sin(theta)), v3_scale(up, (float)cos(theta)));
   }
   case RR_CAMERA_FISHEYE: {
     double rad = sqrt(u * u + v * v);
     if (rad > 1) return v3(0, 0, 0);
-    double a = rad * in->fov_deg * RR_PI / 360, psi = atan2(v, u);
-    return v3_add(v3_scale(v3_add(v3_scale(r, (float)cos(psi)), v3_scale(up, (float)sin(psi))), (float)sin(a)),
-                  v3_scale(f, (float)cos(a)));
+    double k = c->fov_deg * RR_PI / 360, a = rad * c->fov_deg * RR_PI / 360, psi = atan2(v, u); /* a = k·rad */
+    vec3 radial = v3_add(v3_scale(r, (float)cos(psi)), v3_scale(up, (float)sin(psi)));
+    if (dd) {
+      /* In polar form: ∂d/∂rad = k (cos a radial − sin a fwd), ∂d/∂ψ = sin a tangential,
+       * with ∂rad/∂(u, v) = (cos ψ, sin ψ) and ∂ψ/∂(u, v) = (−sin ψ, cos ψ)/rad;
+       * sin a / rad tends to k at the centre, where ψ is 0. */
+      vec3 tang = v3_sub(v3_scale(up, (float)cos(psi)), v3_scale(r, (float)sin(psi)));
+      vec3 drad = v3_scale(v3_sub(v3_scale(radial, (float)cos(a)), v3_scale(f, (float)sin(a))), (float)k);
+      double s = rad > 0 ? sin(a) / rad : k;
+      dd[0] = v3_scale(v3_sub(v3_scale(drad, (float)cos(psi)), v3_scale(tang, (float)(s * sin(psi)))), (float)du);
+      dd[1] = v3_scale(v3_add(v3_scale(drad, (float)sin(psi)), v3_scale(tang, (float)(s * cos(psi)))), (float)dv);
+    }
+    return v3_add(v3_scale(radial, (float)sin(a)), v3_scale(f, (float)cos(a)));
   }
   case RR_CAMERA_CUBE: {
     /* horizontal cross: row 0 top face, row 1 left/front/right/back, row 2 bottom */
@@ -85,6 +107,7 @@ static vec3 curved_dir(const camera *c, const rr_camera *in, int x, int y) {
     else if (col == 0) ff = v3_neg(r), fr = f;
     else if (col == 2) ff = r, fr = v3_neg(f);
     else if (col == 3) ff = v3_neg(f), fr = v3_neg(r);
+    if (dd) dd[0] = v3_scale(fr, 2.0f / (float)F), dd[1] = v3_scale(fu, -2.0f / (float)F); /* within the face */
     return v3_add(ff, v3_add(v3_scale(fr, a), v3_scale(fu, b)));
   }
   default:
@@ -115,6 +138,7 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
   c->width = width;
   c->height = height;
   c->eye = v3_load(in->eye);
+  c->fov_deg = in->fov_deg;
   c->fwd = v3_norm(v3_sub(v3_load(in->target), c->eye));
   c->right = v3_norm(v3_cross(c->fwd, v3_load(in->up)));
   c->up = v3_cross(c->right, c->fwd);
@@ -151,7 +175,7 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
   if (!c->dirs) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
   c->face = height / 3;
   for (int y = 0; y < height; y++)
-    for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, in, x, y);
+    for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);
   switch (in->type) {
   case RR_CAMERA_PARABOLIC: /* conformal, angle = 2 atan(r): at most 2 radians per unit of u */
     c->lipschitz = 2.0f * 2.0f / (float)(width < height ? width : height);
@@ -210,6 +234,19 @@ bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
     *dir = c->dirs[(size_t)y * c->width + x];
     return dir->x != 0 || dir->y != 0 || dir->z != 0;
   }
+}
+
+bool rr_cam_ray_diff(const camera *c, int x, int y, vec3 *origin, vec3 *dir, vec3 do_dxy[2], vec3 dd_dxy[2]) {
+  bool has = rr_cam_ray(c, x, y, origin, dir);
+  do_dxy[0] = do_dxy[1] = dd_dxy[0] = dd_dxy[1] = v3(0, 0, 0);
+  switch (c->type) {
+  case RR_CAMERA_PERSPECTIVE: dd_dxy[0] = c->dx, dd_dxy[1] = c->dy; break;
+  case RR_CAMERA_ORTHOGRAPHIC: do_dxy[0] = c->ox, do_dxy[1] = c->oy; break;
+  default:
+    if (has) curved_dir(c, x, y, dd_dxy);
+    break;
+  }
+  return has;
 }
 
 bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy) {

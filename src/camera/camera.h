@@ -26,6 +26,7 @@ typedef struct camera {
                                       /* row y likewise, facing increasing x (y) */
   vec3 o0, ox, oy;
   float tan_half_h, tan_half_w;
+  float fov_deg; /* as given: the fisheye's angle */
   vec3 *dirs;
   float lipschitz;
   float dir_len_max; /* longest |d| of the camera's rays */
@@ -53,6 +54,11 @@ static inline vec3 camera_dir(const camera *c, float sx, float sy) {
 /* The ray of pixel (x, y) for any camera: origin and (unnormalised) direction;
  * false when the pixel has no ray (outside a hemisphere's disk, a cube's cross). */
 bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir);
+/* rr_cam_ray with the ray's differentials: the derivatives of its origin and of
+ * its (unnormalised) direction with respect to the sample position, per pixel step
+ * in x ([0]) and in y ([1]), exact for every camera (constant for the planar ones;
+ * a cube's within the pixel's face). Zero where the pixel has no ray (false). */
+bool rr_cam_ray_diff(const camera *c, int x, int y, vec3 *origin, vec3 *dir, vec3 do_dxy[2], vec3 dd_dxy[2]);
 /* What a triangle's edge functions are evaluated against at pixel (x, y):
  * (1, sx, sy) for planar cameras, the ray direction for curved ones. */
 static inline vec3 camera_w(const camera *c, int x, int y) {
