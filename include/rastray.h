@@ -503,16 +503,20 @@ typedef enum rr_aov {
   RR_AOV_SAMPLE_ID,    /* N uint32 (N = samples): the id of each sample, channel s = sample s */
   RR_AOV_SAMPLE_DEPTH, /* N floats: the depth of each sample (+inf on a miss) */
   RR_AOV_SAMPLE_MESH,  /* N uint32: the geometry id of each sample */
+  RR_AOV_UV,           /* 2 floats: texture coordinates u, v; 0 on a miss or without texture coordinates */
+  RR_AOV_UV_DERIV,     /* 4 floats: their derivatives per pixel step du/dx, dv/dx, du/dy, dv/dy (exact,
+                          from the camera's ray differentials); 0 where uv is */
   RR_AOV_COUNT
 } rr_aov;
 /* With several samples per pixel the per-pixel AOVs follow one rule each: id, mesh,
- * material, normal and bary are those of the sample nearest the pixel's centre (the
+ * material, normal, bary, uv and uv-deriv are those of the sample nearest the pixel's centre (the
  * lowest such s on a tie; the same s in every pixel), so they belong to one
  * surface; depth is the nearest depth among all the pixel's samples; evals and
  * nodes sum over the samples. The sample-* AOVs give every sample. */
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
- * "material", "coverage", "sample-id", "sample-depth", "sample-mesh"); -1 when unknown. */
+ * "material", "coverage", "sample-id", "sample-depth", "sample-mesh", "uv",
+ * "uv-deriv"); -1 when unknown. */
 RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
@@ -527,7 +531,7 @@ typedef enum rr_image_kind {
   RR_IMAGE_AOV         /* RR_IMAGE_AOV + a: AOV a of rr_frame_aov, values as they are, EXR channels
                           depth Z, normal N.X N.Y N.Z, bary bary.u bary.v (λ1, λ2), id, mesh and
                           material (32-bit UINT), evals, nodes, coverage; per sample s (2 digits):
-                          id.sNN, Z.sNN, mesh.sNN */
+                          id.sNN, Z.sNN, mesh.sNN; uv uv.u uv.v, uv-deriv uvdx.u uvdx.v uvdy.u uvdy.v */
 } rr_image_kind;
 
 /* An image owned by the caller or by rastray (rr_image_free). */
@@ -574,6 +578,11 @@ typedef enum rr_texture_filter {
   RR_TEXTURE_EWA,         /* an elliptical Gaussian over the footprint */
   RR_TEXTURE_FILTER_COUNT
 } rr_texture_filter;
+
+/* The texture filter named `name` ("nearest", "bilinear", "trilinear", "aniso", "ewa"); -1 when unknown. */
+RR_API int rr_texture_filter_from_name(const char *name);
+/* The name of a texture filter, NULL when out of range. */
+RR_API const char *rr_texture_filter_name(int filter);
 
 /* How a texture repeats outside [0, 1] (from the material). */
 typedef enum rr_texture_wrap {

@@ -70,7 +70,7 @@ enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
   OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA, OPT_AA_PATTERN, OPT_AA_FILTER,
-  OPT_ALPHA,
+  OPT_ALPHA, OPT_TEXTURE_FILTER, OPT_LOD_BIAS,
 };
 
 typedef struct cli_option {
@@ -142,6 +142,11 @@ static const cli_option render_options[] = {
     {"alpha", OPT_ALPHA, NULL,
      "give the colour image an alpha channel: the coverage of the pixel's samples\n"
      "(filtered), colour straight (PNG RGBA, EXR R G B A)"},
+    {"texture-filter", OPT_TEXTURE_FILTER, "NAME",
+     "how textures are read over a pixel's footprint (exact derivatives for every\n"
+     "camera): nearest, bilinear (level 0; they alias), trilinear, aniso[:N] (up\n"
+     "to N trilinear probes along the footprint, N 1..16; default aniso:16), ewa"},
+    {"lod-bias", OPT_LOD_BIAS, "F", "added to the texture's MIP level (default 0; > 0 blurs, < 0 sharpens)"},
     {"output", 'o', "PATH",
      "colour image: .png (sRGB), .exr or .pfm (linear light); default rastray.png\n"
      "unless --aov is given. PATH may be - (stdout, PNG), FMT:PATH (png:-, exr:-),\n"
@@ -152,9 +157,11 @@ static const cli_option render_options[] = {
      "(the shaded image), depth (EXR Z), normal (N.X N.Y N.Z), bary (bary.u bary.v),\n"
      "id (triangle), mesh (geometry id), material (index) (ids: EXR UINT), evals,\n"
      "nodes, coverage (fraction of samples hit), sample-id, sample-depth,\n"
-     "sample-mesh (H×W×N, one per sample: EXR id.s00.., Z.s00.., mesh.s00..); all:\n"
-     "color to nodes (evals, nodes with heat). With several samples id, mesh,\n"
-     "material, normal, bary are the sample nearest the centre's, depth the nearest.\n"
+     "sample-mesh (H×W×N, one per sample: EXR id.s00.., Z.s00.., mesh.s00..), uv\n"
+     "(texture coordinates: uv.u uv.v), uv-deriv (their derivatives per pixel:\n"
+     "uvdx.u uvdx.v uvdy.u uvdy.v); all: color to nodes (evals, nodes with heat).\n"
+     "With several samples id, mesh, material, normal, bary, uv, uv-deriv are the\n"
+     "sample nearest the centre's, depth the nearest.\n"
      "Outputs are all or nothing"},
     {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default 0: all cores)"},
     {"repeat", OPT_REPEAT, "N", "run the visibility pass N times, report the median time"},
@@ -386,7 +393,7 @@ static aov_out parse_aov(const char *arg) {
     else
       die(EXIT_USAGE,
           "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes, coverage, "
-          "sample-id, sample-depth, sample-mesh or all)",
+          "sample-id, sample-depth, sample-mesh, uv, uv-deriv or all)",
           name);
   }
   if (!a.images && !a.all) die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
@@ -410,6 +417,26 @@ static void parse_filter(const char *arg, rr_shade_options *ro) {
   if (!(ro->radius >= 0.5f && ro->radius <= RR_FILTER_MAX_RADIUS))
     die(EXIT_USAGE, "bad radius '%s' for --aa-filter (expected 0.5..%g pixels)", colon + 1,
         (double)RR_FILTER_MAX_RADIUS);
+}
+
+/* Parses --texture-filter NAME[:N] (N: aniso's probes). */
+static void parse_texture_filter(const char *arg, rr_shade_options *ro) {
+  char name[32];
+  const char *colon = strchr(arg, ':');
+  size_t len = colon ? (size_t)(colon - arg) : strlen(arg);
+  int f = -1;
+  if (len < sizeof name) {
+    memcpy(name, arg, len), name[len] = 0;
+    f = rr_texture_filter_from_name(name);
+  }
+  if (f < 0)
+    die(EXIT_USAGE,
+        "unknown texture filter '%s' for --texture-filter (expected nearest, bilinear, trilinear, aniso[:N] or ewa)",
+        arg);
+  ro->texture_filter = (rr_texture_filter)f;
+  if (!colon) return;
+  if (f != RR_TEXTURE_ANISO) die(EXIT_USAGE, "bad --texture-filter '%s' (only aniso takes :N)", arg);
+  ro->aniso = (int)parse_int("--texture-filter aniso:N", colon + 1, 1, 16);
 }
 
 static int cmp_double(const void *a, const void *b) {
@@ -713,6 +740,11 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_AA_PATTERN: pattern = parse_aa_pattern(optarg, &seed), pattern_given = true; break;
     case OPT_AA_FILTER: parse_filter(optarg, &shading); break;
     case OPT_ALPHA: shading.alpha = 1; break;
+    case OPT_TEXTURE_FILTER: parse_texture_filter(optarg, &shading); break;
+    case OPT_LOD_BIAS:
+      shading.lod_bias = parse_float(option_name, optarg);
+      if (fabsf(shading.lod_bias) > 64) die(EXIT_USAGE, "bad value '%s' for --lod-bias (expected -64..64 levels)", optarg);
+      break;
     case OPT_CAMERA_FILE: camera_file = optarg; break;
     case OPT_SAVE_CAMERA: save_camera = optarg; break;
     }
@@ -732,7 +764,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   const unsigned heat_aovs = 1u << RR_AOV_EVALS | 1u << RR_AOV_NODES;
   for (int k = 0; k < naov; k++) opt.heat |= (aovs[k].images & heat_aovs) != 0;
   const unsigned by_name = 1u << RR_AOV_COVERAGE | 1u << RR_AOV_SAMPLE_ID | 1u << RR_AOV_SAMPLE_DEPTH |
-                           1u << RR_AOV_SAMPLE_MESH; /* the AA outputs: asked for by name */
+                           1u << RR_AOV_SAMPLE_MESH | 1u << RR_AOV_UV |
+                           1u << RR_AOV_UV_DERIV; /* the AA and texture outputs: asked for by name */
   for (int k = 0; k < naov; k++) /* all: every per-pixel AOV of the visibility the frame has */
     if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~by_name & ~(opt.heat ? 0 : heat_aovs);
   if (camera_file) { /* the file's values, where no flag gave one */

@@ -284,6 +284,9 @@ static const struct {
     [RR_AOV_SAMPLE_ID] = PER_SAMPLE("id.s"),
     [RR_AOV_SAMPLE_DEPTH] = PER_SAMPLE("Z.s"),
     [RR_AOV_SAMPLE_MESH] = PER_SAMPLE("mesh.s"),
+    [RR_AOV_UV] = {2, {"uv.u", "uv.v"}},
+    /* two layers, the derivatives along x and along y: sorted as du/dx, dv/dx, du/dy, dv/dy */
+    [RR_AOV_UV_DERIV] = {4, {"uvdx.u", "uvdx.v", "uvdy.u", "uvdy.v"}},
 };
 _Static_assert(RR_MAX_SAMPLES == 16, "PER_SAMPLE names 16 samples");
 

@@ -3,7 +3,7 @@
 #include "vis/vis.h"
 #include "core/color.h"
 #include "shade/resolve.h"
-#include "shade/texture.h"
+#include "shade/texcoord.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -21,6 +21,10 @@ typedef struct hit {
   float dist;  /* eye-to-hit distance */
   vec3 normal; /* unit shading normal facing the eye */
   float l0, l1, l2;
+  float t;           /* along the unnormalised ray of camera cam's pixel (x, y): */
+  const camera *cam; /* what texture coordinates and their derivatives are made from */
+  int x, y;
+  float footprint; /* the pixel steps the sample's texture footprint spans (ssaa: 1/√N) */
 } hit;
 
 static vec3 geometric_normal(const rr_scene *s, uint32_t i) {
@@ -30,9 +34,11 @@ static vec3 geometric_normal(const rr_scene *s, uint32_t i) {
 }
 
 /* The shading inputs of triangle `id` at barycentrics (l1, l2), seen along the
- * (unnormalised) ray direction d at parameter t; not valid on a miss. */
-static hit hit_make(const rr_scene *s, uint32_t id, float l1, float l2, float t, vec3 d) {
-  hit h = {.has_ray = true, .id = id};
+ * (unnormalised) ray direction d of camera c's pixel (x, y) at parameter t; not
+ * valid on a miss. */
+static hit hit_make(const rr_scene *s, const camera *c, int x, int y, uint32_t id, float l1, float l2, float t,
+                    vec3 d) {
+  hit h = {.has_ray = true, .id = id, .t = t, .cam = c, .x = x, .y = y, .footprint = 1.0f};
   if (id == RR_MISS || id >= s->ntris) return h;
   h.valid = true;
   float len = v3_len(d);
@@ -59,7 +65,7 @@ static hit hit_make(const rr_scene *s, uint32_t id, float l1, float l2, float t,
 static hit sample_hit(const rr_scene *s, const camera *c, const visbuf *vb, size_t i, int x, int y) {
   vec3 o, d;
   if (!rr_cam_ray(c, x, y, &o, &d)) return (hit){.id = vb->id[i]};
-  return hit_make(s, vb->id[i], vb->l1[i], vb->l2[i], vb->t[i], d);
+  return hit_make(s, c, x, y, vb->id[i], vb->l1[i], vb->l2[i], vb->t[i], d);
 }
 
 /* Sample 0 of pixel (x, y). */
@@ -67,17 +73,27 @@ static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, i
   return sample_hit(s, c, vb, (size_t)y * vb->width + x, x, y);
 }
 
+/* The texture coordinates of a valid hit on a triangle with UVs; with derivs, their
+ * derivatives over the sample's footprint too (else 0). */
+static tex_coord hit_texcoord(const rr_scene *s, const hit *h, bool derivs) {
+  vec3 o, d, do_dxy[2], dd_dxy[2];
+  if (!derivs) {
+    rr_cam_ray(h->cam, h->x, h->y, &o, &d);
+    return rr_texcoord(s, h->id, h->l1, h->l2, h->t, o, d, NULL, NULL);
+  }
+  rr_cam_ray_diff(h->cam, h->x, h->y, &o, &d, do_dxy, dd_dxy);
+  tex_coord tc = rr_texcoord(s, h->id, h->l1, h->l2, h->t, o, d, do_dxy, dd_dxy);
+  tc.dudx *= h->footprint, tc.dvdx *= h->footprint, tc.dudy *= h->footprint, tc.dvdy *= h->footprint;
+  return tc;
+}
+
 static void base_color(const rr_scene *s, const hit *h, const tex_filter *tf, float rgb[3]) {
   const rr_material *m = s->nmaterials ? &s->materials[s->material[h->id] % s->nmaterials] : NULL;
   rgb[0] = rgb[1] = rgb[2] = SCENE_GREY;
   if (!m) return;
   memcpy(rgb, m->color, sizeof m->color);
-  if (m->texture.width > 0 && s->uv[0][0]) {
-    uint32_t i = h->id;
-    float u = h->l0 * s->uv[0][0][i] + h->l1 * s->uv[1][0][i] + h->l2 * s->uv[2][0][i];
-    float v = h->l0 * s->uv[0][1][i] + h->l1 * s->uv[1][1][i] + h->l2 * s->uv[2][1][i];
-    /* TODO(issue 15): the footprint from exact derivatives */
-    tex_coord tc = {u, v, 0, 0, 0, 0};
+  if (m->texture.width > 0 && s->uv[0][0]) { /* only textured materials pay for derivatives */
+    tex_coord tc = hit_texcoord(s, h, true);
     float t[4];
     rr_texture_sample(&m->texture, &tc, tf, t);
     for (int c = 0; c < 3; c++) rgb[c] *= t[c];
@@ -200,6 +216,7 @@ typedef struct shade_pass {
   const visbuf *vb;
   rr_shade_mode mode;
   tex_filter tex;
+  float footprint; /* hit.footprint */
   rr_aa_mode aa;
   int samples, stored; /* samples shaded and those carrying colour (csaa: K; else all) */
   float dmin, dmax;
@@ -253,7 +270,8 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, in
         if (r->id[m][j] == id) l1 += r->l1[m][j], l2 += r->l2[m][j], t += r->t[m][j], members++;
       if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
         float inv = 1.0f / (float)members;
-        hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, d);
+        hit h = hit_make(s, &p->cams[i], x, y, id, l1 * inv, l2 * inv, t * inv, d);
+        h.footprint = p->footprint;
         shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
         shades++;
       }
@@ -367,6 +385,10 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
   *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = opt->mode, .aa = f->aa, .samples = f->samples,
                       .tex = {opt->texture_filter, opt->aniso, opt->lod_bias}};
   p->stored = f->aa == RR_AA_CSAA ? f->aa_stored : p->samples;
+  /* Derivatives are per pixel step. A sample shaded for the whole pixel (one per
+   * pixel, msaa, csaa) filters over all of it; ssaa's N samples each over their
+   * share, a pixel step of 1/√N, so that their mean is not filtered twice. */
+  p->footprint = f->aa == RR_AA_SSAA ? 1.0f / sqrtf((float)p->samples) : 1.0f;
   const float(*pos)[2] = (const float(*)[2])f->sample_pos;
   /* coverage samples' stored samples by distance (ties: the lower index) */
   for (int c = p->stored; c < p->samples; c++) {
@@ -464,7 +486,10 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
                           rr_image *out) {
   const visbuf *vb = &f->vb;
   rr_error e;
-  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1, 1, 1, 1};
+  static const int channels[RR_AOV_COUNT] = {[RR_AOV_DEPTH] = 1, [RR_AOV_ID] = 1,       [RR_AOV_NORMAL] = 3,
+                                             [RR_AOV_BARY] = 2,  [RR_AOV_EVALS] = 1,    [RR_AOV_NODES] = 1,
+                                             [RR_AOV_MESH] = 1,  [RR_AOV_MATERIAL] = 1, [RR_AOV_COVERAGE] = 1,
+                                             [RR_AOV_UV] = 2,    [RR_AOV_UV_DERIV] = 4};
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
     if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
@@ -502,9 +527,27 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
         if (base == RR_AOV_DEPTH) *p = fminf(*p, h.valid ? h.dist : INFINITY);
         else if (base == RR_AOV_NORMAL && h.valid) p[0] = h.normal.x, p[1] = h.normal.y, p[2] = h.normal.z;
         else if (base == RR_AOV_BARY && h.valid) p[0] = h.l1, p[1] = h.l2;
+        else if ((base == RR_AOV_UV || base == RR_AOV_UV_DERIV) && h.valid && s->uv[0][0]) {
+          tex_coord tc = hit_texcoord(s, &h, base == RR_AOV_UV_DERIV);
+          if (base == RR_AOV_UV) p[0] = tc.u, p[1] = tc.v;
+          else p[0] = tc.dudx, p[1] = tc.dvdx, p[2] = tc.dudy, p[3] = tc.dvdy;
+        }
       }
   }
   return rr_ok(dev);
+}
+
+static const char *const texture_filter_names[RR_TEXTURE_FILTER_COUNT] = {"nearest", "bilinear", "trilinear",
+                                                                          "aniso", "ewa"};
+
+int rr_texture_filter_from_name(const char *name) {
+  for (int i = 0; name && i < RR_TEXTURE_FILTER_COUNT; i++)
+    if (!strcmp(name, texture_filter_names[i])) return i;
+  return -1;
+}
+
+const char *rr_texture_filter_name(int filter) {
+  return filter >= 0 && filter < RR_TEXTURE_FILTER_COUNT ? texture_filter_names[filter] : NULL;
 }
 
 /* The public entry points resolve the frame's cameras, one per sample position, around the work. */
@@ -520,6 +563,11 @@ rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
   if ((int)opt->mode < 0 || opt->mode >= RR_SHADE_COUNT)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shade mode %d", (int)opt->mode);
+  if ((int)opt->texture_filter < 0 || opt->texture_filter >= RR_TEXTURE_FILTER_COUNT)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown texture filter %d", (int)opt->texture_filter);
+  if (opt->aniso < 1 || opt->aniso > 16)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad anisotropy %d (expected 1..16 probes)", opt->aniso);
+  if (!isfinite(opt->lod_bias)) return rr_fail(dev, RR_ERROR_ARGUMENT, "the texture LOD bias must be finite");
   if (stats) *stats = (rr_shade_stats){0};
   if (opt->mode == RR_SHADE_HEAT_EVALS || opt->mode == RR_SHADE_HEAT_NODES) {
     double t0 = rr_now_ms();

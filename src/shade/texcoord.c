@@ -1,0 +1,59 @@
+/* Texture coordinates and their derivatives: (u, v) is an affine function on the
+ * triangle's plane, so its derivative along the image is its gradient in the plane
+ * times the hit point's derivative, which the ray differentials give. */
+#include "shade/texcoord.h"
+
+/* Corner k's UVs. */
+static void corner_uv(const rr_scene *s, int k, uint32_t i, float uv[2]) {
+  uv[0] = s->uv[k][0][i], uv[1] = s->uv[k][1][i];
+}
+
+tex_coord rr_texcoord(const rr_scene *s, uint32_t i, float l1, float l2, float t, vec3 o, vec3 d,
+                      const vec3 do_dxy[2], const vec3 dd_dxy[2]) {
+  tex_coord tc = {0};
+  /* Two edges from a finite base corner f: to a finite corner, the differences of
+   * positions and of UVs; to a corner at infinity, its direction and its UV rate.
+   * Their dual basis in the plane (g_a·e_a = 1, g_a·e_b = 0 and so on) gives the
+   * gradients of u and v: G = Δuv_a g_a + Δuv_b g_b. */
+  unsigned inf = scene_inf(s, i);
+  int f = !(inf & 1u) ? 0 : !(inf & 2u) ? 1 : 2, a = (f + 1) % 3, b = (f + 2) % 3;
+  vec3 pf = scene_vertex(s, f, i), ea = scene_vertex(s, a, i), eb = scene_vertex(s, b, i);
+  float uvf[2], dua[2], dub[2];
+  corner_uv(s, f, i, uvf), corner_uv(s, a, i, dua), corner_uv(s, b, i, dub);
+  if (!(inf >> a & 1u)) ea = v3_sub(ea, pf), dua[0] -= uvf[0], dua[1] -= uvf[1];
+  if (!(inf >> b & 1u)) eb = v3_sub(eb, pf), dub[0] -= uvf[0], dub[1] -= uvf[1];
+  vec3 n = v3_cross(ea, eb);
+  float nn = v3_dot(n, n);
+  if (!(nn > 0)) return tc; /* kept triangles are not degenerate; a guard all the same */
+  vec3 ga = v3_scale(v3_cross(eb, n), 1.0f / nn), gb = v3_scale(v3_cross(n, ea), 1.0f / nn);
+  vec3 gu = v3_add(v3_scale(ga, dua[0]), v3_scale(gb, dub[0]));
+  vec3 gv = v3_add(v3_scale(ga, dua[1]), v3_scale(gb, dub[1]));
+  if (!inf) { /* the perspective-correct barycentrics of the visibility buffer */
+    float l0 = 1.0f - l1 - l2;
+    tc.u = l0 * s->uv[0][0][i] + l1 * s->uv[1][0][i] + l2 * s->uv[2][0][i];
+    tc.v = l0 * s->uv[0][1][i] + l1 * s->uv[1][1][i] + l2 * s->uv[2][1][i];
+  } else { /* from the hit point: no corner to weigh by 1 - l1 - l2 */
+    vec3 q = v3_sub(v3_add(o, v3_scale(d, t)), pf);
+    tc.u = uvf[0] + v3_dot(gu, q), tc.v = uvf[1] + v3_dot(gv, q);
+  }
+  if (!do_dxy) return tc;
+  /* The hit p = o + t d stays on the plane n·p = const as the sample moves:
+   * ∂p = w − d (n·w)/(n·d) with w = ∂o + t ∂d (Igehy's ray differentials). For a
+   * perspective view this is the derivative of λ_i = V_i / ΣV (paper Sect. 3) along
+   * dx, dy, written with the plane so that every camera (the orthographic's moving
+   * origin too) shares it; its one subtraction takes the part along the ray away
+   * from w instead of cancelling products of large edge values, V_i,x ΣV − V_i ΣV_x. */
+  float nd = v3_dot(n, d);
+  if (!(nd != 0)) return tc; /* a ray in the plane sees no hit */
+  float dudv[2][2]; /* [x or y][u or v] */
+  for (int k = 0; k < 2; k++) {
+    vec3 w = v3_add(do_dxy[k], v3_scale(dd_dxy[k], t));
+    vec3 dp = v3_sub(w, v3_scale(d, v3_dot(n, w) / nd));
+    dudv[k][0] = v3_dot(gu, dp), dudv[k][1] = v3_dot(gv, dp);
+    /* at a grazing angle the footprint may overflow: a million texture spans per
+     * pixel cover any texture, and keep the filter's squares finite */
+    for (int c = 0; c < 2; c++) dudv[k][c] = fminf(fmaxf(dudv[k][c], -1e6f), 1e6f);
+  }
+  tc.dudx = dudv[0][0], tc.dvdx = dudv[0][1], tc.dudy = dudv[1][0], tc.dvdy = dudv[1][1];
+  return tc;
+}
