@@ -65,7 +65,7 @@ int main(void) {
 
   /* A good render with every output kind. */
   int rc = run("render tri.obj --size 32x24 --method rc -o c.png --aov depth=d.pfm --aov id=i.npy --aov normal=n.exr "
-               "--aov bary=b.npy --stats --stats-json s.json");
+               "--aov bary=b.npy --aov uv,uv-deriv=u.exr --texture-filter aniso:4 --lod-bias -0.5 --stats --stats-json s.json");
   CHECK(rc == 0, "render exit %d: %s", rc, err);
   CHECK(strstr(err, "method=rc") && strstr(err, "setups=1 ") && strstr(err, "edge_evals=768"),
         "--stats line: %s", err);
@@ -85,7 +85,7 @@ int main(void) {
     CHECK(isinf(d[0]) && d[12 * 32 + 16] > 0 && isfinite(d[12 * 32 + 16]), "depth AOV: +inf at a miss, finite at a hit");
     rr_image_free(&img);
   } else CHECK(0, "depth pfm unreadable: %s", rr_device_message(dev));
-  CHECK(exists("n.exr") && exists("b.npy"), "normal and bary AOVs written");
+  CHECK(exists("n.exr") && exists("b.npy") && exists("u.exr"), "normal, bary and uv AOVs written");
   snprintf(path, sizeof path, "%s/s.json", dir);
   f = fopen(path, "r");
   char json[2048] = {0};
@@ -96,7 +96,7 @@ int main(void) {
 
   /* Bad input: message, exit code, and nothing written. */
   char cmd[700];
-  snprintf(cmd, sizeof cmd, "cd %s && rm -f c.png d.pfm i.npy n.exr b.npy s.json", dir);
+  snprintf(cmd, sizeof cmd, "cd %s && rm -f c.png d.pfm i.npy n.exr b.npy u.exr s.json", dir);
   CHECK(system(cmd) == 0, "clean");
   struct {
     const char *args;
@@ -126,6 +126,17 @@ int main(void) {
       {"render tri.obj --frobnicate -o o.png", 2, "--frobnicate"},
       {"render tri.obj --method", 2, "--method"},
       {"render tri.obj other.obj -o o.png", 2, "other.obj"},
+      {"render tri.obj --texture-filter cubic -o o.png", 2, "cubic"},
+      {"render tri.obj --texture-filter '' -o o.png", 2, "--texture-filter"},
+      {"render tri.obj --texture-filter aniso:0 -o o.png", 2, "'0'"},
+      {"render tri.obj --texture-filter aniso:17 -o o.png", 2, "'17'"},
+      {"render tri.obj --texture-filter aniso:2.5 -o o.png", 2, "'2.5'"},
+      {"render tri.obj --texture-filter aniso: -o o.png", 2, "aniso:N"},
+      {"render tri.obj --texture-filter trilinear:4 -o o.png", 2, "trilinear:4"},
+      {"render tri.obj --texture-filter anisotropic -o o.png", 2, "anisotropic"},
+      {"render tri.obj --lod-bias nan -o o.png", 2, "--lod-bias"},
+      {"render tri.obj --lod-bias 100 -o o.png", 2, "'100'"},
+      {"render tri.obj --aov uvw=x.npy", 2, "uvw"},
       {"paint tri.obj", 2, "paint"},
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {

@@ -572,13 +572,14 @@ static bool frame_images(const rr_scene *s, rr_image images[1 + RR_AOV_COUNT]) {
  * as the layers of one file with the same names, types and bits. */
 static void test_exr_layers(void) {
   static const float rgb[3] = {0.5f, 0.2f, 0.8f};
-  static const char *const names[1 + RR_AOV_COUNT][3] = {
+  static const char *const names[1 + RR_AOV_COUNT][4] = {
       {"B", "G", "R"}, [1 + RR_AOV_DEPTH] = {"Z"}, [1 + RR_AOV_ID] = {"id"},
       [1 + RR_AOV_NORMAL] = {"N.X", "N.Y", "N.Z"}, [1 + RR_AOV_BARY] = {"bary.u", "bary.v"},
       [1 + RR_AOV_EVALS] = {"evals"}, [1 + RR_AOV_NODES] = {"nodes"}, [1 + RR_AOV_MESH] = {"mesh"},
       [1 + RR_AOV_MATERIAL] = {"material"}, [1 + RR_AOV_COVERAGE] = {"coverage"},
       [1 + RR_AOV_SAMPLE_ID] = {"id.s00"}, [1 + RR_AOV_SAMPLE_DEPTH] = {"Z.s00"},
-      [1 + RR_AOV_SAMPLE_MESH] = {"mesh.s00"}};
+      [1 + RR_AOV_SAMPLE_MESH] = {"mesh.s00"}, [1 + RR_AOV_UV] = {"uv.u", "uv.v"},
+      [1 + RR_AOV_UV_DERIV] = {"uvdx.u", "uvdx.v", "uvdy.u", "uvdy.v"}};
   rr_scene *s = colour_scene(rgb);
   rr_image images[1 + RR_AOV_COUNT];
   memset(images, 0, sizeof images);
