@@ -92,8 +92,10 @@ static void base_color(const rr_scene *s, const hit *h, const tex_filter *tf, fl
   rgb[0] = rgb[1] = rgb[2] = SCENE_GREY;
   if (!m) return;
   memcpy(rgb, m->color, sizeof m->color);
-  if (m->texture.width > 0 && s->uv[0][0]) { /* only textured materials pay for derivatives */
-    tex_coord tc = hit_texcoord(s, h, true);
+  if (m->texture.width > 0 && s->uv[0][0]) {
+    /* only textured materials pay for derivatives, and only filters with a footprint */
+    bool footprint = tf->filter != RR_TEXTURE_NEAREST && tf->filter != RR_TEXTURE_BILINEAR;
+    tex_coord tc = hit_texcoord(s, h, footprint);
     float t[4];
     rr_texture_sample(&m->texture, &tc, tf, t);
     for (int c = 0; c < 3; c++) rgb[c] *= t[c];

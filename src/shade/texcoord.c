@@ -52,7 +52,10 @@ tex_coord rr_texcoord(const rr_scene *s, uint32_t i, float l1, float l2, float t
     dudv[k][0] = v3_dot(gu, dp), dudv[k][1] = v3_dot(gv, dp);
     /* at a grazing angle the footprint may overflow: a million texture spans per
      * pixel cover any texture, and keep the filter's squares finite */
-    for (int c = 0; c < 2; c++) dudv[k][c] = fminf(fmaxf(dudv[k][c], -1e6f), 1e6f);
+    for (int c = 0; c < 2; c++) {
+      float g = dudv[k][c];
+      dudv[k][c] = g > 1e6f ? 1e6f : g < -1e6f ? -1e6f : g == g ? g : 0.0f;
+    }
   }
   tc.dudx = dudv[0][0], tc.dvdx = dudv[0][1], tc.dudy = dudv[1][0], tc.dvdy = dudv[1][1];
   return tc;
