@@ -7,7 +7,8 @@
  * - the uv-deriv AOV against central differences of the uv AOV over frames rendered
  *   at sample positions ±h around a base position away from the pixel's centre, on
  *   random views with every camera: perspective, orthographic, parabolic, lat-long,
- *   fisheye and cube. */
+ *   fisheye and cube;
+ * - the texture filters' names and rr_shade_frame's refusal of bad texture options. */
 #include "vis/vis.h"
 #include "io/io.h"
 #include "testutil.h"
@@ -201,7 +202,7 @@ static void free_view(view_frames *v) {
 }
 
 /* One view of a plane scene: uv against the map at the hit, uv-deriv against
- * central differences; returns the pixels whose derivatives were compared. */
+ * central differences; returns the pixel directions whose derivatives were compared. */
 static int check_view(rr_device *dev, const rr_scene *s, const uv_map *m, float L, const rr_camera *cam, int W,
                       int Hh, const float pos[2], const char *what) {
   view_frames v;
@@ -304,8 +305,41 @@ static void test_plane_views(rr_device *dev, bool infinite) {
   }
 }
 
+static void test_options(rr_device *dev) {
+  for (int f = 0; f < RR_TEXTURE_FILTER_COUNT; f++)
+    CHECK(rr_texture_filter_from_name(rr_texture_filter_name(f)) == f, "filter %d's name", f);
+  CHECK(rr_texture_filter_from_name("aniso:4") < 0 && rr_texture_filter_from_name(NULL) < 0 &&
+            rr_texture_filter_name(RR_TEXTURE_FILTER_COUNT) == NULL && !strcmp(rr_texture_filter_name(RR_TEXTURE_EWA), "ewa"),
+        "texture filter names");
+  uv_map m = {1, 0, 0, 0, 1, 0};
+  rr_scene *s = plane_scene(dev, &m, false, 4);
+  if (!s) return;
+  rr_camera cam = make_camera(RR_CAMERA_PERSPECTIVE, v3(0, 2, 2), v3(0, 0, 0), 45);
+  rr_frame *f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 1, 16, 12, 0);
+  rr_shade_options o;
+  rr_shade_options_init(&o);
+  CHECK(o.texture_filter == RR_TEXTURE_ANISO && o.aniso == 16 && o.lod_bias == 0, "defaults: aniso:16, no bias");
+  const struct {
+    int filter, aniso;
+    float bias;
+    const char *needle;
+  } bad[] = {{-1, 16, 0, "texture filter"}, {RR_TEXTURE_FILTER_COUNT, 16, 0, "texture filter"},
+             {RR_TEXTURE_ANISO, 0, 0, "anisotropy"},  {RR_TEXTURE_ANISO, 17, 0, "anisotropy"},
+             {RR_TEXTURE_TRILINEAR, 16, NAN, "bias"}, {RR_TEXTURE_TRILINEAR, 16, INFINITY, "bias"}};
+  for (size_t k = 0; f && k < sizeof bad / sizeof bad[0]; k++) {
+    o.texture_filter = (rr_texture_filter)bad[k].filter, o.aniso = bad[k].aniso, o.lod_bias = bad[k].bias;
+    rr_image img = {0};
+    CHECK(rr_shade_frame(dev, s, &cam, f, &o, &img, NULL) == RR_ERROR_ARGUMENT && !img.data &&
+              strstr(rr_device_message(dev), bad[k].needle),
+          "bad texture options %zu refused: %s", k, rr_device_message(dev));
+  }
+  rr_frame_release(f);
+  rr_scene_release(s);
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
+  test_options(dev);
   test_ray_differentials(dev);
   test_plane_views(dev, false);
   test_plane_views(dev, true);
