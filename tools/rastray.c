@@ -142,7 +142,7 @@ static const cli_option render_options[] = {
     {"alpha", OPT_ALPHA, NULL,
      "give the colour image an alpha channel: the coverage of the pixel's samples\n"
      "(filtered), colour straight (PNG RGBA, EXR R G B A)"},
-    {"texture-filter", OPT_TEXTURE_FILTER, "NAME",
+    {"texture-filter", OPT_TEXTURE_FILTER, "NAME[:N]",
      "how textures are read over a pixel's footprint (exact derivatives for every\n"
      "camera): nearest, bilinear (level 0; they alias), trilinear, aniso[:N] (up\n"
      "to N trilinear probes along the footprint, N 1..16; default aniso:16), ewa"},
