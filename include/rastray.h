@@ -251,10 +251,14 @@ typedef enum rr_camera_type {
   RR_CAMERA_COUNT
 } rr_camera_type;
 
+/* The narrowest field of view, in degrees: narrower ones put a framed eye beyond
+ * the range of floats. */
+#define RR_FOV_MIN 1e-3f
+
 typedef struct rr_camera {
   rr_camera_type type;
   float eye[3], target[3], up[3];
-  float fov_deg;      /* vertical field of view (perspective), full angle (fisheye) */
+  float fov_deg;      /* vertical field of view (perspective), full angle (fisheye); at least RR_FOV_MIN */
   float ortho_height; /* orthographic view height; 0: 2·|target - eye|·tan(fov/2) */
 } rr_camera;
 

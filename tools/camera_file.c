@@ -20,6 +20,8 @@
 #include <string.h>
 
 static const char *path_;
+static char *text_; /* the file being read and its parse, freed when it is refused */
+static cJSON *root_;
 
 static void bad(const char *fmt, ...) __attribute__((noreturn, format(printf, 1, 2)));
 static void bad(const char *fmt, ...) {
@@ -28,6 +30,8 @@ static void bad(const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
+  cJSON_Delete(root_), free(text_);
+  root_ = NULL, text_ = NULL;
   die(EXIT_INPUT, "camera file '%s': %s", path_, msg);
 }
 
@@ -59,7 +63,7 @@ unsigned camera_file_read(const char *path, rr_camera *cam) {
   FILE *f = fopen(path, "rb");
   if (!f) die(EXIT_INPUT, "cannot open camera file '%s'", path);
   enum { MAX_BYTES = 1 << 20 }; /* a camera is a few hundred */
-  char *text = malloc(MAX_BYTES + 1);
+  char *text = text_ = malloc(MAX_BYTES + 1);
   size_t n = text ? fread(text, 1, MAX_BYTES + 1, f) : 0;
   bool failed = ferror(f);
   fclose(f);
@@ -67,7 +71,7 @@ unsigned camera_file_read(const char *path, rr_camera *cam) {
   if (n > MAX_BYTES) bad("larger than %d bytes", MAX_BYTES);
   text[n] = 0;
   const char *end = NULL;
-  cJSON *root = cJSON_ParseWithOpts(text, &end, 1);
+  cJSON *root = root_ = cJSON_ParseWithOpts(text, &end, 1);
   if (!root) {
     int line = 1;
     for (const char *p = text; end && p < end; p++) line += *p == '\n';
@@ -114,7 +118,7 @@ unsigned camera_file_read(const char *path, rr_camera *cam) {
   }
   if ((item = cJSON_GetObjectItemCaseSensitive(root, "fov"))) {
     cam->fov_deg = number(item, "fov"), given |= CAM_FOV;
-    if (!(cam->fov_deg > 0 && cam->fov_deg <= 360)) bad("'fov' must be in (0, 360]");
+    if (!(cam->fov_deg >= RR_FOV_MIN && cam->fov_deg <= 360)) bad("'fov' must be in [%g, 360]", (double)RR_FOV_MIN);
   }
   if ((item = cJSON_GetObjectItemCaseSensitive(root, "ortho_height"))) {
     cam->ortho_height = number(item, "ortho_height"), given |= CAM_ORTHO;
@@ -123,8 +127,8 @@ unsigned camera_file_read(const char *path, rr_camera *cam) {
   for (int k = 0; k < 2; k++) /* for reference only, but a wrong type is still a bad file */
     if ((item = cJSON_GetObjectItemCaseSensitive(root, k ? "height" : "width")) && !cJSON_IsNumber(item))
       bad("'%s' must be a number", k ? "height" : "width");
-  cJSON_Delete(root);
-  free(text);
+  cJSON_Delete(root), free(text);
+  root_ = NULL, text_ = NULL;
   return given;
 }
 
@@ -139,5 +143,4 @@ void camera_file_add(rr_device *dev, rr_output *set, const char *path, const rr_
   cJSON_AddNumberToObject(root, "width", width);
   cJSON_AddNumberToObject(root, "height", height);
   json_add(dev, set, root, path);
-  cJSON_Delete(root);
 }

@@ -19,9 +19,9 @@ double now_ms(void);
 
 struct cJSON;
 /* Adds a JSON value as the file `path` to the run's output set, written with the
- * images, all or nothing ("-": stdout; a device such as /dev/null directly); exits
- * when it cannot. */
-void json_add(rr_device *dev, rr_output *set, const struct cJSON *root, const char *path);
+ * images, all or nothing ("-": stdout; a device such as /dev/null directly), and
+ * frees it; exits when it cannot. */
+void json_add(rr_device *dev, rr_output *set, struct cJSON *root, const char *path);
 
 /* The fields of an rr_camera that a flag or a camera file gives. */
 enum { CAM_TYPE = 1, CAM_EYE = 2, CAM_TARGET = 4, CAM_UP = 8, CAM_FOV = 16, CAM_ORTHO = 32 };

@@ -9,6 +9,9 @@
 #include <cjson/cJSON.h>
 #include <getopt.h>
 #include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,6 +22,58 @@
 
 static int verbosity; /* -1: --quiet, 0, 1: --verbose */
 
+/* What a run holds, so that every exit releases it: die() on a refusal, and the
+ * signal watcher on SIGINT, SIGTERM or SIGHUP. The output set's temporaries are
+ * removed on either; `lock` is held while the set changes, so a signal never
+ * meets it half made. */
+static struct {
+  pthread_mutex_t lock;
+  rr_device *dev;
+  rr_scene *scene;
+  rr_frame *frame;
+  rr_output *set;
+  rr_image *images; /* the run's images in the making, nimages of them */
+  int nimages;
+  atomic_bool committing; /* the set's temporaries are renamed (at once) and its streams written */
+} run = {.lock = PTHREAD_MUTEX_INITIALIZER};
+
+static void run_release(void) {
+  pthread_mutex_lock(&run.lock);
+  rr_output_release(run.set); /* removes its temporaries */
+  run.set = NULL;
+  pthread_mutex_unlock(&run.lock);
+  for (int i = 0; i < run.nimages; i++) rr_image_free(&run.images[i]);
+  rr_frame_release(run.frame);
+  rr_scene_release(run.scene);
+  rr_device_release(run.dev);
+  run.frame = NULL, run.scene = NULL, run.dev = NULL;
+}
+
+/* Waits for the signals main() blocked in every thread; on one, removes the
+ * output set's temporaries and exits with 128 + the signal (130 for SIGINT). The
+ * rest of the run is the kernel's to free. */
+static void *watch_signals(void *arg) {
+  int sig;
+  if (sigwait(arg, &sig) != 0) return NULL;
+  /* An add ends in bounded time: wait for it. A commit renames the temporaries at
+   * once, then may block on a pipe that is not read: nothing is left to remove. */
+  for (;;) {
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    ts.tv_nsec += 50000000;
+    if (ts.tv_nsec >= 1000000000) ts.tv_sec++, ts.tv_nsec -= 1000000000;
+    if (pthread_mutex_timedlock(&run.lock, &ts) == 0) {
+      rr_output_release(run.set);
+      break;
+    }
+    if (atomic_load(&run.committing)) break;
+  }
+  static const char msg[] = "\nrastray: interrupted\n";
+  ssize_t ignored = write(STDERR_FILENO, msg, sizeof msg - 1);
+  (void)ignored;
+  _exit(128 + sig);
+}
+
 void die(int code, const char *fmt, ...) {
   progress_stop();
   va_list ap;
@@ -27,6 +82,7 @@ void die(int code, const char *fmt, ...) {
   vfprintf(stderr, fmt, ap);
   fputc('\n', stderr);
   va_end(ap);
+  run_release();
   exit(code);
 }
 
@@ -47,12 +103,15 @@ double now_ms(void) {
 
 static void output_failed(rr_device *dev, rr_output *set);
 
-void json_add(rr_device *dev, rr_output *set, const cJSON *root, const char *path) {
+void json_add(rr_device *dev, rr_output *set, cJSON *root, const char *path) {
   char *text = cJSON_Print(root);
+  cJSON_Delete(root);
   if (!text) die(EXIT_INPUT, "out of memory writing '%s'", path);
   size_t n = strlen(text);
   text[n] = '\n'; /* over the terminating NUL: the bytes are counted */
+  pthread_mutex_lock(&run.lock);
   rr_error e = rr_output_add_bytes(set, text, n + 1, path);
+  pthread_mutex_unlock(&run.lock);
   cJSON_free(text);
   if (e) output_failed(dev, set);
 }
@@ -460,6 +519,7 @@ static rr_scene *load_scene(rr_device *dev, const char *name, int threads, doubl
   double t0 = now_ms();
   rr_scene *scene;
   if (rr_scene_load(dev, name, &scene) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+  run.scene = scene;
   rr_scene_info in;
   rr_scene_get_info(scene, &in);
   *load_ms = now_ms() - t0 - in.bvh_build_ms;
@@ -474,15 +534,21 @@ static rr_scene *load_scene(rr_device *dev, const char *name, int threads, doubl
   return scene;
 }
 
-/* Ends the run on a failed output (the set's device holds why); the set's temporaries go first. */
+/* Ends the run on a failed output (the set's device holds why); die() removes the set's temporaries. */
 static void output_failed(rr_device *dev, rr_output *set) {
-  rr_output_release(set);
+  (void)set;
   die(rr_device_error(dev) == RR_ERROR_ARGUMENT ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
 }
 
-static void add_output(rr_device *dev, rr_output *set, const rr_image *images, int n, const char *path) {
+static rr_error set_add(rr_output *set, const rr_image *images, int n, const char *path) {
+  pthread_mutex_lock(&run.lock);
   rr_error e = rr_output_add(set, images, n, path);
-  if (e) output_failed(dev, set);
+  pthread_mutex_unlock(&run.lock);
+  return e;
+}
+
+static void add_output(rr_device *dev, rr_output *set, const rr_image *images, int n, const char *path) {
+  if (set_add(set, images, n, path)) output_failed(dev, set);
 }
 
 /* Cuts the six faces out of a cube camera's cross and adds DIR/<face>.png to the set. */
@@ -494,17 +560,14 @@ static void add_cube_faces(rr_device *dev, rr_output *set, const rr_image *cross
   int n = cross->height / 3;
   for (int f = 0; f < 6; f++) {
     rr_image img = {n, n, 3, RR_PIXEL_F32, malloc((size_t)n * n * 3 * sizeof(float)), cross->kind};
-    if (!img.data) {
-      rr_output_release(set);
-      die(EXIT_INPUT, "out of memory");
-    }
+    if (!img.data) die(EXIT_INPUT, "out of memory");
     for (int y = 0; y < n; y++)
       memcpy((float *)img.data + (size_t)y * n * 3,
              (const float *)cross->data + ((size_t)(faces[f].row * n + y) * cross->width + faces[f].col * n) * 3,
              (size_t)n * 3 * sizeof(float));
     char path[4096];
     snprintf(path, sizeof path, "%s/%s.png", dir, faces[f].name);
-    rr_error e = rr_output_add(set, &img, 1, path);
+    rr_error e = set_add(set, &img, 1, path);
     free(img.data);
     if (e) output_failed(dev, set);
   }
@@ -525,6 +588,7 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
   for (int k = 0; k < naov; k++) need |= aovs[k].images;
   rr_image images[RR_AOV_COUNT + 1] = {{0}}; /* AOV a at a, the colour last */
   rr_image *colour = &images[RR_AOV_COUNT];
+  run.images = images, run.nimages = RR_AOV_COUNT + 1;
   progress_stage("shading");
   double t = now_ms();
   for (int a = 0; a <= RR_AOV_COUNT; a++) {
@@ -533,10 +597,7 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
     rr_error e = a == RR_AOV_COUNT ? rr_shade_frame(dev, scene, cam, frame, shading, colour, &st)
                                    : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
     ms->resolve += st.resolve_ms, ms->shades += st.shades;
-    if (e) {
-      rr_output_release(set);
-      die(EXIT_INPUT, "%s", rr_device_message(dev));
-    }
+    if (e) die(EXIT_INPUT, "%s", rr_device_message(dev));
   }
   ms->shade = now_ms() - t - ms->resolve; /* shading the samples and the AOVs */
   progress_stage("writing");
@@ -552,6 +613,7 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
   }
   ms->write = now_ms() - t;
   for (int a = 0; a <= RR_AOV_COUNT; a++) rr_image_free(&images[a]);
+  run.images = NULL, run.nimages = 0;
 }
 
 static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
@@ -630,7 +692,6 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
   printf("bvh sah cost %.3f\n", in.bvh_sah_cost);
   printf("bvh build    %.1f ms\n", in.bvh_build_ms);
   printf("bvh memory   %.2f MiB\n", in.bvh_bytes / 1048576.0);
-  rr_scene_release(scene);
   return 0;
 }
 
@@ -666,7 +727,6 @@ static void add_stats_json(rr_device *dev, rr_output *set, const char *path, con
     cJSON_AddNumberToObject(o, numbers[k].key, round(numbers[k].value * 1000) / 1000);
   cJSON_AddStringToObject(o, "auto", st->why);
   json_add(dev, set, o, path);
-  cJSON_Delete(o);
 }
 
 static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
@@ -716,8 +776,9 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_CAMERA_FROM_FILE: file_cam = optarg; break;
     case OPT_FOV:
       cam.fov_deg = parse_float(option_name, optarg), given |= CAM_FOV;
-      if (!(cam.fov_deg > 0 && cam.fov_deg <= 360))
-        die(EXIT_USAGE, "bad value '%s' for --fov (expected 0 < fov < 180, or up to 360 for fisheye)", optarg);
+      if (!(cam.fov_deg >= RR_FOV_MIN && cam.fov_deg <= 360))
+        die(EXIT_USAGE, "bad value '%s' for --fov (expected %g <= fov < 180, or up to 360 for fisheye)", optarg,
+            (double)RR_FOV_MIN);
       break;
     case OPT_SHADE:
       shade = rr_shade_from_name(optarg);
@@ -794,14 +855,16 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   if (cube_dir && cam.type != RR_CAMERA_CUBE) die(EXIT_USAGE, "--cube-faces needs --camera cube");
 
   double *times = malloc(sizeof(double) * repeat), *cpus = malloc(sizeof(double) * repeat);
-  if (!times || !cpus) die(EXIT_INPUT, "out of memory for %d repeats", repeat);
+  if (!times || !cpus) free(times), free(cpus), die(EXIT_INPUT, "out of memory for %d repeats", repeat);
   rr_frame *frame = NULL;
   opt.frames_hint = repeat; /* auto weighs a trial against the frames to come */
   for (int r = 0; r < repeat; r++) {
     rr_frame_release(frame);
+    run.frame = frame = NULL;
     progress_frame(r, repeat);
     rr_error e = rr_render(dev, scene, &cam, &opt, &frame);
-    if (e) die(e == RR_ERROR_ARGUMENT || e == RR_ERROR_UNSUPPORTED ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
+    run.frame = frame;
+    if (e) free(times), free(cpus), die(e == RR_ERROR_ARGUMENT || e == RR_ERROR_UNSUPPORTED ? EXIT_USAGE : EXIT_INPUT, "%s", rr_device_message(dev));
     rr_stats st;
     rr_frame_get_stats(frame, &st);
     times[r] = st.frame_ms, cpus[r] = st.cpu_ms;
@@ -817,6 +880,9 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   /* Every file of the run goes into one output set: all of them appear, or none. */
   rr_output *set;
   if (rr_output_new(dev, &set) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+  pthread_mutex_lock(&run.lock);
+  run.set = set;
+  pthread_mutex_unlock(&run.lock);
   shading.mode = (rr_shade_mode)shade;
   add_images(dev, set, scene, &cam, frame, &shading, out, cube_dir, aovs, naov, &ms);
   if (save_camera) camera_file_add(dev, set, save_camera, &cam, opt.width, opt.height);
@@ -825,8 +891,12 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   ms.build = info.bvh_build_ms;
   ms.total = now_ms() - t_start;
   if (json) add_stats_json(dev, set, json, scene_name, &cam, &opt, repeat, &info, &st, &ms);
-  if (rr_output_commit(set) != RR_OK) output_failed(dev, set);
-  rr_output_release(set);
+  pthread_mutex_lock(&run.lock);
+  atomic_store(&run.committing, true);
+  rr_error committed = rr_output_commit(set);
+  atomic_store(&run.committing, false);
+  pthread_mutex_unlock(&run.lock);
+  if (committed != RR_OK) output_failed(dev, set);
   progress_stop();
   if (stats)
     fprintf(stderr,
@@ -850,8 +920,6 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
        ms.load, ms.build, ms.frame, repeat > 1 ? " (median)" : "", ms.shade, ms.resolve, ms.write, ms.total);
   if (out && !stats && verbosity == 0)
     note(0, "wrote %s (%dx%d, %s, %.1f ms)\n", out, opt.width, opt.height, method, ms.frame);
-  rr_frame_release(frame);
-  rr_scene_release(scene);
   return 0;
 }
 
@@ -879,9 +947,17 @@ int main(int argc, char **argv) {
     return 0;
   }
   const cli_command *cmd = find_command(argv[1]);
-  rr_device *dev = rr_device_new();
-  if (!dev) die(EXIT_INPUT, "out of memory");
-  int rc = cmd->run(dev, cmd, argc - 1, argv + 1); /* the command's name stands as getopt's argv[0] */
-  rr_device_release(dev);
+  /* Blocked before any thread starts, so every thread inherits it and only the watcher takes them. */
+  static sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT), sigaddset(&signals, SIGTERM), sigaddset(&signals, SIGHUP);
+  pthread_t watcher;
+  if (pthread_sigmask(SIG_BLOCK, &signals, NULL) != 0 || pthread_create(&watcher, NULL, watch_signals, &signals) != 0)
+    die(EXIT_INPUT, "cannot start the signal watcher");
+  pthread_detach(watcher);
+  run.dev = rr_device_new();
+  if (!run.dev) die(EXIT_INPUT, "out of memory");
+  int rc = cmd->run(run.dev, cmd, argc - 1, argv + 1); /* the command's name stands as getopt's argv[0] */
+  run_release();
   return rc;
 }

@@ -1,6 +1,8 @@
 /* Cameras: the ray direction of every sample, and bounds for rasterization. */
 #include "camera/camera.h"
 
+#include <float.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -35,17 +37,24 @@ rr_error rr_camera_check(rr_device *dev, const rr_camera *c) {
   float fov_max = c->type == RR_CAMERA_FISHEYE ? 360 : 180;
   bool fov_used = c->type == RR_CAMERA_PERSPECTIVE || c->type == RR_CAMERA_FISHEYE ||
                   (c->type == RR_CAMERA_ORTHOGRAPHIC && c->ortho_height == 0);
-  if (fov_used && !(c->fov_deg > 0 && (c->fov_deg < fov_max || (fov_max == 360 && c->fov_deg == 360))))
-    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad field of view %g (expected 0 < fov < %g degrees)", c->fov_deg,
-                   fov_max);
+  if (fov_used && !(c->fov_deg >= RR_FOV_MIN && (c->fov_deg < fov_max || (fov_max == 360 && c->fov_deg == 360))))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "bad field of view %g (expected %g <= fov < %g degrees)", c->fov_deg,
+                   (double)RR_FOV_MIN, fov_max);
   if (!(c->ortho_height >= 0) || !isfinite(c->ortho_height))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad orthographic height %g (expected > 0)", c->ortho_height);
-  vec3 f = v3_sub(v3_load(c->target), v3_load(c->eye));
-  if (f.x == 0 && f.y == 0 && f.z == 0)
+  /* in double: the lengths of float vectors neither overflow nor underflow there */
+  double f[3], u[3], x[3], lf = 0, lu = 0, lx = 0;
+  for (int i = 0; i < 3; i++) f[i] = (double)c->target[i] - c->eye[i], u[i] = c->up[i];
+  for (int i = 0; i < 3; i++) {
+    x[i] = f[(i + 1) % 3] * u[(i + 2) % 3] - f[(i + 2) % 3] * u[(i + 1) % 3];
+    lf += f[i] * f[i], lu += u[i] * u[i], lx += x[i] * x[i];
+  }
+  if (lf == 0)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "eye equals target (%g,%g,%g)", c->eye[0], c->eye[1], c->eye[2]);
-  vec3 up = v3_load(c->up);
-  float lf = v3_len(f), lu = v3_len(up);
-  if (!(lu > 0) || !(v3_len(v3_cross(f, up)) > 1e-6f * lf * lu))
+  if (!((float)sqrt(lf) < FLT_MAX))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "eye and target too far apart (their distance %g overflows a float)",
+                   sqrt(lf));
+  if (!(lu > 0) || !(sqrt(lx) > 1e-6 * sqrt(lf) * sqrt(lu)))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "up (%g,%g,%g) is parallel to the view direction", c->up[0], c->up[1],
                    c->up[2]);
   return rr_ok(dev);

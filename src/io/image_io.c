@@ -446,6 +446,9 @@ static rr_error check_fits(rr_device *dev, image_format fmt, const rr_image *img
       return rr_fail(dev, RR_ERROR_UNSUPPORTED,
                      "cannot write '%s': PNG holds 1, 3 or 4 channels, not %d (use .npy or .exr)",
                      path, c);
+    if (is_aov_kind(img->kind) && img->type == RR_PIXEL_F32) /* 8 bits would clamp and round them */
+      return rr_fail(dev, RR_ERROR_UNSUPPORTED,
+                     "cannot write '%s': PNG holds 8-bit colour, not an AOV's floats (use .exr, .npy or .pfm)", path);
     return RR_OK;
   case FMT_PFM:
     if (c != 1 && c != 3)

@@ -5,6 +5,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <stddef.h>
 #include <string.h>
 
 /* ---- names ---------------------------------------------------------------- */
@@ -52,24 +53,39 @@ static rr_error parse_oracles(rr_device *dev, const char *spec, oracles *o) {
     *eq = 0;
     char *end;
     double v = strtod(eq + 1, &end);
-    if (*end || !isfinite(v) || v < 0 || v > 65536)
-      return rr_fail(dev, RR_ERROR_ARGUMENT, "bad value '%s' for oracle '%s'", eq + 1, kv);
-    int iv = (int)v;
-    bool flag = v != 0;
-    if (strcmp(kv, "frustum") == 0) o->frustum_size = iv;
-    else if (strcmp(kv, "leaves") == 0) o->leaves = flag;
-    else if (strcmp(kv, "outside") == 0) o->cull_outside = flag;
-    else if (strcmp(kv, "occluded") == 0) o->cull_occluded = flag;
-    else if (strcmp(kv, "split") == 0) o->split_min = iv;
-    else if (strcmp(kv, "split-ratio") == 0) o->split_ratio = (float)v;
-    else if (strcmp(kv, "binning") == 0) o->binning = flag;
-    else if (strcmp(kv, "early-z") == 0) o->early_z = flag;
-    else if (strcmp(kv, "bin") == 0 && iv >= 1) o->bin_size = iv;
-    else if (strcmp(kv, "bin-min") == 0 && iv >= 1) o->bin_min = iv;
-    else
+    if (*end || !isfinite(v)) return rr_fail(dev, RR_ERROR_ARGUMENT, "bad value '%s' for oracle '%s'", eq + 1, kv);
+    /* each key, where it goes and its range: 0|1 flags, whole counts, one ratio */
+    static const struct {
+      const char *key;
+      size_t offset;
+      char kind; /* 'b' bool flag, 'i' int, 'f' float */
+      double lo, hi;
+    } keys[] = {{"frustum", offsetof(oracles, frustum_size), 'i', 0, 65536},
+                {"leaves", offsetof(oracles, leaves), 'b', 0, 1},
+                {"outside", offsetof(oracles, cull_outside), 'b', 0, 1},
+                {"occluded", offsetof(oracles, cull_occluded), 'b', 0, 1},
+                {"split", offsetof(oracles, split_min), 'i', 0, 65536},
+                {"split-ratio", offsetof(oracles, split_ratio), 'f', 0, 65536},
+                {"binning", offsetof(oracles, binning), 'b', 0, 1},
+                {"early-z", offsetof(oracles, early_z), 'b', 0, 1},
+                {"bin", offsetof(oracles, bin_size), 'i', 1, 65536},
+                {"bin-min", offsetof(oracles, bin_min), 'i', 1, 65536}};
+    size_t k = 0;
+    while (k < sizeof keys / sizeof *keys && strcmp(kv, keys[k].key) != 0) k++;
+    if (k == sizeof keys / sizeof *keys)
       return rr_fail(dev, RR_ERROR_ARGUMENT,
                      "unknown oracle '%s' (expected frustum, leaves, outside, occluded, split, split-ratio, binning, "
                      "early-z, bin or bin-min)", kv);
+    bool whole = keys[k].kind != 'f';
+    if (!(v >= keys[k].lo && v <= keys[k].hi) || (whole && v != floor(v)))
+      return keys[k].kind == 'b'
+                 ? rr_fail(dev, RR_ERROR_ARGUMENT, "bad value '%s' for oracle '%s' (expected 0 or 1)", eq + 1, kv)
+                 : rr_fail(dev, RR_ERROR_ARGUMENT, "bad value '%s' for oracle '%s' (expected %s %g..%g)", eq + 1, kv,
+                           whole ? "a whole number" : "a number", keys[k].lo, keys[k].hi);
+    char *field = (char *)o + keys[k].offset;
+    if (keys[k].kind == 'b') *(bool *)field = v != 0;
+    else if (whole) *(int *)field = (int)v;
+    else *(float *)field = (float)v;
   }
   if (o->split_min && o->split_min < 8) o->split_min = 8; /* frusta split down to the z tiles */
   return RR_OK;
