@@ -65,7 +65,11 @@ static inline float rr_vf4_hmax(rr_vf4 a) {
   return m;
 }
 /* Lanes 1, 2, 0, 3 of a (the cyclic next axis of an xyz vector). */
+#ifdef __clang__ /* the fuzzing build: clang names GCC's vector shuffle differently */
+static inline rr_vf4 rr_vf4_yzx(rr_vf4 a) { return __builtin_shufflevector(a, a, 1, 2, 0, 3); }
+#else
 static inline rr_vf4 rr_vf4_yzx(rr_vf4 a) { return __builtin_shuffle(a, (rr_vi4){1, 2, 0, 3}); }
+#endif
 /* Float to int, rounding towards zero (for lanes in int range). */
 static inline rr_vi4 rr_vi4_trunc(rr_vf4 a) { return __builtin_convertvector(a, rr_vi4); }
 

@@ -20,9 +20,9 @@ static const struct {
   oracles o;
   bool all_samples;
 } methods[RR_METHOD_COUNT] = {
-    [RR_METHOD_RC] = {"rc", rr_vis_rc, {0}},
-    [RR_METHOD_RC_BVH] = {"rc-bvh", rr_vis_rc_bvh, {0}},
-    [RR_METHOD_RC_PACKET] = {"rc-packet", rr_vis_rc_packet, {0}},
+    [RR_METHOD_RC] = {"rc", rr_vis_rc, {0}, false},
+    [RR_METHOD_RC_BVH] = {"rc-bvh", rr_vis_rc_bvh, {0}, false},
+    [RR_METHOD_RC_PACKET] = {"rc-packet", rr_vis_rc_packet, {0}, false},
     [RR_METHOD_2DR_BB] = {"2dr-bb", rr_vis_2dr_bb, {0}, true},
     [RR_METHOD_2DR_BIN] = {"2dr-bin", rr_vis_2dr_bin, {0}, true},
     [RR_METHOD_3DR_BB] = {"3dr-bb", rr_vis_traverse, {.bin_size = 64, .bin_min = 4}, true},
