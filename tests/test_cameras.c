@@ -9,14 +9,6 @@
 
 #include <string.h>
 
-static rr_camera make_camera(rr_camera_type type, vec3 eye, vec3 target, float fov) {
-  rr_camera c;
-  rr_camera_init(&c);
-  c.type = type;
-  memcpy(c.eye, &eye, 12), memcpy(c.target, &target, 12);
-  c.fov_deg = fov;
-  return c;
-}
 
 /* The issue's definitions, in double precision, with the basis of an eye on -z
  * looking at the origin (right = +x, up = +y, fwd = +z... computed here). */
@@ -55,7 +47,7 @@ static void check_directions(rr_device *dev) {
   const int pts[][2] = {{31, 23}, {32, 24}, {0, 0},  {63, 0},  {0, 47}, {63, 47},
                         {31, 0},  {31, 47}, {0, 23}, {63, 23}, {8, 8},  {56, 40}};
   for (size_t t = 0; t < sizeof types / sizeof types[0]; t++) {
-    rr_camera rc = make_camera(types[t], v3(1, 2, 3), v3(-1, 0.5f, -2), types[t] == RR_CAMERA_FISHEYE ? 230 : 60);
+    rr_camera rc = test_camera(types[t], v3(1, 2, 3), v3(-1, 0.5f, -2), types[t] == RR_CAMERA_FISHEYE ? 230 : 60);
     camera c;
     if (rr_cam_setup(dev, &rc, W, H, &c) != RR_OK) {
       CHECK(0, "camera %s: %s", rr_camera_name(types[t]), rr_device_message(dev));
@@ -79,7 +71,7 @@ static void check_directions(rr_device *dev) {
     rr_cam_release(&c);
   }
   /* Orthographic: parallel rays along fwd from the image plane through the eye. */
-  rr_camera rc = make_camera(RR_CAMERA_ORTHOGRAPHIC, v3(0, 0, 5), v3(0, 0, 0), 45);
+  rr_camera rc = test_camera(RR_CAMERA_ORTHOGRAPHIC, v3(0, 0, 5), v3(0, 0, 0), 45);
   rc.ortho_height = 4;
   camera c;
   CHECK(rr_cam_setup(dev, &rc, 40, 20, &c) == RR_OK, "ortho");
@@ -137,7 +129,7 @@ static void check_cube(rr_device *dev) {
   rr_scene *s;
   if (rr_scene_load(dev, "rooms:2", &s) != RR_OK) return;
   vec3 eye = v3(3.3f, 1.4f, 4.1f), f = v3(1, 0, 0), u = v3(0, 1, 0);
-  rr_camera cube = make_camera(RR_CAMERA_CUBE, eye, v3_add(eye, f), 90);
+  rr_camera cube = test_camera(RR_CAMERA_CUBE, eye, v3_add(eye, f), 90);
   const int F = 48;
   rr_frame *cf = test_render(dev, s, &cube, RR_METHOD_3DR_FULL, 2, 4 * F, 3 * F, 0);
   /* faces of the cross: (col, row, forward, up) in the camera basis right = f × u */
@@ -149,7 +141,7 @@ static void check_cube(rr_device *dev) {
                 {1, 0, u, v3_neg(f)}, {1, 2, v3_neg(u), f}};
   int same = 0, total = 0, depth_ok = 0, both = 0;
   for (int k = 0; k < 6 && cf; k++) {
-    rr_camera p = make_camera(RR_CAMERA_PERSPECTIVE, eye, v3_add(eye, faces[k].fwd), 90);
+    rr_camera p = test_camera(RR_CAMERA_PERSPECTIVE, eye, v3_add(eye, faces[k].fwd), 90);
     memcpy(p.up, &faces[k].up, 12);
     rr_frame *pf = test_render(dev, s, &p, RR_METHOD_3DR_BB, 1, F, F, 0);
     if (!pf) continue;
@@ -186,7 +178,7 @@ int main(void) {
   /* 2D rasterization cannot draw curved views, and says which methods can. */
   rr_scene *s;
   rr_scene_load(dev, "sphere", &s);
-  rr_camera cam = make_camera(RR_CAMERA_LATLONG, v3(0, 0, 0.2f), v3(0, 0, -1), 60);
+  rr_camera cam = test_camera(RR_CAMERA_LATLONG, v3(0, 0, 0.2f), v3(0, 0, -1), 60);
   rr_render_options opt;
   rr_render_options_init(&opt);
   opt.method = RR_METHOD_2DR_BB, opt.width = 32, opt.height = 16;

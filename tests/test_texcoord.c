@@ -76,14 +76,6 @@ static rr_scene *plane_scene(rr_device *dev, const uv_map *m, bool infinite, flo
   return s;
 }
 
-static rr_camera make_camera(rr_camera_type type, vec3 eye, vec3 target, float fov) {
-  rr_camera c;
-  rr_camera_init(&c);
-  c.type = type;
-  memcpy(c.eye, &eye, 12), memcpy(c.target, &target, 12);
-  c.fov_deg = fov;
-  return c;
-}
 
 /* ---- ray differentials ---------------------------------------------------------- */
 
@@ -142,21 +134,21 @@ static void test_ray_differentials(rr_device *dev) {
   const float positions[3][2] = {{0.5f, 0.5f}, {0.25f, 0.75f}, {0.8125f, 0.1875f}};
   vec3 eye = v3(0.3f, 1.2f, -0.7f), target = v3(-1.0f, 0.4f, 2.0f);
   for (int p = 0; p < 3; p++) {
-    rr_camera persp = make_camera(RR_CAMERA_PERSPECTIVE, eye, target, 50);
+    rr_camera persp = test_camera(RR_CAMERA_PERSPECTIVE, eye, target, 50);
     check_ray_diff(dev, &persp, 64, 48, positions[p]);
-    rr_camera ortho = make_camera(RR_CAMERA_ORTHOGRAPHIC, eye, target, 50);
+    rr_camera ortho = test_camera(RR_CAMERA_ORTHOGRAPHIC, eye, target, 50);
     ortho.ortho_height = 3;
     check_ray_diff(dev, &ortho, 64, 48, positions[p]);
-    rr_camera para = make_camera(RR_CAMERA_PARABOLIC, eye, target, 50);
+    rr_camera para = test_camera(RR_CAMERA_PARABOLIC, eye, target, 50);
     check_ray_diff(dev, &para, 64, 48, positions[p]);
-    rr_camera ll = make_camera(RR_CAMERA_LATLONG, eye, target, 50);
+    rr_camera ll = test_camera(RR_CAMERA_LATLONG, eye, target, 50);
     check_ray_diff(dev, &ll, 96, 48, positions[p]);
     for (int k = 0; k < 3; k++) { /* the centre (ψ undefined there) falls on a sample at (0.5, 0.5) */
       const float fovs[3] = {100, 230, 360};
-      rr_camera fish = make_camera(RR_CAMERA_FISHEYE, eye, target, fovs[k]);
+      rr_camera fish = test_camera(RR_CAMERA_FISHEYE, eye, target, fovs[k]);
       check_ray_diff(dev, &fish, 64, 64, positions[p]);
     }
-    rr_camera cube = make_camera(RR_CAMERA_CUBE, eye, target, 50);
+    rr_camera cube = test_camera(RR_CAMERA_CUBE, eye, target, 50);
     check_ray_diff(dev, &cube, 96, 72, positions[p]);
   }
 }
@@ -291,7 +283,7 @@ static void test_plane_views(rr_device *dev, bool infinite) {
       vec3 eye = v3(test_randf(-3, 3), test_randf(0.3f, 3), test_randf(-3, 3));
       float ang = test_randf(0, 6.2832f), reach = test_randf(0.5f, 8) * eye.y;
       vec3 target = v3(eye.x + reach * cosf(ang), 0, eye.z + reach * sinf(ang));
-      rr_camera cam = make_camera(types[t], eye, target, types[t] == RR_CAMERA_FISHEYE ? 200 : test_randf(30, 80));
+      rr_camera cam = test_camera(types[t], eye, target, types[t] == RR_CAMERA_FISHEYE ? 200 : test_randf(30, 80));
       if (types[t] == RR_CAMERA_ORTHOGRAPHIC) cam.ortho_height = test_randf(1, 6);
       int W = types[t] == RR_CAMERA_CUBE ? 96 : types[t] == RR_CAMERA_LATLONG ? 128 : 80, Hh = types[t] == RR_CAMERA_CUBE ? 72 : 64;
       float pos[2] = {test_randf(H, 1 - H), test_randf(H, 1 - H)};
@@ -314,7 +306,7 @@ static void test_options(rr_device *dev) {
   uv_map m = {1, 0, 0, 0, 1, 0};
   rr_scene *s = plane_scene(dev, &m, false, 4);
   if (!s) return;
-  rr_camera cam = make_camera(RR_CAMERA_PERSPECTIVE, v3(0, 2, 2), v3(0, 0, 0), 45);
+  rr_camera cam = test_camera(RR_CAMERA_PERSPECTIVE, v3(0, 2, 2), v3(0, 0, 0), 45);
   rr_frame *f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 1, 16, 12, 0);
   rr_shade_options o;
   rr_shade_options_init(&o);

@@ -251,3 +251,12 @@ bool test_depth_errors(rr_device *dev, const rr_scene *s, const rr_camera *cam, 
   rr_cam_release(&c);
   return ok;
 }
+
+rr_camera test_camera(rr_camera_type type, vec3 eye, vec3 target, float fov) {
+  rr_camera c;
+  rr_camera_init(&c);
+  c.type = type;
+  memcpy(c.eye, &eye, 12), memcpy(c.target, &target, 12);
+  c.fov_deg = fov;
+  return c;
+}

@@ -94,6 +94,8 @@ int test_exr_find(const test_exr_file *x, const char *name);
  * sample test of rc (rr_tri_ray_hit), ties in t to the lower id; *any: whether
  * any triangle is hit in [tmin, tmax]. */
 rr_hit test_brute_ray(const rr_scene *s, const rr_ray *ray, int *any);
+/* A camera of `type` at eye looking at target, fov_deg fov, y up. */
+rr_camera test_camera(rr_camera_type type, vec3 eye, vec3 target, float fov);
 /* Deterministic random numbers for property tests. */
 unsigned test_rand(void);
 float test_randf(float lo, float hi);

@@ -459,43 +459,42 @@ static aov_out parse_aov(const char *arg) {
   return a;
 }
 
-/* Parses --aa-filter NAME[:RADIUS]. */
-static void parse_filter(const char *arg, rr_shade_options *ro) {
+/* NAME[:REST]: NAME looked up by from_name (-1 when unknown); *rest is what
+ * follows the colon, NULL without one. */
+static int name_and_rest(const char *arg, int (*from_name)(const char *), const char **rest) {
   char name[32];
   const char *colon = strchr(arg, ':');
   size_t len = colon ? (size_t)(colon - arg) : strlen(arg);
-  int f = -1;
-  if (len < sizeof name) {
-    memcpy(name, arg, len), name[len] = 0;
-    f = rr_filter_from_name(name);
-  }
+  *rest = colon ? colon + 1 : NULL;
+  if (len >= sizeof name) return -1;
+  memcpy(name, arg, len), name[len] = 0;
+  return from_name(name);
+}
+
+/* Parses --aa-filter NAME[:RADIUS]. */
+static void parse_filter(const char *arg, rr_shade_options *ro) {
+  const char *radius;
+  int f = name_and_rest(arg, rr_filter_from_name, &radius);
   if (f < 0) die(EXIT_USAGE, "unknown filter '%s' for --aa-filter (expected box, mitchell or blackman-harris)", arg);
   ro->filter = (rr_filter)f;
-  if (!colon) return;
-  ro->radius = parse_float(option_name, colon + 1);
+  if (!radius) return;
+  ro->radius = parse_float(option_name, radius);
   if (!(ro->radius >= 0.5f && ro->radius <= RR_FILTER_MAX_RADIUS))
-    die(EXIT_USAGE, "bad radius '%s' for --aa-filter (expected 0.5..%g pixels)", colon + 1,
-        (double)RR_FILTER_MAX_RADIUS);
+    die(EXIT_USAGE, "bad radius '%s' for --aa-filter (expected 0.5..%g pixels)", radius, (double)RR_FILTER_MAX_RADIUS);
 }
 
 /* Parses --texture-filter NAME[:N] (N: aniso's probes). */
 static void parse_texture_filter(const char *arg, rr_shade_options *ro) {
-  char name[32];
-  const char *colon = strchr(arg, ':');
-  size_t len = colon ? (size_t)(colon - arg) : strlen(arg);
-  int f = -1;
-  if (len < sizeof name) {
-    memcpy(name, arg, len), name[len] = 0;
-    f = rr_texture_filter_from_name(name);
-  }
+  const char *probes;
+  int f = name_and_rest(arg, rr_texture_filter_from_name, &probes);
   if (f < 0)
     die(EXIT_USAGE,
         "unknown texture filter '%s' for --texture-filter (expected nearest, bilinear, trilinear, aniso[:N] or ewa)",
         arg);
   ro->texture_filter = (rr_texture_filter)f;
-  if (!colon) return;
+  if (!probes) return;
   if (f != RR_TEXTURE_ANISO) die(EXIT_USAGE, "bad --texture-filter '%s' (only aniso takes :N)", arg);
-  ro->aniso = (int)parse_int("--texture-filter aniso:N", colon + 1, 1, 16);
+  ro->aniso = (int)parse_int("--texture-filter aniso:N", probes, 1, 16);
 }
 
 static int cmp_double(const void *a, const void *b) {
