@@ -289,13 +289,47 @@ typedef enum rr_texture_status {
 /* The name of a texture status ("none", "file", "embedded", "missing", "unreadable"), NULL when out of range. */
 RR_API const char *rr_texture_status_name(int status);
 
+/* Which lobes a material's specular part takes (docs/shading.md). */
+typedef enum rr_material_model {
+  RR_MATERIAL_PHONG = 0, /* MTL and the other formats: Lambert diffuse + normalised Blinn–Phong (ks, shininess) */
+  RR_MATERIAL_PBR,       /* glTF metallic–roughness: Lambert diffuse + GGX microfacet specular */
+  RR_MATERIAL_MODEL_COUNT
+} rr_material_model;
+
+/* The name of a material model ("phong", "pbr"), NULL when out of range. */
+RR_API const char *rr_material_model_name(int model);
+
+/* Textures a material may name besides the base colour's; listed, not yet used in shading. */
+typedef enum rr_material_map {
+  RR_MAP_SPECULAR = 0,         /* MTL map_Ks */
+  RR_MAP_NORMAL,               /* MTL map_Bump / bump / norm, glTF normalTexture */
+  RR_MAP_OCCLUSION,            /* glTF occlusionTexture */
+  RR_MAP_EMISSIVE,             /* MTL map_Ke, glTF emissiveTexture */
+  RR_MAP_METALLIC_ROUGHNESS,   /* glTF metallicRoughnessTexture */
+  RR_MAP_COUNT
+} rr_material_map;
+
+/* The shading inputs of a material, linear RGB; see docs/shading.md for how they are used. */
+typedef struct rr_material_params {
+  rr_material_model model;
+  float specular[3]; /* phong: Ks, the specular lobe's colour (0: none) */
+  float shininess;   /* phong: Ns, the Blinn–Phong exponent (0 .. 10000) */
+  float ambient[3];  /* MTL Ka, kept for reference: ambient light comes from the scene's sky (see shading.md) */
+  float emission[3]; /* MTL Ke, glTF emissiveFactor: emitted radiance */
+  float opacity;     /* MTL d (or 1 - Tr), glTF base colour alpha; 1: opaque (kept; shading is opaque) */
+  int illum;         /* MTL illum (-1 when not given); 3: mirror reflection of colour Ks */
+  float metallic, roughness; /* pbr: glTF's factors (default 1, 1); roughness below 0.1 is a mirror */
+} rr_material_params;
+
 typedef struct rr_material_info {
   const char *name;     /* the file's name for it, NULL when none */
-  float color[3];       /* base colour, linear RGB */
+  float color[3];       /* base colour, linear RGB (MTL Kd, glTF baseColorFactor) */
   const char *texture;  /* the base colour texture as the file names it ("*0": the file's first
                            embedded one), NULL when none */
   rr_texture_status texture_status;
   int texture_width, texture_height; /* 0 unless the texture was read */
+  rr_material_params params;
+  const char *maps[RR_MAP_COUNT]; /* other textures the file names (not yet used), NULL when none */
 } rr_material_info;
 
 /* Fills what is known about material `material` (0 .. rr_scene_info.materials - 1);

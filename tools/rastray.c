@@ -527,6 +527,23 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
   for (int a = 0; a <= RR_AOV_COUNT; a++) rr_image_free(&images[a]);
 }
 
+/* The shading inputs of a material (rastray info), on one indented line, and the textures it names but shading does not use yet. */
+static void print_params(const rr_material_info *mi) {
+  const rr_material_params *p = &mi->params;
+  printf("      %s", rr_material_model_name(p->model));
+  if (p->model == RR_MATERIAL_PBR) printf(", metallic %.3g, roughness %.3g", p->metallic, p->roughness);
+  else printf(", specular (%.3g, %.3g, %.3g), shininess %.3g", p->specular[0], p->specular[1], p->specular[2], p->shininess);
+  if (p->ambient[0] || p->ambient[1] || p->ambient[2]) printf(", ambient (%.3g, %.3g, %.3g)", p->ambient[0], p->ambient[1], p->ambient[2]);
+  if (p->emission[0] || p->emission[1] || p->emission[2])
+    printf(", emission (%.3g, %.3g, %.3g)", p->emission[0], p->emission[1], p->emission[2]);
+  if (p->opacity != 1) printf(", opacity %.3g", p->opacity);
+  if (p->illum >= 0) printf(", illum %d%s", p->illum, p->illum == 3 ? " (mirror)" : "");
+  static const char *const maps[RR_MAP_COUNT] = {"specular", "normal", "occlusion", "emissive", "metallic-roughness"};
+  for (int k = 0; k < RR_MAP_COUNT; k++)
+    if (mi->maps[k]) printf(", %s map '%s' (unused)", maps[k], mi->maps[k]);
+  putchar('\n');
+}
+
 static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
   int threads = 0;
   for (int key; (key = next_option(cmd, argc, argv)) != -1;)
@@ -562,6 +579,7 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
              mi.texture_height);
     else if (mi.texture) printf(", texture '%s' (%s)", mi.texture, rr_texture_status_name(mi.texture_status));
     putchar('\n');
+    print_params(&mi);
   }
   printf("textures     %u (%u missing or unreadable)\n", in.textures, in.textures_missing);
   for (uint32_t m = 0; in.textures_missing && m < in.materials; m++) {

@@ -32,6 +32,7 @@ void rr_scene_release(rr_scene *s) {
     free(s->materials[m].name);
     free(s->materials[m].texture_path);
     free(s->materials[m].texture.rgb);
+    for (int k = 0; k < RR_MAP_COUNT; k++) free(s->materials[m].maps[k]);
   }
   free(s->materials);
   free(s->geoms);
@@ -224,6 +225,7 @@ uint32_t rr_scene_add_material(rr_scene *s, const float color[3], const char *te
   rr_material *mat = &m[s->nmaterials];
   memset(mat, 0, sizeof *mat);
   memcpy(mat->color, color, sizeof mat->color);
+  mat->params = (rr_material_params){.model = RR_MATERIAL_PHONG, .opacity = 1, .illum = -1, .metallic = 1, .roughness = 1};
   if (texture_path && *texture_path) {
     mat->texture_path = malloc(strlen(texture_path) + 1);
     if (!mat->texture_path) return UINT32_MAX;
@@ -472,12 +474,18 @@ rr_error rr_scene_get_material_info(const rr_scene *s, uint32_t material, rr_mat
                    material, s->nmaterials);
   const rr_material *m = &s->materials[material];
   *info = (rr_material_info){m->name, {m->color[0], m->color[1], m->color[2]}, m->texture_path, m->texture_status,
-                             m->texture.width, m->texture.height};
+                             m->texture.width, m->texture.height, m->params, {NULL}};
+  for (int k = 0; k < RR_MAP_COUNT; k++) info->maps[k] = m->maps[k];
   return rr_ok(s->dev);
 }
 
 static const char *const light_names[RR_LIGHT_TYPE_COUNT] = {"undefined", "directional", "point", "spot", "ambient",
                                                              "area"};
+
+const char *rr_material_model_name(int model) {
+  static const char *const names[RR_MATERIAL_MODEL_COUNT] = {"phong", "pbr"};
+  return model >= 0 && model < RR_MATERIAL_MODEL_COUNT ? names[model] : NULL;
+}
 
 const char *rr_light_type_name(int type) { return type >= 0 && type < RR_LIGHT_TYPE_COUNT ? light_names[type] : NULL; }
 

@@ -22,6 +22,8 @@ typedef struct rr_material {
   char *texture_path; /* NULL when the material names no texture */
   rr_texture texture;
   rr_texture_status texture_status; /* where the texels came from, or why there are none */
+  rr_material_params params;        /* the shading model's inputs (docs/shading.md) */
+  char *maps[RR_MAP_COUNT];         /* other textures the file names (read but not yet used); NULL: none */
 } rr_material;
 
 /* A camera of the file, in world space: it looks along fwd with up (both unit and
