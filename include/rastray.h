@@ -362,20 +362,36 @@ typedef enum rr_light_type {
 /* The name of a light type ("directional", ...), NULL when out of range. */
 RR_API const char *rr_light_type_name(int type);
 
-/* A light of the file in world space, kept for lighting; nothing renders it yet. */
+/* A light in world space, from a file or rr_scene_add_light; the lit shade mode
+ * renders it (docs/shading.md). Units as glTF's KHR_lights_punctual: color is linear
+ * RGB with the intensity multiplied in, in candela for point and spot lights
+ * (irradiance I/d² lux at distance d, no range cut-off), in lux (irradiance on a
+ * surface facing the light) for directional ones, and radiance (nits) for ambient
+ * ones, a sky: a white Lambert surface under a directional light of E lux has
+ * radiance E/π. Other formats' colours are read in the same units. */
 typedef struct rr_light_info {
   const char *name;     /* NULL when none; valid until the scene is released */
   rr_light_type type;
   float position[3];
   float direction[3];   /* unit: where the light shines */
-  float color[3];       /* linear RGB with the file's intensity multiplied in */
-  float attenuation[3]; /* constant, linear and quadratic factors */
+  float color[3];       /* linear RGB with the file's intensity multiplied in (units above) */
+  float attenuation[3]; /* constant, linear and quadratic factors as the file gives them (shading
+                           uses the inverse square law whatever they say) */
   float inner_cone_deg, outer_cone_deg; /* spot: half-angles from direction (full and no light) */
-  float size[2];        /* area: extent */
+  float size[2];        /* area: extent (shaded as a point light at position) */
+  float ground[3];      /* ambient: radiance from straight below, color being the one from straight
+                           above, blended linearly in between along the scene's up (a gradient sky);
+                           all 0: color from every direction (a constant sky) */
 } rr_light_info;
 
-/* Fills the file's light `index` (0 .. rr_scene_info.lights - 1). */
+/* Fills the scene's light `index` (0 .. rr_scene_info.lights - 1). */
 RR_API rr_error rr_scene_get_light(const rr_scene *scene, uint32_t index, rr_light_info *info);
+/* Adds a light (copied, name too) after the file's: directional, point, spot or
+ * ambient (area and undefined ones are refused), with finite values, colours and
+ * ground at least 0, a nonzero direction for directional and spot lights (made
+ * unit) and, for spot lights, 0 <= inner_cone_deg <= outer_cone_deg <= 90 (both 0:
+ * glTF's defaults 0 and 45). Not thread-safe: nothing may render the scene meanwhile. */
+RR_API rr_error rr_scene_add_light(rr_scene *scene, const rr_light_info *light);
 
 /* ---- visibility ---------------------------------------------------------- */
 
@@ -518,6 +534,8 @@ typedef enum rr_shade_mode {
   RR_SHADE_DEPTH,       /* eye distance, near bright, far dark */
   RR_SHADE_HEAT_EVALS,  /* edge evaluations per pixel as a heat map with a legend */
   RR_SHADE_HEAT_NODES,  /* BVH nodes visited per pixel as a heat map with a legend */
+  RR_SHADE_LIT,         /* the scene's lights (or a default rig) on its materials, with shadows and
+                           mirror reflections: the shading model of docs/shading.md */
   RR_SHADE_COUNT
 } rr_shade_mode;
 
@@ -617,6 +635,21 @@ typedef enum rr_texture_wrap {
   RR_WRAP_COUNT
 } rr_texture_wrap;
 
+/* How the lit shade mode finds which lights a point sees. */
+typedef enum rr_shadow_mode {
+  RR_SHADOWS_NONE = 0, /* every light reaches every point facing it */
+  RR_SHADOWS_RAYS,     /* a shadow ray per point and light through rr_occluded_stream, leaving the surface
+                          offset along its geometric normal (docs/shading.md) */
+  RR_SHADOWS_RASTER,   /* 3D rasterization from the light (the same bits as rays): not implemented yet,
+                          refused with RR_ERROR_UNSUPPORTED */
+  RR_SHADOWS_COUNT
+} rr_shadow_mode;
+
+/* The shadow mode named `name` ("none", "rays", "raster"); -1 when unknown. */
+RR_API int rr_shadows_from_name(const char *name);
+
+#define RR_MAX_DEPTH 16 /* most mirror bounces the lit shade mode follows */
+
 /* How rr_shade_frame shades and resolves a frame. The AA mode (which samples are
  * shaded) is the frame's own, from rr_render_options; these say what is drawn and
  * how the samples' colours become pixels. */
@@ -630,6 +663,10 @@ typedef struct rr_shade_options {
   rr_texture_filter texture_filter; /* default RR_TEXTURE_ANISO */
   int aniso;                        /* most probes of RR_TEXTURE_ANISO, 1 .. 16 (default 16) */
   float lod_bias;                   /* added to the MIP level, in levels (default 0) */
+  rr_shadow_mode shadows;           /* lit: how shadows are found (default RR_SHADOWS_RAYS) */
+  int max_depth;                    /* lit: most mirror bounces along a path, 0 .. RR_MAX_DEPTH (default 2) */
+  int default_lights;               /* lit: nonzero (default): a scene without lights gets the default rig
+                                       (a key light with shadows placed from the camera, and a sky) */
 } rr_shade_options;
 
 /* Fills options with defaults: Lambert, box filter, no alpha, aniso:16 textures. */
@@ -643,6 +680,11 @@ typedef struct rr_shade_stats {
                         0.5 each pixel is resolved as its samples are shaded: that time is here) */
   double resolve_ms; /* wall time of a separate resolve, per-sample colours to pixels (the wide filters;
                         about 0 for the box) */
+  uint64_t shadow_rays;     /* lit: shadow rays traced (one per point, light facing it) */
+  uint64_t reflection_rays; /* lit: mirror reflection rays traced, all bounces */
+  double shadow_ms;         /* lit: time tracing shadow rays, summed over the shading threads */
+  double reflection_ms;     /* lit: time tracing reflection rays and making their hits' surfaces, summed
+                               over the shading threads */
 } rr_shade_stats;
 
 /* Shades a frame and resolves its samples to one colour per pixel (opt NULL: the

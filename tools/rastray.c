@@ -70,7 +70,7 @@ enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
   OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA, OPT_AA_PATTERN, OPT_AA_FILTER,
-  OPT_ALPHA,
+  OPT_ALPHA, OPT_LIGHT, OPT_SHADOWS, OPT_MAX_DEPTH,
 };
 
 typedef struct cli_option {
@@ -127,7 +127,17 @@ static const cli_option render_options[] = {
     {"save-camera", OPT_SAVE_CAMERA, "FILE", "write the camera used (after automatic framing) as JSON"},
     {"camera-from-file", OPT_CAMERA_FROM_FILE, "NAME|INDEX",
      "look through a camera the scene file defines (see info); --camera may\nchange its projection"},
-    {"shade", OPT_SHADE, "MODE", "lambert (default), id, normal, depth, heat-evals, heat-nodes"},
+    {"shade", OPT_SHADE, "MODE",
+     "lit (default: the scene's lights, or a key light and a sky when it has none,\n"
+     "with shadows and mirror reflections; see docs/shading.md), lambert (a\n"
+     "headlight), id, normal, depth, heat-evals, heat-nodes"},
+    {"light", OPT_LIGHT, "SPEC",
+     "add a light (repeatable; the default rig is then off): point:X,Y,Z:R,G,B[:I]\n"
+     "(I candela, default 1), dir:DX,DY,DZ:R,G,B[:E] (shining along D, E lux),\n"
+     "spot:X,Y,Z:DX,DY,DZ:R,G,B[:I[:INNER[:OUTER]]] (half-angles, default 0 and 45\n"
+     "degrees), sky:R,G,B[:R,G,B] (radiance from above[, from below: a gradient])"},
+    {"shadows", OPT_SHADOWS, "MODE", "lit: none, rays (default: shadow rays through the ray streams)"},
+    {"max-depth", OPT_MAX_DEPTH, "N", "lit: most mirror bounces, 0.." VALUE(RR_MAX_DEPTH) " (default 2)"},
     {"aa", OPT_AA, "MODE",
      "anti-aliasing: none (default), ssaa:N (N samples, each shaded), msaa:N (shaded\n"
      "once per pixel per primitive), csaa:K/N (N coverage samples, K with colour);\n"
@@ -393,6 +403,50 @@ static aov_out parse_aov(const char *arg) {
   return a;
 }
 
+/* Parses --light (see its help) into a light for rr_scene_add_light. */
+static rr_light_info parse_light(const char *arg) {
+  static const char usage[] = "(expected point:X,Y,Z:R,G,B[:I], dir:DX,DY,DZ:R,G,B[:E], "
+                              "spot:X,Y,Z:DX,DY,DZ:R,G,B[:I[:INNER[:OUTER]]] or sky:R,G,B[:R,G,B])";
+  char buf[512], *field[8];
+  int n = 0;
+  if (strlen(arg) >= sizeof buf) die(EXIT_USAGE, "bad light '%.40s...' for --light %s", arg, usage);
+  strcpy(buf, arg);
+  for (char *p = buf; n < 8; n++) {
+    field[n] = p;
+    if (!(p = strchr(p, ':'))) {
+      n++;
+      break;
+    }
+    *p++ = 0;
+  }
+  rr_light_info l = {0};
+  const char *kind = field[0];
+  int vectors = 0, most = 0; /* the X,Y,Z fields and the most fields in all */
+  if (strcmp(kind, "point") == 0) l.type = RR_LIGHT_POINT, vectors = 2, most = 4;
+  else if (strcmp(kind, "dir") == 0) l.type = RR_LIGHT_DIRECTIONAL, vectors = 2, most = 4;
+  else if (strcmp(kind, "spot") == 0) l.type = RR_LIGHT_SPOT, vectors = 3, most = 7;
+  else if (strcmp(kind, "sky") == 0) l.type = RR_LIGHT_AMBIENT, vectors = 2, most = 3;
+  if (!vectors || n < vectors + 1 || n > most) die(EXIT_USAGE, "bad light '%s' for --light %s", arg, usage);
+  float *vec[3] = {l.position, l.direction, l.color}; /* the fields' places by kind */
+  if (l.type == RR_LIGHT_DIRECTIONAL) vec[0] = l.direction, vec[1] = l.color;
+  if (l.type == RR_LIGHT_AMBIENT) vec[0] = l.color, vec[1] = l.ground;
+  for (int k = 1; k < n && k <= vectors + (l.type == RR_LIGHT_AMBIENT); k++) parse_vec("--light", field[k], vec[k - 1]);
+  float scale = 1, inner = 0, outer = 45;
+  if (l.type != RR_LIGHT_AMBIENT && n > vectors + 1) scale = parse_float("--light", field[vectors + 1]);
+  if (n > vectors + 2) inner = parse_float("--light", field[vectors + 2]);
+  if (n > vectors + 3) outer = parse_float("--light", field[vectors + 3]);
+  for (int c = 0; c < 3; c++) l.color[c] *= scale;
+  if (!(scale >= 0)) die(EXIT_USAGE, "bad light '%s' for --light: a negative intensity", arg);
+  for (int c = 0; c < 3; c++)
+    if (l.color[c] < 0 || l.ground[c] < 0) die(EXIT_USAGE, "bad light '%s' for --light: a negative colour", arg);
+  if ((l.type == RR_LIGHT_DIRECTIONAL || l.type == RR_LIGHT_SPOT) && !l.direction[0] && !l.direction[1] && !l.direction[2])
+    die(EXIT_USAGE, "bad light '%s' for --light: a zero direction", arg);
+  if (l.type == RR_LIGHT_SPOT && !(inner >= 0 && inner <= outer && outer <= 90 && outer > 0))
+    die(EXIT_USAGE, "bad light '%s' for --light: cone angles outside 0 <= inner <= outer <= 90 degrees", arg);
+  l.inner_cone_deg = inner, l.outer_cone_deg = outer;
+  return l;
+}
+
 /* Parses --aa-filter NAME[:RADIUS]. */
 static void parse_filter(const char *arg, rr_shade_options *ro) {
   char name[32];
@@ -487,6 +541,8 @@ static void add_cube_faces(rr_device *dev, rr_output *set, const rr_image *cross
 typedef struct {
   double load, build, frame, cpu, shade, resolve, write, total;
   uint64_t shades; /* shading invocations of the colour image */
+  uint64_t shadow_rays, reflection_rays; /* lit: rays shading traced, and their time summed over threads */
+  double shadow, reflection;
 } timings;
 
 /* Adds the run's images to its output set. The colour image and each AOV are made
@@ -506,6 +562,8 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
     rr_error e = a == RR_AOV_COUNT ? rr_shade_frame(dev, scene, cam, frame, shading, colour, &st)
                                    : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
     ms->resolve += st.resolve_ms, ms->shades += st.shades;
+    ms->shadow_rays += st.shadow_rays, ms->reflection_rays += st.reflection_rays;
+    ms->shadow += st.shadow_ms, ms->reflection += st.reflection_ms;
     if (e) {
       rr_output_release(set);
       die(EXIT_INPUT, "%s", rr_device_message(dev));
@@ -651,6 +709,8 @@ static void add_stats_json(rr_device *dev, rr_output *set, const char *path, con
                  {"samples", opt->samples}, {"load_ms", ms->load}, {"build_ms", ms->build}, {"frame_ms", ms->frame},
                  {"vis_ms", ms->frame}, {"cpu_ms", ms->cpu}, {"shade_ms", ms->shade}, {"resolve_ms", ms->resolve},
                  {"write_ms", ms->write}, {"total_ms", ms->total}, {"shades", (double)ms->shades},
+                 {"shadow_rays", (double)ms->shadow_rays}, {"shadow_ms", ms->shadow},
+                 {"reflection_rays", (double)ms->reflection_rays}, {"reflection_ms", ms->reflection},
                  {"setups", (double)st->setups}, {"edge_evals", (double)st->edge_evals}, {"nodes", (double)st->nodes},
                  {"bins", (double)st->bins}, {"bins_empty", (double)st->bins_empty}};
   for (size_t k = 0; k < sizeof numbers / sizeof *numbers; k++) /* times to the microsecond */
@@ -671,7 +731,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   const char *file_cam = NULL; /* --camera-from-file */
   unsigned given = 0;           /* the camera's fields set by flags */
   bool stats = false;
-  int shade = RR_SHADE_LAMBERT, repeat = 1, naov = 0;
+  int shade = RR_SHADE_LIT, repeat = 1, naov = 0, nlights = 0;
+  rr_light_info lights[32];
   aa_spec aa = {RR_AA_NONE, 1, 0};
   rr_aa_pattern pattern = RR_AA_STANDARD;
   uint32_t seed = 1;
@@ -713,9 +774,22 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_SHADE:
       shade = rr_shade_from_name(optarg);
       if (shade < 0)
-        die(EXIT_USAGE, "unknown shade mode '%s' (expected lambert, id, normal, depth, heat-evals or heat-nodes)",
-            optarg);
+        die(EXIT_USAGE,
+            "unknown shade mode '%s' (expected lit, lambert, id, normal, depth, heat-evals or heat-nodes)", optarg);
       break;
+    case OPT_LIGHT:
+      if (nlights == 32) die(EXIT_USAGE, "too many --light (at most 32)");
+      lights[nlights++] = parse_light(optarg);
+      break;
+    case OPT_SHADOWS: {
+      int m = rr_shadows_from_name(optarg);
+      if (m == RR_SHADOWS_RASTER)
+        die(EXIT_USAGE, "--shadows raster (3D rasterization from the light) is not implemented yet; use rays or none");
+      if (m < 0) die(EXIT_USAGE, "unknown shadow mode '%s' for --shadows (expected none or rays)", optarg);
+      shading.shadows = (rr_shadow_mode)m;
+      break;
+    }
+    case OPT_MAX_DEPTH: shading.max_depth = (int)parse_int(option_name, optarg, 0, RR_MAX_DEPTH); break;
     case 'o': out = optarg; break;
     case OPT_AOV:
       if (naov == 16) die(EXIT_USAGE, "too many --aov (at most 16)");
@@ -762,6 +836,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
 
   timings ms = {0};
   rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load);
+  for (int k = 0; k < nlights; k++)
+    if (rr_scene_add_light(scene, &lights[k]) != RR_OK) die(EXIT_USAGE, "--light: %s", rr_device_message(dev));
   if (file_cam) { /* the file's camera; --camera may change its projection */
     rr_camera_type type = cam.type;
     uint32_t index;
@@ -817,10 +893,12 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     fprintf(stderr,
             "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d aa=%s samples=%d frame_ms=%.3f "
             "vis_ms=%.3f cpu_ms=%.3f load_ms=%.1f build_ms=%.1f shade_ms=%.1f resolve_ms=%.1f write_ms=%.1f "
-            "total_ms=%.1f shades=%llu setups=%llu edge_evals=%llu nodes=%llu bins=%llu bins_empty=%llu\n",
+            "total_ms=%.1f shades=%llu shadow_rays=%llu shadow_ms=%.1f reflection_rays=%llu reflection_ms=%.1f "
+            "setups=%llu edge_evals=%llu nodes=%llu bins=%llu bins_empty=%llu\n",
             method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, st.threads,
             rr_aa_mode_name(opt.aa), opt.samples, ms.frame, ms.frame, ms.cpu, ms.load, ms.build, ms.shade, ms.resolve,
-            ms.write, ms.total, (unsigned long long)ms.shades, (unsigned long long)st.setups,
+            ms.write, ms.total, (unsigned long long)ms.shades, (unsigned long long)ms.shadow_rays, ms.shadow,
+            (unsigned long long)ms.reflection_rays, ms.reflection, (unsigned long long)st.setups,
             (unsigned long long)st.edge_evals, (unsigned long long)st.nodes, (unsigned long long)st.bins,
             (unsigned long long)st.bins_empty);
   if (stats && st.why[0]) fprintf(stderr, "auto chose %s: %s\n", method, st.why);

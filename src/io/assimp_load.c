@@ -205,7 +205,7 @@ static rr_error add_lights(rr_scene *s, const struct aiScene *sc) {
                        .size = {al->mSize.x, al->mSize.y}};
     v3_store(l.position, xform_point(&m, al->mPosition));
     v3_store(l.direction, v3_norm(xform_dir(&m, al->mDirection)));
-    rr_error e = rr_scene_add_light(s, &l);
+    rr_error e = rr_scene_append_light(s, &l);
     if (e) return e;
   }
   return RR_OK;

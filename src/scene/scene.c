@@ -260,7 +260,7 @@ rr_error rr_scene_add_camera(rr_scene *s, const char *name, const file_camera *c
   return RR_OK;
 }
 
-rr_error rr_scene_add_light(rr_scene *s, const rr_light_info *light) {
+rr_error rr_scene_append_light(rr_scene *s, const rr_light_info *light) {
   rr_light_info *p = realloc(s->lights, (s->nlights + 1) * sizeof *p);
   char *name = NULL;
   if (p) s->lights = p;
@@ -481,6 +481,51 @@ rr_error rr_scene_get_material_info(const rr_scene *s, uint32_t material, rr_mat
 
 static const char *const light_names[RR_LIGHT_TYPE_COUNT] = {"undefined", "directional", "point", "spot", "ambient",
                                                              "area"};
+
+uint32_t rr_scene_index_of(const rr_scene *s, uint32_t id) {
+  if (!s->file_id) return id < s->ntris ? id : RR_MISS;
+  uint32_t lo = 0, hi = s->ntris;
+  while (lo < hi) {
+    uint32_t mid = lo + (hi - lo) / 2;
+    if (s->file_id[mid] < id) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo < s->ntris && s->file_id[lo] == id ? lo : RR_MISS;
+}
+
+/* Why a caller's light cannot be added, or NULL; fills the unit direction and the default cone into *l. */
+static const char *light_problem(rr_light_info *l) {
+  if (l->type != RR_LIGHT_DIRECTIONAL && l->type != RR_LIGHT_POINT && l->type != RR_LIGHT_SPOT &&
+      l->type != RR_LIGHT_AMBIENT)
+    return "a type other than directional, point, spot or ambient";
+  const float *v[] = {l->position, l->direction, l->color, l->ground};
+  for (int k = 0; k < 4; k++)
+    for (int c = 0; c < 3; c++)
+      if (!isfinite(v[k][c])) return "a non-finite value";
+  for (int c = 0; c < 3; c++)
+    if (l->color[c] < 0 || l->ground[c] < 0) return "a negative colour";
+  if (l->type == RR_LIGHT_DIRECTIONAL || l->type == RR_LIGHT_SPOT) {
+    vec3 d = v3_load(l->direction);
+    if (!(v3_dot(d, d) > 0)) return "a zero direction";
+    v3_store(l->direction, v3_norm(d));
+  }
+  if (l->type == RR_LIGHT_SPOT) {
+    if (l->inner_cone_deg == 0 && l->outer_cone_deg == 0) l->outer_cone_deg = 45;
+    if (!(l->inner_cone_deg >= 0 && l->inner_cone_deg <= l->outer_cone_deg && l->outer_cone_deg <= 90))
+      return "cone angles outside 0 <= inner <= outer <= 90 degrees";
+  }
+  return NULL;
+}
+
+rr_error rr_scene_add_light(rr_scene *s, const rr_light_info *light) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if (!light) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_light: light is NULL");
+  rr_light_info l = *light;
+  const char *why = light_problem(&l);
+  if (why) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_light: a light with %s", why);
+  rr_error e = rr_scene_append_light(s, &l);
+  return e ? e : rr_ok(s->dev);
+}
 
 const char *rr_material_model_name(int model) {
   static const char *const names[RR_MATERIAL_MODEL_COUNT] = {"phong", "pbr"};

@@ -2,6 +2,7 @@
  * scene, so it never knows which method made the frame. */
 #include "vis/vis.h"
 #include "core/color.h"
+#include "shade/light.h"
 #include "shade/resolve.h"
 #include "shade/texture.h"
 
@@ -193,6 +194,22 @@ static void shade_hit(const rr_scene *s, const hit *h, rr_shade_mode mode, const
   for (int ch = 0; ch < 3; ch++) o[ch] = srgb_decode(o[ch]);
 }
 
+/* The surface the lit mode shades at a valid hit h, whose ray left from o. */
+static void hit_surface(const rr_scene *s, const hit *h, vec3 o, const tex_filter *tf, surface *sf) {
+  uint32_t i = h->id;
+  vec3 ng = geometric_normal(s, i);
+  sf->ng = v3_dot(ng, h->dir) > 0 ? v3_neg(ng) : ng;
+  sf->n = h->normal, sf->v = v3_neg(h->dir);
+  if (scene_inf(s, i)) { /* corners at infinity: along the ray */
+    sf->p = v3_add(o, v3_scale(h->dir, h->dist));
+  } else { /* from the corners: as exact as the triangle, wherever the ray came from */
+    sf->p = v3_add(v3_add(v3_scale(scene_vertex(s, 0, i), h->l0), v3_scale(scene_vertex(s, 1, i), h->l1)),
+                   v3_scale(scene_vertex(s, 2, i), h->l2));
+  }
+  sf->m = s->nmaterials ? &s->materials[s->material[i] % s->nmaterials] : NULL;
+  base_color(s, h, tf, sf->base);
+}
+
 /* One shading pass over the samples of a frame (rows dealt out in jobs). */
 typedef struct shade_pass {
   const rr_scene *s;
@@ -209,7 +226,19 @@ typedef struct shade_pass {
   float *out; /* a filter of each pixel's own samples: the image, resolved as shading goes (no rgb kept) */
   uint64_t shades[RR_MAX_THREADS];
   bool failed; /* a job found no memory */
+  bool lit;          /* RR_SHADE_LIT: the run's points are shaded together (light.h) */
+  lighting lights;
+  lit_stats lit_st[RR_MAX_THREADS];
 } shade_pass;
+
+/* A reflection ray's hit as the lit mode's surface (light.h's surface_fn). Texture
+ * lookups there have no footprint: TODO(issue 15) derivatives of reflected rays. */
+static void reflected_surface(void *ctx, uint32_t index, float l1, float l2, float t, vec3 org, vec3 dir,
+                              surface *out) {
+  const shade_pass *p = ctx;
+  hit h = hit_make(p->s, index, l1, l2, t, dir);
+  hit_surface(p->s, &h, org, &p->tex, out);
+}
 
 enum { SHADE_ROWS = 8 }; /* rows per job */
 
@@ -224,14 +253,17 @@ static void background(int y, int height, float o[3]) {
  * power of two apart, so reading a pixel's samples in place would map them all to
  * the same cache sets. */
 enum { RUN = 64 };
+_Static_assert(RUN * RR_MAX_SAMPLES <= LIT_BATCH, "a run's points fit one batch of the lit mode");
 typedef struct sample_run {
   uint32_t id[RR_MAX_SAMPLES][RUN];
   float l1[RR_MAX_SAMPLES][RUN], l2[RR_MAX_SAMPLES][RUN], t[RR_MAX_SAMPLES][RUN];
   float rgb[RR_MAX_SAMPLES][3 * RUN], w[RR_MAX_SAMPLES][RUN], a[RR_MAX_SAMPLES][RUN];
+  signed char lead[RR_MAX_SAMPLES][RUN]; /* lit: the sample whose colour this one shares */
 } sample_run;
 
 /* Shades pixel (x, y), run entry j: see rr_aa_mode for what each mode does. */
-static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, int y, const float bg[3]) {
+static uint64_t shade_pixel(const shade_pass *p, sample_run *r, lit_batch *lb, int j, int x, int y,
+                            const float bg[3]) {
   const rr_scene *s = p->s;
   int n = p->samples, K = p->stored;
   bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
@@ -245,6 +277,7 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, in
     uint32_t id = r->id[i][j];
     int last = grouped ? n : i + 1;
     float col[3] = {0, 0, 0};
+    bool queued = false;
     vec3 o, d;
     if (id < s->ntris) {
       float l1 = 0, l2 = 0, t = 0;
@@ -254,7 +287,13 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, in
       if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
         float inv = 1.0f / (float)members;
         hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, d);
-        shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
+        if (p->lit) { /* shaded with the run's other points; the colour arrives in r->rgb[i] */
+          surface sf;
+          hit_surface(s, &h, o, &p->tex, &sf);
+          queued = lit_batch_add(lb, &sf, &r->rgb[i][3 * j]);
+        } else {
+          shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
+        }
         shades++;
       }
     } else if (p->cams[i].planar || rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
@@ -262,8 +301,8 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, in
     }
     for (int m = i; m < (last < K ? last : K); m++)
       if (r->id[m][j] == id) {
-        memcpy(&r->rgb[m][3 * j], col, sizeof col);
-        done[m] = true, r->w[m][j] = 1.0f;
+        if (m > i || !queued) memcpy(&r->rgb[m][3 * j], col, sizeof col);
+        done[m] = true, r->w[m][j] = 1.0f, r->lead[m][j] = (signed char)i;
       }
   }
   /* csaa: a coverage sample votes for the nearest stored sample of its primitive;
@@ -287,8 +326,10 @@ static void shade_rows(int job, int thread, void *arg) {
   int n = p->samples;
   uint64_t shades = 0;
   sample_run *r = malloc(sizeof *r);
-  if (!r) { /* a job without room leaves its rows for shade_frame to report */
+  lit_batch *lb = p->lit ? lit_batch_new() : NULL;
+  if (!r || (p->lit && !lb)) { /* a job without room leaves its rows for shade_frame to report */
     p->failed = true;
+    free(r), lit_batch_free(lb);
     return;
   }
   for (int y = job * SHADE_ROWS; y < vb->height && y < (job + 1) * SHADE_ROWS; y++) {
@@ -304,7 +345,13 @@ static void shade_rows(int job, int thread, void *arg) {
         memcpy(r->l2[i], vb->l2 + e, len * sizeof(float));
         memcpy(r->t[i], vb->t + e, len * sizeof(float));
       }
-      for (int j = 0; j < len; j++) shades += shade_pixel(p, r, j, x0 + j, y, bg);
+      for (int j = 0; j < len; j++) shades += shade_pixel(p, r, lb, j, x0 + j, y, bg);
+      if (p->lit) { /* the run's points at once (a run holds at most LIT_BATCH), then their groups */
+        lit_batch_shade(lb, p->s, &p->lights, reflected_surface, p, &p->lit_st[thread]);
+        for (int i = 0; i < p->stored; i++)
+          for (int j = 0; j < len; j++)
+            if (r->lead[i][j] != i) memcpy(&r->rgb[i][3 * j], &r->rgb[r->lead[i][j]][3 * j], 3 * sizeof(float));
+      }
       for (int i = 0; p->has_alpha && i < n; i++)
         for (int j = 0; j < len; j++) r->a[i][j] = r->id[i][j] < p->s->ntris ? 1.0f : 0.0f;
       const float *w = p->aa == RR_AA_CSAA ? r->w[0] : NULL, *a = p->has_alpha ? r->a[0] : NULL;
@@ -322,7 +369,7 @@ static void shade_rows(int job, int thread, void *arg) {
       }
     }
   }
-  free(r);
+  free(r), lit_batch_free(lb);
   p->shades[thread] += shades;
 }
 
@@ -359,13 +406,15 @@ static rr_error shade_heat_frame(rr_device *dev, const rr_frame *f, rr_shade_mod
 /* Shades the samples as the frame's AA mode says (cams: one per sample position),
  * then resolves them into out with the options' filter. */
 static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f,
-                              const rr_shade_options *opt, rr_image *out, rr_shade_stats *st) {
+                              const rr_shade_options *opt, const lighting *lights, rr_image *out,
+                              rr_shade_stats *st) {
   const visbuf *vb = &f->vb;
   size_t npix = (size_t)vb->width * vb->height;
   shade_pass *p = calloc(1, sizeof *p);
   if (!p) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading");
   *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = opt->mode, .aa = f->aa, .samples = f->samples,
-                      .tex = {opt->texture_filter, opt->aniso, opt->lod_bias}};
+                      .tex = {opt->texture_filter, opt->aniso, opt->lod_bias}, .lit = lights != NULL};
+  if (lights) p->lights = *lights;
   p->stored = f->aa == RR_AA_CSAA ? f->aa_stored : p->samples;
   const float(*pos)[2] = (const float(*)[2])f->sample_pos;
   /* coverage samples' stored samples by distance (ties: the lower index) */
@@ -409,7 +458,12 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
     if (e && own) free(out->data), out->data = NULL;
     if (st) {
       *st = (rr_shade_stats){.shade_ms = t1 - t0, .resolve_ms = rr_now_ms() - t1};
-      for (int t = 0; t < RR_MAX_THREADS; t++) st->shades += p->shades[t];
+      for (int t = 0; t < RR_MAX_THREADS; t++) {
+        const lit_stats *l = &p->lit_st[t];
+        st->shades += p->shades[t];
+        st->shadow_rays += l->shadow_rays, st->reflection_rays += l->reflection_rays;
+        st->shadow_ms += l->shadow_ms, st->reflection_ms += l->reflection_ms;
+      }
     }
   }
   free(p->rgb), free(p->weight), free(p->alpha), free(p);
@@ -510,7 +564,8 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
 /* The public entry points resolve the frame's cameras, one per sample position, around the work. */
 void rr_shade_options_init(rr_shade_options *opt) {
   *opt = (rr_shade_options){.mode = RR_SHADE_LAMBERT, .filter = RR_FILTER_BOX, .radius = 0, .alpha = 0,
-                              .texture_filter = RR_TEXTURE_ANISO, .aniso = 16, .lod_bias = 0};
+                              .texture_filter = RR_TEXTURE_ANISO, .aniso = 16, .lod_bias = 0,
+                              .shadows = RR_SHADOWS_RAYS, .max_depth = 2, .default_lights = 1};
 }
 
 rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
@@ -527,11 +582,26 @@ rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam,
     if (stats) stats->shade_ms = rr_now_ms() - t0;
     return e;
   }
-  camera cams[RR_MAX_SAMPLES];
-  rr_error e = frame_cameras(dev, cam, f, cams);
+  bool lit = opt->mode == RR_SHADE_LIT;
+  if (lit && opt->shadows == RR_SHADOWS_RASTER)
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED,
+                   "shadows by rasterization from the light are not implemented yet (use rays or none)");
+  if (lit && ((int)opt->shadows < 0 || opt->shadows >= RR_SHADOWS_COUNT))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shadow mode %d", (int)opt->shadows);
+  if (lit && (opt->max_depth < 0 || opt->max_depth > RR_MAX_DEPTH))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "max depth %d out of range (0 .. %d)", opt->max_depth, RR_MAX_DEPTH);
+  bool empty;
+  if (lit && !rr_bvh_of(dev, s, &empty) && !empty) return RR_ERROR_ARGUMENT; /* rays need the current BVH */
+  lighting lights;
+  rr_error e = lit ? lighting_make(dev, s, cam, opt, &lights) : RR_OK;
   if (e) return e;
-  e = shade_samples(dev, s, cams, f, opt, out, stats);
-  for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
+  camera cams[RR_MAX_SAMPLES];
+  e = frame_cameras(dev, cam, f, cams);
+  if (!e) {
+    e = shade_samples(dev, s, cams, f, opt, lit ? &lights : NULL, out, stats);
+    for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
+  }
+  if (lit) lighting_release(&lights);
   return e;
 }
 

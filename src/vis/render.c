@@ -93,7 +93,7 @@ static int name_index(const char *const *names, int n, const char *name) {
 }
 
 int rr_shade_from_name(const char *name) {
-  static const char *const names[RR_SHADE_COUNT] = {"lambert", "id", "normal", "depth", "heat-evals", "heat-nodes"};
+  static const char *const names[RR_SHADE_COUNT] = {"lambert", "id", "normal", "depth", "heat-evals", "heat-nodes", "lit"};
   return name_index(names, RR_SHADE_COUNT, name);
 }
 
