@@ -50,7 +50,7 @@ static bool default_rig(lighting *L, const rr_scene *s, const rr_camera *cam) {
   return push_light(L, &key);
 }
 
-rr_error lighting_make(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_shade_options *opt,
+rr_error rr_lighting_make(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_shade_options *opt,
                        lighting *L) {
   *L = (lighting){.up = s->up, .shadows = opt->shadows, .max_depth = opt->max_depth};
   vec3 ext = v3_sub(s->bmax, s->bmin);
@@ -63,13 +63,13 @@ rr_error lighting_make(rr_device *dev, const rr_scene *s, const rr_camera *cam, 
   }
   if (ok && s->nlights == 0 && opt->default_lights) ok = default_rig(L, s, cam);
   if (!ok) {
-    lighting_release(L);
+    rr_lighting_release(L);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the lights");
   }
   return RR_OK;
 }
 
-void lighting_release(lighting *L) {
+void rr_lighting_release(lighting *L) {
   free(L->lights);
   L->lights = NULL, L->nlights = 0;
 }
@@ -197,10 +197,10 @@ struct lit_batch {
   rr_hit hit[LIT_BATCH];
 };
 
-lit_batch *lit_batch_new(void) { return calloc(1, sizeof(lit_batch)); }
-void lit_batch_free(lit_batch *b) { free(b); }
+lit_batch *rr_lit_batch_new(void) { return calloc(1, sizeof(lit_batch)); }
+void rr_lit_batch_free(lit_batch *b) { free(b); }
 
-bool lit_batch_add(lit_batch *b, const surface *sf, float *out) {
+bool rr_lit_batch_add(lit_batch *b, const surface *sf, float *out) {
   level *lv = &b->lv[b->cur];
   if (lv->n == LIT_BATCH) return false;
   lv->pt[lv->n] = *sf, lv->out[lv->n] = out;
@@ -317,7 +317,7 @@ static void reflect(lit_batch *b, const level *lv, level *next, bool last, const
   st->reflection_ms += rr_now_ms() - t0, st->reflection_rays += (uint64_t)nr;
 }
 
-void lit_batch_shade(lit_batch *b, const rr_scene *s, const lighting *L, surface_fn fn, void *ctx, lit_stats *st) {
+void rr_lit_batch_shade(lit_batch *b, const rr_scene *s, const lighting *L, surface_fn fn, void *ctx, lit_stats *st) {
   for (int depth = 0;; depth++) {
     level *lv = &b->lv[b->cur], *next = &b->lv[1 - b->cur];
     if (!lv->n) break;

@@ -39,9 +39,9 @@ typedef struct lighting {
 
 /* The lights of a frame: the scene's, or the default rig placed from cam when the
  * scene has none and opt->default_lights is set. */
-rr_error lighting_make(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_shade_options *opt,
+rr_error rr_lighting_make(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_shade_options *opt,
                        lighting *out);
-void lighting_release(lighting *l);
+void rr_lighting_release(lighting *l);
 
 /* Fills out with the surface a reflection ray (org, dir) hit: triangle index, its
  * barycentrics and t along dir (shade.c gives it; ctx is its own). */
@@ -57,13 +57,13 @@ enum { LIT_BATCH = 1024 }; /* most points of a batch */
 typedef struct lit_batch lit_batch;
 
 /* A batch, empty (NULL when out of memory); one per thread. */
-lit_batch *lit_batch_new(void);
-void lit_batch_free(lit_batch *b);
+lit_batch *rr_lit_batch_new(void);
+void rr_lit_batch_free(lit_batch *b);
 /* Queues a point whose linear colour goes to out[0..2] when the batch is shaded;
  * false when the batch is full. */
-bool lit_batch_add(lit_batch *b, const surface *sf, float *out);
+bool rr_lit_batch_add(lit_batch *b, const surface *sf, float *out);
 /* Shades the queued points under L, writes their colours and empties the batch;
  * rays through s's streams on this thread, reflected hits made by fn(ctx). */
-void lit_batch_shade(lit_batch *b, const rr_scene *s, const lighting *L, surface_fn fn, void *ctx, lit_stats *st);
+void rr_lit_batch_shade(lit_batch *b, const rr_scene *s, const lighting *L, surface_fn fn, void *ctx, lit_stats *st);
 
 #endif

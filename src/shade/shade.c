@@ -290,7 +290,7 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, lit_batch *lb, i
         if (p->lit) { /* shaded with the run's other points; the colour arrives in r->rgb[i] */
           surface sf;
           hit_surface(s, &h, o, &p->tex, &sf);
-          queued = lit_batch_add(lb, &sf, &r->rgb[i][3 * j]);
+          queued = rr_lit_batch_add(lb, &sf, &r->rgb[i][3 * j]);
         } else {
           shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
         }
@@ -326,10 +326,10 @@ static void shade_rows(int job, int thread, void *arg) {
   int n = p->samples;
   uint64_t shades = 0;
   sample_run *r = malloc(sizeof *r);
-  lit_batch *lb = p->lit ? lit_batch_new() : NULL;
+  lit_batch *lb = p->lit ? rr_lit_batch_new() : NULL;
   if (!r || (p->lit && !lb)) { /* a job without room leaves its rows for shade_frame to report */
     p->failed = true;
-    free(r), lit_batch_free(lb);
+    free(r), rr_lit_batch_free(lb);
     return;
   }
   for (int y = job * SHADE_ROWS; y < vb->height && y < (job + 1) * SHADE_ROWS; y++) {
@@ -347,7 +347,7 @@ static void shade_rows(int job, int thread, void *arg) {
       }
       for (int j = 0; j < len; j++) shades += shade_pixel(p, r, lb, j, x0 + j, y, bg);
       if (p->lit) { /* the run's points at once (a run holds at most LIT_BATCH), then their groups */
-        lit_batch_shade(lb, p->s, &p->lights, reflected_surface, p, &p->lit_st[thread]);
+        rr_lit_batch_shade(lb, p->s, &p->lights, reflected_surface, p, &p->lit_st[thread]);
         for (int i = 0; i < p->stored; i++)
           for (int j = 0; j < len; j++)
             if (r->lead[i][j] != i) memcpy(&r->rgb[i][3 * j], &r->rgb[r->lead[i][j]][3 * j], 3 * sizeof(float));
@@ -369,7 +369,7 @@ static void shade_rows(int job, int thread, void *arg) {
       }
     }
   }
-  free(r), lit_batch_free(lb);
+  free(r), rr_lit_batch_free(lb);
   p->shades[thread] += shades;
 }
 
@@ -593,7 +593,7 @@ rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   bool empty;
   if (lit && !rr_bvh_of(dev, s, &empty) && !empty) return RR_ERROR_ARGUMENT; /* rays need the current BVH */
   lighting lights;
-  rr_error e = lit ? lighting_make(dev, s, cam, opt, &lights) : RR_OK;
+  rr_error e = lit ? rr_lighting_make(dev, s, cam, opt, &lights) : RR_OK;
   if (e) return e;
   camera cams[RR_MAX_SAMPLES];
   e = frame_cameras(dev, cam, f, cams);
@@ -601,7 +601,7 @@ rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam,
     e = shade_samples(dev, s, cams, f, opt, lit ? &lights : NULL, out, stats);
     for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
   }
-  if (lit) lighting_release(&lights);
+  if (lit) rr_lighting_release(&lights);
   return e;
 }
 
