@@ -421,16 +421,16 @@ static rr_light_info parse_light(const char *arg) {
   }
   rr_light_info l = {0};
   const char *kind = field[0];
-  int vectors = 0, most = 0; /* the X,Y,Z fields and the most fields in all */
-  if (strcmp(kind, "point") == 0) l.type = RR_LIGHT_POINT, vectors = 2, most = 4;
-  else if (strcmp(kind, "dir") == 0) l.type = RR_LIGHT_DIRECTIONAL, vectors = 2, most = 4;
-  else if (strcmp(kind, "spot") == 0) l.type = RR_LIGHT_SPOT, vectors = 3, most = 7;
-  else if (strcmp(kind, "sky") == 0) l.type = RR_LIGHT_AMBIENT, vectors = 2, most = 3;
-  if (!vectors || n < vectors + 1 || n > most) die(EXIT_USAGE, "bad light '%s' for --light %s", arg, usage);
+  int vectors = 0, least = 0, most = 0; /* the X,Y,Z fields; the fewest and most fields in all */
+  if (strcmp(kind, "point") == 0) l.type = RR_LIGHT_POINT, vectors = 2, least = 3, most = 4;
+  else if (strcmp(kind, "dir") == 0) l.type = RR_LIGHT_DIRECTIONAL, vectors = 2, least = 3, most = 4;
+  else if (strcmp(kind, "spot") == 0) l.type = RR_LIGHT_SPOT, vectors = 3, least = 4, most = 7;
+  else if (strcmp(kind, "sky") == 0) l.type = RR_LIGHT_AMBIENT, vectors = 2, least = 2, most = 3;
+  if (!vectors || n < least || n > most) die(EXIT_USAGE, "bad light '%s' for --light %s", arg, usage);
   float *vec[3] = {l.position, l.direction, l.color}; /* the fields' places by kind */
   if (l.type == RR_LIGHT_DIRECTIONAL) vec[0] = l.direction, vec[1] = l.color;
   if (l.type == RR_LIGHT_AMBIENT) vec[0] = l.color, vec[1] = l.ground;
-  for (int k = 1; k < n && k <= vectors + (l.type == RR_LIGHT_AMBIENT); k++) parse_vec("--light", field[k], vec[k - 1]);
+  for (int k = 1; k < n && k <= vectors; k++) parse_vec("--light", field[k], vec[k - 1]);
   float scale = 1, inner = 0, outer = 45;
   if (l.type != RR_LIGHT_AMBIENT && n > vectors + 1) scale = parse_float("--light", field[vectors + 1]);
   if (n > vectors + 2) inner = parse_float("--light", field[vectors + 2]);
