@@ -521,6 +521,28 @@ static void check_cli(void) {
                         "-o good.png --stats",
                         true, out, sizeof out);
   CHECK(rc == 0 && strstr(out, "shadow_rays=0"), "good lights: exit %d: %s", rc, out);
+  /* the flags' numbers land where they belong: a directional light of 3 lux, then a
+   * point light of 4 cd 2 units in front, on the OBJ's default grey 0.6 facing them */
+  const struct {
+    const char *light;
+    double most; /* the brightest pixel's radiance */
+  } good[] = {{"dir:0,0,-1:1,0.5,0.25:3", 0.6 * 3 / RR_PI}, {"point:0,0,2:1,0.5,0.25:4", 0.6 * 4 / (RR_PI * 4)}};
+  for (int k = 0; k < 2; k++) {
+    char args[256], path[600];
+    snprintf(args, sizeof args, "render tri.obj --size 65x65 --light %s -o c.pfm", good[k].light);
+    snprintf(path, sizeof path, "%s/c.pfm", dir);
+    rr_image img = {0};
+    CHECK(test_run_cli(dir, args, true, out, sizeof out) == 0 && rr_image_read(dev, path, &img) == RR_OK,
+          "%s: %s", args, out);
+    float top[3] = {0, 0, 0}; /* the reddest pixel (the background is bluish) */
+    for (int i = 0; img.data && i < 65 * 65; i++)
+      if (((float *)img.data)[3 * i] > top[0]) memcpy(top, (float *)img.data + 3 * i, sizeof top);
+    CHECK(fabs(top[0] - good[k].most) < 0.01 * good[k].most && fabs(top[1] - 0.5 * good[k].most) < 0.01 * good[k].most &&
+              fabs(top[2] - 0.25 * good[k].most) < 0.01 * good[k].most,
+          "--light %s: brightest (%g, %g, %g), expected %g at most in red", good[k].light, top[0], top[1], top[2],
+          good[k].most);
+    rr_image_free(&img);
+  }
 }
 
 int main(void) {

@@ -427,7 +427,8 @@ static rr_light_info parse_light(const char *arg) {
   else if (strcmp(kind, "spot") == 0) l.type = RR_LIGHT_SPOT, vectors = 3, least = 4, most = 7;
   else if (strcmp(kind, "sky") == 0) l.type = RR_LIGHT_AMBIENT, vectors = 2, least = 2, most = 3;
   if (!vectors || n < least || n > most) die(EXIT_USAGE, "bad light '%s' for --light %s", arg, usage);
-  float *vec[3] = {l.position, l.direction, l.color}; /* the fields' places by kind */
+  float *vec[3] = {l.position, l.direction, l.color}; /* the fields' places by kind: spot's */
+  if (l.type == RR_LIGHT_POINT) vec[1] = l.color;
   if (l.type == RR_LIGHT_DIRECTIONAL) vec[0] = l.direction, vec[1] = l.color;
   if (l.type == RR_LIGHT_AMBIENT) vec[0] = l.color, vec[1] = l.ground;
   for (int k = 1; k < n && k <= vectors; k++) parse_vec("--light", field[k], vec[k - 1]);
