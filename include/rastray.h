@@ -555,6 +555,15 @@ typedef enum rr_aov {
   RR_AOV_SAMPLE_ID,    /* N uint32 (N = samples): the id of each sample, channel s = sample s */
   RR_AOV_SAMPLE_DEPTH, /* N floats: the depth of each sample (+inf on a miss) */
   RR_AOV_SAMPLE_MESH,  /* N uint32: the geometry id of each sample */
+  /* The lit mode's parts (docs/shading.md), named as Blender Cycles' passes, with the
+   * lights rr_shade_options_init's lit shading uses (the scene's, or the default rig);
+   * 0 on a miss. The colour is direct + reflection + emission. */
+  RR_AOV_ALBEDO,       /* 3 floats: the diffuse lobe's colour (base colour; × (1 - metallic) for pbr) */
+  RR_AOV_DIRECT,       /* 3 floats: light from the lights (shadowed) and the sky on the point itself */
+  RR_AOV_REFLECTION,   /* 3 floats: what its mirror reflects, every bounce */
+  RR_AOV_SHADOW,       /* 1 float: the fraction of the punctual lights that reach it (facing it, inside
+                          its cone, unblocked); 1 when there is none */
+  RR_AOV_EMISSION,     /* 3 floats: the radiance it emits */
   RR_AOV_COUNT
 } rr_aov;
 /* With several samples per pixel the per-pixel AOVs follow one rule each: id, mesh,
@@ -564,7 +573,8 @@ typedef enum rr_aov {
  * nodes sum over the samples. The sample-* AOVs give every sample. */
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
- * "material", "coverage", "sample-id", "sample-depth", "sample-mesh"); -1 when unknown. */
+ * "material", "coverage", "sample-id", "sample-depth", "sample-mesh", "albedo", "direct",
+ * "reflection", "shadow", "emission"); -1 when unknown. */
 RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
@@ -578,8 +588,9 @@ typedef enum rr_image_kind {
                           colour to sRGB, EXR and PFM decode 8-bit colour to linear light */
   RR_IMAGE_AOV         /* RR_IMAGE_AOV + a: AOV a of rr_frame_aov, values as they are, EXR channels
                           depth Z, normal N.X N.Y N.Z, bary bary.u bary.v (λ1, λ2), id, mesh and
-                          material (32-bit UINT), evals, nodes, coverage; per sample s (2 digits):
-                          id.sNN, Z.sNN, mesh.sNN */
+                          material (32-bit UINT), evals, nodes, coverage, albedo.R/G/B, direct.R/G/B,
+                          reflection.R/G/B, shadow, emission.R/G/B; per sample s (2 digits): id.sNN,
+                          Z.sNN, mesh.sNN */
 } rr_image_kind;
 
 /* An image owned by the caller or by rastray (rr_image_free). */

@@ -51,6 +51,18 @@ static void add_light(rr_scene *s, rr_light_info l) {
   CHECK(rr_scene_add_light(s, &l) == RR_OK, "rr_scene_add_light: %s", rr_device_message(dev));
 }
 
+static bool near3(const float *v, float x, float y, float z, float tol) {
+  return fabsf(v[0] - x) <= tol && fabsf(v[1] - y) <= tol && fabsf(v[2] - z) <= tol;
+}
+
+static float *aov(const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_aov a) {
+  rr_image img = {0};
+  CHECK(rr_frame_aov(dev, s, cam, f, a, &img) == RR_OK && img.channels == (a == RR_AOV_SHADOW ? 1 : 3) &&
+            img.kind == RR_IMAGE_AOV + (int)a,
+        "AOV %d: %s", (int)a, rr_device_message(dev));
+  return img.data;
+}
+
 /* A white Lambert plane under a directional light of irradiance E has radiance
  * E cos θ / π, from every direction it is seen; shadow rays: one per pixel. */
 static void check_radiance_identity(void) {
@@ -162,7 +174,7 @@ static void check_shadows(void) {
   rr_camera cam = view(0, 5, 0.01f, 0, 0, 0, 0, 0, -1);
   enum { W = 160 };
   rr_frame *f = NULL;
-  float *img = lit(s, &cam, W, W, NULL, &f, NULL);
+  float *img = lit(s, &cam, W, W, NULL, &f, NULL), *shadow = f ? aov(s, &cam, f, RR_AOV_SHADOW) : NULL;
   int judged = 0, dark = 0, wrong = 0;
   for (int k = 0; img && f && k < W * W; k++) {
     if (rr_frame_ids(f)[k] >= 2) continue; /* the plane's */
@@ -175,14 +187,14 @@ static void check_shadows(void) {
     bool blocked = t > 0;
     double want = blocked ? 0 : I * (d[1] / sqrt(d2)) / (RR_PI * d2);
     judged++, dark += blocked;
-    if (fabs(img[3 * k] - want) > 1e-4 * want + (blocked ? 0 : 1e-7)) {
+    if (fabs(img[3 * k] - want) > 1e-4 * want + (blocked ? 0 : 1e-7) || !shadow || shadow[k] != !blocked) {
       if (wrong++ < 5) fprintf(stderr, "pixel %d (%g, %g): %g, expected %g\n", k, p[0], p[2], img[3 * k], want);
     }
   }
   printf("shadows: %d plane pixels judged, %d in shadow, %d wrong\n", judged, dark, wrong);
   CHECK(judged > W * W / 2 && dark > 300 && wrong == 0, "%d of %d plane pixels wrong (%d in shadow)", wrong, judged,
         dark);
-  free(img);
+  free(img), free(shadow);
   rr_frame_release(f);
   /* no shadows: no rays, every plane pixel lit */
   rr_shade_options so;
@@ -216,11 +228,48 @@ static void box_obj(char *out, size_t cap, float y0, float y1, const char *mtl, 
                   first_vertex + faces[f][2], first_vertex + faces[f][3]);
 }
 
+/* The lit AOVs of the mirror scene: colour = direct + reflection + emission; the
+ * box's albedo and emission are its MTL's Kd and Ke, the mirror's reflection is
+ * the colour itself (Kd 0), and light reaches the box's top. */
+static void check_parts(const rr_scene *s, const rr_camera *cam, const rr_frame *f, const float *colour) {
+  float *albedo = aov(s, cam, f, RR_AOV_ALBEDO), *direct = aov(s, cam, f, RR_AOV_DIRECT),
+        *refl = aov(s, cam, f, RR_AOV_REFLECTION), *emit = aov(s, cam, f, RR_AOV_EMISSION),
+        *shadow = aov(s, cam, f, RR_AOV_SHADOW);
+  int w, h, sums = 0, box = 0, mirror = 0, bad_sum = 0, bad_box = 0, bad_mirror = 0;
+  rr_frame_get_size(f, &w, &h);
+  for (int k = 0; albedo && direct && refl && emit && shadow && k < w * h; k++) {
+    uint32_t g = RR_MISS;
+    rr_scene_get_geometry(s, rr_frame_ids(f)[k], &g, NULL);
+    if (g == RR_MISS) continue;
+    rr_geometry_info gi;
+    rr_scene_get_geometry_info(s, g, &gi);
+    bool is_mirror = gi.name && strcmp(gi.name, "mirror") == 0;
+    for (int c = 0; c < 3; c++) {
+      float sum = direct[3 * k + c] + refl[3 * k + c] + emit[3 * k + c];
+      bad_sum += fabsf(sum - colour[3 * k + c]) > 1e-5f * (1 + colour[3 * k + c]);
+    }
+    sums++;
+    if (is_mirror) {
+      mirror++;
+      bad_mirror += !near3(albedo + 3 * k, 0, 0, 0, 0) || !near3(direct + 3 * k, 0, 0, 0, 0) ||
+                    !near3(refl + 3 * k, colour[3 * k], colour[3 * k + 1], colour[3 * k + 2], 1e-6f);
+    } else {
+      box++;
+      bad_box += !near3(albedo + 3 * k, 0.8f, 0.2f, 0.1f, 1e-6f) || !near3(emit + 3 * k, 0.05f, 0, 0, 1e-6f) ||
+                 !near3(refl + 3 * k, 0, 0, 0, 0) || !(shadow[k] == 0 || shadow[k] == 1);
+    }
+  }
+  CHECK(sums > 1000 && bad_sum == 0, "%d of %d pixels: colour != direct + reflection + emission", bad_sum, sums);
+  CHECK(box > 100 && bad_box == 0, "%d of %d box pixels with wrong parts", bad_box, box);
+  CHECK(mirror > 1000 && bad_mirror == 0, "%d of %d mirror pixels with wrong parts", bad_mirror, mirror);
+  free(albedo), free(direct), free(refl), free(emit), free(shadow);
+}
+
 /* A mirror plane (MTL illum 3, Ks 1) under a glossy box shows what the box
  * mirrored in the plane, without the plane, shows directly (lights mirrored too). */
 static void check_mirror(void) {
   write_file("m.mtl", "newmtl mirror\nKd 0 0 0\nKs 1 1 1\nillum 3\n"
-                      "newmtl red\nKd 0.8 0.2 0.1\nKs 0.4 0.4 0.4\nNs 20\nillum 2\n");
+                      "newmtl red\nKd 0.8 0.2 0.1\nKs 0.4 0.4 0.4\nNs 20\nKe 0.05 0 0\nillum 2\n");
   char a[4096], b[4096], box[2048];
   box_obj(box, sizeof box, 0.2f, 0.8f, "red", 5);
   snprintf(a, sizeof a, "mtllib m.mtl\no mirror\nusemtl mirror\nv -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\nf 1 2 3 4\n%s",
@@ -261,6 +310,7 @@ static void check_mirror(void) {
   CHECK(compared > 300 && off <= compared / 50, "mirror: %d of %d pixel channels differ from the mirrored scene (worst %g)",
         off, compared, worst);
   CHECK(st.reflection_rays > (uint64_t)compared, "%llu reflection rays", (unsigned long long)st.reflection_rays);
+  check_parts(sa, &cam, fa, ia);
   /* max depth 0: no reflection rays, the mirror shows the sky */
   rr_shade_options so;
   rr_shade_options_init(&so);
@@ -271,10 +321,6 @@ static void check_mirror(void) {
   rr_frame_release(fa), rr_frame_release(fb);
 done:
   rr_scene_release(sa), rr_scene_release(sb);
-}
-
-static bool near3(const float *v, float x, float y, float z, float tol) {
-  return fabsf(v[0] - x) <= tol && fabsf(v[1] - y) <= tol && fabsf(v[2] - z) <= tol;
 }
 
 /* The material of a file's first named material `name`, false when none. */

@@ -157,34 +157,40 @@ static void sky_along(const lighting *L, vec3 w, float o[3]) {
   for (int c = 0; c < 3; c++) o[c] = L->ground[c] + (L->sky[c] - L->ground[c]) * a;
 }
 
-/* What needs no ray: emission, and the sky on the diffuse lobe (its irradiance
- * over the hemisphere of n, exactly, without occlusion) and, on rough PBR
- * surfaces, on the specular lobe (F0 times the sky along n, an approximation). */
-static void unshadowed(const surface *sf, const lighting *L, float o[3]) {
+/* The colour of the diffuse lobe. */
+static void albedo_of(const surface *sf, float a[3]) {
+  bool pbr = sf->m && sf->m->params.model == RR_MATERIAL_PBR;
+  for (int c = 0; c < 3; c++) a[c] = sf->base[c] * (pbr ? 1 - sf->m->params.metallic : 1);
+}
+
+/* The sky's light, which needs no ray: on the diffuse lobe its irradiance over the
+ * hemisphere of n, exactly, without occlusion; on rough PBR surfaces also on the
+ * specular lobe, as F0 times the sky along n (an approximation). */
+static void sky_light(const surface *sf, const lighting *L, float o[3]) {
   const rr_material *m = sf->m;
   float nu = v3_dot(sf->n, L->up), diffuse[3], spec_sky[3] = {0, 0, 0};
-  bool pbr = m && m->params.model == RR_MATERIAL_PBR;
-  for (int c = 0; c < 3; c++) diffuse[c] = sf->base[c] * (pbr ? 1 - m->params.metallic : 1);
-  if (pbr && !(m->params.roughness < MIRROR_ROUGHNESS)) {
+  albedo_of(sf, diffuse);
+  if (m && m->params.model == RR_MATERIAL_PBR && !(m->params.roughness < MIRROR_ROUGHNESS)) {
     sky_along(L, sf->n, spec_sky);
     for (int c = 0; c < 3; c++) spec_sky[c] *= f0_of(sf, c);
   }
   for (int c = 0; c < 3; c++) {
     /* E/π of the sky L(w) = g + (s - g)(1 + w·up)/2 over the hemisphere of n */
     float e = 0.5f * (L->sky[c] + L->ground[c]) + (L->sky[c] - L->ground[c]) * nu / 3;
-    o[c] = (m ? m->params.emission[c] : 0) + diffuse[c] * e + spec_sky[c];
+    o[c] = diffuse[c] * e + spec_sky[c];
   }
 }
 
 /* ---- batches --------------------------------------------------------------- */
 
 /* The points of one bounce: their surfaces, what they pass on to the pixel
- * (throughput, rgb) and where their colour goes. */
+ * (throughput, rgb) and where their colour goes: out, and the parts of the first
+ * bounce's points (parts) or the reflection part of the point they are seen in (refl). */
 typedef struct level {
   int n;
   surface pt[LIT_BATCH];
   float w[LIT_BATCH][3];
-  float *out[LIT_BATCH];
+  float *out[LIT_BATCH], *parts[LIT_BATCH], *refl[LIT_BATCH];
 } level;
 
 struct lit_batch {
@@ -200,12 +206,17 @@ struct lit_batch {
 lit_batch *rr_lit_batch_new(void) { return calloc(1, sizeof(lit_batch)); }
 void rr_lit_batch_free(lit_batch *b) { free(b); }
 
-bool rr_lit_batch_add(lit_batch *b, const surface *sf, float *out) {
+bool rr_lit_batch_add(lit_batch *b, const surface *sf, float *out, float *parts) {
   level *lv = &b->lv[b->cur];
   if (lv->n == LIT_BATCH) return false;
-  lv->pt[lv->n] = *sf, lv->out[lv->n] = out;
+  lv->pt[lv->n] = *sf, lv->out[lv->n] = out, lv->parts[lv->n] = parts, lv->refl[lv->n] = NULL;
   lv->w[lv->n][0] = lv->w[lv->n][1] = lv->w[lv->n][2] = 1;
   out[0] = out[1] = out[2] = 0;
+  if (parts) {
+    memset(parts, 0, LIT_PARTS * sizeof *parts);
+    albedo_of(sf, parts + LIT_ALBEDO);
+    parts[LIT_SHADOW] = 1;
+  }
   lv->n++;
   return true;
 }
@@ -219,17 +230,27 @@ static rr_ray leave(const lighting *L, vec3 p, vec3 ng, vec3 dir, float tmax) {
   return (rr_ray){{o.x, o.y, o.z}, {dir.x, dir.y, dir.z}, 0, tmax};
 }
 
-static void add_to(float *out, const float w[3], const float v[3]) {
-  for (int c = 0; c < 3; c++) out[c] += w[c] * v[c];
+/* Adds w·v to point i's colour and to the part it belongs to: `part` for a point
+ * of the first bounce, the reflection of the point it is seen in for the others. */
+static void credit(const level *lv, int i, int part, const float w[3], const float v[3]) {
+  float *p = lv->parts[i] ? lv->parts[i] + part : lv->refl[i];
+  for (int c = 0; c < 3; c++) {
+    lv->out[i][c] += w[c] * v[c];
+    if (p) p[c] += w[c] * v[c];
+  }
 }
 
 /* Direct light on a level's points: one pass per light, its shadow rays in one stream. */
 static void direct(lit_batch *b, const level *lv, const rr_scene *s, const lighting *L, lit_stats *st) {
   for (int i = 0; i < lv->n; i++) {
-    float u[3];
-    unshadowed(&lv->pt[i], L, u);
-    add_to(lv->out[i], lv->w[i], u);
+    float sky[3];
+    sky_light(&lv->pt[i], L, sky);
+    credit(lv, i, LIT_DIRECT, lv->w[i], sky);
+    if (lv->pt[i].m) credit(lv, i, LIT_EMISSION, lv->w[i], lv->pt[i].m->params.emission);
   }
+  float share = L->nlights ? 1.0f / (float)L->nlights : 0; /* of the shadow part, per light */
+  for (int i = 0; i < lv->n; i++)
+    if (lv->parts[i] && L->nlights) lv->parts[i][LIT_SHADOW] = 0;
   for (int li = 0; li < L->nlights; li++) {
     const light *lt = &L->lights[li];
     int nr = 0;
@@ -242,9 +263,10 @@ static void direct(lit_batch *b, const level *lv, const rr_scene *s, const light
       if (!(cos > 0)) continue;
       brdf(sf, l, f);
       float c3[3];
-      for (int c = 0; c < 3; c++) c3[c] = lv->w[i][c] * f[c] * E[c] * cos;
+      for (int c = 0; c < 3; c++) c3[c] = f[c] * E[c] * cos;
       if (L->shadows == RR_SHADOWS_NONE) {
-        for (int c = 0; c < 3; c++) lv->out[i][c] += c3[c];
+        credit(lv, i, LIT_DIRECT, lv->w[i], c3);
+        if (lv->parts[i]) lv->parts[i][LIT_SHADOW] += share;
         continue;
       }
       bool far = lt->type == RR_LIGHT_DIRECTIONAL;
@@ -262,9 +284,12 @@ static void direct(lit_batch *b, const level *lv, const rr_scene *s, const light
     rr_ray_stream rs = rr_ray_stream_aos(b->ray, (size_t)nr);
     rr_occluded_stream(NULL, s, &rs, 1, b->occluded); /* a refused ray (zero length) counts as lit */
     st->shadow_ms += rr_now_ms() - t0, st->shadow_rays += (uint64_t)nr;
-    for (int k = 0; k < nr; k++)
-      if (!b->occluded[k])
-        for (int c = 0; c < 3; c++) lv->out[b->who[k]][c] += b->add[k][c];
+    for (int k = 0; k < nr; k++) {
+      int i = b->who[k];
+      if (b->occluded[k]) continue;
+      credit(lv, i, LIT_DIRECT, lv->w[i], b->add[k]);
+      if (lv->parts[i]) lv->parts[i][LIT_SHADOW] += share;
+    }
   }
 }
 
@@ -287,7 +312,7 @@ static void reflect(lit_batch *b, const level *lv, level *next, bool last, const
     if (last) {
       float sky[3];
       sky_along(L, r, sky);
-      add_to(lv->out[i], w, sky);
+      credit(lv, i, LIT_REFLECTION, w, sky);
       continue;
     }
     b->ray[nr] = leave(L, sf->p, sf->ng, r, INFINITY);
@@ -302,17 +327,18 @@ static void reflect(lit_batch *b, const level *lv, level *next, bool last, const
   for (int k = 0; k < nr; k++) {
     uint32_t idx = rr_scene_index_of(s, b->hit[k].prim);
     vec3 org = v3_load(b->ray[k].org), dir = v3_load(b->ray[k].dir);
-    float *out = lv->out[b->who[k]];
+    int i = b->who[k];
     if (idx == RR_MISS) {
       float sky[3];
       sky_along(L, dir, sky);
-      add_to(out, b->add[k], sky);
+      credit(lv, i, LIT_REFLECTION, b->add[k], sky);
       continue;
     }
     int j = next->n++;
     fn(ctx, idx, b->hit[k].l1, b->hit[k].l2, b->hit[k].t, org, dir, &next->pt[j]);
     memcpy(next->w[j], b->add[k], sizeof b->add[k]);
-    next->out[j] = out;
+    next->out[j] = lv->out[i], next->parts[j] = NULL;
+    next->refl[j] = lv->parts[i] ? lv->parts[i] + LIT_REFLECTION : lv->refl[i];
   }
   st->reflection_ms += rr_now_ms() - t0, st->reflection_rays += (uint64_t)nr;
 }

@@ -54,14 +54,26 @@ typedef struct lit_stats {
 } lit_stats;
 
 enum { LIT_BATCH = 1024 }; /* most points of a batch */
+
+/* A point's colour in parts (the lit AOVs, named as Blender Cycles' passes): offsets
+ * into an array of LIT_PARTS floats. The colour is direct + reflection + emission. */
+enum {
+  LIT_ALBEDO = 0,      /* rgb: the diffuse lobe's colour */
+  LIT_DIRECT = 3,      /* rgb: light from the lights and the sky on the point itself */
+  LIT_REFLECTION = 6,  /* rgb: what its mirror reflects (all bounces) */
+  LIT_EMISSION = 9,    /* rgb: what it emits */
+  LIT_SHADOW = 12,     /* the fraction of the punctual lights that reach it (1 when there is none) */
+  LIT_PARTS = 13
+};
 typedef struct lit_batch lit_batch;
 
 /* A batch, empty (NULL when out of memory); one per thread. */
 lit_batch *rr_lit_batch_new(void);
 void rr_lit_batch_free(lit_batch *b);
-/* Queues a point whose linear colour goes to out[0..2] when the batch is shaded;
- * false when the batch is full. */
-bool rr_lit_batch_add(lit_batch *b, const surface *sf, float *out);
+/* Queues a point whose linear colour goes to out[0..2] when the batch is shaded,
+ * and its parts to parts[0 .. LIT_PARTS - 1] unless parts is NULL; false when the
+ * batch is full. */
+bool rr_lit_batch_add(lit_batch *b, const surface *sf, float *out, float *parts);
 /* Shades the queued points under L, writes their colours and empties the batch;
  * rays through s's streams on this thread, reflected hits made by fn(ctx). */
 void rr_lit_batch_shade(lit_batch *b, const rr_scene *s, const lighting *L, surface_fn fn, void *ctx, lit_stats *st);

@@ -290,7 +290,7 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, lit_batch *lb, i
         if (p->lit) { /* shaded with the run's other points; the colour arrives in r->rgb[i] */
           surface sf;
           hit_surface(s, &h, o, &p->tex, &sf);
-          queued = rr_lit_batch_add(lb, &sf, &r->rgb[i][3 * j]);
+          queued = rr_lit_batch_add(lb, &sf, &r->rgb[i][3 * j], NULL);
         } else {
           shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
         }
@@ -518,7 +518,7 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
                           rr_image *out) {
   const visbuf *vb = &f->vb;
   rr_error e;
-  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1, 1, 1, 1};
+  static const int channels[RR_AOV_COUNT] = {1, 1, 3, 2, 1, 1, 1, 1, 1}; /* the lit parts: lit_aov */
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
     if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
@@ -559,6 +559,48 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
       }
   }
   return rr_ok(dev);
+}
+
+/* The lit mode's parts (AOVs albedo .. emission) at the sample nearest each pixel's
+ * centre, under the lights of the default lit shading. */
+static rr_error lit_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, const camera *cams,
+                        const rr_frame *f, rr_aov aov, rr_image *out) {
+  static const int part[] = {LIT_ALBEDO, LIT_DIRECT, LIT_REFLECTION, LIT_SHADOW, LIT_EMISSION};
+  int ch = aov == RR_AOV_SHADOW ? 1 : 3, first = part[aov - RR_AOV_ALBEDO], centre = centre_sample(f);
+  rr_shade_options opt;
+  rr_shade_options_init(&opt);
+  opt.mode = RR_SHADE_LIT;
+  bool empty;
+  if (!rr_bvh_of(dev, s, &empty) && !empty) return RR_ERROR_ARGUMENT; /* rays need the current BVH */
+  const visbuf vb = visbuf_layer(&f->vb, centre);
+  size_t npix = (size_t)vb.width * vb.height;
+  shade_pass *p = calloc(1, sizeof *p); /* what reflected_surface reads */
+  float *parts = calloc(npix, LIT_PARTS * sizeof(float)), (*colour)[3] = malloc(LIT_BATCH * sizeof *colour);
+  lit_batch *lb = rr_lit_batch_new();
+  rr_error e = p && parts && colour && lb ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for AOV %d", (int)aov);
+  if (!e) e = rr_lighting_make(dev, s, cam, &opt, &p->lights);
+  if (!e) {
+    p->s = s, p->tex = (tex_filter){opt.texture_filter, opt.aniso, opt.lod_bias};
+    lit_stats st = {0};
+    int queued = 0;
+    for (size_t k = 0; k < npix; k++) {
+      int x = (int)(k % vb.width), y = (int)(k / vb.width);
+      vec3 o, d;
+      if (vb.id[k] >= s->ntris || !rr_cam_ray(&cams[centre], x, y, &o, &d)) continue; /* 0 */
+      hit h = hit_make(s, vb.id[k], vb.l1[k], vb.l2[k], vb.t[k], d);
+      surface sf;
+      hit_surface(s, &h, o, &p->tex, &sf);
+      rr_lit_batch_add(lb, &sf, colour[queued++], parts + k * LIT_PARTS);
+      if (queued == LIT_BATCH) rr_lit_batch_shade(lb, s, &p->lights, reflected_surface, p, &st), queued = 0;
+    }
+    rr_lit_batch_shade(lb, s, &p->lights, reflected_surface, p, &st);
+    rr_lighting_release(&p->lights);
+    e = image_alloc(dev, out, vb.width, vb.height, ch, RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov);
+  }
+  for (size_t k = 0; !e && k < npix; k++)
+    memcpy((float *)out->data + k * ch, parts + k * LIT_PARTS + first, ch * sizeof(float));
+  free(p), free(parts), free(colour), rr_lit_batch_free(lb);
+  return e ? e : rr_ok(dev);
 }
 
 /* The public entry points resolve the frame's cameras, one per sample position, around the work. */
@@ -620,7 +662,7 @@ rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, c
   camera cams[RR_MAX_SAMPLES];
   rr_error e = frame_cameras(dev, cam, f, cams);
   if (e) return e;
-  e = frame_aov(dev, s, cams, f, aov, out);
+  e = aov >= RR_AOV_ALBEDO ? lit_aov(dev, s, cam, cams, f, aov, out) : frame_aov(dev, s, cams, f, aov, out);
   for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
   return e;
 }

@@ -99,7 +99,8 @@ int rr_shade_from_name(const char *name) {
 
 int rr_aov_from_name(const char *name) {
   static const char *const names[RR_AOV_COUNT] = {"depth", "id",       "normal",    "bary",         "evals",      "nodes",
-                                                  "mesh",  "material", "coverage", "sample-id", "sample-depth", "sample-mesh"};
+                                                  "mesh",  "material", "coverage", "sample-id", "sample-depth", "sample-mesh",
+                                                  "albedo", "direct", "reflection", "shadow", "emission"};
   return name_index(names, RR_AOV_COUNT, name);
 }
 
