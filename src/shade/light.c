@@ -76,9 +76,8 @@ void rr_lighting_release(lighting *L) {
 
 /* ---- the material model --------------------------------------------------- */
 
-/* Light arriving at p from light li: the unit direction towards it, the irradiance
- * on a surface facing it (E, rgb) and the shadow ray's end (the light's position,
- * or none for a directional light). false when no light arrives. */
+/* Light arriving at p from light li: the unit direction l towards it and the
+ * irradiance E (rgb) on a surface facing it; false when none arrives. */
 static bool light_at(const light *li, vec3 p, vec3 *l, float E[3]) {
   float k = 1;
   if (li->type == RR_LIGHT_DIRECTIONAL) {
@@ -215,7 +214,6 @@ bool rr_lit_batch_add(lit_batch *b, const surface *sf, float *out, float *parts)
   if (parts) {
     memset(parts, 0, LIT_PARTS * sizeof *parts);
     albedo_of(sf, parts + LIT_ALBEDO);
-    parts[LIT_SHADOW] = 1;
   }
   lv->n++;
   return true;
@@ -247,10 +245,9 @@ static void direct(lit_batch *b, const level *lv, const rr_scene *s, const light
     sky_light(&lv->pt[i], L, sky);
     credit(lv, i, LIT_DIRECT, lv->w[i], sky);
     if (lv->pt[i].m) credit(lv, i, LIT_EMISSION, lv->w[i], lv->pt[i].m->params.emission);
+    if (lv->parts[i] && !L->nlights) lv->parts[i][LIT_SHADOW] = 1; /* nothing to block */
   }
   float share = L->nlights ? 1.0f / (float)L->nlights : 0; /* of the shadow part, per light */
-  for (int i = 0; i < lv->n; i++)
-    if (lv->parts[i] && L->nlights) lv->parts[i][LIT_SHADOW] = 0;
   for (int li = 0; li < L->nlights; li++) {
     const light *lt = &L->lights[li];
     int nr = 0;
