@@ -229,6 +229,7 @@ typedef struct shade_pass {
   bool lit;          /* RR_SHADE_LIT: the run's points are shaded together (light.h) */
   lighting lights;
   lit_stats lit_st[RR_MAX_THREADS];
+  lit_batch *batch[RR_MAX_THREADS]; /* each thread's, made by its first job and kept for the pass */
 } shade_pass;
 
 /* A reflection ray's hit as the lit mode's surface (light.h's surface_fn). Texture
@@ -326,10 +327,11 @@ static void shade_rows(int job, int thread, void *arg) {
   int n = p->samples;
   uint64_t shades = 0;
   sample_run *r = malloc(sizeof *r);
-  lit_batch *lb = p->lit ? rr_lit_batch_new() : NULL;
+  if (p->lit && !p->batch[thread]) p->batch[thread] = rr_lit_batch_new();
+  lit_batch *lb = p->lit ? p->batch[thread] : NULL;
   if (!r || (p->lit && !lb)) { /* a job without room leaves its rows for shade_frame to report */
     p->failed = true;
-    free(r), rr_lit_batch_free(lb);
+    free(r);
     return;
   }
   for (int y = job * SHADE_ROWS; y < vb->height && y < (job + 1) * SHADE_ROWS; y++) {
@@ -369,7 +371,7 @@ static void shade_rows(int job, int thread, void *arg) {
       }
     }
   }
-  free(r), rr_lit_batch_free(lb);
+  free(r);
   p->shades[thread] += shades;
 }
 
@@ -466,6 +468,7 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
       }
     }
   }
+  for (int t = 0; t < RR_MAX_THREADS; t++) rr_lit_batch_free(p->batch[t]);
   free(p->rgb), free(p->weight), free(p->alpha), free(p);
   return e ? e : rr_ok(dev);
 }
