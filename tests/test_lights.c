@@ -143,6 +143,40 @@ static void check_inverse_square(void) {
   rr_scene_release(s);
 }
 
+/* A spot light: glTF's falloff, full inside the inner cone, the square of a linear
+ * ramp in cos between the cones, nothing outside the outer one. */
+static void check_spot(void) {
+  static const float plane[1][4][3] = {{{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}}};
+  static const float white[1][3] = {{1, 1, 1}};
+  rr_scene *s = quads(1, plane, white);
+  if (!s) return;
+  const float I = 3.0f;
+  rr_light_info l = {.type = RR_LIGHT_SPOT, .position = {0, 1, 0}, .direction = {0, -1, 0}, .color = {I, I, I},
+                     .inner_cone_deg = 20, .outer_cone_deg = 40};
+  add_light(s, l);
+  rr_camera cam = view(0, 5, 0.01f, 0, 0, 0, 0, 0, -1);
+  enum { W = 64 };
+  rr_frame *f = NULL;
+  float *img = lit(s, &cam, W, W, NULL, &f, NULL);
+  int region[3] = {0, 0, 0}, bad = 0; /* outside, between, inside */
+  double ci = cos(20 * RR_PI / 180), co = cos(40 * RR_PI / 180);
+  for (int k = 0; img && f && k < W * W; k++) {
+    if (rr_frame_ids(f)[k] == RR_MISS) continue;
+    double p[3];
+    sample_point(f, k, plane, p);
+    double d2 = p[0] * p[0] + 1 + p[2] * p[2], cd = 1 / sqrt(d2); /* cos from the axis = cos from the normal */
+    double t = fmin(fmax((cd - co) / (ci - co), 0), 1), want = I * t * t * cd / (RR_PI * d2);
+    region[t <= 0 ? 0 : t >= 1 ? 2 : 1]++;
+    bad += fabs(img[3 * k] - want) > 1e-4 * want + 1e-6;
+  }
+  CHECK(region[0] > 100 && region[1] > 100 && region[2] > 50 && bad == 0,
+        "spot: %d of %d pixels off (%d outside, %d between, %d inside the cones)", bad,
+        region[0] + region[1] + region[2], region[0], region[1], region[2]);
+  free(img);
+  rr_frame_release(f);
+  rr_scene_release(s);
+}
+
 /* Möller–Trumbore in double: the t in (0, 1) where p + t·d meets triangle abc, or -1. */
 static double ray_tri(const double p[3], const double d[3], const float *a, const float *b, const float *c) {
   double e1[3], e2[3], s[3], h[3], q[3];
@@ -436,6 +470,63 @@ static void check_gltf(void) {
   rr_scene_release(s);
 }
 
+/* A glTF metallic–roughness plane under a directional light against the model
+ * of shading.md evaluated in double: Lambert (1 - F) c (1 - m)/π plus GGX D,
+ * height-correlated Smith and Schlick's F, per pixel with its own view direction. */
+static void check_ggx(void) {
+  static const float q[18] = {-1, 0, -1, -1, 0, 1, 1, 0, 1, -1, 0, -1, 1, 0, 1, 1, 0, -1};
+  const double base[3] = {0.8, 0.5, 0.2}, m = 0.5, r = 0.4, E = 2, L[3] = {0.3, -1, 0.2};
+  char b64[128], text[2048];
+  base64((const unsigned char *)q, sizeof q, b64);
+  snprintf(text, sizeof text,
+           "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+           "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
+           "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[%g,%g,%g,1],\"metallicFactor\":%g,"
+           "\"roughnessFactor\":%g}}],\"buffers\":[{\"byteLength\":72,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+           "\"bufferViews\":[{\"buffer\":0,\"byteLength\":72}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,"
+           "\"count\":6,\"type\":\"VEC3\",\"min\":[-1,0,-1],\"max\":[1,0,1]}]}",
+           base[0], base[1], base[2], m, r, b64);
+  rr_scene *s = NULL;
+  CHECK(rr_scene_load(dev, write_file("ggx.gltf", text), &s) == RR_OK, "%s", rr_device_message(dev));
+  if (!s) return;
+  rr_light_info sun = {.type = RR_LIGHT_DIRECTIONAL, .direction = {(float)L[0], (float)L[1], (float)L[2]},
+                       .color = {(float)E, (float)E, (float)E}};
+  add_light(s, sun);
+  const float eye[3] = {0.6f, 2.0f, 0.4f}; /* the light's mirror direction from the centre: the highlight in view */
+  rr_camera cam = view(eye[0], eye[1], eye[2], 0, 0, 0, 0, 0, -1);
+  enum { W = 64 };
+  rr_frame *f = NULL;
+  float *img = lit(s, &cam, W, W, NULL, &f, NULL);
+  int hits = 0, bad = 0;
+  double top = 0, low = INFINITY;
+  double ll = sqrt(L[0] * L[0] + L[1] * L[1] + L[2] * L[2]), l[3] = {-L[0] / ll, -L[1] / ll, -L[2] / ll};
+  for (int k = 0; img && f && k < W * W; k++) {
+    uint32_t id = rr_frame_ids(f)[k];
+    if (id == RR_MISS) continue;
+    double p[3], v[3], vl = 0, l1 = rr_frame_bary1(f)[k], l2 = rr_frame_bary2(f)[k];
+    for (int a = 0; a < 3; a++)
+      p[a] = (1 - l1 - l2) * q[9 * id + a] + l1 * q[9 * id + 3 + a] + l2 * q[9 * id + 6 + a], v[a] = eye[a] - p[a],
+      vl += v[a] * v[a];
+    double h[3], hl = 0;
+    for (int a = 0; a < 3; a++) v[a] /= sqrt(vl), h[a] = v[a] + l[a], hl += h[a] * h[a];
+    double nl = l[1], nv = v[1], nh = h[1] / sqrt(hl), vh = (v[0] * h[0] + v[1] * h[1] + v[2] * h[2]) / sqrt(hl);
+    double a2 = r * r * r * r, D = a2 / (RR_PI * pow(nh * nh * (a2 - 1) + 1, 2));
+    double V = 0.5 / (nl * sqrt(nv * nv * (1 - a2) + a2) + nv * sqrt(nl * nl * (1 - a2) + a2));
+    hits++;
+    for (int c = 0; c < 3; c++) {
+      double F0 = 0.04 * (1 - m) + base[c] * m, F = F0 + (1 - F0) * pow(1 - vh, 5);
+      double want = ((1 - F) * base[c] * (1 - m) / RR_PI + F * D * V) * E * nl;
+      bad += fabs(img[3 * k + c] - want) > 1e-4 * want;
+      if (c == 0) top = fmax(top, want), low = fmin(low, want);
+    }
+  }
+  CHECK(hits > W * W / 4 && top > 1.5 * low && bad == 0, "GGX: %d of %d pixel channels off (radiance %g..%g)", bad,
+        3 * hits, low, top);
+  free(img);
+  rr_frame_release(f);
+  rr_scene_release(s);
+}
+
 static void check_collada(void) {
   const char *dae =
       "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
@@ -596,10 +687,12 @@ int main(void) {
   dev = rr_device_new();
   check_radiance_identity();
   check_inverse_square();
+  check_spot();
   check_shadows();
   check_mirror();
   check_mtl();
   check_gltf();
+  check_ggx();
   check_collada();
   check_api();
   check_cli();
