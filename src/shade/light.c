@@ -50,6 +50,15 @@ static bool default_rig(lighting *L, const rr_scene *s, const rr_camera *cam) {
   return push_light(L, &key);
 }
 
+/* Whether a file's light can be shaded: finite, colours not negative (a file may say anything). */
+static bool usable(const rr_light_info *li) {
+  const float *v[] = {li->position, li->direction, li->color, li->ground};
+  for (int k = 0; k < 4; k++)
+    for (int c = 0; c < 3; c++)
+      if (!isfinite(v[k][c]) || (k >= 2 && v[k][c] < 0)) return false;
+  return isfinite(li->inner_cone_deg) && isfinite(li->outer_cone_deg);
+}
+
 rr_error rr_lighting_make(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_shade_options *opt,
                        lighting *L) {
   *L = (lighting){.up = s->up, .shadows = opt->shadows, .max_depth = opt->max_depth};
@@ -58,6 +67,7 @@ rr_error rr_lighting_make(rr_device *dev, const rr_scene *s, const rr_camera *ca
   bool ok = true;
   for (uint32_t k = 0; k < s->nlights && ok; k++) {
     const rr_light_info *li = &s->lights[k];
+    if (!usable(li)) continue;
     if (li->type == RR_LIGHT_AMBIENT) add_sky(L, li);
     else if (li->type != RR_LIGHT_UNDEFINED) ok = push_light(L, li);
   }
