@@ -335,6 +335,12 @@ typedef struct rr_material_info {
 /* Fills what is known about material `material` (0 .. rr_scene_info.materials - 1);
  * pointers stay valid until the scene is released. */
 RR_API rr_error rr_scene_get_material_info(const rr_scene *scene, uint32_t material, rr_material_info *info);
+/* Overrides material `material`'s base colour (color NULL: kept) and shading inputs
+ * (params NULL: kept), e.g. for a scene file's material overrides: a known model,
+ * finite values, colours at least 0, shininess 0 .. 10000, metallic, roughness and
+ * opacity 0 .. 1; the texture stays. Not thread-safe: nothing may render meanwhile. */
+RR_API rr_error rr_scene_set_material(rr_scene *scene, uint32_t material, const float color[3],
+                                      const rr_material_params *params);
 
 /* The file's camera `index` (0 .. rr_scene_info.cameras - 1) as an rr_camera for a
  * width × height image: eye, target one unit along its view, up, and the field of

@@ -591,6 +591,27 @@ static void check_api(void) {
   rr_scene_info in;
   rr_scene_get_info(s, &in);
   CHECK(in.lights == 0, "%u lights after refusals", in.lights);
+  /* a material made a mirror through the API reflects; bad values are refused */
+  rr_material_info mi;
+  CHECK(rr_scene_get_material_info(s, 0, &mi) == RR_OK, "%s", rr_device_message(dev));
+  rr_material_params mirror = mi.params, bad_params = mi.params;
+  mirror.illum = 3, mirror.specular[0] = mirror.specular[1] = mirror.specular[2] = 0.5f;
+  const float grey[3] = {0.25f, 0.25f, 0.25f};
+  CHECK(rr_scene_set_material(s, 0, grey, &mirror) == RR_OK && rr_scene_get_material_info(s, 0, &mi) == RR_OK &&
+            mi.params.illum == 3 && mi.color[0] == 0.25f,
+        "rr_scene_set_material: %s", rr_device_message(dev));
+  bad_params.roughness = 2;
+  CHECK(rr_scene_set_material(s, 0, NULL, &bad_params) == RR_ERROR_ARGUMENT &&
+            rr_scene_set_material(s, 0, (const float[3]){0, NAN, 0}, NULL) == RR_ERROR_ARGUMENT &&
+            rr_scene_set_material(s, 99, grey, NULL) == RR_ERROR_ARGUMENT,
+        "bad materials accepted");
+  rr_shade_stats mst;
+  rr_camera top = view(0.5f, 0.5f, 0.5f, 0.5f, 0, 0.5f, 0, 0, -1);
+  free(lit(s, &top, 16, 16, NULL, NULL, &mst));
+  CHECK(mst.reflection_rays == 16 * 16, "a mirror set through the API: %llu reflection rays",
+        (unsigned long long)mst.reflection_rays);
+  mirror.illum = 2;
+  rr_scene_set_material(s, 0, NULL, &mirror);
   rr_camera cam = view(0.5f, 0.5f, 0.5f, 0.5f, 0, 0.5f, 0, 0, -1);
   rr_shade_options so;
   rr_shade_options_init(&so);

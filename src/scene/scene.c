@@ -493,6 +493,33 @@ uint32_t rr_scene_index_of(const rr_scene *s, uint32_t id) {
   return lo < s->ntris && s->file_id[lo] == id ? lo : RR_MISS;
 }
 
+/* Why a caller's material cannot be set, or NULL. */
+static const char *material_problem(const float color[3], const rr_material_params *p) {
+  const float *rgb[] = {color, p ? p->specular : NULL, p ? p->ambient : NULL, p ? p->emission : NULL};
+  for (int k = 0; k < 4; k++)
+    for (int c = 0; rgb[k] && c < 3; c++)
+      if (!(rgb[k][c] >= 0 && isfinite(rgb[k][c]))) return "a colour that is negative or not finite";
+  if (!p) return NULL;
+  if ((int)p->model < 0 || p->model >= RR_MATERIAL_MODEL_COUNT) return "an unknown model";
+  if (!(p->shininess >= 0 && p->shininess <= 10000)) return "a shininess outside 0 .. 10000";
+  if (!(p->metallic >= 0 && p->metallic <= 1 && p->roughness >= 0 && p->roughness <= 1 && p->opacity >= 0 &&
+        p->opacity <= 1))
+    return "a metallic, roughness or opacity outside 0 .. 1";
+  return NULL;
+}
+
+rr_error rr_scene_set_material(rr_scene *s, uint32_t material, const float color[3], const rr_material_params *params) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if (material >= s->nmaterials)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_set_material: material %u out of range (%u in the scene)",
+                   material, s->nmaterials);
+  const char *why = material_problem(color, params);
+  if (why) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_set_material: %s", why);
+  if (color) memcpy(s->materials[material].color, color, 3 * sizeof *color);
+  if (params) s->materials[material].params = *params;
+  return rr_ok(s->dev);
+}
+
 /* Why a caller's light cannot be added, or NULL; fills the unit direction and the default cone into *l. */
 static const char *light_problem(rr_light_info *l) {
   if (l->type != RR_LIGHT_DIRECTIONAL && l->type != RR_LIGHT_POINT && l->type != RR_LIGHT_SPOT &&
