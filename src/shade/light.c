@@ -43,7 +43,7 @@ static bool default_rig(lighting *L, const rr_scene *s, const rr_camera *cam) {
   if (!(v3_dot(right, right) > 1e-8f)) right = v3_cross(fwd, v3(fwd.y, fwd.z, fwd.x)); /* looking along up */
   right = v3_norm(right);
   vec3 towards = v3_norm(v3_add(v3_add(v3_scale(up, 1.0f), v3_scale(fwd, -0.7f)), v3_scale(right, -0.6f)));
-  rr_light_info key = {.type = RR_LIGHT_DIRECTIONAL, .color = {2.6f, 2.55f, 2.45f}};
+  rr_light_info key = {.type = RR_LIGHT_DIRECTIONAL, .color = {2.3f, 2.25f, 2.15f}};
   v3_store(key.direction, v3_neg(towards));
   rr_light_info sky = {.type = RR_LIGHT_AMBIENT, .color = {0.24f, 0.27f, 0.32f}, .ground = {0.075f, 0.07f, 0.065f}};
   add_sky(L, &sky);
