@@ -297,7 +297,10 @@ static rr_error read_params(rr_material *mt, const struct aiMaterial *am, bool g
     if (mt->maps[maps[k].map] || aiGetMaterialTexture(am, maps[k].type, 0, &tex, NULL, NULL, NULL, NULL, NULL, NULL) != AI_SUCCESS ||
         !tex.length)
       continue;
-    if (!(mt->maps[maps[k].map] = strdup(tex.data))) return RR_ERROR_MEMORY;
+    char *name = malloc(tex.length + 1);
+    if (!name) return RR_ERROR_MEMORY;
+    memcpy(name, tex.data, tex.length + 1);
+    mt->maps[maps[k].map] = name;
   }
   return RR_OK;
 }
