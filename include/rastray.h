@@ -293,18 +293,58 @@ typedef enum rr_texture_status {
 /* The name of a texture status ("none", "file", "embedded", "missing", "unreadable"), NULL when out of range. */
 RR_API const char *rr_texture_status_name(int status);
 
+/* Which lobes a material's specular part takes (docs/shading.md). */
+typedef enum rr_material_model {
+  RR_MATERIAL_PHONG = 0, /* MTL and the other formats: Lambert diffuse + normalised Blinn–Phong (ks, shininess) */
+  RR_MATERIAL_PBR,       /* glTF metallic–roughness: Lambert diffuse + GGX microfacet specular */
+  RR_MATERIAL_MODEL_COUNT
+} rr_material_model;
+
+/* The name of a material model ("phong", "pbr"), NULL when out of range. */
+RR_API const char *rr_material_model_name(int model);
+
+/* Textures a material may name besides the base colour's; listed, not yet used in shading. */
+typedef enum rr_material_map {
+  RR_MAP_SPECULAR = 0,         /* MTL map_Ks */
+  RR_MAP_NORMAL,               /* MTL map_Bump / bump / norm, glTF normalTexture */
+  RR_MAP_OCCLUSION,            /* glTF occlusionTexture */
+  RR_MAP_EMISSIVE,             /* MTL map_Ke, glTF emissiveTexture */
+  RR_MAP_METALLIC_ROUGHNESS,   /* glTF metallicRoughnessTexture */
+  RR_MAP_COUNT
+} rr_material_map;
+
+/* The shading inputs of a material, linear RGB; see docs/shading.md for how they are used. */
+typedef struct rr_material_params {
+  rr_material_model model;
+  float specular[3]; /* phong: Ks, the specular lobe's colour (0: none) */
+  float shininess;   /* phong: Ns, the Blinn–Phong exponent (0 .. 10000) */
+  float ambient[3];  /* MTL Ka, kept for reference: ambient light comes from the scene's sky (see shading.md) */
+  float emission[3]; /* MTL Ke, glTF emissiveFactor: emitted radiance */
+  float opacity;     /* MTL d (or 1 - Tr), glTF base colour alpha; 1: opaque (kept; shading is opaque) */
+  int illum;         /* MTL illum (-1 when not given); 3: mirror reflection of colour Ks */
+  float metallic, roughness; /* pbr: glTF's factors (default 1, 1); roughness below 0.1 is a mirror */
+} rr_material_params;
+
 typedef struct rr_material_info {
   const char *name;     /* the file's name for it, NULL when none */
-  float color[3];       /* base colour, linear RGB */
+  float color[3];       /* base colour, linear RGB (MTL Kd, glTF baseColorFactor) */
   const char *texture;  /* the base colour texture as the file names it ("*0": the file's first
                            embedded one), NULL when none */
   rr_texture_status texture_status;
   int texture_width, texture_height; /* 0 unless the texture was read */
+  rr_material_params params;
+  const char *maps[RR_MAP_COUNT]; /* other textures the file names (not yet used), NULL when none */
 } rr_material_info;
 
 /* Fills what is known about material `material` (0 .. rr_scene_info.materials - 1);
  * pointers stay valid until the scene is released. */
 RR_API rr_error rr_scene_get_material_info(const rr_scene *scene, uint32_t material, rr_material_info *info);
+/* Overrides material `material`'s base colour (color NULL: kept) and shading inputs
+ * (params NULL: kept), e.g. for a scene file's material overrides: a known model,
+ * finite values, colours at least 0, shininess 0 .. 10000, metallic, roughness and
+ * opacity 0 .. 1; the texture stays. Not thread-safe: nothing may render meanwhile. */
+RR_API rr_error rr_scene_set_material(rr_scene *scene, uint32_t material, const float color[3],
+                                      const rr_material_params *params);
 
 /* The file's camera `index` (0 .. rr_scene_info.cameras - 1) as an rr_camera for a
  * width × height image: eye, target one unit along its view, up, and the field of
@@ -332,20 +372,36 @@ typedef enum rr_light_type {
 /* The name of a light type ("directional", ...), NULL when out of range. */
 RR_API const char *rr_light_type_name(int type);
 
-/* A light of the file in world space, kept for lighting; nothing renders it yet. */
+/* A light in world space, from a file or rr_scene_add_light; the lit shade mode
+ * renders it (docs/shading.md). Units as glTF's KHR_lights_punctual: color is linear
+ * RGB with the intensity multiplied in, in candela for point and spot lights
+ * (irradiance I/d² lux at distance d, no range cut-off), in lux (irradiance on a
+ * surface facing the light) for directional ones, and radiance (nits) for ambient
+ * ones, a sky: a white Lambert surface under a directional light of E lux has
+ * radiance E/π. Other formats' colours are read in the same units. */
 typedef struct rr_light_info {
   const char *name;     /* NULL when none; valid until the scene is released */
   rr_light_type type;
   float position[3];
   float direction[3];   /* unit: where the light shines */
-  float color[3];       /* linear RGB with the file's intensity multiplied in */
-  float attenuation[3]; /* constant, linear and quadratic factors */
+  float color[3];       /* linear RGB with the file's intensity multiplied in (units above) */
+  float attenuation[3]; /* constant, linear and quadratic factors as the file gives them (shading
+                           uses the inverse square law whatever they say) */
   float inner_cone_deg, outer_cone_deg; /* spot: half-angles from direction (full and no light) */
-  float size[2];        /* area: extent */
+  float size[2];        /* area: extent (shaded as a point light at position) */
+  float ground[3];      /* ambient: radiance from straight below, color being the one from straight
+                           above, blended linearly in between along the scene's up (a gradient sky);
+                           all 0: color from every direction (a constant sky) */
 } rr_light_info;
 
-/* Fills the file's light `index` (0 .. rr_scene_info.lights - 1). */
+/* Fills the scene's light `index` (0 .. rr_scene_info.lights - 1). */
 RR_API rr_error rr_scene_get_light(const rr_scene *scene, uint32_t index, rr_light_info *info);
+/* Adds a light (copied, name too) after the file's: directional, point, spot or
+ * ambient (area and undefined ones are refused), with finite values, colours and
+ * ground at least 0, a nonzero direction for directional and spot lights (made
+ * unit) and, for spot lights, 0 <= inner_cone_deg <= outer_cone_deg <= 90 (both 0:
+ * glTF's defaults 0 and 45). Not thread-safe: nothing may render the scene meanwhile. */
+RR_API rr_error rr_scene_add_light(rr_scene *scene, const rr_light_info *light);
 
 /* ---- visibility ---------------------------------------------------------- */
 
@@ -488,6 +544,8 @@ typedef enum rr_shade_mode {
   RR_SHADE_DEPTH,       /* eye distance, near bright, far dark */
   RR_SHADE_HEAT_EVALS,  /* edge evaluations per pixel as a heat map with a legend */
   RR_SHADE_HEAT_NODES,  /* BVH nodes visited per pixel as a heat map with a legend */
+  RR_SHADE_LIT,         /* the scene's lights (or a default rig) on its materials, with shadows and
+                           mirror reflections: the shading model of docs/shading.md */
   RR_SHADE_COUNT
 } rr_shade_mode;
 
@@ -510,6 +568,15 @@ typedef enum rr_aov {
   RR_AOV_UV,           /* 2 floats: texture coordinates u, v; 0 on a miss or without texture coordinates */
   RR_AOV_UV_DERIV,     /* 4 floats: their derivatives per pixel step du/dx, dv/dx, du/dy, dv/dy (exact,
                           from the camera's ray differentials); 0 where uv is */
+  /* The lit mode's parts (docs/shading.md), named as Blender Cycles' passes, with the
+   * lights rr_shade_options_init's lit shading uses (the scene's, or the default rig);
+   * 0 on a miss. The colour is direct + reflection + emission. */
+  RR_AOV_ALBEDO,       /* 3 floats: the diffuse lobe's colour (base colour; × (1 - metallic) for pbr) */
+  RR_AOV_DIRECT,       /* 3 floats: light from the lights (shadowed) and the sky on the point itself */
+  RR_AOV_REFLECTION,   /* 3 floats: what its mirror reflects, every bounce */
+  RR_AOV_SHADOW,       /* 1 float: the fraction of the punctual lights that reach it (facing it, inside
+                          its cone, unblocked); 1 when there is none */
+  RR_AOV_EMISSION,     /* 3 floats: the radiance it emits */
   RR_AOV_COUNT
 } rr_aov;
 /* With several samples per pixel the per-pixel AOVs follow one rule each: id, mesh,
@@ -519,8 +586,8 @@ typedef enum rr_aov {
  * nodes sum over the samples. The sample-* AOVs give every sample. */
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
- * "material", "coverage", "sample-id", "sample-depth", "sample-mesh", "uv",
- * "uv-deriv"); -1 when unknown. */
+ * "material", "coverage", "sample-id", "sample-depth", "sample-mesh", "uv", "uv-deriv",
+ * "albedo", "direct", "reflection", "shadow", "emission"); -1 when unknown. */
 RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
@@ -534,8 +601,9 @@ typedef enum rr_image_kind {
                           colour to sRGB, EXR and PFM decode 8-bit colour to linear light */
   RR_IMAGE_AOV         /* RR_IMAGE_AOV + a: AOV a of rr_frame_aov, values as they are, EXR channels
                           depth Z, normal N.X N.Y N.Z, bary bary.u bary.v (λ1, λ2), id, mesh and
-                          material (32-bit UINT), evals, nodes, coverage; per sample s (2 digits):
-                          id.sNN, Z.sNN, mesh.sNN; uv uv.u uv.v, uv-deriv uvdx.u uvdx.v uvdy.u uvdy.v */
+                          material (32-bit UINT), evals, nodes, coverage, albedo.R/G/B, direct.R/G/B,
+                          reflection.R/G/B, shadow, emission.R/G/B; per sample s (2 digits): id.sNN,
+                          Z.sNN, mesh.sNN; uv uv.u uv.v, uv-deriv uvdx.u uvdx.v uvdy.u uvdy.v */
 } rr_image_kind;
 
 /* An image owned by the caller or by rastray (rr_image_free). */
@@ -596,6 +664,21 @@ typedef enum rr_texture_wrap {
   RR_WRAP_COUNT
 } rr_texture_wrap;
 
+/* How the lit shade mode finds which lights a point sees. */
+typedef enum rr_shadow_mode {
+  RR_SHADOWS_NONE = 0, /* every light reaches every point facing it */
+  RR_SHADOWS_RAYS,     /* a shadow ray per point and light through rr_occluded_stream, leaving the surface
+                          offset along its geometric normal (docs/shading.md) */
+  RR_SHADOWS_RASTER,   /* 3D rasterization from the light (the same bits as rays): not implemented yet,
+                          refused with RR_ERROR_UNSUPPORTED */
+  RR_SHADOWS_COUNT
+} rr_shadow_mode;
+
+/* The shadow mode named `name` ("none", "rays", "raster"); -1 when unknown. */
+RR_API int rr_shadows_from_name(const char *name);
+
+#define RR_MAX_DEPTH 16 /* most mirror bounces the lit shade mode follows */
+
 /* How rr_shade_frame shades and resolves a frame. The AA mode (which samples are
  * shaded) is the frame's own, from rr_render_options; these say what is drawn and
  * how the samples' colours become pixels. */
@@ -609,6 +692,10 @@ typedef struct rr_shade_options {
   rr_texture_filter texture_filter; /* default RR_TEXTURE_ANISO */
   int aniso;                        /* most probes of RR_TEXTURE_ANISO, 1 .. 16 (default 16) */
   float lod_bias;                   /* added to the MIP level, in levels (default 0) */
+  rr_shadow_mode shadows;           /* lit: how shadows are found (default RR_SHADOWS_RAYS) */
+  int max_depth;                    /* lit: most mirror bounces along a path, 0 .. RR_MAX_DEPTH (default 2) */
+  int default_lights;               /* lit: nonzero (default): a scene without lights gets the default rig
+                                       (a key light with shadows placed from the camera, and a sky) */
 } rr_shade_options;
 
 /* Fills options with defaults: Lambert, box filter, no alpha, aniso:16 textures. */
@@ -622,6 +709,11 @@ typedef struct rr_shade_stats {
                         0.5 each pixel is resolved as its samples are shaded: that time is here) */
   double resolve_ms; /* wall time of a separate resolve, per-sample colours to pixels (the wide filters;
                         about 0 for the box) */
+  uint64_t shadow_rays;     /* lit: shadow rays traced (one per point, light facing it) */
+  uint64_t reflection_rays; /* lit: mirror reflection rays traced, all bounces */
+  double shadow_ms;         /* lit: time tracing shadow rays, summed over the shading threads */
+  double reflection_ms;     /* lit: time tracing reflection rays and making their hits' surfaces, summed
+                               over the shading threads */
 } rr_shade_stats;
 
 /* Shades a frame and resolves its samples to one colour per pixel (opt NULL: the

@@ -579,7 +579,11 @@ static void test_exr_layers(void) {
       [1 + RR_AOV_MATERIAL] = {"material"}, [1 + RR_AOV_COVERAGE] = {"coverage"},
       [1 + RR_AOV_SAMPLE_ID] = {"id.s00"}, [1 + RR_AOV_SAMPLE_DEPTH] = {"Z.s00"},
       [1 + RR_AOV_SAMPLE_MESH] = {"mesh.s00"}, [1 + RR_AOV_UV] = {"uv.u", "uv.v"},
-      [1 + RR_AOV_UV_DERIV] = {"uvdx.u", "uvdx.v", "uvdy.u", "uvdy.v"}};
+      [1 + RR_AOV_UV_DERIV] = {"uvdx.u", "uvdx.v", "uvdy.u", "uvdy.v"},
+      [1 + RR_AOV_ALBEDO] = {"albedo.B", "albedo.G", "albedo.R"},
+      [1 + RR_AOV_DIRECT] = {"direct.B", "direct.G", "direct.R"},
+      [1 + RR_AOV_REFLECTION] = {"reflection.B", "reflection.G", "reflection.R"}, [1 + RR_AOV_SHADOW] = {"shadow"},
+      [1 + RR_AOV_EMISSION] = {"emission.B", "emission.G", "emission.R"}};
   rr_scene *s = colour_scene(rgb);
   rr_image images[1 + RR_AOV_COUNT];
   memset(images, 0, sizeof images);
@@ -607,7 +611,8 @@ static void test_exr_layers(void) {
     /* the values are the image's (channels sorted by name: colour B, G, R) */
     bool same = x.img.width == SW && x.img.height == SH;
     for (int k = 0; same && k < img->channels; k++) {
-      int src = i == 0 ? 2 - k : k;
+      bool rgb = i == 0 || (i - 1 >= RR_AOV_ALBEDO && img->channels == 3); /* written B, G, R */
+      int src = rgb ? 2 - k : k;
       for (size_t p = 0; same && p < (size_t)SW * SH; p++)
         same = memcmp((const uint32_t *)img->data + p * img->channels + src, (const uint32_t *)x.img.images[k] + p, 4) == 0;
     }

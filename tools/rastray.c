@@ -129,7 +129,7 @@ enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
   OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA, OPT_AA_PATTERN, OPT_AA_FILTER,
-  OPT_ALPHA, OPT_TEXTURE_FILTER, OPT_LOD_BIAS,
+  OPT_ALPHA, OPT_TEXTURE_FILTER, OPT_LOD_BIAS, OPT_LIGHT, OPT_SHADOWS, OPT_MAX_DEPTH,
 };
 
 typedef struct cli_option {
@@ -186,7 +186,17 @@ static const cli_option render_options[] = {
     {"save-camera", OPT_SAVE_CAMERA, "FILE", "write the camera used (after automatic framing) as JSON"},
     {"camera-from-file", OPT_CAMERA_FROM_FILE, "NAME|INDEX",
      "look through a camera the scene file defines (see info); --camera may\nchange its projection"},
-    {"shade", OPT_SHADE, "MODE", "lambert (default), id, normal, depth, heat-evals, heat-nodes"},
+    {"shade", OPT_SHADE, "MODE",
+     "lit (default: the scene's lights, or a key light and a sky when it has none,\n"
+     "with shadows and mirror reflections; see docs/shading.md), lambert (a\n"
+     "headlight), id, normal, depth, heat-evals, heat-nodes"},
+    {"light", OPT_LIGHT, "SPEC",
+     "add a light (repeatable; the default rig is then off): point:X,Y,Z:R,G,B[:I]\n"
+     "(I candela, default 1), dir:DX,DY,DZ:R,G,B[:E] (shining along D, E lux),\n"
+     "spot:X,Y,Z:DX,DY,DZ:R,G,B[:I[:INNER[:OUTER]]] (half-angles, default 0 and 45\n"
+     "degrees), sky:R,G,B[:R,G,B] (radiance from above[, from below: a gradient])"},
+    {"shadows", OPT_SHADOWS, "MODE", "lit: none, rays (default: shadow rays through the ray streams)"},
+    {"max-depth", OPT_MAX_DEPTH, "N", "lit: most mirror bounces, 0.." VALUE(RR_MAX_DEPTH) " (default 2)"},
     {"aa", OPT_AA, "MODE",
      "anti-aliasing: none (default), ssaa:N (N samples, each shaded), msaa:N (shaded\n"
      "once per pixel per primitive), csaa:K/N (N coverage samples, K with colour);\n"
@@ -221,6 +231,9 @@ static const cli_option render_options[] = {
      "uvdx.u uvdx.v uvdy.u uvdy.v); all: color to nodes (evals, nodes with heat).\n"
      "With several samples id, mesh, material, normal, bary, uv, uv-deriv are the\n"
      "sample nearest the centre's, depth the nearest.\n"
+     "The lit shading's parts, as Blender Cycles' passes (the centre sample's, default\n"
+     "shadows and depth): albedo, direct, reflection, emission (EXR NAME.R/G/B; colour =\n"
+     "direct + reflection + emission), shadow (fraction of the lights reaching a point).\n"
      "Outputs are all or nothing"},
     {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default 0: all cores)"},
     {"repeat", OPT_REPEAT, "N", "run the visibility pass N times, report the median time"},
@@ -452,11 +465,57 @@ static aov_out parse_aov(const char *arg) {
     else
       die(EXIT_USAGE,
           "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes, coverage, "
-          "sample-id, sample-depth, sample-mesh, uv, uv-deriv or all)",
+          "sample-id, sample-depth, sample-mesh, uv, uv-deriv, albedo, direct, reflection, shadow, emission "
+          "or all)",
           name);
   }
   if (!a.images && !a.all) die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
   return a;
+}
+
+/* Parses --light (see its help) into a light for rr_scene_add_light. */
+static rr_light_info parse_light(const char *arg) {
+  static const char usage[] = "(expected point:X,Y,Z:R,G,B[:I], dir:DX,DY,DZ:R,G,B[:E], "
+                              "spot:X,Y,Z:DX,DY,DZ:R,G,B[:I[:INNER[:OUTER]]] or sky:R,G,B[:R,G,B])";
+  char buf[512], *field[8];
+  int n = 0;
+  if (strlen(arg) >= sizeof buf) die(EXIT_USAGE, "bad light '%.40s...' for --light %s", arg, usage);
+  strcpy(buf, arg);
+  for (char *p = buf; n < 8; n++) {
+    field[n] = p;
+    if (!(p = strchr(p, ':'))) {
+      n++;
+      break;
+    }
+    *p++ = 0;
+  }
+  rr_light_info l = {0};
+  const char *kind = field[0];
+  int vectors = 0, least = 0, most = 0; /* the X,Y,Z fields; the fewest and most fields in all */
+  if (strcmp(kind, "point") == 0) l.type = RR_LIGHT_POINT, vectors = 2, least = 3, most = 4;
+  else if (strcmp(kind, "dir") == 0) l.type = RR_LIGHT_DIRECTIONAL, vectors = 2, least = 3, most = 4;
+  else if (strcmp(kind, "spot") == 0) l.type = RR_LIGHT_SPOT, vectors = 3, least = 4, most = 7;
+  else if (strcmp(kind, "sky") == 0) l.type = RR_LIGHT_AMBIENT, vectors = 2, least = 2, most = 3;
+  if (!vectors || n < least || n > most) die(EXIT_USAGE, "bad light '%s' for --light %s", arg, usage);
+  float *vec[3] = {l.position, l.direction, l.color}; /* the fields' places by kind: spot's */
+  if (l.type == RR_LIGHT_POINT) vec[1] = l.color;
+  if (l.type == RR_LIGHT_DIRECTIONAL) vec[0] = l.direction, vec[1] = l.color;
+  if (l.type == RR_LIGHT_AMBIENT) vec[0] = l.color, vec[1] = l.ground;
+  for (int k = 1; k < n && k <= vectors; k++) parse_vec("--light", field[k], vec[k - 1]);
+  float scale = 1, inner = 0, outer = 45;
+  if (l.type != RR_LIGHT_AMBIENT && n > vectors + 1) scale = parse_float("--light", field[vectors + 1]);
+  if (n > vectors + 2) inner = parse_float("--light", field[vectors + 2]);
+  if (n > vectors + 3) outer = parse_float("--light", field[vectors + 3]);
+  for (int c = 0; c < 3; c++) l.color[c] *= scale;
+  if (!(scale >= 0)) die(EXIT_USAGE, "bad light '%s' for --light: a negative intensity", arg);
+  for (int c = 0; c < 3; c++)
+    if (l.color[c] < 0 || l.ground[c] < 0) die(EXIT_USAGE, "bad light '%s' for --light: a negative colour", arg);
+  if ((l.type == RR_LIGHT_DIRECTIONAL || l.type == RR_LIGHT_SPOT) && !l.direction[0] && !l.direction[1] && !l.direction[2])
+    die(EXIT_USAGE, "bad light '%s' for --light: a zero direction", arg);
+  if (l.type == RR_LIGHT_SPOT && !(inner >= 0 && inner <= outer && outer <= 90 && outer > 0))
+    die(EXIT_USAGE, "bad light '%s' for --light: cone angles outside 0 <= inner <= outer <= 90 degrees", arg);
+  l.inner_cone_deg = inner, l.outer_cone_deg = outer;
+  return l;
 }
 
 /* NAME[:REST]: NAME looked up by from_name (-1 when unknown); *rest is what
@@ -576,6 +635,8 @@ static void add_cube_faces(rr_device *dev, rr_output *set, const rr_image *cross
 typedef struct {
   double load, build, frame, cpu, shade, resolve, write, total;
   uint64_t shades; /* shading invocations of the colour image */
+  uint64_t shadow_rays, reflection_rays; /* lit: rays shading traced, and their time summed over threads */
+  double shadow, reflection;
 } timings;
 
 /* Adds the run's images to its output set. The colour image and each AOV are made
@@ -596,6 +657,8 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
     rr_error e = a == RR_AOV_COUNT ? rr_shade_frame(dev, scene, cam, frame, shading, colour, &st)
                                    : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
     ms->resolve += st.resolve_ms, ms->shades += st.shades;
+    ms->shadow_rays += st.shadow_rays, ms->reflection_rays += st.reflection_rays;
+    ms->shadow += st.shadow_ms, ms->reflection += st.reflection_ms;
     if (e) die(EXIT_INPUT, "%s", rr_device_message(dev));
   }
   ms->shade = now_ms() - t - ms->resolve; /* shading the samples and the AOVs */
@@ -613,6 +676,23 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
   ms->write = now_ms() - t;
   for (int a = 0; a <= RR_AOV_COUNT; a++) rr_image_free(&images[a]);
   run.images = NULL, run.nimages = 0;
+}
+
+/* The shading inputs of a material (rastray info), on one indented line, and the textures it names but shading does not use yet. */
+static void print_params(const rr_material_info *mi) {
+  const rr_material_params *p = &mi->params;
+  printf("      %s", rr_material_model_name(p->model));
+  if (p->model == RR_MATERIAL_PBR) printf(", metallic %.3g, roughness %.3g", p->metallic, p->roughness);
+  else printf(", specular (%.3g, %.3g, %.3g), shininess %.3g", p->specular[0], p->specular[1], p->specular[2], p->shininess);
+  if (p->ambient[0] || p->ambient[1] || p->ambient[2]) printf(", ambient (%.3g, %.3g, %.3g)", p->ambient[0], p->ambient[1], p->ambient[2]);
+  if (p->emission[0] || p->emission[1] || p->emission[2])
+    printf(", emission (%.3g, %.3g, %.3g)", p->emission[0], p->emission[1], p->emission[2]);
+  if (p->opacity != 1) printf(", opacity %.3g", p->opacity);
+  if (p->illum >= 0) printf(", illum %d%s", p->illum, p->illum == 3 ? " (mirror)" : "");
+  static const char *const maps[RR_MAP_COUNT] = {"specular", "normal", "occlusion", "emissive", "metallic-roughness"};
+  for (int k = 0; k < RR_MAP_COUNT; k++)
+    if (mi->maps[k]) printf(", %s map '%s' (unused)", maps[k], mi->maps[k]);
+  putchar('\n');
 }
 
 static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
@@ -650,6 +730,7 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
              mi.texture_height);
     else if (mi.texture) printf(", texture '%s' (%s)", mi.texture, rr_texture_status_name(mi.texture_status));
     putchar('\n');
+    print_params(&mi);
   }
   printf("textures     %u (%u missing or unreadable)\n", in.textures, in.textures_missing);
   for (uint32_t m = 0; in.textures_missing && m < in.materials; m++) {
@@ -720,6 +801,8 @@ static void add_stats_json(rr_device *dev, rr_output *set, const char *path, con
                  {"samples", opt->samples}, {"load_ms", ms->load}, {"build_ms", ms->build}, {"frame_ms", ms->frame},
                  {"vis_ms", ms->frame}, {"cpu_ms", ms->cpu}, {"shade_ms", ms->shade}, {"resolve_ms", ms->resolve},
                  {"write_ms", ms->write}, {"total_ms", ms->total}, {"shades", (double)ms->shades},
+                 {"shadow_rays", (double)ms->shadow_rays}, {"shadow_ms", ms->shadow},
+                 {"reflection_rays", (double)ms->reflection_rays}, {"reflection_ms", ms->reflection},
                  {"setups", (double)st->setups}, {"edge_evals", (double)st->edge_evals}, {"nodes", (double)st->nodes},
                  {"bins", (double)st->bins}, {"bins_empty", (double)st->bins_empty}};
   for (size_t k = 0; k < sizeof numbers / sizeof *numbers; k++) /* times to the microsecond */
@@ -739,7 +822,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   const char *file_cam = NULL; /* --camera-from-file */
   unsigned given = 0;           /* the camera's fields set by flags */
   bool stats = false;
-  int shade = RR_SHADE_LAMBERT, repeat = 1, naov = 0;
+  int shade = RR_SHADE_LIT, repeat = 1, naov = 0, nlights = 0;
+  rr_light_info lights[32];
   aa_spec aa = {RR_AA_NONE, 1, 0};
   rr_aa_pattern pattern = RR_AA_STANDARD;
   uint32_t seed = 1;
@@ -782,9 +866,22 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_SHADE:
       shade = rr_shade_from_name(optarg);
       if (shade < 0)
-        die(EXIT_USAGE, "unknown shade mode '%s' (expected lambert, id, normal, depth, heat-evals or heat-nodes)",
-            optarg);
+        die(EXIT_USAGE,
+            "unknown shade mode '%s' (expected lit, lambert, id, normal, depth, heat-evals or heat-nodes)", optarg);
       break;
+    case OPT_LIGHT:
+      if (nlights == 32) die(EXIT_USAGE, "too many --light (at most 32)");
+      lights[nlights++] = parse_light(optarg);
+      break;
+    case OPT_SHADOWS: {
+      int m = rr_shadows_from_name(optarg);
+      if (m == RR_SHADOWS_RASTER)
+        die(EXIT_USAGE, "--shadows raster (3D rasterization from the light) is not implemented yet; use rays or none");
+      if (m < 0) die(EXIT_USAGE, "unknown shadow mode '%s' for --shadows (expected none or rays)", optarg);
+      shading.shadows = (rr_shadow_mode)m;
+      break;
+    }
+    case OPT_MAX_DEPTH: shading.max_depth = (int)parse_int(option_name, optarg, 0, RR_MAX_DEPTH); break;
     case 'o': out = optarg; break;
     case OPT_AOV:
       if (naov == 16) die(EXIT_USAGE, "too many --aov (at most 16)");
@@ -824,8 +921,10 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   const unsigned heat_aovs = 1u << RR_AOV_EVALS | 1u << RR_AOV_NODES;
   for (int k = 0; k < naov; k++) opt.heat |= (aovs[k].images & heat_aovs) != 0;
   const unsigned by_name = 1u << RR_AOV_COVERAGE | 1u << RR_AOV_SAMPLE_ID | 1u << RR_AOV_SAMPLE_DEPTH |
-                           1u << RR_AOV_SAMPLE_MESH | 1u << RR_AOV_UV |
-                           1u << RR_AOV_UV_DERIV; /* the AA and texture outputs: asked for by name */
+                           1u << RR_AOV_SAMPLE_MESH | 1u << RR_AOV_UV | 1u << RR_AOV_UV_DERIV |
+                           1u << RR_AOV_ALBEDO | 1u << RR_AOV_DIRECT | 1u << RR_AOV_REFLECTION |
+                           1u << RR_AOV_SHADOW | 1u << RR_AOV_EMISSION; /* the AA and texture outputs and
+                                                                           the lit parts: asked for by name */
   for (int k = 0; k < naov; k++) /* all: every per-pixel AOV of the visibility the frame has */
     if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~by_name & ~(opt.heat ? 0 : heat_aovs);
   if (camera_file) { /* the file's values, where no flag gave one */
@@ -837,6 +936,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
 
   timings ms = {0};
   rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load);
+  for (int k = 0; k < nlights; k++)
+    if (rr_scene_add_light(scene, &lights[k]) != RR_OK) die(EXIT_USAGE, "--light: %s", rr_device_message(dev));
   if (file_cam) { /* the file's camera; --camera may change its projection */
     rr_camera_type type = cam.type;
     uint32_t index;
@@ -901,10 +1002,12 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     fprintf(stderr,
             "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d aa=%s samples=%d frame_ms=%.3f "
             "vis_ms=%.3f cpu_ms=%.3f load_ms=%.1f build_ms=%.1f shade_ms=%.1f resolve_ms=%.1f write_ms=%.1f "
-            "total_ms=%.1f shades=%llu setups=%llu edge_evals=%llu nodes=%llu bins=%llu bins_empty=%llu\n",
+            "total_ms=%.1f shades=%llu shadow_rays=%llu shadow_ms=%.1f reflection_rays=%llu reflection_ms=%.1f "
+            "setups=%llu edge_evals=%llu nodes=%llu bins=%llu bins_empty=%llu\n",
             method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, st.threads,
             rr_aa_mode_name(opt.aa), opt.samples, ms.frame, ms.frame, ms.cpu, ms.load, ms.build, ms.shade, ms.resolve,
-            ms.write, ms.total, (unsigned long long)ms.shades, (unsigned long long)st.setups,
+            ms.write, ms.total, (unsigned long long)ms.shades, (unsigned long long)ms.shadow_rays, ms.shadow,
+            (unsigned long long)ms.reflection_rays, ms.reflection, (unsigned long long)st.setups,
             (unsigned long long)st.edge_evals, (unsigned long long)st.nodes, (unsigned long long)st.bins,
             (unsigned long long)st.bins_empty);
   if (stats && st.why[0]) fprintf(stderr, "auto chose %s: %s\n", method, st.why);

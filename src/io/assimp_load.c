@@ -11,6 +11,7 @@
 #include "core/color.h"
 #include "io/io.h"
 
+#include <assimp/ObjMaterial.h>
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -204,7 +205,7 @@ static rr_error add_lights(rr_scene *s, const struct aiScene *sc) {
                        .size = {al->mSize.x, al->mSize.y}};
     v3_store(l.position, xform_point(&m, al->mPosition));
     v3_store(l.direction, v3_norm(xform_dir(&m, al->mDirection)));
-    rr_error e = rr_scene_add_light(s, &l);
+    rr_error e = rr_scene_append_light(s, &l);
     if (e) return e;
   }
   return RR_OK;
@@ -246,7 +247,65 @@ static bool decode_embedded(rr_texture *t, const struct aiTexture *at) {
   return true;
 }
 
-static rr_error add_materials(rr_scene *s, const struct aiScene *sc) {
+static void get_rgb(const struct aiMaterial *am, const char *key, unsigned type, unsigned index, float rgb[3]) {
+  struct aiColor4D c;
+  if (aiGetMaterialColor(am, key, type, index, &c) == AI_SUCCESS) rgb[0] = c.r, rgb[1] = c.g, rgb[2] = c.b;
+}
+
+static void get_float(const struct aiMaterial *am, const char *key, unsigned type, unsigned index, float *v) {
+  ai_real f;
+  unsigned one = 1;
+  if (aiGetMaterialFloatArray(am, key, type, index, &f, &one) == AI_SUCCESS && one == 1 && isfinite(f)) *v = (float)f;
+}
+
+/* The shading model's inputs (rr_material_params) of a material and the names of
+ * the textures shading does not use yet. glTF's metallic–roughness comes through
+ * assimp's PBR keys; MTL's Ks, Ns, Ka, Ke, d (Tr: assimp gives 1 - Tr as the
+ * opacity) and illum through the classic ones. */
+static rr_error read_params(rr_material *mt, const struct aiMaterial *am, bool gltf) {
+  rr_material_params *p = &mt->params;
+  p->model = gltf ? RR_MATERIAL_PBR : RR_MATERIAL_PHONG;
+  get_rgb(am, AI_MATKEY_COLOR_SPECULAR, p->specular);
+  get_rgb(am, AI_MATKEY_COLOR_AMBIENT, p->ambient);
+  get_rgb(am, AI_MATKEY_COLOR_EMISSIVE, p->emission);
+  get_float(am, AI_MATKEY_SHININESS, &p->shininess);
+  p->shininess = fminf(fmaxf(p->shininess, 0.0f), 10000.0f);
+  get_float(am, AI_MATKEY_OPACITY, &p->opacity);
+  int illum;
+  unsigned one = 1;
+  if (aiGetMaterialIntegerArray(am, AI_MATKEY_OBJ_ILLUM, &illum, &one) == AI_SUCCESS && one == 1) p->illum = illum;
+  if (gltf) {
+    struct aiColor4D base;
+    if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &base) == AI_SUCCESS) {
+      mt->color[0] = base.r, mt->color[1] = base.g, mt->color[2] = base.b;
+      p->opacity = base.a;
+    }
+    get_float(am, AI_MATKEY_METALLIC_FACTOR, &p->metallic);
+    get_float(am, AI_MATKEY_ROUGHNESS_FACTOR, &p->roughness);
+    p->metallic = fminf(fmaxf(p->metallic, 0.0f), 1.0f), p->roughness = fminf(fmaxf(p->roughness, 0.0f), 1.0f);
+  }
+  static const struct {
+    enum aiTextureType type;
+    rr_material_map map;
+  } maps[] = {{aiTextureType_SPECULAR, RR_MAP_SPECULAR},   {aiTextureType_NORMALS, RR_MAP_NORMAL},
+              {aiTextureType_HEIGHT, RR_MAP_NORMAL},       {aiTextureType_LIGHTMAP, RR_MAP_OCCLUSION},
+              {aiTextureType_AMBIENT_OCCLUSION, RR_MAP_OCCLUSION}, {aiTextureType_EMISSIVE, RR_MAP_EMISSIVE},
+              {aiTextureType_UNKNOWN, RR_MAP_METALLIC_ROUGHNESS}, {aiTextureType_DIFFUSE_ROUGHNESS, RR_MAP_METALLIC_ROUGHNESS}};
+  for (size_t k = 0; k < sizeof maps / sizeof *maps; k++) {
+    struct aiString tex;
+    tex.length = 0;
+    if (mt->maps[maps[k].map] || aiGetMaterialTexture(am, maps[k].type, 0, &tex, NULL, NULL, NULL, NULL, NULL, NULL) != AI_SUCCESS ||
+        !tex.length)
+      continue;
+    char *name = malloc(tex.length + 1);
+    if (!name) return RR_ERROR_MEMORY;
+    memcpy(name, tex.data, tex.length + 1);
+    mt->maps[maps[k].map] = name;
+  }
+  return RR_OK;
+}
+
+static rr_error add_materials(rr_scene *s, const struct aiScene *sc, bool gltf) {
   for (unsigned i = 0; i < sc->mNumMaterials; i++) {
     const struct aiMaterial *am = sc->mMaterials[i];
     struct aiColor4D c = {SCENE_GREY, SCENE_GREY, SCENE_GREY, 1.0f};
@@ -266,6 +325,7 @@ static rr_error add_materials(rr_scene *s, const struct aiScene *sc) {
     /* An embedded texture is read now, while assimp holds it; files come later. */
     const struct aiTexture *at = has_tex ? embedded_texture(sc, tex.data) : NULL;
     rr_material *mt = &s->materials[m];
+    if (read_params(mt, am, gltf)) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding materials");
     if (at) mt->texture_status = decode_embedded(&mt->texture, at) ? RR_TEXTURE_EMBEDDED : RR_TEXTURE_UNREADABLE;
     else if (has_tex && tex.data[0] == '*') mt->texture_status = RR_TEXTURE_MISSING; /* no such embedded one */
   }
@@ -337,7 +397,7 @@ rr_error rr_scene_load_file(rr_scene *s, const char *path) {
    * default) store display (sRGB) values. */
   file_kind kind = {.gltf = gltf, .colors_srgb = !gltf};
   uint32_t mat_base = s->nmaterials;
-  rr_error e = add_materials(s, sc);
+  rr_error e = add_materials(s, sc, gltf);
   if (!e && sc->mRootNode) e = add_node(s, sc, sc->mRootNode, &identity, mat_base, &kind, 0);
   if (!e) e = add_cameras(s, sc, &kind);
   if (!e) e = add_lights(s, sc);

@@ -287,6 +287,11 @@ static const struct {
     [RR_AOV_UV] = {2, {"uv.u", "uv.v"}},
     /* two layers, the derivatives along x and along y: sorted as du/dx, dv/dx, du/dy, dv/dy */
     [RR_AOV_UV_DERIV] = {4, {"uvdx.u", "uvdx.v", "uvdy.u", "uvdy.v"}},
+    [RR_AOV_ALBEDO] = {3, {"albedo.R", "albedo.G", "albedo.B"}},
+    [RR_AOV_DIRECT] = {3, {"direct.R", "direct.G", "direct.B"}},
+    [RR_AOV_REFLECTION] = {3, {"reflection.R", "reflection.G", "reflection.B"}},
+    [RR_AOV_SHADOW] = {1, {"shadow"}},
+    [RR_AOV_EMISSION] = {3, {"emission.R", "emission.G", "emission.B"}},
 };
 _Static_assert(RR_MAX_SAMPLES == 16, "PER_SAMPLE names 16 samples");
 
@@ -1159,12 +1164,21 @@ static rr_error read_exr(rr_device *dev, const char *path, const blob *b, rr_ima
   }
   e = alloc_image(dev, path, (int)w, (int)h, c, ids ? RR_PIXEL_U32 : RR_PIXEL_F32, out);
   if (e) goto done;
-  /* the kind the channel names say (sorted like aov_channels' names) */
+  /* the kind the channel names say, the channels in aov_channels' order (the file
+   * has them sorted by name: albedo.B, albedo.G, albedo.R) */
   out->kind = nrgba == c ? RR_IMAGE_COLOR : RR_IMAGE_VALUES;
-  for (int a = 0; a < RR_AOV_COUNT && nrgba == 0; a++) {
+  for (int a = 0; a < RR_AOV_COUNT && nrgba == 0 && out->kind == RR_IMAGE_VALUES; a++) {
+    int at[4];
     bool same = channels_fit(RR_IMAGE_AOV + a, c);
-    for (int k = 0; same && k < c; k++) same = !strcmp(header.channels[k].name, aov_channels[a].names[k]);
-    if (same) out->kind = RR_IMAGE_AOV + a;
+    for (int k = 0; same && k < c; k++) {
+      at[k] = -1;
+      for (int j = 0; j < c; j++)
+        if (!strcmp(header.channels[j].name, aov_channels[a].names[k])) at[k] = j;
+      same = at[k] >= 0;
+    }
+    if (!same) continue;
+    out->kind = RR_IMAGE_AOV + a;
+    memcpy(order, at, sizeof(int) * c);
   }
   {
     size_t npix = (size_t)w * h;

@@ -32,6 +32,7 @@ void rr_scene_release(rr_scene *s) {
     free(s->materials[m].name);
     free(s->materials[m].texture_path);
     free(s->materials[m].texture.rgb);
+    for (int k = 0; k < RR_MAP_COUNT; k++) free(s->materials[m].maps[k]);
   }
   free(s->materials);
   free(s->geoms);
@@ -224,6 +225,7 @@ uint32_t rr_scene_add_material(rr_scene *s, const float color[3], const char *te
   rr_material *mat = &m[s->nmaterials];
   memset(mat, 0, sizeof *mat);
   memcpy(mat->color, color, sizeof mat->color);
+  mat->params = (rr_material_params){.model = RR_MATERIAL_PHONG, .opacity = 1, .illum = -1, .metallic = 1, .roughness = 1};
   if (texture_path && *texture_path) {
     mat->texture_path = malloc(strlen(texture_path) + 1);
     if (!mat->texture_path) return UINT32_MAX;
@@ -258,7 +260,7 @@ rr_error rr_scene_add_camera(rr_scene *s, const char *name, const file_camera *c
   return RR_OK;
 }
 
-rr_error rr_scene_add_light(rr_scene *s, const rr_light_info *light) {
+rr_error rr_scene_append_light(rr_scene *s, const rr_light_info *light) {
   rr_light_info *p = realloc(s->lights, (s->nlights + 1) * sizeof *p);
   char *name = NULL;
   if (p) s->lights = p;
@@ -472,12 +474,90 @@ rr_error rr_scene_get_material_info(const rr_scene *s, uint32_t material, rr_mat
                    material, s->nmaterials);
   const rr_material *m = &s->materials[material];
   *info = (rr_material_info){m->name, {m->color[0], m->color[1], m->color[2]}, m->texture_path, m->texture_status,
-                             m->texture.width, m->texture.height};
+                             m->texture.width, m->texture.height, m->params, {NULL}};
+  for (int k = 0; k < RR_MAP_COUNT; k++) info->maps[k] = m->maps[k];
   return rr_ok(s->dev);
 }
 
 static const char *const light_names[RR_LIGHT_TYPE_COUNT] = {"undefined", "directional", "point", "spot", "ambient",
                                                              "area"};
+
+uint32_t rr_scene_index_of(const rr_scene *s, uint32_t id) {
+  if (!s->file_id) return id < s->ntris ? id : RR_MISS;
+  uint32_t lo = 0, hi = s->ntris;
+  while (lo < hi) {
+    uint32_t mid = lo + (hi - lo) / 2;
+    if (s->file_id[mid] < id) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo < s->ntris && s->file_id[lo] == id ? lo : RR_MISS;
+}
+
+/* Why a caller's material cannot be set, or NULL. */
+static const char *material_problem(const float color[3], const rr_material_params *p) {
+  const float *rgb[] = {color, p ? p->specular : NULL, p ? p->ambient : NULL, p ? p->emission : NULL};
+  for (int k = 0; k < 4; k++)
+    for (int c = 0; rgb[k] && c < 3; c++)
+      if (!(rgb[k][c] >= 0 && isfinite(rgb[k][c]))) return "a colour that is negative or not finite";
+  if (!p) return NULL;
+  if ((int)p->model < 0 || p->model >= RR_MATERIAL_MODEL_COUNT) return "an unknown model";
+  if (!(p->shininess >= 0 && p->shininess <= 10000)) return "a shininess outside 0 .. 10000";
+  if (!(p->metallic >= 0 && p->metallic <= 1 && p->roughness >= 0 && p->roughness <= 1 && p->opacity >= 0 &&
+        p->opacity <= 1))
+    return "a metallic, roughness or opacity outside 0 .. 1";
+  return NULL;
+}
+
+rr_error rr_scene_set_material(rr_scene *s, uint32_t material, const float color[3], const rr_material_params *params) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if (material >= s->nmaterials)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_set_material: material %u out of range (%u in the scene)",
+                   material, s->nmaterials);
+  const char *why = material_problem(color, params);
+  if (why) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_set_material: %s", why);
+  if (color) memcpy(s->materials[material].color, color, 3 * sizeof *color);
+  if (params) s->materials[material].params = *params;
+  return rr_ok(s->dev);
+}
+
+/* Why a caller's light cannot be added, or NULL; fills the unit direction and the default cone into *l. */
+static const char *light_problem(rr_light_info *l) {
+  if (l->type != RR_LIGHT_DIRECTIONAL && l->type != RR_LIGHT_POINT && l->type != RR_LIGHT_SPOT &&
+      l->type != RR_LIGHT_AMBIENT)
+    return "a type other than directional, point, spot or ambient";
+  const float *v[] = {l->position, l->direction, l->color, l->ground};
+  for (int k = 0; k < 4; k++)
+    for (int c = 0; c < 3; c++)
+      if (!isfinite(v[k][c])) return "a non-finite value";
+  for (int c = 0; c < 3; c++)
+    if (l->color[c] < 0 || l->ground[c] < 0) return "a negative colour";
+  if (l->type == RR_LIGHT_DIRECTIONAL || l->type == RR_LIGHT_SPOT) {
+    vec3 d = v3_load(l->direction);
+    if (!(v3_dot(d, d) > 0)) return "a zero direction";
+    v3_store(l->direction, v3_norm(d));
+  }
+  if (l->type == RR_LIGHT_SPOT) {
+    if (l->inner_cone_deg == 0 && l->outer_cone_deg == 0) l->outer_cone_deg = 45;
+    if (!(l->inner_cone_deg >= 0 && l->inner_cone_deg <= l->outer_cone_deg && l->outer_cone_deg <= 90))
+      return "cone angles outside 0 <= inner <= outer <= 90 degrees";
+  }
+  return NULL;
+}
+
+rr_error rr_scene_add_light(rr_scene *s, const rr_light_info *light) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if (!light) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_light: light is NULL");
+  rr_light_info l = *light;
+  const char *why = light_problem(&l);
+  if (why) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_light: a light with %s", why);
+  rr_error e = rr_scene_append_light(s, &l);
+  return e ? e : rr_ok(s->dev);
+}
+
+const char *rr_material_model_name(int model) {
+  static const char *const names[RR_MATERIAL_MODEL_COUNT] = {"phong", "pbr"};
+  return model >= 0 && model < RR_MATERIAL_MODEL_COUNT ? names[model] : NULL;
+}
 
 const char *rr_light_type_name(int type) { return type >= 0 && type < RR_LIGHT_TYPE_COUNT ? light_names[type] : NULL; }
 

@@ -22,6 +22,8 @@ typedef struct rr_material {
   char *texture_path; /* NULL when the material names no texture */
   rr_texture texture;
   rr_texture_status texture_status; /* where the texels came from, or why there are none */
+  rr_material_params params;        /* the shading model's inputs (docs/shading.md) */
+  char *maps[RR_MAP_COUNT];         /* other textures the file names (read but not yet used); NULL: none */
 } rr_material;
 
 /* A camera of the file, in world space: it looks along fwd with up (both unit and
@@ -101,6 +103,9 @@ static inline vec3 scene_vertex(const rr_scene *s, int k, uint32_t i) {
 static inline uint32_t scene_face_id(const rr_scene *s, uint32_t i) {
   return s->file_id && i < s->ntris ? s->file_id[i] : i;
 }
+/* The index of the kept triangle whose id is `id` (file_id grows, so a binary
+ * search); RR_MISS for RR_MISS and for ids no kept triangle has. */
+uint32_t rr_scene_index_of(const rr_scene *s, uint32_t id);
 /* Faces loaded so far, kept and dropped: ids run from 0 to this. */
 static inline uint64_t scene_faces(const rr_scene *s) { return s->ntris + s->skipped; }
 
@@ -157,9 +162,10 @@ rr_hit rr_scene_hit(const rr_scene *s, uint32_t prim, float t, float l1, float l
 uint32_t rr_scene_add_material(rr_scene *s, const float color[3], const char *texture_path);
 /* Names material m (NULL or "": none). */
 rr_error rr_scene_name_material(rr_scene *s, uint32_t m, const char *name);
-/* Appends a camera or a light of a file (copied, names too; cam->name is ignored). */
+/* Appends a camera or a light of a file (copied, names too; cam->name is ignored);
+ * a file's light is kept as it is (rr_scene_add_light checks the caller's). */
 rr_error rr_scene_add_camera(rr_scene *s, const char *name, const file_camera *cam);
-rr_error rr_scene_add_light(rr_scene *s, const rr_light_info *light);
+rr_error rr_scene_append_light(rr_scene *s, const rr_light_info *light);
 /* Recomputes bounds. */
 void rr_scene_update_bounds(rr_scene *s);
 

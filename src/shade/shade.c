@@ -2,6 +2,7 @@
  * scene, so it never knows which method made the frame. */
 #include "vis/vis.h"
 #include "core/color.h"
+#include "shade/light.h"
 #include "shade/resolve.h"
 #include "shade/texcoord.h"
 
@@ -21,9 +22,10 @@ typedef struct hit {
   float dist;  /* eye-to-hit distance */
   vec3 normal; /* unit shading normal facing the eye */
   float l0, l1, l2;
-  float t;           /* along the unnormalised ray of camera cam's pixel (x, y): */
-  const camera *cam; /* what texture coordinates and their derivatives are made from */
-  int x, y;
+  float t;           /* along the ray org + t·ray (ray unnormalised) */
+  vec3 org, ray;
+  const camera *cam; /* the ray is camera cam's at pixel (x, y), whose differentials give the */
+  int x, y;          /* texture footprint; NULL for other rays (reflections): no footprint */
   float footprint; /* the pixel steps the sample's texture footprint spans (ssaa: 1/√N) */
 } hit;
 
@@ -33,12 +35,12 @@ static vec3 geometric_normal(const rr_scene *s, uint32_t i) {
   return v3_norm(v3_cross(v3_sub(scene_vertex(s, 1, i), p0), v3_sub(scene_vertex(s, 2, i), p0)));
 }
 
-/* The shading inputs of triangle `id` at barycentrics (l1, l2), seen along the
- * (unnormalised) ray direction d of camera c's pixel (x, y) at parameter t; not
- * valid on a miss. */
-static hit hit_make(const rr_scene *s, const camera *c, int x, int y, uint32_t id, float l1, float l2, float t,
-                    vec3 d) {
-  hit h = {.has_ray = true, .id = id, .t = t, .cam = c, .x = x, .y = y, .footprint = 1.0f};
+/* The shading inputs of triangle `id` at barycentrics (l1, l2), seen along the ray
+ * o + t·d (d unnormalised) at parameter t, camera c's at pixel (x, y) (c NULL:
+ * another ray); not valid on a miss. */
+static hit hit_make(const rr_scene *s, uint32_t id, float l1, float l2, float t, vec3 o, vec3 d, const camera *c,
+                    int x, int y) {
+  hit h = {.has_ray = true, .id = id, .t = t, .org = o, .ray = d, .cam = c, .x = x, .y = y, .footprint = 1.0f};
   if (id == RR_MISS || id >= s->ntris) return h;
   h.valid = true;
   float len = v3_len(d);
@@ -65,7 +67,7 @@ static hit hit_make(const rr_scene *s, const camera *c, int x, int y, uint32_t i
 static hit sample_hit(const rr_scene *s, const camera *c, const visbuf *vb, size_t i, int x, int y) {
   vec3 o, d;
   if (!rr_cam_ray(c, x, y, &o, &d)) return (hit){.id = vb->id[i]};
-  return hit_make(s, c, x, y, vb->id[i], vb->l1[i], vb->l2[i], vb->t[i], d);
+  return hit_make(s, vb->id[i], vb->l1[i], vb->l2[i], vb->t[i], o, d, c, x, y);
 }
 
 /* Sample 0 of pixel (x, y). */
@@ -77,10 +79,7 @@ static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, i
  * derivatives over the sample's footprint too (else 0). */
 static tex_coord hit_texcoord(const rr_scene *s, const hit *h, bool derivs) {
   vec3 o, d, do_dxy[2], dd_dxy[2];
-  if (!derivs) {
-    rr_cam_ray(h->cam, h->x, h->y, &o, &d);
-    return rr_texcoord(s, h->id, h->l1, h->l2, h->t, o, d, NULL, NULL);
-  }
+  if (!derivs || !h->cam) return rr_texcoord(s, h->id, h->l1, h->l2, h->t, h->org, h->ray, NULL, NULL);
   rr_cam_ray_diff(h->cam, h->x, h->y, &o, &d, do_dxy, dd_dxy);
   tex_coord tc = rr_texcoord(s, h->id, h->l1, h->l2, h->t, o, d, do_dxy, dd_dxy);
   tc.dudx *= h->footprint, tc.dvdx *= h->footprint, tc.dudy *= h->footprint, tc.dvdy *= h->footprint;
@@ -211,6 +210,22 @@ static void shade_hit(const rr_scene *s, const hit *h, rr_shade_mode mode, const
   for (int ch = 0; ch < 3; ch++) o[ch] = srgb_decode(o[ch]);
 }
 
+/* The surface the lit mode shades at a valid hit h. */
+static void hit_surface(const rr_scene *s, const hit *h, const tex_filter *tf, surface *sf) {
+  uint32_t i = h->id;
+  vec3 ng = geometric_normal(s, i);
+  sf->ng = v3_dot(ng, h->dir) > 0 ? v3_neg(ng) : ng;
+  sf->n = h->normal, sf->v = v3_neg(h->dir);
+  if (scene_inf(s, i)) { /* corners at infinity: along the ray */
+    sf->p = v3_add(h->org, v3_scale(h->dir, h->dist));
+  } else { /* from the corners: as exact as the triangle, wherever the ray came from */
+    sf->p = v3_add(v3_add(v3_scale(scene_vertex(s, 0, i), h->l0), v3_scale(scene_vertex(s, 1, i), h->l1)),
+                   v3_scale(scene_vertex(s, 2, i), h->l2));
+  }
+  sf->m = s->nmaterials ? &s->materials[s->material[i] % s->nmaterials] : NULL;
+  base_color(s, h, tf, sf->base);
+}
+
 /* One shading pass over the samples of a frame (rows dealt out in jobs). */
 typedef struct shade_pass {
   const rr_scene *s;
@@ -228,7 +243,20 @@ typedef struct shade_pass {
   float *out; /* a filter of each pixel's own samples: the image, resolved as shading goes (no rgb kept) */
   uint64_t shades[RR_MAX_THREADS];
   bool failed; /* a job found no memory */
+  bool lit;          /* RR_SHADE_LIT: the run's points are shaded together (light.h) */
+  lighting lights;
+  lit_stats lit_st[RR_MAX_THREADS];
+  lit_batch *batch[RR_MAX_THREADS]; /* each thread's, made by its first job and kept for the pass */
 } shade_pass;
+
+/* A reflection ray's hit as the lit mode's surface (light.h's surface_fn). Texture
+ * lookups there have no footprint (the reflected rays carry no differentials). */
+static void reflected_surface(void *ctx, uint32_t index, float l1, float l2, float t, vec3 org, vec3 dir,
+                              surface *out) {
+  const shade_pass *p = ctx;
+  hit h = hit_make(p->s, index, l1, l2, t, org, dir, NULL, 0, 0);
+  hit_surface(p->s, &h, &p->tex, out);
+}
 
 enum { SHADE_ROWS = 8 }; /* rows per job */
 
@@ -243,14 +271,17 @@ static void background(int y, int height, float o[3]) {
  * power of two apart, so reading a pixel's samples in place would map them all to
  * the same cache sets. */
 enum { RUN = 64 };
+_Static_assert(RUN * RR_MAX_SAMPLES <= LIT_BATCH, "a run's points fit one batch of the lit mode");
 typedef struct sample_run {
   uint32_t id[RR_MAX_SAMPLES][RUN];
   float l1[RR_MAX_SAMPLES][RUN], l2[RR_MAX_SAMPLES][RUN], t[RR_MAX_SAMPLES][RUN];
   float rgb[RR_MAX_SAMPLES][3 * RUN], w[RR_MAX_SAMPLES][RUN], a[RR_MAX_SAMPLES][RUN];
+  signed char lead[RR_MAX_SAMPLES][RUN]; /* lit: the sample whose colour this one shares */
 } sample_run;
 
 /* Shades pixel (x, y), run entry j: see rr_aa_mode for what each mode does. */
-static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, int y, const float bg[3]) {
+static uint64_t shade_pixel(const shade_pass *p, sample_run *r, lit_batch *lb, int j, int x, int y,
+                            const float bg[3]) {
   const rr_scene *s = p->s;
   int n = p->samples, K = p->stored;
   bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
@@ -264,6 +295,7 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, in
     uint32_t id = r->id[i][j];
     int last = grouped ? n : i + 1;
     float col[3] = {0, 0, 0};
+    bool queued = false;
     vec3 o, d;
     if (id < s->ntris) {
       float l1 = 0, l2 = 0, t = 0;
@@ -272,9 +304,15 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, in
         if (r->id[m][j] == id) l1 += r->l1[m][j], l2 += r->l2[m][j], t += r->t[m][j], members++;
       if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
         float inv = 1.0f / (float)members;
-        hit h = hit_make(s, &p->cams[i], x, y, id, l1 * inv, l2 * inv, t * inv, d);
+        hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, o, d, &p->cams[i], x, y);
         h.footprint = p->footprint;
-        shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
+        if (p->lit) { /* shaded with the run's other points; the colour arrives in r->rgb[i] */
+          surface sf;
+          hit_surface(s, &h, &p->tex, &sf);
+          queued = rr_lit_batch_add(lb, &sf, &r->rgb[i][3 * j], NULL);
+        } else {
+          shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
+        }
         shades++;
       }
     } else if (p->cams[i].planar || rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
@@ -282,8 +320,8 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, int j, int x, in
     }
     for (int m = i; m < (last < K ? last : K); m++)
       if (r->id[m][j] == id) {
-        memcpy(&r->rgb[m][3 * j], col, sizeof col);
-        done[m] = true, r->w[m][j] = 1.0f;
+        if (m > i || !queued) memcpy(&r->rgb[m][3 * j], col, sizeof col);
+        done[m] = true, r->w[m][j] = 1.0f, r->lead[m][j] = (signed char)i;
       }
   }
   /* csaa: a coverage sample votes for the nearest stored sample of its primitive;
@@ -307,8 +345,11 @@ static void shade_rows(int job, int thread, void *arg) {
   int n = p->samples;
   uint64_t shades = 0;
   sample_run *r = malloc(sizeof *r);
-  if (!r) { /* a job without room leaves its rows for shade_frame to report */
+  if (p->lit && !p->batch[thread]) p->batch[thread] = rr_lit_batch_new();
+  lit_batch *lb = p->lit ? p->batch[thread] : NULL;
+  if (!r || (p->lit && !lb)) { /* a job without room leaves its rows for shade_frame to report */
     p->failed = true;
+    free(r);
     return;
   }
   for (int y = job * SHADE_ROWS; y < vb->height && y < (job + 1) * SHADE_ROWS; y++) {
@@ -324,7 +365,13 @@ static void shade_rows(int job, int thread, void *arg) {
         memcpy(r->l2[i], vb->l2 + e, len * sizeof(float));
         memcpy(r->t[i], vb->t + e, len * sizeof(float));
       }
-      for (int j = 0; j < len; j++) shades += shade_pixel(p, r, j, x0 + j, y, bg);
+      for (int j = 0; j < len; j++) shades += shade_pixel(p, r, lb, j, x0 + j, y, bg);
+      if (p->lit) { /* the run's points at once (a run holds at most LIT_BATCH), then their groups */
+        rr_lit_batch_shade(lb, p->s, &p->lights, reflected_surface, p, &p->lit_st[thread]);
+        for (int i = 0; i < p->stored; i++)
+          for (int j = 0; j < len; j++)
+            if (r->lead[i][j] != i) memcpy(&r->rgb[i][3 * j], &r->rgb[r->lead[i][j]][3 * j], 3 * sizeof(float));
+      }
       for (int i = 0; p->has_alpha && i < n; i++)
         for (int j = 0; j < len; j++) r->a[i][j] = r->id[i][j] < p->s->ntris ? 1.0f : 0.0f;
       const float *w = p->aa == RR_AA_CSAA ? r->w[0] : NULL, *a = p->has_alpha ? r->a[0] : NULL;
@@ -379,13 +426,15 @@ static rr_error shade_heat_frame(rr_device *dev, const rr_frame *f, rr_shade_mod
 /* Shades the samples as the frame's AA mode says (cams: one per sample position),
  * then resolves them into out with the options' filter. */
 static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f,
-                              const rr_shade_options *opt, rr_image *out, rr_shade_stats *st) {
+                              const rr_shade_options *opt, const lighting *lights, rr_image *out,
+                              rr_shade_stats *st) {
   const visbuf *vb = &f->vb;
   size_t npix = (size_t)vb->width * vb->height;
   shade_pass *p = calloc(1, sizeof *p);
   if (!p) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading");
   *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = opt->mode, .aa = f->aa, .samples = f->samples,
-                      .tex = {opt->texture_filter, opt->aniso, opt->lod_bias}};
+                      .tex = {opt->texture_filter, opt->aniso, opt->lod_bias}, .lit = lights != NULL};
+  if (lights) p->lights = *lights;
   p->stored = f->aa == RR_AA_CSAA ? f->aa_stored : p->samples;
   /* Derivatives are per pixel step. A sample shaded for the whole pixel (one per
    * pixel, msaa, csaa) filters over all of it; ssaa's N samples each over their
@@ -433,9 +482,15 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
     if (e && own) free(out->data), out->data = NULL;
     if (st) {
       *st = (rr_shade_stats){.shade_ms = t1 - t0, .resolve_ms = rr_now_ms() - t1};
-      for (int t = 0; t < RR_MAX_THREADS; t++) st->shades += p->shades[t];
+      for (int t = 0; t < RR_MAX_THREADS; t++) {
+        const lit_stats *l = &p->lit_st[t];
+        st->shades += p->shades[t];
+        st->shadow_rays += l->shadow_rays, st->reflection_rays += l->reflection_rays;
+        st->shadow_ms += l->shadow_ms, st->reflection_ms += l->reflection_ms;
+      }
     }
   }
+  for (int t = 0; t < RR_MAX_THREADS; t++) rr_lit_batch_free(p->batch[t]);
   free(p->rgb), free(p->weight), free(p->alpha), free(p);
   return e ? e : rr_ok(dev);
 }
@@ -491,7 +546,7 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
   static const int channels[RR_AOV_COUNT] = {[RR_AOV_DEPTH] = 1, [RR_AOV_ID] = 1,       [RR_AOV_NORMAL] = 3,
                                              [RR_AOV_BARY] = 2,  [RR_AOV_EVALS] = 1,    [RR_AOV_NODES] = 1,
                                              [RR_AOV_MESH] = 1,  [RR_AOV_MATERIAL] = 1, [RR_AOV_COVERAGE] = 1,
-                                             [RR_AOV_UV] = 2,    [RR_AOV_UV_DERIV] = 4};
+                                             [RR_AOV_UV] = 2,    [RR_AOV_UV_DERIV] = 4}; /* the lit parts: lit_aov */
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
     if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
@@ -552,10 +607,53 @@ const char *rr_texture_filter_name(int filter) {
   return filter >= 0 && filter < RR_TEXTURE_FILTER_COUNT ? texture_filter_names[filter] : NULL;
 }
 
+/* The lit mode's parts (AOVs albedo .. emission) at the sample nearest each pixel's
+ * centre, under the lights of the default lit shading. */
+static rr_error lit_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, const camera *cams,
+                        const rr_frame *f, rr_aov aov, rr_image *out) {
+  static const int part[] = {LIT_ALBEDO, LIT_DIRECT, LIT_REFLECTION, LIT_SHADOW, LIT_EMISSION};
+  int ch = aov == RR_AOV_SHADOW ? 1 : 3, first = part[aov - RR_AOV_ALBEDO], centre = centre_sample(f);
+  rr_shade_options opt;
+  rr_shade_options_init(&opt);
+  opt.mode = RR_SHADE_LIT;
+  bool empty;
+  if (!rr_bvh_of(dev, s, &empty) && !empty) return RR_ERROR_ARGUMENT; /* rays need the current BVH */
+  const visbuf vb = visbuf_layer(&f->vb, centre);
+  size_t npix = (size_t)vb.width * vb.height;
+  shade_pass *p = calloc(1, sizeof *p); /* what reflected_surface reads */
+  float *parts = calloc(npix, LIT_PARTS * sizeof(float)), (*colour)[3] = malloc(LIT_BATCH * sizeof *colour);
+  lit_batch *lb = rr_lit_batch_new();
+  rr_error e = p && parts && colour && lb ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for AOV %d", (int)aov);
+  if (!e) e = rr_lighting_make(dev, s, cam, &opt, &p->lights);
+  if (!e) {
+    p->s = s, p->tex = (tex_filter){opt.texture_filter, opt.aniso, opt.lod_bias};
+    lit_stats st = {0};
+    int queued = 0;
+    for (size_t k = 0; k < npix; k++) {
+      int x = (int)(k % vb.width), y = (int)(k / vb.width);
+      vec3 o, d;
+      if (vb.id[k] >= s->ntris || !rr_cam_ray(&cams[centre], x, y, &o, &d)) continue; /* 0 */
+      hit h = hit_make(s, vb.id[k], vb.l1[k], vb.l2[k], vb.t[k], o, d, &cams[centre], x, y);
+      surface sf;
+      hit_surface(s, &h, &p->tex, &sf);
+      rr_lit_batch_add(lb, &sf, colour[queued++], parts + k * LIT_PARTS);
+      if (queued == LIT_BATCH) rr_lit_batch_shade(lb, s, &p->lights, reflected_surface, p, &st), queued = 0;
+    }
+    rr_lit_batch_shade(lb, s, &p->lights, reflected_surface, p, &st);
+    rr_lighting_release(&p->lights);
+    e = image_alloc(dev, out, vb.width, vb.height, ch, RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov);
+  }
+  for (size_t k = 0; !e && k < npix; k++)
+    memcpy((float *)out->data + k * ch, parts + k * LIT_PARTS + first, ch * sizeof(float));
+  free(p), free(parts), free(colour), rr_lit_batch_free(lb);
+  return e ? e : rr_ok(dev);
+}
+
 /* The public entry points resolve the frame's cameras, one per sample position, around the work. */
 void rr_shade_options_init(rr_shade_options *opt) {
   *opt = (rr_shade_options){.mode = RR_SHADE_LAMBERT, .filter = RR_FILTER_BOX, .radius = 0, .alpha = 0,
-                              .texture_filter = RR_TEXTURE_ANISO, .aniso = 16, .lod_bias = 0};
+                              .texture_filter = RR_TEXTURE_ANISO, .aniso = 16, .lod_bias = 0,
+                              .shadows = RR_SHADOWS_RAYS, .max_depth = 2, .default_lights = 1};
 }
 
 rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
@@ -577,11 +675,26 @@ rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam,
     if (stats) stats->shade_ms = rr_now_ms() - t0;
     return e;
   }
-  camera cams[RR_MAX_SAMPLES];
-  rr_error e = frame_cameras(dev, cam, f, cams);
+  bool lit = opt->mode == RR_SHADE_LIT;
+  if (lit && opt->shadows == RR_SHADOWS_RASTER)
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED,
+                   "shadows by rasterization from the light are not implemented yet (use rays or none)");
+  if (lit && ((int)opt->shadows < 0 || opt->shadows >= RR_SHADOWS_COUNT))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shadow mode %d", (int)opt->shadows);
+  if (lit && (opt->max_depth < 0 || opt->max_depth > RR_MAX_DEPTH))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "max depth %d out of range (0 .. %d)", opt->max_depth, RR_MAX_DEPTH);
+  bool empty;
+  if (lit && !rr_bvh_of(dev, s, &empty) && !empty) return RR_ERROR_ARGUMENT; /* rays need the current BVH */
+  lighting lights;
+  rr_error e = lit ? rr_lighting_make(dev, s, cam, opt, &lights) : RR_OK;
   if (e) return e;
-  e = shade_samples(dev, s, cams, f, opt, out, stats);
-  for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
+  camera cams[RR_MAX_SAMPLES];
+  e = frame_cameras(dev, cam, f, cams);
+  if (!e) {
+    e = shade_samples(dev, s, cams, f, opt, lit ? &lights : NULL, out, stats);
+    for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
+  }
+  if (lit) rr_lighting_release(&lights);
   return e;
 }
 
@@ -600,7 +713,7 @@ rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, c
   camera cams[RR_MAX_SAMPLES];
   rr_error e = frame_cameras(dev, cam, f, cams);
   if (e) return e;
-  e = frame_aov(dev, s, cams, f, aov, out);
+  e = aov >= RR_AOV_ALBEDO ? lit_aov(dev, s, cam, cams, f, aov, out) : frame_aov(dev, s, cams, f, aov, out);
   for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
   return e;
 }

@@ -109,14 +109,15 @@ static int name_index(const char *const *names, int n, const char *name) {
 }
 
 int rr_shade_from_name(const char *name) {
-  static const char *const names[RR_SHADE_COUNT] = {"lambert", "id", "normal", "depth", "heat-evals", "heat-nodes"};
+  static const char *const names[RR_SHADE_COUNT] = {"lambert", "id", "normal", "depth", "heat-evals", "heat-nodes", "lit"};
   return name_index(names, RR_SHADE_COUNT, name);
 }
 
 int rr_aov_from_name(const char *name) {
   static const char *const names[RR_AOV_COUNT] = {"depth", "id",       "normal",    "bary",         "evals",      "nodes",
                                                   "mesh",  "material", "coverage", "sample-id", "sample-depth", "sample-mesh",
-                                                  "uv",    "uv-deriv"};
+                                                  "uv",    "uv-deriv", "albedo", "direct", "reflection", "shadow",
+                                                  "emission"};
   return name_index(names, RR_AOV_COUNT, name);
 }
 

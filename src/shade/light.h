@@ -1,0 +1,81 @@
+/* The lit shade mode (docs/shading.md): direct light from point, spot, directional
+ * and sky lights, emission and mirror reflections over a material's diffuse and
+ * specular lobes. Points are shaded a batch at a time (a run of pixels), so that
+ * each light's shadow rays and each bounce's reflection rays go through the ray
+ * streams together. Shading of one point never knows which method saw it. */
+#ifndef RR_LIGHT_H
+#define RR_LIGHT_H
+
+#include "scene/scene.h"
+
+/* A point to shade: where it is, how it faces, where it is seen from, what it is made of. */
+typedef struct surface {
+  vec3 p;               /* position */
+  vec3 ng;              /* unit geometric normal, on the viewer's side */
+  vec3 n;               /* unit shading normal, on the viewer's side */
+  vec3 v;               /* unit direction towards the viewer */
+  float base[3];        /* base colour: the material's times its texture and vertex colours */
+  const rr_material *m; /* NULL: the default grey, Lambert alone */
+} surface;
+
+/* A punctual light as shading uses it. */
+typedef struct light {
+  rr_light_type type;           /* directional, point or spot (area lights shade as points) */
+  vec3 pos, dir;                /* dir: unit, where the light shines */
+  float rgb[3];                 /* intensity (cd) or, directional, irradiance (lux) */
+  float cos_inner, cos_outer;   /* spot: cosines of the cone's half-angles */
+} light;
+
+/* What a frame is lit by, and how. */
+typedef struct lighting {
+  light *lights; /* the punctual lights */
+  int nlights;
+  float sky[3], ground[3]; /* the ambient lights' sum: radiance from straight above and below */
+  vec3 up;                 /* the scene's up, the sky's axis */
+  rr_shadow_mode shadows;
+  int max_depth;           /* mirror bounces */
+  float eps;               /* the scene-wide part of a ray's offset (shading.md) */
+} lighting;
+
+/* The lights of a frame: the scene's, or the default rig placed from cam when the
+ * scene has none and opt->default_lights is set. */
+rr_error rr_lighting_make(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_shade_options *opt,
+                       lighting *out);
+void rr_lighting_release(lighting *l);
+
+/* Fills out with the surface a reflection ray (org, dir) hit: triangle index, its
+ * barycentrics and t along dir (shade.c gives it; ctx is its own). */
+typedef void (*surface_fn)(void *ctx, uint32_t index, float l1, float l2, float t, vec3 org, vec3 dir, surface *out);
+
+/* Rays a batch traced and the time they took. */
+typedef struct lit_stats {
+  uint64_t shadow_rays, reflection_rays;
+  double shadow_ms, reflection_ms;
+} lit_stats;
+
+enum { LIT_BATCH = 1024 }; /* most points of a batch */
+
+/* A point's colour in parts (the lit AOVs, named as Blender Cycles' passes): offsets
+ * into an array of LIT_PARTS floats. The colour is direct + reflection + emission. */
+enum {
+  LIT_ALBEDO = 0,      /* rgb: the diffuse lobe's colour */
+  LIT_DIRECT = 3,      /* rgb: light from the lights and the sky on the point itself */
+  LIT_REFLECTION = 6,  /* rgb: what its mirror reflects (all bounces) */
+  LIT_EMISSION = 9,    /* rgb: what it emits */
+  LIT_SHADOW = 12,     /* the fraction of the punctual lights that reach it (1 when there is none) */
+  LIT_PARTS = 13
+};
+typedef struct lit_batch lit_batch;
+
+/* A batch, empty (NULL when out of memory); one per thread. */
+lit_batch *rr_lit_batch_new(void);
+void rr_lit_batch_free(lit_batch *b);
+/* Queues a point whose linear colour goes to out[0..2] when the batch is shaded,
+ * and its parts to parts[0 .. LIT_PARTS - 1] unless parts is NULL; false when the
+ * batch is full. */
+bool rr_lit_batch_add(lit_batch *b, const surface *sf, float *out, float *parts);
+/* Shades the queued points under L, writes their colours and empties the batch;
+ * rays through s's streams on this thread, reflected hits made by fn(ctx). */
+void rr_lit_batch_shade(lit_batch *b, const rr_scene *s, const lighting *L, surface_fn fn, void *ctx, lit_stats *st);
+
+#endif
