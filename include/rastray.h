@@ -770,6 +770,70 @@ RR_API rr_error rr_image_write_layers(rr_device *dev, const rr_image *images, in
  * files give plain values. */
 RR_API rr_error rr_image_read(rr_device *dev, const char *path, rr_image *out);
 
+
+/* ---- scene files ------------------------------------------------------------ */
+/* A JSON file that composes a scene: meshes (files or built-ins) with transforms and
+ * material overrides, lights, a camera and render settings (docs/scene-file.md). */
+
+typedef struct rr_load_options {
+  const char *base_dir; /* where the file's relative paths start; NULL: the scene file's directory */
+  int sandbox;          /* nonzero: refuse every path (after symbolic links) outside base_dir, and
+                           built-ins that read files (grid:); default 0 */
+  int builtins;         /* nonzero (default): meshes may be built-in names ("builtin": "sphere:32") */
+  uint64_t max_tris;    /* most triangles the scene may reserve, meshes together; 0 (default): no limit */
+} rr_load_options;
+
+/* Fills load options with defaults: paths from the scene file's directory, no
+ * sandbox, built-ins allowed, no triangle limit. */
+RR_API void rr_load_options_init(rr_load_options *opt);
+
+/* Which fields of rr_scene_settings a scene file gave (rr_scene_settings.given). */
+enum {
+  RR_SETTING_SIZE = 1u << 0,           /* render.width, render.height */
+  RR_SETTING_METHOD = 1u << 1,         /* render.method */
+  RR_SETTING_AA = 1u << 2,             /* render.aa, samples, aa_stored, sample_pos */
+  RR_SETTING_CULL = 1u << 3,           /* render.cull_backfaces */
+  RR_SETTING_SHADE = 1u << 4,          /* shade.mode */
+  RR_SETTING_SHADOWS = 1u << 5,        /* shade.shadows */
+  RR_SETTING_MAX_DEPTH = 1u << 6,      /* shade.max_depth */
+  RR_SETTING_FILTER = 1u << 7,         /* shade.filter, shade.radius */
+  RR_SETTING_TEXTURE_FILTER = 1u << 8, /* shade.texture_filter, shade.aniso */
+  RR_SETTING_LOD_BIAS = 1u << 9,       /* shade.lod_bias */
+  RR_SETTING_ALPHA = 1u << 10,         /* shade.alpha */
+  RR_SETTING_DEFAULT_LIGHTS = 1u << 11 /* shade.default_lights */
+};
+/* Which fields of an rr_camera a camera file or a scene file's camera gave. */
+enum {
+  RR_CAMERA_FIELD_TYPE = 1u << 0,
+  RR_CAMERA_FIELD_EYE = 1u << 1,
+  RR_CAMERA_FIELD_TARGET = 1u << 2,
+  RR_CAMERA_FIELD_UP = 1u << 3,
+  RR_CAMERA_FIELD_FOV = 1u << 4,
+  RR_CAMERA_FIELD_ORTHO = 1u << 5
+};
+
+/* What a scene file says about rendering it. Fields the file does not give keep
+ * the defaults of rr_render_options_init and rr_shade_options_init, except that
+ * the method is RR_METHOD_AUTO and the shade mode RR_SHADE_LIT (as the command line's). */
+typedef struct rr_scene_settings {
+  unsigned given;           /* RR_SETTING_* bits */
+  unsigned camera_given;    /* RR_CAMERA_FIELD_* bits; 0: the file has no camera */
+  rr_camera camera;         /* rr_camera_init's where the file gives nothing */
+  rr_render_options render; /* oracles is always NULL */
+  rr_shade_options shade;
+} rr_scene_settings;
+
+/* Loads a scene file (opt NULL: defaults) into a new committed scene; settings, when
+ * not NULL, receives its camera and render settings. Nothing is made on failure:
+ * the message names the file and the key ("scene file 'a.json': meshes[1].scale:
+ * expected a number"). rr_scene_load reads a ".json" path this way too. */
+RR_API rr_error rr_scene_load_file(rr_device *dev, const char *path, const rr_load_options *opt, rr_scene **out,
+                                   rr_scene_settings *settings);
+/* Reads a camera file ({"eye", "target", "up", "fov", "type", "ortho_height"}, or a
+ * 4x4 camera-to-world "matrix"; docs/scene-file.md) into *cam: the fields it gives
+ * change, the others stay; *fields (may be NULL) receives their RR_CAMERA_FIELD_* bits. */
+RR_API rr_error rr_camera_load(rr_device *dev, const char *path, rr_camera *cam, unsigned *fields);
+
 #ifdef __cplusplus
 }
 #endif

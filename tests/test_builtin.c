@@ -162,7 +162,7 @@ static void test_grid(int n) {
   const char *path = RR_DATA_DIR "/teapot.obj";
   rr_scene *ref = NULL;
   rr_error e = rr_scene_new(dev, &ref);
-  if (!e) e = rr_scene_load_file(ref, path);
+  if (!e) e = rr_scene_import_file(ref, path);
   CHECK(e == RR_OK, "loading %s: %s", path, rr_device_message(dev));
   char name[512];
   snprintf(name, sizeof name, "grid:%s:%d", path, n);

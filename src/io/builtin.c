@@ -299,7 +299,7 @@ static rr_error load_grid(rr_scene *s, const char *name) {
   path[len] = 0;
   uint32_t t0 = s->ntris, g0 = s->ngeoms;
   uint64_t skipped0 = s->skipped, f0 = scene_faces(s);
-  rr_error e = rr_scene_load_file(s, path);
+  rr_error e = rr_scene_import_file(s, path);
   free(path);
   if (e) return e;
 
@@ -531,7 +531,7 @@ static rr_error place_file(rr_scene *s, const char *file, const char *name, floa
   *first_mat = s->nmaterials;
   char path[DATA_PATH_MAX];
   rr_error e = find_data_file(s->dev, file, path);
-  if (!e) e = rr_scene_load_file(s, path);
+  if (!e) e = rr_scene_import_file(s, path);
   if (!e && s->ntris == t0) e = rr_fail(s->dev, RR_ERROR_EMPTY, "demo mesh '%s' has no triangles", path);
   for (uint32_t g = g0; !e && g < s->ngeoms; g++) e = rr_scene_name_geometry(s, g, name);
   if (!e) e = smooth_normals(s, t0, s->ntris);
@@ -609,6 +609,11 @@ rr_error rr_scene_load_builtin(rr_scene *s, const char *name) {
   } else if ((arg = builtin_arg(name, "box"))) {
     e = size_arg(s, name, arg, 8, 1, 1024, &n);
     if (!e) e = gen_box(s, (int)n);
+  } else if ((arg = builtin_arg(name, "torus"))) {
+    uint32_t mat; /* a ring of radius 1 around +y, tube radius 0.35: curved and closed, for shading */
+    e = size_arg(s, name, arg, 48, 4, 4096, &n);
+    if (!e) e = add_material(s, SCENE_GREY, SCENE_GREY, SCENE_GREY, &mat);
+    if (!e) e = gen_torus(s, (int)n, (int)(n + 1) / 2, 1.0f, 0.35f, v3(0, 0, 0), mat);
   } else if ((arg = builtin_arg(name, "rooms"))) {
     e = size_arg(s, name, arg, 4, 1, 100, &n);
     if (!e) e = gen_rooms(s, (int)n);

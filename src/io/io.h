@@ -5,7 +5,7 @@
 #include "scene/scene.h"
 
 /* Loaders: assimp files and the built-in scenes. */
-rr_error rr_scene_load_file(rr_scene *s, const char *path);
+rr_error rr_scene_import_file(rr_scene *s, const char *path);
 /* Returns RR_OK when `name` named a built-in scene (and fills s), RR_ERROR_UNSUPPORTED
  * when it is not a built-in name; other codes are real failures. */
 rr_error rr_scene_load_builtin(rr_scene *s, const char *name);

@@ -59,6 +59,9 @@ rr_error rr_scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool wi
   if (scene_faces(s) + more > UINT32_MAX - 1) /* every id, dropped faces' too, below RR_MISS */
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "scene too large: %llu triangles",
                    (unsigned long long)(scene_faces(s) + more));
+  if (s->max_tris && need > s->max_tris)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "scene too large: %llu triangles, over the limit of %llu",
+                   (unsigned long long)need, (unsigned long long)s->max_tris);
   /* Attribute arrays appear when the first mesh that has them arrives; earlier
    * triangles get zeros so the arrays stay aligned with the positions. */
   bool add_n = with_normals && !s->n[0][0], add_uv = with_uvs && !s->uv[0][0];

@@ -93,6 +93,7 @@ struct rr_scene {
   rr_light_info *lights; /* in world space; names are the scene's copies */
   uint32_t nlights;
   struct rr_bvh *bvh; /* built by rr_scene_commit */
+  uint64_t max_tris;  /* most triangles rr_scene_reserve grants (a scene file's budget); 0: no limit */
 };
 
 static inline vec3 scene_vertex(const rr_scene *s, int k, uint32_t i) {
