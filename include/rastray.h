@@ -825,7 +825,7 @@ typedef struct rr_scene_settings {
 
 /* Loads a scene file (opt NULL: defaults) into a new committed scene; settings, when
  * not NULL, receives its camera and render settings. Nothing is made on failure:
- * the message names the file and the key ("scene file 'a.json': meshes[1].scale:
+ * the message names the file and the key ("scene file 'a.json': 'meshes[1].scale':
  * expected a number"). rr_scene_load reads a ".json" path this way too. */
 RR_API rr_error rr_scene_load_file(rr_device *dev, const char *path, const rr_load_options *opt, rr_scene **out,
                                    rr_scene_settings *settings);

@@ -23,11 +23,14 @@ struct cJSON;
  * frees it; exits when it cannot. */
 void json_add(rr_device *dev, rr_output *set, struct cJSON *root, const char *path);
 
-/* The fields of an rr_camera that a flag or a camera file gives. */
-enum { CAM_TYPE = 1, CAM_EYE = 2, CAM_TARGET = 4, CAM_UP = 8, CAM_FOV = 16, CAM_ORTHO = 32 };
-/* Reads a camera file (tools/camera_file.c) into *cam and returns the fields it
- * gave; the others keep their values. A bad file ends the program (exit 1). */
-unsigned camera_file_read(const char *path, rr_camera *cam);
+/* The fields of an rr_camera that a flag or a camera file gives (rastray.h's RR_CAMERA_FIELD_*). */
+enum {
+  CAM_TYPE = RR_CAMERA_FIELD_TYPE, CAM_EYE = RR_CAMERA_FIELD_EYE, CAM_TARGET = RR_CAMERA_FIELD_TARGET,
+  CAM_UP = RR_CAMERA_FIELD_UP, CAM_FOV = RR_CAMERA_FIELD_FOV, CAM_ORTHO = RR_CAMERA_FIELD_ORTHO
+};
+/* Reads a camera file (rr_camera_load) into *cam and returns the fields it gave;
+ * the others keep their values. A bad file ends the program (exit 1). */
+unsigned camera_file_read(rr_device *dev, const char *path, rr_camera *cam);
 /* Adds a camera file for an image of width × height to the output set. */
 void camera_file_add(rr_device *dev, rr_output *set, const char *path, const rr_camera *cam, int width, int height);
 

@@ -568,7 +568,16 @@ static double median(double *v, int n) {
 
 /* Loads a scene, its BVH built on `threads` threads; *load_ms is the time of the
  * load without the build. Progress shows from here on: loading is the first long step. */
-static rr_scene *load_scene(rr_device *dev, const char *name, int threads, double *load_ms) {
+/* Whether a scene name is a scene file (rr_scene_load_file), by its extension. */
+static bool is_scene_file(const char *name) {
+  size_t n = strlen(name);
+  return n > 5 && strcmp(name + n - 5, ".json") == 0;
+}
+
+/* Loads a scene (exits when it cannot); a scene file's settings go to *settings
+ * (which may be NULL), given 0 for other scenes. */
+static rr_scene *load_scene(rr_device *dev, const char *name, int threads, double *load_ms,
+                            rr_scene_settings *settings) {
   if (verbosity >= 0) progress_start(dev, force_progress);
   rr_build_options build;
   rr_build_options_init(&build);
@@ -576,7 +585,10 @@ static rr_scene *load_scene(rr_device *dev, const char *name, int threads, doubl
   rr_device_set_build_options(dev, &build);
   double t0 = now_ms();
   rr_scene *scene;
-  if (rr_scene_load(dev, name, &scene) != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
+  if (settings) settings->given = settings->camera_given = 0;
+  rr_error e = is_scene_file(name) ? rr_scene_load_file(dev, name, NULL, &scene, settings)
+                                   : rr_scene_load(dev, name, &scene);
+  if (e != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
   run.scene = scene;
   rr_scene_info in;
   rr_scene_get_info(scene, &in);
@@ -702,7 +714,7 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
   if (argc - optind != 1) die(EXIT_USAGE, "info takes one scene (see --help)");
   const char *scene_name = argv[optind];
   double load_ms;
-  rr_scene *scene = load_scene(dev, scene_name, threads, &load_ms);
+  rr_scene *scene = load_scene(dev, scene_name, threads, &load_ms, NULL);
   progress_stop();
   rr_scene_info in;
   rr_scene_get_info(scene, &in);
@@ -811,6 +823,38 @@ static void add_stats_json(rr_device *dev, rr_output *set, const char *path, con
   json_add(dev, set, o, path);
 }
 
+#define FLAG(key) (1ull << ((key) - 256))
+
+/* A scene file's render settings, each where no flag gave it (flags: FLAG bits). */
+static void take_settings(const rr_scene_settings *file, uint64_t flags, rr_render_options *opt,
+                          rr_shade_options *shading, int *shade, aa_spec *aa) {
+  const rr_render_options *fr = &file->render;
+  const rr_shade_options *fs = &file->shade;
+  unsigned take = file->given;
+  const struct {
+    unsigned setting;
+    int flag;
+  } flag_of[] = {{RR_SETTING_SIZE, OPT_SIZE}, {RR_SETTING_METHOD, OPT_METHOD}, {RR_SETTING_AA, OPT_AA},
+                 {RR_SETTING_CULL, OPT_CULL_BACKFACES}, {RR_SETTING_SHADE, OPT_SHADE},
+                 {RR_SETTING_SHADOWS, OPT_SHADOWS}, {RR_SETTING_MAX_DEPTH, OPT_MAX_DEPTH},
+                 {RR_SETTING_FILTER, OPT_AA_FILTER}, {RR_SETTING_TEXTURE_FILTER, OPT_TEXTURE_FILTER},
+                 {RR_SETTING_LOD_BIAS, OPT_LOD_BIAS}, {RR_SETTING_ALPHA, OPT_ALPHA}};
+  for (size_t k = 0; k < sizeof flag_of / sizeof *flag_of; k++)
+    if (flags & FLAG(flag_of[k].flag)) take &= ~flag_of[k].setting;
+  if (take & RR_SETTING_SIZE) opt->width = fr->width, opt->height = fr->height;
+  if (take & RR_SETTING_METHOD) opt->method = fr->method;
+  if (take & RR_SETTING_AA) *aa = (aa_spec){fr->aa, fr->samples, fr->aa_stored};
+  if (take & RR_SETTING_CULL) opt->cull_backfaces = fr->cull_backfaces;
+  if (take & RR_SETTING_SHADE) *shade = fs->mode;
+  if (take & RR_SETTING_SHADOWS) shading->shadows = fs->shadows;
+  if (take & RR_SETTING_MAX_DEPTH) shading->max_depth = fs->max_depth;
+  if (take & RR_SETTING_FILTER) shading->filter = fs->filter, shading->radius = fs->radius;
+  if (take & RR_SETTING_TEXTURE_FILTER) shading->texture_filter = fs->texture_filter, shading->aniso = fs->aniso;
+  if (take & RR_SETTING_LOD_BIAS) shading->lod_bias = fs->lod_bias;
+  if (take & RR_SETTING_ALPHA) shading->alpha = fs->alpha;
+  if (take & RR_SETTING_DEFAULT_LIGHTS) shading->default_lights = fs->default_lights;
+}
+
 static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
   double t_start = now_ms();
   rr_render_options opt;
@@ -831,7 +875,9 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   aov_out aovs[16];
   rr_shade_options shading;
   rr_shade_options_init(&shading);
+  uint64_t flags = 0; /* bit key - 256: the long options given, which override a scene file's settings */
   for (int key; (key = next_option(cmd, argc, argv)) != -1;) {
+    if (key >= 256 && key < 256 + 64) flags |= 1ull << (key - 256);
     switch (key) {
     case OPT_METHOD: {
       int m = rr_method_from_name(optarg);
@@ -913,9 +959,15 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     die(EXIT_USAGE, "--camera-from-file takes the view from the file: no --eye, --target, --up or --fov with it");
   if (file_cam && camera_file) die(EXIT_USAGE, "--camera-from-file and --camera-file exclude each other");
   if (!scene_name) scene_name = "demo";
+  timings ms = {0};
+  rr_scene_settings file; /* a scene file's settings, where no flag gave them */
+  rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load, &file);
+  take_settings(&file, flags, &opt, &shading, &shade, &aa);
   if (pattern_given && aa.mode == RR_AA_NONE) die(EXIT_USAGE, "--aa-pattern needs --aa other than none");
   if (rr_render_options_set_aa(dev, &opt, aa.mode, aa.samples, aa.stored, pattern, seed) != RR_OK)
     die(EXIT_USAGE, "%s", rr_device_message(dev));
+  if ((file.given & RR_SETTING_AA) && !(flags & FLAG(OPT_AA)) && !pattern_given) /* the file's pattern too */
+    memcpy(opt.sample_pos, file.render.sample_pos, sizeof opt.sample_pos);
   if (!out && naov == 0) out = "rastray.png";
   if (shade == RR_SHADE_HEAT_EVALS || shade == RR_SHADE_HEAT_NODES) opt.heat = 1;
   const unsigned heat_aovs = 1u << RR_AOV_EVALS | 1u << RR_AOV_NODES;
@@ -929,13 +981,15 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~by_name & ~(opt.heat ? 0 : heat_aovs);
   if (camera_file) { /* the file's values, where no flag gave one */
     rr_camera from_file = cam;
-    unsigned fields = camera_file_read(camera_file, &from_file);
+    unsigned fields = camera_file_read(dev, camera_file, &from_file);
     camera_take(&cam, &from_file, fields & ~given);
     given |= fields;
   }
+  if (!file_cam) { /* then the scene file's camera */
+    camera_take(&cam, &file.camera, file.camera_given & ~given);
+    given |= file.camera_given;
+  }
 
-  timings ms = {0};
-  rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load);
   for (int k = 0; k < nlights; k++)
     if (rr_scene_add_light(scene, &lights[k]) != RR_OK) die(EXIT_USAGE, "--light: %s", rr_device_message(dev));
   if (file_cam) { /* the file's camera; --camera may change its projection */

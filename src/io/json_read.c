@@ -58,7 +58,8 @@ rr_error json_fail(json_reader *r, const char *key, const char *fmt, ...) {
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
   size_t len = key ? json_enter(r, key, 0) : strlen(r->at);
-  rr_error e = rr_fail(r->dev, RR_ERROR_PARSE, "%s: %s%s%s", r->what, r->at, r->at[0] ? ": " : "", msg);
+  rr_error e = r->at[0] ? rr_fail(r->dev, RR_ERROR_PARSE, "%s: '%s': %s", r->what, r->at, msg)
+                        : rr_fail(r->dev, RR_ERROR_PARSE, "%s: %s", r->what, msg);
   json_leave(r, len);
   return e;
 }

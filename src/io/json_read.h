@@ -1,6 +1,6 @@
 /* Typed reading of JSON objects (cJSON) for the scene and camera files: every
  * getter checks the value's type and range and, when it is wrong, fails with one
- * line naming the file and the key's path ("scene file 'a.json': meshes[1].scale:
+ * line naming the file and the key's path ("scene file 'a.json': 'meshes[1].scale':
  * expected a number > 0"). A key that is absent leaves the output untouched. */
 #ifndef RR_IO_JSON_READ_H
 #define RR_IO_JSON_READ_H
