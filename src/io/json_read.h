@@ -19,42 +19,42 @@ typedef struct json_reader {
 /* Reads a whole text file of at most max_bytes and parses it; *root is an object.
  * On failure (the file, its size, bad JSON with its line, not an object) returns
  * the error, *root NULL. */
-rr_error json_parse_file(json_reader *r, const char *path, size_t max_bytes, cJSON **root);
+rr_error rr_json_parse_file(json_reader *r, const char *path, size_t max_bytes, cJSON **root);
 
 /* Steps into a member: appends ".key" (or "key" at the top) or "[index]" (key NULL)
- * to r->at and returns the previous length, for json_leave. */
-size_t json_enter(json_reader *r, const char *key, int index);
-static inline void json_leave(json_reader *r, size_t len) { r->at[len] = 0; }
+ * to r->at and returns the previous length, for rr_json_leave. */
+size_t rr_json_enter(json_reader *r, const char *key, int index);
+static inline void rr_json_leave(json_reader *r, size_t len) { r->at[len] = 0; }
 
 /* Fails with RR_ERROR_PARSE: "<what>: <at>.<key>: <message>" (key may be NULL). */
-rr_error json_fail(json_reader *r, const char *key, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+rr_error rr_json_fail(json_reader *r, const char *key, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
 /* Checks that obj is an object whose keys are all among `keys` (a NULL-ended list),
  * each once. */
-rr_error json_keys(json_reader *r, const cJSON *obj, const char *const *keys);
+rr_error rr_json_keys(json_reader *r, const cJSON *obj, const char *const *keys);
 
 /* The member `key` of obj, NULL when absent. */
-static inline const cJSON *json_get(const cJSON *obj, const char *key) {
+static inline const cJSON *rr_json_get(const cJSON *obj, const char *key) {
   return cJSON_GetObjectItemCaseSensitive(obj, key);
 }
 
 /* A finite number in [lo, hi]. */
-rr_error json_float(json_reader *r, const cJSON *obj, const char *key, double lo, double hi, float *out);
+rr_error rr_json_float(json_reader *r, const cJSON *obj, const char *key, double lo, double hi, float *out);
 /* The same, kept as a double. */
-rr_error json_double(json_reader *r, const cJSON *obj, const char *key, double lo, double hi, double *out);
+rr_error rr_json_double(json_reader *r, const cJSON *obj, const char *key, double lo, double hi, double *out);
 /* An integer in [lo, hi]. */
-rr_error json_int(json_reader *r, const cJSON *obj, const char *key, int lo, int hi, int *out);
+rr_error rr_json_int(json_reader *r, const cJSON *obj, const char *key, int lo, int hi, int *out);
 /* true or false. */
-rr_error json_bool(json_reader *r, const cJSON *obj, const char *key, int *out);
+rr_error rr_json_bool(json_reader *r, const cJSON *obj, const char *key, int *out);
 /* A string (owned by the parse). */
-rr_error json_string(json_reader *r, const cJSON *obj, const char *key, const char **out);
+rr_error rr_json_string(json_reader *r, const cJSON *obj, const char *key, const char **out);
 /* An array (the item itself) of exactly n <= 16 finite numbers, each in [lo, hi]. */
-rr_error json_array_floats(json_reader *r, const cJSON *item, int n, double lo, double hi, float *out);
+rr_error rr_json_array_floats(json_reader *r, const cJSON *item, int n, double lo, double hi, float *out);
 /* The member key: an array of exactly n <= 16 finite numbers, each in [lo, hi]. */
-rr_error json_floats(json_reader *r, const cJSON *obj, const char *key, int n, double lo, double hi, float *out);
+rr_error rr_json_floats(json_reader *r, const cJSON *obj, const char *key, int n, double lo, double hi, float *out);
 /* A name that from_name knows (an rr_*_from_name: -1 when unknown); `expected`
  * lists the names for the message. */
-rr_error json_named(json_reader *r, const cJSON *obj, const char *key, int (*from_name)(const char *),
+rr_error rr_json_named(json_reader *r, const cJSON *obj, const char *key, int (*from_name)(const char *),
                     const char *expected, int *out);
 
 #endif

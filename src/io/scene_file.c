@@ -29,21 +29,21 @@ void rr_load_options_init(rr_load_options *opt) {
 /* The camera of a camera-to-world matrix in the OpenGL convention (columns right,
  * up, back, position; bottom row 0 0 0 1): the eye, a target one back-vector ahead. */
 static rr_error camera_matrix(json_reader *r, const cJSON *obj, rr_camera *cam) {
-  const cJSON *m = json_get(obj, "matrix");
+  const cJSON *m = rr_json_get(obj, "matrix");
   if (!cJSON_IsArray(m) || cJSON_GetArraySize(m) != 4)
-    return json_fail(r, "matrix", "expected four rows of four numbers (camera to world, OpenGL convention)");
+    return rr_json_fail(r, "matrix", "expected four rows of four numbers (camera to world, OpenGL convention)");
   float row[4][4];
-  size_t len = json_enter(r, "matrix", 0);
+  size_t len = rr_json_enter(r, "matrix", 0);
   rr_error e = RR_OK;
   for (int i = 0; i < 4 && !e; i++) {
-    size_t l2 = json_enter(r, NULL, i);
-    e = json_array_floats(r, cJSON_GetArrayItem(m, i), 4, -MAX_COORD, MAX_COORD, row[i]);
-    json_leave(r, l2);
+    size_t l2 = rr_json_enter(r, NULL, i);
+    e = rr_json_array_floats(r, cJSON_GetArrayItem(m, i), 4, -MAX_COORD, MAX_COORD, row[i]);
+    rr_json_leave(r, l2);
   }
-  json_leave(r, len);
+  rr_json_leave(r, len);
   if (e) return e;
   if (row[3][0] != 0 || row[3][1] != 0 || row[3][2] != 0 || row[3][3] != 1)
-    return json_fail(r, "matrix", "the bottom row must be 0 0 0 1");
+    return rr_json_fail(r, "matrix", "the bottom row must be 0 0 0 1");
   for (int i = 0; i < 3; i++)
     cam->eye[i] = row[i][3], cam->target[i] = row[i][3] - row[i][2], cam->up[i] = row[i][1];
   return RR_OK;
@@ -53,43 +53,43 @@ static rr_error camera_matrix(json_reader *r, const cJSON *obj, rr_camera *cam) 
  * (or a matrix) must be there (camera files); else they may both be absent. */
 static rr_error read_camera(json_reader *r, const cJSON *obj, rr_camera *cam, unsigned *fields, bool need_view) {
   static const char *const keys[] = {"type", "eye", "target", "up", "fov", "ortho_height", "matrix", "width", "height", NULL};
-  rr_error e = json_keys(r, obj, keys);
+  rr_error e = rr_json_keys(r, obj, keys);
   if (e) return e;
   rr_camera c = *cam;
   unsigned given = 0;
   int type = c.type;
-  e = json_named(r, obj, "type", rr_camera_from_name, "perspective, orthographic, parabolic, latlong, fisheye or cube",
+  e = rr_json_named(r, obj, "type", rr_camera_from_name, "perspective, orthographic, parabolic, latlong, fisheye or cube",
                  &type);
   if (e) return e;
   c.type = (rr_camera_type)type;
-  given |= json_get(obj, "type") ? RR_CAMERA_FIELD_TYPE : 0;
-  if (json_get(obj, "matrix")) {
-    if (json_get(obj, "eye") || json_get(obj, "target") || json_get(obj, "up"))
-      return json_fail(r, NULL, "give either 'matrix' or 'eye', 'target' and 'up', not both");
+  given |= rr_json_get(obj, "type") ? RR_CAMERA_FIELD_TYPE : 0;
+  if (rr_json_get(obj, "matrix")) {
+    if (rr_json_get(obj, "eye") || rr_json_get(obj, "target") || rr_json_get(obj, "up"))
+      return rr_json_fail(r, NULL, "give either 'matrix' or 'eye', 'target' and 'up', not both");
     if ((e = camera_matrix(r, obj, &c))) return e;
     given |= RR_CAMERA_FIELD_EYE | RR_CAMERA_FIELD_TARGET | RR_CAMERA_FIELD_UP;
   } else {
-    if ((e = json_floats(r, obj, "eye", 3, -MAX_COORD, MAX_COORD, c.eye)) ||
-        (e = json_floats(r, obj, "target", 3, -MAX_COORD, MAX_COORD, c.target)) ||
-        (e = json_floats(r, obj, "up", 3, -MAX_COORD, MAX_COORD, c.up)))
+    if ((e = rr_json_floats(r, obj, "eye", 3, -MAX_COORD, MAX_COORD, c.eye)) ||
+        (e = rr_json_floats(r, obj, "target", 3, -MAX_COORD, MAX_COORD, c.target)) ||
+        (e = rr_json_floats(r, obj, "up", 3, -MAX_COORD, MAX_COORD, c.up)))
       return e;
-    bool eye = json_get(obj, "eye"), target = json_get(obj, "target");
-    if ((need_view || eye) && !target) return json_fail(r, NULL, "missing 'target' (or a 'matrix')");
-    if ((need_view || target) && !eye) return json_fail(r, NULL, "missing 'eye' (or a 'matrix')");
-    given |= (eye ? RR_CAMERA_FIELD_EYE | RR_CAMERA_FIELD_TARGET : 0) | (json_get(obj, "up") ? RR_CAMERA_FIELD_UP : 0);
+    bool eye = rr_json_get(obj, "eye"), target = rr_json_get(obj, "target");
+    if ((need_view || eye) && !target) return rr_json_fail(r, NULL, "missing 'target' (or a 'matrix')");
+    if ((need_view || target) && !eye) return rr_json_fail(r, NULL, "missing 'eye' (or a 'matrix')");
+    given |= (eye ? RR_CAMERA_FIELD_EYE | RR_CAMERA_FIELD_TARGET : 0) | (rr_json_get(obj, "up") ? RR_CAMERA_FIELD_UP : 0);
   }
-  if ((e = json_float(r, obj, "fov", RR_FOV_MIN, 360, &c.fov_deg))) return e;
-  if ((e = json_float(r, obj, "ortho_height", 0, MAX_COORD, &c.ortho_height))) return e;
-  given |= (json_get(obj, "fov") ? RR_CAMERA_FIELD_FOV : 0) | (json_get(obj, "ortho_height") ? RR_CAMERA_FIELD_ORTHO : 0);
+  if ((e = rr_json_float(r, obj, "fov", RR_FOV_MIN, 360, &c.fov_deg))) return e;
+  if ((e = rr_json_float(r, obj, "ortho_height", 0, MAX_COORD, &c.ortho_height))) return e;
+  given |= (rr_json_get(obj, "fov") ? RR_CAMERA_FIELD_FOV : 0) | (rr_json_get(obj, "ortho_height") ? RR_CAMERA_FIELD_ORTHO : 0);
   int size; /* the image the camera was saved for: for reference only, but still a number */
-  if ((e = json_int(r, obj, "width", 0, INT_MAX, &size)) || (e = json_int(r, obj, "height", 0, INT_MAX, &size)))
+  if ((e = rr_json_int(r, obj, "width", 0, INT_MAX, &size)) || (e = rr_json_int(r, obj, "height", 0, INT_MAX, &size)))
     return e;
   if (given & RR_CAMERA_FIELD_EYE) {
     rr_camera check = c;
     if (rr_camera_check(r->dev, &check) != RR_OK) {
       char msg[256];
       snprintf(msg, sizeof msg, "%s", rr_device_message(r->dev));
-      return json_fail(r, NULL, "%s", msg);
+      return rr_json_fail(r, NULL, "%s", msg);
     }
   }
   *cam = c;
@@ -103,7 +103,7 @@ rr_error rr_camera_load(rr_device *dev, const char *path, rr_camera *cam, unsign
   snprintf(what, sizeof what, "camera file '%s'", path);
   json_reader r = {.dev = dev, .what = what};
   cJSON *root;
-  rr_error e = json_parse_file(&r, path, 1 << 20, &root);
+  rr_error e = rr_json_parse_file(&r, path, 1 << 20, &root);
   unsigned given = 0;
   if (!e) e = read_camera(&r, root, cam, &given, true);
   cJSON_Delete(root);
@@ -149,8 +149,8 @@ static int find_name(const char *name, const char *(*name_of)(int), int count) {
 /* "aa": none, ssaa:N, msaa:N, csaa:K/N, with "aa_pattern": standard, rotated, jitter[:SEED]. */
 static rr_error read_aa(json_reader *r, const cJSON *obj, rr_render_options *ro) {
   const char *aa = "none", *pattern = "standard", *arg;
-  rr_error e = json_string(r, obj, "aa", &aa);
-  if (!e) e = json_string(r, obj, "aa_pattern", &pattern);
+  rr_error e = rr_json_string(r, obj, "aa", &aa);
+  if (!e) e = rr_json_string(r, obj, "aa_pattern", &pattern);
   if (e) return e;
   char name[16];
   split_name(aa, name, sizeof name, &arg);
@@ -165,18 +165,18 @@ static rr_error read_aa(json_reader *r, const cJSON *obj, rr_render_options *ro)
   } else if (ok && arg) {
     ok = count_in(arg, 1, 16, &samples);
   }
-  if (!ok) return json_fail(r, "aa", "expected none, ssaa:N, msaa:N or csaa:K/N (N, K: 1, 2, 4, 8 or 16)");
+  if (!ok) return rr_json_fail(r, "aa", "expected none, ssaa:N, msaa:N or csaa:K/N (N, K: 1, 2, 4, 8 or 16)");
   split_name(pattern, name, sizeof name, &arg);
   int pat = find_name(name, rr_aa_pattern_name, RR_AA_PATTERN_COUNT);
   long seed = 1;
   if (pat < 0 || (arg && (pat != RR_AA_JITTER || !count_in(arg, 0, 999999999, &seed))))
-    return json_fail(r, "aa_pattern", "expected standard, rotated or jitter[:SEED]");
-  if (json_get(obj, "aa_pattern") && mode == RR_AA_NONE) return json_fail(r, "aa_pattern", "needs an 'aa' other than none");
+    return rr_json_fail(r, "aa_pattern", "expected standard, rotated or jitter[:SEED]");
+  if (rr_json_get(obj, "aa_pattern") && mode == RR_AA_NONE) return rr_json_fail(r, "aa_pattern", "needs an 'aa' other than none");
   if (rr_render_options_set_aa(r->dev, ro, (rr_aa_mode)mode, (int)samples, (int)stored, (rr_aa_pattern)pat,
                                (uint32_t)seed) != RR_OK) {
     char msg[256];
     snprintf(msg, sizeof msg, "%s", rr_device_message(r->dev));
-    return json_fail(r, "aa", "%s", msg);
+    return rr_json_fail(r, "aa", "%s", msg);
   }
   return RR_OK;
 }
@@ -186,74 +186,74 @@ static rr_error read_render(json_reader *r, const cJSON *obj, rr_scene_settings 
   static const char *const keys[] = {"size", "method", "aa", "aa_pattern", "aa_filter", "cull_backfaces", "shade",
                                      "shadows", "max_depth", "texture_filter", "lod_bias", "alpha", "default_lights",
                                      NULL};
-  rr_error e = json_keys(r, obj, keys);
+  rr_error e = rr_json_keys(r, obj, keys);
   if (e) return e;
   rr_render_options *ro = &st->render;
   rr_shade_options *so = &st->shade;
-  const cJSON *size = json_get(obj, "size");
+  const cJSON *size = rr_json_get(obj, "size");
   if (size) {
-    size_t len = json_enter(r, "size", 0);
+    size_t len = rr_json_enter(r, "size", 0);
     e = !cJSON_IsArray(size) || cJSON_GetArraySize(size) != 2
-            ? json_fail(r, NULL, "expected [width, height]")
+            ? rr_json_fail(r, NULL, "expected [width, height]")
             : RR_OK;
     for (int i = 0; i < 2 && !e; i++) {
       const cJSON *v = cJSON_GetArrayItem(size, i);
       if (!cJSON_IsNumber(v) || !(v->valuedouble >= 1 && v->valuedouble <= RR_MAX_SIZE) ||
           v->valuedouble != floor(v->valuedouble))
-        e = json_fail(r, NULL, "expected [width, height], integers 1..%d", RR_MAX_SIZE);
+        e = rr_json_fail(r, NULL, "expected [width, height], integers 1..%d", RR_MAX_SIZE);
       else if (i == 0) ro->width = (int)v->valuedouble;
       else ro->height = (int)v->valuedouble;
     }
-    json_leave(r, len);
+    rr_json_leave(r, len);
     if (e) return e;
     st->given |= RR_SETTING_SIZE;
   }
   int v = ro->method;
-  if ((e = json_named(r, obj, "method", rr_method_from_name,
+  if ((e = rr_json_named(r, obj, "method", rr_method_from_name,
                       "auto, rc, rc-bvh, rc-packet, 2dr-bb, 2dr-bin, 3dr-bb, 3dr-bin, 3dr-fc, 3dr-fs or 3dr-full", &v)))
     return e;
   ro->method = (rr_method)v;
-  if (json_get(obj, "aa") || json_get(obj, "aa_pattern")) {
+  if (rr_json_get(obj, "aa") || rr_json_get(obj, "aa_pattern")) {
     if ((e = read_aa(r, obj, ro))) return e;
     st->given |= RR_SETTING_AA;
   }
-  if ((e = json_bool(r, obj, "cull_backfaces", &ro->cull_backfaces))) return e;
+  if ((e = rr_json_bool(r, obj, "cull_backfaces", &ro->cull_backfaces))) return e;
   v = so->mode;
-  if ((e = json_named(r, obj, "shade", rr_shade_from_name, "lit, lambert, id, normal, depth, heat-evals or heat-nodes",
+  if ((e = rr_json_named(r, obj, "shade", rr_shade_from_name, "lit, lambert, id, normal, depth, heat-evals or heat-nodes",
                       &v)))
     return e;
   so->mode = (rr_shade_mode)v;
   v = so->shadows;
-  if ((e = json_named(r, obj, "shadows", rr_shadows_from_name, "none or rays", &v))) return e;
+  if ((e = rr_json_named(r, obj, "shadows", rr_shadows_from_name, "none or rays", &v))) return e;
   /* Shadows by rasterization from the light are not built yet: refused as the command line refuses them. */
-  if (v == RR_SHADOWS_RASTER) return json_fail(r, "shadows", "raster is not implemented yet (expected none or rays)");
+  if (v == RR_SHADOWS_RASTER) return rr_json_fail(r, "shadows", "raster is not implemented yet (expected none or rays)");
   so->shadows = (rr_shadow_mode)v;
-  if ((e = json_int(r, obj, "max_depth", 0, RR_MAX_DEPTH, &so->max_depth))) return e;
+  if ((e = rr_json_int(r, obj, "max_depth", 0, RR_MAX_DEPTH, &so->max_depth))) return e;
   const char *text, *arg;
   char name[32];
-  if (json_get(obj, "aa_filter")) {
-    if ((e = json_string(r, obj, "aa_filter", &text))) return e;
+  if (rr_json_get(obj, "aa_filter")) {
+    if ((e = rr_json_string(r, obj, "aa_filter", &text))) return e;
     split_name(text, name, sizeof name, &arg);
     int f = rr_filter_from_name(name);
     float radius = 0;
     if (f < 0 || (arg && !float_in(arg, 0.5, RR_FILTER_MAX_RADIUS, &radius)))
-      return json_fail(r, "aa_filter", "expected box, mitchell[:R] or blackman-harris[:R] (R 0.5..4)");
+      return rr_json_fail(r, "aa_filter", "expected box, mitchell[:R] or blackman-harris[:R] (R 0.5..4)");
     so->filter = (rr_filter)f, so->radius = radius;
     st->given |= RR_SETTING_FILTER;
   }
-  if (json_get(obj, "texture_filter")) {
-    if ((e = json_string(r, obj, "texture_filter", &text))) return e;
+  if (rr_json_get(obj, "texture_filter")) {
+    if ((e = rr_json_string(r, obj, "texture_filter", &text))) return e;
     split_name(text, name, sizeof name, &arg);
     int f = rr_texture_filter_from_name(name);
     long aniso = so->aniso;
     if (f < 0 || (arg && (f != RR_TEXTURE_ANISO || !count_in(arg, 1, 16, &aniso))))
-      return json_fail(r, "texture_filter", "expected nearest, bilinear, trilinear, aniso[:N] (N 1..16) or ewa");
+      return rr_json_fail(r, "texture_filter", "expected nearest, bilinear, trilinear, aniso[:N] (N 1..16) or ewa");
     so->texture_filter = (rr_texture_filter)f, so->aniso = (int)aniso;
     st->given |= RR_SETTING_TEXTURE_FILTER;
   }
-  if ((e = json_float(r, obj, "lod_bias", -64, 64, &so->lod_bias))) return e;
-  if ((e = json_bool(r, obj, "alpha", &so->alpha))) return e;
-  if ((e = json_bool(r, obj, "default_lights", &so->default_lights))) return e;
+  if ((e = rr_json_float(r, obj, "lod_bias", -64, 64, &so->lod_bias))) return e;
+  if ((e = rr_json_bool(r, obj, "alpha", &so->alpha))) return e;
+  if ((e = rr_json_bool(r, obj, "default_lights", &so->default_lights))) return e;
   static const struct {
     const char *key;
     unsigned bit;
@@ -261,7 +261,7 @@ static rr_error read_render(json_reader *r, const cJSON *obj, rr_scene_settings 
               {"shadows", RR_SETTING_SHADOWS}, {"max_depth", RR_SETTING_MAX_DEPTH}, {"lod_bias", RR_SETTING_LOD_BIAS},
               {"alpha", RR_SETTING_ALPHA}, {"default_lights", RR_SETTING_DEFAULT_LIGHTS}};
   for (size_t k = 0; k < sizeof bits / sizeof *bits; k++)
-    if (json_get(obj, bits[k].key)) st->given |= bits[k].bit;
+    if (rr_json_get(obj, bits[k].key)) st->given |= bits[k].bit;
   return RR_OK;
 }
 
@@ -288,26 +288,26 @@ static double det3(const double m[3][3]) {
  * 0 0 0 1), or scale, then rotate (degrees about X, then Y, then Z), then translate. */
 static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
   *x = (xform){{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
-  const cJSON *matrix = json_get(obj, "matrix");
+  const cJSON *matrix = rr_json_get(obj, "matrix");
   rr_error e;
   if (matrix) {
-    if (json_get(obj, "translate") || json_get(obj, "rotate") || json_get(obj, "scale"))
-      return json_fail(r, NULL, "give either 'matrix' or 'translate', 'rotate' and 'scale', not both");
+    if (rr_json_get(obj, "translate") || rr_json_get(obj, "rotate") || rr_json_get(obj, "scale"))
+      return rr_json_fail(r, NULL, "give either 'matrix' or 'translate', 'rotate' and 'scale', not both");
     if (!cJSON_IsArray(matrix) || cJSON_GetArraySize(matrix) != 4)
-      return json_fail(r, "matrix", "expected four rows of four numbers");
+      return rr_json_fail(r, "matrix", "expected four rows of four numbers");
     double row[4][4];
     int i = 0;
     for (const cJSON *rw = matrix->child; rw; rw = rw->next, i++) {
-      if (!cJSON_IsArray(rw) || cJSON_GetArraySize(rw) != 4) return json_fail(r, "matrix", "expected four rows of four numbers");
+      if (!cJSON_IsArray(rw) || cJSON_GetArraySize(rw) != 4) return rr_json_fail(r, "matrix", "expected four rows of four numbers");
       int j = 0;
       for (const cJSON *v = rw->child; v; v = v->next, j++) {
         if (!cJSON_IsNumber(v) || !(fabs(v->valuedouble) <= MAX_COORD))
-          return json_fail(r, "matrix", "expected finite numbers of magnitude at most 1e30");
+          return rr_json_fail(r, "matrix", "expected finite numbers of magnitude at most 1e30");
         row[i][j] = v->valuedouble;
       }
     }
     if (row[3][0] != 0 || row[3][1] != 0 || row[3][2] != 0 || row[3][3] != 1)
-      return json_fail(r, "matrix", "the bottom row must be 0 0 0 1");
+      return rr_json_fail(r, "matrix", "the bottom row must be 0 0 0 1");
     for (i = 0; i < 3; i++) {
       for (int j = 0; j < 3; j++) x->m[i][j] = row[i][j];
       x->t[i] = row[i][3];
@@ -315,31 +315,31 @@ static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
   } else {
     double s[3] = {1, 1, 1}, deg[3] = {0, 0, 0};
     float f[3];
-    const cJSON *scale = json_get(obj, "scale");
+    const cJSON *scale = rr_json_get(obj, "scale");
     if (cJSON_IsNumber(scale)) {
-      if ((e = json_double(r, obj, "scale", -MAX_COORD, MAX_COORD, &s[0]))) return e;
+      if ((e = rr_json_double(r, obj, "scale", -MAX_COORD, MAX_COORD, &s[0]))) return e;
       s[1] = s[2] = s[0];
     } else if (scale) {
-      if ((e = json_floats(r, obj, "scale", 3, -MAX_COORD, MAX_COORD, f))) return e;
+      if ((e = rr_json_floats(r, obj, "scale", 3, -MAX_COORD, MAX_COORD, f))) return e;
       for (int k = 0; k < 3; k++) s[k] = f[k];
     }
-    const cJSON *rot = json_get(obj, "rotate");
+    const cJSON *rot = rr_json_get(obj, "rotate");
     if (rot) { /* read as doubles: the angles' own digits, not the float nearest them */
-      if (!cJSON_IsArray(rot) || cJSON_GetArraySize(rot) != 3) return json_fail(r, "rotate", "expected an array of 3 numbers");
+      if (!cJSON_IsArray(rot) || cJSON_GetArraySize(rot) != 3) return rr_json_fail(r, "rotate", "expected an array of 3 numbers");
       int k = 0;
       for (const cJSON *v = rot->child; v; v = v->next, k++) {
         if (!cJSON_IsNumber(v) || !(fabs(v->valuedouble) <= 1e6))
-          return json_fail(r, "rotate", "expected 3 angles in degrees, each within ±1e6");
+          return rr_json_fail(r, "rotate", "expected 3 angles in degrees, each within ±1e6");
         deg[k] = v->valuedouble;
       }
     }
-    const cJSON *tr = json_get(obj, "translate");
+    const cJSON *tr = rr_json_get(obj, "translate");
     if (tr) {
-      if (!cJSON_IsArray(tr) || cJSON_GetArraySize(tr) != 3) return json_fail(r, "translate", "expected an array of 3 numbers");
+      if (!cJSON_IsArray(tr) || cJSON_GetArraySize(tr) != 3) return rr_json_fail(r, "translate", "expected an array of 3 numbers");
       int k = 0;
       for (const cJSON *v = tr->child; v; v = v->next, k++) {
         if (!cJSON_IsNumber(v) || !(fabs(v->valuedouble) <= MAX_COORD))
-          return json_fail(r, "translate", "expected finite numbers of magnitude at most 1e30");
+          return rr_json_fail(r, "translate", "expected finite numbers of magnitude at most 1e30");
         x->t[k] = v->valuedouble;
       }
     }
@@ -354,7 +354,7 @@ static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
     memcpy(x->m, m, sizeof m);
   }
   double d = det3(x->m);
-  if (!(fabs(d) > 1e-300) || !isfinite(d)) return json_fail(r, NULL, "the transform is singular (a zero scale?)");
+  if (!(fabs(d) > 1e-300) || !isfinite(d)) return rr_json_fail(r, NULL, "the transform is singular (a zero scale?)");
   return RR_OK;
 }
 
@@ -389,7 +389,7 @@ static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_
       vec3 p = xf_point(x, scene_vertex(s, k, i), inf >> k & 1u);
       if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z) || fabsf(p.x) > 1e30f || fabsf(p.y) > 1e30f ||
           fabsf(p.z) > 1e30f)
-        return json_fail(r, NULL, "the transform takes vertices beyond 1e30");
+        return rr_json_fail(r, NULL, "the transform takes vertices beyond 1e30");
       s->p[k][0][i] = p.x, s->p[k][1][i] = p.y, s->p[k][2][i] = p.z;
       if (s->n[0][0]) {
         vec3 n = xf_unit(nm, v3(s->n[k][0][i], s->n[k][1][i], s->n[k][2][i]));
@@ -451,27 +451,27 @@ static int model_from_name(const char *name) {
 static rr_error read_material(json_reader *r, const cJSON *obj, rr_scene *s, uint32_t m0) {
   static const char *const keys[] = {"model", "color", "specular", "shininess", "emission", "opacity", "metallic",
                                      "roughness", "mirror", NULL};
-  rr_error e = json_keys(r, obj, keys);
+  rr_error e = rr_json_keys(r, obj, keys);
   for (uint32_t m = m0; !e && m < s->nmaterials; m++) {
     rr_material_info mi;
     rr_scene_get_material_info(s, m, &mi);
     float color[3] = {mi.color[0], mi.color[1], mi.color[2]};
     rr_material_params p = mi.params;
     int model = p.model, mirror = p.illum == 3;
-    if ((e = json_named(r, obj, "model", model_from_name, "phong or pbr", &model)) ||
-        (e = json_floats(r, obj, "color", 3, 0, MAX_COORD, color)) ||
-        (e = json_floats(r, obj, "specular", 3, 0, MAX_COORD, p.specular)) ||
-        (e = json_float(r, obj, "shininess", 0, 10000, &p.shininess)) ||
-        (e = json_floats(r, obj, "emission", 3, 0, MAX_COORD, p.emission)) ||
-        (e = json_float(r, obj, "opacity", 0, 1, &p.opacity)) || (e = json_float(r, obj, "metallic", 0, 1, &p.metallic)) ||
-        (e = json_float(r, obj, "roughness", 0, 1, &p.roughness)) || (e = json_bool(r, obj, "mirror", &mirror)))
+    if ((e = rr_json_named(r, obj, "model", model_from_name, "phong or pbr", &model)) ||
+        (e = rr_json_floats(r, obj, "color", 3, 0, MAX_COORD, color)) ||
+        (e = rr_json_floats(r, obj, "specular", 3, 0, MAX_COORD, p.specular)) ||
+        (e = rr_json_float(r, obj, "shininess", 0, 10000, &p.shininess)) ||
+        (e = rr_json_floats(r, obj, "emission", 3, 0, MAX_COORD, p.emission)) ||
+        (e = rr_json_float(r, obj, "opacity", 0, 1, &p.opacity)) || (e = rr_json_float(r, obj, "metallic", 0, 1, &p.metallic)) ||
+        (e = rr_json_float(r, obj, "roughness", 0, 1, &p.roughness)) || (e = rr_json_bool(r, obj, "mirror", &mirror)))
       break;
     p.model = (rr_material_model)model;
-    if (json_get(obj, "mirror")) p.illum = mirror ? 3 : (p.illum == 3 ? -1 : p.illum);
+    if (rr_json_get(obj, "mirror")) p.illum = mirror ? 3 : (p.illum == 3 ? -1 : p.illum);
     if (rr_scene_set_material(s, m, color, &p) != RR_OK) {
       char msg[256];
       snprintf(msg, sizeof msg, "%s", rr_device_message(s->dev));
-      e = json_fail(r, NULL, "%s", msg);
+      e = rr_json_fail(r, NULL, "%s", msg);
     }
   }
   return e;
@@ -482,14 +482,14 @@ static rr_error read_material(json_reader *r, const cJSON *obj, rr_scene *s, uin
 static rr_error resolve_path(json_reader *r, const char *key, const char *base_dir, const char *rel, bool sandbox,
                              char out[MAX_PATH]) {
   int n = rel[0] == '/' ? snprintf(out, MAX_PATH, "%s", rel) : snprintf(out, MAX_PATH, "%s/%s", base_dir, rel);
-  if (n < 0 || n >= MAX_PATH) return json_fail(r, key, "path too long");
+  if (n < 0 || n >= MAX_PATH) return rr_json_fail(r, key, "path too long");
   if (!sandbox) return RR_OK;
   char base_real[PATH_MAX], real[PATH_MAX];
-  if (!realpath(base_dir, base_real)) return json_fail(r, key, "cannot resolve the base directory '%s'", base_dir);
-  if (!realpath(out, real)) return json_fail(r, key, "cannot open '%.200s'", rel);
+  if (!realpath(base_dir, base_real)) return rr_json_fail(r, key, "cannot resolve the base directory '%s'", base_dir);
+  if (!realpath(out, real)) return rr_json_fail(r, key, "cannot open '%.200s'", rel);
   size_t b = strlen(base_real);
   if (strncmp(real, base_real, b) != 0 || (real[b] != '/' && !(b == 1 && base_real[0] == '/')))
-    return json_fail(r, key, "'%.200s' is outside the scene file's directory (sandbox)", rel);
+    return rr_json_fail(r, key, "'%.200s' is outside the scene file's directory (sandbox)", rel);
   snprintf(out, MAX_PATH, "%s", real);
   return RR_OK;
 }
@@ -498,45 +498,45 @@ static rr_error resolve_path(json_reader *r, const char *key, const char *base_d
 static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const char *base_dir,
                           const rr_load_options *opt) {
   static const char *const keys[] = {"file", "builtin", "name", "translate", "rotate", "scale", "matrix", "material", NULL};
-  rr_error e = json_keys(r, obj, keys);
+  rr_error e = rr_json_keys(r, obj, keys);
   if (e) return e;
   const char *file = NULL, *builtin = NULL, *name = NULL;
-  if ((e = json_string(r, obj, "file", &file)) || (e = json_string(r, obj, "builtin", &builtin)) ||
-      (e = json_string(r, obj, "name", &name)))
+  if ((e = rr_json_string(r, obj, "file", &file)) || (e = rr_json_string(r, obj, "builtin", &builtin)) ||
+      (e = rr_json_string(r, obj, "name", &name)))
     return e;
-  if (!file == !builtin) return json_fail(r, NULL, "expected one of 'file' (a path) and 'builtin' (a name)");
+  if (!file == !builtin) return rr_json_fail(r, NULL, "expected one of 'file' (a path) and 'builtin' (a name)");
   xform x;
   if ((e = read_xform(r, obj, &x))) return e;
-  const cJSON *material = json_get(obj, "material");
+  const cJSON *material = rr_json_get(obj, "material");
   uint32_t t0 = s->ntris, g0 = s->ngeoms, m0 = s->nmaterials, c0 = s->ncameras, l0 = s->nlights;
   char path[MAX_PATH];
   if (builtin) {
-    if (!opt->builtins) return json_fail(r, "builtin", "built-in meshes are not allowed here");
+    if (!opt->builtins) return rr_json_fail(r, "builtin", "built-in meshes are not allowed here");
     if (opt->sandbox && strncmp(builtin, "grid:", 5) == 0)
-      return json_fail(r, "builtin", "grid: reads a file, which the sandbox does not allow (use 'file' and a transform)");
+      return rr_json_fail(r, "builtin", "grid: reads a file, which the sandbox does not allow (use 'file' and a transform)");
     e = rr_scene_load_builtin(s, builtin);
     if (e == RR_ERROR_UNSUPPORTED)
-      return json_fail(r, "builtin", "unknown built-in '%.64s' (expected demo, plane[:N], sphere[:N], box[:N], "
+      return rr_json_fail(r, "builtin", "unknown built-in '%.64s' (expected demo, plane[:N], sphere[:N], box[:N], "
                                      "torus[:N], rooms[:N], ground or grid:PATH:N)", builtin);
   } else {
-    if (!file[0]) return json_fail(r, "file", "empty path");
-    if (strlen(file) >= MAX_PATH) return json_fail(r, "file", "path too long");
+    if (!file[0]) return rr_json_fail(r, "file", "empty path");
+    if (strlen(file) >= MAX_PATH) return rr_json_fail(r, "file", "path too long");
     if ((e = resolve_path(r, "file", base_dir, file, opt->sandbox, path))) return e;
     e = rr_scene_import_file(s, path);
   }
   if (e) {
     char msg[512];
     snprintf(msg, sizeof msg, "%s", rr_device_message(s->dev));
-    return json_fail(r, builtin ? "builtin" : "file", "%s", msg);
+    return rr_json_fail(r, builtin ? "builtin" : "file", "%s", msg);
   }
-  if (s->ntris == t0 && !s->skipped) return json_fail(r, builtin ? "builtin" : "file", "no triangles");
+  if (s->ntris == t0 && !s->skipped) return rr_json_fail(r, builtin ? "builtin" : "file", "no triangles");
   for (uint32_t g = g0; name && g < s->ngeoms; g++)
     if ((e = rr_scene_name_geometry(s, g, name))) return e;
   if ((e = apply_xform(r, s, &x, t0, c0, l0))) return e;
   if (material) {
-    size_t len = json_enter(r, "material", 0);
+    size_t len = rr_json_enter(r, "material", 0);
     e = read_material(r, material, s, m0);
-    json_leave(r, len);
+    rr_json_leave(r, len);
   }
   return e;
 }
@@ -546,11 +546,11 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
 static rr_error read_light(json_reader *r, const cJSON *obj, rr_scene *s) {
   static const char *const keys[] = {"type", "name", "position", "direction", "color", "intensity", "inner", "outer",
                                      "ground", NULL};
-  rr_error e = json_keys(r, obj, keys);
+  rr_error e = rr_json_keys(r, obj, keys);
   if (e) return e;
   const char *type = NULL, *name = NULL;
-  if ((e = json_string(r, obj, "type", &type)) || (e = json_string(r, obj, "name", &name))) return e;
-  if (!type) return json_fail(r, NULL, "missing 'type' (point, directional, spot or sky)");
+  if ((e = rr_json_string(r, obj, "type", &type)) || (e = rr_json_string(r, obj, "name", &name))) return e;
+  if (!type) return rr_json_fail(r, NULL, "missing 'type' (point, directional, spot or sky)");
   rr_light_info l = {.name = name, .color = {1, 1, 1}, .outer_cone_deg = 45};
   /* the keys each type takes, besides type, name, color and intensity */
   static const struct {
@@ -563,34 +563,34 @@ static rr_error read_light(json_reader *r, const cJSON *obj, rr_scene *s) {
                {"sky", RR_LIGHT_AMBIENT, false, false, false, true}};
   int t = 0;
   while (t < 4 && strcmp(type, types[t].name) != 0) t++;
-  if (t == 4) return json_fail(r, "type", "expected point, directional, spot or sky");
+  if (t == 4) return rr_json_fail(r, "type", "expected point, directional, spot or sky");
   l.type = types[t].type;
   const char *needs[] = {"position", "direction"};
   bool takes[] = {types[t].position, types[t].direction};
   for (int k = 0; k < 2; k++) {
-    if (takes[k] && !json_get(obj, needs[k])) return json_fail(r, NULL, "a %s light needs '%s'", type, needs[k]);
-    if (!takes[k] && json_get(obj, needs[k])) return json_fail(r, needs[k], "not used by a %s light", type);
+    if (takes[k] && !rr_json_get(obj, needs[k])) return rr_json_fail(r, NULL, "a %s light needs '%s'", type, needs[k]);
+    if (!takes[k] && rr_json_get(obj, needs[k])) return rr_json_fail(r, needs[k], "not used by a %s light", type);
   }
   const char *only[] = {"inner", "outer", "ground"};
   bool used[] = {types[t].cone, types[t].cone, types[t].ground};
   for (int k = 0; k < 3; k++)
-    if (!used[k] && json_get(obj, only[k])) return json_fail(r, only[k], "not used by a %s light", type);
+    if (!used[k] && rr_json_get(obj, only[k])) return rr_json_fail(r, only[k], "not used by a %s light", type);
   float intensity = 1;
-  if ((e = json_floats(r, obj, "position", 3, -MAX_COORD, MAX_COORD, l.position)) ||
-      (e = json_floats(r, obj, "direction", 3, -MAX_COORD, MAX_COORD, l.direction)) ||
-      (e = json_floats(r, obj, "color", 3, 0, MAX_COORD, l.color)) ||
-      (e = json_float(r, obj, "intensity", 0, MAX_COORD, &intensity)) ||
-      (e = json_float(r, obj, "inner", 0, 90, &l.inner_cone_deg)) ||
-      (e = json_float(r, obj, "outer", 0, 90, &l.outer_cone_deg)) ||
-      (e = json_floats(r, obj, "ground", 3, 0, MAX_COORD, l.ground)))
+  if ((e = rr_json_floats(r, obj, "position", 3, -MAX_COORD, MAX_COORD, l.position)) ||
+      (e = rr_json_floats(r, obj, "direction", 3, -MAX_COORD, MAX_COORD, l.direction)) ||
+      (e = rr_json_floats(r, obj, "color", 3, 0, MAX_COORD, l.color)) ||
+      (e = rr_json_float(r, obj, "intensity", 0, MAX_COORD, &intensity)) ||
+      (e = rr_json_float(r, obj, "inner", 0, 90, &l.inner_cone_deg)) ||
+      (e = rr_json_float(r, obj, "outer", 0, 90, &l.outer_cone_deg)) ||
+      (e = rr_json_floats(r, obj, "ground", 3, 0, MAX_COORD, l.ground)))
     return e;
   for (int c = 0; c < 3; c++) l.color[c] *= intensity;
   if (l.type == RR_LIGHT_SPOT && !(l.inner_cone_deg <= l.outer_cone_deg && l.outer_cone_deg > 0))
-    return json_fail(r, NULL, "expected 0 <= inner <= outer <= 90 degrees, outer > 0");
+    return rr_json_fail(r, NULL, "expected 0 <= inner <= outer <= 90 degrees, outer > 0");
   if (rr_scene_add_light(s, &l) != RR_OK) {
     char msg[256];
     snprintf(msg, sizeof msg, "%s", rr_device_message(s->dev));
-    return json_fail(r, NULL, "%s", msg);
+    return rr_json_fail(r, NULL, "%s", msg);
   }
   return RR_OK;
 }
@@ -600,17 +600,17 @@ static rr_error read_light(json_reader *r, const cJSON *obj, rr_scene *s) {
 /* Runs `read` over every element of the array obj[key] (absent: nothing). */
 static rr_error each(json_reader *r, const cJSON *root, const char *key, bool required,
                      rr_error (*read)(json_reader *, const cJSON *, void *), void *arg) {
-  const cJSON *list = json_get(root, key);
-  if (!list && required) return json_fail(r, NULL, "missing '%s'", key);
+  const cJSON *list = rr_json_get(root, key);
+  if (!list && required) return rr_json_fail(r, NULL, "missing '%s'", key);
   if (!list) return RR_OK;
-  if (!cJSON_IsArray(list)) return json_fail(r, key, "expected an array of objects");
+  if (!cJSON_IsArray(list)) return rr_json_fail(r, key, "expected an array of objects");
   int i = 0;
   rr_error e = RR_OK;
   for (const cJSON *item = list->child; item && !e; item = item->next, i++) {
-    size_t len = json_enter(r, key, 0);
-    json_enter(r, NULL, i);
-    e = cJSON_IsObject(item) ? read(r, item, arg) : json_fail(r, NULL, "expected an object");
-    json_leave(r, len);
+    size_t len = rr_json_enter(r, key, 0);
+    rr_json_enter(r, NULL, i);
+    e = cJSON_IsObject(item) ? read(r, item, arg) : rr_json_fail(r, NULL, "expected an object");
+    rr_json_leave(r, len);
   }
   return e;
 }
@@ -642,19 +642,19 @@ static void settings_init(rr_scene_settings *st) {
 static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const char *base_dir,
                            const rr_load_options *opt, rr_scene_settings *st) {
   static const char *const keys[] = {"meshes", "lights", "camera", "render", "comment", NULL};
-  rr_error e = json_keys(r, root, keys);
+  rr_error e = rr_json_keys(r, root, keys);
   const char *comment;
-  if (!e) e = json_string(r, root, "comment", &comment);
+  if (!e) e = rr_json_string(r, root, "comment", &comment);
   const cJSON *item;
-  if (!e && (item = json_get(root, "render"))) {
-    size_t len = json_enter(r, "render", 0);
+  if (!e && (item = rr_json_get(root, "render"))) {
+    size_t len = rr_json_enter(r, "render", 0);
     e = read_render(r, item, st);
-    json_leave(r, len);
+    rr_json_leave(r, len);
   }
-  if (!e && (item = json_get(root, "camera"))) {
-    size_t len = json_enter(r, "camera", 0);
+  if (!e && (item = rr_json_get(root, "camera"))) {
+    size_t len = rr_json_enter(r, "camera", 0);
     e = read_camera(r, item, &st->camera, &st->camera_given, false);
-    json_leave(r, len);
+    rr_json_leave(r, len);
   }
   mesh_arg ma = {s, base_dir, opt};
   if (!e) e = each(r, root, "meshes", true, mesh_item, &ma);
@@ -684,7 +684,7 @@ rr_error rr_scene_load_file(rr_device *dev, const char *path, const rr_load_opti
   progress_span progress = {dev, RR_PROGRESS_LOAD, 0, 1};
   rr_progress(&progress, 0);
   cJSON *root;
-  rr_error e = json_parse_file(&r, path, MAX_FILE_BYTES, &root);
+  rr_error e = rr_json_parse_file(&r, path, MAX_FILE_BYTES, &root);
   if (e) return e;
   rr_scene *s;
   if ((e = rr_scene_new(dev, &s))) {
