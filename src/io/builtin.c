@@ -461,10 +461,7 @@ static int corner_cmp(const void *pa, const void *pb) {
   return 0;
 }
 
-/* Smooth corner normals for triangles [t0, t1): each corner averages the
- * area-weighted normals of the triangles meeting at the same position whose faces
- * turn by less than 60° from its own, so creases (the teapot's rim) stay sharp. */
-static rr_error smooth_normals(rr_scene *s, uint32_t t0, uint32_t t1) {
+rr_error rr_scene_smooth_normals(rr_scene *s, uint32_t t0, uint32_t t1) {
   size_t nt = t1 - t0, nc = 3 * nt;
   rr_error e = rr_scene_reserve(s, 0, true, false);
   if (e) return e;
@@ -534,7 +531,7 @@ static rr_error place_file(rr_scene *s, const char *file, const char *name, floa
   if (!e) e = rr_scene_import_file(s, path);
   if (!e && s->ntris == t0) e = rr_fail(s->dev, RR_ERROR_EMPTY, "demo mesh '%s' has no triangles", path);
   for (uint32_t g = g0; !e && g < s->ngeoms; g++) e = rr_scene_name_geometry(s, g, name);
-  if (!e) e = smooth_normals(s, t0, s->ntris);
+  if (!e) e = rr_scene_smooth_normals(s, t0, s->ntris);
   if (e) return e;
   float cy = cosf(yaw * (float)(RR_PI / 180)), sy = sinf(yaw * (float)(RR_PI / 180));
   vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);

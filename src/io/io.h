@@ -9,6 +9,10 @@ rr_error rr_scene_import_file(rr_scene *s, const char *path);
 /* Returns RR_OK when `name` named a built-in scene (and fills s), RR_ERROR_UNSUPPORTED
  * when it is not a built-in name; other codes are real failures. */
 rr_error rr_scene_load_builtin(rr_scene *s, const char *name);
+/* Smooth corner normals for triangles [t0, t1) (src/io/builtin.c): each corner
+ * averages the area-weighted normals of the triangles meeting at the same position
+ * whose faces turn by less than 60° from its own, so creases (the teapot's rim) stay sharp. */
+rr_error rr_scene_smooth_normals(rr_scene *s, uint32_t t0, uint32_t t1);
 /* Loads the textures named by the materials that have none yet, from files found
  * from base_dir; the materials' texture_status says what became of each. */
 void rr_scene_load_textures(rr_scene *s, const char *base_dir);

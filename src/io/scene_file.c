@@ -497,7 +497,8 @@ static rr_error resolve_path(json_reader *r, const char *key, const char *base_d
 /* A mesh: "file" or "builtin", "name", a transform, "material". */
 static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const char *base_dir,
                           const rr_load_options *opt) {
-  static const char *const keys[] = {"file", "builtin", "name", "translate", "rotate", "scale", "matrix", "material", NULL};
+  static const char *const keys[] = {"file",   "builtin", "name",     "translate", "rotate",
+                                     "scale",  "matrix",  "material", "smooth",    NULL};
   rr_error e = rr_json_keys(r, obj, keys);
   if (e) return e;
   const char *file = NULL, *builtin = NULL, *name = NULL;
@@ -507,6 +508,8 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
   if (!file == !builtin) return rr_json_fail(r, NULL, "expected one of 'file' (a path) and 'builtin' (a name)");
   xform x;
   if ((e = read_xform(r, obj, &x))) return e;
+  int smooth = 0;
+  if ((e = rr_json_bool(r, obj, "smooth", &smooth))) return e;
   const cJSON *material = rr_json_get(obj, "material");
   uint32_t t0 = s->ntris, g0 = s->ngeoms, m0 = s->nmaterials, c0 = s->ncameras, l0 = s->nlights;
   char path[MAX_PATH];
@@ -533,6 +536,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
   for (uint32_t g = g0; name && g < s->ngeoms; g++)
     if ((e = rr_scene_name_geometry(s, g, name))) return e;
   if ((e = apply_xform(r, s, &x, t0, c0, l0))) return e;
+  if (smooth && (e = rr_scene_smooth_normals(s, t0, s->ntris))) return e;
   if (material) {
     size_t len = rr_json_enter(r, "material", 0);
     e = read_material(r, material, s, m0);
