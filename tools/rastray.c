@@ -161,9 +161,11 @@ struct cli_command {
       HELP_OPTION
 
 static const char scenes_note[] =
-    "scenes: a file assimp reads (.obj .ply .gltf .glb .dae .3ds ...), or demo, plane[:N],\n"
-    "        sphere[:N], box[:N], rooms[:N], grid:PATH:N (N×N copies of a mesh), ground (an\n"
-    "        infinite plane through points at infinity, with a sphere and a box; 3D methods)\n";
+    "scenes: a file assimp reads (.obj .ply .gltf .glb .dae .3ds ...), a scene file (.json:\n"
+    "        meshes, transforms, materials, lights, camera and settings, which options\n"
+    "        override; docs/scene-file.md), or demo, plane[:N], sphere[:N], box[:N], torus[:N],\n"
+    "        rooms[:N], grid:PATH:N (N×N copies of a mesh), ground (an infinite plane\n"
+    "        through points at infinity, with a sphere and a box; 3D methods)\n";
 
 static const cli_option render_options[] = {
     {"method", OPT_METHOD, "NAME",
