@@ -9,7 +9,7 @@
  * Besides triangles the file gives materials (with embedded textures), vertex
  * colours, cameras, lights and its up axis. */
 #include "core/color.h"
-#include "io/io.h"
+#include "io/import_guard.h"
 
 #include <assimp/ObjMaterial.h>
 #include <assimp/cimport.h>
@@ -371,7 +371,7 @@ static void set_axes(rr_scene *s, const struct aiScene *sc, const char *ext) {
   s->front = axis_vec(front, front_sign);
 }
 
-rr_error rr_scene_load_file(rr_scene *s, const char *path) {
+rr_error rr_scene_import_file(rr_scene *s, const char *path) {
   struct stat st;
   if (stat(path, &st) != 0)
     return rr_fail(s->dev, RR_ERROR_IO, "cannot open scene '%s': %s", path, strerror(errno));
