@@ -279,6 +279,17 @@ int main(void) {
   check_cli("chunk.glb", "4286578688");
   check_cli("trunc.ply", "truncated PLY header");
   check_cli("short.stl", "1000000 triangles");
+  /* the largest size the options accept, on a cube camera: refused before any work */
+  {
+    char out[4096], png[600];
+    struct stat st;
+    snprintf(png, sizeof png, "%s/out.png", dir);
+    double t0 = now_s();
+    int rc = test_run_cli(dir, "render plane --camera cube --size 16384x12288 -o out.png", true, out, sizeof out);
+    CHECK(rc == 2 && strstr(out, "budget") && strchr(out, '\n') == out + strlen(out) - 1 && stat(png, &st) != 0,
+          "16384x12288 cube: exit %d: %s", rc, out);
+    CHECK(now_s() - t0 < 10, "16384x12288 cube: refused after %.1f s", now_s() - t0);
+  }
   /* the command line's peak memory over all of them: the checks allocate nothing */
   struct rusage ru;
   getrusage(RUSAGE_CHILDREN, &ru);

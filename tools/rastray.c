@@ -409,6 +409,30 @@ static void parse_vec(const char *flag, const char *s, float out[3]) {
     die(EXIT_USAGE, "bad vector '%s' for %s (expected X,Y,Z with finite numbers)", s, flag);
 }
 
+/* The most samples a frame may have: 2^27, e.g. 16384x8192 with one sample per pixel
+ * or 4096x2048 with 16 (a frame of 2^27 samples takes about a minute on two cores). */
+#define SAMPLE_BUDGET (1u << 27)
+/* Bytes a frame takes per pixel and per sample, about (visibility buffer, shading,
+ * resolve; measured with /usr/bin/time -v on cube views of a plane). */
+enum { PIXEL_BYTES = 16, SAMPLE_BYTES = 32 };
+
+/* Refuses a frame whose sample count or estimated memory exceeds the budget: half of
+ * the physical memory, SAMPLE_BUDGET samples. */
+static void check_frame_budget(const rr_render_options *opt) {
+  uint64_t pixels = (uint64_t)opt->width * (uint64_t)opt->height, samples = pixels * (uint64_t)opt->samples;
+  uint64_t bytes = pixels * PIXEL_BYTES + samples * SAMPLE_BYTES;
+  long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  uint64_t half = pages > 0 && page > 0 ? (uint64_t)pages * (uint64_t)page / 2 : 0;
+  if (samples > SAMPLE_BUDGET)
+    die(EXIT_USAGE, "a %dx%d image with %d sample%s per pixel has %llu samples, more than the budget of %u "
+        "(lower --size or the --aa samples)", opt->width, opt->height, opt->samples, opt->samples == 1 ? "" : "s",
+        (unsigned long long)samples, SAMPLE_BUDGET);
+  if (half && bytes > half)
+    die(EXIT_USAGE, "a %dx%d image with %d sample%s per pixel needs about %.1f GiB, more than half the physical "
+        "memory (%.1f GiB; lower --size or the --aa samples)", opt->width, opt->height, opt->samples,
+        opt->samples == 1 ? "" : "s", bytes / 1073741824.0, half / 1073741824.0);
+}
+
 static void parse_size(const char *s, int *w, int *h) {
   char buf[64];
   if (!s || strlen(s) >= sizeof buf) die(EXIT_USAGE, "bad size '%s' (expected WxH, e.g. 1024x768)", s ? s : "");
@@ -966,6 +990,7 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     given |= fields;
   }
 
+  check_frame_budget(&opt);
   timings ms = {0};
   rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load);
   for (int k = 0; k < nlights; k++)

@@ -332,7 +332,8 @@ bool rr_import_check(const char *path, char *why, size_t cap) {
   if (m == MAP_FAILED) return true;
   f.p = m;
   bool ok = true;
-  if (has_prefix(f, "ply\n") || has_prefix(f, "ply\r")) ok = check_ply(f, why, cap);
+  /* assimp takes any file starting with "ply" (or "PLY") for one */
+  if (has_prefix(f, "ply") || has_prefix(f, "PLY")) ok = check_ply(f, why, cap);
   else if (has_prefix(f, "glTF")) ok = check_glb(f, why, cap);
   else if (ext_is(path, "stl")) ok = check_stl(f, why, cap);
   else if (ext_is(path, "off")) ok = check_off(f, why, cap);
