@@ -290,6 +290,29 @@ int main(void) {
           "16384x12288 cube: exit %d: %s", rc, out);
     CHECK(now_s() - t0 < 10, "16384x12288 cube: refused after %.1f s", now_s() - t0);
   }
+  /* outputs replace regular files only: a symbolic link (to a file elsewhere, or to
+   * nothing) is refused and stays as it was */
+  {
+    char out[4096], link[600], target[600];
+    snprintf(link, sizeof link, "%s/link.png", dir);
+    snprintf(target, sizeof target, "%s/elsewhere.png", dir);
+    write_bytes("elsewhere.png", "keep", 4);
+    for (int dangling = 0; dangling < 2; dangling++) {
+      unlink(link);
+      CHECK(symlink(dangling ? "/nonexistent/x.png" : target, link) == 0, "cannot make a symbolic link");
+      int rc = test_run_cli(dir, "render plane --size 8x8 -o link.png", true, out, sizeof out);
+      struct stat st;
+      CHECK(rc == 1 && strstr(out, "symbolic link") && lstat(link, &st) == 0 && S_ISLNK(st.st_mode),
+            "output through a %s link: exit %d: %s", dangling ? "dangling" : "", rc, out);
+    }
+    struct stat st;
+    CHECK(stat(target, &st) == 0 && st.st_size == 4, "the link's target changed");
+    uint8_t px[3] = {1, 2, 3};
+    rr_image img = {.width = 1, .height = 1, .channels = 3, .type = RR_PIXEL_U8, .data = px, .kind = RR_IMAGE_COLOR};
+    CHECK(rr_image_write(dev, &img, link) == RR_ERROR_IO && strstr(rr_device_message(dev), "symbolic link"),
+          "the library wrote over a symbolic link: %s", rr_device_message(dev));
+    unlink(link);
+  }
   /* the command line's peak memory over all of them: the checks allocate nothing */
   struct rusage ru;
   getrusage(RUSAGE_CHILDREN, &ru);
