@@ -9,6 +9,7 @@
 #include "scene/scene.h"
 #include "testutil.h"
 
+#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/resource.h>
@@ -188,6 +189,40 @@ static bool same_floats(float *const a[3][3], float *const b[3][3], int comps, u
   return true;
 }
 
+/* Loads in two threads at once, one of them hanging until its time limit: the
+ * other loads as if alone. */
+static void *hanging_load(void *arg) {
+  rr_device *d = rr_device_new();
+  rr_import_limits lim;
+  rr_import_limits_init(&lim);
+  lim.timeout_s = 1.5;
+  rr_device_set_import_limits(d, &lim);
+  rr_device_set_import_test_hook(d, IMPORT_HOOK_NO_CHECK);
+  rr_scene *s = NULL;
+  *(rr_error *)arg = rr_scene_load(d, test_write_file(dir, "trunc2.ply", "ply\nformat ascii 1.0\nelement vertex 3\nprop"), &s);
+  rr_scene_release(s);
+  rr_device_release(d);
+  return NULL;
+}
+
+static void check_threads(void) {
+  pthread_t t;
+  rr_error hung = RR_OK;
+  if (pthread_create(&t, NULL, hanging_load, &hung) != 0) return;
+  struct timespec pause = {0, 200000000};
+  nanosleep(&pause, NULL); /* the hanging child has started */
+  char path[512];
+  snprintf(path, sizeof path, "%s/tri.obj", dir);
+  rr_scene *s = NULL;
+  double t0 = now_s();
+  rr_error e = rr_scene_load(dev, path, &s);
+  double dt = now_s() - t0;
+  rr_scene_release(s);
+  pthread_join(t, NULL);
+  CHECK(e == RR_OK && dt < 2.5, "a load beside a hanging one: %s after %.1f s", rr_device_message(dev), dt);
+  CHECK(hung == RR_ERROR_PARSE, "the hanging load: %d", hung);
+}
+
 static bool v3_eq(vec3 a, vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 
 static bool same_str(const char *a, const char *b) { return (!a && !b) || (a && b && !strcmp(a, b)); }
@@ -318,6 +353,7 @@ int main(void) {
   getrusage(RUSAGE_CHILDREN, &ru);
   CHECK(ru.ru_maxrss < 1024 * 1024, "a refusal's peak memory: %ld KiB", ru.ru_maxrss);
   check_limits();
+  check_threads();
 
   /* the child's scenes equal the in-process ones: every format of the fuzz seeds,
    * a textured model, a glTF with a camera and lights, files appended to a scene

@@ -20,6 +20,7 @@
 #define _GNU_SOURCE /* memfd_create, strsignal */
 #include "io/import_guard.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -27,6 +28,7 @@
 #include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
@@ -368,6 +370,14 @@ static void child_main(rr_device *dev, const char *path, const rr_import_limits 
   prctl(PR_SET_PDEATHSIG, SIGKILL); /* the parent gone, nobody waits for the import */
 #endif
   if (getppid() != parent) _exit(127);
+  /* other threads' pipes to their own import children stay open in a fork: closed,
+   * so that their parents see their children end when those do */
+  DIR *fds = opendir("/proc/self/fd");
+  for (struct dirent *d; fds && (d = readdir(fds));) {
+    int fd = atoi(d->d_name);
+    if (fd > STDERR_FILENO && fd != memfd && fd != msgfd && fd != dirfd(fds)) close(fd);
+  }
+  if (fds) closedir(fds);
   struct rlimit no_core = {0, 0};
   setrlimit(RLIMIT_CORE, &no_core); /* a crash leaves no core file in the working directory */
   if (lim->max_memory) {
