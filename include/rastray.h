@@ -122,6 +122,24 @@ RR_API rr_error rr_device_set_build_options(rr_device *dev, const rr_build_optio
 /* Releases a scene. */
 RR_API void rr_scene_release(rr_scene *scene);
 
+/* How files are imported (rr_scene_load, and the built-ins that read files). By
+ * default assimp runs in a child process: a crash, a hang or a runaway allocation
+ * in the importer then fails the call (RR_ERROR_PARSE, a message naming the file
+ * and the cause) instead of taking the caller down. Before that, the formats that
+ * declare counts (PLY, OFF, binary STL, GLB) are checked against the file's size. */
+typedef struct rr_import_limits {
+  double timeout_s;    /* longest an import may take, seconds; 0: no limit (default 60) */
+  uint64_t max_memory; /* most bytes an import may allocate; 0: no limit (default: half the physical memory) */
+  int in_process;      /* nonzero: import in the calling process (no fork; no time or memory limit, and
+                          an importer crash is the caller's); the structural checks still run */
+  int importer_log;    /* nonzero: the importer's own messages reach stderr (default 0: discarded) */
+} rr_import_limits;
+
+/* Fills import limits with defaults: 60 s, half the physical memory, in a child process, quiet. */
+RR_API void rr_import_limits_init(rr_import_limits *lim);
+/* Sets the limits of this device's later imports (like rr_device_set_build_options). */
+RR_API rr_error rr_device_set_import_limits(rr_device *dev, const rr_import_limits *lim);
+
 typedef struct rr_scene_info {
   uint64_t triangles;    /* triangles kept */
   uint64_t skipped;      /* degenerate or non-finite triangles dropped at load (never hit; their ids stay taken) */

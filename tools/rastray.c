@@ -130,6 +130,7 @@ enum { /* keys of the options without a short form (above every char) */
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
   OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA, OPT_AA_PATTERN, OPT_AA_FILTER,
   OPT_ALPHA, OPT_TEXTURE_FILTER, OPT_LOD_BIAS, OPT_LIGHT, OPT_SHADOWS, OPT_MAX_DEPTH,
+  OPT_IMPORT_TIMEOUT, OPT_MAX_MEMORY,
 };
 
 typedef struct cli_option {
@@ -152,6 +153,11 @@ struct cli_command {
 #define HELP_OPTION {"help", 'h', NULL, "print this help and exit"}
 /* Every command's last options; next_option handles them. */
 #define COMMON_OPTIONS                                                                                    \
+  {"import-timeout", OPT_IMPORT_TIMEOUT, "SECONDS",                                                     \
+   "longest a scene file's import may take (default 60; 0: no limit)"},                                \
+      {"max-memory", OPT_MAX_MEMORY, "BYTES[K|M|G]",                                                    \
+       "most memory a scene file's import may allocate (default: half the\n"                           \
+       "physical memory; 0: no limit); files are imported in a child process"},                        \
   {"progress", OPT_PROGRESS, NULL,                                                                      \
    "show progress on stderr even when it is not a terminal (on a terminal it\n"                        \
    "appears by itself once a command runs longer than a second)"},                                     \
@@ -310,6 +316,28 @@ static void print_usage(FILE *f, const cli_command *cmd) {
 
 static char option_name[64]; /* the option being handled, "--name", for messages */
 static bool force_progress; /* --progress */
+static rr_import_limits import_limits; /* --import-timeout, --max-memory; rr_import_limits_init's by main */
+
+/* --import-timeout's value: seconds, 0 (no limit) up to a year. */
+static double parse_seconds(const char *flag, const char *s) {
+  char *end;
+  double v = strtod(s, &end);
+  if (!*s || *end || !(v >= 0) || v > 3.2e7) die(EXIT_USAGE, "bad value '%s' for %s (expected seconds, 0..3.2e7)", s, flag);
+  return v;
+}
+
+/* --max-memory's value: bytes with an optional K, M or G (powers of 1024). */
+static uint64_t parse_bytes(const char *flag, const char *s) {
+  char *end;
+  double v = strtod(s, &end);
+  double unit = 1;
+  if (*end && !end[1]) unit = *end == 'K' || *end == 'k' ? 1024.0 : *end == 'M' || *end == 'm' ? 1048576.0
+                              : *end == 'G' || *end == 'g' ? 1073741824.0 : 0;
+  else if (*end) unit = 0;
+  if (end == s || unit == 0 || !(v >= 0) || v * unit > 1.8e19 || !isfinite(v))
+    die(EXIT_USAGE, "bad value '%s' for %s (expected bytes, with K, M or G for KiB, MiB, GiB)", s, flag);
+  return (uint64_t)(v * unit);
+}
 
 /* The next option of the command's argv (argv[0] is the command's name): its key,
  * its value in optarg; -1 after the last (the operands are then argv[optind..]).
@@ -344,6 +372,8 @@ static int next_option(const cli_command *cmd, int argc, char **argv) {
   case 'q': verbosity = -1; return next_option(cmd, argc, argv);
   case 'v': verbosity = 1; return next_option(cmd, argc, argv);
   case OPT_PROGRESS: force_progress = true; return next_option(cmd, argc, argv);
+  case OPT_IMPORT_TIMEOUT: import_limits.timeout_s = parse_seconds(option_name, optarg); return next_option(cmd, argc, argv);
+  case OPT_MAX_MEMORY: import_limits.max_memory = parse_bytes(option_name, optarg); return next_option(cmd, argc, argv);
   }
   return key;
 }
@@ -379,6 +409,30 @@ static void parse_vec(const char *flag, const char *s, float out[3]) {
   }
   if (n != 3 || tok || s[strlen(s) - 1] == ',' || s[0] == ',')
     die(EXIT_USAGE, "bad vector '%s' for %s (expected X,Y,Z with finite numbers)", s, flag);
+}
+
+/* The most samples a frame may have: 2^27, e.g. 16384x8192 with one sample per pixel
+ * or 4096x2048 with 16 (a frame of 2^27 samples takes about a minute on two cores). */
+#define SAMPLE_BUDGET (1u << 27)
+/* Bytes a frame takes per pixel and per sample, about (visibility buffer, shading,
+ * resolve; measured with /usr/bin/time -v on cube views of a plane). */
+enum { PIXEL_BYTES = 16, SAMPLE_BYTES = 32 };
+
+/* Refuses a frame whose sample count or estimated memory exceeds the budget: half of
+ * the physical memory, SAMPLE_BUDGET samples. */
+static void check_frame_budget(const rr_render_options *opt) {
+  uint64_t pixels = (uint64_t)opt->width * (uint64_t)opt->height, samples = pixels * (uint64_t)opt->samples;
+  uint64_t bytes = pixels * PIXEL_BYTES + samples * SAMPLE_BYTES;
+  long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  uint64_t half = pages > 0 && page > 0 ? (uint64_t)pages * (uint64_t)page / 2 : 0;
+  if (samples > SAMPLE_BUDGET)
+    die(EXIT_USAGE, "a %dx%d image with %d sample%s per pixel has %llu samples, more than the budget of %u "
+        "(lower --size or the --aa samples)", opt->width, opt->height, opt->samples, opt->samples == 1 ? "" : "s",
+        (unsigned long long)samples, SAMPLE_BUDGET);
+  if (half && bytes > half)
+    die(EXIT_USAGE, "a %dx%d image with %d sample%s per pixel needs about %.1f GiB, more than half the physical "
+        "memory (%.1f GiB; lower --size or the --aa samples)", opt->width, opt->height, opt->samples,
+        opt->samples == 1 ? "" : "s", bytes / 1073741824.0, half / 1073741824.0);
 }
 
 static void parse_size(const char *s, int *w, int *h) {
@@ -588,6 +642,8 @@ static rr_scene *load_scene(rr_device *dev, const char *name, int threads, doubl
   double t0 = now_ms();
   rr_scene *scene;
   if (settings) settings->given = settings->camera_given = 0;
+  import_limits.importer_log = verbosity > 0;
+  rr_device_set_import_limits(dev, &import_limits);
   rr_error e = is_scene_file(name) ? rr_scene_load_file(dev, name, NULL, &scene, settings)
                                    : rr_scene_load(dev, name, &scene);
   if (e != RR_OK) die(EXIT_INPUT, "%s", rr_device_message(dev));
@@ -968,6 +1024,7 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   if (pattern_given && aa.mode == RR_AA_NONE) die(EXIT_USAGE, "--aa-pattern needs --aa other than none");
   if (rr_render_options_set_aa(dev, &opt, aa.mode, aa.samples, aa.stored, pattern, seed) != RR_OK)
     die(EXIT_USAGE, "%s", rr_device_message(dev));
+  check_frame_budget(&opt);
   if ((file.given & RR_SETTING_AA) && !(flags & FLAG(OPT_AA)) && !pattern_given) /* the file's pattern too */
     memcpy(opt.sample_pos, file.render.sample_pos, sizeof opt.sample_pos);
   if (!out && naov == 0) out = "rastray.png";
@@ -1105,6 +1162,7 @@ int main(int argc, char **argv) {
     return 0;
   }
   const cli_command *cmd = find_command(argv[1]);
+  rr_import_limits_init(&import_limits);
   /* Blocked before any thread starts, so every thread inherits it and only the watcher takes them. */
   static sigset_t signals;
   sigemptyset(&signals);

@@ -17,6 +17,9 @@ struct rr_device {
   rr_error error;
   char message[512];
   rr_build_options build; /* used by rr_scene_commit; zeros mean defaults */
+  rr_import_limits import; /* rr_device_set_import_limits's, when import_set; else the defaults */
+  bool import_set;
+  int import_hook;         /* tests only: an import_test_hook of io/import_guard.h */
   struct auto_choice {    /* auto's last trial: the same view again reuses its choice */
     const void *scene, *bvh;
     uint32_t ntris;

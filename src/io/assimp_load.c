@@ -9,7 +9,7 @@
  * Besides triangles the file gives materials (with embedded textures), vertex
  * colours, cameras, lights and its up axis. */
 #include "core/color.h"
-#include "io/io.h"
+#include "io/import_guard.h"
 
 #include <assimp/ObjMaterial.h>
 #include <assimp/cimport.h>

@@ -588,6 +588,12 @@ static rr_error output_target(rr_output *set, const char *path, const char *file
   bool stream = is_stdout || (exists && !S_ISREG(st.st_mode));
   if (exists && S_ISDIR(st.st_mode))
     return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': %s", path, strerror(EISDIR));
+  /* a link to a regular file (or to nothing) would be replaced by the temporary, not
+   * written through: refused; a link to a device or FIFO is written through as a stream */
+  struct stat lst;
+  if (!is_stdout && (!exists || S_ISREG(st.st_mode)) && lstat(file, &lst) == 0 && S_ISLNK(lst.st_mode))
+    return rr_fail(dev, RR_ERROR_IO, "cannot write '%s': a symbolic link%s (name the file it points to, or remove it)",
+                   path, exists ? "" : " to nothing");
   for (int i = 0; i < set->n; i++)
     if ((is_stdout && set->v[i].is_stdout) || (!stream && !set->v[i].stream && !strcmp(set->v[i].file, file)))
       return rr_fail(dev, RR_ERROR_ARGUMENT, "cannot write '%s': %s written twice", path,

@@ -31,8 +31,16 @@ static inline int fuzz_write_file(const uint8_t *data, size_t size, const char *
 /* The run's device (libFuzzer never returns from its loop, so it is not released). */
 static inline rr_device *fuzz_device(void) {
   static rr_device *dev;
-  if (!dev) dev = rr_device_new();
-  if (!dev) abort();
+  if (!dev) {
+    dev = rr_device_new();
+    if (!dev) abort();
+    /* files are imported in this process, where libFuzzer sees the importer's
+     * coverage and its crashes; the structural checks still run first */
+    rr_import_limits lim;
+    rr_import_limits_init(&lim);
+    lim.in_process = 1;
+    rr_device_set_import_limits(dev, &lim);
+  }
   return dev;
 }
 
