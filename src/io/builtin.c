@@ -299,7 +299,7 @@ static rr_error load_grid(rr_scene *s, const char *name) {
   path[len] = 0;
   uint32_t t0 = s->ntris, g0 = s->ngeoms;
   uint64_t skipped0 = s->skipped, f0 = scene_faces(s);
-  rr_error e = rr_scene_import_file(s, path);
+  rr_error e = rr_scene_import_guarded(s, path);
   free(path);
   if (e) return e;
 
@@ -528,7 +528,7 @@ static rr_error place_file(rr_scene *s, const char *file, const char *name, floa
   *first_mat = s->nmaterials;
   char path[DATA_PATH_MAX];
   rr_error e = find_data_file(s->dev, file, path);
-  if (!e) e = rr_scene_import_file(s, path);
+  if (!e) e = rr_scene_import_guarded(s, path);
   if (!e && s->ntris == t0) e = rr_fail(s->dev, RR_ERROR_EMPTY, "demo mesh '%s' has no triangles", path);
   for (uint32_t g = g0; !e && g < s->ngeoms; g++) e = rr_scene_name_geometry(s, g, name);
   if (!e) e = rr_scene_smooth_normals(s, t0, s->ntris);

@@ -1,4 +1,4 @@
-/* rr_scene_load_file: import that cannot take the process down.
+/* rr_scene_import_guarded: import that cannot take the process down.
  *
  * assimp crashes, loops and allocates without bound on small malformed files. So
  * a file is first held against its declared counts (import_check.c), then
@@ -522,7 +522,7 @@ static rr_error import_guarded(rr_scene *s, const char *path, const rr_import_li
   return e;
 }
 
-rr_error rr_scene_load_file(rr_scene *s, const char *path) {
+rr_error rr_scene_import_guarded(rr_scene *s, const char *path) {
   rr_device *dev = s->dev;
   rr_import_limits lim;
   if (dev && dev->import_set) lim = dev->import;

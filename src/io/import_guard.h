@@ -10,11 +10,6 @@
  * the file cannot be valid. Files of other formats, and files it cannot open, pass. */
 bool rr_import_check(const char *path, char *why, size_t cap);
 
-/* The import itself, in the calling process: assimp, then the textures the
- * materials name (assimp_load.c). rr_scene_load_file runs it, in a child process
- * unless the device's limits say in_process. */
-rr_error rr_scene_import_file(rr_scene *s, const char *path);
-
 /* Test hooks for the guard's child (the device's; tests only). */
 typedef enum import_test_hook {
   IMPORT_HOOK_NONE = 0,

@@ -4,7 +4,10 @@
 
 #include "scene/scene.h"
 
-/* Loaders: assimp files and the built-in scenes. */
+/* Loaders: assimp files and the built-in scenes. rr_scene_import_guarded is the one
+ * for files a user names: structural checks, then assimp in a child process under
+ * the device's import limits (import_guard.c); rr_scene_import_file is assimp itself. */
+rr_error rr_scene_import_guarded(rr_scene *s, const char *path);
 rr_error rr_scene_import_file(rr_scene *s, const char *path);
 /* Returns RR_OK when `name` named a built-in scene (and fills s), RR_ERROR_UNSUPPORTED
  * when it is not a built-in name; other codes are real failures. */

@@ -14,7 +14,7 @@ rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out) {
   progress_span progress = {dev, RR_PROGRESS_LOAD, 0, 1}; /* files give no fraction to report */
   rr_progress(&progress, 0);
   e = rr_scene_load_builtin(s, path);
-  if (e == RR_ERROR_UNSUPPORTED) e = rr_scene_import_file(s, path);
+  if (e == RR_ERROR_UNSUPPORTED) e = rr_scene_import_guarded(s, path);
   if (!e) rr_progress(&progress, 1);
   if (!e && s->ntris == 0)
     e = rr_fail(dev, RR_ERROR_EMPTY, "scene '%s' has no triangles%s", path,

@@ -525,7 +525,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
     if (!file[0]) return rr_json_fail(r, "file", "empty path");
     if (strlen(file) >= MAX_PATH) return rr_json_fail(r, "file", "path too long");
     if ((e = resolve_path(r, "file", base_dir, file, opt->sandbox, path))) return e;
-    e = rr_scene_import_file(s, path);
+    e = rr_scene_import_guarded(s, path);
   }
   if (e) {
     char msg[512];
