@@ -163,7 +163,8 @@ struct cli_command {
 static const char scenes_note[] =
     "scenes: a file assimp reads (.obj .ply .gltf .glb .dae .3ds ...), or demo, plane[:N],\n"
     "        sphere[:N], box[:N], rooms[:N], grid:PATH:N (N×N copies of a mesh), ground (an\n"
-    "        infinite plane through points at infinity, with a sphere and a box; 3D methods)\n";
+    "        infinite plane through points at infinity, with a sphere and a box; 3D methods),\n"
+    "        checker (an infinite checkerboard-textured plane seen at a grazing angle)\n";
 
 static const cli_option render_options[] = {
     {"method", OPT_METHOD, "NAME",
@@ -732,7 +733,8 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
     putchar('\n');
     print_params(&mi);
   }
-  printf("textures     %u (%u missing or unreadable)\n", in.textures, in.textures_missing);
+  printf("textures     %u (%u missing or unreadable), %.2f MiB with MIP chains\n", in.textures, in.textures_missing,
+         in.texture_bytes / 1048576.0);
   for (uint32_t m = 0; in.textures_missing && m < in.materials; m++) {
     rr_material_info mi;
     rr_scene_get_material_info(scene, m, &mi);
