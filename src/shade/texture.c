@@ -202,30 +202,36 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
   }
 }
 
-/* The Gaussian's falloff exp(-alpha r²), r the distance in pixels, as a multiple of
- * the footprint: alpha = 6 gives it the variance of the pixel's box (1/12). */
-#define EWA_ALPHA 6.0f
+/* The Gaussian exp(-alpha r²), r the distance in pixels mapped through the
+ * footprint, truncated at r = EWA_RADIUS (pbrt-v4 takes alpha = 2 and r = 1: wider
+ * than the pixel, blurrier than its box); EWA_RECON texels² of width added to the
+ * footprint for the reconstruction between texels. Chosen for the least RMSE against
+ * the pixel's box on the checker view (tests/test_texture.c). */
+#define EWA_ALPHA 2.0f
+#define EWA_RADIUS 0.8f
+#define EWA_RECON 2.0f
 
-/* One level's EWA: the texels of level l inside the ellipse x^T M^-1 x < 1, M = J Jᵀ
- * + I (J the footprint in this level's texels; + I: a texel's own width), each
- * weighed by exp(-alpha x^T M^-1 x) - exp(-alpha). */
+/* One level's EWA: the texels of level l inside the ellipse x^T M^-1 x < R², M = J Jᵀ
+ * + EWA_RECON·I (J the footprint in this level's texels), each weighed by
+ * exp(-alpha x^T M^-1 x) - exp(-alpha R²). */
 static void ewa_level(const rr_texture *t, int l, float s, float r, const footprint *fp, float w, float acc[4]) {
   const tex_level *lv = &t->levels[l];
   float sx = (float)lv->width / (float)t->width, sy = (float)lv->height / (float)t->height;
   float ax = fp->ax * sx, ay = fp->ay * sy, bx = fp->bx * sx, by = fp->by * sy;
-  float m11 = ax * ax + bx * bx + 1, m12 = ax * ay + bx * by, m22 = ay * ay + by * by + 1;
+  float m11 = ax * ax + bx * bx + EWA_RECON, m12 = ax * ay + bx * by, m22 = ay * ay + by * by + EWA_RECON;
   float det = m11 * m22 - m12 * m12;
   float q11 = m22 / det, q12 = -m12 / det, q22 = m11 / det; /* M^-1 */
   float cx = s * sx - 0.5f, cy = r * sy - 0.5f;             /* texel centres at integers */
-  float ex = sqrtf(m11), ey = sqrtf(m22);                   /* the ellipse's bounding box */
+  const float R2 = EWA_RADIUS * EWA_RADIUS;
+  float ex = sqrtf(m11 * R2), ey = sqrtf(m22 * R2); /* the ellipse's bounding box */
   int x0 = ifloor(cx - ex) + 1, x1 = ifloor(cx + ex), y0 = ifloor(cy - ey) + 1, y1 = ifloor(cy + ey);
-  float sum[4] = {0, 0, 0, 0}, wsum = 0, floor_w = expf(-EWA_ALPHA);
+  float sum[4] = {0, 0, 0, 0}, wsum = 0, floor_w = expf(-EWA_ALPHA * R2);
   for (int y = y0; y <= y1; y++) {
     float ty = (float)y - cy;
     const uint16_t *row = lv->texels + (size_t)4 * wrap_index(y, lv->height, t->wrap[1]) * lv->width;
     for (int x = x0; x <= x1; x++) {
       float tx = (float)x - cx, q = q11 * tx * tx + 2 * q12 * tx * ty + q22 * ty * ty;
-      if (q >= 1) continue;
+      if (q >= R2) continue;
       float g = expf(-EWA_ALPHA * q) - floor_w;
       const uint16_t *p = row + 4 * wrap_index(x, lv->width, t->wrap[0]);
       for (int c = 0; c < 4; c++) sum[c] += g * p[c];
