@@ -83,7 +83,8 @@ RR_API rr_error rr_device_set_progress(rr_device *dev, rr_progress_fn fn, void *
 /* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...)
  * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]",
  * "grid:PATH:N" (N×N copies of a mesh on the XZ plane), "ground" (an infinite
- * plane with vertices at infinity, and objects on it). "demo" reads meshes from
+ * plane with vertices at infinity, and objects on it), "checker" (an infinite
+ * checkerboard-textured plane, with a grazing view of its own). "demo" reads meshes from
  * the first directory holding them: $RASTRAY_DATA, the installed share/rastray,
  * the source tree's data/. */
 RR_API rr_error rr_scene_load(rr_device *dev, const char *path, rr_scene **out);
@@ -157,6 +158,7 @@ typedef struct rr_scene_info {
   uint32_t cameras, lights;  /* cameras and lights the file defines */
   float up[3];    /* the model's up direction: +Y unless the file says otherwise (Z-up files: +Z) */
   float front[3]; /* the side the model faces, seen by rr_camera_frame: +Z for Y-up, -Y for Z-up files */
+  uint64_t texture_bytes; /* the textures' texels as read and their MIP chains (16-bit linear RGBA) */
 } rr_scene_info;
 
 /* Fills what is known about a scene. */

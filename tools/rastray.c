@@ -171,7 +171,8 @@ static const char scenes_note[] =
     "        meshes, transforms, materials, lights, camera and settings, which options\n"
     "        override; docs/scene-file.md), or demo, plane[:N], sphere[:N], box[:N], torus[:N],\n"
     "        rooms[:N], grid:PATH:N (N×N copies of a mesh), ground (an infinite plane\n"
-    "        through points at infinity, with a sphere and a box; 3D methods)\n";
+    "        through points at infinity, with a sphere and a box; 3D methods), checker (an\n"
+    "        infinite checkerboard-textured plane seen at a grazing angle)\n";
 
 static const cli_option render_options[] = {
     {"method", OPT_METHOD, "NAME",
@@ -802,7 +803,8 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
     putchar('\n');
     print_params(&mi);
   }
-  printf("textures     %u (%u missing or unreadable)\n", in.textures, in.textures_missing);
+  printf("textures     %u (%u missing or unreadable), %.2f MiB with MIP chains\n", in.textures, in.textures_missing,
+         in.texture_bytes / 1048576.0);
   for (uint32_t m = 0; in.textures_missing && m < in.materials; m++) {
     rr_material_info mi;
     rr_scene_get_material_info(scene, m, &mi);

@@ -303,6 +303,10 @@ rr_error rr_camera_frame(rr_device *dev, const rr_scene *s, int width, int heigh
   if (!s || !cam) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_camera_frame: NULL argument");
   if (s->ntris == 0) return rr_fail(dev, RR_ERROR_EMPTY, "cannot frame an empty scene");
   if (width < 1 || height < 1) return rr_fail(dev, RR_ERROR_ARGUMENT, "bad image size %dx%d", width, height);
+  if (s->has_view) { /* a built-in that comes with its own view */
+    v3_store(cam->eye, s->view_eye), v3_store(cam->target, s->view_target), v3_store(cam->up, s->up);
+    return rr_ok(dev);
+  }
   vec3 centre = v3_scale(v3_add(s->bmin, s->bmax), 0.5f);
   float th = cam->fov_deg > 0 && cam->fov_deg < 180 ? tanf(cam->fov_deg * (float)RR_PI / 360.0f) : 0.41f;
   float tw = th * (float)width / (float)height, fill = 0.94f;

@@ -10,6 +10,7 @@
  * colours, cameras, lights and its up axis. */
 #include "core/color.h"
 #include "io/import_guard.h"
+#include "shade/texture.h"
 
 #include <assimp/ObjMaterial.h>
 #include <assimp/cimport.h>
@@ -239,12 +240,18 @@ static bool decode_embedded(rr_texture *t, const struct aiTexture *at) {
   if (at->mHeight == 0) return rr_texture_decode(t, at->pcData, at->mWidth);
   if (at->mWidth > RR_MAX_SIZE || at->mHeight > RR_MAX_SIZE) return false;
   size_t n = (size_t)at->mWidth * at->mHeight;
-  uint8_t *rgb = malloc(3 * n);
-  if (!rgb) return false;
-  for (size_t k = 0; k < n; k++)
+  bool opaque = true;
+  for (size_t k = 0; k < n; k++) opaque &= at->pcData[k].a == 255;
+  uint8_t *rgb = malloc(3 * n), *alpha = opaque ? NULL : malloc(n);
+  if (!rgb || (!opaque && !alpha)) return free(rgb), free(alpha), false;
+  for (size_t k = 0; k < n; k++) {
     rgb[3 * k] = at->pcData[k].r, rgb[3 * k + 1] = at->pcData[k].g, rgb[3 * k + 2] = at->pcData[k].b;
-  t->width = (int)at->mWidth, t->height = (int)at->mHeight, t->rgb = rgb;
-  return true;
+    if (alpha) alpha[k] = at->pcData[k].a;
+  }
+  t->width = (int)at->mWidth, t->height = (int)at->mHeight, t->rgb = rgb, t->alpha = alpha;
+  if (rr_texture_prepare(t)) return true;
+  rr_texture_clear(t);
+  return false;
 }
 
 static void get_rgb(const struct aiMaterial *am, const char *key, unsigned type, unsigned index, float rgb[3]) {
@@ -312,8 +319,9 @@ static rr_error add_materials(rr_scene *s, const struct aiScene *sc, bool gltf) 
     aiGetMaterialColor(am, AI_MATKEY_COLOR_DIFFUSE, &c);
     struct aiString tex, name;
     tex.length = name.length = 0;
+    enum aiTextureMapMode wrap[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
     bool has_tex = aiGetMaterialTexture(am, aiTextureType_DIFFUSE, 0, &tex, NULL, NULL, NULL, NULL,
-                                        NULL, NULL) == AI_SUCCESS && tex.length > 0;
+                                        wrap, NULL) == AI_SUCCESS && tex.length > 0;
     bool named = aiGetMaterialString(am, AI_MATKEY_NAME, &name) == AI_SUCCESS;
     float rgb[3] = {c.r, c.g, c.b};
     /* A textured material's texture carries the colour; OBJ files often leave Kd at 0. */
@@ -326,6 +334,11 @@ static rr_error add_materials(rr_scene *s, const struct aiScene *sc, bool gltf) 
     const struct aiTexture *at = has_tex ? embedded_texture(sc, tex.data) : NULL;
     rr_material *mt = &s->materials[m];
     if (read_params(mt, am, gltf)) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding materials");
+    /* glTF samplers' wrapS/wrapT and MTL's -clamp arrive as assimp's map modes (decal: clamped too) */
+    for (int k = 0; k < 2; k++)
+      mt->texture.wrap[k] = wrap[k] == aiTextureMapMode_Mirror ? RR_WRAP_MIRROR
+                            : wrap[k] == aiTextureMapMode_Clamp || wrap[k] == aiTextureMapMode_Decal ? RR_WRAP_CLAMP
+                                                                                                        : RR_WRAP_REPEAT;
     if (at) mt->texture_status = decode_embedded(&mt->texture, at) ? RR_TEXTURE_EMBEDDED : RR_TEXTURE_UNREADABLE;
     else if (has_tex && tex.data[0] == '*') mt->texture_status = RR_TEXTURE_MISSING; /* no such embedded one */
   }

@@ -6,6 +6,7 @@
  * by several triangles has bitwise identical coordinates in all of them: the shared
  * sample test then leaves no cracks and counts no pixel twice along shared edges. */
 #include "io/io.h"
+#include "shade/texture.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -270,6 +271,47 @@ static rr_error gen_ground(rr_scene *s) {
     }
   float *box_rgb = s->materials[s->nmaterials - 1].color;
   box_rgb[0] = 0.90f, box_rgb[1] = 0.55f, box_rgb[2] = 0.20f;
+  rr_scene_update_bounds(s);
+  return RR_OK;
+}
+
+/* ---- checkerboard to the horizon (textured, homogeneous vertices) ------------- */
+
+/* The checker texture: CHECKER_SIZE² texels in checks of CHECKER_CELL texels, light
+ * and dark sRGB bytes; repeated every CHECKER_REPEAT units on the ground. */
+enum { CHECKER_SIZE = 512, CHECKER_CELL = 16 };
+#define CHECKER_REPEAT 8.0f
+
+/* The plane y = 0 as in `ground` with u = x/8, v = -z/8 (its corners at infinity
+ * carry those rates) and a black-and-white checkerboard texture of 32×32 checks a
+ * repeat: a check is a quarter unit, so that a grazing view minifies it thousands
+ * of times towards the horizon. Its own view looks along -z from 1 unit above the
+ * plane, 9.5° down: the horizon a third of the way down the image. */
+static rr_error gen_checker(rr_scene *s) {
+  float white[3] = {1, 1, 1};
+  uint32_t mat = rr_scene_add_material(s, white, "checker");
+  if (mat == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
+  rr_texture *t = &s->materials[mat].texture;
+  t->rgb = malloc((size_t)3 * CHECKER_SIZE * CHECKER_SIZE);
+  if (!t->rgb) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for the checker texture");
+  t->width = t->height = CHECKER_SIZE;
+  for (int y = 0; y < CHECKER_SIZE; y++)
+    for (int x = 0; x < CHECKER_SIZE; x++)
+      memset(t->rgb + 3 * ((size_t)y * CHECKER_SIZE + x), ((x / CHECKER_CELL) ^ (y / CHECKER_CELL)) & 1 ? 20 : 235, 3);
+  if (!rr_texture_prepare(t)) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for the checker texture");
+  s->materials[mat].texture_status = RR_TEXTURE_EMBEDDED;
+  rr_error e = rr_scene_reserve(s, 4, false, true);
+  if (!e) e = open_object(s, "checker", mat);
+  if (!e) e = rr_scene_reserve_inf(s);
+  if (e) return e;
+  const vec3 origin = v3(0, 0, 0), dir[4] = {v3(1, 0, 0), v3(0, 0, -1), v3(-1, 0, 0), v3(0, 0, 1)};
+  for (int q = 0; q < 4; q++) {
+    vec3 p[3] = {origin, dir[q], dir[(q + 1) % 4]};
+    float uv[3][2] = {{0, 0}};
+    for (int k = 1; k < 3; k++) uv[k][0] = p[k].x / CHECKER_REPEAT, uv[k][1] = -p[k].z / CHECKER_REPEAT;
+    rr_scene_push_inf(s, p, 6u, NULL, (const float(*)[2])uv, NULL, mat);
+  }
+  s->has_view = true, s->view_eye = v3(0, 1, 0), s->view_target = v3(0, 0, -6);
   rr_scene_update_bounds(s);
   return RR_OK;
 }
@@ -616,6 +658,8 @@ rr_error rr_scene_load_builtin(rr_scene *s, const char *name) {
     if (!e) e = gen_rooms(s, (int)n);
   } else if (strcmp(name, "ground") == 0) {
     e = gen_ground(s);
+  } else if (strcmp(name, "checker") == 0) {
+    e = gen_checker(s);
   } else if (strncmp(name, "grid:", 5) == 0) {
     e = load_grid(s, name);
   } else {

@@ -1,5 +1,5 @@
 /* Material textures: the files named by materials, or images embedded in the scene
- * file, decoded to 8-bit RGB.
+ * file, decoded to 8-bit RGB (and alpha), with their MIP chains (shade/texture.h).
  *
  * A texture that cannot be found or decoded is not an error: the material keeps an
  * empty texture (width 0), shades with its base colour, and its status says why
@@ -7,6 +7,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "io/io.h"
+#include "shade/texture.h"
 
 #include <dirent.h>
 #include <stdio.h>
@@ -16,27 +17,36 @@
 
 #include <stb_image.h>
 
-/* Takes stb's pixels (or NULL) of size w×h into tex when that size is acceptable. */
+/* Takes stb's RGBA pixels (or NULL) of size w×h into tex when that size is
+ * acceptable: RGB, alpha when any texel is not opaque, and the MIP chain. */
 static bool take_rgb(rr_texture *tex, uint8_t *px, int w, int h) {
   if (!px) return false;
   bool ok = w >= 1 && h >= 1 && w <= RR_MAX_SIZE && h <= RR_MAX_SIZE;
-  size_t bytes = ok ? (size_t)w * h * 3 : 0;
+  size_t n = ok ? (size_t)w * h : 0;
+  bool opaque = true;
+  for (size_t k = 0; k < n; k++) opaque &= px[4 * k + 3] == 255;
   /* copied so that the scene can release it with free() whatever allocator stb uses */
-  uint8_t *rgb = ok ? malloc(bytes) : NULL;
-  if (rgb) {
-    memcpy(rgb, px, bytes);
-    tex->width = w;
-    tex->height = h;
-    tex->rgb = rgb;
+  uint8_t *rgb = ok ? malloc(3 * n) : NULL, *alpha = ok && !opaque ? malloc(n) : NULL;
+  if (rgb && (opaque || alpha)) {
+    for (size_t k = 0; k < n; k++) {
+      memcpy(rgb + 3 * k, px + 4 * k, 3);
+      if (alpha) alpha[k] = px[4 * k + 3];
+    }
+    tex->width = w, tex->height = h, tex->rgb = rgb, tex->alpha = alpha;
+    ok = rr_texture_prepare(tex);
+    if (!ok) rr_texture_clear(tex);
+  } else {
+    free(rgb), free(alpha);
+    ok = false;
   }
   stbi_image_free(px);
-  return rgb != NULL;
+  return ok;
 }
 
 bool rr_texture_decode(rr_texture *tex, const void *bytes, size_t len) {
   int w = 0, h = 0, n;
   if (len > INT32_MAX) return false;
-  uint8_t *px = stbi_load_from_memory(bytes, (int)len, &w, &h, &n, 3);
+  uint8_t *px = stbi_load_from_memory(bytes, (int)len, &w, &h, &n, 4);
   return take_rgb(tex, px, w, h);
 }
 
@@ -113,7 +123,7 @@ void rr_scene_load_textures(rr_scene *s, const char *base_dir) {
     m->texture.width = m->texture.height = 0;
     char *file = find_texture(base_dir, m->texture_path);
     int w = 0, h = 0, n;
-    uint8_t *px = file ? stbi_load(file, &w, &h, &n, 3) : NULL;
+    uint8_t *px = file ? stbi_load(file, &w, &h, &n, 4) : NULL;
     m->texture_status = !file ? RR_TEXTURE_MISSING : take_rgb(&m->texture, px, w, h) ? RR_TEXTURE_FILE
                                                                                        : RR_TEXTURE_UNREADABLE;
     free(file);

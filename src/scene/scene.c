@@ -31,7 +31,7 @@ void rr_scene_release(rr_scene *s) {
   for (uint32_t m = 0; m < s->nmaterials; m++) {
     free(s->materials[m].name);
     free(s->materials[m].texture_path);
-    free(s->materials[m].texture.rgb);
+    rr_texture_clear(&s->materials[m].texture);
     for (int k = 0; k < RR_MAP_COUNT; k++) free(s->materials[m].maps[k]);
   }
   free(s->materials);
@@ -457,6 +457,11 @@ rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
     info->textures_missing += st == RR_TEXTURE_MISSING || st == RR_TEXTURE_UNREADABLE;
   }
   info->cameras = s->ncameras, info->lights = s->nlights;
+  for (uint32_t m = 0; m < s->nmaterials; m++) {
+    const rr_texture *t = &s->materials[m].texture;
+    info->texture_bytes += (uint64_t)t->width * t->height * (3 + (t->alpha != NULL));
+    for (int l = 0; l < t->nlevels; l++) info->texture_bytes += (uint64_t)t->levels[l].width * t->levels[l].height * 8;
+  }
   v3_store(info->up, s->up), v3_store(info->front, s->front);
   rr_bvh_fill_info(s->bvh, info);
   return RR_OK;
@@ -464,6 +469,12 @@ rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
 
 static const char *const texture_status_names[RR_TEXTURE_STATUS_COUNT] = {"none", "file", "embedded", "missing",
                                                                           "unreadable"};
+
+void rr_texture_clear(rr_texture *t) {
+  for (int l = 0; l < t->nlevels; l++) free(t->levels[l].texels);
+  free(t->levels), free(t->rgb), free(t->alpha);
+  t->levels = NULL, t->rgb = t->alpha = NULL, t->nlevels = t->width = t->height = 0;
+}
 
 const char *rr_texture_status_name(int status) {
   return status >= 0 && status < RR_TEXTURE_STATUS_COUNT ? texture_status_names[status] : NULL;

@@ -10,11 +10,26 @@ struct rr_bvh;
 
 /* The base colour of a mesh that names none (every channel). */
 #define SCENE_GREY 0.8f
+/* One level of a texture's MIP chain: premultiplied linear-light RGBA, 16 bits a
+ * channel (0 .. 65535 for 0 .. 1), row 0 at the top. */
+typedef struct tex_level {
+  int width, height;
+  uint16_t *texels; /* 4 per texel */
+} tex_level;
+
 typedef struct rr_texture {
   int width, height; /* 0 when the file could not be read */
-  uint8_t *rgb;      /* 3 bytes per texel, row 0 at the top */
+  uint8_t *rgb;      /* 3 bytes per texel (sRGB as the file has them), row 0 at the top */
+  uint8_t *alpha;    /* 1 byte per texel (linear coverage); NULL when opaque */
   rr_texture_wrap wrap[2]; /* in u, in v */
+  /* The MIP chain built from rgb and alpha (rr_texture_prepare): level 0 at full size,
+   * each next one half as large (rounded down, at least 1), down to 1×1. */
+  int nlevels;
+  tex_level *levels;
 } rr_texture;
+
+/* Frees what a texture holds (its texels and MIP chain) and empties it. */
+void rr_texture_clear(rr_texture *t);
 
 typedef struct rr_material {
   char *name;         /* NULL when the file gives none */
@@ -88,6 +103,8 @@ struct rr_scene {
   uint8_t *inf;
   vec3 bmin, bmax; /* of the finite corners */
   vec3 up, front;  /* unit: the model's up and the side it faces (+Y, +Z unless the file says) */
+  bool has_view;              /* a built-in's own default view, which rr_camera_frame takes */
+  vec3 view_eye, view_target; /* (the checker scene's grazing view) */
   file_camera *cameras;
   uint32_t ncameras;
   rr_light_info *lights; /* in world space; names are the scene's copies */

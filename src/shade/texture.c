@@ -1,30 +1,320 @@
-/* Texture lookups. For now: bilinear at level 0, whatever the filter. */
+/* Texture filtering over a sample's footprint (docs/textures.md).
+ *
+ * At load every texture gets a MIP chain: level 0 holds the file's texels decoded
+ * from sRGB to linear light and premultiplied by alpha (so that transparent texels
+ * add no colour when averaged), 16 bits a channel; each next level is the exact box
+ * average of the one before, at half the size rounded down, whatever the size (an
+ * odd side weighs its input texels by their fractional overlap).
+ *
+ * A lookup reads the footprint, the parallelogram spanned by the derivatives of
+ * (u, v) per pixel step, as the filter says: nearest and bilinear at level 0;
+ * trilinear at the level where a texel is as wide as the footprint; aniso as up to
+ * N trilinear probes along the footprint's long side, each the size of its short
+ * side (as EXT_texture_filter_anisotropic); ewa as a Gaussian over the footprint's
+ * ellipse (Heckbert's EWA, as pbrt-v4's MIPMap), its width matched to the pixel's
+ * box. */
 #include "shade/texture.h"
 #include "core/color.h"
 
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TEXEL_ONE 65535.0f
+
+/* ---- the MIP chain ------------------------------------------------------------------ */
+
+/* How output texel j of a downsampling axis reads its input: the input texels
+ * first .. first + 3 with weights w (their overlap with [j r, (j + 1) r), r = N / n,
+ * over r). r <= 3 (N = 3, n = 1), so four taps always suffice. */
+typedef struct box_taps {
+  int first;
+  float w[4];
+} box_taps;
+
+static void box_weights(int N, int n, box_taps *t) {
+  double r = (double)N / n;
+  for (int j = 0; j < n; j++) {
+    double a = j * r, b = (j + 1) * r;
+    int i0 = (int)floor(a);
+    t[j].first = i0;
+    for (int k = 0; k < 4; k++) {
+      double lo = fmax(a, i0 + k), hi = fmin(b, i0 + k + 1.0);
+      t[j].w[k] = i0 + k < N && hi > lo ? (float)((hi - lo) / r) : 0.0f;
+    }
+  }
+}
+
+/* Level `out` as the box average of level `in`: rows first into tmp (floats, out's
+ * width × in's height), then columns, rounded to 16 bits. */
+static void downsample(const tex_level *in, tex_level *out, float *tmp, box_taps *tx, box_taps *ty) {
+  box_weights(in->width, out->width, tx);
+  box_weights(in->height, out->height, ty);
+  for (int y = 0; y < in->height; y++) {
+    const uint16_t *row = in->texels + (size_t)4 * y * in->width;
+    for (int x = 0; x < out->width; x++) {
+      float acc[4] = {0, 0, 0, 0};
+      for (int k = 0; k < 4; k++)
+        if (tx[x].w[k] > 0)
+          for (int c = 0; c < 4; c++) acc[c] += tx[x].w[k] * row[4 * (tx[x].first + k) + c];
+      memcpy(tmp + 4 * ((size_t)y * out->width + x), acc, sizeof acc);
+    }
+  }
+  for (int y = 0; y < out->height; y++)
+    for (int x = 0; x < out->width; x++) {
+      float acc[4] = {0, 0, 0, 0};
+      for (int k = 0; k < 4; k++)
+        if (ty[y].w[k] > 0)
+          for (int c = 0; c < 4; c++) acc[c] += ty[y].w[k] * tmp[4 * ((size_t)(ty[y].first + k) * out->width + x) + c];
+      uint16_t *o = out->texels + 4 * ((size_t)y * out->width + x);
+      for (int c = 0; c < 4; c++) o[c] = (uint16_t)fminf(acc[c] + 0.5f, TEXEL_ONE);
+    }
+}
 
 bool rr_texture_prepare(rr_texture *t) {
-  (void)t;
+  if (t->nlevels || t->width < 1 || t->height < 1 || !t->rgb) return true;
+  int n = 1;
+  for (int w = t->width, h = t->height; w > 1 || h > 1; n++) w = w > 1 ? w / 2 : 1, h = h > 1 ? h / 2 : 1;
+  tex_level *lv = calloc(n, sizeof *lv);
+  float *tmp = malloc((size_t)4 * (t->width / 2 + 1) * t->height * sizeof *tmp);
+  box_taps *taps = malloc(((size_t)t->width + t->height) * sizeof *taps); /* a level's rows', then columns' */
+  bool ok = lv && tmp && taps;
+  for (int l = 0; ok && l < n; l++) {
+    lv[l].width = l ? (lv[l - 1].width > 1 ? lv[l - 1].width / 2 : 1) : t->width;
+    lv[l].height = l ? (lv[l - 1].height > 1 ? lv[l - 1].height / 2 : 1) : t->height;
+    lv[l].texels = malloc((size_t)lv[l].width * lv[l].height * 4 * sizeof(uint16_t));
+    ok = lv[l].texels != NULL;
+  }
+  if (ok) {
+    float lin[256]; /* the sRGB curve once per byte value */
+    for (int i = 0; i < 256; i++) lin[i] = srgb_decode(i / 255.0f);
+    size_t texels = (size_t)t->width * t->height;
+    for (size_t k = 0; k < texels; k++) {
+      float a = t->alpha ? t->alpha[k] / 255.0f : 1.0f;
+      uint16_t *o = lv[0].texels + 4 * k;
+      for (int c = 0; c < 3; c++) o[c] = (uint16_t)(lin[t->rgb[3 * k + c]] * a * TEXEL_ONE + 0.5f);
+      o[3] = (uint16_t)(a * TEXEL_ONE + 0.5f);
+    }
+    for (int l = 1; l < n; l++) downsample(&lv[l - 1], &lv[l], tmp, taps, taps + t->width);
+  }
+  free(tmp), free(taps);
+  if (!ok) {
+    for (int l = 0; lv && l < n; l++) free(lv[l].texels);
+    free(lv);
+    return false;
+  }
+  t->levels = lv, t->nlevels = n;
   return true;
 }
 
-void rr_texture_sample(const rr_texture *t, const tex_coord *tc, const tex_filter *f, float rgba[4]) {
-  (void)f;
-  /* Wrap, bilinear; v points up in the file's convention, rows run down. */
-  float u = tc->u - floorf(tc->u), v = tc->v - floorf(tc->v);
-  float fx = u * t->width - 0.5f, fy = (1.0f - v) * t->height - 0.5f;
-  int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
-  float ax = fx - x0, ay = fy - y0;
-  for (int c = 0; c < 3; c++) rgba[c] = 0;
-  for (int j = 0; j < 2; j++)
-    for (int i = 0; i < 2; i++) {
-      int xx = ((x0 + i) % t->width + t->width) % t->width, yy = ((y0 + j) % t->height + t->height) % t->height;
-      float w = (i ? ax : 1 - ax) * (j ? ay : 1 - ay);
-      const uint8_t *p = t->rgb + 3 * ((size_t)yy * t->width + xx);
-      for (int c = 0; c < 3; c++) rgba[c] += w * p[c] / 255.0f;
+/* ---- lookups ------------------------------------------------------------------------ */
+
+/* floor(x) as an int, kept within ±2^30 so that footprints far outside [0, 1] wrap
+ * without overflow. */
+static inline int ifloor(float x) {
+  float f = floorf(x);
+  return f > 1073741824.0f ? 1073741824 : f < -1073741824.0f ? -1073741824 : (int)f;
+}
+
+/* Texel index i of a side of n texels, wrapped as mode says. */
+static inline int wrap_index(int i, int n, rr_texture_wrap mode) {
+  if ((unsigned)i < (unsigned)n) return i;
+  if (mode == RR_WRAP_CLAMP) return i < 0 ? 0 : n - 1;
+  if (mode == RR_WRAP_MIRROR) {
+    int p = 2 * n;
+    i %= p;
+    if (i < 0) i += p;
+    return i < n ? i : p - 1 - i;
+  }
+  i %= n;
+  return i < 0 ? i + n : i;
+}
+
+/* Adds weight w times the bilinear lookup of level lv at texel coordinates (x, y)
+ * (texel centres at half-integers) to acc. */
+static inline void bilerp(const rr_texture *t, const tex_level *lv, float x, float y, float w, float acc[4]) {
+  x -= 0.5f, y -= 0.5f;
+  int x0 = ifloor(x), y0 = ifloor(y);
+  float ax = x - (float)x0, ay = y - (float)y0;
+  int x1 = wrap_index(x0 + 1, lv->width, t->wrap[0]), y1 = wrap_index(y0 + 1, lv->height, t->wrap[1]);
+  x0 = wrap_index(x0, lv->width, t->wrap[0]), y0 = wrap_index(y0, lv->height, t->wrap[1]);
+  const uint16_t *r0 = lv->texels + (size_t)4 * y0 * lv->width, *r1 = lv->texels + (size_t)4 * y1 * lv->width;
+  float w00 = w * (1 - ax) * (1 - ay), w10 = w * ax * (1 - ay), w01 = w * (1 - ax) * ay, w11 = w * ax * ay;
+  for (int c = 0; c < 4; c++)
+    acc[c] += w00 * r0[4 * x0 + c] + w10 * r0[4 * x1 + c] + w01 * r1[4 * x0 + c] + w11 * r1[4 * x1 + c];
+}
+
+/* Two levels and their weights: the trilinear blend at level of detail lod. */
+typedef struct lod_pair {
+  const tex_level *lv[2];
+  float w[2];
+} lod_pair;
+
+static inline lod_pair lod_levels(const rr_texture *t, float lod) {
+  int top = t->nlevels - 1;
+  if (!(lod > 0)) return (lod_pair){{&t->levels[0], NULL}, {1, 0}}; /* magnified (NaN too) */
+  if (lod >= (float)top) return (lod_pair){{&t->levels[top], NULL}, {1, 0}};
+  int l = (int)lod;
+  float f = lod - (float)l;
+  return (lod_pair){{&t->levels[l], &t->levels[l + 1]}, {1 - f, f}};
+}
+
+/* Adds weight w times the trilinear lookup at (s, r) (level-0 texel units) to acc. */
+static inline void trilerp(const rr_texture *t, const lod_pair *p, float s, float r, float w, float acc[4]) {
+  for (int k = 0; k < 2 && p->lv[k]; k++) {
+    float sx = (float)p->lv[k]->width / (float)t->width, sy = (float)p->lv[k]->height / (float)t->height;
+    bilerp(t, p->lv[k], s * sx, r * sy, w * p->w[k], acc);
+  }
+}
+
+/* The footprint in level-0 texels: the derivative vectors per pixel step in x (a)
+ * and y (b), texel rows running down as v runs up. */
+typedef struct footprint {
+  float ax, ay, bx, by;
+} footprint;
+
+/* Up to f->aniso trilinear probes spread along the long side of the parallelogram
+ * spanned by a and b, each as wide as the parallelogram across. */
+static void filter_aniso(const rr_texture *t, float s, float r, const footprint *fp, const tex_filter *f,
+                         float acc[4]) {
+  float la = fp->ax * fp->ax + fp->ay * fp->ay, lb = fp->bx * fp->bx + fp->by * fp->by;
+  float mx = la >= lb ? fp->ax : fp->bx, my = la >= lb ? fp->ay : fp->by; /* the longer vector */
+  float nx = la >= lb ? fp->bx : fp->ax, ny = la >= lb ? fp->by : fp->ay;
+  float lmaj = sqrtf(fmaxf(la, lb));
+  if (!(lmaj > 0)) { /* no footprint: magnified */
+    lod_pair p = lod_levels(t, f->lod_bias);
+    trilerp(t, &p, s, r, 1, acc);
+    return;
+  }
+  /* the parallelogram's extent along the longer vector and its width across it */
+  float along = lmaj + fabsf(mx * nx + my * ny) / lmaj, across = fabsf(mx * ny - my * nx) / lmaj;
+  int n = f->filter == RR_TEXTURE_ANISO ? f->aniso : 1;
+  if (along < (float)n * across) n = (int)ceilf(along / fmaxf(across, 1e-30f));
+  if (n < 1) n = 1;
+  float size = fmaxf(along / (float)n, across);
+  lod_pair p = lod_levels(t, log2f(fmaxf(size, 1e-30f)) + f->lod_bias);
+  /* probe k at ((k + 1/2)/n - 1/2)·along along the unit longer vector */
+  float step = along / ((float)n * lmaj), dx = mx * step, dy = my * step, w = 1.0f / (float)n;
+  float k0 = 0.5f - 0.5f * (float)n;
+  for (int k = 0; k < n; k++) {
+    float o = k0 + (float)k;
+    trilerp(t, &p, s + o * dx, r + o * dy, w, acc);
+  }
+}
+
+/* The Gaussian exp(-alpha r²), r the distance in pixels mapped through the
+ * footprint, truncated at r = EWA_RADIUS (pbrt-v4 takes alpha = 2 and r = 1: wider
+ * than the pixel, blurrier than its box); EWA_RECON texels² of width added to the
+ * footprint for the reconstruction between texels. Chosen for the least RMSE against
+ * the pixel's box on the checker view (tests/test_texture.c). */
+#define EWA_ALPHA 2.0f
+#define EWA_RADIUS 0.8f
+#define EWA_RECON 2.0f
+
+/* One level's EWA: the texels of level l inside the ellipse x^T M^-1 x < R², M = J Jᵀ
+ * + EWA_RECON·I (J the footprint in this level's texels), each weighed by
+ * exp(-alpha x^T M^-1 x) - exp(-alpha R²). */
+static void ewa_level(const rr_texture *t, int l, float s, float r, const footprint *fp, float w, float acc[4]) {
+  const tex_level *lv = &t->levels[l];
+  float sx = (float)lv->width / (float)t->width, sy = (float)lv->height / (float)t->height;
+  float ax = fp->ax * sx, ay = fp->ay * sy, bx = fp->bx * sx, by = fp->by * sy;
+  float m11 = ax * ax + bx * bx + EWA_RECON, m12 = ax * ay + bx * by, m22 = ay * ay + by * by + EWA_RECON;
+  float det = m11 * m22 - m12 * m12;
+  float q11 = m22 / det, q12 = -m12 / det, q22 = m11 / det; /* M^-1 */
+  float cx = s * sx - 0.5f, cy = r * sy - 0.5f;             /* texel centres at integers */
+  const float R2 = EWA_RADIUS * EWA_RADIUS;
+  float ex = sqrtf(m11 * R2), ey = sqrtf(m22 * R2); /* the ellipse's bounding box */
+  int x0 = ifloor(cx - ex) + 1, x1 = ifloor(cx + ex), y0 = ifloor(cy - ey) + 1, y1 = ifloor(cy + ey);
+  float sum[4] = {0, 0, 0, 0}, wsum = 0, floor_w = expf(-EWA_ALPHA * R2);
+  for (int y = y0; y <= y1; y++) {
+    float ty = (float)y - cy;
+    const uint16_t *row = lv->texels + (size_t)4 * wrap_index(y, lv->height, t->wrap[1]) * lv->width;
+    for (int x = x0; x <= x1; x++) {
+      float tx = (float)x - cx, q = q11 * tx * tx + 2 * q12 * tx * ty + q22 * ty * ty;
+      if (q >= R2) continue;
+      float g = expf(-EWA_ALPHA * q) - floor_w;
+      const uint16_t *p = row + 4 * wrap_index(x, lv->width, t->wrap[0]);
+      for (int c = 0; c < 4; c++) sum[c] += g * p[c];
+      wsum += g;
     }
-  /* textures are sRGB-encoded; shading works in linear light */
-  for (int c = 0; c < 3; c++) rgba[c] = srgb_decode(rgba[c]);
-  rgba[3] = 1.0f;
+  }
+  if (wsum > 0)
+    for (int c = 0; c < 4; c++) acc[c] += w * sum[c] / wsum;
+  else /* (a box always holds its centre's texel; a guard all the same) */
+    bilerp(t, lv, s * sx, r * sy, w, acc);
+}
+
+/* EWA at the two levels around the one where the ellipse's short axis spans about
+ * two texels, the ellipse's eccentricity limited to f->aniso (its short axis grown). */
+static void filter_ewa(const rr_texture *t, float s, float r, footprint fp, const tex_filter *f, float acc[4]) {
+  float la = fp.ax * fp.ax + fp.ay * fp.ay, lb = fp.bx * fp.bx + fp.by * fp.by;
+  if (la < lb) {
+    footprint sw = {fp.bx, fp.by, fp.ax, fp.ay};
+    fp = sw;
+    float tmp = la;
+    la = lb, lb = tmp;
+  }
+  float lmaj = sqrtf(la), lmin = sqrtf(lb), limit = (float)(f->aniso > 1 ? f->aniso : 1);
+  if (lmin * limit < lmaj && lmin > 0) {
+    float k = lmaj / (lmin * limit);
+    fp.bx *= k, fp.by *= k, lmin *= k;
+  }
+  if (!(lmin > 0)) { /* a degenerate footprint */
+    lod_pair p = lod_levels(t, f->lod_bias);
+    trilerp(t, &p, s, r, 1, acc);
+    return;
+  }
+  float lod = log2f(lmin) - 1.0f + f->lod_bias;
+  int top = t->nlevels - 1;
+  if (!(lod > 0)) {
+    ewa_level(t, 0, s, r, &fp, 1, acc);
+  } else if (lod >= (float)top) {
+    ewa_level(t, top, s, r, &fp, 1, acc);
+  } else {
+    int l = (int)lod;
+    float w = lod - (float)l;
+    ewa_level(t, l, s, r, &fp, 1 - w, acc);
+    ewa_level(t, l + 1, s, r, &fp, w, acc);
+  }
+}
+
+/* A coordinate brought near [0, 1] (repeat) or [0, 2] (mirror) so that texel
+ * coordinates stay exact far from the origin; clamp keeps it (ifloor bounds it). */
+static inline float wrap_coord(float u, rr_texture_wrap mode) {
+  if (mode == RR_WRAP_REPEAT) return u - floorf(u);
+  if (mode == RR_WRAP_MIRROR) return u - 2.0f * floorf(0.5f * u);
+  return u;
+}
+
+void rr_texture_sample(const rr_texture *t, const tex_coord *tc, const tex_filter *f, float rgba[4]) {
+  if (t->nlevels < 1) { /* no texels: white, so that the base colour shows */
+    rgba[0] = rgba[1] = rgba[2] = rgba[3] = 1.0f;
+    return;
+  }
+  float W = (float)t->width, H = (float)t->height;
+  /* level-0 texel coordinates (s, r), rows running down from v = 1 */
+  float s = wrap_coord(tc->u, t->wrap[0]) * W, r = (1.0f - wrap_coord(tc->v, t->wrap[1])) * H;
+  float acc[4] = {0, 0, 0, 0};
+  switch (f->filter) {
+  case RR_TEXTURE_NEAREST: {
+    const tex_level *lv = &t->levels[0];
+    int x = wrap_index(ifloor(s), lv->width, t->wrap[0]), y = wrap_index(ifloor(r), lv->height, t->wrap[1]);
+    const uint16_t *p = lv->texels + 4 * ((size_t)y * lv->width + x);
+    for (int c = 0; c < 4; c++) acc[c] = p[c];
+    break;
+  }
+  case RR_TEXTURE_BILINEAR:
+    bilerp(t, &t->levels[0], s, r, 1, acc);
+    break;
+  default: {
+    footprint fp = {tc->dudx * W, -tc->dvdx * H, tc->dudy * W, -tc->dvdy * H};
+    if (f->filter == RR_TEXTURE_EWA) filter_ewa(t, s, r, fp, f, acc);
+    else filter_aniso(t, s, r, &fp, f, acc); /* trilinear: one probe */
+    break;
+  }
+  }
+  /* premultiplied to straight colour: the colour of what is there */
+  float a = acc[3] / TEXEL_ONE, inv = a > 0 ? 1.0f / acc[3] : 0.0f;
+  for (int c = 0; c < 3; c++) rgba[c] = fminf(acc[c] * inv, 1.0f);
+  rgba[3] = a;
 }
