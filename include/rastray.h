@@ -180,6 +180,9 @@ typedef struct rr_geometry_info {
 RR_API rr_error rr_scene_get_geometry(const rr_scene *scene, uint32_t prim, uint32_t *geom, uint32_t *local);
 /* Fills what is known about geometry `geom` (0 .. rr_scene_info.geometries - 1). */
 RR_API rr_error rr_scene_get_geometry_info(const rr_scene *scene, uint32_t geom, rr_geometry_info *info);
+/* The unit geometric normals (p1 - p0) × (p2 - p0) of n triangles by id, 3 floats each
+ * into normals; zero for RR_MISS and ids of skipped triangles. */
+RR_API rr_error rr_scene_get_normals(const rr_scene *scene, const uint32_t *prims, size_t n, float *normals);
 
 /* ---- ray queries --------------------------------------------------------- */
 
