@@ -334,19 +334,20 @@ class Scene:
         return linear, np.round(srgb * 255).astype(np.uint8)
 
     def _stream(self, rays, tmax=None):
+        """A ray stream over the caller's (N, 6) array itself: one stride serves every
+        component, so the ranges sit in an (N, 6) array of their own (columns 0, 1)."""
         r = _array(rays, "rays", np.float32, 6)
         n = len(r)
-        tmin = np.zeros(n, dtype=np.float32)
-        tm = np.full(n, np.inf, dtype=np.float32) if tmax is None else np.ascontiguousarray(
-            np.broadcast_to(np.asarray(tmax, dtype=np.float32), (n,)))
+        ranges = np.zeros((n, 6), dtype=np.float32)
+        ranges[:, 1] = np.inf if tmax is None else np.broadcast_to(np.asarray(tmax, dtype=np.float32), (n,))
         s = ffi.new("rr_ray_stream *")
         s.count, s.stride = n, 24
-        base = ffi.from_buffer("float[]", r)
+        base, rng = ffi.from_buffer("float[]", r), ffi.from_buffer("float[]", ranges)
         for k in range(3):
             s.org[k] = base + k
             s.dir[k] = base + 3 + k
-        s.tmin, s.tmax = ffi.from_buffer("float[]", tmin), ffi.from_buffer("float[]", tm)
-        return s, (r, base, tmin, tm)
+        s.tmin, s.tmax = rng, rng + 1
+        return s, (r, base, ranges, rng)
 
     def intersect(self, rays, threads=0):
         """Closest hits of rays (N, 6) float32 (origin, direction) through the ray
