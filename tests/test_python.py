@@ -289,3 +289,11 @@ def test_bad_input(mesh):
         s3.render(cam, size=(8, 8))
     with pytest.raises(rastray.Error, match="released"):
         s3.intersect(np.zeros((1, 6), np.float32))
+
+
+def test_readme_quickstart():
+    """The README's Python example is python/examples/quickstart.py, which the README's
+    commands run (tests/test_readme.py)."""
+    text = open(os.path.join(ROOT, "README.md"), encoding="utf-8").read()
+    shown = text.split("`python/examples/quickstart.py`:\n\n```python\n", 1)[1].split("```", 1)[0]
+    assert shown == open(os.path.join(ROOT, "python", "examples", "quickstart.py"), encoding="utf-8").read()
