@@ -274,6 +274,10 @@ def test_bad_input(mesh):
         rastray.Camera.opencv(np.eye(3), [0.1] * 5, fisheye=True)
     with pytest.raises(ValueError):
         rastray.Camera(kind="nonesuch")
+    with pytest.raises(rastray.Error, match="eye equals target"):
+        rastray.Camera(eye=(1, 2, 3), target=(1, 2, 3))
+    with pytest.raises(rastray.Error, match="field of view"):
+        rastray.Camera(fov=200)
     cam = rastray.Camera()
     with pytest.raises(ValueError):
         scene.render(cam, size=(8, 8), method="nonesuch")
@@ -297,3 +301,30 @@ def test_readme_quickstart():
     text = open(os.path.join(ROOT, "README.md"), encoding="utf-8").read()
     shown = text.split("`python/examples/quickstart.py`:\n\n```python\n", 1)[1].split("```", 1)[0]
     assert shown == open(os.path.join(ROOT, "python", "examples", "quickstart.py"), encoding="utf-8").read()
+
+
+@pytest.mark.skipif(not os.path.exists(CLI), reason="the command-line tool is not built")
+def test_cli_lens_options():
+    """--extrinsics from a file equals the values; --save-camera keeps the lens (the
+    same bytes again through --camera-file); lens flags without an OpenCV camera and
+    bad values are usage errors (exit 2) naming the flag."""
+    with tempfile.TemporaryDirectory() as tmp:
+        pose = "1,0,0,0,0,1,0,-1,0,0,0,1.2"
+        with open(os.path.join(tmp, "pose.txt"), "w") as fp:
+            fp.write(pose.replace(",", " ") + "\n")
+        base = ["plane:8", "--size", "64x48", "--method", "3dr-bb", "--intrinsics", "40,40,31.5,23.5",
+                "--distortion", "-0.3,0.1,0.001,0.001"]
+        a = cli_npy(tmp, base + ["--extrinsics", pose, "--save-camera", os.path.join(tmp, "cam.json")], ["id"])
+        b = cli_npy(tmp, base + ["--extrinsics", os.path.join(tmp, "pose.txt")], ["id"])
+        c = cli_npy(tmp, ["plane:8", "--size", "64x48", "--method", "3dr-bb", "--camera-file",
+                          os.path.join(tmp, "cam.json")], ["id"])
+        assert a == b == c
+        ids = np.load(os.path.join(tmp, "id.npy"))
+        assert (ids != rastray.MISS).sum() > 1000
+        for args, word in ((["--distortion", "0.1"], "--distortion"), (["--intrinsics", "1,2,3"], "--intrinsics"),
+                           (["--extrinsics", "1,0,0,0,2,0,0,0,1,0,0,0"], "rotation"),
+                           (["--camera", "opencv", "--intrinsics", "-1,1,1,1"], "intrinsics")):
+            p = subprocess.run([CLI, "render", "plane:8", "-o", os.path.join(tmp, "x.png")] + args,
+                               capture_output=True, text=True)
+            assert p.returncode == 2 and word in p.stderr and p.stderr.count("\n") == 1, (args, p.stderr)
+            assert not os.path.exists(os.path.join(tmp, "x.png"))

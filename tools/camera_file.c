@@ -3,7 +3,8 @@
  *   {"type": "perspective", "eye": [x, y, z], "target": [x, y, z], "up": [x, y, z],
  *    "fov": 45, "ortho_height": 0, "width": 1024, "height": 768}
  * (width and height record the image the camera was made for; reading ignores
- * them) or a camera-to-world matrix in the OpenGL convention, four rows of four
+ * them; the OpenCV cameras add "intrinsics": [fx, fy, cx, cy] and "distortion":
+ * [up to 8 coefficients]) or a camera-to-world matrix in the OpenGL convention, four rows of four
  * numbers: columns right (+X), up (+Y) and back (+Z; the camera looks down -Z),
  * then the position, bottom row 0 0 0 1:
  *   {"matrix": [[1,0,0,0], [0,1,0,0], [0,0,1,5], [0,0,0,1]], "fov": 40}
@@ -78,19 +79,21 @@ unsigned camera_file_read(const char *path, rr_camera *cam) {
     bad("not valid JSON (line %d)", line);
   }
   if (!cJSON_IsObject(root)) bad("not a JSON object");
-  static const char *const keys[] = {"type", "eye", "target", "up", "fov", "ortho_height", "matrix", "width", "height"};
+  static const char *const keys[] = {"type", "eye", "target", "up", "fov", "ortho_height", "matrix", "width", "height",
+                                     "intrinsics", "distortion"};
   for (const cJSON *k = root->child; k; k = k->next) {
     size_t i = 0;
     while (i < sizeof keys / sizeof *keys && strcmp(k->string, keys[i]) != 0) i++;
     if (i == sizeof keys / sizeof *keys)
-      bad("unknown key '%s' (expected type, eye, target, up, fov, ortho_height, width, height, or matrix and fov)",
+      bad("unknown key '%s' (expected type, eye, target, up, fov, ortho_height, width, height, intrinsics, "
+          "distortion, or matrix and fov)",
           k->string);
   }
   unsigned given = 0;
   const cJSON *item;
   if ((item = cJSON_GetObjectItemCaseSensitive(root, "type"))) {
     int type = cJSON_IsString(item) ? rr_camera_from_name(item->valuestring) : -1;
-    if (type < 0) bad("'type' must be perspective, orthographic, parabolic, latlong, fisheye or cube");
+    if (type < 0) bad("'type' must be perspective, orthographic, parabolic, latlong, fisheye, cube, opencv or opencv-fisheye");
     cam->type = (rr_camera_type)type, given |= CAM_TYPE;
   }
   const cJSON *matrix = cJSON_GetObjectItemCaseSensitive(root, "matrix");
@@ -124,6 +127,18 @@ unsigned camera_file_read(const char *path, rr_camera *cam) {
     cam->ortho_height = number(item, "ortho_height"), given |= CAM_ORTHO;
     if (!(cam->ortho_height >= 0)) bad("'ortho_height' must be >= 0 (0: from the distance and fov)");
   }
+  if ((item = cJSON_GetObjectItemCaseSensitive(root, "intrinsics"))) {
+    float k[4];
+    numbers(item, "intrinsics", 4, k);
+    cam->fx = k[0], cam->fy = k[1], cam->cx = k[2], cam->cy = k[3], given |= CAM_LENS;
+  }
+  if ((item = cJSON_GetObjectItemCaseSensitive(root, "distortion"))) {
+    int n = cJSON_IsArray(item) ? cJSON_GetArraySize(item) : -1;
+    if (n < 0 || n > 8) bad("'distortion' must be an array of at most 8 numbers");
+    memset(cam->dist, 0, sizeof cam->dist);
+    numbers(item, "distortion", n, cam->dist);
+    given |= CAM_LENS;
+  }
   for (int k = 0; k < 2; k++) /* for reference only, but a wrong type is still a bad file */
     if ((item = cJSON_GetObjectItemCaseSensitive(root, k ? "height" : "width")) && !cJSON_IsNumber(item))
       bad("'%s' must be a number", k ? "height" : "width");
@@ -138,6 +153,11 @@ void camera_file_add(rr_device *dev, rr_output *set, const char *path, const rr_
   cJSON_AddItemToObject(root, "eye", cJSON_CreateFloatArray(cam->eye, 3));
   cJSON_AddItemToObject(root, "target", cJSON_CreateFloatArray(cam->target, 3));
   cJSON_AddItemToObject(root, "up", cJSON_CreateFloatArray(cam->up, 3));
+  if (cam->type == RR_CAMERA_OPENCV || cam->type == RR_CAMERA_OPENCV_FISHEYE) {
+    const float k[4] = {cam->fx, cam->fy, cam->cx, cam->cy};
+    cJSON_AddItemToObject(root, "intrinsics", cJSON_CreateFloatArray(k, 4));
+    cJSON_AddItemToObject(root, "distortion", cJSON_CreateFloatArray(cam->dist, 8));
+  }
   cJSON_AddNumberToObject(root, "fov", cam->fov_deg);
   cJSON_AddNumberToObject(root, "ortho_height", cam->ortho_height);
   cJSON_AddNumberToObject(root, "width", width);

@@ -24,7 +24,8 @@ struct cJSON;
 void json_add(rr_device *dev, rr_output *set, struct cJSON *root, const char *path);
 
 /* The fields of an rr_camera that a flag or a camera file gives. */
-enum { CAM_TYPE = 1, CAM_EYE = 2, CAM_TARGET = 4, CAM_UP = 8, CAM_FOV = 16, CAM_ORTHO = 32 };
+enum { CAM_TYPE = 1, CAM_EYE = 2, CAM_TARGET = 4, CAM_UP = 8, CAM_FOV = 16, CAM_ORTHO = 32,
+       CAM_LENS = 64 /* intrinsics and distortion */ };
 /* Reads a camera file (tools/camera_file.c) into *cam and returns the fields it
  * gave; the others keep their values. A bad file ends the program (exit 1). */
 unsigned camera_file_read(const char *path, rr_camera *cam);

@@ -831,6 +831,10 @@ static void camera_take(rr_camera *dst, const rr_camera *src, unsigned fields) {
   if (fields & CAM_UP) memcpy(dst->up, src->up, sizeof dst->up);
   if (fields & CAM_FOV) dst->fov_deg = src->fov_deg;
   if (fields & CAM_ORTHO) dst->ortho_height = src->ortho_height;
+  if (fields & CAM_LENS) {
+    dst->fx = src->fx, dst->fy = src->fy, dst->cx = src->cx, dst->cy = src->cy;
+    memcpy(dst->dist, src->dist, sizeof dst->dist);
+  }
 }
 
 /* --stats-json: the statistics as one JSON object. */
@@ -974,11 +978,9 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   if (optind < argc) scene_name = argv[optind];
   if (argc - optind > 1) die(EXIT_USAGE, "more than one scene given ('%s' and '%s')", scene_name, argv[optind + 1]);
   if (!(given & CAM_EYE) != !(given & CAM_TARGET)) die(EXIT_USAGE, "--eye and --target go together");
-  bool opencv = cam.type == RR_CAMERA_OPENCV || cam.type == RR_CAMERA_OPENCV_FISHEYE;
-  if ((lens & 1) && !(given & CAM_TYPE)) cam.type = RR_CAMERA_OPENCV, given |= CAM_TYPE, opencv = true;
-  if (opencv && !(lens & 1)) die(EXIT_USAGE, "--camera %s needs --intrinsics", rr_camera_name(cam.type));
-  if ((lens & 3) && !opencv) die(EXIT_USAGE, "--intrinsics and --distortion go with --camera opencv or opencv-fisheye");
+  if ((lens & 1) && !(given & CAM_TYPE)) cam.type = RR_CAMERA_OPENCV, given |= CAM_TYPE;
   if ((lens & 4) && (file_cam || camera_file)) die(EXIT_USAGE, "--extrinsics gives the pose: no camera file with it");
+  if (lens) given |= CAM_LENS;
   if (file_cam && (given & (CAM_EYE | CAM_TARGET | CAM_UP | CAM_FOV)))
     die(EXIT_USAGE, "--camera-from-file takes the view from the file: no --eye, --target, --up or --fov with it");
   if (file_cam && camera_file) die(EXIT_USAGE, "--camera-from-file and --camera-file exclude each other");
@@ -1003,6 +1005,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     camera_take(&cam, &from_file, fields & ~given);
     given |= fields;
   }
+  if ((lens & 3) && cam.type != RR_CAMERA_OPENCV && cam.type != RR_CAMERA_OPENCV_FISHEYE)
+    die(EXIT_USAGE, "--intrinsics and --distortion go with --camera opencv or opencv-fisheye");
 
   timings ms = {0};
   rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load);

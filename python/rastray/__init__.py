@@ -89,8 +89,9 @@ class Camera:
         self._cam.eye, self._cam.target, self._cam.up = _vec(eye, "eye"), _vec(target, "target"), _vec(up, "up")
         self._cam.fov_deg = float(fov)
         self._cam.ortho_height = float(ortho_height)
-        self.size = None  # the image size the intrinsics were made for, when known
-        _Device().check(lib.rr_camera_check(ffi.NULL, self._cam))
+        self.size = None  # the default image size of render, when known
+        dev = _Device()
+        dev.check(lib.rr_camera_check(dev.ptr, self._cam))
 
     @classmethod
     def opencv(cls, K, dist=None, R=np.eye(3), t=np.zeros(3), size=None, fisheye=False):
