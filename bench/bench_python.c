@@ -8,7 +8,7 @@
  * array, as Python's) through rr_intersect_stream (what Scene.intersect does).
  * bench/python_overhead.py does the same through the Python package; callgrind's
  * instruction counts at N = 0 and N = 2 give the cost of one call on each side. */
-#include "benchutil.h"
+#include "rastray.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,6 +1,7 @@
 """The Python side of the overhead measure (bench/python_overhead.sh): as bench_python.
 
-usage: PYTHONPATH=python python3 bench/python_overhead.py render|rays N [SIZE]"""
+usage: PYTHONPATH=python python3 bench/python_overhead.py render|rays|rays+normals N [SIZE]
+(rays+normals: Scene.intersect with its normals, which the C stream API does not give)"""
 import sys
 
 import numpy as np
@@ -18,4 +19,4 @@ with rastray.Scene.from_file("demo", threads=1) as scene:
         org, dirs = cam.rays((size, size))
         rays = np.concatenate([org, dirs], axis=-1).reshape(-1, 6)
         for _ in range(n):
-            scene.intersect(rays, threads=1)
+            scene.intersect(rays, threads=1, normals=mode == "rays+normals")

@@ -22,6 +22,8 @@ METHODS = [ffi.string(lib.rr_method_name(m)).decode() for m in range(lib.RR_METH
 CAMERAS = [ffi.string(lib.rr_camera_name(c)).decode() for c in range(lib.RR_CAMERA_COUNT)]
 AOVS = ("depth", "id", "normal", "bary", "evals", "nodes", "mesh", "material", "coverage", "sample-id",
         "sample-depth", "sample-mesh", "uv", "uv-deriv", "albedo", "direct", "reflection", "shadow", "emission")
+_HIT = np.dtype([("prim", "<u4"), ("t", "<f4"), ("l1", "<f4"), ("l2", "<f4"), ("geom", "<u4")])  # rr_hit
+assert _HIT.itemsize == ffi.sizeof("rr_hit")
 _DTYPES = {lib.RR_PIXEL_U8: np.uint8, lib.RR_PIXEL_F32: np.float32, lib.RR_PIXEL_U32: np.uint32}
 
 
@@ -350,27 +352,29 @@ class Scene:
         s.tmin, s.tmax = rng, rng + 1
         return s, (r, base, ranges, rng)
 
-    def intersect(self, rays, threads=0):
+    def intersect(self, rays, threads=0, normals=True):
         """Closest hits of rays (N, 6) float32 (origin, direction) through the ray
         streams, as Open3D's cast_rays: t_hit (+inf on a miss), primitive_ids and
-        geometry_ids (MISS on a miss), primitive_uvs (barycentrics λ1, λ2),
-        primitive_normals (unit geometric normals, 0 on a miss)."""
+        geometry_ids (MISS on a miss), primitive_uvs (barycentrics λ1, λ2) and, with
+        normals, primitive_normals (unit geometric normals, 0 on a miss). The first
+        four are views into the library's array of hits (strided, not copied)."""
         s, keep = self._stream(rays)
         n = s.count
-        hits = np.empty(n, dtype=np.dtype([("prim", "<u4"), ("t", "<f4"), ("l1", "<f4"), ("l2", "<f4"),
-                                            ("geom", "<u4")]))
-        assert ffi.sizeof("rr_hit") == hits.itemsize
+        hits = np.empty(n, dtype=_HIT)
         if n:
             dev = _Device()
             dev.check(lib.rr_intersect_stream(dev.ptr, self._scene(), s, _threads(threads),
-                                                    ffi.from_buffer("rr_hit[]", hits)))
-        prim = np.ascontiguousarray(hits["prim"])
-        normals = np.zeros((n, 3), dtype=np.float32)
-        if n:
-            self._dev.check(lib.rr_scene_get_normals(self._scene(), ffi.from_buffer("uint32_t[]", prim), n,
-                                                     ffi.from_buffer("float[]", normals)))
-        return {"t_hit": hits["t"].copy(), "primitive_ids": prim, "geometry_ids": hits["geom"].copy(),
-                "primitive_uvs": np.stack([hits["l1"], hits["l2"]], axis=1), "primitive_normals": normals}
+                                              ffi.from_buffer("rr_hit[]", hits)))
+        words = hits.view(np.float32).reshape(n, 5)
+        out = {"t_hit": hits["t"], "primitive_ids": hits["prim"], "geometry_ids": hits["geom"],
+               "primitive_uvs": words[:, 2:4]}
+        if normals:
+            prim = np.ascontiguousarray(hits["prim"])
+            out["primitive_normals"] = np.zeros((n, 3), dtype=np.float32)
+            if n:
+                self._dev.check(lib.rr_scene_get_normals(self._scene(), ffi.from_buffer("uint32_t[]", prim), n,
+                                                         ffi.from_buffer("float[]", out["primitive_normals"])))
+        return out
 
     def occluded(self, rays, tmax=None, threads=0):
         """Whether each ray (N, 6) hits anything with 0 <= t <= tmax (scalar or (N,);
