@@ -328,3 +328,41 @@ def test_cli_lens_options():
                                capture_output=True, text=True)
             assert p.returncode == 2 and word in p.stderr and p.stderr.count("\n") == 1, (args, p.stderr)
             assert not os.path.exists(os.path.join(tmp, "x.png"))
+
+
+def test_importers():
+    """COLMAP text models and transforms.json give the cameras they describe (the same
+    rays as Camera.opencv of the equivalent OpenCV parameters)."""
+    R = rastray._rodrigues(np.array([0.1, -0.2, 0.05]))
+    t = np.array([0.3, -0.1, 2.0])
+    K = np.array([[70.0, 0, 31.2], [0, 72.0, 24.1], [0, 0, 1]])
+    dist = [-0.1, 0.02, 0.001, -0.002]
+    ref = rastray.Camera.opencv(K, dist, R, t)
+    # quaternion of R (w, x, y, z)
+    w = np.sqrt(max(0.0, 1 + np.trace(R))) / 2
+    q = [w, (R[2, 1] - R[1, 2]) / (4 * w), (R[0, 2] - R[2, 0]) / (4 * w), (R[1, 0] - R[0, 1]) / (4 * w)]
+    with tempfile.TemporaryDirectory() as tmp:
+        with open(os.path.join(tmp, "cameras.txt"), "w") as f:
+            f.write("# comment\n3 OPENCV 64 48 70 72 31.7 24.6 %r %r %r %r\n" % tuple(dist))
+        with open(os.path.join(tmp, "images.txt"), "w") as f:
+            f.write("# image list\n7 %r %r %r %r %r %r %r 3 view.png\n1.0 2.0 -1\n" % tuple(list(q) + list(t)))
+        (name, cam), = rastray.colmap_cameras(tmp)
+        assert name == "view.png" and cam.size == (64, 48)
+        assert np.allclose(cam.rays()[1], ref.rays((64, 48))[1], atol=1e-5)
+        with open(os.path.join(tmp, "cameras.txt"), "w") as f:
+            f.write("3 THIN_PRISM_FISHEYE 64 48 1 2 3 4 5 6 7 8 9 10 11 12\n")
+        with pytest.raises(ValueError, match="THIN_PRISM_FISHEYE"):
+            rastray.colmap_cameras(tmp)
+        # transforms.json: camera-to-world in OpenGL's axes
+        c2w = np.eye(4)
+        c2w[:3, :3] = R.T @ np.diag([1.0, -1, -1])
+        c2w[:3, 3] = -R.T @ t
+        meta = {"w": 64, "h": 48, "fl_x": 70, "fl_y": 72, "cx": 31.2, "cy": 24.1, "k1": dist[0], "k2": dist[1],
+                "p1": dist[2], "p2": dist[3], "frames": [{"file_path": "./a", "transform_matrix": c2w.tolist()}]}
+        import json
+        with open(os.path.join(tmp, "transforms.json"), "w") as f:
+            json.dump(meta, f)
+        (name, cam), = rastray.nerf_cameras(os.path.join(tmp, "transforms.json"))
+        assert name == "./a"
+        assert np.allclose(cam.rays()[1], ref.rays((64, 48))[1], atol=1e-5)
+        assert np.allclose(cam.eye, -R.T @ t, atol=1e-5)

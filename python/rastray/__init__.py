@@ -386,3 +386,8 @@ class Scene:
             dev.check(lib.rr_occluded_stream(dev.ptr, self._scene(), s, _threads(threads),
                                                    ffi.from_buffer("int[]", occ)))
         return occ.astype(bool)
+
+
+from .importers import colmap_cameras, nerf_cameras  # noqa: E402  (they use Camera)
+
+__all__ += ["colmap_cameras", "nerf_cameras"]
