@@ -21,6 +21,31 @@ static double theta_d(const float *k, double th, double *dth) {
   return th * (1 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3]))));
 }
 
+/* Brown–Conrady's radial map r·q(r²) and its derivative by r. */
+static double radial_r(const float *k, double r, double *dr) {
+  double dq, q = radial(k, r * r, &dq);
+  *dr = q + 2 * r * r * dq;
+  return r * q;
+}
+
+/* The x in [0, hi] where f, increasing there with f(0) = 0, reaches y < f(hi):
+ * Newton's steps inside a shrinking bracket, bisection when a step would leave it
+ * (quadratic convergence near the root, never lost). */
+static double solve_increasing(double (*f)(const float *, double, double *), const float *k, double y, double hi) {
+  double lo = 0, x = y < hi ? y : 0.5 * hi;
+  for (int it = 0; it < 200 && y > 0; it++) {
+    double d, e = f(k, x, &d) - y;
+    if (e == 0) break;
+    if (e < 0) lo = x;
+    else hi = x;
+    double next = d > 0 ? x - e / d : lo;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (next == x || hi - lo <= 1e-16 * hi) break;
+    x = next;
+  }
+  return y > 0 ? x : 0;
+}
+
 /* Brown–Conrady forwards: the distorted point m of the undistorted (a, b), and its Jacobian. */
 static void distort(const float *k, double a, double b, double m[2], double J[2][2]) {
   double r2 = a * a + b * b, dq, q = radial(k, r2, &dq), p1 = k[2], p2 = k[3];
@@ -51,21 +76,16 @@ double rr_lens_fold(const rr_camera *cam) {
   return limit;
 }
 
-/* The undistorted (a, b) of distorted m: the radius first, by bisection on the
- * monotone radial map (robust from any start), then Newton's method on the whole
+/* The undistorted (a, b) of distorted m: the radius first, on the monotone radial
+ * map (solve_increasing: robust from any start), then Newton's method on the whole
  * map with the tangential terms, which converges quadratically from there for the
  * small tangential coefficients of real lenses. Stops when the residual is below
  * 1e-13 (relative); false when it does not get there in 40 steps, leaves [0, fold),
  * or lands where the map is not locally one-to-one. */
 static bool undistort(const float *k, double fold, const double m[2], double p[2], double Jinv[2][2]) {
-  double rd = sqrt(m[0] * m[0] + m[1] * m[1]), lo = 0, hi = fold;
-  if (!(hi * radial(k, hi * hi, NULL) > rd)) return false; /* beyond the fold's image */
-  for (int i = 0; i < 80 && hi - lo > 1e-15 * hi; i++) {
-    double mid = 0.5 * (lo + hi);
-    if (mid * radial(k, mid * mid, NULL) < rd) lo = mid;
-    else hi = mid;
-  }
-  double r = 0.5 * (lo + hi), s = rd > 0 ? r / rd : 1 / radial(k, 0, NULL);
+  double rd = sqrt(m[0] * m[0] + m[1] * m[1]), d;
+  if (!(radial_r(k, fold, &d) > rd)) return false; /* beyond the fold's image */
+  double r = solve_increasing(radial_r, k, rd, fold), s = rd > 0 ? r / rd : 1 / radial(k, 0, NULL);
   p[0] = m[0] * s, p[1] = m[1] * s;
   double tol = 1e-13 * (1 + rd);
   for (int it = 0; it < 40; it++) {
@@ -88,17 +108,11 @@ bool rr_lens_unproject(const rr_camera *cam, double fold, double u, double v, do
   double m[2] = {(u - cam->cx) / cam->fx, (v - cam->cy) / cam->fy};
   double dm[2] = {1.0 / cam->fx, 1.0 / cam->fy}; /* dm0/du, dm1/dv */
   if (cam->type == RR_CAMERA_OPENCV_FISHEYE) {
-    /* θ from θd by bisection then Newton on the monotone [0, fold); the ray is
+    /* θ from θd on the monotone [0, fold) (solve_increasing); the ray is
      * (sin θ·e, cos θ) with e = m/|m| (polar form, as the equidistant fisheye). */
-    double rd = sqrt(m[0] * m[0] + m[1] * m[1]), lo = 0, hi = fold;
-    if (!(theta_d(k, hi, NULL) > rd)) return false;
-    for (int i = 0; i < 80 && hi - lo > 1e-15 * hi; i++) {
-      double mid = 0.5 * (lo + hi);
-      if (theta_d(k, mid, NULL) < rd) lo = mid;
-      else hi = mid;
-    }
-    double th = 0.5 * (lo + hi), dth;
-    for (int it = 0; it < 3; it++) th -= (theta_d(k, th, &dth) - rd) / dth; /* polish */
+    double rd = sqrt(m[0] * m[0] + m[1] * m[1]), dth;
+    if (!(theta_d(k, fold, NULL) > rd)) return false;
+    double th = solve_increasing(theta_d, k, rd, fold);
     theta_d(k, th, &dth);
     if (!(th >= 0 && th < fold && dth > 0)) return false;
     double e[2] = {rd > 0 ? m[0] / rd : 1, rd > 0 ? m[1] / rd : 0}, st = sin(th), ct = cos(th);
