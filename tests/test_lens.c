@@ -3,7 +3,8 @@
  * and fisheye distortions, pixels beyond the fold having no ray; the ray
  * derivatives match central differences; the defaults (fx = fy = 0) give the
  * perspective camera's rays; rr_camera_set_extrinsics recovers OpenCV's pose;
- * bad intrinsics and poses are refused. */
+ * every 3D method renders strongly distorted views (folding inside the image) bit
+ * for bit as rc does; bad intrinsics and poses are refused. */
 #include "camera/camera.h"
 #include "camera/lens.h"
 #include "testutil.h"
@@ -50,6 +51,31 @@ static int round_trip(const rr_camera *c, int W, int H, const char *what) {
   return rays;
 }
 
+/* Every 3D method against rc on a lens that folds inside the image: the measured
+ * Lipschitz bound must keep the cones of curved binning and culling conservative. */
+static void methods_agree(rr_device *dev, const rr_camera *cam, const char *what) {
+  static const rr_method methods[] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
+                                      RR_METHOD_3DR_FC, RR_METHOD_3DR_FS,    RR_METHOD_3DR_FULL};
+  rr_scene *s;
+  if (rr_scene_load(dev, "sphere:24", &s) != RR_OK) {
+    CHECK(0, "load: %s", rr_device_message(dev));
+    return;
+  }
+  const int W = 80, H = 60;
+  rr_frame *ref = test_render(dev, s, cam, RR_METHOD_RC, 1, W, H, 0);
+  CHECK(ref && test_frame_hits(ref) > W * H / 8, "%s: the sphere is seen", what);
+  for (size_t m = 0; ref && m < sizeof methods / sizeof *methods; m++)
+    for (int threads = 1; threads <= 2; threads++) {
+      rr_frame *f = test_render(dev, s, cam, methods[m], threads, W, H, 0);
+      int diff = f ? test_frames_differ(ref, f) : -1;
+      CHECK(diff == 0, "%s: %s on %d threads differs from rc at %d samples", what, rr_method_name(methods[m]),
+            threads, diff);
+      rr_frame_release(f);
+    }
+  rr_frame_release(ref);
+  rr_scene_release(s);
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
   const int W = 320, H = 240, all = ((W + 2) / 3) * ((H + 2) / 3);
@@ -70,6 +96,15 @@ int main(void) {
   c = lens_camera(RR_CAMERA_OPENCV_FISHEYE, 120, 120, 160, 120, fish_strong, 4);
   n = round_trip(&c, W, H, "fisheye strong");
   CHECK(n > all / 4 && n < all, "a fisheye folding inside the image (%d of %d)", n, all);
+
+  /* Views of a sphere through the lenses that fold inside the image (the pose looks at it). */
+  float pose_R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, pose_t[3] = {0, 0, 2.2f};
+  c = lens_camera(RR_CAMERA_OPENCV, 60, 60, 39.5f, 29.5f, strong, 5);
+  rr_camera_set_extrinsics(dev, &c, pose_R, pose_t);
+  methods_agree(dev, &c, "brown-conrady strong");
+  c = lens_camera(RR_CAMERA_OPENCV_FISHEYE, 45, 45, 39.5f, 29.5f, fish_strong, 4);
+  rr_camera_set_extrinsics(dev, &c, pose_R, pose_t);
+  methods_agree(dev, &c, "fisheye strong");
 
   /* No distortion and the perspective intrinsics: the perspective camera's rays. */
   rr_camera persp, cv;
