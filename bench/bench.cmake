@@ -14,6 +14,12 @@ else()
 endif()
 
 file(GLOB RR_BENCH_PROGRAMS CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/bench/bench_*.c)
+# bench_python: the public API alone, on the very library the Python package loads
+# (bench/python_overhead.sh compares the two).
+list(REMOVE_ITEM RR_BENCH_PROGRAMS ${PROJECT_SOURCE_DIR}/bench/bench_python.c)
+add_executable(bench_python ${PROJECT_SOURCE_DIR}/bench/bench_python.c)
+target_link_libraries(bench_python PRIVATE rastray_shared m)
+rr_target_flags(bench_python)
 foreach(src ${RR_BENCH_PROGRAMS})
   get_filename_component(name ${src} NAME_WE)
   add_executable(${name} ${src} ${PROJECT_SOURCE_DIR}/bench/benchutil.c)

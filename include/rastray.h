@@ -200,6 +200,9 @@ typedef struct rr_geometry_info {
 RR_API rr_error rr_scene_get_geometry(const rr_scene *scene, uint32_t prim, uint32_t *geom, uint32_t *local);
 /* Fills what is known about geometry `geom` (0 .. rr_scene_info.geometries - 1). */
 RR_API rr_error rr_scene_get_geometry_info(const rr_scene *scene, uint32_t geom, rr_geometry_info *info);
+/* The unit geometric normals (p1 - p0) × (p2 - p0) of n triangles by id, 3 floats each
+ * into normals; zero for RR_MISS and ids of skipped triangles. */
+RR_API rr_error rr_scene_get_normals(const rr_scene *scene, const uint32_t *prims, size_t n, float *normals);
 
 /* ---- ray queries --------------------------------------------------------- */
 
@@ -268,6 +271,8 @@ typedef enum rr_camera_type {
   RR_CAMERA_LATLONG,         /* 360°×180° panorama: φ = 2π(x+0.5)/W - π, θ = π(y+0.5)/H */
   RR_CAMERA_FISHEYE,         /* equidistant: r = √(u²+v²) <= 1, angle from fwd = r·fov_deg/2 (fov up to 360) */
   RR_CAMERA_CUBE,            /* six 90° faces in a horizontal cross (image 4F × 3F) */
+  RR_CAMERA_OPENCV,          /* OpenCV's pinhole with Brown–Conrady distortion (cv::projectPoints), below */
+  RR_CAMERA_OPENCV_FISHEYE,  /* OpenCV's fisheye, Kannala–Brandt (cv::fisheye::projectPoints), below */
   RR_CAMERA_COUNT
 } rr_camera_type;
 
@@ -280,6 +285,20 @@ typedef struct rr_camera {
   float eye[3], target[3], up[3];
   float fov_deg;      /* vertical field of view (perspective), full angle (fisheye); at least RR_FOV_MIN */
   float ortho_height; /* orthographic view height; 0: 2·|target - eye|·tan(fov/2) */
+  /* The OpenCV cameras: intrinsics in pixels of the rendered image, OpenCV's convention
+   * (pixel (x, y)'s centre at (x, y), so rastray's sample (sx, sy) is OpenCV's point
+   * (sx - 0.5, sy - 0.5)); the pose is eye, target and up (rr_camera_set_extrinsics
+   * sets them from R, t). A point at (a, b, 1) in camera axes (x right = fwd × up,
+   * y down, z forward) appears at fx·a' + cx, fy·b' + cy with (a', b') its distorted
+   * image: opencv: r² = a² + b², a' = a·q + 2p1·ab + p2(r² + 2a²), b' = b·q + p1(r² + 2b²)
+   * + 2p2·ab, q = (1 + k1r² + k2r⁴ + k3r⁶) / (1 + k4r² + k5r⁴ + k6r⁶); fisheye: θ = atan r,
+   * θd = θ(1 + k1θ² + k2θ⁴ + k3θ⁶ + k4θ⁸), (a', b') = (θd / r)(a, b). A pixel's ray
+   * inverts this (Newton's method in double); a pixel outside the image of the map's
+   * one-to-one part (beyond the radius where the radial map folds back, fisheye
+   * θ >= 180°) has no ray. Rays are unit: the depth AOV is the eye distance. fx = fy = 0
+   * (rr_camera_init's): the perspective camera's intrinsics for fov_deg and the image size. */
+  float fx, fy, cx, cy;
+  float dist[8]; /* opencv: k1 k2 p1 p2 k3 k4 k5 k6 (OpenCV's order); fisheye: k1 k2 k3 k4; zeros: none */
 } rr_camera;
 
 /* The camera type named `name` ("perspective", "orthographic", "parabolic", "latlong",
@@ -297,6 +316,14 @@ RR_API rr_error rr_camera_frame(rr_device *dev, const rr_scene *scene, int width
                                 rr_camera *cam);
 /* Checks a camera (finite values, eye != target, up not parallel to the view). */
 RR_API rr_error rr_camera_check(rr_device *dev, const rr_camera *cam);
+/* Sets eye, target and up from OpenCV extrinsics, world to camera: x_cam = R·x_world + t
+ * (R row-major, a rotation within 1e-3; camera axes x right, y down, z forward). */
+RR_API rr_error rr_camera_set_extrinsics(rr_device *dev, rr_camera *cam, const float R[9], const float t[3]);
+/* The rays of a camera for a width × height image, one per pixel centre, row 0 at the
+ * top: origins org[3·i] and unit directions dir[3·i] of pixel i = y·width + x (either
+ * may be NULL); a pixel without a ray gets a zero direction. Orthographic rays are
+ * along the view; every other camera's leave the eye. */
+RR_API rr_error rr_camera_rays(rr_device *dev, const rr_camera *cam, int width, int height, float *org, float *dir);
 
 /* ---- materials, cameras and lights of a file ------------------------------- */
 
@@ -829,7 +856,8 @@ enum {
   RR_CAMERA_FIELD_TARGET = 1u << 2,
   RR_CAMERA_FIELD_UP = 1u << 3,
   RR_CAMERA_FIELD_FOV = 1u << 4,
-  RR_CAMERA_FIELD_ORTHO = 1u << 5
+  RR_CAMERA_FIELD_ORTHO = 1u << 5,
+  RR_CAMERA_FIELD_LENS = 1u << 6 /* intrinsics and distortion (opencv cameras) */
 };
 
 /* What a scene file says about rendering it. Fields the file does not give keep

@@ -4,7 +4,7 @@
 set -eu
 pkgs="cmake make gcc g++ pkg-config libassimp-dev libstb-dev libtinyexr-dev libpng-dev
       libembree-dev libosmesa6-dev hyperfine valgrind gcc-aarch64-linux-gnu
-      libcjson-dev python3-numpy groff-base clang libclang-rt-14-dev"
+      libcjson-dev python3-numpy python3-cffi python3-opencv python3-pytest groff-base clang libclang-rt-14-dev"
 missing=""
 for p in $pkgs; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -7,7 +7,7 @@ The first ```sh block must be the two commands of a fresh machine (install and
 build, run the tests); they exist and are executable but are not run here (the
 second is what runs this test). Every later ```sh block runs with bash in a new
 directory that looks like a clone after the first command (`build`, `data`,
-`scripts`, `docs` link to the real ones), and must exit 0 and leave every file it names
+`scripts`, `docs`, `python` link to the real ones), and must exit 0 and leave every file it names
 after -o, --aov NAME=, --save-camera or --stats-json. With RR_TEST_QUICK set,
 image sizes are divided by 4 (the sanitizer builds run them too)."""
 import os
@@ -78,7 +78,8 @@ def main():
         script = "\n".join(quick(c) if os.environ.get("RR_TEST_QUICK") else c for c in cmds)
         with tempfile.TemporaryDirectory() as clone:
             for name, target in (("build", build), ("data", os.path.join(source, "data")),
-                                 ("scripts", os.path.join(source, "scripts")), ("docs", os.path.join(source, "docs"))):
+                                 ("scripts", os.path.join(source, "scripts")), ("docs", os.path.join(source, "docs")),
+                                 ("python", os.path.join(source, "python"))):
                 os.symlink(os.path.abspath(target), os.path.join(clone, name))
             # python3 is Debian's, as on a fresh machine (a python of one's own may
             # come first in PATH and lack NumPy)

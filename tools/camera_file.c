@@ -3,7 +3,8 @@
  *   {"type": "perspective", "eye": [x, y, z], "target": [x, y, z], "up": [x, y, z],
  *    "fov": 45, "ortho_height": 0, "width": 1024, "height": 768}
  * (width and height record the image the camera was made for; reading ignores
- * them) or a camera-to-world matrix in the OpenGL convention, four rows of four
+ * them; the OpenCV cameras add "intrinsics": [fx, fy, cx, cy] and "distortion":
+ * [up to 8 coefficients]) or a camera-to-world matrix in the OpenGL convention, four rows of four
  * numbers: columns right (+X), up (+Y) and back (+Z; the camera looks down -Z),
  * then the position, bottom row 0 0 0 1:
  *   {"matrix": [[1,0,0,0], [0,1,0,0], [0,0,1,5], [0,0,0,1]], "fov": 40}
@@ -25,6 +26,11 @@ void camera_file_add(rr_device *dev, rr_output *set, const char *path, const rr_
   cJSON_AddItemToObject(root, "eye", cJSON_CreateFloatArray(cam->eye, 3));
   cJSON_AddItemToObject(root, "target", cJSON_CreateFloatArray(cam->target, 3));
   cJSON_AddItemToObject(root, "up", cJSON_CreateFloatArray(cam->up, 3));
+  if (cam->type == RR_CAMERA_OPENCV || cam->type == RR_CAMERA_OPENCV_FISHEYE) {
+    const float k[4] = {cam->fx, cam->fy, cam->cx, cam->cy};
+    cJSON_AddItemToObject(root, "intrinsics", cJSON_CreateFloatArray(k, 4));
+    cJSON_AddItemToObject(root, "distortion", cJSON_CreateFloatArray(cam->dist, 8));
+  }
   cJSON_AddNumberToObject(root, "fov", cam->fov_deg);
   cJSON_AddNumberToObject(root, "ortho_height", cam->ortho_height);
   cJSON_AddNumberToObject(root, "width", width);

@@ -26,7 +26,8 @@ void json_add(rr_device *dev, rr_output *set, struct cJSON *root, const char *pa
 /* The fields of an rr_camera that a flag or a camera file gives (rastray.h's RR_CAMERA_FIELD_*). */
 enum {
   CAM_TYPE = RR_CAMERA_FIELD_TYPE, CAM_EYE = RR_CAMERA_FIELD_EYE, CAM_TARGET = RR_CAMERA_FIELD_TARGET,
-  CAM_UP = RR_CAMERA_FIELD_UP, CAM_FOV = RR_CAMERA_FIELD_FOV, CAM_ORTHO = RR_CAMERA_FIELD_ORTHO
+  CAM_UP = RR_CAMERA_FIELD_UP, CAM_FOV = RR_CAMERA_FIELD_FOV, CAM_ORTHO = RR_CAMERA_FIELD_ORTHO,
+  CAM_LENS = RR_CAMERA_FIELD_LENS
 };
 /* Reads a camera file (rr_camera_load) into *cam and returns the fields it gave;
  * the others keep their values. A bad file ends the program (exit 1). */

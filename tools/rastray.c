@@ -7,6 +7,7 @@
 #include "progress.h"
 
 #include <cjson/cJSON.h>
+#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <pthread.h>
@@ -131,6 +132,7 @@ enum { /* keys of the options without a short form (above every char) */
   OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA, OPT_AA_PATTERN, OPT_AA_FILTER,
   OPT_ALPHA, OPT_TEXTURE_FILTER, OPT_LOD_BIAS, OPT_LIGHT, OPT_SHADOWS, OPT_MAX_DEPTH,
   OPT_IMPORT_TIMEOUT, OPT_MAX_MEMORY,
+  OPT_INTRINSICS, OPT_DISTORTION, OPT_EXTRINSICS,
 };
 
 typedef struct cli_option {
@@ -182,7 +184,16 @@ static const cli_option render_options[] = {
      "override a 3dr method's traversal: frustum=N leaves=0|1 outside=0|1\n"
      "occluded=0|1 split=N split-ratio=F binning=0|1 early-z=0|1 bin=N bin-min=N"},
     {"size", OPT_SIZE, "WxH", "image size (default 1024x768, at most " VALUE(RR_MAX_SIZE) " a side)"},
-    {"camera", OPT_CAMERA, "NAME", "perspective (default), orthographic, parabolic, latlong, fisheye, cube"},
+    {"camera", OPT_CAMERA, "NAME",
+     "perspective (default), orthographic, parabolic, latlong, fisheye, cube,\n"
+     "opencv, opencv-fisheye (OpenCV's models: --intrinsics, --distortion)"},
+    {"intrinsics", OPT_INTRINSICS, "FX,FY,CX,CY",
+     "OpenCV intrinsics in pixels (pixel centres at integers); alone: --camera opencv"},
+    {"distortion", OPT_DISTORTION, "K1,K2,...",
+     "OpenCV distortion: k1,k2,p1,p2[,k3[,k4,k5,k6]] (opencv) or k1,k2,k3,k4\n(opencv-fisheye)"},
+    {"extrinsics", OPT_EXTRINSICS, "R,T|FILE",
+     "world-to-camera pose x_cam = R·x + t (x right, y down, z forward): 12\n"
+     "numbers R11,R12,...,R33,T1,T2,T3, or a file holding them (in place of\n--eye/--target/--up)"},
     {"ortho-height", OPT_ORTHO_HEIGHT, "H", "orthographic view height (default 2·|target-eye|·tan(fov/2))"},
     {"cube-faces", OPT_CUBE_FACES, "DIR", "cube camera: also write the six faces as DIR/front.png, right, back, ..."},
     {"eye", OPT_EYE, "X,Y,Z", "camera position; without --eye/--target the scene is framed automatically"},
@@ -434,6 +445,43 @@ static void check_frame_budget(const rr_render_options *opt) {
     die(EXIT_USAGE, "a %dx%d image with %d sample%s per pixel needs about %.1f GiB, more than half the physical "
         "memory (%.1f GiB; lower --size or the --aa samples)", opt->width, opt->height, opt->samples,
         opt->samples == 1 ? "" : "s", bytes / 1073741824.0, half / 1073741824.0);
+}
+
+/* Up to max comma-separated finite numbers (whitespace too, for files); their count. */
+static int parse_floats(const char *flag, const char *s, float *out, int max) {
+  int n = 0;
+  const char *p = s;
+  for (;;) {
+    while (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r') p++;
+    if (!*p) break;
+    char *end;
+    double v = strtod(p, &end);
+    if (end == p || !isfinite(v) || fabs(v) > 1e30 || n == max)
+      die(EXIT_USAGE, "bad value '%s' for %s (expected at most %d finite numbers separated by commas)", s, flag, max);
+    out[n++] = (float)v;
+    p = end;
+    while (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r') p++;
+    if (*p == ',') p++;
+  }
+  return n;
+}
+
+/* --extrinsics: 12 numbers, given or in a file. */
+static void parse_extrinsics(rr_device *dev, const char *s, rr_camera *cam) {
+  float v[12];
+  char text[4096];
+  const char *src = s;
+  if (strchr(s, ',') == NULL) { /* a file */
+    FILE *f = fopen(s, "rb");
+    if (!f) die(EXIT_INPUT, "cannot open extrinsics file '%s': %s", s, strerror(errno));
+    size_t len = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[len] = 0;
+    src = text;
+  }
+  if (parse_floats("--extrinsics", src, v, 12) != 12)
+    die(EXIT_USAGE, "bad value '%s' for --extrinsics (expected 12 numbers: R row by row, then t)", s);
+  if (rr_camera_set_extrinsics(dev, cam, v, v + 9) != RR_OK) die(EXIT_USAGE, "--extrinsics: %s", rr_device_message(dev));
 }
 
 static void parse_size(const char *s, int *w, int *h) {
@@ -855,6 +903,10 @@ static void camera_take(rr_camera *dst, const rr_camera *src, unsigned fields) {
   if (fields & CAM_UP) memcpy(dst->up, src->up, sizeof dst->up);
   if (fields & CAM_FOV) dst->fov_deg = src->fov_deg;
   if (fields & CAM_ORTHO) dst->ortho_height = src->ortho_height;
+  if (fields & CAM_LENS) {
+    dst->fx = src->fx, dst->fy = src->fy, dst->cx = src->cx, dst->cy = src->cy;
+    memcpy(dst->dist, src->dist, sizeof dst->dist);
+  }
 }
 
 /* --stats-json: the statistics as one JSON object. */
@@ -925,6 +977,7 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   const char *scene_name = NULL, *out = NULL, *json = NULL, *cube_dir = NULL, *camera_file = NULL, *save_camera = NULL;
   const char *file_cam = NULL; /* --camera-from-file */
   unsigned given = 0;           /* the camera's fields set by flags */
+  unsigned lens = 0;            /* --intrinsics (1), --distortion (2), --extrinsics (4) given */
   bool stats = false;
   int shade = RR_SHADE_LIT, repeat = 1, naov = 0, nlights = 0;
   rr_light_info lights[32];
@@ -949,7 +1002,9 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_CAMERA: {
       int type = rr_camera_from_name(optarg);
       if (type < 0)
-        die(EXIT_USAGE, "unknown camera '%s' (expected perspective, orthographic, parabolic, latlong, fisheye or cube)",
+        die(EXIT_USAGE,
+            "unknown camera '%s' (expected perspective, orthographic, parabolic, latlong, fisheye, cube, opencv or "
+            "opencv-fisheye)",
             optarg);
       cam.type = (rr_camera_type)type, given |= CAM_TYPE;
       break;
@@ -963,6 +1018,20 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_TARGET: parse_vec(option_name, optarg, cam.target), given |= CAM_TARGET; break;
     case OPT_UP: parse_vec(option_name, optarg, cam.up), given |= CAM_UP; break;
     case OPT_CAMERA_FROM_FILE: file_cam = optarg; break;
+    case OPT_INTRINSICS: {
+      float k[4];
+      if (parse_floats(option_name, optarg, k, 4) != 4)
+        die(EXIT_USAGE, "bad value '%s' for --intrinsics (expected FX,FY,CX,CY)", optarg);
+      cam.fx = k[0], cam.fy = k[1], cam.cx = k[2], cam.cy = k[3], lens |= 1;
+      break;
+    }
+    case OPT_DISTORTION:
+      memset(cam.dist, 0, sizeof cam.dist);
+      if (parse_floats(option_name, optarg, cam.dist, 8) < 1)
+        die(EXIT_USAGE, "bad value '%s' for --distortion (expected k1,k2,p1,p2[,k3[,k4,k5,k6]])", optarg);
+      lens |= 2;
+      break;
+    case OPT_EXTRINSICS: parse_extrinsics(dev, optarg, &cam), given |= CAM_EYE | CAM_TARGET | CAM_UP, lens |= 4; break;
     case OPT_FOV:
       cam.fov_deg = parse_float(option_name, optarg), given |= CAM_FOV;
       if (!(cam.fov_deg >= RR_FOV_MIN && cam.fov_deg <= 360))
@@ -1015,6 +1084,9 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   if (optind < argc) scene_name = argv[optind];
   if (argc - optind > 1) die(EXIT_USAGE, "more than one scene given ('%s' and '%s')", scene_name, argv[optind + 1]);
   if (!(given & CAM_EYE) != !(given & CAM_TARGET)) die(EXIT_USAGE, "--eye and --target go together");
+  if ((lens & 1) && !(given & CAM_TYPE)) cam.type = RR_CAMERA_OPENCV, given |= CAM_TYPE;
+  if ((lens & 4) && (file_cam || camera_file)) die(EXIT_USAGE, "--extrinsics gives the pose: no camera file with it");
+  if (lens) given |= CAM_LENS;
   if (file_cam && (given & (CAM_EYE | CAM_TARGET | CAM_UP | CAM_FOV)))
     die(EXIT_USAGE, "--camera-from-file takes the view from the file: no --eye, --target, --up or --fov with it");
   if (file_cam && camera_file) die(EXIT_USAGE, "--camera-from-file and --camera-file exclude each other");
@@ -1050,6 +1122,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     camera_take(&cam, &file.camera, file.camera_given & ~given);
     given |= file.camera_given;
   }
+  if ((lens & 3) && cam.type != RR_CAMERA_OPENCV && cam.type != RR_CAMERA_OPENCV_FISHEYE)
+    die(EXIT_USAGE, "--intrinsics and --distortion go with --camera opencv or opencv-fisheye");
 
   for (int k = 0; k < nlights; k++)
     if (rr_scene_add_light(scene, &lights[k]) != RR_OK) die(EXIT_USAGE, "--light: %s", rr_device_message(dev));

@@ -1,5 +1,6 @@
 /* Cameras: the ray direction of every sample, and bounds for rasterization. */
 #include "camera/camera.h"
+#include "camera/lens.h"
 
 #include <float.h>
 #include <math.h>
@@ -16,7 +17,8 @@ void rr_camera_init(rr_camera *cam) {
 }
 
 static const char *const camera_names[RR_CAMERA_COUNT] = {"perspective", "orthographic", "parabolic",
-                                                          "latlong",     "fisheye",      "cube"};
+                                                          "latlong",     "fisheye",      "cube",
+                                                          "opencv",      "opencv-fisheye"};
 
 int rr_camera_from_name(const char *name) {
   for (int i = 0; name && i < RR_CAMERA_COUNT; i++)
@@ -36,10 +38,22 @@ rr_error rr_camera_check(rr_device *dev, const rr_camera *c) {
     return rr_fail(dev, RR_ERROR_ARGUMENT, "camera vectors must be finite");
   float fov_max = c->type == RR_CAMERA_FISHEYE ? 360 : 180;
   bool fov_used = c->type == RR_CAMERA_PERSPECTIVE || c->type == RR_CAMERA_FISHEYE ||
+                  ((c->type == RR_CAMERA_OPENCV || c->type == RR_CAMERA_OPENCV_FISHEYE) && c->fx == 0 && c->fy == 0) ||
                   (c->type == RR_CAMERA_ORTHOGRAPHIC && c->ortho_height == 0);
   if (fov_used && !(c->fov_deg >= RR_FOV_MIN && (c->fov_deg < fov_max || (fov_max == 360 && c->fov_deg == 360))))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad field of view %g (expected %g <= fov < %g degrees)", c->fov_deg,
                    (double)RR_FOV_MIN, fov_max);
+  if (c->type == RR_CAMERA_OPENCV || c->type == RR_CAMERA_OPENCV_FISHEYE) {
+    bool from_fov = c->fx == 0 && c->fy == 0;
+    if (!from_fov && (!(c->fx > 0 && c->fy > 0 && c->fx < FLT_MAX && c->fy < FLT_MAX) || !isfinite(c->cx) ||
+                      !isfinite(c->cy)))
+      return rr_fail(dev, RR_ERROR_ARGUMENT, "bad intrinsics fx=%g fy=%g cx=%g cy=%g (focal lengths > 0, all finite)",
+                     c->fx, c->fy, c->cx, c->cy);
+    for (int i = 0; i < 8; i++)
+      if (!isfinite(c->dist[i]) || (c->type == RR_CAMERA_OPENCV_FISHEYE && i >= 4 && c->dist[i] != 0))
+        return rr_fail(dev, RR_ERROR_ARGUMENT, "bad distortion coefficient %d: %g (%s)", i + 1, c->dist[i],
+                       i >= 4 && c->type == RR_CAMERA_OPENCV_FISHEYE ? "the fisheye model has 4" : "not finite");
+  }
   if (!(c->ortho_height >= 0) || !isfinite(c->ortho_height))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad orthographic height %g (expected > 0)", c->ortho_height);
   /* in double: the lengths of float vectors neither overflow nor underflow there */
@@ -119,9 +133,42 @@ static vec3 curved_dir(const camera *c, int x, int y, vec3 *dd) {
     if (dd) dd[0] = v3_scale(fr, 2.0f / (float)F), dd[1] = v3_scale(fu, -2.0f / (float)F); /* within the face */
     return v3_add(ff, v3_add(v3_scale(fr, a), v3_scale(fu, b)));
   }
+  case RR_CAMERA_OPENCV:
+  case RR_CAMERA_OPENCV_FISHEYE: {
+    /* OpenCV's image point of the sample: pixel centres at integers */
+    double d[3], dd2[2][3];
+    if (!rr_lens_unproject(&c->lens, c->lens_fold, sx - 0.5, sy - 0.5, d, dd ? dd2 : NULL)) return v3(0, 0, 0);
+    vec3 down = v3_neg(up); /* camera axes: x right, y down, z forward */
+    for (int j = 0; dd && j < 2; j++)
+      dd[j] = v3_add(v3_add(v3_scale(r, (float)dd2[j][0]), v3_scale(down, (float)dd2[j][1])),
+                     v3_scale(f, (float)dd2[j][2]));
+    return v3_add(v3_add(v3_scale(r, (float)d[0]), v3_scale(down, (float)d[1])), v3_scale(f, (float)d[2]));
+  }
   default:
     return v3(0, 0, 0);
   }
+}
+
+/* The largest angle between the rays of two samples one pixel apart (in x or y) of
+ * a curved camera, over the whole image: along a staircase path of such steps the
+ * angle between any two samples is at most that times their L1 distance, so √2
+ * times it bounds the angle per pixel of Euclidean distance. For the maps without a
+ * closed-form bound (the OpenCV lenses). */
+static float measured_lipschitz(const camera *c) {
+  float worst = 0; /* the longest chord between unit rays */
+  for (int y = 0; y < c->height; y++)
+    for (int x = 0; x < c->width; x++) {
+      vec3 d = c->dirs[(size_t)y * c->width + x];
+      if (d.x == 0 && d.y == 0 && d.z == 0) continue;
+      for (int k = 0; k < 2; k++) {
+        int nx = x + (k == 0), ny = y + (k == 1);
+        if (nx >= c->width || ny >= c->height) continue;
+        vec3 e = c->dirs[(size_t)ny * c->width + nx];
+        if (e.x == 0 && e.y == 0 && e.z == 0) continue;
+        worst = fmaxf(worst, v3_len(v3_sub(d, e)));
+      }
+    }
+  return 2.0f * asinf(fminf(1.0f, 0.5f * worst)) * sqrtf(2.0f);
 }
 
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
@@ -183,6 +230,13 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
   c->dirs = malloc((size_t)width * height * sizeof *c->dirs);
   if (!c->dirs) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
   c->face = height / 3;
+  if (in->type == RR_CAMERA_OPENCV || in->type == RR_CAMERA_OPENCV_FISHEYE) {
+    c->lens = *in, c->lens_fold = rr_lens_fold(in);
+    if (in->fx == 0 && in->fy == 0) { /* the perspective camera's intrinsics */
+      c->lens.fx = c->lens.fy = 0.5f * (float)height / c->tan_half_h;
+      c->lens.cx = 0.5f * (float)width - 0.5f, c->lens.cy = 0.5f * (float)height - 0.5f;
+    }
+  }
   for (int y = 0; y < height; y++)
     for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);
   switch (in->type) {
@@ -194,6 +248,10 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     break;
   case RR_CAMERA_FISHEYE: /* angle = r·fov/2; the tangential rate sin(a)/r is smaller */
     c->lipschitz = in->fov_deg * (float)RR_PI / 360.0f * 2.0f / (float)(width < height ? width : height);
+    break;
+  case RR_CAMERA_OPENCV:
+  case RR_CAMERA_OPENCV_FISHEYE:
+    c->lipschitz = measured_lipschitz(c);
     break;
   default: /* cube: a 90° face, atan' <= 1 on its [-1, 1] image plane */
     c->lipschitz = 2.0f / (float)c->face;
@@ -390,4 +448,46 @@ void rr_cam_for_ray(const float org[3], const float dir[3], camera *out) {
   out->dx = u;
   out->dy = v3_cross(d, u);
   out->fwd = d;
+}
+
+rr_error rr_camera_set_extrinsics(rr_device *dev, rr_camera *cam, const float R[9], const float t[3]) {
+  if (!cam || !R || !t) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_camera_set_extrinsics: NULL argument");
+  double err = 0, det = 0;
+  for (int i = 0; i < 12; i++)
+    if (!isfinite(i < 9 ? R[i] : t[i - 9])) return rr_fail(dev, RR_ERROR_ARGUMENT, "extrinsics must be finite");
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) { /* R·Rᵀ = I */
+      double dot = 0;
+      for (int k = 0; k < 3; k++) dot += (double)R[3 * i + k] * R[3 * j + k];
+      err = fmax(err, fabs(dot - (i == j)));
+    }
+  for (int i = 0; i < 3; i++)
+    det += R[i] * ((double)R[3 + (i + 1) % 3] * R[6 + (i + 2) % 3] - (double)R[3 + (i + 2) % 3] * R[6 + (i + 1) % 3]);
+  if (!(err <= 1e-3) || !(det > 0))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "R is not a rotation (|R·Rt - I| = %g, det %g)", err, det);
+  /* eye = -Rᵀt; the camera's z row is forward, its y row down */
+  for (int i = 0; i < 3; i++) {
+    double e = 0;
+    for (int k = 0; k < 3; k++) e -= (double)R[3 * k + i] * t[k];
+    cam->eye[i] = (float)e;
+    cam->target[i] = (float)(e + R[6 + i]);
+    cam->up[i] = -R[3 + i];
+  }
+  return rr_ok(dev);
+}
+
+rr_error rr_camera_rays(rr_device *dev, const rr_camera *cam, int width, int height, float *org, float *dir) {
+  camera c;
+  rr_error e = rr_cam_setup(dev, cam, width, height, &c);
+  if (e) return e;
+  for (int y = 0; y < height; y++)
+    for (int x = 0; x < width; x++) {
+      vec3 o, d;
+      size_t i = (size_t)y * width + x;
+      if (!rr_cam_ray(&c, x, y, &o, &d)) d = v3(0, 0, 0);
+      if (org) v3_store(org + 3 * i, o);
+      if (dir) v3_store(dir + 3 * i, v3_norm(d));
+    }
+  rr_cam_release(&c);
+  return rr_ok(dev);
 }

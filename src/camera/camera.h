@@ -11,7 +11,7 @@
  * cameras, one layer of the visibility buffer each. Planar cameras (perspective, orthographic)
  * have edge functions linear in (sx, sy): a perspective ray leaves the eye along
  * d0 + sx·dx + sy·dy; an orthographic ray leaves eye + o0 + sx·ox + sy·oy along fwd.
- * Curved cameras (parabolic, lat-long, fisheye, cube) keep one direction per
+ * Curved cameras (parabolic, lat-long, fisheye, cube, the OpenCV lenses) keep one direction per
  * sample in `dirs` (zero where the image has no ray), and bound the directions of
  * a rectangle of samples by a cone whose half-angle grows by `lipschitz` radians
  * per pixel of distance. */
@@ -33,6 +33,8 @@ typedef struct camera {
   int face;          /* cube: side of a face in pixels */
   int cells_x, cells_y; /* curved: cones of CAMERA_CELL² cells of samples, 4 floats each: */
   float *cells;         /* unit axis and half-angle; no bound when >= CAMERA_NO_CONE, no rays when < 0 */
+  rr_camera lens;       /* the OpenCV cameras: intrinsics and distortion as given */
+  double lens_fold;     /* and the edge of their field (rr_lens_fold) */
 } camera;
 
 #define CAMERA_CELL 32

@@ -52,13 +52,14 @@ static rr_error camera_matrix(json_reader *r, const cJSON *obj, rr_camera *cam) 
 /* A camera object into *cam; *fields gets what it gave. need_view: eye and target
  * (or a matrix) must be there (camera files); else they may both be absent. */
 static rr_error read_camera(json_reader *r, const cJSON *obj, rr_camera *cam, unsigned *fields, bool need_view) {
-  static const char *const keys[] = {"type", "eye", "target", "up", "fov", "ortho_height", "matrix", "width", "height", NULL};
+  static const char *const keys[] = {"type", "eye", "target", "up", "fov", "ortho_height", "matrix", "width", "height",
+                                     "intrinsics", "distortion", NULL};
   rr_error e = rr_json_keys(r, obj, keys);
   if (e) return e;
   rr_camera c = *cam;
   unsigned given = 0;
   int type = c.type;
-  e = rr_json_named(r, obj, "type", rr_camera_from_name, "perspective, orthographic, parabolic, latlong, fisheye or cube",
+  e = rr_json_named(r, obj, "type", rr_camera_from_name, "perspective, orthographic, parabolic, latlong, fisheye, cube, opencv or opencv-fisheye",
                  &type);
   if (e) return e;
   c.type = (rr_camera_type)type;
@@ -81,6 +82,19 @@ static rr_error read_camera(json_reader *r, const cJSON *obj, rr_camera *cam, un
   if ((e = rr_json_float(r, obj, "fov", RR_FOV_MIN, 360, &c.fov_deg))) return e;
   if ((e = rr_json_float(r, obj, "ortho_height", 0, MAX_COORD, &c.ortho_height))) return e;
   given |= (rr_json_get(obj, "fov") ? RR_CAMERA_FIELD_FOV : 0) | (rr_json_get(obj, "ortho_height") ? RR_CAMERA_FIELD_ORTHO : 0);
+  float k[4];
+  if (rr_json_get(obj, "intrinsics")) {
+    if ((e = rr_json_floats(r, obj, "intrinsics", 4, -MAX_COORD, MAX_COORD, k))) return e;
+    c.fx = k[0], c.fy = k[1], c.cx = k[2], c.cy = k[3], given |= RR_CAMERA_FIELD_LENS;
+  }
+  const cJSON *dist = rr_json_get(obj, "distortion");
+  if (dist) { /* OpenCV's 4, 5 or 8 coefficients (or fewer: the rest are zero) */
+    int n = cJSON_IsArray(dist) ? cJSON_GetArraySize(dist) : -1;
+    if (n < 0 || n > 8) return rr_json_fail(r, "distortion", "must be an array of at most 8 numbers");
+    memset(c.dist, 0, sizeof c.dist);
+    if (n > 0 && (e = rr_json_floats(r, obj, "distortion", n, -MAX_COORD, MAX_COORD, c.dist))) return e;
+    given |= RR_CAMERA_FIELD_LENS;
+  }
   int size; /* the image the camera was saved for: for reference only, but still a number */
   if ((e = rr_json_int(r, obj, "width", 0, INT_MAX, &size)) || (e = rr_json_int(r, obj, "height", 0, INT_MAX, &size)))
     return e;

@@ -599,3 +599,13 @@ rr_error rr_scene_commit(rr_scene *s) {
   s->bvh = b;
   return rr_ok(s->dev);
 }
+
+rr_error rr_scene_get_normals(const rr_scene *s, const uint32_t *prims, size_t n, float *normals) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if (n && (!prims || !normals)) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_normals: NULL array");
+  for (size_t k = 0; k < n; k++) {
+    uint32_t i = rr_scene_index_of(s, prims[k]);
+    v3_store(normals + 3 * k, i == RR_MISS ? v3(0, 0, 0) : v3_norm(rr_scene_tri_normal(s, i)));
+  }
+  return rr_ok(s->dev);
+}

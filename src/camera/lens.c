@@ -1,0 +1,156 @@
+/* OpenCV's lens models: Brown–Conrady (cv::projectPoints) and Kannala–Brandt
+ * (cv::fisheye::projectPoints), forwards and inverted, in double. */
+#include "camera/lens.h"
+
+#include <math.h>
+
+#include "core/vec.h"
+
+/* Brown–Conrady's radial factor q(r²) and its derivative by r². */
+static double radial(const float *k, double r2, double *dq) {
+  double num = 1 + r2 * (k[0] + r2 * (k[1] + r2 * k[4])), den = 1 + r2 * (k[5] + r2 * (k[6] + r2 * k[7]));
+  double dnum = k[0] + r2 * (2 * k[1] + 3 * r2 * k[4]), dden = k[5] + r2 * (2 * k[6] + 3 * r2 * k[7]);
+  if (dq) *dq = (dnum * den - num * dden) / (den * den);
+  return num / den;
+}
+
+/* Kannala–Brandt: θd(θ) and its derivative. */
+static double theta_d(const float *k, double th, double *dth) {
+  double t2 = th * th;
+  if (dth) *dth = 1 + t2 * (3 * k[0] + t2 * (5 * k[1] + t2 * (7 * k[2] + t2 * 9 * k[3])));
+  return th * (1 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3]))));
+}
+
+/* Brown–Conrady's radial map r·q(r²) and its derivative by r. */
+static double radial_r(const float *k, double r, double *dr) {
+  double dq, q = radial(k, r * r, &dq);
+  *dr = q + 2 * r * r * dq;
+  return r * q;
+}
+
+/* The x in [0, hi] where f, increasing there with f(0) = 0, reaches y < f(hi):
+ * Newton's steps inside a shrinking bracket, bisection when a step would leave it
+ * (quadratic convergence near the root, never lost). */
+static double solve_increasing(double (*f)(const float *, double, double *), const float *k, double y, double hi) {
+  double lo = 0, x = y < hi ? y : 0.5 * hi;
+  for (int it = 0; it < 200 && y > 0; it++) {
+    double d, e = f(k, x, &d) - y;
+    if (e == 0) break;
+    if (e < 0) lo = x;
+    else hi = x;
+    double next = d > 0 ? x - e / d : lo;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (next == x || hi - lo <= 1e-16 * hi) break;
+    x = next;
+  }
+  return y > 0 ? x : 0;
+}
+
+/* Brown–Conrady forwards: the distorted point m of the undistorted (a, b), and its Jacobian. */
+static void distort(const float *k, double a, double b, double m[2], double J[2][2]) {
+  double r2 = a * a + b * b, dq, q = radial(k, r2, &dq), p1 = k[2], p2 = k[3];
+  m[0] = a * q + 2 * p1 * a * b + p2 * (r2 + 2 * a * a);
+  m[1] = b * q + p1 * (r2 + 2 * b * b) + 2 * p2 * a * b;
+  if (J) {
+    J[0][0] = q + 2 * a * a * dq + 2 * p1 * b + 6 * p2 * a;
+    J[0][1] = 2 * a * b * dq + 2 * p1 * a + 2 * p2 * b;
+    J[1][0] = 2 * a * b * dq + 2 * p1 * a + 2 * p2 * b;
+    J[1][1] = q + 2 * b * b * dq + 6 * p1 * b + 2 * p2 * a;
+  }
+}
+
+/* The radius (or angle) where the radial map stops growing, scanned outwards in
+ * steps of 1/1000 of it (relative), up to `limit`: beyond it the map folds back and
+ * a distorted point has two preimages, so the rendered field stops there. */
+double rr_lens_fold(const rr_camera *cam) {
+  const float *k = cam->dist;
+  bool fish = cam->type == RR_CAMERA_OPENCV_FISHEYE;
+  double limit = fish ? RR_PI : 1e4, x = 0, prev = 0;
+  for (double step = 1e-4; x < limit; x += step, step = fmax(1e-4, x * 1e-3)) {
+    double next = x + step, f;
+    if (fish) f = theta_d(k, next, NULL);
+    else f = next * radial(k, next * next, NULL);
+    if (!(f > prev) || !isfinite(f)) return x;
+    prev = f;
+  }
+  return limit;
+}
+
+/* The undistorted (a, b) of distorted m: the radius first, on the monotone radial
+ * map (solve_increasing: robust from any start), then Newton's method on the whole
+ * map with the tangential terms, which converges quadratically from there for the
+ * small tangential coefficients of real lenses. Stops when the residual is below
+ * 1e-13 (relative); false when it does not get there in 40 steps, leaves [0, fold),
+ * or lands where the map is not locally one-to-one. */
+static bool undistort(const float *k, double fold, const double m[2], double p[2], double Jinv[2][2]) {
+  double rd = sqrt(m[0] * m[0] + m[1] * m[1]), d;
+  if (!(radial_r(k, fold, &d) > rd)) return false; /* beyond the fold's image */
+  double r = solve_increasing(radial_r, k, rd, fold), s = rd > 0 ? r / rd : 1 / radial(k, 0, NULL);
+  p[0] = m[0] * s, p[1] = m[1] * s;
+  double tol = 1e-13 * (1 + rd);
+  for (int it = 0; it < 40; it++) {
+    double f[2], J[2][2];
+    distort(k, p[0], p[1], f, J);
+    double e0 = f[0] - m[0], e1 = f[1] - m[1], det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+    if (!(det > 0)) return false;
+    Jinv[0][0] = J[1][1] / det, Jinv[0][1] = -J[0][1] / det;
+    Jinv[1][0] = -J[1][0] / det, Jinv[1][1] = J[0][0] / det;
+    if (fabs(e0) + fabs(e1) <= tol) return p[0] * p[0] + p[1] * p[1] < fold * fold;
+    p[0] -= Jinv[0][0] * e0 + Jinv[0][1] * e1;
+    p[1] -= Jinv[1][0] * e0 + Jinv[1][1] * e1;
+    if (!isfinite(p[0]) || !isfinite(p[1])) return false;
+  }
+  return false;
+}
+
+bool rr_lens_unproject(const rr_camera *cam, double fold, double u, double v, double dir[3], double ddir[2][3]) {
+  const float *k = cam->dist;
+  double m[2] = {(u - cam->cx) / cam->fx, (v - cam->cy) / cam->fy};
+  double dm[2] = {1.0 / cam->fx, 1.0 / cam->fy}; /* dm0/du, dm1/dv */
+  if (cam->type == RR_CAMERA_OPENCV_FISHEYE) {
+    /* θ from θd on the monotone [0, fold) (solve_increasing); the ray is
+     * (sin θ·e, cos θ) with e = m/|m| (polar form, as the equidistant fisheye). */
+    double rd = sqrt(m[0] * m[0] + m[1] * m[1]), dth;
+    if (!(theta_d(k, fold, NULL) > rd)) return false;
+    double th = solve_increasing(theta_d, k, rd, fold);
+    theta_d(k, th, &dth);
+    if (!(th >= 0 && th < fold && dth > 0)) return false;
+    double e[2] = {rd > 0 ? m[0] / rd : 1, rd > 0 ? m[1] / rd : 0}, st = sin(th), ct = cos(th);
+    dir[0] = st * e[0], dir[1] = st * e[1], dir[2] = ct;
+    if (ddir) {
+      /* ∂dir/∂m = (1/θd')(cos θ e, −sin θ) ⊗ e + (sin θ / rd)(t, 0) ⊗ t, t ⊥ e; sin θ / rd → 1 at 0 */
+      double g = 1 / dth, s = rd > 0 ? st / rd : 1, t[2] = {-e[1], e[0]};
+      for (int j = 0; j < 2; j++) {
+        double ej = e[j] * g, tj = t[j] * s;
+        ddir[j][0] = (ct * e[0] * ej + t[0] * tj) * dm[j];
+        ddir[j][1] = (ct * e[1] * ej + t[1] * tj) * dm[j];
+        ddir[j][2] = -st * ej * dm[j];
+      }
+    }
+    return true;
+  }
+  double p[2], Ji[2][2];
+  if (!undistort(k, fold, m, p, Ji)) return false;
+  double w[3] = {p[0], p[1], 1}, len = sqrt(p[0] * p[0] + p[1] * p[1] + 1);
+  for (int i = 0; i < 3; i++) dir[i] = w[i] / len;
+  if (ddir)
+    for (int j = 0; j < 2; j++) { /* w's derivative by m_j is (Jinv[0][j], Jinv[1][j], 0); normalised */
+      double dw[3] = {Ji[0][j] * dm[j], Ji[1][j] * dm[j], 0};
+      double along = dir[0] * dw[0] + dir[1] * dw[1];
+      for (int i = 0; i < 3; i++) ddir[j][i] = (dw[i] - dir[i] * along) / len;
+    }
+  return true;
+}
+
+bool rr_lens_project(const rr_camera *cam, const double p[3], double *u, double *v) {
+  if (!(p[2] > 0)) return false;
+  double a = p[0] / p[2], b = p[1] / p[2], m[2];
+  if (cam->type == RR_CAMERA_OPENCV_FISHEYE) {
+    double r = sqrt(a * a + b * b), td = theta_d(cam->dist, atan(r), NULL), s = r > 0 ? td / r : 1;
+    m[0] = a * s, m[1] = b * s;
+  } else {
+    distort(cam->dist, a, b, m, NULL);
+  }
+  *u = cam->fx * m[0] + cam->cx, *v = cam->fy * m[1] + cam->cy;
+  return true;
+}

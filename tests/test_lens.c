@@ -1,0 +1,149 @@
+/* OpenCV's lens models inverted: every pixel's ray projects back onto the pixel
+ * (OpenCV's forward formulas, rr_lens_project) within 1e-6 px, for mild, strong
+ * and fisheye distortions, pixels beyond the fold having no ray; the ray
+ * derivatives match central differences; the defaults (fx = fy = 0) give the
+ * perspective camera's rays; rr_camera_set_extrinsics recovers OpenCV's pose;
+ * every 3D method renders strongly distorted views (folding inside the image) bit
+ * for bit as rc does; bad intrinsics and poses are refused. */
+#include "camera/camera.h"
+#include "camera/lens.h"
+#include "testutil.h"
+
+#include <string.h>
+
+static rr_camera lens_camera(rr_camera_type type, float fx, float fy, float cx, float cy, const float *k, int n) {
+  rr_camera c;
+  rr_camera_init(&c);
+  c.type = type, c.fx = fx, c.fy = fy, c.cx = cx, c.cy = cy;
+  for (int i = 0; i < n; i++) c.dist[i] = k[i];
+  return c;
+}
+
+/* Round trips over a grid of image points; returns the pixels with a ray. */
+static int round_trip(const rr_camera *c, int W, int H, const char *what) {
+  double fold = rr_lens_fold(c), worst = 0, worst_d = 0;
+  int rays = 0;
+  for (int y = 0; y < H; y += 3)
+    for (int x = 0; x < W; x += 3) {
+      double dir[3], dd[2][3], u, v;
+      if (!rr_lens_unproject(c, fold, x, y, dir, dd)) continue;
+      rays++;
+      CHECK(fabs(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2] - 1) < 1e-12, "%s: ray not unit", what);
+      if (dir[2] <= 1e-9) continue; /* behind the camera: OpenCV's projection does not reach it */
+      CHECK(rr_lens_project(c, dir, &u, &v), "%s: ray (%d,%d) not in front", what, x, y);
+      worst = fmax(worst, hypot(u - x, v - y));
+      /* derivatives against central differences of the inversion itself */
+      for (int j = 0; j < 2; j++) {
+        double a[3], b[3], h = 1e-4;
+        if (!rr_lens_unproject(c, fold, x + (j == 0 ? h : 0), y + (j == 1 ? h : 0), a, NULL) ||
+            !rr_lens_unproject(c, fold, x - (j == 0 ? h : 0), y - (j == 1 ? h : 0), b, NULL))
+          continue;
+        for (int i = 0; i < 3; i++) {
+          double fd = (a[i] - b[i]) / (2 * h);
+          worst_d = fmax(worst_d, fabs(fd - dd[j][i]) / (1e-3 + fabs(fd)));
+        }
+      }
+    }
+  CHECK(worst < 1e-6, "%s: round trip off by %g px", what, worst);
+  CHECK(worst_d < 1e-4, "%s: derivatives off by %g (relative)", what, worst_d);
+  printf("%s: %d of %d points with a ray, round trip within %.2g px, derivatives within %.2g\n", what, rays,
+         ((W + 2) / 3) * ((H + 2) / 3), worst, worst_d);
+  return rays;
+}
+
+/* Every 3D method against rc on a lens that folds inside the image: the measured
+ * Lipschitz bound must keep the cones of curved binning and culling conservative. */
+static void methods_agree(rr_device *dev, const rr_camera *cam, const char *what) {
+  static const rr_method methods[] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
+                                      RR_METHOD_3DR_FC, RR_METHOD_3DR_FS,    RR_METHOD_3DR_FULL};
+  rr_scene *s;
+  if (rr_scene_load(dev, "sphere:24", &s) != RR_OK) {
+    CHECK(0, "load: %s", rr_device_message(dev));
+    return;
+  }
+  const int W = 80, H = 60;
+  rr_frame *ref = test_render(dev, s, cam, RR_METHOD_RC, 1, W, H, 0);
+  CHECK(ref && test_frame_hits(ref) > W * H / 8, "%s: the sphere is seen", what);
+  for (size_t m = 0; ref && m < sizeof methods / sizeof *methods; m++)
+    for (int threads = 1; threads <= 2; threads++) {
+      rr_frame *f = test_render(dev, s, cam, methods[m], threads, W, H, 0);
+      int diff = f ? test_frames_differ(ref, f) : -1;
+      CHECK(diff == 0, "%s: %s on %d threads differs from rc at %d samples", what, rr_method_name(methods[m]),
+            threads, diff);
+      rr_frame_release(f);
+    }
+  rr_frame_release(ref);
+  rr_scene_release(s);
+}
+
+int main(void) {
+  rr_device *dev = rr_device_new();
+  const int W = 320, H = 240, all = ((W + 2) / 3) * ((H + 2) / 3);
+  const float mild[] = {-0.12f, 0.03f, 0.001f, -0.0015f, -0.004f};
+  const float rational[] = {0.6f, -0.2f, 0.0005f, 0.001f, 0.01f, 0.8f, -0.1f, 0.02f};
+  const float strong[] = {-0.45f, 0.05f, 0.002f, 0.001f, 0};   /* folds back inside the image */
+  const float fish[] = {0.03f, -0.01f, 0.004f, -0.001f};
+  const float fish_strong[] = {-0.3f, 0.02f, 0, 0};             /* θd stops growing before 180° */
+  rr_camera c = lens_camera(RR_CAMERA_OPENCV, 280, 275, 161.3f, 118.7f, mild, 5);
+  CHECK(round_trip(&c, W, H, "brown-conrady mild") == all, "a mild lens has a ray at every pixel");
+  c = lens_camera(RR_CAMERA_OPENCV, 300, 300, 160, 120, rational, 8);
+  CHECK(round_trip(&c, W, H, "brown-conrady rational") == all, "the rational lens has a ray at every pixel");
+  c = lens_camera(RR_CAMERA_OPENCV, 300, 300, 160, 120, strong, 5);
+  int n = round_trip(&c, W, H, "brown-conrady strong");
+  CHECK(n > all / 2 && n < all, "a lens folding inside the image has rays inside the fold only (%d of %d)", n, all);
+  c = lens_camera(RR_CAMERA_OPENCV_FISHEYE, 90, 92, 158, 121, fish, 4);
+  round_trip(&c, W, H, "fisheye");
+  c = lens_camera(RR_CAMERA_OPENCV_FISHEYE, 120, 120, 160, 120, fish_strong, 4);
+  n = round_trip(&c, W, H, "fisheye strong");
+  CHECK(n > all / 4 && n < all, "a fisheye folding inside the image (%d of %d)", n, all);
+
+  /* Views of a sphere through the lenses that fold inside the image (the pose looks at it). */
+  float pose_R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, pose_t[3] = {0, 0, 2.2f};
+  c = lens_camera(RR_CAMERA_OPENCV, 60, 60, 39.5f, 29.5f, strong, 5);
+  rr_camera_set_extrinsics(dev, &c, pose_R, pose_t);
+  methods_agree(dev, &c, "brown-conrady strong");
+  c = lens_camera(RR_CAMERA_OPENCV_FISHEYE, 45, 45, 39.5f, 29.5f, fish_strong, 4);
+  rr_camera_set_extrinsics(dev, &c, pose_R, pose_t);
+  methods_agree(dev, &c, "fisheye strong");
+
+  /* No distortion and the perspective intrinsics: the perspective camera's rays. */
+  rr_camera persp, cv;
+  rr_camera_init(&persp);
+  persp.fov_deg = 50;
+  cv = persp, cv.type = RR_CAMERA_OPENCV;
+  float *o1 = malloc(sizeof(float) * 3 * 64 * 48 * 4), *d1 = o1 + 3 * 64 * 48, *o2 = d1 + 3 * 64 * 48,
+        *d2 = o2 + 3 * 64 * 48;
+  CHECK(rr_camera_rays(dev, &persp, 64, 48, o1, d1) == RR_OK && rr_camera_rays(dev, &cv, 64, 48, o2, d2) == RR_OK,
+        "rays: %s", rr_device_message(dev));
+  double worst = 0;
+  for (int i = 0; i < 64 * 48 * 3; i++) worst = fmax(worst, fabs(d1[i] - d2[i]));
+  CHECK(worst < 1e-6, "opencv with the default intrinsics is the perspective camera (off by %g)", worst);
+  free(o1);
+
+  /* OpenCV's pose: R, t (world to camera) to eye/target/up and back. */
+  float R[9] = {0.36f, 0.48f, -0.8f, -0.8f, 0.6f, 0, 0.48f, 0.64f, 0.6f}, t[3] = {1, -2, 5};
+  CHECK(rr_camera_set_extrinsics(dev, &cv, R, t) == RR_OK, "extrinsics: %s", rr_device_message(dev));
+  camera cc;
+  CHECK(rr_cam_setup(dev, &cv, 64, 48, &cc) == RR_OK, "setup");
+  for (int i = 0; i < 3; i++) {
+    CHECK(fabsf(v3_get(cc.right, i) - R[i]) < 1e-6f && fabsf(v3_get(cc.up, i) + R[3 + i]) < 1e-6f &&
+              fabsf(v3_get(cc.fwd, i) - R[6 + i]) < 1e-6f, "axis %d of the pose", i);
+    double x = 0; /* R·eye + t = 0 */
+    for (int k = 0; k < 3; k++) x += (double)R[3 * i + k] * cv.eye[k];
+    CHECK(fabs(x + t[i]) < 1e-5, "eye: R·eye + t = %g", x + t[i]);
+  }
+  rr_cam_release(&cc);
+  R[0] = 2;
+  CHECK(rr_camera_set_extrinsics(dev, &cv, R, t) == RR_ERROR_ARGUMENT && strstr(rr_device_message(dev), "rotation"),
+        "a matrix that is not a rotation is refused: %s", rr_device_message(dev));
+  c = lens_camera(RR_CAMERA_OPENCV, -3, 300, 160, 120, mild, 5);
+  CHECK(rr_camera_check(dev, &c) == RR_ERROR_ARGUMENT && strstr(rr_device_message(dev), "intrinsics"),
+        "negative focal length refused: %s", rr_device_message(dev));
+  c = lens_camera(RR_CAMERA_OPENCV_FISHEYE, 300, 300, 160, 120, rational, 8);
+  CHECK(rr_camera_check(dev, &c) == RR_ERROR_ARGUMENT, "a fisheye with 8 coefficients refused");
+  c = lens_camera(RR_CAMERA_OPENCV, 300, 300, 160, 120, mild, 5);
+  c.dist[1] = NAN;
+  CHECK(rr_camera_check(dev, &c) == RR_ERROR_ARGUMENT, "a NaN coefficient refused");
+  rr_device_release(dev);
+  return test_done();
+}
