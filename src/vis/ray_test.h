@@ -42,7 +42,7 @@ typedef struct {
  * where all are positive (rr_tri_ray_finish), else with the part of the setup the
  * ray's one sample reads (rr_tri_ray_hit1), or, for corners at infinity, the full
  * setup (rr_tri_ray_hit) — the same bits each way. True on a hit in [tmin, tmax]. */
-static inline bool ray_tri_test(const rr_scene *s, uint32_t id, ray_cam *rc, const float org[3], const float dir[3],
+KERNEL bool ray_tri_test(const rr_scene *s, uint32_t id, ray_cam *rc, const float org[3], const float dir[3],
                                 const float pre[4], float tmin, float tmax, float *t, float *l1, float *l2) {
   if (!rc->ready) {
     rr_cam_for_ray(org, dir, &rc->cam);

@@ -28,7 +28,7 @@
 
 #include <string.h>
 
-enum { SR_BIN = 64, SR_GRID = 64, SR_BINS_PER_JOB = 16 };
+enum { SR_BIN = 32, SR_GRID = 64, SR_BINS_PER_JOB = 16 };
 
 /* One bin being rasterized: its samples, its frustum, its live samples. */
 typedef struct sr_state {
@@ -45,6 +45,10 @@ typedef struct sr_state {
   rr_vf4 plane[4][3];      /* inward normals of the frustum's side planes through the light */
   rr_vf4 corner[4][3];     /* the frustum's corner directions */
   rr_vf4 dir[SR_BIN][3];   /* each sample's direction, broadcast */
+  /* samples 4k..4k+3 side by side: their inverse directions, near planes' factor
+   * shrunk and far planes' grown by the margin (as query_node's), and their tmax */
+  rr_vf4 inv_near[SR_BIN / 4][3], inv_far[SR_BIN / 4][3], tmax[SR_BIN / 4];
+  rr_vi4 neg[SR_BIN / 4][3]; /* the direction is negative: the near plane is the box's hi */
   ray_cam rc[SR_BIN];      /* each sample's pseudo-camera, when its first triangle passes */
   rr_shadow_counts st;
 } sr_state;
@@ -73,7 +77,28 @@ KERNEL int sr_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, tra
     in &= ~(m < rr_vf4_splat(-1e-5f) * mag); /* (NaN keeps the box) */
   }
   s->order = d2, s->key = rr_vf4_splat(0);
-  return rr_vi4_bits(in);
+  int hits = rr_vi4_bits(in);
+  /* a leaf is entered by the samples whose segment meets its box (query_node's
+   * slab test, four samples at a time): the bin test at the leaf then spares the
+   * others, which its triangles cannot occlude */
+  for (int h = hits; h; h &= h - 1) {
+    int k = __builtin_ctz(h);
+    if (!w->count[k]) continue;
+    uint64_t m = 0;
+    for (int g = 0; g < (b->n + 3) / 4; g++) {
+      if (!(lanes >> (4 * g) & 15u)) continue;
+      rr_vf4 t0 = rr_vf4_splat(0), t1 = b->tmax[g];
+      for (int a = 0; a < 3; a++) { /* (a NaN slab is ignored, as in query_node) */
+        rr_vf4 l = rr_vf4_splat(lo[a][k]), u = rr_vf4_splat(hi[a][k]);
+        t0 = rr_vf4_max(rr_vf4_select(b->neg[g][a], u, l) * b->inv_near[g][a], t0);
+        t1 = rr_vf4_min(rr_vf4_select(b->neg[g][a], l, u) * b->inv_far[g][a], t1);
+      }
+      m |= (uint64_t)rr_vi4_bits(t0 <= t1) << (4 * g);
+    }
+    s->lanes[k] = m & lanes;
+    if (!s->lanes[k]) hits &= ~(1 << k);
+  }
+  return hits;
 }
 
 KERNEL float sr_best(const void *q) {
@@ -83,7 +108,6 @@ KERNEL float sr_best(const void *q) {
 
 /* A leaf's triangles against the bin's live samples, four triangles at a time. */
 KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
-  (void)lanes;
   sr_state *b = q;
   const rr_scene *s = b->s;
   const float *v = b->b->leaf_v + (size_t)9 * first;
@@ -113,7 +137,7 @@ KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
       cand &= ~rr_vi4_bits(out);
     }
     if (!(cand | inf)) continue;
-    for (uint64_t live = b->live; live; live &= live - 1) {
+    for (uint64_t live = b->live & lanes; live; live &= live - 1) {
       int k = __builtin_ctzll(live);
       const rr_ray *r = &b->rays[b->idx[k]];
       rr_vf4 pre[4];
@@ -177,6 +201,15 @@ static void sr_bin_init(sr_state *b, const rr_ray *rays, const uint32_t *idx, in
     }
     b->rc[k].ready = false;
   }
+  for (int k = 0; k < (n + 3) / 4 * 4; k++) { /* lanes past n: an empty range, never entered */
+    const rr_ray *r = &rays[idx[k < n ? k : 0]];
+    for (int a = 0; a < 3; a++) {
+      float inv = 1.0f / r->dir[a];
+      b->inv_near[k / 4][a][k % 4] = inv * (1 - 2 * RAY_MARGIN), b->inv_far[k / 4][a][k % 4] = inv * (1 + 2 * RAY_MARGIN);
+      b->neg[k / 4][a][k % 4] = inv < 0 ? -1 : 0;
+    }
+    b->tmax[k / 4][k % 4] = k < n ? r->tmax : -1.0f;
+  }
   /* pad the box for hits computed a few ulps beyond the segment and edge values a
    * few ulps inside a triangle, the rectangle for the rounding of u and v */
   float ext = 0;
@@ -230,7 +263,7 @@ KERNEL void sr_run_body(int job, int thread, void *arg) {
   for (uint32_t i = (uint32_t)job * SR_BINS_PER_JOB; i < j->nbins && i < (uint32_t)(job + 1) * SR_BINS_PER_JOB; i++) {
     sr_bin_init(b, j->rays, j->order + j->bin[i], (int)(j->bin[i + 1] - j->bin[i]));
     b->st.bins++;
-    bvh_trace(j->b, b, 1, sr_node, sr_leaf, sr_best);
+    bvh_trace(j->b, b, b->live, sr_node, sr_leaf, sr_best);
   }
   rr_shadow_counts *c = &j->st[thread];
   c->bins += b->st.bins, c->nodes += b->st.nodes, c->setups += b->st.setups, c->edge_evals += b->st.edge_evals;
