@@ -196,6 +196,29 @@ static void compare_rays(rr_device *dev, const char *name, const rr_scene *s, co
   } else {
     printf("0 | - | - | - |\n");
   }
+  /* where raster starts to pay: the same rays in pixel-order runs of `run` rays
+   * (the lit mode rasterizes each batch's rays of a light, at most 1024), one thread */
+  printf("<!-- one thread, the rays in runs of N: raster / streams ms (instructions under callgrind):");
+  for (size_t run = 1024; run <= ns * 2 && run <= ((size_t)1 << 22); run *= 4) {
+    size_t len = run < ns ? run : ns;
+    char part[64];
+    double t0 = bench_now_ms();
+    snprintf(part, sizeof part, "raster-run-%zu", len);
+    if (counting) COUNT_BEGIN();
+    for (size_t k = 0; k < ns; k += len) rr_occluded_raster(s, bvh, shadow + k, ns - k < len ? ns - k : len, 1, occ_r + k, NULL);
+    if (counting) COUNT_END(part);
+    double t1 = bench_now_ms();
+    snprintf(part, sizeof part, "stream-run-%zu", len);
+    if (counting) COUNT_BEGIN();
+    for (size_t k = 0; k < ns; k += len) {
+      rr_ray_stream st = rr_ray_stream_aos(shadow + k, ns - k < len ? ns - k : len);
+      rr_occluded_stream(dev, s, &st, 1, occ_s + k);
+    }
+    if (counting) COUNT_END(part);
+    printf(" N=%zu %.1f/%.1f", len, t1 - t0, bench_now_ms() - t1);
+    if (len == ns) break;
+  }
+  printf(" -->\n");
   printf("<!-- raster: %llu bins, %llu BVH slots, %llu triangle setups, %llu edge tests -->\n",
          (unsigned long long)cnt.bins, (unsigned long long)cnt.nodes, (unsigned long long)cnt.setups,
          (unsigned long long)cnt.edge_evals);

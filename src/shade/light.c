@@ -254,8 +254,11 @@ static void credit(const level *lv, int i, int part, const float w[3], const flo
 }
 
 /* --shadows auto rasterizes a light's shadow rays from the light when a batch
- * holds at least this many of them (bench/bench_shading measures the break-even). */
-#define SHADOW_RASTER_MIN 256
+ * holds at least this many of them: bench/bench_shading measured the break-even
+ * in instructions near 16384 rays on the demo (runs of 1024 cost raster 1.6x the
+ * streams' instructions; the bunny on a plane never broke even), so within the
+ * lit mode's batches (LIT_BATCH points) auto traces rays today. */
+#define SHADOW_RASTER_MIN 16384
 
 /* Direct light on a level's points: one pass per light, its shadow rays in one
  * stream, or rasterized from the light (vis/shadow_raster.c: the same bits). */

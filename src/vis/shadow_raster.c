@@ -276,9 +276,18 @@ static void sr_run(int job, int thread, void *arg) { sr_run_body(job, thread, ar
 RR_TARGET_AVX2 static void sr_run_avx2(int job, int thread, void *arg) { sr_run_body(job, thread, arg); }
 #endif
 
-static int cmp_u64(const void *a, const void *b) {
-  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-  return x < y ? -1 : x > y;
+/* Sorts the m keys (bin key << 32 | ray) by their 15-bit bin key, stably (the
+ * rays stay in their order within a cell): two passes of an LSD radix sort
+ * through tmp. */
+static void sort_keys(uint64_t *key, uint64_t *tmp, size_t m) {
+  for (int pass = 0; pass < 2; pass++) {
+    int shift = 32 + 8 * pass;
+    size_t count[257] = {0};
+    for (size_t k = 0; k < m; k++) count[(key[k] >> shift & 255u) + 1]++;
+    for (int c = 0; c < 256; c++) count[c + 1] += count[c];
+    for (size_t k = 0; k < m; k++) tmp[count[key[k] >> shift & 255u]++] = key[k];
+    memcpy(key, tmp, m * sizeof *key);
+  }
 }
 
 bool rr_occluded_raster(const rr_scene *s, const rr_bvh *b, const rr_ray *rays, size_t n, int threads, int *occluded,
@@ -287,7 +296,7 @@ bool rr_occluded_raster(const rr_scene *s, const rr_bvh *b, const rr_ray *rays, 
   if (n > UINT32_MAX) return false;
   for (size_t i = 0; i < n; i++) occluded[i] = 0;
   if (!b || !n) return true; /* an empty scene: every ray misses */
-  uint64_t *key = malloc(n * sizeof *key);
+  uint64_t *key = malloc(2 * n * sizeof *key);
   uint32_t *order = malloc(n * sizeof *order), *bin = malloc((n + 1) * sizeof *bin);
   if (!key || !order || !bin) {
     free(key), free(order), free(bin);
@@ -309,7 +318,7 @@ bool rr_occluded_raster(const rr_scene *s, const rr_bvh *b, const rr_ray *rays, 
     uint32_t face = (uint32_t)sr_face(r->dir, &u, &v);
     key[m++] = (uint64_t)(face << 12 | sr_morton((uint32_t)sr_cell(u), (uint32_t)sr_cell(v))) << 32 | i;
   }
-  qsort(key, m, sizeof *key, cmp_u64);
+  sort_keys(key, key + n, m);
   uint32_t nbins = 0;
   for (size_t k = 0; k < m; k++) {
     order[k] = (uint32_t)key[k];
