@@ -86,7 +86,7 @@ KERNEL int sr_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, tra
     if (!w->count[k]) continue;
     uint64_t m = 0;
     for (int g = 0; g < (b->n + 3) / 4; g++) {
-      if (!(lanes >> (4 * g) & 15u)) continue;
+      if (!((lanes & b->live) >> (4 * g) & 15u)) continue;
       rr_vf4 t0 = rr_vf4_splat(0), t1 = b->tmax[g];
       for (int a = 0; a < 3; a++) { /* (a NaN slab is ignored, as in query_node) */
         rr_vf4 l = rr_vf4_splat(lo[a][k]), u = rr_vf4_splat(hi[a][k]);
@@ -170,12 +170,14 @@ static int sr_face(const float d[3], float *u, float *v) {
   return 2 * a + (d[a] < 0);
 }
 
-/* Bit-interleaves two 6-bit cells into a 12-bit Morton code. */
-static uint32_t sr_morton(uint32_t x, uint32_t y) {
-  uint32_t m = 0;
-  for (int i = 0; i < 6; i++) m |= (x >> i & 1u) << (2 * i) | (y >> i & 1u) << (2 * i + 1);
-  return m;
+/* Spreads the 6 bits of x to the even bits 0, 2, .., 10. */
+static uint32_t sr_spread(uint32_t x) {
+  x = (x | x << 4) & 0x0F0Fu;
+  x = (x | x << 2) & 0x3333u;
+  return (x | x << 1) & 0x5555u;
 }
+/* Bit-interleaves two 6-bit cells into a 12-bit Morton code. */
+static uint32_t sr_morton(uint32_t x, uint32_t y) { return sr_spread(x) | sr_spread(y) << 1; }
 
 static int sr_cell(float u) {
   int c = (int)((u + 1.0f) * 0.5f * SR_GRID);
