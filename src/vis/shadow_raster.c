@@ -29,6 +29,9 @@
 #include <string.h>
 
 enum { SR_BIN = 32, SR_GRID = 64, SR_BINS_PER_JOB = 16 };
+#ifndef SR_LANES_INNER
+#define SR_LANES_INNER 1
+#endif
 
 /* One bin being rasterized: its samples, its frustum, its live samples. */
 typedef struct sr_state {
@@ -83,7 +86,7 @@ KERNEL int sr_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, tra
    * others, which its triangles cannot occlude */
   for (int h = hits; h; h &= h - 1) {
     int k = __builtin_ctz(h);
-    if (!w->count[k]) continue;
+    if (!w->count[k] && !SR_LANES_INNER) continue;
     uint64_t m = 0;
     for (int g = 0; g < (b->n + 3) / 4; g++) {
       if (!((lanes & b->live) >> (4 * g) & 15u)) continue;
@@ -246,7 +249,7 @@ typedef struct {
   uint32_t nbins;
   float org[3];
   int *occluded;
-  rr_shadow_counts st[RR_MAX_THREADS];
+  rr_shadow_counts *st; /* per thread */
 } sr_job;
 
 KERNEL void sr_run_body(int job, int thread, void *arg) {
@@ -282,6 +285,15 @@ RR_TARGET_AVX2 static void sr_run_avx2(int job, int thread, void *arg) { sr_run_
  * rays stay in their order within a cell): two passes of an LSD radix sort
  * through tmp. */
 static void sort_keys(uint64_t *key, uint64_t *tmp, size_t m) {
+  if (m <= 256) { /* a batch's rays: insertion sort, without the passes' counters */
+    for (size_t k = 1; k < m; k++) {
+      uint64_t v = key[k];
+      size_t i = k;
+      for (; i > 0 && key[i - 1] > v; i--) key[i] = key[i - 1];
+      key[i] = v;
+    }
+    return;
+  }
   for (int pass = 0; pass < 2; pass++) {
     int shift = 32 + 8 * pass;
     size_t count[257] = {0};
@@ -327,23 +339,24 @@ bool rr_occluded_raster(const rr_scene *s, const rr_bvh *b, const rr_ray *rays, 
     if (k == 0 || k - bin[nbins - 1] == SR_BIN || key[k] >> 44 != key[k - 1] >> 44) bin[nbins++] = (uint32_t)k;
   }
   bin[nbins] = (uint32_t)m;
-  sr_job *j = calloc(1, sizeof *j);
-  if (!j) {
+  threads = threads < 1 ? 1 : threads > RR_MAX_THREADS ? RR_MAX_THREADS : threads;
+  sr_job job = {.s = s, .b = b, .rays = rays, .order = order, .bin = bin, .nbins = nbins, .occluded = occluded,
+                .st = calloc((size_t)threads, sizeof(rr_shadow_counts))}, *j = &job;
+  if (!j->st) {
     free(key), free(order), free(bin);
     return false;
   }
-  *j = (sr_job){.s = s, .b = b, .rays = rays, .order = order, .bin = bin, .nbins = nbins, .occluded = occluded};
   if (org) memcpy(j->org, org, sizeof j->org);
   rr_parallel_fn run = sr_run;
 #ifdef RR_SIMD_X86
   if (__builtin_cpu_supports("avx2")) run = sr_run_avx2;
 #endif
-  rr_parallel_for((int)((nbins + SR_BINS_PER_JOB - 1) / SR_BINS_PER_JOB), threads > 0 ? threads : 1, run, j);
+  rr_parallel_for((int)((nbins + SR_BINS_PER_JOB - 1) / SR_BINS_PER_JOB), threads, run, j);
   if (counts)
-    for (int t = 0; t < RR_MAX_THREADS; t++) {
+    for (int t = 0; t < threads; t++) {
       counts->bins += j->st[t].bins, counts->nodes += j->st[t].nodes;
       counts->setups += j->st[t].setups, counts->edge_evals += j->st[t].edge_evals;
     }
-  free(j), free(key), free(order), free(bin);
+  free(j->st), free(key), free(order), free(bin);
   return true;
 }
