@@ -149,8 +149,15 @@ static void check_lit(const char *name, bool inside) {
   int views = test_quick() ? 1 : 3;
   for (int v = 0; v < views; v++) {
     rr_camera cam = inside ? test_random_view(s, 0.1f, 0.3f, 0.2f, 60, 90) : test_random_view(s, 1.5f, 3, 0.3f, 30, 60);
-    for (int ti = 0; ti < TEST_NTHREADS; ti++) {
-      rr_frame *f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, test_threads[ti], 96, 72, 0);
+    for (int ti = 0; ti < TEST_NTHREADS + 1; ti++) {
+      /* the last: 16 samples per pixel, whose batches are long enough for auto to rasterize */
+      rr_render_options o;
+      rr_render_options_init(&o);
+      o.method = RR_METHOD_3DR_BB, o.width = 96, o.height = 72, o.threads = test_threads[ti % TEST_NTHREADS];
+      if (ti == TEST_NTHREADS)
+        CHECK(rr_render_options_set_aa(dev, &o, RR_AA_SSAA, 16, 0, RR_AA_STANDARD, 0) == RR_OK, "%s",
+              rr_device_message(dev));
+      rr_frame *f = test_render_opt(dev, s, &cam, &o);
       if (!f) continue;
       float *img[3] = {NULL, NULL, NULL};
       rr_shadow_mode modes[3] = {RR_SHADOWS_RAYS, RR_SHADOWS_RASTER, RR_SHADOWS_AUTO};
@@ -170,8 +177,9 @@ static void check_lit(const char *name, bool inside) {
       for (int m = 1; m < 3; m++) {
         size_t diff = 0;
         for (size_t k = 0; img[0] && img[m] && k < (size_t)96 * 72 * 3; k++) diff += memcmp(&img[0][k], &img[m][k], 4) != 0;
-        CHECK(img[0] && img[m] && diff == 0, "%s view %d, %d threads: %zu channels of the %s image differ from rays",
-              name, v, test_threads[ti], diff, m == 1 ? "raster" : "auto");
+        CHECK(img[0] && img[m] && diff == 0, "%s view %d, %d threads%s: %zu channels of the %s image differ from rays",
+              name, v, test_threads[ti % TEST_NTHREADS], ti == TEST_NTHREADS ? ", ssaa:16" : "", diff,
+              m == 1 ? "raster" : "auto");
       }
       CHECK(rays > 0, "%s view %d: no shadow rays", name, v);
       for (int m = 0; m < 3; m++) free(img[m]);

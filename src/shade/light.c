@@ -254,11 +254,12 @@ static void credit(const level *lv, int i, int part, const float w[3], const flo
 }
 
 /* --shadows auto rasterizes a light's shadow rays from the light when a batch
- * holds at least this many of them: bench/bench_shading measured the break-even
- * in instructions near 16384 rays on the demo (runs of 1024 cost raster 1.6x the
- * streams' instructions; the bunny on a plane never broke even), so within the
- * lit mode's batches (LIT_BATCH points) auto traces rays today. */
-#define SHADOW_RASTER_MIN 16384
+ * holds at least this many of them. bench/bench_shading's sweep (instructions,
+ * 1024²): in runs of 1024 rays raster costs 0.96x the streams on the demo and
+ * 1.08x on the bunny over a plane (whole frames 0.90x and 1.04x); in the lit
+ * mode's batches of 64 points (one sample per pixel) 1.16x, of 1024 (16 samples)
+ * 0.90x on the demo. */
+#define SHADOW_RASTER_MIN 512
 
 /* Direct light on a level's points: one pass per light, its shadow rays in one
  * stream, or rasterized from the light (vis/shadow_raster.c: the same bits). */
