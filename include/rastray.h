@@ -714,14 +714,15 @@ typedef enum rr_texture_wrap {
 /* How the lit shade mode finds which lights a point sees. */
 typedef enum rr_shadow_mode {
   RR_SHADOWS_NONE = 0, /* every light reaches every point facing it */
-  RR_SHADOWS_RAYS,     /* a shadow ray per point and light through rr_occluded_stream, leaving the surface
-                          offset along its geometric normal (docs/shading.md) */
-  RR_SHADOWS_RASTER,   /* 3D rasterization from the light (the same bits as rays): not implemented yet,
-                          refused with RR_ERROR_UNSUPPORTED */
+  RR_SHADOWS_RAYS,     /* a shadow ray per point and light through rr_occluded_stream: from a point or spot
+                          light to the point offset along its geometric normal (docs/shading.md) */
+  RR_SHADOWS_RASTER,   /* point and spot lights: 3D rasterization from the light of the same rays, the same
+                          bits; directional lights: rays */
+  RR_SHADOWS_AUTO,     /* raster where a light has enough points at once to repay it, else rays */
   RR_SHADOWS_COUNT
 } rr_shadow_mode;
 
-/* The shadow mode named `name` ("none", "rays", "raster"); -1 when unknown. */
+/* The shadow mode named `name` ("none", "rays", "raster", "auto"); -1 when unknown. */
 RR_API int rr_shadows_from_name(const char *name);
 
 #define RR_MAX_DEPTH 16 /* most mirror bounces the lit shade mode follows */

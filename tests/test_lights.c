@@ -237,12 +237,12 @@ static void check_shadows(void) {
   rr_shade_stats st;
   free(lit(s, &cam, 32, 32, &so, NULL, &st));
   CHECK(st.shadow_rays == 0 && st.shades > 0, "shadows none traced %llu rays", (unsigned long long)st.shadow_rays);
-  so.shadows = RR_SHADOWS_RASTER;
+  so.shadows = RR_SHADOWS_COUNT;
   rr_frame *fr = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 1, 8, 8, 0);
   rr_image im = {0};
-  CHECK(fr && rr_shade_frame(dev, s, &cam, fr, &so, &im, NULL) == RR_ERROR_UNSUPPORTED && !im.data &&
-            strstr(rr_device_message(dev), "not implemented"),
-        "shadows raster: %s", rr_device_message(dev));
+  CHECK(fr && rr_shade_frame(dev, s, &cam, fr, &so, &im, NULL) == RR_ERROR_ARGUMENT && !im.data &&
+            strstr(rr_device_message(dev), "shadow mode"),
+        "unknown shadow mode: %s", rr_device_message(dev));
   so.shadows = RR_SHADOWS_RAYS, so.max_depth = RR_MAX_DEPTH + 1;
   CHECK(fr && rr_shade_frame(dev, s, &cam, fr, &so, &im, NULL) == RR_ERROR_ARGUMENT && !im.data, "max depth 17 accepted");
   rr_frame_release(fr);
@@ -692,7 +692,6 @@ static void check_cli(void) {
       {"--light spot:0,1,0:0,-1,0:1,1,1:1:50:40", "cone"},
       {"--light sky:1,-1,1", "negative"},
       {"--light sky:1,1,1:0,0,nan", "nan"},
-      {"--shadows raster", "not implemented"},
       {"--shadows soft", "soft"},
       {"--max-depth 17", "17"},
   };

@@ -215,7 +215,8 @@ static const cli_option render_options[] = {
      "(I candela, default 1), dir:DX,DY,DZ:R,G,B[:E] (shining along D, E lux),\n"
      "spot:X,Y,Z:DX,DY,DZ:R,G,B[:I[:INNER[:OUTER]]] (half-angles, default 0 and 45\n"
      "degrees), sky:R,G,B[:R,G,B] (radiance from above[, from below: a gradient])"},
-    {"shadows", OPT_SHADOWS, "MODE", "lit: none, rays (default: shadow rays through the ray streams)"},
+    {"shadows", OPT_SHADOWS, "MODE", "lit: none, rays (default: shadow rays through the ray streams), raster\n"
+                                     "(point and spot lights rasterized from the light, the same bits), auto"},
     {"max-depth", OPT_MAX_DEPTH, "N", "lit: most mirror bounces, 0.." VALUE(RR_MAX_DEPTH) " (default 2)"},
     {"aa", OPT_AA, "MODE",
      "anti-aliasing: none (default), ssaa:N (N samples, each shaded), msaa:N (shaded\n"
@@ -1050,9 +1051,7 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
       break;
     case OPT_SHADOWS: {
       int m = rr_shadows_from_name(optarg);
-      if (m == RR_SHADOWS_RASTER)
-        die(EXIT_USAGE, "--shadows raster (3D rasterization from the light) is not implemented yet; use rays or none");
-      if (m < 0) die(EXIT_USAGE, "unknown shadow mode '%s' for --shadows (expected none or rays)", optarg);
+      if (m < 0) die(EXIT_USAGE, "unknown shadow mode '%s' for --shadows (expected none, rays, raster or auto)", optarg);
       shading.shadows = (rr_shadow_mode)m;
       break;
     }

@@ -188,24 +188,42 @@ KERNEL tri_v4 tri_v4_edge_cross(tri_v4 a, tri_v4 b, rr_vi4 *neg) {
 }
 /* Negation is exact and rounding symmetric, so x·(−m) is −(x·m) up to the sign of
  * a zero, which no test below tells apart: the signs (the edge's and σ) are
- * applied to the dot products as sign bits. */
-KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3], rr_vf4 out[4]) {
+ * applied to the dot products as sign bits. The part that depends on the eye
+ * alone (the edge normals, their signs, the volume) is set up once for rays
+ * sharing an origin (tri4_edges_setup: a leaf's triangles seen from a light);
+ * tri4_edges_test is the part each direction pays. */
+typedef struct {
+  tri_v4 m[3];    /* h × (l − h) of each edge */
+  rr_vi4 sgn[3];  /* the sign bits that turn m·d into the edge value: the edge's and σ */
+  rr_vf4 vol;     /* q0·n0 */
+  rr_vi4 ok;      /* the volume is not 0 and finite: the triangle is not edge-on */
+} tri4_edges;
+KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 eye[3], tri4_edges *te) {
   tri_v4 q[3];
   for (int k = 0; k < 3; k++)
     q[k] = (tri_v4){rr_vf4_load(v + (3 * k) * stride) - eye[0], rr_vf4_load(v + (3 * k + 1) * stride) - eye[1],
                     rr_vf4_load(v + (3 * k + 2) * stride) - eye[2]};
-  tri_v4 dv = {d[0], d[1], d[2]};
   rr_vi4 neg[3];
-  tri_v4 m0 = tri_v4_edge_cross(q[1], q[2], &neg[0]), m1 = tri_v4_edge_cross(q[2], q[0], &neg[1]),
-         m2 = tri_v4_edge_cross(q[0], q[1], &neg[2]);
-  rr_vf4 vol = (rr_vf4)((rr_vi4)tri_v4_dot(q[0], m0) ^ neg[0]);
+  te->m[0] = tri_v4_edge_cross(q[1], q[2], &neg[0]), te->m[1] = tri_v4_edge_cross(q[2], q[0], &neg[1]),
+  te->m[2] = tri_v4_edge_cross(q[0], q[1], &neg[2]);
+  rr_vf4 vol = (rr_vf4)((rr_vi4)tri_v4_dot(q[0], te->m[0]) ^ neg[0]);
   rr_vi4 sigma = (rr_vi4)vol & (rr_vi4)rr_vf4_splat(-0.0f); /* σ = −1 where the volume is negative */
-  rr_vf4 a0 = (rr_vf4)((rr_vi4)tri_v4_dot(m0, dv) ^ neg[0] ^ sigma),
-         a1 = (rr_vf4)((rr_vi4)tri_v4_dot(m1, dv) ^ neg[1] ^ sigma),
-         a2 = (rr_vf4)((rr_vi4)tri_v4_dot(m2, dv) ^ neg[2] ^ sigma);
-  out[0] = a0, out[1] = a1, out[2] = a2, out[3] = vol;
-  rr_vi4 may = (vol != 0) & (rr_vf4_abs(vol) < INFINITY) & (a0 >= 0) & (a1 >= 0) & (a2 >= 0);
-  return rr_vi4_bits(may);
+  for (int e = 0; e < 3; e++) te->sgn[e] = neg[e] ^ sigma;
+  te->vol = vol;
+  te->ok = (vol != 0) & (rr_vf4_abs(vol) < INFINITY);
+}
+KERNEL int tri4_edges_test(const tri4_edges *te, const rr_vf4 d[3], rr_vf4 out[4]) {
+  tri_v4 dv = {d[0], d[1], d[2]};
+  rr_vf4 a0 = (rr_vf4)((rr_vi4)tri_v4_dot(te->m[0], dv) ^ te->sgn[0]),
+         a1 = (rr_vf4)((rr_vi4)tri_v4_dot(te->m[1], dv) ^ te->sgn[1]),
+         a2 = (rr_vf4)((rr_vi4)tri_v4_dot(te->m[2], dv) ^ te->sgn[2]);
+  out[0] = a0, out[1] = a1, out[2] = a2, out[3] = te->vol;
+  return rr_vi4_bits(te->ok & (a0 >= 0) & (a1 >= 0) & (a2 >= 0));
+}
+KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3], rr_vf4 out[4]) {
+  tri4_edges te;
+  tri4_edges_setup(v, stride, eye, &te);
+  return tri4_edges_test(&te, d, out);
 }
 
 /* The inclusive pixel rectangle a set-up triangle's samples may lie in; false when

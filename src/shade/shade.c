@@ -676,9 +676,6 @@ rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam,
     return e;
   }
   bool lit = opt->mode == RR_SHADE_LIT;
-  if (lit && opt->shadows == RR_SHADOWS_RASTER)
-    return rr_fail(dev, RR_ERROR_UNSUPPORTED,
-                   "shadows by rasterization from the light are not implemented yet (use rays or none)");
   if (lit && ((int)opt->shadows < 0 || opt->shadows >= RR_SHADOWS_COUNT))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shadow mode %d", (int)opt->shadows);
   if (lit && (opt->max_depth < 0 || opt->max_depth > RR_MAX_DEPTH))

@@ -21,6 +21,7 @@
  * so any number of threads may trace rays through one committed scene. A stream
  * (rr_intersect_stream, rr_occluded_stream) traces each ray the same way. */
 #include "vis/bvh_trace.h"
+#include "vis/ray_test.h"
 
 #include <limits.h>
 #include <stdatomic.h>
@@ -36,9 +37,7 @@ typedef struct {
   uint32_t id;
   const rr_scene *s;
   const rr_bvh *b; /* NULL for an empty scene: every ray misses */
-  bool cam_ready;  /* cam is made for the first full test: many rays need none */
-  bool small;      /* the scene and direction keep the setup's b_i, c_i finite (query_leaf) */
-  camera cam;
+  ray_cam rc;      /* made for the first full test (vis/ray_test.h) */
 } query_ray;
 
 /* The slots whose box the ray meets within [max(tmin, 0), best t], nearest entry
@@ -62,20 +61,6 @@ KERNEL int query_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, 
   return rr_vi4_bits(t0 <= t1);
 }
 
-/* Whether the setup's b_i, c_i (n_i·dx, n_i·dy) are finite for every finite
- * triangle of s: |n_i| ≤ 4Q² (per axis, up to rounding) for corners within Q of the
- * origin, so |b_i|, |c_i| ≤ 12·Q²·D for dx, dy within D, far below FLT_MAX for
- * Q, D < 1e12. NaN (no finite corner) is not small. */
-static bool query_small(const rr_scene *s, const float org[3], const camera *c) {
-  const float lo[3] = {s->bmin.x, s->bmin.y, s->bmin.z}, hi[3] = {s->bmax.x, s->bmax.y, s->bmax.z};
-  const float dx[3] = {c->dx.x, c->dx.y, c->dx.z}, dy[3] = {c->dy.x, c->dy.y, c->dy.z};
-  bool small = true;
-  for (int a = 0; a < 3; a++)
-    small &= fabsf(lo[a] - org[a]) < 1e12f && fabsf(hi[a] - org[a]) < 1e12f && fabsf(dx[a]) < 1e12f &&
-             fabsf(dy[a]) < 1e12f;
-  return small;
-}
-
 /* Tests a leaf's triangles, keeping the nearest hit; `any`: stops at the first.
  * Four at a time through the edge pre-test, then the full test for the lanes
  * that pass it (and for triangles with corners at infinity, which it cannot
@@ -91,23 +76,10 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
       for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, r->b->prims[first + j + k]) != 0) << k;
     for (; may; may &= may - 1) {
       uint32_t lane = (uint32_t)__builtin_ctz(may), id = r->b->prims[first + j + lane];
-      float t, l1, l2;
-      if (!r->cam_ready) {
-        float org[3] = {r->q.o[0][0], r->q.o[1][0], r->q.o[2][0]}, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
-        rr_cam_for_ray(org, dir, &r->cam);
-        r->cam_ready = true;
-        r->small = query_small(r->s, org, &r->cam);
-      }
-      /* Edge values all positive are the sample test's (tri_ray_may_hit4): no tie,
-       * no sign of a zero to settle, only the plane left to compute. */
-      const float e[3] = {pre[0][lane], pre[1][lane], pre[2][lane]};
-      bool hit;
-      if (r->s->inf && scene_inf(r->s, id))
-        hit = rr_tri_ray_hit(r->s, id, &r->cam, false, r->tmin, r->t, &t, &l1, &l2);
-      else if (r->small && e[0] > 0 && e[1] > 0 && e[2] > 0)
-        hit = rr_tri_ray_finish(r->s, id, &r->cam, e, 0, pre[3][lane], r->tmin, r->t, &t, &l1, &l2);
-      else
-        hit = rr_tri_ray_hit1(r->s, id, &r->cam, r->tmin, r->t, &t, &l1, &l2);
+      float t, l1, l2, org[3] = {r->q.o[0][0], r->q.o[1][0], r->q.o[2][0]},
+                       dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
+      const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
+      bool hit = ray_tri_test(r->s, id, &r->rc, org, dir, e, r->tmin, r->t, &t, &l1, &l2);
       if (!hit) continue;
       if (any) return true;
       if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
@@ -128,19 +100,10 @@ KERNEL bool query_leaf_any(void *q, uint32_t first, uint32_t count, uint64_t lan
 
 KERNEL float query_best(const void *q) { return ((const query_ray *)q)->t; }
 
-/* Why a ray cannot be traced, or NULL. */
-static const char *ray_problem(const float org[3], const float dir[3], float tmin, float tmax) {
-  for (int a = 0; a < 3; a++)
-    if (!isfinite(org[a]) || !isfinite(dir[a])) return "a non-finite origin or direction";
-  if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0) return "a zero direction";
-  if (isnan(tmin) || isnan(tmax)) return "a NaN range";
-  return NULL;
-}
-
 /* Prepares a valid ray against the scene's tree b (NULL: an empty scene). */
 static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const float org[3], const float dir[3],
                        float tmin, float tmax) {
-  r->s = s, r->b = b, r->cam_ready = false;
+  r->s = s, r->b = b, r->rc.ready = false;
   ray_q_init(&r->q, v3_load(org), v3_load(dir));
   for (int a = 0; a < 3; a++) {
     r->inv_far[a] = r->q.inv[a] * rr_vf4_splat(1 + RAY_MARGIN);

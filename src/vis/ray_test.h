@@ -1,0 +1,61 @@
+/* One ray against one triangle, after the edge pre-test (prim/triangle.h:
+ * tri4_edges_test) let it through: the test of rr_intersect and rr_occluded
+ * (vis/ray_query.c), written once so that shadows by rasterization from a light
+ * (vis/shadow_raster.c) test each (sample, triangle) pair with the same bits. */
+#ifndef RR_RAY_TEST_H
+#define RR_RAY_TEST_H
+
+#include "prim/triangle.h"
+
+/* Whether the setup's b_i, c_i (n_i·dx, n_i·dy) are finite for every finite
+ * triangle of s seen by the ray camera c from org: |n_i| ≤ 4Q² (per axis, up to
+ * rounding) for corners within Q of the origin, so |b_i|, |c_i| ≤ 12·Q²·D for dx,
+ * dy within D, far below FLT_MAX for Q, D < 1e12. NaN (no finite corner) is not small. */
+static inline bool ray_small(const rr_scene *s, const float org[3], const camera *c) {
+  const float lo[3] = {s->bmin.x, s->bmin.y, s->bmin.z}, hi[3] = {s->bmax.x, s->bmax.y, s->bmax.z};
+  const float dx[3] = {c->dx.x, c->dx.y, c->dx.z}, dy[3] = {c->dy.x, c->dy.y, c->dy.z};
+  bool small = true;
+  for (int a = 0; a < 3; a++)
+    small &= fabsf(lo[a] - org[a]) < 1e12f && fabsf(hi[a] - org[a]) < 1e12f && fabsf(dx[a]) < 1e12f &&
+             fabsf(dy[a]) < 1e12f;
+  return small;
+}
+
+/* Why a ray cannot be traced, or NULL. */
+static inline const char *ray_problem(const float org[3], const float dir[3], float tmin, float tmax) {
+  for (int a = 0; a < 3; a++)
+    if (!isfinite(org[a]) || !isfinite(dir[a])) return "a non-finite origin or direction";
+  if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0) return "a zero direction";
+  if (isnan(tmin) || isnan(tmax)) return "a NaN range";
+  return NULL;
+}
+
+/* A ray's pseudo-camera, made when its first triangle passes the pre-test (many
+ * rays need none). */
+typedef struct {
+  bool ready, small;
+  camera cam;
+} ray_cam;
+
+/* The full test of triangle id for the ray (org, dir) whose pre-test values are
+ * pre (edge values e_0..e_2 and the volume q0·n0): with the pre-test's edge values
+ * where all are positive (rr_tri_ray_finish), else with the part of the setup the
+ * ray's one sample reads (rr_tri_ray_hit1), or, for corners at infinity, the full
+ * setup (rr_tri_ray_hit) — the same bits each way. True on a hit in [tmin, tmax]. */
+KERNEL bool ray_tri_test(const rr_scene *s, uint32_t id, ray_cam *rc, const float org[3], const float dir[3],
+                                const float pre[4], float tmin, float tmax, float *t, float *l1, float *l2) {
+  if (!rc->ready) {
+    rr_cam_for_ray(org, dir, &rc->cam);
+    rc->ready = true;
+    rc->small = ray_small(s, org, &rc->cam);
+  }
+  /* Edge values all positive are the sample test's: no tie, no sign of a zero to
+   * settle, only the plane left to compute. */
+  const float e[3] = {pre[0], pre[1], pre[2]};
+  if (s->inf && scene_inf(s, id)) return rr_tri_ray_hit(s, id, &rc->cam, false, tmin, tmax, t, l1, l2);
+  if (rc->small && e[0] > 0 && e[1] > 0 && e[2] > 0)
+    return rr_tri_ray_finish(s, id, &rc->cam, e, 0, pre[3], tmin, tmax, t, l1, l2);
+  return rr_tri_ray_hit1(s, id, &rc->cam, tmin, tmax, t, l1, l2);
+}
+
+#endif

@@ -1,0 +1,235 @@
+/* Shadows by rasterization from the light (vis/shadow_raster.c) against shadow
+ * rays: the same occlusion bit as rr_occluded for every ray of a light, on random
+ * lights (outside the scene, inside its bounds, inside a closed mesh, exactly on a
+ * surface) and target points (surface points seen from random views, inside views
+ * too, and rays through vertices and edges, where the tie rule decides), on 1, 2
+ * and 8 threads; lit images with point and spot lights the same bits with
+ * --shadows rays, raster and auto; an empty scene. */
+#include "vis/shadow_raster.h"
+#include "testutil.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static rr_device *dev;
+static uint32_t rng = 0x2545F491u;
+
+static float frand(void) { /* [0, 1) */
+  rng ^= rng << 13, rng ^= rng >> 17, rng ^= rng << 5;
+  return (float)(rng >> 8) / 16777216.0f;
+}
+
+static rr_scene *load(const char *name) {
+  rr_scene *s = NULL;
+  CHECK(rr_scene_load(dev, name, &s) == RR_OK, "%s: %s", name, rr_device_message(dev));
+  return s;
+}
+
+static vec3 corner(const rr_scene *s, int k, uint32_t i) { return scene_vertex(s, k, i); }
+
+/* The scene's bounds, widened by a tenth of their diagonal (a plane's have no
+ * height): a point at (fx, fy, fz) of them. */
+static vec3 in_bounds(const rr_scene *s, float fx, float fy, float fz) {
+  vec3 e = v3_sub(s->bmax, s->bmin);
+  float pad = 0.1f * v3_len(e);
+  vec3 lo = v3_sub(s->bmin, v3(pad, pad, pad));
+  e = v3_add(e, v3(2 * pad, 2 * pad, 2 * pad));
+  return v3(lo.x + fx * e.x, lo.y + fy * e.y, lo.z + fz * e.z);
+}
+
+/* Target points: surface points seen by random rays from `eye` (their hit points,
+ * pulled towards the light by a little, as shading's offset does, or exact),
+ * triangles' corners and edge midpoints (rays through vertices and edges), and
+ * points beyond corners (rays that graze a vertex on their way). */
+static size_t targets(const rr_scene *s, vec3 eye, vec3 light, vec3 *out, size_t n) {
+  size_t m = 0;
+  for (size_t k = 0; k < n; k++) {
+    float kind = frand();
+    uint32_t i = (uint32_t)(frand() * (float)s->ntris) % s->ntris;
+    vec3 p;
+    if (kind < 0.6f) {
+      vec3 d = v3(frand() - 0.5f, frand() - 0.5f, frand() - 0.5f);
+      rr_ray r = {{eye.x, eye.y, eye.z}, {d.x, d.y, d.z}, 0, INFINITY};
+      rr_hit h;
+      if (rr_intersect(dev, s, &r, &h) != RR_OK || h.prim == RR_MISS) continue;
+      p = v3_add(eye, v3_scale(d, h.t));
+      if (kind < 0.45f) p = v3_add(p, v3_scale(v3_sub(light, p), 1e-4f));
+    } else if (kind < 0.75f) {
+      p = corner(s, (int)(frand() * 3) % 3, i);
+    } else if (kind < 0.9f) {
+      p = v3_scale(v3_add(corner(s, 0, i), corner(s, 1, i)), 0.5f);
+    } else {
+      p = v3_add(light, v3_scale(v3_sub(corner(s, 2, i), light), 1.5f));
+    }
+    out[m++] = p;
+  }
+  return m;
+}
+
+/* Every ray from light to the points: rr_occluded_raster on 1, 2, 8 threads
+ * against rr_occluded ray by ray. Adds the occluded and lit counts to seen[]. */
+static void check_light(const rr_scene *s, vec3 light, const vec3 *pts, size_t n, const char *what, size_t seen[2]) {
+  rr_ray *rays = malloc(n * sizeof *rays);
+  int *ref = malloc(n * sizeof *ref), *got = malloc(n * sizeof *got);
+  if (!rays || !ref || !got) {
+    CHECK(0, "out of memory");
+    free(rays), free(ref), free(got);
+    return;
+  }
+  for (size_t k = 0; k < n; k++) {
+    vec3 d = v3_sub(pts[k], light);
+    rays[k] = (rr_ray){{light.x, light.y, light.z}, {d.x, d.y, d.z}, 0, 1};
+    ref[k] = 0;
+    rr_occluded(NULL, s, &rays[k], &ref[k]);
+    seen[ref[k] != 0]++;
+  }
+  bool empty;
+  const rr_bvh *b = rr_bvh_of(dev, s, &empty);
+  for (int ti = 0; ti < TEST_NTHREADS; ti++) {
+    rr_shadow_counts c;
+    bool ok = rr_occluded_raster(s, b, rays, n, test_threads[ti], got, &c);
+    size_t diff = 0, first = 0;
+    for (size_t k = 0; k < n; k++)
+      if ((got[k] != 0) != (ref[k] != 0)) first = diff++ ? first : k;
+    CHECK(ok && diff == 0, "%s, %d threads: %zu of %zu rays differ from rr_occluded (first: ray %zu, raster %d)", what,
+          test_threads[ti], diff, n, first, got[first]);
+    CHECK(empty || c.bins > 0, "%s: no bins", what);
+  }
+  free(rays), free(ref), free(got);
+}
+
+/* Random lights and targets in scene `name`. */
+static void check_scene(const char *name, int lights, size_t npts) {
+  rr_scene *s = load(name);
+  if (!s) return;
+  vec3 *pts = malloc(npts * sizeof *pts);
+  size_t seen[2] = {0, 0};
+  char what[160];
+  for (int l = 0; l < lights && pts; l++) {
+    vec3 light, eye;
+    const char *where;
+    int kind = l % 4;
+    if (kind == 0) { /* outside, above */
+      light = in_bounds(s, frand() * 3 - 1, 1.5f + frand(), frand() * 3 - 1), where = "outside";
+    } else if (kind == 1) { /* inside the bounds */
+      light = in_bounds(s, frand(), frand(), frand()), where = "inside the bounds";
+    } else if (kind == 2) { /* exactly on a corner of a triangle */
+      light = corner(s, 0, (uint32_t)(frand() * (float)s->ntris) % s->ntris), where = "on a vertex";
+    } else { /* on a triangle (within its plane's rounding) */
+      uint32_t i = (uint32_t)(frand() * (float)s->ntris) % s->ntris;
+      vec3 p0 = corner(s, 0, i);
+      light = v3_add(p0, v3_add(v3_scale(v3_sub(corner(s, 1, i), p0), 0.25f), v3_scale(v3_sub(corner(s, 2, i), p0), 0.5f)));
+      where = "on a surface";
+    }
+    /* targets seen from an eye inside or outside the bounds */
+    eye = l % 2 ? in_bounds(s, 0.3f + 0.4f * frand(), 0.3f + 0.4f * frand(), 0.3f + 0.4f * frand())
+                : in_bounds(s, frand() * 3 - 1, frand() * 3 - 1, frand() * 3 - 1);
+    size_t n = targets(s, eye, light, pts, npts);
+    snprintf(what, sizeof what, "%s, light %d %s (%g, %g, %g)", name, l, where, light.x, light.y, light.z);
+    check_light(s, light, pts, n, what, seen);
+  }
+  CHECK(seen[0] > 0 && seen[1] > 0, "%s: %zu lit and %zu occluded rays: the test sees only one kind", name, seen[0],
+        seen[1]);
+  free(pts);
+  rr_scene_release(s);
+}
+
+/* Lit images: shadows by rays, raster and auto give the same bits on random views
+ * (inside ones too) with a point and a spot light, frames on 1, 2, 8 threads. */
+static void check_lit(const char *name, bool inside) {
+  rr_scene *s = load(name);
+  if (!s) return;
+  vec3 c = v3_scale(v3_add(s->bmin, s->bmax), 0.5f), ext = v3_sub(s->bmax, s->bmin);
+  rr_light_info pt = {.type = RR_LIGHT_POINT, .color = {2, 2, 2}};
+  v3_store(pt.position, inside ? v3_add(c, v3_scale(ext, 0.2f)) : v3_add(c, v3(0.3f * ext.x, ext.y, 0.4f * ext.z)));
+  rr_light_info sp = {.type = RR_LIGHT_SPOT, .color = {3, 2, 1}, .inner_cone_deg = 10, .outer_cone_deg = 35};
+  v3_store(sp.position, inside ? v3_sub(c, v3_scale(ext, 0.2f)) : v3_add(c, v3(-0.5f * ext.x, 0.8f * ext.y, 0)));
+  v3_store(sp.direction, v3_sub(c, v3_load(sp.position)));
+  CHECK(rr_scene_add_light(s, &pt) == RR_OK && rr_scene_add_light(s, &sp) == RR_OK, "%s", rr_device_message(dev));
+  int views = test_quick() ? 1 : 3;
+  for (int v = 0; v < views; v++) {
+    rr_camera cam = inside ? test_random_view(s, 0.1f, 0.3f, 0.2f, 60, 90) : test_random_view(s, 1.5f, 3, 0.3f, 30, 60);
+    for (int ti = 0; ti < TEST_NTHREADS + 1; ti++) {
+      /* the last: 16 samples per pixel, whose batches are long enough for auto to rasterize */
+      rr_render_options o;
+      rr_render_options_init(&o);
+      o.method = RR_METHOD_3DR_BB, o.width = 96, o.height = 72, o.threads = test_threads[ti % TEST_NTHREADS];
+      if (ti == TEST_NTHREADS)
+        CHECK(rr_render_options_set_aa(dev, &o, RR_AA_SSAA, 16, 0, RR_AA_STANDARD, 0) == RR_OK, "%s",
+              rr_device_message(dev));
+      rr_frame *f = test_render_opt(dev, s, &cam, &o);
+      if (!f) continue;
+      float *img[3] = {NULL, NULL, NULL};
+      rr_shadow_mode modes[3] = {RR_SHADOWS_RAYS, RR_SHADOWS_RASTER, RR_SHADOWS_AUTO};
+      uint64_t rays = 0;
+      for (int m = 0; m < 3; m++) {
+        rr_shade_options so;
+        rr_shade_options_init(&so);
+        so.mode = RR_SHADE_LIT, so.shadows = modes[m], so.max_depth = 1;
+        rr_image im = {0};
+        rr_shade_stats st;
+        CHECK(rr_shade_frame(dev, s, &cam, f, &so, &im, &st) == RR_OK, "%s", rr_device_message(dev));
+        img[m] = im.data;
+        if (m == 0) rays = st.shadow_rays;
+        CHECK(st.shadow_rays == rays, "%s: mode %d traced %llu shadow rays, rays %llu", name, m,
+              (unsigned long long)st.shadow_rays, (unsigned long long)rays);
+      }
+      for (int m = 1; m < 3; m++) {
+        size_t diff = 0;
+        for (size_t k = 0; img[0] && img[m] && k < (size_t)96 * 72 * 3; k++) diff += memcmp(&img[0][k], &img[m][k], 4) != 0;
+        CHECK(img[0] && img[m] && diff == 0, "%s view %d, %d threads%s: %zu channels of the %s image differ from rays",
+              name, v, test_threads[ti % TEST_NTHREADS], ti == TEST_NTHREADS ? ", ssaa:16" : "", diff,
+              m == 1 ? "raster" : "auto");
+      }
+      CHECK(rays > 0, "%s view %d: no shadow rays", name, v);
+      for (int m = 0; m < 3; m++) free(img[m]);
+      rr_frame_release(f);
+    }
+  }
+  rr_scene_release(s);
+}
+
+/* An empty scene: nothing occludes, and the lit mode shades it. */
+static void check_empty(void) {
+  rr_scene *s = NULL;
+  CHECK(rr_scene_new(dev, &s) == RR_OK && rr_scene_commit(s) == RR_OK, "%s", rr_device_message(dev));
+  if (!s) return;
+  rr_ray r[3] = {{{0, 0, 0}, {1, 0, 0}, 0, 1}, {{0, 0, 0}, {0, 0, 0}, 0, 1}, {{1, 0, 0}, {0, 1, 0}, 0, 1}};
+  int occ[3] = {7, 7, 7};
+  bool empty;
+  CHECK(rr_occluded_raster(s, rr_bvh_of(dev, s, &empty), r, 3, 2, occ, NULL) && !occ[0] && !occ[1] && !occ[2],
+        "empty scene: %d %d %d", occ[0], occ[1], occ[2]);
+  rr_light_info pt = {.type = RR_LIGHT_POINT, .position = {0, 1, 0}, .color = {1, 1, 1}};
+  CHECK(rr_scene_add_light(s, &pt) == RR_OK, "%s", rr_device_message(dev));
+  rr_camera cam;
+  rr_camera_init(&cam);
+  rr_frame *f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 2, 16, 16, 0);
+  rr_shade_options so;
+  rr_shade_options_init(&so);
+  so.mode = RR_SHADE_LIT, so.shadows = RR_SHADOWS_RASTER;
+  rr_image im = {0};
+  CHECK(f && rr_shade_frame(dev, s, &cam, f, &so, &im, NULL) == RR_OK && im.data, "empty lit: %s",
+        rr_device_message(dev));
+  free(im.data);
+  rr_frame_release(f);
+  rr_scene_release(s);
+}
+
+int main(void) {
+  dev = rr_device_new();
+  bool quick = test_quick();
+  size_t npts = quick ? 1500 : 20000;
+  check_scene("demo", quick ? 4 : 16, npts);
+  check_scene("sphere:24", quick ? 4 : 8, npts); /* closed: lights and eyes inside it */
+  check_scene("plane:16", 4, npts);              /* shared vertices and edges on a regular grid */
+  check_scene("box:3", 8, npts);
+  if (!quick) {
+    const char *bunny = test_model("stanford-bunny.obj");
+    if (bunny) check_scene(bunny, 4, npts);
+  }
+  check_lit("demo", false);
+  check_lit("sphere:24", true);
+  check_empty();
+  rr_device_release(dev);
+  return test_done();
+}
