@@ -476,7 +476,7 @@ static void errors(void) {
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"texture_filter\": \"aniso:32\"}}",
        "'render.texture_filter'"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"shade\": \"toon\"}}", "'render.shade'"},
-      {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"shadows\": \"raster\"}}", "not implemented"},
+      {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"shadows\": \"shadow-map\"}}", "none, rays, raster or auto"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"max_depth\": 1.5}}", "'render.max_depth': expected an integer"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"max_depth\": 99}}", "'render.max_depth'"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"alpha\": \"yes\"}}", "'render.alpha'"},

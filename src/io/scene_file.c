@@ -238,9 +238,7 @@ static rr_error read_render(json_reader *r, const cJSON *obj, rr_scene_settings 
     return e;
   so->mode = (rr_shade_mode)v;
   v = so->shadows;
-  if ((e = rr_json_named(r, obj, "shadows", rr_shadows_from_name, "none or rays", &v))) return e;
-  /* Shadows by rasterization from the light are not built yet: refused as the command line refuses them. */
-  if (v == RR_SHADOWS_RASTER) return rr_json_fail(r, "shadows", "raster is not implemented yet (expected none or rays)");
+  if ((e = rr_json_named(r, obj, "shadows", rr_shadows_from_name, "none, rays, raster or auto", &v))) return e;
   so->shadows = (rr_shadow_mode)v;
   if ((e = rr_json_int(r, obj, "max_depth", 0, RR_MAX_DEPTH, &so->max_depth))) return e;
   const char *text, *arg;
