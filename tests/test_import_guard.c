@@ -78,6 +78,26 @@ static void make_files(void) {
   unsigned char stl[134] = {0};
   put32(stl + 80, 1000000);
   write_bytes("short.stl", stl, sizeof stl);
+  /* glTF buffers longer than their data: a data URI, a file beside it */
+  static const char gltf_uri[] =
+      "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":4000000000,"
+      "\"uri\":\"data:application/octet-stream;base64,AAAAAAAAAAAAAAAA\"}]}";
+  write_bytes("uri.gltf", gltf_uri, sizeof gltf_uri - 1);
+  static const char gltf_file[] =
+      "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":12},{\"uri\":\"small%20data.bin\","
+      "\"byteLength\":3000000000}]}";
+  write_bytes("file.gltf", gltf_file, sizeof gltf_file - 1);
+  write_bytes("small data.bin", "0123456789ab", 12);
+  /* a GLB whose buffer is longer than its BIN chunk */
+  {
+    static const char js[] = "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":1000000}]}  ";
+    unsigned char g2[12 + 8 + sizeof js - 1 + 8 + 36] = {0};
+    size_t jn = sizeof js - 1; /* a multiple of 4 */
+    memcpy(g2, "glTF", 4), put32(g2 + 4, 2), put32(g2 + 8, sizeof g2);
+    put32(g2 + 12, (uint32_t)jn), memcpy(g2 + 16, "JSON", 4), memcpy(g2 + 20, js, jn);
+    put32(g2 + 20 + jn, 36), memcpy(g2 + 24 + jn, "BIN", 4);
+    write_bytes("bin.glb", g2, sizeof g2);
+  }
   /* a valid triangle, for the child's crash */
   static const char obj[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
   write_bytes("tri.obj", obj, sizeof obj - 1);
@@ -314,6 +334,9 @@ int main(void) {
   check_cli("chunk.glb", "4286578688");
   check_cli("trunc.ply", "truncated PLY header");
   check_cli("short.stl", "1000000 triangles");
+  check_cli("bin.glb", "declares 1000000 bytes but its BIN chunk holds 36");
+  check_cli("uri.gltf", "declares 4000000000 bytes but its data URI holds 12");
+  check_cli("file.gltf", "buffer 1 declares 3000000000 bytes but its file holds 12");
   /* the largest size the options accept, on a cube camera: refused before any work */
   {
     char out[4096], png[600];
