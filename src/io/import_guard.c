@@ -486,6 +486,8 @@ static rr_error import_guarded(rr_scene *s, const char *path, const rr_import_li
     got += keep;
   }
   msg[got] = 0;
+  for (char *c = msg; *c; c++) /* one line, whatever the child sent */
+    if (*c == '\n' || *c == '\r') *c = ' ';
   close(pipefd[0]);
   if (timed_out) kill(pid, SIGKILL);
   int status = 0;
