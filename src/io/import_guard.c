@@ -370,8 +370,8 @@ static void child_main(rr_device *dev, const char *path, const rr_import_limits 
   prctl(PR_SET_PDEATHSIG, SIGKILL); /* the parent gone, nobody waits for the import */
 #endif
   if (getppid() != parent) _exit(127);
-  /* other threads' pipes to their own import children stay open in a fork: closed,
-   * so that their parents see their children end when those do */
+  /* a fork in another thread between its pipe() and its close() of the write end
+   * copies that end here: closed, so that its parent sees its own child end */
   DIR *fds = opendir("/proc/self/fd");
   for (struct dirent *d; fds && (d = readdir(fds));) {
     int fd = atoi(d->d_name);
