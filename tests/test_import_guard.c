@@ -223,7 +223,7 @@ static void *hanging_load(void *arg) {
   rr_device *d = rr_device_new();
   rr_import_limits lim;
   rr_import_limits_init(&lim);
-  lim.timeout_s = 4;
+  lim.timeout_s = 2.5;
   rr_device_set_import_limits(d, &lim);
   rr_device_set_import_test_hook(d, IMPORT_HOOK_NO_CHECK);
   rr_scene *s = NULL;
