@@ -133,7 +133,8 @@ typedef struct rr_import_limits {
   uint64_t max_memory; /* most bytes an import may allocate; 0: no limit (default: half the physical memory) */
   int in_process;      /* nonzero: import in the calling process (no fork; no time or memory limit, and
                           an importer crash is the caller's); the structural checks still run */
-  int importer_log;    /* nonzero: the importer's own messages reach stderr (default 0: discarded) */
+  int importer_log;    /* nonzero: the child's importer messages reach stderr (default 0: discarded;
+                          in process they go wherever the importer sends them) */
 } rr_import_limits;
 
 /* Fills import limits with defaults: 60 s, half the physical memory, in a child process, quiet. */

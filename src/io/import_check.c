@@ -283,7 +283,9 @@ static bool check_stl(span f, char *why, size_t cap) {
   return true;
 }
 
-static bool check_glb(span f, char *why, size_t cap) {
+static bool check_gltf_json(const char *path, span text, uint64_t bin, char *why, size_t cap);
+
+static bool check_glb(const char *path, span f, char *why, size_t cap) {
   if (f.n < 20) return refuse(why, cap, "GLB of %zu bytes, shorter than its header", f.n);
   uint32_t version = le32(f.p + 4), length = le32(f.p + 8);
   if (length > f.n)
@@ -295,21 +297,195 @@ static bool check_glb(span f, char *why, size_t cap) {
     return true;
   }
   size_t pos = 12;
+  span text = {NULL, 0};
+  uint64_t bin = 0;
   for (int k = 0; pos + 8 <= f.n; k++) {
     uint32_t clen = le32(f.p + pos);
     pos += 8;
     if (clen > f.n - pos)
       return refuse(why, cap, "GLB chunk %d declares %u bytes but %zu remain", k, clen, f.n - pos);
+    if (k == 0 && !memcmp(f.p + pos - 4, "JSON", 4)) text = (span){f.p + pos, clen};
+    if (k == 1 && !memcmp(f.p + pos - 4, "BIN", 4)) bin = clen;
     pos += clen;
   }
+  return !text.p || check_gltf_json(path, text, bin, why, cap);
+}
+
+/* glTF's buffers: each byteLength must fit in the data it names: a data: URI's
+ * decoded bytes, a file beside the glTF, or (no uri, in a GLB) the BIN chunk. A
+ * small JSON walker finds "buffers" at the top level; anything it does not
+ * understand passes to assimp, which runs under the guard's limits. */
+
+typedef struct json {
+  const unsigned char *p, *end;
+  int depth;
+  bool bad;
+} json;
+
+static void json_ws(json *j) {
+  while (j->p < j->end && (*j->p == ' ' || *j->p == '\t' || *j->p == '\n' || *j->p == '\r')) j->p++;
+}
+
+static bool json_eat(json *j, char c) {
+  json_ws(j);
+  if (j->p < j->end && *j->p == (unsigned char)c) return j->p++, true;
+  return false;
+}
+
+/* A string's raw bytes (escapes left as they are) in *s, *n. */
+static bool json_string(json *j, const unsigned char **s, size_t *n) {
+  if (!json_eat(j, '"')) return j->bad = true, false;
+  const unsigned char *start = j->p;
+  while (j->p < j->end && *j->p != '"') j->p += *j->p == '\\' ? 2 : 1;
+  if (j->p >= j->end) return j->bad = true, false;
+  *s = start, *n = (size_t)(j->p - start);
+  j->p++;
   return true;
 }
 
-/* glTF's buffers: each byteLength must fit in the data it names (a data: URI's
- * decoded bytes, or a file beside the glTF). A small scan of the JSON for
- * "byteLength" and "uri" pairs inside "buffers" would need a JSON parser to be
- * exact; the check is left to the limits instead (assimp reads the file's bytes
- * before allocating a buffer for them). */
+static void json_skip(json *j);
+
+/* Calls member(j, key, key_len, user) for each member of an object; the callback
+ * reads (or skips) the value. */
+static void json_object(json *j, void (*member)(json *, const unsigned char *, size_t, void *), void *user) {
+  if (!json_eat(j, '{')) return (void)(j->bad = true);
+  if (json_eat(j, '}')) return;
+  do {
+    const unsigned char *k;
+    size_t n;
+    if (!json_string(j, &k, &n) || !json_eat(j, ':')) return (void)(j->bad = true);
+    member(j, k, n, user);
+  } while (!j->bad && json_eat(j, ','));
+  if (!json_eat(j, '}')) j->bad = true;
+}
+
+static void skip_member(json *j, const unsigned char *k, size_t n, void *user) {
+  (void)k, (void)n, (void)user;
+  json_skip(j);
+}
+
+static void json_skip(json *j) {
+  json_ws(j);
+  if (j->p >= j->end || ++j->depth > 256) return (void)(j->bad = true);
+  if (*j->p == '{') json_object(j, skip_member, NULL);
+  else if (*j->p == '[') {
+    j->p++;
+    if (!json_eat(j, ']')) {
+      do json_skip(j);
+      while (!j->bad && json_eat(j, ','));
+      if (!json_eat(j, ']')) j->bad = true;
+    }
+  } else if (*j->p == '"') {
+    const unsigned char *s;
+    size_t n;
+    json_string(j, &s, &n);
+  } else {
+    while (j->p < j->end && (isalnum(*j->p) || *j->p == '-' || *j->p == '+' || *j->p == '.')) j->p++;
+  }
+  j->depth--;
+}
+
+typedef struct gltf_buffer {
+  double byte_length; /* -1: none given */
+  const unsigned char *uri;
+  size_t uri_len;
+} gltf_buffer;
+
+static void buffer_member(json *j, const unsigned char *k, size_t n, void *user) {
+  gltf_buffer *b = user;
+  json_ws(j);
+  if (n == 10 && !memcmp(k, "byteLength", 10) && j->p < j->end && (isdigit(*j->p) || *j->p == '-')) {
+    char num[64];
+    size_t len = 0;
+    while (j->p < j->end && len + 1 < sizeof num && (isalnum(*j->p) || *j->p == '-' || *j->p == '+' || *j->p == '.'))
+      num[len++] = (char)*j->p++;
+    num[len] = 0;
+    b->byte_length = strtod(num, NULL);
+  } else if (n == 3 && !memcmp(k, "uri", 3) && j->p < j->end && *j->p == '"') {
+    json_string(j, &b->uri, &b->uri_len);
+  } else {
+    json_skip(j);
+  }
+}
+
+typedef struct gltf_check {
+  const char *path;   /* the glTF's own path: files are found beside it */
+  uint64_t bin;       /* the GLB's BIN chunk bytes (UINT64_MAX: not a GLB) */
+  char *why;
+  size_t cap;
+  bool refused;
+} gltf_check;
+
+/* The bytes a buffer's data holds; UINT64_MAX when unknown (the check passes). */
+static uint64_t buffer_bytes(const gltf_check *c, const gltf_buffer *b) {
+  if (!b->uri) return c->bin;
+  static const char b64[] = ";base64,";
+  if (b->uri_len >= 5 && !memcmp(b->uri, "data:", 5)) {
+    for (size_t i = 5; i + sizeof b64 - 1 <= b->uri_len; i++)
+      if (!memcmp(b->uri + i, b64, sizeof b64 - 1)) {
+        const unsigned char *data = b->uri + i + sizeof b64 - 1;
+        size_t n = b->uri_len - i - (sizeof b64 - 1);
+        while (n && data[n - 1] == '=') n--;
+        return (uint64_t)n * 3 / 4;
+      }
+    return UINT64_MAX;
+  }
+  /* a file beside the glTF: its name percent-decoded, escapes and odd names left alone */
+  char file[1024];
+  const char *slash = strrchr(c->path, '/');
+  size_t dir = slash ? (size_t)(slash - c->path) + 1 : 0, n = dir;
+  if (dir >= sizeof file) return UINT64_MAX;
+  memcpy(file, c->path, dir);
+  for (size_t i = 0; i < b->uri_len; i++) {
+    unsigned ch = b->uri[i];
+    if (ch == '\\' || ch == 0) return UINT64_MAX;
+    if (ch == '%' && i + 2 < b->uri_len && isxdigit(b->uri[i + 1]) && isxdigit(b->uri[i + 2])) {
+      char hex[3] = {(char)b->uri[i + 1], (char)b->uri[i + 2], 0};
+      ch = (unsigned)strtoul(hex, NULL, 16), i += 2;
+    }
+    if (n + 1 >= sizeof file) return UINT64_MAX;
+    file[n++] = (char)ch;
+  }
+  file[n] = 0;
+  struct stat st;
+  if (b->uri_len == 0 || stat(file, &st) != 0 || !S_ISREG(st.st_mode)) return UINT64_MAX;
+  return (uint64_t)st.st_size;
+}
+
+static void buffers_member(json *j, const unsigned char *k, size_t n, void *user) {
+  gltf_check *c = user;
+  json_ws(j);
+  if (!(n == 7 && !memcmp(k, "buffers", 7) && j->p < j->end && *j->p == '[')) return json_skip(j);
+  j->p++;
+  if (json_eat(j, ']')) return;
+  int index = 0;
+  do {
+    json_ws(j);
+    if (j->p >= j->end || *j->p != '{') {
+      json_skip(j);
+      continue;
+    }
+    gltf_buffer b = {-1, NULL, 0};
+    json_object(j, buffer_member, &b);
+    uint64_t have = j->bad || b.byte_length < 0 ? UINT64_MAX : buffer_bytes(c, &b);
+    if (!c->refused && have != UINT64_MAX && b.byte_length > (double)have) {
+      c->refused = true;
+      refuse(c->why, c->cap, "glTF buffer %d declares %.0f bytes but its %s holds %llu", index, b.byte_length,
+             !b.uri ? "BIN chunk" : b.uri_len >= 5 && !memcmp(b.uri, "data:", 5) ? "data URI" : "file",
+             (unsigned long long)have);
+    }
+    index++;
+  } while (!j->bad && json_eat(j, ','));
+  if (!json_eat(j, ']')) j->bad = true;
+}
+
+static bool check_gltf_json(const char *path, span text, uint64_t bin, char *why, size_t cap) {
+  json j = {text.p, text.p + text.n, 0, false};
+  gltf_check c = {path, bin, why, cap, false};
+  json_ws(&j);
+  if (j.p < j.end && *j.p == '{') json_object(&j, buffers_member, &c);
+  return !c.refused;
+}
 
 /* ---- dispatch ---------------------------------------------------------------------- */
 
@@ -334,9 +510,10 @@ bool rr_import_check(const char *path, char *why, size_t cap) {
   bool ok = true;
   /* assimp takes any file starting with "ply" (or "PLY") for one */
   if (has_prefix(f, "ply") || has_prefix(f, "PLY")) ok = check_ply(f, why, cap);
-  else if (has_prefix(f, "glTF")) ok = check_glb(f, why, cap);
+  else if (has_prefix(f, "glTF")) ok = check_glb(path, f, why, cap);
   else if (ext_is(path, "stl")) ok = check_stl(f, why, cap);
   else if (ext_is(path, "off")) ok = check_off(f, why, cap);
+  else if (ext_is(path, "gltf")) ok = check_gltf_json(path, f, UINT64_MAX, why, cap);
   munmap(m, f.n);
   return ok;
 }

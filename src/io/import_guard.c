@@ -370,8 +370,8 @@ static void child_main(rr_device *dev, const char *path, const rr_import_limits 
   prctl(PR_SET_PDEATHSIG, SIGKILL); /* the parent gone, nobody waits for the import */
 #endif
   if (getppid() != parent) _exit(127);
-  /* other threads' pipes to their own import children stay open in a fork: closed,
-   * so that their parents see their children end when those do */
+  /* a fork in another thread between its pipe() and its close() of the write end
+   * copies that end here: closed, so that its parent sees its own child end */
   DIR *fds = opendir("/proc/self/fd");
   for (struct dirent *d; fds && (d = readdir(fds));) {
     int fd = atoi(d->d_name);
@@ -486,6 +486,8 @@ static rr_error import_guarded(rr_scene *s, const char *path, const rr_import_li
     got += keep;
   }
   msg[got] = 0;
+  for (char *c = msg; *c; c++) /* one line, whatever the child sent */
+    if (*c == '\n' || *c == '\r') *c = ' ';
   close(pipefd[0]);
   if (timed_out) kill(pid, SIGKILL);
   int status = 0;
