@@ -80,8 +80,9 @@ RR_API rr_error rr_device_set_progress(rr_device *dev, rr_progress_fn fn, void *
 
 /* ---- scenes -------------------------------------------------------------- */
 
-/* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...)
- * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]",
+/* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...),
+ * a scene file (a path ending in ".json": rr_scene_load_file with default options)
+ * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]", "torus[:N]",
  * "grid:PATH:N" (N×N copies of a mesh on the XZ plane), "ground" (an infinite
  * plane with vertices at infinity, and objects on it). "demo" reads meshes from
  * the first directory holding them: $RASTRAY_DATA, the installed share/rastray,

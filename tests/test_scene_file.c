@@ -382,6 +382,10 @@ static void options(void) {
   CHECK(rr_scene_load_file(dev, two, &budget, &s, NULL) != RR_OK && !s && strstr(rr_device_message(dev), "limit") &&
             strstr(rr_device_message(dev), "meshes[1]"),
         "max_tris: %s", rr_device_message(dev));
+  const char *file_budget = test_write_file(dir, "budget2.json", "{\"meshes\": [{\"file\": \"tet.obj\"}]}");
+  budget.max_tris = 3;
+  CHECK(rr_scene_load_file(dev, file_budget, &budget, &s, NULL) != RR_OK && !s && strstr(rr_device_message(dev), "limit"),
+        "max_tris on a mesh file: %s", rr_device_message(dev));
   budget.max_tris = 100000;
   CHECK(rr_scene_load_file(dev, two, &budget, &s, NULL) == RR_OK, "within max_tris: %s", rr_device_message(dev));
   rr_scene_release(s), s = NULL;
@@ -429,6 +433,8 @@ static void errors(void) {
       {"{\"meshes\": [{\"file\": \"not_a_mesh.obj\"}]}", "'meshes[0].file'"},
       {"{\"meshes\": [{\"builtin\": \"teapot\"}]}", "unknown built-in 'teapot'"},
       {"{\"meshes\": [{\"builtin\": \"sphere:2\"}]}", "'meshes[0].builtin': bad size"},
+      {"{\"meshes\": [{\"builtin\": \"a\\nb\"}]}", "unknown built-in 'a?b'"},
+      {"{\"meshes\": [{\"file\": \"x\\n.obj\"}]}", "'meshes[0].file'"},
       {"{\"meshes\": [{\"builtin\": \"box\", \"colour\": 1}]}", "unknown key 'colour'"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"meshs\": []}", "unknown key 'meshs'"},
       {"{\"meshes\": [{\"builtin\": \"box\", \"name\": \"a\", \"name\": \"b\"}]}", "'meshes[0].name': given twice"},

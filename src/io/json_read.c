@@ -58,6 +58,8 @@ rr_error rr_json_fail(json_reader *r, const char *key, const char *fmt, ...) {
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
   size_t len = key ? rr_json_enter(r, key, 0) : strlen(r->at);
+  for (char *c = msg; *c; c++) /* the file's strings quoted in it (names, paths) stay on one line */
+    if ((unsigned char)*c < 32) *c = '?';
   rr_error e = r->at[0] ? rr_fail(r->dev, RR_ERROR_PARSE, "%s: '%s': %s", r->what, r->at, msg)
                         : rr_fail(r->dev, RR_ERROR_PARSE, "%s: %s", r->what, msg);
   rr_json_leave(r, len);
