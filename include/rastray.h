@@ -697,6 +697,9 @@ typedef struct rr_shade_options {
   int max_depth;                    /* lit: most mirror bounces along a path, 0 .. RR_MAX_DEPTH (default 2) */
   int default_lights;               /* lit: nonzero (default): a scene without lights gets the default rig
                                        (a key light with shadows placed from the camera, and a sky) */
+  int has_background;               /* nonzero: background is the colour behind misses (default 0: a quiet
+                                       grey-blue gradient) */
+  float background[3];              /* linear RGB, finite, at least 0 */
 } rr_shade_options;
 
 /* Fills options with defaults: Lambert, box filter, no alpha, aniso:16 textures. */
@@ -801,7 +804,8 @@ enum {
   RR_SETTING_TEXTURE_FILTER = 1u << 8, /* shade.texture_filter, shade.aniso */
   RR_SETTING_LOD_BIAS = 1u << 9,       /* shade.lod_bias */
   RR_SETTING_ALPHA = 1u << 10,         /* shade.alpha */
-  RR_SETTING_DEFAULT_LIGHTS = 1u << 11 /* shade.default_lights */
+  RR_SETTING_DEFAULT_LIGHTS = 1u << 11, /* shade.default_lights */
+  RR_SETTING_BACKGROUND = 1u << 12      /* shade.has_background, shade.background */
 };
 /* Which fields of an rr_camera a camera file or a scene file's camera gave. */
 enum {

@@ -50,7 +50,7 @@ static void every_key(void) {
       " \"render\": {\"size\": [320, 200], \"method\": \"3dr-bin\", \"aa\": \"csaa:4/8\", \"aa_pattern\": \"jitter:7\",\n"
       "            \"aa_filter\": \"mitchell:1.5\", \"cull_backfaces\": true, \"shade\": \"normal\", \"shadows\": \"none\",\n"
       "            \"max_depth\": 5, \"texture_filter\": \"aniso:4\", \"lod_bias\": -0.5, \"alpha\": true,\n"
-      "            \"default_lights\": false}\n"
+      "            \"default_lights\": false, \"background\": [0.5, 0.25, 0]}\n"
       "}\n";
   rr_scene_settings st;
   rr_scene *s = load_text("every.json", text, NULL, &st);
@@ -108,7 +108,7 @@ static void every_key(void) {
         "camera values");
   unsigned all = RR_SETTING_SIZE | RR_SETTING_METHOD | RR_SETTING_AA | RR_SETTING_CULL | RR_SETTING_SHADE |
                  RR_SETTING_SHADOWS | RR_SETTING_MAX_DEPTH | RR_SETTING_FILTER | RR_SETTING_TEXTURE_FILTER |
-                 RR_SETTING_LOD_BIAS | RR_SETTING_ALPHA | RR_SETTING_DEFAULT_LIGHTS;
+                 RR_SETTING_LOD_BIAS | RR_SETTING_ALPHA | RR_SETTING_DEFAULT_LIGHTS | RR_SETTING_BACKGROUND;
   CHECK(st.given == all, "settings given %#x, expected %#x", st.given, all);
   CHECK(st.render.width == 320 && st.render.height == 200 && st.render.method == RR_METHOD_3DR_BIN, "size, method");
   rr_render_options aa;
@@ -124,6 +124,9 @@ static void every_key(void) {
   CHECK(st.shade.texture_filter == RR_TEXTURE_ANISO && st.shade.aniso == 4 && st.shade.lod_bias == -0.5f,
         "texture filter, lod bias");
   CHECK(st.shade.alpha == 1 && st.shade.default_lights == 0, "alpha, default_lights");
+  CHECK(st.shade.has_background == 1 && st.shade.background[0] == 0.5f && st.shade.background[1] == 0.25f &&
+            st.shade.background[2] == 0,
+        "background");
   rr_scene_release(s);
 
   /* the least file: defaults everywhere */
@@ -488,6 +491,7 @@ static void errors(void) {
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"alpha\": \"yes\"}}", "'render.alpha'"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"lod_bias\": 1e300}}", "'render.lod_bias'"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": []}", "'render': expected an object"},
+      {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"background\": [0, -1, 0]}}", "'render.background'"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"comment\": 5}", "'comment'"},
   };
   test_write_file(dir, "not_a_mesh.obj", "this is not a mesh\n\x01\x02\n");
@@ -526,6 +530,17 @@ static void errors(void) {
   CHECK(rc == 0 && strstr(out, "width=40 height=30"), "CLI takes the file's size: %d %s", rc, out);
   rc = test_run_cli(dir, "render cli.json -o cli.png --size 20x10 --stats", true, out, sizeof out);
   CHECK(rc == 0 && strstr(out, "width=20 height=10"), "a flag overrides the file's size: %d %s", rc, out);
+  test_write_file(dir, "bg.json",
+                  "{\"meshes\": [{\"builtin\": \"box:1\", \"scale\": 0.2}], \"render\": {\"size\": [16, 12], "
+                  "\"background\": [0.25, 0.5, 1]}}");
+  rc = test_run_cli(dir, "render bg.json -o bg.exr", true, out, sizeof out);
+  rr_image bg = {0};
+  char exr[300];
+  snprintf(exr, sizeof exr, "%s/bg.exr", dir);
+  CHECK(rc == 0 && rr_image_read(dev, exr, &bg) == RR_OK && bg.type == RR_PIXEL_F32 && bg.channels >= 3 &&
+            ((float *)bg.data)[0] == 0.25f && ((float *)bg.data)[1] == 0.5f && ((float *)bg.data)[2] == 1.0f,
+        "the file's background behind misses: %d %s", rc, out);
+  rr_image_free(&bg);
   rc = test_run_cli(dir, "info cli.json", false, out, sizeof out);
   CHECK(rc == 0 && strstr(out, "triangles    12"), "info of a scene file: %d %s", rc, out);
 }

@@ -129,7 +129,7 @@ enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
   OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA, OPT_AA_PATTERN, OPT_AA_FILTER,
-  OPT_ALPHA, OPT_TEXTURE_FILTER, OPT_LOD_BIAS, OPT_LIGHT, OPT_SHADOWS, OPT_MAX_DEPTH,
+  OPT_ALPHA, OPT_TEXTURE_FILTER, OPT_LOD_BIAS, OPT_LIGHT, OPT_SHADOWS, OPT_MAX_DEPTH, OPT_BACKGROUND,
 };
 
 typedef struct cli_option {
@@ -213,6 +213,7 @@ static const cli_option render_options[] = {
     {"alpha", OPT_ALPHA, NULL,
      "give the colour image an alpha channel: the coverage of the pixel's samples\n"
      "(filtered), colour straight (PNG RGBA, EXR R G B A)"},
+    {"background", OPT_BACKGROUND, "R,G,B", "the colour behind misses, linear RGB (default: a grey-blue gradient)"},
     {"texture-filter", OPT_TEXTURE_FILTER, "NAME[:N]",
      "how textures are read over a pixel's footprint (exact derivatives for every\n"
      "camera): nearest, bilinear (level 0; they alias), trilinear, aniso[:N] (up\n"
@@ -840,7 +841,8 @@ static void take_settings(const rr_scene_settings *file, uint64_t flags, rr_rend
                  {RR_SETTING_CULL, OPT_CULL_BACKFACES}, {RR_SETTING_SHADE, OPT_SHADE},
                  {RR_SETTING_SHADOWS, OPT_SHADOWS}, {RR_SETTING_MAX_DEPTH, OPT_MAX_DEPTH},
                  {RR_SETTING_FILTER, OPT_AA_FILTER}, {RR_SETTING_TEXTURE_FILTER, OPT_TEXTURE_FILTER},
-                 {RR_SETTING_LOD_BIAS, OPT_LOD_BIAS}, {RR_SETTING_ALPHA, OPT_ALPHA}};
+                 {RR_SETTING_LOD_BIAS, OPT_LOD_BIAS}, {RR_SETTING_ALPHA, OPT_ALPHA},
+                 {RR_SETTING_BACKGROUND, OPT_BACKGROUND}};
   for (size_t k = 0; k < sizeof flag_of / sizeof *flag_of; k++)
     if (flags & FLAG(flag_of[k].flag)) take &= ~flag_of[k].setting;
   if (take & RR_SETTING_SIZE) opt->width = fr->width, opt->height = fr->height;
@@ -855,6 +857,10 @@ static void take_settings(const rr_scene_settings *file, uint64_t flags, rr_rend
   if (take & RR_SETTING_LOD_BIAS) shading->lod_bias = fs->lod_bias;
   if (take & RR_SETTING_ALPHA) shading->alpha = fs->alpha;
   if (take & RR_SETTING_DEFAULT_LIGHTS) shading->default_lights = fs->default_lights;
+  if (take & RR_SETTING_BACKGROUND) {
+    shading->has_background = fs->has_background;
+    memcpy(shading->background, fs->background, sizeof shading->background);
+  }
 }
 
 static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
@@ -945,6 +951,11 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_AA_PATTERN: pattern = parse_aa_pattern(optarg, &seed), pattern_given = true; break;
     case OPT_AA_FILTER: parse_filter(optarg, &shading); break;
     case OPT_ALPHA: shading.alpha = 1; break;
+    case OPT_BACKGROUND:
+      parse_vec(option_name, optarg, shading.background), shading.has_background = 1;
+      if (!(shading.background[0] >= 0 && shading.background[1] >= 0 && shading.background[2] >= 0))
+        die(EXIT_USAGE, "bad value '%s' for --background (expected R,G,B at least 0)", optarg);
+      break;
     case OPT_TEXTURE_FILTER: parse_texture_filter(optarg, &shading); break;
     case OPT_LOD_BIAS:
       shading.lod_bias = parse_float(option_name, optarg);

@@ -185,7 +185,7 @@ static rr_error read_aa(json_reader *r, const cJSON *obj, rr_render_options *ro)
 static rr_error read_render(json_reader *r, const cJSON *obj, rr_scene_settings *st) {
   static const char *const keys[] = {"size", "method", "aa", "aa_pattern", "aa_filter", "cull_backfaces", "shade",
                                      "shadows", "max_depth", "texture_filter", "lod_bias", "alpha", "default_lights",
-                                     NULL};
+                                     "background", NULL};
   rr_error e = rr_json_keys(r, obj, keys);
   if (e) return e;
   rr_render_options *ro = &st->render;
@@ -254,12 +254,15 @@ static rr_error read_render(json_reader *r, const cJSON *obj, rr_scene_settings 
   if ((e = rr_json_float(r, obj, "lod_bias", -64, 64, &so->lod_bias))) return e;
   if ((e = rr_json_bool(r, obj, "alpha", &so->alpha))) return e;
   if ((e = rr_json_bool(r, obj, "default_lights", &so->default_lights))) return e;
+  if ((e = rr_json_floats(r, obj, "background", 3, 0, MAX_COORD, so->background))) return e;
+  so->has_background |= rr_json_get(obj, "background") != NULL;
   static const struct {
     const char *key;
     unsigned bit;
   } bits[] = {{"method", RR_SETTING_METHOD}, {"cull_backfaces", RR_SETTING_CULL}, {"shade", RR_SETTING_SHADE},
               {"shadows", RR_SETTING_SHADOWS}, {"max_depth", RR_SETTING_MAX_DEPTH}, {"lod_bias", RR_SETTING_LOD_BIAS},
-              {"alpha", RR_SETTING_ALPHA}, {"default_lights", RR_SETTING_DEFAULT_LIGHTS}};
+              {"alpha", RR_SETTING_ALPHA}, {"default_lights", RR_SETTING_DEFAULT_LIGHTS},
+              {"background", RR_SETTING_BACKGROUND}};
   for (size_t k = 0; k < sizeof bits / sizeof *bits; k++)
     if (rr_json_get(obj, bits[k].key)) st->given |= bits[k].bit;
   return RR_OK;
