@@ -415,6 +415,11 @@ static void options(void) {
 /* ---- malformed files ------------------------------------------------------------------ */
 
 static bool one_line(const char *m) { return m && *m && !strchr(m, '\n'); }
+/* The output of a command: one line, ending in its line break. */
+static bool printed_one_line(const char *out) {
+  const char *nl = strchr(out, '\n');
+  return nl && nl > out && nl[1] == 0;
+}
 
 static void errors(void) {
   static const struct {
@@ -424,6 +429,7 @@ static void errors(void) {
       {"{\"meshes\": [", "line 1"},
       {"{\n\"meshes\": [\n{\"builtin\": \"box\"},\n]\n}", "line 4"},
       {"[1, 2]", "not a JSON object"},
+      {"{\"meshes\": [{\"builtin\": \"box\", \"scale\": NaN}]}", "not valid JSON (line 1)"},
       {"{}", "missing 'meshes'"},
       {"{\"meshes\": {}}", "'meshes': expected an array"},
       {"{\"meshes\": [1]}", "'meshes[0]': expected an object"},
@@ -521,8 +527,13 @@ static void errors(void) {
   int rc = test_run_cli(dir, "render bad.json -o bad.png", true, out, sizeof out);
   char png[300];
   snprintf(png, sizeof png, "%s/bad.png", dir);
-  CHECK(rc == 1 && one_line(strtok(out, "\n")) && strstr(out, "'meshes[0].scale'") && access(png, F_OK) != 0,
+  CHECK(rc == 1 && printed_one_line(out) && strstr(out, "'meshes[0].scale'") && access(png, F_OK) != 0,
         "CLI refusal: %d %s", rc, out);
+  test_write_file(dir, "missing.json", "{\"meshes\": [{\"file\": \"nowhere.obj\"}]}");
+  rc = test_run_cli(dir, "render missing.json -o bad.png", true, out, sizeof out);
+  CHECK(rc == 1 && printed_one_line(out) && strstr(out, "'meshes[0].file'") && strstr(out, "nowhere.obj") &&
+            access(png, F_OK) != 0,
+        "CLI, a missing mesh: %d %s", rc, out);
   test_write_file(dir, "cli.json",
                   "{\"meshes\": [{\"builtin\": \"box:1\"}], \"render\": {\"size\": [40, 30], \"shade\": \"normal\"},"
                   " \"camera\": {\"eye\": [2, 2, 3], \"target\": [0, 0, 0]}}");
