@@ -32,12 +32,12 @@ static rr_error camera_matrix(json_reader *r, const cJSON *obj, rr_camera *cam) 
   const cJSON *m = rr_json_get(obj, "matrix");
   if (!cJSON_IsArray(m) || cJSON_GetArraySize(m) != 4)
     return rr_json_fail(r, "matrix", "expected four rows of four numbers (camera to world, OpenGL convention)");
-  float row[4][4];
+  double row[4][4];
   size_t len = rr_json_enter(r, "matrix", 0);
   rr_error e = RR_OK;
   for (int i = 0; i < 4 && !e; i++) {
     size_t l2 = rr_json_enter(r, NULL, i);
-    e = rr_json_array_floats(r, cJSON_GetArrayItem(m, i), 4, -MAX_COORD, MAX_COORD, row[i]);
+    e = rr_json_array_doubles(r, cJSON_GetArrayItem(m, i), 4, -MAX_COORD, MAX_COORD, row[i]);
     rr_json_leave(r, l2);
   }
   rr_json_leave(r, len);
@@ -45,7 +45,7 @@ static rr_error camera_matrix(json_reader *r, const cJSON *obj, rr_camera *cam) 
   if (row[3][0] != 0 || row[3][1] != 0 || row[3][2] != 0 || row[3][3] != 1)
     return rr_json_fail(r, "matrix", "the bottom row must be 0 0 0 1");
   for (int i = 0; i < 3; i++)
-    cam->eye[i] = row[i][3], cam->target[i] = row[i][3] - row[i][2], cam->up[i] = row[i][1];
+    cam->eye[i] = (float)row[i][3], cam->target[i] = (float)row[i][3] - (float)row[i][2], cam->up[i] = (float)row[i][1];
   return RR_OK;
 }
 
@@ -292,23 +292,22 @@ static double det3(const double m[3][3]) {
 static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
   *x = (xform){{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
   const cJSON *matrix = rr_json_get(obj, "matrix");
-  rr_error e;
+  rr_error e = RR_OK;
   if (matrix) {
     if (rr_json_get(obj, "translate") || rr_json_get(obj, "rotate") || rr_json_get(obj, "scale"))
       return rr_json_fail(r, NULL, "give either 'matrix' or 'translate', 'rotate' and 'scale', not both");
     if (!cJSON_IsArray(matrix) || cJSON_GetArraySize(matrix) != 4)
       return rr_json_fail(r, "matrix", "expected four rows of four numbers");
     double row[4][4];
+    size_t len = rr_json_enter(r, "matrix", 0);
     int i = 0;
-    for (const cJSON *rw = matrix->child; rw; rw = rw->next, i++) {
-      if (!cJSON_IsArray(rw) || cJSON_GetArraySize(rw) != 4) return rr_json_fail(r, "matrix", "expected four rows of four numbers");
-      int j = 0;
-      for (const cJSON *v = rw->child; v; v = v->next, j++) {
-        if (!cJSON_IsNumber(v) || !(fabs(v->valuedouble) <= MAX_COORD))
-          return rr_json_fail(r, "matrix", "expected finite numbers of magnitude at most 1e30");
-        row[i][j] = v->valuedouble;
-      }
+    for (const cJSON *rw = matrix->child; rw && !e; rw = rw->next, i++) {
+      size_t l2 = rr_json_enter(r, NULL, i);
+      e = rr_json_array_doubles(r, rw, 4, -MAX_COORD, MAX_COORD, row[i]);
+      rr_json_leave(r, l2);
     }
+    rr_json_leave(r, len);
+    if (e) return e;
     if (row[3][0] != 0 || row[3][1] != 0 || row[3][2] != 0 || row[3][3] != 1)
       return rr_json_fail(r, "matrix", "the bottom row must be 0 0 0 1");
     for (i = 0; i < 3; i++) {
@@ -316,36 +315,17 @@ static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
       x->t[i] = row[i][3];
     }
   } else {
+    /* doubles throughout: the file's own digits, not the floats nearest them */
     double s[3] = {1, 1, 1}, deg[3] = {0, 0, 0};
-    float f[3];
-    const cJSON *scale = rr_json_get(obj, "scale");
-    if (cJSON_IsNumber(scale)) {
-      if ((e = rr_json_double(r, obj, "scale", -MAX_COORD, MAX_COORD, &s[0]))) return e;
+    if (cJSON_IsNumber(rr_json_get(obj, "scale"))) {
+      e = rr_json_double(r, obj, "scale", -MAX_COORD, MAX_COORD, &s[0]);
       s[1] = s[2] = s[0];
-    } else if (scale) {
-      if ((e = rr_json_floats(r, obj, "scale", 3, -MAX_COORD, MAX_COORD, f))) return e;
-      for (int k = 0; k < 3; k++) s[k] = f[k];
+    } else {
+      e = rr_json_doubles(r, obj, "scale", 3, -MAX_COORD, MAX_COORD, s);
     }
-    const cJSON *rot = rr_json_get(obj, "rotate");
-    if (rot) { /* read as doubles: the angles' own digits, not the float nearest them */
-      if (!cJSON_IsArray(rot) || cJSON_GetArraySize(rot) != 3) return rr_json_fail(r, "rotate", "expected an array of 3 numbers");
-      int k = 0;
-      for (const cJSON *v = rot->child; v; v = v->next, k++) {
-        if (!cJSON_IsNumber(v) || !(fabs(v->valuedouble) <= 1e6))
-          return rr_json_fail(r, "rotate", "expected 3 angles in degrees, each within ±1e6");
-        deg[k] = v->valuedouble;
-      }
-    }
-    const cJSON *tr = rr_json_get(obj, "translate");
-    if (tr) {
-      if (!cJSON_IsArray(tr) || cJSON_GetArraySize(tr) != 3) return rr_json_fail(r, "translate", "expected an array of 3 numbers");
-      int k = 0;
-      for (const cJSON *v = tr->child; v; v = v->next, k++) {
-        if (!cJSON_IsNumber(v) || !(fabs(v->valuedouble) <= MAX_COORD))
-          return rr_json_fail(r, "translate", "expected finite numbers of magnitude at most 1e30");
-        x->t[k] = v->valuedouble;
-      }
-    }
+    if (e || (e = rr_json_doubles(r, obj, "rotate", 3, -1e6, 1e6, deg)) ||
+        (e = rr_json_doubles(r, obj, "translate", 3, -MAX_COORD, MAX_COORD, x->t)))
+      return e;
     double m[3][3] = {{s[0], 0, 0}, {0, s[1], 0}, {0, 0, s[2]}};
     for (int axis = 0; axis < 3; axis++) {
       double a = deg[axis] * (RR_PI / 180), c = cos(a), sn = sin(a);
