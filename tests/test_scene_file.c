@@ -217,6 +217,19 @@ static void transforms(void) {
   CHECK(close == 9, "matrix: %d of 9 coordinates within float rounding", close);
   rr_scene_release(sc);
 
+  /* no transform: the file's mesh as rr_scene_load reads it, normals' bits too */
+  rr_scene *plain = load_text("plain.json", "{\"meshes\": [{\"file\": \"n.obj\"}]}", NULL, NULL), *direct = NULL;
+  char obj[300];
+  snprintf(obj, sizeof obj, "%s/n.obj", dir);
+  CHECK(plain && rr_scene_load(dev, obj, &direct) == RR_OK, "%s", rr_device_message(dev));
+  bool bits = plain && direct && plain->ntris == direct->ntris && plain->n[0][0] && direct->n[0][0];
+  for (int k = 0; bits && k < 3; k++)
+    for (int c = 0; c < 3; c++)
+      bits &= memcmp(plain->p[k][c], direct->p[k][c], plain->ntris * sizeof(float)) == 0 &&
+              memcmp(plain->n[k][c], direct->n[k][c], plain->ntris * sizeof(float)) == 0;
+  CHECK(bits, "a mesh without a transform is its file's, bit for bit");
+  rr_scene_release(plain), rr_scene_release(direct);
+
   /* a mirror keeps the front face in front: corners 1 and 2 trade places */
   sc = load_text("xmirror.json", "{\"meshes\": [{\"file\": \"tri.obj\", \"scale\": [-1, 1, 1]}]}", NULL, NULL);
   CHECK(sc != NULL, "mirror: %s", rr_device_message(dev));

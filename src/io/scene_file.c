@@ -359,7 +359,18 @@ static vec3 xf_unit(const double m[3][3], vec3 v) {
 /* Moves triangles t0.. and the cameras and lights from c0, l0 on by x. Normals go
  * through the inverse transpose; a mirroring transform swaps corners 1 and 2 so
  * that front faces stay front faces. */
+static void swapf(float *a, float *b) {
+  float t = *a;
+  *a = *b, *b = t;
+}
+
+static bool is_identity(const xform *x) {
+  static const xform id = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
+  return memcmp(x, &id, sizeof id) == 0;
+}
+
 static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_t t0, uint32_t c0, uint32_t l0) {
+  if (is_identity(x)) return RR_OK; /* the mesh as its file has it, normals' bits too */
   double d = det3(x->m), nm[3][3]; /* the cofactor matrix: the inverse transpose times det */
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
@@ -380,29 +391,12 @@ static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_
       }
     }
     if (d < 0) {
-#define SWAP12(a)            \
-  do {                       \
-    float tmp_ = (a)[1][i];  \
-    (a)[1][i] = (a)[2][i];   \
-    (a)[2][i] = tmp_;        \
-  } while (0)
       for (int c = 0; c < 3; c++) {
-        float *pp[3] = {s->p[0][c], s->p[1][c], s->p[2][c]};
-        SWAP12(pp);
-        if (s->n[0][0]) {
-          float *nn[3] = {s->n[0][c], s->n[1][c], s->n[2][c]};
-          SWAP12(nn);
-        }
-        if (s->col[0][0]) {
-          float *cc[3] = {s->col[0][c], s->col[1][c], s->col[2][c]};
-          SWAP12(cc);
-        }
-        if (c < 2 && s->uv[0][0]) {
-          float *uu[3] = {s->uv[0][c], s->uv[1][c], s->uv[2][c]};
-          SWAP12(uu);
-        }
+        swapf(&s->p[1][c][i], &s->p[2][c][i]);
+        if (s->n[0][0]) swapf(&s->n[1][c][i], &s->n[2][c][i]);
+        if (s->col[0][0]) swapf(&s->col[1][c][i], &s->col[2][c][i]);
+        if (c < 2 && s->uv[0][0]) swapf(&s->uv[1][c][i], &s->uv[2][c][i]);
       }
-#undef SWAP12
       if (s->inf) s->inf[i] = (uint8_t)((inf & 1u) | (inf >> 1 & 2u) | (inf << 1 & 4u));
     }
   }
