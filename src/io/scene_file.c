@@ -489,6 +489,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
   if ((e = rr_json_bool(r, obj, "smooth", &smooth))) return e;
   const cJSON *material = rr_json_get(obj, "material");
   uint32_t t0 = s->ntris, g0 = s->ngeoms, m0 = s->nmaterials, c0 = s->ncameras, l0 = s->nlights;
+  uint64_t faces = scene_faces(s);
   char path[MAX_PATH];
   if (builtin) {
     if (!opt->builtins) return rr_json_fail(r, "builtin", "built-in meshes are not allowed here");
@@ -509,7 +510,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
     snprintf(msg, sizeof msg, "%s", rr_device_message(s->dev));
     return rr_json_fail(r, builtin ? "builtin" : "file", "%s", msg);
   }
-  if (s->ntris == t0 && !s->skipped) return rr_json_fail(r, builtin ? "builtin" : "file", "no triangles");
+  if (scene_faces(s) == faces) return rr_json_fail(r, builtin ? "builtin" : "file", "no triangles");
   for (uint32_t g = g0; name && g < s->ngeoms; g++)
     if ((e = rr_scene_name_geometry(s, g, name))) return e;
   if ((e = apply_xform(r, s, &x, t0, c0, l0))) return e;
