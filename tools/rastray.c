@@ -973,8 +973,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   if (file_cam && camera_file) die(EXIT_USAGE, "--camera-from-file and --camera-file exclude each other");
   if (!scene_name) scene_name = "demo";
   timings ms = {0};
-  rr_scene_settings file; /* a scene file's settings, where no flag gave them */
-  rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load, &file);
+  rr_scene_settings file = {0}; /* a scene file's settings, where no flag gave them: read first */
+  rr_scene *scene = is_scene_file(scene_name) ? load_scene(dev, scene_name, opt.threads, &ms.load, &file) : NULL;
   take_settings(&file, flags, &opt, &shading, &shade, &aa);
   if (pattern_given && aa.mode == RR_AA_NONE) die(EXIT_USAGE, "--aa-pattern needs --aa other than none");
   if (rr_render_options_set_aa(dev, &opt, aa.mode, aa.samples, aa.stored, pattern, seed) != RR_OK)
@@ -1002,6 +1002,7 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     camera_take(&cam, &file.camera, file.camera_given & ~given);
     given |= file.camera_given;
   }
+  if (!scene) scene = load_scene(dev, scene_name, opt.threads, &ms.load, NULL);
 
   for (int k = 0; k < nlights; k++)
     if (rr_scene_add_light(scene, &lights[k]) != RR_OK) die(EXIT_USAGE, "--light: %s", rr_device_message(dev));
