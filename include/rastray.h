@@ -80,8 +80,9 @@ RR_API rr_error rr_device_set_progress(rr_device *dev, rr_progress_fn fn, void *
 
 /* ---- scenes -------------------------------------------------------------- */
 
-/* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...)
- * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]",
+/* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...),
+ * a scene file (a path ending in ".json": rr_scene_load_file with default options)
+ * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]", "torus[:N]",
  * "grid:PATH:N" (N×N copies of a mesh on the XZ plane), "ground" (an infinite
  * plane with vertices at infinity, and objects on it), "checker" (an infinite
  * checkerboard-textured plane, with a grazing view of its own). "demo" reads meshes from
@@ -745,6 +746,9 @@ typedef struct rr_shade_options {
   int max_depth;                    /* lit: most mirror bounces along a path, 0 .. RR_MAX_DEPTH (default 2) */
   int default_lights;               /* lit: nonzero (default): a scene without lights gets the default rig
                                        (a key light with shadows placed from the camera, and a sky) */
+  int has_background;               /* nonzero: background is the colour behind misses (default 0: a quiet
+                                       grey-blue gradient) */
+  float background[3];              /* linear RGB, finite, at least 0 */
 } rr_shade_options;
 
 /* Fills options with defaults: Lambert, box filter, no alpha, aniso:16 textures. */
@@ -849,7 +853,8 @@ enum {
   RR_SETTING_TEXTURE_FILTER = 1u << 8, /* shade.texture_filter, shade.aniso */
   RR_SETTING_LOD_BIAS = 1u << 9,       /* shade.lod_bias */
   RR_SETTING_ALPHA = 1u << 10,         /* shade.alpha */
-  RR_SETTING_DEFAULT_LIGHTS = 1u << 11 /* shade.default_lights */
+  RR_SETTING_DEFAULT_LIGHTS = 1u << 11, /* shade.default_lights */
+  RR_SETTING_BACKGROUND = 1u << 12      /* shade.has_background, shade.background */
 };
 /* Which fields of an rr_camera a camera file or a scene file's camera gave. */
 enum {

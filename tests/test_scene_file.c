@@ -50,7 +50,7 @@ static void every_key(void) {
       " \"render\": {\"size\": [320, 200], \"method\": \"3dr-bin\", \"aa\": \"csaa:4/8\", \"aa_pattern\": \"jitter:7\",\n"
       "            \"aa_filter\": \"mitchell:1.5\", \"cull_backfaces\": true, \"shade\": \"normal\", \"shadows\": \"none\",\n"
       "            \"max_depth\": 5, \"texture_filter\": \"aniso:4\", \"lod_bias\": -0.5, \"alpha\": true,\n"
-      "            \"default_lights\": false}\n"
+      "            \"default_lights\": false, \"background\": [0.5, 0.25, 0]}\n"
       "}\n";
   rr_scene_settings st;
   rr_scene *s = load_text("every.json", text, NULL, &st);
@@ -108,7 +108,7 @@ static void every_key(void) {
         "camera values");
   unsigned all = RR_SETTING_SIZE | RR_SETTING_METHOD | RR_SETTING_AA | RR_SETTING_CULL | RR_SETTING_SHADE |
                  RR_SETTING_SHADOWS | RR_SETTING_MAX_DEPTH | RR_SETTING_FILTER | RR_SETTING_TEXTURE_FILTER |
-                 RR_SETTING_LOD_BIAS | RR_SETTING_ALPHA | RR_SETTING_DEFAULT_LIGHTS;
+                 RR_SETTING_LOD_BIAS | RR_SETTING_ALPHA | RR_SETTING_DEFAULT_LIGHTS | RR_SETTING_BACKGROUND;
   CHECK(st.given == all, "settings given %#x, expected %#x", st.given, all);
   CHECK(st.render.width == 320 && st.render.height == 200 && st.render.method == RR_METHOD_3DR_BIN, "size, method");
   rr_render_options aa;
@@ -124,6 +124,9 @@ static void every_key(void) {
   CHECK(st.shade.texture_filter == RR_TEXTURE_ANISO && st.shade.aniso == 4 && st.shade.lod_bias == -0.5f,
         "texture filter, lod bias");
   CHECK(st.shade.alpha == 1 && st.shade.default_lights == 0, "alpha, default_lights");
+  CHECK(st.shade.has_background == 1 && st.shade.background[0] == 0.5f && st.shade.background[1] == 0.25f &&
+            st.shade.background[2] == 0,
+        "background");
   rr_scene_release(s);
 
   /* the least file: defaults everywhere */
@@ -213,6 +216,19 @@ static void transforms(void) {
     for (int c = 0; c < 3; c++) close += near(sc->p[k][c][0], want[k][c], 2e-7);
   CHECK(close == 9, "matrix: %d of 9 coordinates within float rounding", close);
   rr_scene_release(sc);
+
+  /* no transform: the file's mesh as rr_scene_load reads it, normals' bits too */
+  rr_scene *plain = load_text("plain.json", "{\"meshes\": [{\"file\": \"n.obj\"}]}", NULL, NULL), *direct = NULL;
+  char obj[300];
+  snprintf(obj, sizeof obj, "%s/n.obj", dir);
+  CHECK(plain && rr_scene_load(dev, obj, &direct) == RR_OK, "%s", rr_device_message(dev));
+  bool bits = plain && direct && plain->ntris == direct->ntris && plain->n[0][0] && direct->n[0][0];
+  for (int k = 0; bits && k < 3; k++)
+    for (int c = 0; c < 3; c++)
+      bits &= memcmp(plain->p[k][c], direct->p[k][c], plain->ntris * sizeof(float)) == 0 &&
+              memcmp(plain->n[k][c], direct->n[k][c], plain->ntris * sizeof(float)) == 0;
+  CHECK(bits, "a mesh without a transform is its file's, bit for bit");
+  rr_scene_release(plain), rr_scene_release(direct);
 
   /* a mirror keeps the front face in front: corners 1 and 2 trade places */
   sc = load_text("xmirror.json", "{\"meshes\": [{\"file\": \"tri.obj\", \"scale\": [-1, 1, 1]}]}", NULL, NULL);
@@ -382,6 +398,10 @@ static void options(void) {
   CHECK(rr_scene_load_file(dev, two, &budget, &s, NULL) != RR_OK && !s && strstr(rr_device_message(dev), "limit") &&
             strstr(rr_device_message(dev), "meshes[1]"),
         "max_tris: %s", rr_device_message(dev));
+  const char *file_budget = test_write_file(dir, "budget2.json", "{\"meshes\": [{\"file\": \"tet.obj\"}]}");
+  budget.max_tris = 3;
+  CHECK(rr_scene_load_file(dev, file_budget, &budget, &s, NULL) != RR_OK && !s && strstr(rr_device_message(dev), "limit"),
+        "max_tris on a mesh file: %s", rr_device_message(dev));
   budget.max_tris = 100000;
   CHECK(rr_scene_load_file(dev, two, &budget, &s, NULL) == RR_OK, "within max_tris: %s", rr_device_message(dev));
   rr_scene_release(s), s = NULL;
@@ -408,6 +428,11 @@ static void options(void) {
 /* ---- malformed files ------------------------------------------------------------------ */
 
 static bool one_line(const char *m) { return m && *m && !strchr(m, '\n'); }
+/* The output of a command: one line, ending in its line break. */
+static bool printed_one_line(const char *out) {
+  const char *nl = strchr(out, '\n');
+  return nl && nl > out && nl[1] == 0;
+}
 
 static void errors(void) {
   static const struct {
@@ -417,6 +442,7 @@ static void errors(void) {
       {"{\"meshes\": [", "line 1"},
       {"{\n\"meshes\": [\n{\"builtin\": \"box\"},\n]\n}", "line 4"},
       {"[1, 2]", "not a JSON object"},
+      {"{\"meshes\": [{\"builtin\": \"box\", \"scale\": NaN}]}", "not valid JSON (line 1)"},
       {"{}", "missing 'meshes'"},
       {"{\"meshes\": {}}", "'meshes': expected an array"},
       {"{\"meshes\": [1]}", "'meshes[0]': expected an object"},
@@ -429,6 +455,8 @@ static void errors(void) {
       {"{\"meshes\": [{\"file\": \"not_a_mesh.obj\"}]}", "'meshes[0].file'"},
       {"{\"meshes\": [{\"builtin\": \"teapot\"}]}", "unknown built-in 'teapot'"},
       {"{\"meshes\": [{\"builtin\": \"sphere:2\"}]}", "'meshes[0].builtin': bad size"},
+      {"{\"meshes\": [{\"builtin\": \"a\\nb\"}]}", "unknown built-in 'a?b'"},
+      {"{\"meshes\": [{\"file\": \"x\\n.obj\"}]}", "'meshes[0].file'"},
       {"{\"meshes\": [{\"builtin\": \"box\", \"colour\": 1}]}", "unknown key 'colour'"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"meshs\": []}", "unknown key 'meshs'"},
       {"{\"meshes\": [{\"builtin\": \"box\", \"name\": \"a\", \"name\": \"b\"}]}", "'meshes[0].name': given twice"},
@@ -482,6 +510,7 @@ static void errors(void) {
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"alpha\": \"yes\"}}", "'render.alpha'"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"lod_bias\": 1e300}}", "'render.lod_bias'"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": []}", "'render': expected an object"},
+      {"{\"meshes\": [{\"builtin\": \"box\"}], \"render\": {\"background\": [0, -1, 0]}}", "'render.background'"},
       {"{\"meshes\": [{\"builtin\": \"box\"}], \"comment\": 5}", "'comment'"},
   };
   test_write_file(dir, "not_a_mesh.obj", "this is not a mesh\n\x01\x02\n");
@@ -511,8 +540,13 @@ static void errors(void) {
   int rc = test_run_cli(dir, "render bad.json -o bad.png", true, out, sizeof out);
   char png[300];
   snprintf(png, sizeof png, "%s/bad.png", dir);
-  CHECK(rc == 1 && one_line(strtok(out, "\n")) && strstr(out, "'meshes[0].scale'") && access(png, F_OK) != 0,
+  CHECK(rc == 1 && printed_one_line(out) && strstr(out, "'meshes[0].scale'") && access(png, F_OK) != 0,
         "CLI refusal: %d %s", rc, out);
+  test_write_file(dir, "missing.json", "{\"meshes\": [{\"file\": \"nowhere.obj\"}]}");
+  rc = test_run_cli(dir, "render missing.json -o bad.png", true, out, sizeof out);
+  CHECK(rc == 1 && printed_one_line(out) && strstr(out, "'meshes[0].file'") && strstr(out, "nowhere.obj") &&
+            access(png, F_OK) != 0,
+        "CLI, a missing mesh: %d %s", rc, out);
   test_write_file(dir, "cli.json",
                   "{\"meshes\": [{\"builtin\": \"box:1\"}], \"render\": {\"size\": [40, 30], \"shade\": \"normal\"},"
                   " \"camera\": {\"eye\": [2, 2, 3], \"target\": [0, 0, 0]}}");
@@ -520,6 +554,17 @@ static void errors(void) {
   CHECK(rc == 0 && strstr(out, "width=40 height=30"), "CLI takes the file's size: %d %s", rc, out);
   rc = test_run_cli(dir, "render cli.json -o cli.png --size 20x10 --stats", true, out, sizeof out);
   CHECK(rc == 0 && strstr(out, "width=20 height=10"), "a flag overrides the file's size: %d %s", rc, out);
+  test_write_file(dir, "bg.json",
+                  "{\"meshes\": [{\"builtin\": \"box:1\", \"scale\": 0.2}], \"render\": {\"size\": [16, 12], "
+                  "\"background\": [0.25, 0.5, 1]}}");
+  rc = test_run_cli(dir, "render bg.json -o bg.exr", true, out, sizeof out);
+  rr_image bg = {0};
+  char exr[300];
+  snprintf(exr, sizeof exr, "%s/bg.exr", dir);
+  CHECK(rc == 0 && rr_image_read(dev, exr, &bg) == RR_OK && bg.type == RR_PIXEL_F32 && bg.channels >= 3 &&
+            ((float *)bg.data)[0] == 0.25f && ((float *)bg.data)[1] == 0.5f && ((float *)bg.data)[2] == 1.0f,
+        "the file's background behind misses: %d %s", rc, out);
+  rr_image_free(&bg);
   rc = test_run_cli(dir, "info cli.json", false, out, sizeof out);
   CHECK(rc == 0 && strstr(out, "triangles    12"), "info of a scene file: %d %s", rc, out);
 }

@@ -130,7 +130,7 @@ enum { /* keys of the options without a short form (above every char) */
   OPT_METHOD = 256, OPT_ORACLES, OPT_SIZE, OPT_CAMERA, OPT_ORTHO_HEIGHT, OPT_CUBE_FACES, OPT_EYE, OPT_TARGET,
   OPT_UP, OPT_FOV, OPT_SHADE, OPT_AOV, OPT_THREADS, OPT_REPEAT, OPT_STATS, OPT_STATS_JSON, OPT_CULL_BACKFACES,
   OPT_CAMERA_FROM_FILE, OPT_CAMERA_FILE, OPT_SAVE_CAMERA, OPT_PROGRESS, OPT_AA, OPT_AA_PATTERN, OPT_AA_FILTER,
-  OPT_ALPHA, OPT_TEXTURE_FILTER, OPT_LOD_BIAS, OPT_LIGHT, OPT_SHADOWS, OPT_MAX_DEPTH,
+  OPT_ALPHA, OPT_TEXTURE_FILTER, OPT_LOD_BIAS, OPT_LIGHT, OPT_SHADOWS, OPT_MAX_DEPTH, OPT_BACKGROUND,
   OPT_IMPORT_TIMEOUT, OPT_MAX_MEMORY,
   OPT_INTRINSICS, OPT_DISTORTION, OPT_EXTRINSICS,
 };
@@ -232,6 +232,7 @@ static const cli_option render_options[] = {
     {"alpha", OPT_ALPHA, NULL,
      "give the colour image an alpha channel: the coverage of the pixel's samples\n"
      "(filtered), colour straight (PNG RGBA, EXR R G B A)"},
+    {"background", OPT_BACKGROUND, "R,G,B", "the colour behind misses, linear RGB (default: a grey-blue gradient)"},
     {"texture-filter", OPT_TEXTURE_FILTER, "NAME[:N]",
      "how textures are read over a pixel's footprint (exact derivatives for every\n"
      "camera): nearest, bilinear (level 0; they alias), trilinear, aniso[:N] (up\n"
@@ -951,7 +952,8 @@ static void take_settings(const rr_scene_settings *file, uint64_t flags, rr_rend
                  {RR_SETTING_CULL, OPT_CULL_BACKFACES}, {RR_SETTING_SHADE, OPT_SHADE},
                  {RR_SETTING_SHADOWS, OPT_SHADOWS}, {RR_SETTING_MAX_DEPTH, OPT_MAX_DEPTH},
                  {RR_SETTING_FILTER, OPT_AA_FILTER}, {RR_SETTING_TEXTURE_FILTER, OPT_TEXTURE_FILTER},
-                 {RR_SETTING_LOD_BIAS, OPT_LOD_BIAS}, {RR_SETTING_ALPHA, OPT_ALPHA}};
+                 {RR_SETTING_LOD_BIAS, OPT_LOD_BIAS}, {RR_SETTING_ALPHA, OPT_ALPHA},
+                 {RR_SETTING_BACKGROUND, OPT_BACKGROUND}};
   for (size_t k = 0; k < sizeof flag_of / sizeof *flag_of; k++)
     if (flags & FLAG(flag_of[k].flag)) take &= ~flag_of[k].setting;
   if (take & RR_SETTING_SIZE) opt->width = fr->width, opt->height = fr->height;
@@ -966,6 +968,10 @@ static void take_settings(const rr_scene_settings *file, uint64_t flags, rr_rend
   if (take & RR_SETTING_LOD_BIAS) shading->lod_bias = fs->lod_bias;
   if (take & RR_SETTING_ALPHA) shading->alpha = fs->alpha;
   if (take & RR_SETTING_DEFAULT_LIGHTS) shading->default_lights = fs->default_lights;
+  if (take & RR_SETTING_BACKGROUND) {
+    shading->has_background = fs->has_background;
+    memcpy(shading->background, fs->background, sizeof shading->background);
+  }
 }
 
 static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **argv) {
@@ -1071,6 +1077,11 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     case OPT_AA_PATTERN: pattern = parse_aa_pattern(optarg, &seed), pattern_given = true; break;
     case OPT_AA_FILTER: parse_filter(optarg, &shading); break;
     case OPT_ALPHA: shading.alpha = 1; break;
+    case OPT_BACKGROUND:
+      parse_vec(option_name, optarg, shading.background), shading.has_background = 1;
+      if (!(shading.background[0] >= 0 && shading.background[1] >= 0 && shading.background[2] >= 0))
+        die(EXIT_USAGE, "bad value '%s' for --background (expected R,G,B at least 0)", optarg);
+      break;
     case OPT_TEXTURE_FILTER: parse_texture_filter(optarg, &shading); break;
     case OPT_LOD_BIAS:
       shading.lod_bias = parse_float(option_name, optarg);
@@ -1091,8 +1102,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   if (file_cam && camera_file) die(EXIT_USAGE, "--camera-from-file and --camera-file exclude each other");
   if (!scene_name) scene_name = "demo";
   timings ms = {0};
-  rr_scene_settings file; /* a scene file's settings, where no flag gave them */
-  rr_scene *scene = load_scene(dev, scene_name, opt.threads, &ms.load, &file);
+  rr_scene_settings file = {0}; /* a scene file's settings, where no flag gave them: read first */
+  rr_scene *scene = is_scene_file(scene_name) ? load_scene(dev, scene_name, opt.threads, &ms.load, &file) : NULL;
   take_settings(&file, flags, &opt, &shading, &shade, &aa);
   if (pattern_given && aa.mode == RR_AA_NONE) die(EXIT_USAGE, "--aa-pattern needs --aa other than none");
   if (rr_render_options_set_aa(dev, &opt, aa.mode, aa.samples, aa.stored, pattern, seed) != RR_OK)
@@ -1123,6 +1134,7 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   }
   if ((lens & 3) && cam.type != RR_CAMERA_OPENCV && cam.type != RR_CAMERA_OPENCV_FISHEYE)
     die(EXIT_USAGE, "--intrinsics and --distortion go with --camera opencv or opencv-fisheye");
+  if (!scene) scene = load_scene(dev, scene_name, opt.threads, &ms.load, NULL);
 
   for (int k = 0; k < nlights; k++)
     if (rr_scene_add_light(scene, &lights[k]) != RR_OK) die(EXIT_USAGE, "--light: %s", rr_device_message(dev));

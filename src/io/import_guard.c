@@ -328,6 +328,7 @@ static rr_error read_scene(rr_scene *s, const char *path, const uint8_t *data, s
     if (get_u32(&r) != IMAGE_MAGIC || r.bad) e = RR_ERROR_PARSE;
     else s->up = up, s->front = front;
   }
+  if (e == RR_ERROR_ARGUMENT) return e; /* the scene's own refusal (a triangle budget), already said */
   if (e == RR_ERROR_MEMORY) return rr_fail(s->dev, e, "cannot read scene '%s': out of memory", path);
   if (e) return rr_fail(s->dev, e, "cannot read scene '%s': the import process handed back a damaged scene", path);
   return RR_OK;

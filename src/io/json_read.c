@@ -58,6 +58,8 @@ rr_error rr_json_fail(json_reader *r, const char *key, const char *fmt, ...) {
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
   size_t len = key ? rr_json_enter(r, key, 0) : strlen(r->at);
+  for (char *c = msg; *c; c++) /* the file's strings quoted in it (names, paths) stay on one line */
+    if ((unsigned char)*c < 32) *c = '?';
   rr_error e = r->at[0] ? rr_fail(r->dev, RR_ERROR_PARSE, "%s: '%s': %s", r->what, r->at, msg)
                         : rr_fail(r->dev, RR_ERROR_PARSE, "%s: %s", r->what, msg);
   rr_json_leave(r, len);
@@ -135,26 +137,32 @@ rr_error rr_json_string(json_reader *r, const cJSON *obj, const char *key, const
   return RR_OK;
 }
 
-rr_error rr_json_array_floats(json_reader *r, const cJSON *item, int n, double lo, double hi, float *out) {
+rr_error rr_json_array_doubles(json_reader *r, const cJSON *item, int n, double lo, double hi, double *out) {
   if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != n) return rr_json_fail(r, NULL, "expected an array of %d numbers", n);
-  float v[16];
+  double v[16];
   int i = 0;
   for (const cJSON *x = item->child; x && i < 16; x = x->next, i++) {
-    double d;
-    rr_error e = number(r, x, NULL, lo, hi, &d);
+    rr_error e = number(r, x, NULL, lo, hi, &v[i]);
     if (e) return e;
-    v[i] = (float)d;
   }
   memcpy(out, v, sizeof *v * (size_t)n);
   return RR_OK;
 }
 
-rr_error rr_json_floats(json_reader *r, const cJSON *obj, const char *key, int n, double lo, double hi, float *out) {
+rr_error rr_json_doubles(json_reader *r, const cJSON *obj, const char *key, int n, double lo, double hi, double *out) {
   const cJSON *item = rr_json_get(obj, key);
   if (!item) return RR_OK;
   size_t len = rr_json_enter(r, key, 0);
-  rr_error e = rr_json_array_floats(r, item, n, lo, hi, out);
+  rr_error e = rr_json_array_doubles(r, item, n, lo, hi, out);
   rr_json_leave(r, len);
+  return e;
+}
+
+rr_error rr_json_floats(json_reader *r, const cJSON *obj, const char *key, int n, double lo, double hi, float *out) {
+  double v[16];
+  if (!rr_json_get(obj, key)) return RR_OK;
+  rr_error e = rr_json_doubles(r, obj, key, n, lo, hi, v);
+  for (int i = 0; !e && i < n; i++) out[i] = (float)v[i];
   return e;
 }
 

@@ -49,8 +49,10 @@ rr_error rr_json_bool(json_reader *r, const cJSON *obj, const char *key, int *ou
 /* A string (owned by the parse). */
 rr_error rr_json_string(json_reader *r, const cJSON *obj, const char *key, const char **out);
 /* An array (the item itself) of exactly n <= 16 finite numbers, each in [lo, hi]. */
-rr_error rr_json_array_floats(json_reader *r, const cJSON *item, int n, double lo, double hi, float *out);
+rr_error rr_json_array_doubles(json_reader *r, const cJSON *item, int n, double lo, double hi, double *out);
 /* The member key: an array of exactly n <= 16 finite numbers, each in [lo, hi]. */
+rr_error rr_json_doubles(json_reader *r, const cJSON *obj, const char *key, int n, double lo, double hi, double *out);
+/* The same, rounded to floats. */
 rr_error rr_json_floats(json_reader *r, const cJSON *obj, const char *key, int n, double lo, double hi, float *out);
 /* A name that from_name knows (an rr_*_from_name: -1 when unknown); `expected`
  * lists the names for the message. */

@@ -32,12 +32,12 @@ static rr_error camera_matrix(json_reader *r, const cJSON *obj, rr_camera *cam) 
   const cJSON *m = rr_json_get(obj, "matrix");
   if (!cJSON_IsArray(m) || cJSON_GetArraySize(m) != 4)
     return rr_json_fail(r, "matrix", "expected four rows of four numbers (camera to world, OpenGL convention)");
-  float row[4][4];
+  double row[4][4];
   size_t len = rr_json_enter(r, "matrix", 0);
   rr_error e = RR_OK;
   for (int i = 0; i < 4 && !e; i++) {
     size_t l2 = rr_json_enter(r, NULL, i);
-    e = rr_json_array_floats(r, cJSON_GetArrayItem(m, i), 4, -MAX_COORD, MAX_COORD, row[i]);
+    e = rr_json_array_doubles(r, cJSON_GetArrayItem(m, i), 4, -MAX_COORD, MAX_COORD, row[i]);
     rr_json_leave(r, l2);
   }
   rr_json_leave(r, len);
@@ -45,7 +45,7 @@ static rr_error camera_matrix(json_reader *r, const cJSON *obj, rr_camera *cam) 
   if (row[3][0] != 0 || row[3][1] != 0 || row[3][2] != 0 || row[3][3] != 1)
     return rr_json_fail(r, "matrix", "the bottom row must be 0 0 0 1");
   for (int i = 0; i < 3; i++)
-    cam->eye[i] = row[i][3], cam->target[i] = row[i][3] - row[i][2], cam->up[i] = row[i][1];
+    cam->eye[i] = (float)row[i][3], cam->target[i] = (float)row[i][3] - (float)row[i][2], cam->up[i] = (float)row[i][1];
   return RR_OK;
 }
 
@@ -199,7 +199,7 @@ static rr_error read_aa(json_reader *r, const cJSON *obj, rr_render_options *ro)
 static rr_error read_render(json_reader *r, const cJSON *obj, rr_scene_settings *st) {
   static const char *const keys[] = {"size", "method", "aa", "aa_pattern", "aa_filter", "cull_backfaces", "shade",
                                      "shadows", "max_depth", "texture_filter", "lod_bias", "alpha", "default_lights",
-                                     NULL};
+                                     "background", NULL};
   rr_error e = rr_json_keys(r, obj, keys);
   if (e) return e;
   rr_render_options *ro = &st->render;
@@ -266,12 +266,15 @@ static rr_error read_render(json_reader *r, const cJSON *obj, rr_scene_settings 
   if ((e = rr_json_float(r, obj, "lod_bias", -64, 64, &so->lod_bias))) return e;
   if ((e = rr_json_bool(r, obj, "alpha", &so->alpha))) return e;
   if ((e = rr_json_bool(r, obj, "default_lights", &so->default_lights))) return e;
+  if ((e = rr_json_floats(r, obj, "background", 3, 0, MAX_COORD, so->background))) return e;
+  so->has_background |= rr_json_get(obj, "background") != NULL;
   static const struct {
     const char *key;
     unsigned bit;
   } bits[] = {{"method", RR_SETTING_METHOD}, {"cull_backfaces", RR_SETTING_CULL}, {"shade", RR_SETTING_SHADE},
               {"shadows", RR_SETTING_SHADOWS}, {"max_depth", RR_SETTING_MAX_DEPTH}, {"lod_bias", RR_SETTING_LOD_BIAS},
-              {"alpha", RR_SETTING_ALPHA}, {"default_lights", RR_SETTING_DEFAULT_LIGHTS}};
+              {"alpha", RR_SETTING_ALPHA}, {"default_lights", RR_SETTING_DEFAULT_LIGHTS},
+              {"background", RR_SETTING_BACKGROUND}};
   for (size_t k = 0; k < sizeof bits / sizeof *bits; k++)
     if (rr_json_get(obj, bits[k].key)) st->given |= bits[k].bit;
   return RR_OK;
@@ -301,23 +304,22 @@ static double det3(const double m[3][3]) {
 static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
   *x = (xform){{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
   const cJSON *matrix = rr_json_get(obj, "matrix");
-  rr_error e;
+  rr_error e = RR_OK;
   if (matrix) {
     if (rr_json_get(obj, "translate") || rr_json_get(obj, "rotate") || rr_json_get(obj, "scale"))
       return rr_json_fail(r, NULL, "give either 'matrix' or 'translate', 'rotate' and 'scale', not both");
     if (!cJSON_IsArray(matrix) || cJSON_GetArraySize(matrix) != 4)
       return rr_json_fail(r, "matrix", "expected four rows of four numbers");
     double row[4][4];
+    size_t len = rr_json_enter(r, "matrix", 0);
     int i = 0;
-    for (const cJSON *rw = matrix->child; rw; rw = rw->next, i++) {
-      if (!cJSON_IsArray(rw) || cJSON_GetArraySize(rw) != 4) return rr_json_fail(r, "matrix", "expected four rows of four numbers");
-      int j = 0;
-      for (const cJSON *v = rw->child; v; v = v->next, j++) {
-        if (!cJSON_IsNumber(v) || !(fabs(v->valuedouble) <= MAX_COORD))
-          return rr_json_fail(r, "matrix", "expected finite numbers of magnitude at most 1e30");
-        row[i][j] = v->valuedouble;
-      }
+    for (const cJSON *rw = matrix->child; rw && !e; rw = rw->next, i++) {
+      size_t l2 = rr_json_enter(r, NULL, i);
+      e = rr_json_array_doubles(r, rw, 4, -MAX_COORD, MAX_COORD, row[i]);
+      rr_json_leave(r, l2);
     }
+    rr_json_leave(r, len);
+    if (e) return e;
     if (row[3][0] != 0 || row[3][1] != 0 || row[3][2] != 0 || row[3][3] != 1)
       return rr_json_fail(r, "matrix", "the bottom row must be 0 0 0 1");
     for (i = 0; i < 3; i++) {
@@ -325,36 +327,17 @@ static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
       x->t[i] = row[i][3];
     }
   } else {
+    /* doubles throughout: the file's own digits, not the floats nearest them */
     double s[3] = {1, 1, 1}, deg[3] = {0, 0, 0};
-    float f[3];
-    const cJSON *scale = rr_json_get(obj, "scale");
-    if (cJSON_IsNumber(scale)) {
-      if ((e = rr_json_double(r, obj, "scale", -MAX_COORD, MAX_COORD, &s[0]))) return e;
+    if (cJSON_IsNumber(rr_json_get(obj, "scale"))) {
+      e = rr_json_double(r, obj, "scale", -MAX_COORD, MAX_COORD, &s[0]);
       s[1] = s[2] = s[0];
-    } else if (scale) {
-      if ((e = rr_json_floats(r, obj, "scale", 3, -MAX_COORD, MAX_COORD, f))) return e;
-      for (int k = 0; k < 3; k++) s[k] = f[k];
+    } else {
+      e = rr_json_doubles(r, obj, "scale", 3, -MAX_COORD, MAX_COORD, s);
     }
-    const cJSON *rot = rr_json_get(obj, "rotate");
-    if (rot) { /* read as doubles: the angles' own digits, not the float nearest them */
-      if (!cJSON_IsArray(rot) || cJSON_GetArraySize(rot) != 3) return rr_json_fail(r, "rotate", "expected an array of 3 numbers");
-      int k = 0;
-      for (const cJSON *v = rot->child; v; v = v->next, k++) {
-        if (!cJSON_IsNumber(v) || !(fabs(v->valuedouble) <= 1e6))
-          return rr_json_fail(r, "rotate", "expected 3 angles in degrees, each within ±1e6");
-        deg[k] = v->valuedouble;
-      }
-    }
-    const cJSON *tr = rr_json_get(obj, "translate");
-    if (tr) {
-      if (!cJSON_IsArray(tr) || cJSON_GetArraySize(tr) != 3) return rr_json_fail(r, "translate", "expected an array of 3 numbers");
-      int k = 0;
-      for (const cJSON *v = tr->child; v; v = v->next, k++) {
-        if (!cJSON_IsNumber(v) || !(fabs(v->valuedouble) <= MAX_COORD))
-          return rr_json_fail(r, "translate", "expected finite numbers of magnitude at most 1e30");
-        x->t[k] = v->valuedouble;
-      }
-    }
+    if (e || (e = rr_json_doubles(r, obj, "rotate", 3, -1e6, 1e6, deg)) ||
+        (e = rr_json_doubles(r, obj, "translate", 3, -MAX_COORD, MAX_COORD, x->t)))
+      return e;
     double m[3][3] = {{s[0], 0, 0}, {0, s[1], 0}, {0, 0, s[2]}};
     for (int axis = 0; axis < 3; axis++) {
       double a = deg[axis] * (RR_PI / 180), c = cos(a), sn = sin(a);
@@ -388,7 +371,18 @@ static vec3 xf_unit(const double m[3][3], vec3 v) {
 /* Moves triangles t0.. and the cameras and lights from c0, l0 on by x. Normals go
  * through the inverse transpose; a mirroring transform swaps corners 1 and 2 so
  * that front faces stay front faces. */
+static void swapf(float *a, float *b) {
+  float t = *a;
+  *a = *b, *b = t;
+}
+
+static bool is_identity(const xform *x) {
+  static const xform id = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
+  return memcmp(x, &id, sizeof id) == 0;
+}
+
 static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_t t0, uint32_t c0, uint32_t l0) {
+  if (is_identity(x)) return RR_OK; /* the mesh as its file has it, normals' bits too */
   double d = det3(x->m), nm[3][3]; /* the cofactor matrix: the inverse transpose times det */
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 3; j++) {
@@ -409,29 +403,12 @@ static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_
       }
     }
     if (d < 0) {
-#define SWAP12(a)            \
-  do {                       \
-    float tmp_ = (a)[1][i];  \
-    (a)[1][i] = (a)[2][i];   \
-    (a)[2][i] = tmp_;        \
-  } while (0)
       for (int c = 0; c < 3; c++) {
-        float *pp[3] = {s->p[0][c], s->p[1][c], s->p[2][c]};
-        SWAP12(pp);
-        if (s->n[0][0]) {
-          float *nn[3] = {s->n[0][c], s->n[1][c], s->n[2][c]};
-          SWAP12(nn);
-        }
-        if (s->col[0][0]) {
-          float *cc[3] = {s->col[0][c], s->col[1][c], s->col[2][c]};
-          SWAP12(cc);
-        }
-        if (c < 2 && s->uv[0][0]) {
-          float *uu[3] = {s->uv[0][c], s->uv[1][c], s->uv[2][c]};
-          SWAP12(uu);
-        }
+        swapf(&s->p[1][c][i], &s->p[2][c][i]);
+        if (s->n[0][0]) swapf(&s->n[1][c][i], &s->n[2][c][i]);
+        if (s->col[0][0]) swapf(&s->col[1][c][i], &s->col[2][c][i]);
+        if (c < 2 && s->uv[0][0]) swapf(&s->uv[1][c][i], &s->uv[2][c][i]);
       }
-#undef SWAP12
       if (s->inf) s->inf[i] = (uint8_t)((inf & 1u) | (inf >> 1 & 2u) | (inf << 1 & 4u));
     }
   }
@@ -524,6 +501,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
   if ((e = rr_json_bool(r, obj, "smooth", &smooth))) return e;
   const cJSON *material = rr_json_get(obj, "material");
   uint32_t t0 = s->ntris, g0 = s->ngeoms, m0 = s->nmaterials, c0 = s->ncameras, l0 = s->nlights;
+  uint64_t faces = scene_faces(s);
   char path[MAX_PATH];
   if (builtin) {
     if (!opt->builtins) return rr_json_fail(r, "builtin", "built-in meshes are not allowed here");
@@ -544,7 +522,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
     snprintf(msg, sizeof msg, "%s", rr_device_message(s->dev));
     return rr_json_fail(r, builtin ? "builtin" : "file", "%s", msg);
   }
-  if (s->ntris == t0 && !s->skipped) return rr_json_fail(r, builtin ? "builtin" : "file", "no triangles");
+  if (scene_faces(s) == faces) return rr_json_fail(r, builtin ? "builtin" : "file", "no triangles");
   for (uint32_t g = g0; name && g < s->ngeoms; g++)
     if ((e = rr_scene_name_geometry(s, g, name))) return e;
   if ((e = apply_xform(r, s, &x, t0, c0, l0))) return e;

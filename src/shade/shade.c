@@ -237,6 +237,7 @@ typedef struct shade_pass {
   rr_aa_mode aa;
   int samples, stored; /* samples shaded and those carrying colour (csaa: K; else all) */
   float dmin, dmax;
+  const float *background; /* the caller's colour behind misses, NULL: the gradient */
   signed char nearest[RR_MAX_SAMPLES][RR_MAX_SAMPLES]; /* csaa: coverage sample c's stored samples, nearest first */
   float *rgb, *weight, *alpha; /* the resolve's input (resolve.h); weight NULL: all 1; alpha NULL: opaque */
   bool has_alpha;
@@ -354,7 +355,8 @@ static void shade_rows(int job, int thread, void *arg) {
   }
   for (int y = job * SHADE_ROWS; y < vb->height && y < (job + 1) * SHADE_ROWS; y++) {
     float bg[3];
-    background(y, vb->height, bg);
+    if (p->background) memcpy(bg, p->background, sizeof bg);
+    else background(y, vb->height, bg);
     for (int x0 = 0; x0 < vb->width; x0 += RUN) {
       int len = vb->width - x0 < RUN ? vb->width - x0 : RUN;
       size_t k0 = (size_t)y * vb->width + x0;
@@ -435,6 +437,7 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
   *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = opt->mode, .aa = f->aa, .samples = f->samples,
                       .tex = {opt->texture_filter, opt->aniso, opt->lod_bias}, .lit = lights != NULL};
   if (lights) p->lights = *lights;
+  p->background = opt->has_background ? opt->background : NULL;
   p->stored = f->aa == RR_AA_CSAA ? f->aa_stored : p->samples;
   /* Derivatives are per pixel step. A sample shaded for the whole pixel (one per
    * pixel, msaa, csaa) filters over all of it; ssaa's N samples each over their
@@ -668,6 +671,9 @@ rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   if (opt->aniso < 1 || opt->aniso > 16)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "bad anisotropy %d (expected 1..16 probes)", opt->aniso);
   if (!isfinite(opt->lod_bias)) return rr_fail(dev, RR_ERROR_ARGUMENT, "the texture LOD bias must be finite");
+  for (int c = 0; opt->has_background && c < 3; c++)
+    if (!(opt->background[c] >= 0 && opt->background[c] <= 1e30f))
+      return rr_fail(dev, RR_ERROR_ARGUMENT, "the background colour must be finite and at least 0");
   if (stats) *stats = (rr_shade_stats){0};
   if (opt->mode == RR_SHADE_HEAT_EVALS || opt->mode == RR_SHADE_HEAT_NODES) {
     double t0 = rr_now_ms();
