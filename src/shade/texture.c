@@ -223,7 +223,9 @@ static void ewa_level(const rr_texture *t, int l, float s, float r, const footpr
   float q11 = m22 / det, q12 = -m12 / det, q22 = m11 / det; /* M^-1 */
   float cx = s * sx - 0.5f, cy = r * sy - 0.5f;             /* texel centres at integers */
   const float R2 = EWA_RADIUS * EWA_RADIUS;
-  float ex = sqrtf(m11 * R2), ey = sqrtf(m22 * R2); /* the ellipse's bounding box */
+  /* the ellipse's bounding box, at most a period of the texture each way (a thin
+   * texture's levels stop halving across: the rest would revisit the same texels) */
+  float ex = fminf(sqrtf(m11 * R2), (float)lv->width + 1), ey = fminf(sqrtf(m22 * R2), (float)lv->height + 1);
   int x0 = ifloor(cx - ex) + 1, x1 = ifloor(cx + ex), y0 = ifloor(cy - ey) + 1, y1 = ifloor(cy + ey);
   float sum[4] = {0, 0, 0, 0}, wsum = 0, floor_w = expf(-EWA_ALPHA * R2);
   for (int y = y0; y <= y1; y++) {
@@ -268,8 +270,8 @@ static void filter_ewa(const rr_texture *t, float s, float r, footprint fp, cons
   int top = t->nlevels - 1;
   if (!(lod > 0)) {
     ewa_level(t, 0, s, r, &fp, 1, acc);
-  } else if (lod >= (float)top) {
-    ewa_level(t, top, s, r, &fp, 1, acc);
+  } else if (lod >= (float)top) { /* the ellipse covers the texture: its mean (and a bounded loop) */
+    bilerp(t, &t->levels[top], s / (float)t->width, r / (float)t->height, 1, acc);
   } else {
     int l = (int)lod;
     float w = lod - (float)l;
