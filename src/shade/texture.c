@@ -259,7 +259,10 @@ static void ewa_level(const rr_texture *t, int l, float s, float r, const footpr
 }
 
 /* EWA at the two levels around the one where the ellipse's short axis spans about
- * two texels, the ellipse's eccentricity limited to f->aniso (its short axis grown). */
+ * two texels, the ellipse's eccentricity limited to f->aniso (its short axis grown).
+ * Where it spans fewer than two texels of level 0, a Gaussian sampled at texel
+ * centres would be narrower than their spacing: the footprint is then read through
+ * the bilinear reconstruction, by aniso's probes. */
 static void filter_ewa(const rr_texture *t, float s, float r, footprint fp, const tex_filter *f, rr_vf4 *acc) {
   float la = fp.ax * fp.ax + fp.ay * fp.ay, lb = fp.bx * fp.bx + fp.by * fp.by;
   if (la < lb) {
@@ -280,8 +283,9 @@ static void filter_ewa(const rr_texture *t, float s, float r, footprint fp, cons
   }
   float lod = log2f(lmin) - 1.0f + f->lod_bias;
   int top = t->nlevels - 1;
-  if (!(lod > 0)) {
-    ewa_level(t, 0, s, r, &fp, 1, acc);
+  if (!(lod > 0)) { /* magnified: the texels' bilinear reconstruction over the footprint, as aniso reads it */
+    tex_filter probes = {RR_TEXTURE_ANISO, f->aniso, f->lod_bias};
+    filter_aniso(t, s, r, &fp, &probes, acc);
   } else if (lod >= (float)top) { /* the ellipse covers the texture: its mean (and a bounded loop) */
     bilerp(t, &t->levels[top], s / (float)t->width, r / (float)t->height, 1, acc);
   } else {
