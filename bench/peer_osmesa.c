@@ -8,6 +8,8 @@
 #include "vis/vis.h"
 
 #include <GL/osmesa.h>
+#include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,6 +28,8 @@ struct osmesa_peer {
 };
 
 static double now(void) { return rr_now_ms(); }
+
+#define PLANE_HALF 4096.0f /* half the side of the textured plane's square */
 
 
 static int cmp_double(const void *a, const void *b) {
@@ -250,4 +254,92 @@ const uint32_t *osmesa_ids(osmesa_peer *p) {
     }
   }
   return p->ids;
+}
+
+double osmesa_render_textured_plane(osmesa_peer *p, const rr_camera *cam, const uint8_t *rgb, int w, int h,
+                                    float scale, float aniso, int reps, float *out) {
+  camera c;
+  if (rr_cam_setup(NULL, cam, p->w, p->h, &c) != RR_OK || cam->type != RR_CAMERA_PERSPECTIVE) {
+    fprintf(stderr, "osmesa: needs a valid perspective camera\n");
+    return -1;
+  }
+  /* a square of side 2·PLANE_HALF: beyond it the plane is less than a pixel from
+   * the horizon (GL cannot clip points at infinity through its far plane) */
+  const float R = PLANE_HALF;
+  vec3 bmin = p->bmin, bmax = p->bmax;
+  p->bmin = v3(-R, 0, -R), p->bmax = v3(R, 0, R);
+  double m[16];
+  clip_matrix(&c, p, m);
+  p->bmin = bmin, p->bmax = bmax;
+  rr_cam_release(&c);
+  /* a float target, so that the filtered linear values come back unquantized */
+  GLuint fbo, rb, tex;
+  glGenFramebuffers(1, &fbo);
+  glGenRenderbuffers(1, &rb);
+  glBindRenderbuffer(GL_RENDERBUFFER, rb);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, p->w, p->h);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb);
+  /* texels: GL's rows run up from t = 0, ours down from v = 1, so rows are flipped */
+  uint8_t *flip = malloc((size_t)3 * w * h);
+  for (int y = 0; flip && y < h; y++) memcpy(flip + (size_t)3 * y * w, rgb + (size_t)3 * (h - 1 - y) * w, (size_t)3 * w);
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8, w, h, 0, GL_RGB, GL_UNSIGNED_BYTE, flip);
+  free(flip);
+  glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  glTexParameterf(GL_TEXTURE_2D, GL_TEXTURE_MAX_ANISOTROPY_EXT, aniso);
+  glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_REPLACE);
+  glEnable(GL_TEXTURE_2D);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  glShadeModel(GL_SMOOTH);
+  glMatrixMode(GL_PROJECTION);
+  glLoadMatrixd(m);
+  glClearColor(-1, -1, -1, -1);
+  bool ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE && glGetError() == GL_NO_ERROR;
+  double t[64];
+  if (reps < 1) reps = 1;
+  if (reps > 64) reps = 64;
+  /* the square's corners and their texture coordinates (x/scale, -z/scale) */
+  static const float corner[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  for (int r = 0; ok && r < reps; r++) {
+    glClear(GL_COLOR_BUFFER_BIT);
+    glFinish();
+    double t0 = now();
+    glBegin(GL_QUADS);
+    for (int k = 0; k < 4; k++) {
+      float x = corner[k][0] * R, z = corner[k][1] * R;
+      glTexCoord2f(x / scale, -z / scale), glVertex3f(x, 0, z);
+    }
+    glEnd();
+    glFinish();
+    t[r] = now() - t0;
+  }
+  float *px = ok ? malloc((size_t)p->w * p->h * 4 * sizeof *px) : NULL;
+  if (px) {
+    glReadPixels(0, 0, p->w, p->h, GL_RGBA, GL_FLOAT, px);
+    for (int y = 0; y < p->h; y++)
+      for (int x = 0; x < p->w; x++) out[(size_t)y * p->w + x] = px[4 * ((size_t)(p->h - 1 - y) * p->w + x)];
+  }
+  ok = ok && px && glGetError() == GL_NO_ERROR;
+  free(px);
+  glDisable(GL_TEXTURE_2D);
+  glEnable(GL_DEPTH_TEST);
+  glShadeModel(GL_FLAT);
+  glClearColor(0, 0, 0, 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteTextures(1, &tex);
+  glDeleteRenderbuffers(1, &rb);
+  glDeleteFramebuffers(1, &fbo);
+  if (!ok) {
+    fprintf(stderr, "osmesa: the textured plane failed (GL error or incomplete float framebuffer)\n");
+    return -1;
+  }
+  return median(t, reps);
 }

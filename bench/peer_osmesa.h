@@ -37,4 +37,15 @@ double osmesa_resolve_ms(const osmesa_peer *p);
 /* The ids of the last rendering, row 0 at the top (RR_MISS where nothing was
  * drawn); owned by the peer. */
 const uint32_t *osmesa_ids(osmesa_peer *p);
+/* Draws the plane y = 0 (a square of side 8192 around the origin: the rest is within
+ * a pixel of the horizon at 1024 rows and 45°, from 1 unit above it) seen by cam with
+ * texture coordinates (x/scale, -z/scale), textured by the w×h sRGB texels rgb
+ * (3 bytes each, row 0 at the top: v = 1) as an sRGB texture (so filtering is in
+ * linear light) with its mipmaps (glGenerateMipmap), GL_LINEAR_MIPMAP_LINEAR,
+ * GL_REPEAT and `aniso`× anisotropic filtering (EXT_texture_filter_anisotropic), into
+ * a float framebuffer, `reps` times. Writes the linear red channel per pixel (row 0
+ * at the top; -1 where the plane is not drawn) to out and returns the median
+ * milliseconds of the draw and glFinish; -1, with a message, when it cannot. */
+double osmesa_render_textured_plane(osmesa_peer *p, const rr_camera *cam, const uint8_t *rgb, int w, int h,
+                                    float scale, float aniso, int reps, float *out);
 #endif

@@ -521,7 +521,7 @@ static void test_textures(void) {
   CHECK(mats[3].texture.width == 0 && mats[3].texture.rgb == NULL, "material without texture");
   t = &mats[4].texture;
   CHECK(t->width == 4 && t->rgb && memcmp(t->rgb, rgb.data, 24) == 0, "backslash path");
-  for (int i = 0; i < 5; i++) free(mats[i].texture.rgb);
+  for (int i = 0; i < 5; i++) rr_texture_clear(&mats[i].texture);
 
   unlink(tpath("sub/t.png"));
   rmdir(tpath("sub"));

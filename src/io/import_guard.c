@@ -19,6 +19,7 @@
  * and stdio buffers are the parent's. */
 #define _GNU_SOURCE /* memfd_create, strsignal */
 #include "io/import_guard.h"
+#include "shade/texture.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -101,7 +102,10 @@ static bool write_scene(const rr_scene *c, int fd) {
     bool texels = mt->texture.rgb && mt->texture.width > 0 && mt->texture.height > 0;
     put_u32(&w, texels ? (uint32_t)mt->texture.width : 0);
     put_u32(&w, texels ? (uint32_t)mt->texture.height : 0);
-    if (texels) put(&w, mt->texture.rgb, (size_t)mt->texture.width * (size_t)mt->texture.height * 3);
+    size_t texel_count = texels ? (size_t)mt->texture.width * (size_t)mt->texture.height : 0;
+    if (texels) put(&w, mt->texture.rgb, texel_count * 3);
+    put_u32(&w, texels && mt->texture.alpha);
+    if (texels && mt->texture.alpha) put(&w, mt->texture.alpha, texel_count);
     for (int k = 0; k < RR_MAP_COUNT; k++) put_str(&w, mt->maps[k]);
   }
   unsigned flags = (c->n[0][0] ? HAS_N : 0) | (c->uv[0][0] ? HAS_UV : 0) | (c->col[0][0] ? HAS_COL : 0) |
@@ -213,10 +217,16 @@ static bool read_materials(rr_scene *s, reader *r) {
     uint32_t w = get_u32(r), h = get_u32(r);
     if (w > RR_MAX_SIZE || h > RR_MAX_SIZE) r->bad = true;
     const uint8_t *texels = w && h ? get_span(r, (uint64_t)w * h * 3) : NULL;
-    if (texels) {
+    const uint8_t *alpha = get_u32(r) && texels ? get_span(r, (uint64_t)w * h) : NULL;
+    if (texels) { /* level 0 as the child read it; the MIP chain is rebuilt here, not sent */
       if (!(mt->texture.rgb = malloc((size_t)w * h * 3))) return false;
       memcpy(mt->texture.rgb, texels, (size_t)w * h * 3);
       mt->texture.width = (int)w, mt->texture.height = (int)h;
+      if (alpha) {
+        if (!(mt->texture.alpha = malloc((size_t)w * h))) return false;
+        memcpy(mt->texture.alpha, alpha, (size_t)w * h);
+      }
+      if (!rr_texture_prepare(&mt->texture)) return false;
     }
     for (int k = 0; k < RR_MAP_COUNT; k++) mt->maps[k] = get_str(r, &nomem);
     if (nomem) return false;

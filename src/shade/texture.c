@@ -15,6 +15,7 @@
  * box. */
 #include "shade/texture.h"
 #include "core/color.h"
+#include "core/simd.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -111,9 +112,10 @@ bool rr_texture_prepare(rr_texture *t) {
 
 /* floor(x) as an int, kept within ±2^30 so that footprints far outside [0, 1] wrap
  * without overflow. */
-static inline int ifloor(float x) {
-  float f = floorf(x);
-  return f > 1073741824.0f ? 1073741824 : f < -1073741824.0f ? -1073741824 : (int)f;
+KERNEL int ifloor(float x) {
+  x = x > 1073741824.0f ? 1073741824.0f : x < -1073741824.0f ? -1073741824.0f : x == x ? x : 0.0f;
+  int i = (int)x; /* truncation, then down for negatives: no floorf call without SSE4.1 */
+  return i - (x < (float)i);
 }
 
 /* Texel index i of a side of n texels, wrapped as mode says. */
@@ -130,41 +132,51 @@ static inline int wrap_index(int i, int n, rr_texture_wrap mode) {
   return i < 0 ? i + n : i;
 }
 
-/* Adds weight w times the bilinear lookup of level lv at texel coordinates (x, y)
- * (texel centres at half-integers) to acc. */
-static inline void bilerp(const rr_texture *t, const tex_level *lv, float x, float y, float w, float acc[4]) {
-  x -= 0.5f, y -= 0.5f;
-  int x0 = ifloor(x), y0 = ifloor(y);
-  float ax = x - (float)x0, ay = y - (float)y0;
-  int x1 = wrap_index(x0 + 1, lv->width, t->wrap[0]), y1 = wrap_index(y0 + 1, lv->height, t->wrap[1]);
-  x0 = wrap_index(x0, lv->width, t->wrap[0]), y0 = wrap_index(y0, lv->height, t->wrap[1]);
-  const uint16_t *r0 = lv->texels + (size_t)4 * y0 * lv->width, *r1 = lv->texels + (size_t)4 * y1 * lv->width;
-  float w00 = w * (1 - ax) * (1 - ay), w10 = w * ax * (1 - ay), w01 = w * (1 - ax) * ay, w11 = w * ax * ay;
-  for (int c = 0; c < 4; c++)
-    acc[c] += w00 * r0[4 * x0 + c] + w10 * r0[4 * x1 + c] + w01 * r1[4 * x0 + c] + w11 * r1[4 * x1 + c];
+/* Four 16-bit channels of a texel as floats (one vector conversion). */
+typedef uint16_t texel_u16 __attribute__((vector_size(8)));
+KERNEL rr_vf4 texel(const uint16_t *p) {
+  texel_u16 v;
+  memcpy(&v, p, sizeof v);
+  return __builtin_convertvector(__builtin_convertvector(v, rr_vi4), rr_vf4);
 }
 
-/* Two levels and their weights: the trilinear blend at level of detail lod. */
+/* Adds weight w times the bilinear lookup of level lv at texel coordinates (x, y)
+ * (texel centres at half-integers) to acc. Hot: up to 32 a pixel with aniso:16. */
+KERNEL void bilerp(const rr_texture *t, const tex_level *lv, float x, float y, float w, rr_vf4 *acc) {
+  x -= 0.5f, y -= 0.5f;
+  int x0 = ifloor(x), y0 = ifloor(y), W = lv->width, H = lv->height;
+  float ax = x - (float)x0, ay = y - (float)y0;
+  int x1 = x0 + 1, y1 = y0 + 1;
+  if ((unsigned)x0 >= (unsigned)(W - 1)) /* wrap only at the edges */
+    x1 = wrap_index(x1, W, t->wrap[0]), x0 = wrap_index(x0, W, t->wrap[0]);
+  if ((unsigned)y0 >= (unsigned)(H - 1)) y1 = wrap_index(y1, H, t->wrap[1]), y0 = wrap_index(y0, H, t->wrap[1]);
+  const uint16_t *r0 = lv->texels + (size_t)4 * y0 * W, *r1 = lv->texels + (size_t)4 * y1 * W;
+  float w01 = w * ay, w00 = w - w01, w11 = w01 * ax, w10 = w00 * ax;
+  w01 -= w11, w00 -= w10;
+  *acc += rr_vf4_splat(w00) * texel(r0 + 4 * x0) + rr_vf4_splat(w10) * texel(r0 + 4 * x1) +
+          rr_vf4_splat(w01) * texel(r1 + 4 * x0) + rr_vf4_splat(w11) * texel(r1 + 4 * x1);
+}
+
+/* Two levels, their weights (the trilinear blend at a level of detail) and their
+ * sizes relative to level 0's. */
 typedef struct lod_pair {
   const tex_level *lv[2];
-  float w[2];
+  float w[2], sx[2], sy[2];
+  int n; /* levels used: 1 or 2 */
 } lod_pair;
 
 static inline lod_pair lod_levels(const rr_texture *t, float lod) {
-  int top = t->nlevels - 1;
-  if (!(lod > 0)) return (lod_pair){{&t->levels[0], NULL}, {1, 0}}; /* magnified (NaN too) */
-  if (lod >= (float)top) return (lod_pair){{&t->levels[top], NULL}, {1, 0}};
-  int l = (int)lod;
-  float f = lod - (float)l;
-  return (lod_pair){{&t->levels[l], &t->levels[l + 1]}, {1 - f, f}};
+  int top = t->nlevels - 1, l = !(lod > 0) ? 0 : lod >= (float)top ? top : (int)lod; /* NaN: level 0 */
+  float f = l == top || !(lod > 0) ? 0.0f : lod - (float)l;
+  lod_pair p = {{&t->levels[l], &t->levels[l < top ? l + 1 : l]}, {1 - f, f}, {0, 0}, {0, 0}, f > 0 ? 2 : 1};
+  for (int k = 0; k < 2; k++)
+    p.sx[k] = (float)p.lv[k]->width / (float)t->width, p.sy[k] = (float)p.lv[k]->height / (float)t->height;
+  return p;
 }
 
 /* Adds weight w times the trilinear lookup at (s, r) (level-0 texel units) to acc. */
-static inline void trilerp(const rr_texture *t, const lod_pair *p, float s, float r, float w, float acc[4]) {
-  for (int k = 0; k < 2 && p->lv[k]; k++) {
-    float sx = (float)p->lv[k]->width / (float)t->width, sy = (float)p->lv[k]->height / (float)t->height;
-    bilerp(t, p->lv[k], s * sx, r * sy, w * p->w[k], acc);
-  }
+KERNEL void trilerp(const rr_texture *t, const lod_pair *p, float s, float r, float w, rr_vf4 *acc) {
+  for (int k = 0; k < p->n; k++) bilerp(t, p->lv[k], s * p->sx[k], r * p->sy[k], w * p->w[k], acc);
 }
 
 /* The footprint in level-0 texels: the derivative vectors per pixel step in x (a)
@@ -176,11 +188,11 @@ typedef struct footprint {
 /* Up to f->aniso trilinear probes spread along the long side of the parallelogram
  * spanned by a and b, each as wide as the parallelogram across. */
 static void filter_aniso(const rr_texture *t, float s, float r, const footprint *fp, const tex_filter *f,
-                         float acc[4]) {
+                         rr_vf4 *acc) {
   float la = fp->ax * fp->ax + fp->ay * fp->ay, lb = fp->bx * fp->bx + fp->by * fp->by;
   float mx = la >= lb ? fp->ax : fp->bx, my = la >= lb ? fp->ay : fp->by; /* the longer vector */
   float nx = la >= lb ? fp->bx : fp->ax, ny = la >= lb ? fp->by : fp->ay;
-  float lmaj = sqrtf(fmaxf(la, lb));
+  float lmaj = sqrtf(la >= lb ? la : lb);
   if (!(lmaj > 0)) { /* no footprint: magnified */
     lod_pair p = lod_levels(t, f->lod_bias);
     trilerp(t, &p, s, r, 1, acc);
@@ -189,10 +201,10 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
   /* the parallelogram's extent along the longer vector and its width across it */
   float along = lmaj + fabsf(mx * nx + my * ny) / lmaj, across = fabsf(mx * ny - my * nx) / lmaj;
   int n = f->filter == RR_TEXTURE_ANISO ? f->aniso : 1;
-  if (along < (float)n * across) n = (int)ceilf(along / fmaxf(across, 1e-30f));
+  if (along < (float)n * across) n = (int)ceilf(along / across); /* across > 0 here */
   if (n < 1) n = 1;
-  float size = fmaxf(along / (float)n, across);
-  lod_pair p = lod_levels(t, log2f(fmaxf(size, 1e-30f)) + f->lod_bias);
+  float size = along / (float)n > across ? along / (float)n : across;
+  lod_pair p = lod_levels(t, log2f(size) + f->lod_bias);
   /* probe k at ((k + 1/2)/n - 1/2)·along along the unit longer vector */
   float step = along / ((float)n * lmaj), dx = mx * step, dy = my * step, w = 1.0f / (float)n;
   float k0 = 0.5f - 0.5f * (float)n;
@@ -214,7 +226,7 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
 /* One level's EWA: the texels of level l inside the ellipse x^T M^-1 x < R², M = J Jᵀ
  * + EWA_RECON·I (J the footprint in this level's texels), each weighed by
  * exp(-alpha x^T M^-1 x) - exp(-alpha R²). */
-static void ewa_level(const rr_texture *t, int l, float s, float r, const footprint *fp, float w, float acc[4]) {
+static void ewa_level(const rr_texture *t, int l, float s, float r, const footprint *fp, float w, rr_vf4 *acc) {
   const tex_level *lv = &t->levels[l];
   float sx = (float)lv->width / (float)t->width, sy = (float)lv->height / (float)t->height;
   float ax = fp->ax * sx, ay = fp->ay * sy, bx = fp->bx * sx, by = fp->by * sy;
@@ -223,9 +235,12 @@ static void ewa_level(const rr_texture *t, int l, float s, float r, const footpr
   float q11 = m22 / det, q12 = -m12 / det, q22 = m11 / det; /* M^-1 */
   float cx = s * sx - 0.5f, cy = r * sy - 0.5f;             /* texel centres at integers */
   const float R2 = EWA_RADIUS * EWA_RADIUS;
-  float ex = sqrtf(m11 * R2), ey = sqrtf(m22 * R2); /* the ellipse's bounding box */
+  /* the ellipse's bounding box, at most a period of the texture each way (a thin
+   * texture's levels stop halving across: the rest would revisit the same texels) */
+  float ex = fminf(sqrtf(m11 * R2), (float)lv->width + 1), ey = fminf(sqrtf(m22 * R2), (float)lv->height + 1);
   int x0 = ifloor(cx - ex) + 1, x1 = ifloor(cx + ex), y0 = ifloor(cy - ey) + 1, y1 = ifloor(cy + ey);
-  float sum[4] = {0, 0, 0, 0}, wsum = 0, floor_w = expf(-EWA_ALPHA * R2);
+  rr_vf4 sum = rr_vf4_splat(0);
+  float wsum = 0, floor_w = expf(-EWA_ALPHA * R2);
   for (int y = y0; y <= y1; y++) {
     float ty = (float)y - cy;
     const uint16_t *row = lv->texels + (size_t)4 * wrap_index(y, lv->height, t->wrap[1]) * lv->width;
@@ -233,20 +248,22 @@ static void ewa_level(const rr_texture *t, int l, float s, float r, const footpr
       float tx = (float)x - cx, q = q11 * tx * tx + 2 * q12 * tx * ty + q22 * ty * ty;
       if (q >= R2) continue;
       float g = expf(-EWA_ALPHA * q) - floor_w;
-      const uint16_t *p = row + 4 * wrap_index(x, lv->width, t->wrap[0]);
-      for (int c = 0; c < 4; c++) sum[c] += g * p[c];
+      sum += rr_vf4_splat(g) * texel(row + 4 * wrap_index(x, lv->width, t->wrap[0]));
       wsum += g;
     }
   }
   if (wsum > 0)
-    for (int c = 0; c < 4; c++) acc[c] += w * sum[c] / wsum;
+    *acc += rr_vf4_splat(w / wsum) * sum;
   else /* (a box always holds its centre's texel; a guard all the same) */
     bilerp(t, lv, s * sx, r * sy, w, acc);
 }
 
 /* EWA at the two levels around the one where the ellipse's short axis spans about
- * two texels, the ellipse's eccentricity limited to f->aniso (its short axis grown). */
-static void filter_ewa(const rr_texture *t, float s, float r, footprint fp, const tex_filter *f, float acc[4]) {
+ * two texels, the ellipse's eccentricity limited to f->aniso (its short axis grown).
+ * Where it spans fewer than two texels of level 0, a Gaussian sampled at texel
+ * centres would be narrower than their spacing: the footprint is then read through
+ * the bilinear reconstruction, by aniso's probes. */
+static void filter_ewa(const rr_texture *t, float s, float r, footprint fp, const tex_filter *f, rr_vf4 *acc) {
   float la = fp.ax * fp.ax + fp.ay * fp.ay, lb = fp.bx * fp.bx + fp.by * fp.by;
   if (la < lb) {
     footprint sw = {fp.bx, fp.by, fp.ax, fp.ay};
@@ -266,10 +283,11 @@ static void filter_ewa(const rr_texture *t, float s, float r, footprint fp, cons
   }
   float lod = log2f(lmin) - 1.0f + f->lod_bias;
   int top = t->nlevels - 1;
-  if (!(lod > 0)) {
-    ewa_level(t, 0, s, r, &fp, 1, acc);
-  } else if (lod >= (float)top) {
-    ewa_level(t, top, s, r, &fp, 1, acc);
+  if (!(lod > 0)) { /* magnified: the texels' bilinear reconstruction over the footprint, as aniso reads it */
+    tex_filter probes = {RR_TEXTURE_ANISO, f->aniso, f->lod_bias};
+    filter_aniso(t, s, r, &fp, &probes, acc);
+  } else if (lod >= (float)top) { /* the ellipse covers the texture: its mean (and a bounded loop) */
+    bilerp(t, &t->levels[top], s / (float)t->width, r / (float)t->height, 1, acc);
   } else {
     int l = (int)lod;
     float w = lod - (float)l;
@@ -294,22 +312,21 @@ void rr_texture_sample(const rr_texture *t, const tex_coord *tc, const tex_filte
   float W = (float)t->width, H = (float)t->height;
   /* level-0 texel coordinates (s, r), rows running down from v = 1 */
   float s = wrap_coord(tc->u, t->wrap[0]) * W, r = (1.0f - wrap_coord(tc->v, t->wrap[1])) * H;
-  float acc[4] = {0, 0, 0, 0};
+  rr_vf4 acc = rr_vf4_splat(0);
   switch (f->filter) {
   case RR_TEXTURE_NEAREST: {
     const tex_level *lv = &t->levels[0];
     int x = wrap_index(ifloor(s), lv->width, t->wrap[0]), y = wrap_index(ifloor(r), lv->height, t->wrap[1]);
-    const uint16_t *p = lv->texels + 4 * ((size_t)y * lv->width + x);
-    for (int c = 0; c < 4; c++) acc[c] = p[c];
+    acc = texel(lv->texels + 4 * ((size_t)y * lv->width + x));
     break;
   }
   case RR_TEXTURE_BILINEAR:
-    bilerp(t, &t->levels[0], s, r, 1, acc);
+    bilerp(t, &t->levels[0], s, r, 1, &acc);
     break;
   default: {
     footprint fp = {tc->dudx * W, -tc->dvdx * H, tc->dudy * W, -tc->dvdy * H};
-    if (f->filter == RR_TEXTURE_EWA) filter_ewa(t, s, r, fp, f, acc);
-    else filter_aniso(t, s, r, &fp, f, acc); /* trilinear: one probe */
+    if (f->filter == RR_TEXTURE_EWA) filter_ewa(t, s, r, fp, f, &acc);
+    else filter_aniso(t, s, r, &fp, f, &acc); /* trilinear: one probe */
     break;
   }
   }
