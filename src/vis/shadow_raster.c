@@ -67,8 +67,8 @@ typedef struct sr_state {
 /* The slots whose box meets the bin's segment box and lies not wholly outside a
  * side plane; nearest to the light first (an occluder near the light ends a
  * sample's search soonest, any one does). Nothing is dropped on pop. */
-KERNEL int sr_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s) {
-  (void)ref, (void)lanes;
+KERNEL int sr_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s, const bool parallel) {
+  (void)ref;
   sr_state *b = q;
   b->st.nodes += wide_slots(w);
   rr_vf4 lo[3], hi[3], d2 = rr_vf4_splat(0);
@@ -78,10 +78,10 @@ KERNEL int sr_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, tra
     in &= (lo[a] <= b->hi[a]) & (hi[a] >= b->lo[a]);
     /* nearest first: the distance from the light, or (parallel) along the rays */
     rr_vf4 g = rr_vf4_max(rr_vf4_max(lo[a], -hi[a]), rr_vf4_splat(0));
-    d2 += b->parallel ? rr_vf4_min(lo[a] * b->axis[a], hi[a] * b->axis[a]) : g * g;
+    d2 += parallel ? rr_vf4_min(lo[a] * b->axis[a], hi[a] * b->axis[a]) : g * g;
   }
-  for (int p = 0; p < 4; p++) {
-    rr_vf4 m = rr_vf4_splat(-b->off[p]), mag = rr_vf4_splat(fabsf(b->off[p]));
+  for (int p = 0; p < 4; p++) { /* (planes through the light have off 0) */
+    rr_vf4 m = rr_vf4_splat(parallel ? -b->off[p] : 0.0f), mag = rr_vf4_splat(parallel ? fabsf(b->off[p]) : 0.0f);
     for (int a = 0; a < 3; a++) {
       rr_vf4 l = b->plane[p][a] * lo[a], h = b->plane[p][a] * hi[a];
       m += rr_vf4_max(l, h), mag += rr_vf4_abs(l) + rr_vf4_abs(h);
@@ -99,7 +99,8 @@ KERNEL int sr_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, tra
       if (!((lanes & b->live) >> (4 * g) & 15u)) continue;
       rr_vf4 t0 = rr_vf4_splat(0), t1 = b->tmax[g];
       for (int a = 0; a < 3; a++) { /* (a NaN slab is ignored, as in query_node) */
-        rr_vf4 l = rr_vf4_splat(lo[a][k]) - b->og[g][a], u = rr_vf4_splat(hi[a][k]) - b->og[g][a];
+        rr_vf4 l = rr_vf4_splat(lo[a][k]), u = rr_vf4_splat(hi[a][k]);
+        if (parallel) l -= b->og[g][a], u -= b->og[g][a]; /* (from the light, the origins are 0) */
         t0 = rr_vf4_max(rr_vf4_select(b->neg[g][a], u, l) * b->inv_near[g][a], t0);
         t1 = rr_vf4_min(rr_vf4_select(b->neg[g][a], l, u) * b->inv_far[g][a], t1);
       }
@@ -117,7 +118,7 @@ KERNEL float sr_best(const void *q) {
 }
 
 /* A leaf's triangles against the bin's live samples, four triangles at a time. */
-KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
+KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes, const bool parallel) {
   sr_state *b = q;
   const rr_scene *s = b->s;
   const float *v = b->b->leaf_v + (size_t)9 * first;
@@ -128,7 +129,7 @@ KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
       for (uint32_t k = 0; k < n; k++) inf |= (scene_inf(s, b->b->prims[first + j + k]) != 0) << k;
     tri4_edges te;
     b->st.setups += n;
-    if (b->parallel) { /* each ray its own pre-test: the edges depend on its origin */
+    if (parallel) { /* each ray its own pre-test: the edges depend on its origin */
       for (uint64_t live = b->live & lanes; live; live &= live - 1) {
         int k = __builtin_ctzll(live);
         const rr_ray *r = &b->rays[b->idx[k]];
@@ -190,6 +191,20 @@ KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
     if (!b->live) return true;
   }
   return false;
+}
+
+/* The policies of bvh_trace, specialised for a camera at a light and for parallel rays. */
+KERNEL int sr_node_point(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s) {
+  return sr_node(q, w, ref, lanes, s, false);
+}
+KERNEL int sr_node_parallel(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s) {
+  return sr_node(q, w, ref, lanes, s, true);
+}
+KERNEL bool sr_leaf_point(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
+  return sr_leaf(q, first, count, lanes, false);
+}
+KERNEL bool sr_leaf_parallel(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
+  return sr_leaf(q, first, count, lanes, true);
 }
 
 /* Where a direction falls: its cube-map face (major axis a, sign), and its
@@ -255,7 +270,8 @@ static void sr_bin_init(sr_state *b, const rr_ray *rays, const uint32_t *idx, in
       /* the segment, t in [0, tmax] (every hit has t ≥ 0), relative to org */
       float d = r->dir[a], o = r->org[a] - b->org[a], e = d == 0 || !(r->tmax > 0) ? 0 : r->tmax * d;
       lo[a] = minf(lo[a], minf(o, o + e)), hi[a] = maxf(hi[a], maxf(o, o + e));
-      b->dir[k][a] = rr_vf4_splat(d), b->from[k][a] = rr_vf4_splat(r->org[a]);
+      b->dir[k][a] = rr_vf4_splat(d);
+      if (b->parallel) b->from[k][a] = rr_vf4_splat(r->org[a]);
     }
     b->rc[k].ready = false;
   }
@@ -343,7 +359,8 @@ KERNEL void sr_run_body(int job, int thread, void *arg) {
   for (uint32_t i = (uint32_t)job * SR_BINS_PER_JOB; i < j->nbins && i < (uint32_t)(job + 1) * SR_BINS_PER_JOB; i++) {
     sr_bin_init(b, j->rays, j->order + j->bin[i], (int)(j->bin[i + 1] - j->bin[i]));
     b->st.bins++;
-    bvh_trace(j->b, b, b->live, sr_node, sr_leaf, sr_best);
+    if (b->parallel) bvh_trace(j->b, b, b->live, sr_node_parallel, sr_leaf_parallel, sr_best);
+    else bvh_trace(j->b, b, b->live, sr_node_point, sr_leaf_point, sr_best);
   }
   rr_shadow_counts *c = &j->st[thread];
   c->bins += b->st.bins, c->nodes += b->st.nodes, c->setups += b->st.setups, c->edge_evals += b->st.edge_evals;
@@ -392,18 +409,18 @@ bool rr_occluded_raster(const rr_scene *s, const rr_bvh *b, const rr_ray *rays, 
     return false;
   }
   /* The rays of one light are binned: those from the first valid ray's origin (a
-   * point or spot light) or, when more share its direction, those along it (a
-   * directional light, an orthographic camera); the others go one at a time, and
-   * a refused ray is a miss (rr_occluded_stream's rule). */
-  const rr_ray *r0 = NULL;
-  size_t same_org = 0, same_dir = 0;
-  for (size_t i = 0; i < n; i++) {
+   * point or spot light) or, when the second valid ray shares its direction and
+   * not its origin, those along it (a directional light, an orthographic camera);
+   * the others go one at a time, and a refused ray is a miss (rr_occluded_stream's
+   * rule). */
+  const rr_ray *r0 = NULL, *r1 = NULL; /* the first two valid rays */
+  for (size_t i = 0; i < n && !r1; i++) {
     const rr_ray *r = &rays[i];
     if (ray_problem(r->org, r->dir, r->tmin, r->tmax)) continue;
     if (!r0) r0 = r;
-    same_org += memcmp(r0->org, r->org, sizeof r->org) == 0, same_dir += memcmp(r0->dir, r->dir, sizeof r->dir) == 0;
+    else r1 = r;
   }
-  bool parallel = same_dir > same_org;
+  bool parallel = r1 && memcmp(r0->org, r1->org, sizeof r1->org) != 0 && memcmp(r0->dir, r1->dir, sizeof r1->dir) == 0;
   sr_proj pj = r0 ? sr_proj_of(r0->dir) : (sr_proj){0, 0, 0};
   float ulo = INFINITY, uhi = -INFINITY, vlo = INFINITY, vhi = -INFINITY; /* parallel: the origins' extent */
   for (size_t i = 0; parallel && i < n; i++) {

@@ -12,8 +12,9 @@ typedef struct rr_shadow_counts {
 
 /* occluded[k] for rays[0..n-1] through s's tree b (NULL: an empty scene), the
  * same bit rr_occluded gives each ray, on `threads` threads. The rays that share
- * the first valid ray's origin (a point light: a camera there) or, when more share
- * its direction, its direction (a directional light: an orthographic camera) are
+ * the first valid ray's origin (a point light: a camera there) or, when the second
+ * shares its direction and not its origin, its direction (a directional light: an
+ * orthographic camera) are
  * rasterized; the others are traced one at a time, and a ray rr_occluded refuses
  * is not occluded (rr_occluded_stream's rule). False when memory runs out
  * (occluded is then incomplete). counts may be NULL. */
