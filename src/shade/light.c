@@ -253,13 +253,13 @@ static void credit(const level *lv, int i, int part, const float w[3], const flo
   }
 }
 
-/* --shadows auto rasterizes a light's shadow rays from the light when a batch
+/* --shadows auto rasterizes a point or spot light's shadow rays when a batch
  * holds at least this many of them. bench/bench_shading's sweep (instructions,
- * 1024²): in runs of 1024 rays raster costs 0.96x the streams on the demo and
- * 1.08x on the bunny over a plane (whole frames 0.90x and 1.04x); in the lit
- * mode's batches of 64 points (one sample per pixel) 1.16x, of 1024 (16 samples)
- * 0.90x on the demo. A directional light's parallel rays rasterized cost 2.0x and
- * 1.6x (each ray keeps its own edge setup): auto traces them. */
+ * 1024²): in runs of 1024 rays raster costs 0.99x the streams on the demo and
+ * 1.12x on the bunny over a plane (whole frames 0.94x and 1.09x); in the lit
+ * mode's batches of 64 points (one sample per pixel) 1.20x, of 1024 (16 samples)
+ * 0.94x on the demo. A directional light's parallel rays rasterized cost about
+ * 2.0x and 1.6x (each ray keeps its own edge setup): auto traces them. */
 #define SHADOW_RASTER_MIN 512
 
 /* Direct light on a level's points: one pass per light, its shadow rays in one
