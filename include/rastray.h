@@ -718,9 +718,9 @@ typedef enum rr_shadow_mode {
   RR_SHADOWS_NONE = 0, /* every light reaches every point facing it */
   RR_SHADOWS_RAYS,     /* a shadow ray per point and light through rr_occluded_stream: from a point or spot
                           light to the point offset along its geometric normal (docs/shading.md) */
-  RR_SHADOWS_RASTER,   /* point and spot lights: 3D rasterization from the light of the same rays, the same
-                          bits; directional lights: rays */
-  RR_SHADOWS_AUTO,     /* raster where a light has enough points at once to repay it, else rays */
+  RR_SHADOWS_RASTER,   /* the same rays rasterized, the same bits: from a point or spot light (a camera at the
+                          light), along a directional light (an orthographic camera) */
+  RR_SHADOWS_AUTO,     /* raster where a point or spot light has enough points at once to repay it, else rays */
   RR_SHADOWS_COUNT
 } rr_shadow_mode;
 

@@ -98,12 +98,43 @@ static void check_light(const rr_scene *s, vec3 light, const vec3 *pts, size_t n
   free(rays), free(ref), free(got);
 }
 
+/* A directional light: rays from every point along `towards` (one direction,
+ * unbounded), rr_occluded_raster (parallel rays: an orthographic camera) on 1, 2, 8
+ * threads against rr_occluded ray by ray. */
+static void check_parallel(const rr_scene *s, vec3 towards, const vec3 *pts, size_t n, const char *what,
+                           size_t seen[2]) {
+  rr_ray *rays = malloc(n * sizeof *rays);
+  int *ref = malloc(n * sizeof *ref), *got = malloc(n * sizeof *got);
+  if (!rays || !ref || !got) {
+    CHECK(0, "out of memory");
+    free(rays), free(ref), free(got);
+    return;
+  }
+  for (size_t k = 0; k < n; k++) {
+    rays[k] = (rr_ray){{pts[k].x, pts[k].y, pts[k].z}, {towards.x, towards.y, towards.z}, 0, INFINITY};
+    ref[k] = 0;
+    rr_occluded(NULL, s, &rays[k], &ref[k]);
+    seen[ref[k] != 0]++;
+  }
+  bool empty;
+  const rr_bvh *b = rr_bvh_of(dev, s, &empty);
+  for (int ti = 0; ti < TEST_NTHREADS; ti++) {
+    bool ok = rr_occluded_raster(s, b, rays, n, test_threads[ti], got, NULL);
+    size_t diff = 0, first = 0;
+    for (size_t k = 0; k < n; k++)
+      if ((got[k] != 0) != (ref[k] != 0)) first = diff++ ? first : k;
+    CHECK(ok && diff == 0, "%s, %d threads: %zu of %zu parallel rays differ from rr_occluded (first: ray %zu)", what,
+          test_threads[ti], diff, n, first);
+  }
+  free(rays), free(ref), free(got);
+}
+
 /* Random lights and targets in scene `name`. */
 static void check_scene(const char *name, int lights, size_t npts) {
   rr_scene *s = load(name);
   if (!s) return;
   vec3 *pts = malloc(npts * sizeof *pts);
-  size_t seen[2] = {0, 0};
+  size_t seen[2] = {0, 0}, seen_dir[2] = {0, 0};
   char what[160];
   for (int l = 0; l < lights && pts; l++) {
     vec3 light, eye;
@@ -127,9 +158,18 @@ static void check_scene(const char *name, int lights, size_t npts) {
     size_t n = targets(s, eye, light, pts, npts);
     snprintf(what, sizeof what, "%s, light %d %s (%g, %g, %g)", name, l, where, light.x, light.y, light.z);
     check_light(s, light, pts, n, what, seen);
+    /* the same points under a directional light from where the point light was (an
+     * axis now and then: zero components) */
+    vec3 towards = l % 3 == 0 ? v3(0, 1, 0) : v3_sub(light, v3_scale(v3_add(s->bmin, s->bmax), 0.5f));
+    if (l % 5 == 4) towards = v3(frand() - 0.5f, 0, frand() - 0.5f);
+    snprintf(what, sizeof what, "%s, directional light %d towards (%g, %g, %g)", name, l, towards.x, towards.y,
+             towards.z);
+    check_parallel(s, towards, pts, n, what, seen_dir);
   }
   CHECK(seen[0] > 0 && seen[1] > 0, "%s: %zu lit and %zu occluded rays: the test sees only one kind", name, seen[0],
         seen[1]);
+  CHECK(seen_dir[0] > 0 && seen_dir[1] > 0, "%s: %zu lit and %zu occluded parallel rays: only one kind", name,
+        seen_dir[0], seen_dir[1]);
   free(pts);
   rr_scene_release(s);
 }
@@ -145,7 +185,9 @@ static void check_lit(const char *name, bool inside) {
   rr_light_info sp = {.type = RR_LIGHT_SPOT, .color = {3, 2, 1}, .inner_cone_deg = 10, .outer_cone_deg = 35};
   v3_store(sp.position, inside ? v3_sub(c, v3_scale(ext, 0.2f)) : v3_add(c, v3(-0.5f * ext.x, 0.8f * ext.y, 0)));
   v3_store(sp.direction, v3_sub(c, v3_load(sp.position)));
-  CHECK(rr_scene_add_light(s, &pt) == RR_OK && rr_scene_add_light(s, &sp) == RR_OK, "%s", rr_device_message(dev));
+  rr_light_info dl = {.type = RR_LIGHT_DIRECTIONAL, .direction = {0.3f, -1, -0.2f}, .color = {0.5f, 0.5f, 0.6f}};
+  CHECK(rr_scene_add_light(s, &pt) == RR_OK && rr_scene_add_light(s, &sp) == RR_OK && rr_scene_add_light(s, &dl) == RR_OK,
+        "%s", rr_device_message(dev));
   int views = test_quick() ? 1 : 3;
   for (int v = 0; v < views; v++) {
     rr_camera cam = inside ? test_random_view(s, 0.1f, 0.3f, 0.2f, 60, 90) : test_random_view(s, 1.5f, 3, 0.3f, 30, 60);

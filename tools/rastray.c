@@ -216,7 +216,7 @@ static const cli_option render_options[] = {
      "spot:X,Y,Z:DX,DY,DZ:R,G,B[:I[:INNER[:OUTER]]] (half-angles, default 0 and 45\n"
      "degrees), sky:R,G,B[:R,G,B] (radiance from above[, from below: a gradient])"},
     {"shadows", OPT_SHADOWS, "MODE", "lit: none, rays (default: shadow rays through the ray streams), raster\n"
-                                     "(point and spot lights rasterized from the light, the same bits), auto"},
+                                     "(the same rays rasterized from the light, the same bits), auto"},
     {"max-depth", OPT_MAX_DEPTH, "N", "lit: most mirror bounces, 0.." VALUE(RR_MAX_DEPTH) " (default 2)"},
     {"aa", OPT_AA, "MODE",
      "anti-aliasing: none (default), ssaa:N (N samples, each shaded), msaa:N (shaded\n"

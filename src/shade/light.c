@@ -253,12 +253,13 @@ static void credit(const level *lv, int i, int part, const float w[3], const flo
   }
 }
 
-/* --shadows auto rasterizes a light's shadow rays from the light when a batch
+/* --shadows auto rasterizes a point or spot light's shadow rays when a batch
  * holds at least this many of them. bench/bench_shading's sweep (instructions,
- * 1024²): in runs of 1024 rays raster costs 0.96x the streams on the demo and
- * 1.08x on the bunny over a plane (whole frames 0.90x and 1.04x); in the lit
- * mode's batches of 64 points (one sample per pixel) 1.16x, of 1024 (16 samples)
- * 0.90x on the demo. */
+ * 1024²): in runs of 1024 rays raster costs 0.99x the streams on the demo and
+ * 1.12x on the bunny over a plane (whole frames 0.94x and 1.09x); in the lit
+ * mode's batches of 64 points (one sample per pixel) 1.20x, of 1024 (16 samples)
+ * 0.94x on the demo. A directional light's parallel rays rasterized cost about
+ * 2.0x and 1.6x (each ray keeps its own edge setup): auto traces them. */
 #define SHADOW_RASTER_MIN 512
 
 /* Direct light on a level's points: one pass per light, its shadow rays in one
@@ -304,7 +305,7 @@ static void direct(lit_batch *b, const level *lv, const rr_scene *s, const light
     }
     if (!nr) continue;
     double t0 = rr_now_ms();
-    bool raster = !far && (L->shadows == RR_SHADOWS_RASTER || (L->shadows == RR_SHADOWS_AUTO && nr >= SHADOW_RASTER_MIN));
+    bool raster = L->shadows == RR_SHADOWS_RASTER || (L->shadows == RR_SHADOWS_AUTO && !far && nr >= SHADOW_RASTER_MIN);
     if (!raster || !rr_occluded_raster(s, bvh, b->ray, (size_t)nr, 1, b->occluded, NULL)) {
       rr_ray_stream rs = rr_ray_stream_aos(b->ray, (size_t)nr);
       rr_occluded_stream(NULL, s, &rs, 1, b->occluded); /* a refused ray (zero length) counts as lit */
