@@ -626,6 +626,8 @@ typedef enum rr_aov {
   RR_AOV_SHADOW,       /* 1 float: the fraction of the punctual lights that reach it (facing it, inside
                           its cone, unblocked); 1 when there is none */
   RR_AOV_EMISSION,     /* 3 floats: the radiance it emits */
+  RR_AOV_ZDEPTH,       /* 1 float: the hit's distance along the camera's forward axis (the optical axis;
+                          depth sensors' convention), +inf on a miss; with several samples the nearest */
   RR_AOV_COUNT
 } rr_aov;
 /* With several samples per pixel the per-pixel AOVs follow one rule each: id, mesh,
@@ -636,7 +638,7 @@ typedef enum rr_aov {
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
  * "material", "coverage", "sample-id", "sample-depth", "sample-mesh", "uv", "uv-deriv",
- * "albedo", "direct", "reflection", "shadow", "emission"); -1 when unknown. */
+ * "albedo", "direct", "reflection", "shadow", "emission", "z-depth"); -1 when unknown. */
 RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
@@ -652,7 +654,7 @@ typedef enum rr_image_kind {
                           depth Z, normal N.X N.Y N.Z, bary bary.u bary.v (λ1, λ2), id, mesh and
                           material (32-bit UINT), evals, nodes, coverage, albedo.R/G/B, direct.R/G/B,
                           reflection.R/G/B, shadow, emission.R/G/B; per sample s (2 digits): id.sNN,
-                          Z.sNN, mesh.sNN; uv uv.u uv.v, uv-deriv uvdx.u uvdx.v uvdy.u uvdy.v */
+                          Z.sNN, mesh.sNN; uv uv.u uv.v, uv-deriv uvdx.u uvdx.v uvdy.u uvdy.v; z-depth zdepth */
 } rr_image_kind;
 
 /* An image owned by the caller or by rastray (rr_image_free). */

@@ -133,6 +133,14 @@ int main(void) {
     CHECK(fabs(x + t[i]) < 1e-5, "eye: R·eye + t = %g", x + t[i]);
   }
   rr_cam_release(&cc);
+  /* far from the origin the direction keeps float precision */
+  const float far_t[3] = {3e4f, -2e4f, 5e4f};
+  CHECK(rr_camera_set_extrinsics(dev, &cv, R, far_t) == RR_OK && rr_cam_setup(dev, &cv, 64, 48, &cc) == RR_OK,
+        "far extrinsics: %s", rr_device_message(dev));
+  for (int i = 0; i < 3; i++)
+    CHECK(fabsf(v3_get(cc.fwd, i) - R[6 + i]) < 1e-6f && fabsf(v3_get(cc.right, i) - R[i]) < 1e-6f,
+          "axis %d of a pose far from the origin: %g", i, v3_get(cc.fwd, i) - R[6 + i]);
+  rr_cam_release(&cc);
   R[0] = 2;
   CHECK(rr_camera_set_extrinsics(dev, &cv, R, t) == RR_ERROR_ARGUMENT && strstr(rr_device_message(dev), "rotation"),
         "a matrix that is not a rotation is refused: %s", rr_device_message(dev));

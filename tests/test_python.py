@@ -91,7 +91,7 @@ def test_opencv_agreement(mesh, kind):
         K, dist, rvec, tvec = random_camera(rng, kind, w, h)
         fisheye = kind == "fisheye"
         cam = rastray.Camera.opencv(K, dist, rvec, tvec, size=(w, h), fisheye=fisheye)
-        out = scene.render(cam, aovs=("depth", "id"), method="3dr-bin")
+        out = scene.render(cam, aovs=("depth", "id", "z-depth"), method="3dr-bin")
         ids, depth = out["id"], out["depth"]
         # OpenCV's projection of the vertices
         pts = v.astype(np.float64).reshape(-1, 1, 3)
@@ -134,6 +134,9 @@ def test_opencv_agreement(mesh, kind):
         else:
             back, _ = cv2.projectPoints(P, rvec, tvec, K, dist)
         ys, xs = np.nonzero(hitmask)
+        z = (P.reshape(-1, 3) @ R.T + tvec)[:, 2]  # z-depth: the hit's z in camera axes
+        assert np.allclose(out["z-depth"][hitmask], z, rtol=2e-6, atol=0)
+        assert np.all(np.isinf(out["z-depth"][~hitmask]))
         err = np.hypot(back.reshape(-1, 2)[:, 0] - xs, back.reshape(-1, 2)[:, 1] - ys)
         worst_centre = max(worst_centre, float(err.max()))
     share = total_ok / total
@@ -161,7 +164,7 @@ def npy_bytes(a):
 @pytest.mark.parametrize("which", ["perspective", "opencv", "fisheye"])
 def test_equals_cli(which):
     """Arrays equal to the CLI's .npy files byte for byte (same scene, camera, method)."""
-    aovs = ("depth", "id", "normal", "mesh")
+    aovs = ("depth", "id", "normal", "mesh", "z-depth")
     w, h = 96, 72
     with rastray.Scene.from_file("demo") as scene, tempfile.TemporaryDirectory() as tmp:
         if which == "perspective":

@@ -84,6 +84,10 @@ def main():
             # python3 is Debian's, as on a fresh machine (a python of one's own may
             # come first in PATH and lack NumPy)
             env = dict(os.environ, PATH="/usr/bin:" + os.environ.get("PATH", ""))
+            # in the ASan/UBSan build the uninstrumented python3 loads an instrumented
+            # librastray.so only with the sanitizer runtimes preloaded (CMakeLists.txt)
+            if os.environ.get("RR_PYTHON_PRELOAD") and "python3" in script:
+                env.update(LD_PRELOAD=os.environ["RR_PYTHON_PRELOAD"], ASAN_OPTIONS="detect_leaks=0")
             try:
                 p = subprocess.run(["bash", "-euo", "pipefail", "-c", script], cwd=clone, capture_output=True,
                                    text=True, timeout=300, env=env)

@@ -21,7 +21,8 @@ MAX_THREADS = CONSTANTS["RR_MAX_THREADS"]
 METHODS = [ffi.string(lib.rr_method_name(m)).decode() for m in range(lib.RR_METHOD_COUNT)] + ["auto"]
 CAMERAS = [ffi.string(lib.rr_camera_name(c)).decode() for c in range(lib.RR_CAMERA_COUNT)]
 AOVS = ("depth", "id", "normal", "bary", "evals", "nodes", "mesh", "material", "coverage", "sample-id",
-        "sample-depth", "sample-mesh", "uv", "uv-deriv", "albedo", "direct", "reflection", "shadow", "emission")
+        "sample-depth", "sample-mesh", "uv", "uv-deriv", "albedo", "direct", "reflection", "shadow", "emission",
+        "z-depth")
 _HIT = np.dtype([("prim", "<u4"), ("t", "<f4"), ("l1", "<f4"), ("l2", "<f4"), ("geom", "<u4")])  # rr_hit
 assert _HIT.itemsize == ffi.sizeof("rr_hit")
 _DTYPES = {lib.RR_PIXEL_U8: np.uint8, lib.RR_PIXEL_F32: np.float32, lib.RR_PIXEL_U32: np.uint32}
@@ -295,28 +296,20 @@ class Scene:
 
     def render(self, camera, size=None, method="auto", aa=None, aovs=("depth", "id", "normal", "mesh"), threads=0,
                cull_backfaces=False):
-        """Visibility from camera into a dict of arrays, one per AOV name (see AOVS,
-        and "z-depth": the distance along the optical axis, depth × cos of the ray's
-        angle to it). The arrays are (h, w) or (h, w, channels), row 0 at the top;
+        """Visibility from camera into a dict of arrays, one per AOV name (AOVS: those
+        of the CLI's --aov; "z-depth" is the distance along the optical axis, "depth"
+        the distance from the eye). The arrays are (h, w) or (h, w, channels), row 0 at the top;
         ids uint32 (MISS on a miss), the rest float32; "stats" holds S, E, N and the
         method that ran."""
         frame, dev = self._frame(camera, size, method, aa, threads, cull_backfaces)
         result = {}
         for name in aovs:
-            key = "depth" if name in ("z-depth", "zdepth") else name
-            if key not in result:
-                a = lib.rr_aov_from_name(key.encode())
-                if a < 0:
-                    raise ValueError("unknown AOV %r (expected one of %s, z-depth)" % (name, ", ".join(AOVS)))
-                img = ffi.new("rr_image *")
-                dev.check(lib.rr_frame_aov(dev.ptr, self._scene(), camera._cam, frame, a, img))
-                result[key] = _image_array(img)
-            if name in ("z-depth", "zdepth"):
-                _, dirs = camera.rays((result["depth"].shape[1], result["depth"].shape[0]))
-                cos = dirs.astype(np.float64) @ camera.forward
-                result[name] = (result["depth"] * cos).astype(np.float32)
-        if "depth" in result and "depth" not in aovs:
-            del result["depth"]
+            a = lib.rr_aov_from_name(str(name).encode())
+            if a < 0:
+                raise ValueError("unknown AOV %r (expected one of %s)" % (name, ", ".join(AOVS)))
+            img = ffi.new("rr_image *")
+            dev.check(lib.rr_frame_aov(dev.ptr, self._scene(), camera._cam, frame, a, img))
+            result[name] = _image_array(img)
         st = ffi.new("rr_stats *")
         dev.check(lib.rr_frame_get_stats(frame, st))
         result["stats"] = {"setups": st.setups, "edge_evals": st.edge_evals, "nodes": st.nodes,

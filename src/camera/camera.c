@@ -465,12 +465,18 @@ rr_error rr_camera_set_extrinsics(rr_device *dev, rr_camera *cam, const float R[
     det += R[i] * ((double)R[3 + (i + 1) % 3] * R[6 + (i + 2) % 3] - (double)R[3 + (i + 2) % 3] * R[6 + (i + 1) % 3]);
   if (!(err <= 1e-3) || !(det > 0))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "R is not a rotation (|R·Rt - I| = %g, det %g)", err, det);
-  /* eye = -Rᵀt; the camera's z row is forward, its y row down */
+  /* eye = -Rᵀt; the camera's z row is forward, its y row down. The target lies as far
+   * ahead as the eye is from the origin (at least 1), so that target - eye in floats
+   * keeps the direction to float precision wherever the camera is. */
+  double e[3] = {0, 0, 0}, len = 0;
   for (int i = 0; i < 3; i++) {
-    double e = 0;
-    for (int k = 0; k < 3; k++) e -= (double)R[3 * k + i] * t[k];
-    cam->eye[i] = (float)e;
-    cam->target[i] = (float)(e + R[6 + i]);
+    for (int k = 0; k < 3; k++) e[i] -= (double)R[3 * k + i] * t[k];
+    len += e[i] * e[i];
+  }
+  double ahead = fmax(1.0, sqrt(len));
+  for (int i = 0; i < 3; i++) {
+    cam->eye[i] = (float)e[i];
+    cam->target[i] = (float)(e[i] + ahead * R[6 + i]);
     cam->up[i] = -R[3 + i];
   }
   return rr_ok(dev);

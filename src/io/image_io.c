@@ -292,6 +292,7 @@ static const struct {
     [RR_AOV_REFLECTION] = {3, {"reflection.R", "reflection.G", "reflection.B"}},
     [RR_AOV_SHADOW] = {1, {"shadow"}},
     [RR_AOV_EMISSION] = {3, {"emission.R", "emission.G", "emission.B"}},
+    [RR_AOV_ZDEPTH] = {1, {"zdepth"}},
 };
 _Static_assert(RR_MAX_SAMPLES == 16, "PER_SAMPLE names 16 samples");
 

@@ -549,7 +549,8 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
   static const int channels[RR_AOV_COUNT] = {[RR_AOV_DEPTH] = 1, [RR_AOV_ID] = 1,       [RR_AOV_NORMAL] = 3,
                                              [RR_AOV_BARY] = 2,  [RR_AOV_EVALS] = 1,    [RR_AOV_NODES] = 1,
                                              [RR_AOV_MESH] = 1,  [RR_AOV_MATERIAL] = 1, [RR_AOV_COVERAGE] = 1,
-                                             [RR_AOV_UV] = 2,    [RR_AOV_UV_DERIV] = 4}; /* the lit parts: lit_aov */
+                                             [RR_AOV_UV] = 2,    [RR_AOV_UV_DERIV] = 4,
+                                             [RR_AOV_ZDEPTH] = 1}; /* the lit parts: lit_aov */
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
     if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
@@ -565,10 +566,11 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
   if (e) return e;
   size_t npix = (size_t)vb->width * vb->height;
   float *o = out->data;
-  if (base == RR_AOV_DEPTH) /* a miss everywhere, until a sample sees nearer */
+  bool depth = base == RR_AOV_DEPTH || base == RR_AOV_ZDEPTH;
+  if (depth) /* a miss everywhere, until a sample sees nearer */
     for (size_t k = 0; k < npix * ch; k++) o[k] = INFINITY;
   for (int smp = 0; smp < f->samples; smp++) {
-    if (!per_sample && base != RR_AOV_DEPTH && aov != RR_AOV_COVERAGE && smp != centre) continue;
+    if (!per_sample && !depth && aov != RR_AOV_COVERAGE && smp != centre) continue;
     visbuf layer = visbuf_layer(&f->vb, smp);
     int c0 = per_sample ? smp : 0; /* this layer's channel */
     for (int y = 0; y < vb->height; y++)
@@ -585,6 +587,7 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
         hit h = hit_at(s, &cams[smp], &layer, x, y);
         float *p = o + k * ch + c0;
         if (base == RR_AOV_DEPTH) *p = fminf(*p, h.valid ? h.dist : INFINITY);
+        else if (base == RR_AOV_ZDEPTH) *p = fminf(*p, h.valid ? h.dist * v3_dot(h.dir, cams[smp].fwd) : INFINITY);
         else if (base == RR_AOV_NORMAL && h.valid) p[0] = h.normal.x, p[1] = h.normal.y, p[2] = h.normal.z;
         else if (base == RR_AOV_BARY && h.valid) p[0] = h.l1, p[1] = h.l2;
         else if ((base == RR_AOV_UV || base == RR_AOV_UV_DERIV) && h.valid && s->uv[0][0]) {
@@ -716,7 +719,7 @@ rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, c
   camera cams[RR_MAX_SAMPLES];
   rr_error e = frame_cameras(dev, cam, f, cams);
   if (e) return e;
-  e = aov >= RR_AOV_ALBEDO ? lit_aov(dev, s, cam, cams, f, aov, out) : frame_aov(dev, s, cams, f, aov, out);
+  e = aov >= RR_AOV_ALBEDO && aov <= RR_AOV_EMISSION ? lit_aov(dev, s, cam, cams, f, aov, out) : frame_aov(dev, s, cams, f, aov, out);
   for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
   return e;
 }
