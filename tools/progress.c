@@ -7,6 +7,7 @@
 #include "cli.h"
 
 #include <pthread.h>
+#include <semaphore.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -90,8 +91,10 @@ static void on_report(void *user, rr_progress_stage stage, double fraction) {
   pthread_mutex_unlock(&P.mu);
 }
 
+static sem_t tick_ready;
 static void *tick(void *arg) {
   (void)arg;
+  sem_post(&tick_ready);
   pthread_mutex_lock(&P.mu);
   while (!P.stopping) {
     struct timespec ts;
@@ -110,7 +113,9 @@ void progress_start(rr_device *dev, bool forced) {
   if (!forced && !tty) return;
   P.on = true, P.forced = forced, P.tty = tty, P.start_ms = now_ms();
   rr_device_set_progress(dev, on_report, NULL);
-  P.ticking = pthread_create(&P.ticker, NULL, tick, NULL) == 0; /* without it, reports still draw */
+  /* without it, reports still draw; waited for, as the watcher is (rastray.c) */
+  P.ticking = sem_init(&tick_ready, 0, 0) == 0 && pthread_create(&P.ticker, NULL, tick, NULL) == 0;
+  while (P.ticking && sem_wait(&tick_ready) != 0) continue;
 }
 
 void progress_stage(const char *label) {

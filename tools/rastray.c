@@ -11,6 +11,7 @@
 #include <getopt.h>
 #include <math.h>
 #include <pthread.h>
+#include <semaphore.h>
 #include <signal.h>
 #include <stdatomic.h>
 #include <stdarg.h>
@@ -53,7 +54,9 @@ static void run_release(void) {
 /* Waits for the signals main() blocked in every thread; on one, removes the
  * output set's temporaries and exits with 128 + the signal (130 for SIGINT). The
  * rest of the run is the kernel's to free. */
+static sem_t watcher_ready;
 static void *watch_signals(void *arg) {
+  sem_post(&watcher_ready);
   int sig;
   if (sigwait(arg, &sig) != 0) return NULL;
   /* An add ends in bounded time: wait for it. A commit renames the temporaries at
@@ -1256,8 +1259,12 @@ int main(int argc, char **argv) {
   sigemptyset(&signals);
   sigaddset(&signals, SIGINT), sigaddset(&signals, SIGTERM), sigaddset(&signals, SIGHUP);
   pthread_t watcher;
-  if (pthread_sigmask(SIG_BLOCK, &signals, NULL) != 0 || pthread_create(&watcher, NULL, watch_signals, &signals) != 0)
+  if (sem_init(&watcher_ready, 0, 0) != 0 || pthread_sigmask(SIG_BLOCK, &signals, NULL) != 0 ||
+      pthread_create(&watcher, NULL, watch_signals, &signals) != 0)
     die(EXIT_INPUT, "cannot start the signal watcher");
+  /* Running before anything else: a thread still starting may hold the allocator's
+   * locks (ASan's do not survive a fork), and the import forks (import_guard.c). */
+  while (sem_wait(&watcher_ready) != 0) continue;
   pthread_detach(watcher);
   run.dev = rr_device_new();
   if (!run.dev) die(EXIT_INPUT, "out of memory");

@@ -409,6 +409,9 @@ static void child_main(rr_device *dev, const char *path, const rr_import_limits 
     signal(SIGSEGV, SIG_DFL); /* past any sanitizer's handler: the parent sees the signal */
     raise(SIGSEGV);
   }
+  /* The caller's progress function is the parent's: it may take locks another of
+   * the parent's threads held at the fork. */
+  dev->progress = NULL;
   rr_scene *c;
   rr_error e = rr_scene_new(dev, &c);
   if (!e) e = rr_scene_import_file(c, path);
