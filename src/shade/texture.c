@@ -140,13 +140,12 @@ KERNEL rr_vf4 texel(const uint16_t *p) {
   return __builtin_convertvector(__builtin_convertvector(v, rr_vi4), rr_vf4);
 }
 
-/* Adds weight w times the bilinear lookup of level lv at texel coordinates (x, y)
- * (texel centres at half-integers) to acc. Hot: up to 32 a pixel with aniso:16. */
-KERNEL void bilerp(const rr_texture *t, const tex_level *lv, float x, float y, float w, rr_vf4 *acc) {
-  x -= 0.5f, y -= 0.5f;
-  int x0 = ifloor(x), y0 = ifloor(y), W = lv->width, H = lv->height;
-  float ax = x - (float)x0, ay = y - (float)y0;
-  int x1 = x0 + 1, y1 = y0 + 1;
+/* Adds weight w times the bilinear lookup of level lv to acc: the texels (x0, y0) to
+ * (x0 + 1, y0 + 1), (ax, ay) the position between them. Hot: up to 32 a pixel with
+ * aniso:16. */
+KERNEL void bilerp_at(const rr_texture *t, const tex_level *lv, int x0, int y0, float ax, float ay, float w,
+                      rr_vf4 *acc) {
+  int x1 = x0 + 1, y1 = y0 + 1, W = lv->width, H = lv->height;
   if ((unsigned)x0 >= (unsigned)(W - 1)) /* wrap only at the edges */
     x1 = wrap_index(x1, W, t->wrap[0]), x0 = wrap_index(x0, W, t->wrap[0]);
   if ((unsigned)y0 >= (unsigned)(H - 1)) y1 = wrap_index(y1, H, t->wrap[1]), y0 = wrap_index(y0, H, t->wrap[1]);
@@ -155,6 +154,27 @@ KERNEL void bilerp(const rr_texture *t, const tex_level *lv, float x, float y, f
   w01 -= w11, w00 -= w10;
   *acc += rr_vf4_splat(w00) * texel(r0 + 4 * x0) + rr_vf4_splat(w10) * texel(r0 + 4 * x1) +
           rr_vf4_splat(w01) * texel(r1 + 4 * x0) + rr_vf4_splat(w11) * texel(r1 + 4 * x1);
+}
+
+/* Two bilinear lookups whose texel addressing is shared: weight wa times level la's
+ * at texel coordinates (p[0], p[1]) and wb times level lb's at (p[2], p[3]) (texel
+ * centres at half-integers), floored in one vector, within ±2^30 so that footprints
+ * far outside [0, 1] wrap without overflow (NaN: -2^30). */
+KERNEL void bilerp2(const rr_texture *t, const tex_level *la, const tex_level *lb, rr_vf4 p, float wa, float wb,
+                    rr_vf4 *acc) {
+  p = rr_vf4_min(rr_vf4_max(p - rr_vf4_splat(0.5f), rr_vf4_splat(-1073741824.0f)), rr_vf4_splat(1073741824.0f));
+  rr_vi4 i = rr_vi4_trunc(p);
+  i += p < __builtin_convertvector(i, rr_vf4); /* truncation, then down for negatives (-1 where true) */
+  rr_vf4 a = p - __builtin_convertvector(i, rr_vf4);
+  bilerp_at(t, la, i[0], i[1], a[0], a[1], wa, acc);
+  bilerp_at(t, lb, i[2], i[3], a[2], a[3], wb, acc);
+}
+
+/* Adds weight w times the bilinear lookup of level lv at texel coordinates (x, y). */
+KERNEL void bilerp(const rr_texture *t, const tex_level *lv, float x, float y, float w, rr_vf4 *acc) {
+  x -= 0.5f, y -= 0.5f;
+  int x0 = ifloor(x), y0 = ifloor(y);
+  bilerp_at(t, lv, x0, y0, x - (float)x0, y - (float)y0, w, acc);
 }
 
 /* Two levels, their weights (the trilinear blend at a level of detail) and their
@@ -176,7 +196,9 @@ static inline lod_pair lod_levels(const rr_texture *t, float lod) {
 
 /* Adds weight w times the trilinear lookup at (s, r) (level-0 texel units) to acc. */
 KERNEL void trilerp(const rr_texture *t, const lod_pair *p, float s, float r, float w, rr_vf4 *acc) {
-  for (int k = 0; k < p->n; k++) bilerp(t, p->lv[k], s * p->sx[k], r * p->sy[k], w * p->w[k], acc);
+  if (p->n == 1) bilerp(t, p->lv[0], s * p->sx[0], r * p->sy[0], w, acc);
+  else bilerp2(t, p->lv[0], p->lv[1], (rr_vf4){s * p->sx[0], r * p->sy[0], s * p->sx[1], r * p->sy[1]}, w * p->w[0],
+               w * p->w[1], acc);
 }
 
 /* The footprint in level-0 texels: the derivative vectors per pixel step in x (a)
@@ -204,13 +226,30 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
   if (along < (float)n * across) n = (int)ceilf(along / across); /* across > 0 here */
   if (n < 1) n = 1;
   float size = along / (float)n > across ? along / (float)n : across;
-  lod_pair p = lod_levels(t, log2f(size) + f->lod_bias);
-  /* probe k at ((k + 1/2)/n - 1/2)·along along the unit longer vector */
-  float step = along / ((float)n * lmaj), dx = mx * step, dy = my * step, w = 1.0f / (float)n;
-  float k0 = 0.5f - 0.5f * (float)n;
-  for (int k = 0; k < n; k++) {
-    float o = k0 + (float)k;
-    trilerp(t, &p, s + o * dx, r + o * dy, w, acc);
+  float lod = log2f(size) + f->lod_bias;
+  if (lod >= (float)(t->nlevels - 1)) n = 1; /* the top level is one texel's mean everywhere */
+  lod_pair p = lod_levels(t, lod);
+  if (n == 1) {
+    trilerp(t, &p, s, r, 1, acc);
+    return;
+  }
+  /* probe j at (j + 1/2 - n/2)·along/n along the unit longer vector, in each level;
+   * two probes of a level at a time */
+  float step = along / ((float)n * lmaj), o = 0.5f - 0.5f * (float)n;
+  float last[2][2];
+  for (int k = 0; k < p.n; k++) {
+    float dx = mx * step * p.sx[k], dy = my * step * p.sy[k], w = p.w[k] / (float)n;
+    float x = s * p.sx[k] + o * dx, y = r * p.sy[k] + o * dy;
+    rr_vf4 q = {x, y, x + dx, y + dy}, d2 = {2 * dx, 2 * dy, 2 * dx, 2 * dy};
+    for (int j = 0; j + 1 < n; j += 2, q += d2) bilerp2(t, p.lv[k], p.lv[k], q, w, w, acc);
+    last[k][0] = q[0], last[k][1] = q[1]; /* probe n - 1 when n is odd */
+  }
+  if (n & 1) {
+    if (p.n == 2)
+      bilerp2(t, p.lv[0], p.lv[1], (rr_vf4){last[0][0], last[0][1], last[1][0], last[1][1]}, p.w[0] / (float)n,
+              p.w[1] / (float)n, acc);
+    else
+      bilerp(t, p.lv[0], last[0][0], last[0][1], 1.0f / (float)n, acc);
   }
 }
 
