@@ -142,39 +142,54 @@ KERNEL rr_vf4 texel(const uint16_t *p) {
 
 /* Adds weight w times the bilinear lookup of level lv to acc: the texels (x0, y0) to
  * (x0 + 1, y0 + 1), (ax, ay) the position between them. Hot: up to 32 a pixel with
- * aniso:16. */
+ * aniso:16. Edges false: the texels are known to be inside the level, no wrapping. */
 KERNEL void bilerp_at(const rr_texture *t, const tex_level *lv, int x0, int y0, float ax, float ay, float w,
-                      rr_vf4 *acc) {
+                      bool edges, rr_vf4 *acc) {
   int x1 = x0 + 1, y1 = y0 + 1, W = lv->width, H = lv->height;
-  if ((unsigned)x0 >= (unsigned)(W - 1)) /* wrap only at the edges */
+  if (edges && (unsigned)x0 >= (unsigned)(W - 1)) /* wrap only at the edges */
     x1 = wrap_index(x1, W, t->wrap[0]), x0 = wrap_index(x0, W, t->wrap[0]);
-  if ((unsigned)y0 >= (unsigned)(H - 1)) y1 = wrap_index(y1, H, t->wrap[1]), y0 = wrap_index(y0, H, t->wrap[1]);
-  const uint16_t *r0 = lv->texels + (size_t)4 * y0 * W, *r1 = lv->texels + (size_t)4 * y1 * W;
-  float w01 = w * ay, w00 = w - w01, w11 = w01 * ax, w10 = w00 * ax;
-  w01 -= w11, w00 -= w10;
-  *acc += rr_vf4_splat(w00) * texel(r0 + 4 * x0) + rr_vf4_splat(w10) * texel(r0 + 4 * x1) +
-          rr_vf4_splat(w01) * texel(r1 + 4 * x0) + rr_vf4_splat(w11) * texel(r1 + 4 * x1);
+  if (edges && (unsigned)y0 >= (unsigned)(H - 1)) y1 = wrap_index(y1, H, t->wrap[1]), y0 = wrap_index(y0, H, t->wrap[1]);
+  const uint16_t *r0 = lv->texels + (size_t)4 * y0 * W, *r1 = edges ? lv->texels + (size_t)4 * y1 * W : r0 + 4 * W;
+  rr_vf4 t00 = texel(r0 + 4 * x0), t10 = texel(r0 + 4 * x1), t01 = texel(r1 + 4 * x0), t11 = texel(r1 + 4 * x1);
+  rr_vf4 vx = rr_vf4_splat(ax), top = t00 + vx * (t10 - t00), bottom = t01 + vx * (t11 - t01);
+  *acc += rr_vf4_splat(w) * (top + rr_vf4_splat(ay) * (bottom - top));
 }
 
 /* Two bilinear lookups whose texel addressing is shared: weight wa times level la's
  * at texel coordinates (p[0], p[1]) and wb times level lb's at (p[2], p[3]) (texel
  * centres at half-integers), floored in one vector, within ±2^30 so that footprints
- * far outside [0, 1] wrap without overflow (NaN: -2^30). */
+ * far outside [0, 1] wrap without overflow (NaN: -2^30). Edges false: both lookups'
+ * texels are known to be inside their levels. */
 KERNEL void bilerp2(const rr_texture *t, const tex_level *la, const tex_level *lb, rr_vf4 p, float wa, float wb,
-                    rr_vf4 *acc) {
-  p = rr_vf4_min(rr_vf4_max(p - rr_vf4_splat(0.5f), rr_vf4_splat(-1073741824.0f)), rr_vf4_splat(1073741824.0f));
+                    bool edges, rr_vf4 *acc) {
+  p -= rr_vf4_splat(0.5f);
+  if (edges) p = rr_vf4_min(rr_vf4_max(p, rr_vf4_splat(-1073741824.0f)), rr_vf4_splat(1073741824.0f));
   rr_vi4 i = rr_vi4_trunc(p);
   i += p < __builtin_convertvector(i, rr_vf4); /* truncation, then down for negatives (-1 where true) */
   rr_vf4 a = p - __builtin_convertvector(i, rr_vf4);
-  bilerp_at(t, la, i[0], i[1], a[0], a[1], wa, acc);
-  bilerp_at(t, lb, i[2], i[3], a[2], a[3], wb, acc);
+  bilerp_at(t, la, i[0], i[1], a[0], a[1], wa, edges, acc);
+  bilerp_at(t, lb, i[2], i[3], a[2], a[3], wb, edges, acc);
 }
 
 /* Adds weight w times the bilinear lookup of level lv at texel coordinates (x, y). */
 KERNEL void bilerp(const rr_texture *t, const tex_level *lv, float x, float y, float w, rr_vf4 *acc) {
   x -= 0.5f, y -= 0.5f;
   int x0 = ifloor(x), y0 = ifloor(y);
-  bilerp_at(t, lv, x0, y0, x - (float)x0, y - (float)y0, w, acc);
+  bilerp_at(t, lv, x0, y0, x - (float)x0, y - (float)y0, w, true, acc);
+}
+
+/* log2(x) for a level of detail: the exponent and a quartic in the mantissa (within
+ * 3e-5 of a level, exact at powers of two so continuous across octaves), without libm's call; libm's
+ * where x is not a normal positive float. */
+static inline float lod_log2(float x) {
+  if (!(x >= 1.17549435e-38f && x <= 3.4e38f)) return log2f(x);
+  uint32_t b;
+  memcpy(&b, &x, sizeof b);
+  float e = (float)((int)(b >> 23) - 127), m;
+  b = (b & 0x7fffffu) | 0x3f800000u; /* the mantissa 1 + m in [1, 2) */
+  memcpy(&m, &b, sizeof m);
+  m -= 1.0f;
+  return e + m + m * (1.0f - m) * (0.44174030f + m * (-0.26602988f + m * (0.14631434f - 0.04400469f * m)));
 }
 
 /* Two levels, their weights (the trilinear blend at a level of detail) and their
@@ -198,7 +213,7 @@ static inline lod_pair lod_levels(const rr_texture *t, float lod) {
 KERNEL void trilerp(const rr_texture *t, const lod_pair *p, float s, float r, float w, rr_vf4 *acc) {
   if (p->n == 1) bilerp(t, p->lv[0], s * p->sx[0], r * p->sy[0], w, acc);
   else bilerp2(t, p->lv[0], p->lv[1], (rr_vf4){s * p->sx[0], r * p->sy[0], s * p->sx[1], r * p->sy[1]}, w * p->w[0],
-               w * p->w[1], acc);
+               w * p->w[1], true, acc);
 }
 
 /* The footprint in level-0 texels: the derivative vectors per pixel step in x (a)
@@ -226,7 +241,7 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
   if (along < (float)n * across) n = (int)ceilf(along / across); /* across > 0 here */
   if (n < 1) n = 1;
   float size = along / (float)n > across ? along / (float)n : across;
-  float lod = log2f(size) + f->lod_bias;
+  float lod = lod_log2(size) + f->lod_bias;
   if (lod >= (float)(t->nlevels - 1)) n = 1; /* the top level is one texel's mean everywhere */
   lod_pair p = lod_levels(t, lod);
   if (n == 1) {
@@ -240,14 +255,20 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
   for (int k = 0; k < p.n; k++) {
     float dx = mx * step * p.sx[k], dy = my * step * p.sy[k], w = p.w[k] / (float)n;
     float x = s * p.sx[k] + o * dx, y = r * p.sy[k] + o * dy;
-    rr_vf4 q = {x, y, x + dx, y + dy}, d2 = {2 * dx, 2 * dy, 2 * dx, 2 * dy};
-    for (int j = 0; j + 1 < n; j += 2, q += d2) bilerp2(t, p.lv[k], p.lv[k], q, w, w, acc);
-    last[k][0] = q[0], last[k][1] = q[1]; /* probe n - 1 when n is odd */
+    /* probe j at (x, y) + j (dx, dy), so that the first and last bound all in float too */
+    rr_vf4 base = {x, y, x, y}, d = {dx, dy, dx, dy}, jj = {0, 0, 1, 1}, two = rr_vf4_splat(2);
+    float xe = x + (float)(n - 1) * dx, ye = y + (float)(n - 1) * dy;
+    float wl = (float)p.lv[k]->width - 0.5f, hl = (float)p.lv[k]->height - 0.5f;
+    if (x >= 0.5f && x < wl && xe >= 0.5f && xe < wl && y >= 0.5f && y < hl && ye >= 0.5f && ye < hl)
+      for (int j = 0; j + 1 < n; j += 2, jj += two) bilerp2(t, p.lv[k], p.lv[k], base + jj * d, w, w, false, acc);
+    else /* (NaN too) */
+      for (int j = 0; j + 1 < n; j += 2, jj += two) bilerp2(t, p.lv[k], p.lv[k], base + jj * d, w, w, true, acc);
+    last[k][0] = xe, last[k][1] = ye; /* probe n - 1 when n is odd */
   }
   if (n & 1) {
     if (p.n == 2)
       bilerp2(t, p.lv[0], p.lv[1], (rr_vf4){last[0][0], last[0][1], last[1][0], last[1][1]}, p.w[0] / (float)n,
-              p.w[1] / (float)n, acc);
+              p.w[1] / (float)n, true, acc);
     else
       bilerp(t, p.lv[0], last[0][0], last[0][1], 1.0f / (float)n, acc);
   }
