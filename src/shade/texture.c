@@ -140,29 +140,46 @@ KERNEL rr_vf4 texel(const uint16_t *p) {
   return __builtin_convertvector(__builtin_convertvector(v, rr_vi4), rr_vf4);
 }
 
+/* Two texels side by side (one load). */
+typedef uint16_t texel2_u16 __attribute__((vector_size(16)));
+typedef int32_t texel2_i32 __attribute__((vector_size(32)));
+KERNEL void texel2(const uint16_t *p, rr_vf4 *a, rr_vf4 *b) {
+  texel2_u16 v;
+  memcpy(&v, p, sizeof v);
+  texel2_i32 i = __builtin_convertvector(v, texel2_i32);
+  rr_vi4 lo, hi;
+  memcpy(&lo, &i, sizeof lo), memcpy(&hi, (char *)&i + sizeof lo, sizeof hi);
+  *a = __builtin_convertvector(lo, rr_vf4), *b = __builtin_convertvector(hi, rr_vf4);
+}
+
 /* Adds weight w times the bilinear lookup of level lv to acc: the texels (x0, y0) to
  * (x0 + 1, y0 + 1), (ax, ay) the position between them. Hot: up to 32 a pixel with
  * aniso:16. Edges false: the texels are known to be inside the level, no wrapping. */
 KERNEL void bilerp_at(const rr_texture *t, const tex_level *lv, int x0, int y0, float ax, float ay, float w,
                       bool edges, rr_vf4 *acc) {
   int x1 = x0 + 1, y1 = y0 + 1, W = lv->width, H = lv->height;
-  if (edges && (unsigned)x0 >= (unsigned)(W - 1)) /* wrap only at the edges */
-    x1 = wrap_index(x1, W, t->wrap[0]), x0 = wrap_index(x0, W, t->wrap[0]);
-  if (edges && (unsigned)y0 >= (unsigned)(H - 1)) y1 = wrap_index(y1, H, t->wrap[1]), y0 = wrap_index(y0, H, t->wrap[1]);
-  const uint16_t *r0 = lv->texels + (size_t)4 * y0 * W, *r1 = edges ? lv->texels + (size_t)4 * y1 * W : r0 + 4 * W;
-  rr_vf4 t00 = texel(r0 + 4 * x0), t10 = texel(r0 + 4 * x1), t01 = texel(r1 + 4 * x0), t11 = texel(r1 + 4 * x1);
+  rr_vf4 t00, t10, t01, t11;
+  if (edges) {
+    if ((unsigned)x0 >= (unsigned)(W - 1)) /* wrap only at the edges */
+      x1 = wrap_index(x1, W, t->wrap[0]), x0 = wrap_index(x0, W, t->wrap[0]);
+    if ((unsigned)y0 >= (unsigned)(H - 1)) y1 = wrap_index(y1, H, t->wrap[1]), y0 = wrap_index(y0, H, t->wrap[1]);
+    const uint16_t *r0 = lv->texels + (size_t)4 * y0 * W, *r1 = lv->texels + (size_t)4 * y1 * W;
+    t00 = texel(r0 + 4 * x0), t10 = texel(r0 + 4 * x1), t01 = texel(r1 + 4 * x0), t11 = texel(r1 + 4 * x1);
+  } else {
+    const uint16_t *r0 = lv->texels + 4 * ((size_t)y0 * W + x0);
+    texel2(r0, &t00, &t10), texel2(r0 + 4 * W, &t01, &t11);
+  }
   rr_vf4 vx = rr_vf4_splat(ax), top = t00 + vx * (t10 - t00), bottom = t01 + vx * (t11 - t01);
   *acc += rr_vf4_splat(w) * (top + rr_vf4_splat(ay) * (bottom - top));
 }
 
 /* Two bilinear lookups whose texel addressing is shared: weight wa times level la's
- * at texel coordinates (p[0], p[1]) and wb times level lb's at (p[2], p[3]) (texel
- * centres at half-integers), floored in one vector, within ±2^30 so that footprints
- * far outside [0, 1] wrap without overflow (NaN: -2^30). Edges false: both lookups'
- * texels are known to be inside their levels. */
+ * at (p[0], p[1]) and wb times level lb's at (p[2], p[3]), texel coordinates with
+ * the texel centres at integers, floored in one vector, within ±2^30 so that
+ * footprints far outside [0, 1] wrap without overflow (NaN: -2^30). Edges false: both
+ * lookups' texels are known to be inside their levels. */
 KERNEL void bilerp2(const rr_texture *t, const tex_level *la, const tex_level *lb, rr_vf4 p, float wa, float wb,
                     bool edges, rr_vf4 *acc) {
-  p -= rr_vf4_splat(0.5f);
   if (edges) p = rr_vf4_min(rr_vf4_max(p, rr_vf4_splat(-1073741824.0f)), rr_vf4_splat(1073741824.0f));
   rr_vi4 i = rr_vi4_trunc(p);
   i += p < __builtin_convertvector(i, rr_vf4); /* truncation, then down for negatives (-1 where true) */
@@ -212,7 +229,7 @@ static inline lod_pair lod_levels(const rr_texture *t, float lod) {
 /* Adds weight w times the trilinear lookup at (s, r) (level-0 texel units) to acc. */
 KERNEL void trilerp(const rr_texture *t, const lod_pair *p, float s, float r, float w, rr_vf4 *acc) {
   if (p->n == 1) bilerp(t, p->lv[0], s * p->sx[0], r * p->sy[0], w, acc);
-  else bilerp2(t, p->lv[0], p->lv[1], (rr_vf4){s * p->sx[0], r * p->sy[0], s * p->sx[1], r * p->sy[1]}, w * p->w[0],
+  else bilerp2(t, p->lv[0], p->lv[1], (rr_vf4){s * p->sx[0] - 0.5f, r * p->sy[0] - 0.5f, s * p->sx[1] - 0.5f, r * p->sy[1] - 0.5f}, w * p->w[0],
                w * p->w[1], true, acc);
 }
 
@@ -253,16 +270,18 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
   float step = along / ((float)n * lmaj), o = 0.5f - 0.5f * (float)n;
   float last[2][2];
   for (int k = 0; k < p.n; k++) {
-    float dx = mx * step * p.sx[k], dy = my * step * p.sy[k], w = p.w[k] / (float)n;
-    float x = s * p.sx[k] + o * dx, y = r * p.sy[k] + o * dy;
-    /* probe j at (x, y) + j (dx, dy), so that the first and last bound all in float too */
-    rr_vf4 base = {x, y, x, y}, d = {dx, dy, dx, dy}, jj = {0, 0, 1, 1}, two = rr_vf4_splat(2);
+    /* probe j at (x, y) + j (dx, dy), texel centres at integers, so that the first
+     * and last bound all in float too; the level's probes summed, then weighed */
+    float dx = mx * step * p.sx[k], dy = my * step * p.sy[k];
+    float x = s * p.sx[k] + o * dx - 0.5f, y = r * p.sy[k] + o * dy - 0.5f;
     float xe = x + (float)(n - 1) * dx, ye = y + (float)(n - 1) * dy;
-    float wl = (float)p.lv[k]->width - 0.5f, hl = (float)p.lv[k]->height - 0.5f;
-    if (x >= 0.5f && x < wl && xe >= 0.5f && xe < wl && y >= 0.5f && y < hl && ye >= 0.5f && ye < hl)
-      for (int j = 0; j + 1 < n; j += 2, jj += two) bilerp2(t, p.lv[k], p.lv[k], base + jj * d, w, w, false, acc);
+    rr_vf4 base = {x, y, x, y}, d = {dx, dy, dx, dy}, jj = {0, 0, 1, 1}, two = rr_vf4_splat(2), sum = rr_vf4_splat(0);
+    float wl = (float)p.lv[k]->width - 1, hl = (float)p.lv[k]->height - 1;
+    if (x >= 0 && x < wl && xe >= 0 && xe < wl && y >= 0 && y < hl && ye >= 0 && ye < hl)
+      for (int j = 0; j + 1 < n; j += 2, jj += two) bilerp2(t, p.lv[k], p.lv[k], base + jj * d, 1, 1, false, &sum);
     else /* (NaN too) */
-      for (int j = 0; j + 1 < n; j += 2, jj += two) bilerp2(t, p.lv[k], p.lv[k], base + jj * d, w, w, true, acc);
+      for (int j = 0; j + 1 < n; j += 2, jj += two) bilerp2(t, p.lv[k], p.lv[k], base + jj * d, 1, 1, true, &sum);
+    *acc += rr_vf4_splat(p.w[k] / (float)n) * sum;
     last[k][0] = xe, last[k][1] = ye; /* probe n - 1 when n is odd */
   }
   if (n & 1) {
@@ -270,7 +289,7 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
       bilerp2(t, p.lv[0], p.lv[1], (rr_vf4){last[0][0], last[0][1], last[1][0], last[1][1]}, p.w[0] / (float)n,
               p.w[1] / (float)n, true, acc);
     else
-      bilerp(t, p.lv[0], last[0][0], last[0][1], 1.0f / (float)n, acc);
+      bilerp(t, p.lv[0], last[0][0] + 0.5f, last[0][1] + 0.5f, 1.0f / (float)n, acc);
   }
 }
 
