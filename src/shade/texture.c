@@ -195,9 +195,9 @@ KERNEL void bilerp(const rr_texture *t, const tex_level *lv, float x, float y, f
   bilerp_at(t, lv, x0, y0, x - (float)x0, y - (float)y0, w, true, acc);
 }
 
-/* log2(x) for a level of detail: the exponent and a quartic in the mantissa (within
- * 3e-5 of a level, exact at powers of two so continuous across octaves), without libm's call; libm's
- * where x is not a normal positive float. */
+/* log2(x) for a level of detail without libm's call: the exponent plus a polynomial
+ * in the mantissa fitted to log2 (within 3e-5 of a level, exact at powers of two, so
+ * continuous across octaves); libm's where x is not a normal positive float. */
 static inline float lod_log2(float x) {
   if (!(x >= 1.17549435e-38f && x <= 3.4e38f)) return log2f(x);
   uint32_t b;
