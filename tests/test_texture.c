@@ -323,6 +323,21 @@ static void test_aniso_definition(void) {
   }
   /* float positions and the level of detail's log2 within 3e-5 of a level */
   CHECK(bad == 0, "aniso differs from its definition at %d of %d footprints (worst by %.2g)", bad, tries, worst);
+  /* degenerate footprints and coordinates read inside the texture, for every filter
+   * (the sanitizer build checks the reads) */
+  const float odd[] = {NAN, INFINITY, -INFINITY, 1e30f, -1e30f, 0.0f, 1e-30f};
+  int finite = 0, total = 0;
+  for (int k = 0; k < 7 * 7 * 3; k++) {
+    t.wrap[0] = t.wrap[1] = modes[k % 3];
+    float x = odd[k / 3 % 7], d = odd[k / 21];
+    tex_coord tc = {x, 0.3f, d, 0.5f * d, 0.01f, x};
+    for (int f = RR_TEXTURE_NEAREST; f < RR_TEXTURE_FILTER_COUNT; f++) {
+      float o[4];
+      rr_texture_sample(&t, &tc, &(tex_filter){(rr_texture_filter)f, 16, 0}, o);
+      if (isfinite(x)) finite += o[0] == o[0] && o[3] == o[3], total++; /* a NaN position may read NaN */
+    }
+  }
+  CHECK(finite == total, "%d of %d lookups of degenerate footprints at finite positions are NaN", total - finite, total);
   rr_texture_clear(&t);
 }
 
