@@ -128,7 +128,9 @@ static inline int wrap_index(int i, int n, rr_texture_wrap mode) {
     if (i < 0) i += p;
     return i < n ? i : p - 1 - i;
   }
-  i %= n;
+  i += i < 0 ? n : -n; /* a probe line crosses the seam by a period at most, mostly */
+  if ((unsigned)i < (unsigned)n) return i;
+  i %= n; /* (no division otherwise) */
   return i < 0 ? i + n : i;
 }
 
