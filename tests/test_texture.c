@@ -9,7 +9,8 @@
  * - each filter on the built-in checker scene's grazing view against a reference
  *   of 16×16 stratified bilinear level-0 lookups per pixel, in linear light: the
  *   issue's aniso target asserted with margin (aniso:16 at most 0.45× trilinear's
- *   RMSE), ewa near it, nearest and bilinear worse than trilinear (they alias). */
+ *   RMSE), ewa near it, nearest and bilinear worse than trilinear (they alias);
+ * - aniso against its definition on random footprints (its fast paths exact). */
 #define _POSIX_C_SOURCE 200809L
 #include "camera/camera.h"
 #include "core/color.h"
@@ -246,6 +247,100 @@ static void test_mtl_clamp(rr_device *dev) {
   CHECK(system(cmd) == 0, "cleanup");
 }
 
+/* ---- aniso against its definition ----------------------------------------------------- */
+
+/* Texel index i of a side of n, wrapped as mode says. */
+static int ref_wrap(long i, int n, rr_texture_wrap mode) {
+  if (mode == RR_WRAP_CLAMP) return i < 0 ? 0 : i >= n ? n - 1 : (int)i;
+  if (mode == RR_WRAP_MIRROR) {
+    long p = 2L * n, k = ((i % p) + p) % p;
+    return (int)(k < n ? k : p - 1 - k);
+  }
+  return (int)(((i % n) + n) % n);
+}
+
+/* Adds w times the bilinear lookup of level l at level-0 texel coordinates (s, r) to
+ * acc (red channel, 0..1), in double. */
+static void ref_bilinear(const rr_texture *t, int l, double s, double r, double w, double *acc) {
+  const tex_level *lv = &t->levels[l];
+  double x = s * lv->width / t->width - 0.5, y = r * lv->height / t->height - 0.5;
+  double fx = floor(x), fy = floor(y), ax = x - fx, ay = y - fy;
+  for (int j = 0; j < 2; j++)
+    for (int i = 0; i < 2; i++) {
+      int xi = ref_wrap((long)fx + i, lv->width, t->wrap[0]), yi = ref_wrap((long)fy + j, lv->height, t->wrap[1]);
+      *acc += w * (i ? ax : 1 - ax) * (j ? ay : 1 - ay) * lv->texels[4 * ((size_t)yi * lv->width + xi)] / 65535.0;
+    }
+}
+
+/* aniso:N as docs/textures.md defines it: n = min(N, ceil(along / across)) trilinear
+ * probes evenly along the parallelogram's long side, at the level of detail log2 of
+ * max(along / n, across). */
+static double ref_aniso(const rr_texture *t, const tex_coord *tc, int N) {
+  double W = t->width, H = t->height;
+  double s = (tc->u - floor(tc->u)) * W, r = (1 - (tc->v - floor(tc->v))) * H;
+  double a[2] = {tc->dudx * W, -tc->dvdx * H}, b[2] = {tc->dudy * W, -tc->dvdy * H};
+  double la = a[0] * a[0] + a[1] * a[1], lb = b[0] * b[0] + b[1] * b[1];
+  const double *m = la >= lb ? a : b, *o = la >= lb ? b : a;
+  double lmaj = sqrt(fmax(la, lb));
+  double along = lmaj + fabs(m[0] * o[0] + m[1] * o[1]) / lmaj, across = fabs(m[0] * o[1] - m[1] * o[0]) / lmaj;
+  int n = along < N * across ? (int)ceil(along / across) : N;
+  double lod = log2(fmax(along / n, across)), acc = 0;
+  int top = t->nlevels - 1, l = lod <= 0 ? 0 : lod >= top ? top : (int)lod;
+  double f = lod <= 0 || l == top ? 0 : lod - l;
+  for (int k = 0; k < n; k++) {
+    double off = ((k + 0.5) / n - 0.5) * along / lmaj;
+    ref_bilinear(t, l, s + off * m[0], r + off * m[1], (1 - f) / n, &acc);
+    if (f > 0) ref_bilinear(t, l + 1, s + off * m[0], r + off * m[1], f / n, &acc);
+  }
+  return acc;
+}
+
+/* The library's aniso (its probes taken two at a time, lines inside a level read
+ * without wrapping, an odd probe of both levels together) matches the definition on
+ * random footprints over a non-square texture, in every wrap mode. */
+static void test_aniso_definition(void) {
+  rr_texture t = random_texture(53, 37, false);
+  CHECK(rr_texture_prepare(&t), "prepare");
+  const rr_texture_wrap modes[] = {RR_WRAP_REPEAT, RR_WRAP_CLAMP, RR_WRAP_MIRROR};
+  double worst = 0;
+  int bad = 0, tries = test_quick() ? 600 : 3000;
+  for (int k = 0; k < tries; k++) {
+    t.wrap[0] = modes[k % 3], t.wrap[1] = modes[k / 3 % 3];
+    float scale = powf(2.0f, (float)(next_rand() % 1200) / 100.0f - 6.0f) / 53.0f; /* 1/64 to 64 texels */
+    float ang = (float)(next_rand() % 6283) / 1000.0f, ecc = 1.0f + (float)(next_rand() % 4000) / 100.0f;
+    float skew = (float)(next_rand() % 200) / 100.0f - 1.0f;
+    tex_coord tc = {(float)(next_rand() % 5000) / 1000.0f - 2.0f, (float)(next_rand() % 5000) / 1000.0f - 2.0f,
+                    scale * ecc * cosf(ang), scale * ecc * sinf(ang), scale * (skew * cosf(ang) - sinf(ang)),
+                    scale * (skew * sinf(ang) + cosf(ang))};
+    if (t.wrap[0] != RR_WRAP_REPEAT || t.wrap[1] != RR_WRAP_REPEAT) /* the definition wraps u, v in repeat only */
+      tc.u = 0.05f + 0.9f * (tc.u + 2.0f) / 5.0f, tc.v = 0.05f + 0.9f * (tc.v + 2.0f) / 5.0f;
+    int N = 1 + (int)(next_rand() % 16);
+    float got[4];
+    rr_texture_sample(&t, &tc, &(tex_filter){RR_TEXTURE_ANISO, N, 0}, got);
+    double want = ref_aniso(&t, &tc, N), d = fabs(got[0] - want);
+    worst = fmax(worst, d);
+    bad += d > 1e-3;
+  }
+  /* float positions and the level of detail's log2 within 3e-5 of a level */
+  CHECK(bad == 0, "aniso differs from its definition at %d of %d footprints (worst by %.2g)", bad, tries, worst);
+  /* degenerate footprints and coordinates read inside the texture, for every filter
+   * (the sanitizer build checks the reads) */
+  const float odd[] = {NAN, INFINITY, -INFINITY, 1e30f, -1e30f, 0.0f, 1e-30f};
+  int finite = 0, total = 0;
+  for (int k = 0; k < 7 * 7 * 3; k++) {
+    t.wrap[0] = t.wrap[1] = modes[k % 3];
+    float x = odd[k / 3 % 7], d = odd[k / 21];
+    tex_coord tc = {x, 0.3f, d, 0.5f * d, 0.01f, x};
+    for (int f = RR_TEXTURE_NEAREST; f < RR_TEXTURE_FILTER_COUNT; f++) {
+      float o[4];
+      rr_texture_sample(&t, &tc, &(tex_filter){(rr_texture_filter)f, 16, 0}, o);
+      if (isfinite(x)) finite += o[0] == o[0] && o[3] == o[3], total++; /* a NaN position may read NaN */
+    }
+  }
+  CHECK(finite == total, "%d of %d lookups of degenerate footprints at finite positions are NaN", total - finite, total);
+  rr_texture_clear(&t);
+}
+
 /* ---- filters against a supersampled reference -------------------------------------- */
 
 enum { SUB = 16 }; /* SUB × SUB stratified lookups per pixel */
@@ -370,10 +465,13 @@ static void test_filters(rr_device *dev) {
   /* the issue's targets, with margin */
   CHECK(e[ANISO16] <= 0.45 * e[TRILINEAR], "aniso:16 RMSE %.4f > 0.45x trilinear's %.4f", e[ANISO16], e[TRILINEAR]);
   /* The issue asks for ewa <= aniso:16; against a box reference a Gaussian loses
-   * to the probes' box along the footprint (about 1.4x here, docs/textures.md): what
+   * to the probes' box along the footprint (about 1.3x here, docs/textures.md): what
    * is asserted is that it is far from trilinear and not far from aniso:16. */
-  CHECK(e[EWA] <= 0.45 * e[TRILINEAR] && e[EWA] <= 1.8 * e[ANISO16], "ewa RMSE %.4f (trilinear %.4f, aniso:16 %.4f)",
+  CHECK(e[EWA] <= 0.45 * e[TRILINEAR] && e[EWA] <= 1.6 * e[ANISO16], "ewa RMSE %.4f (trilinear %.4f, aniso:16 %.4f)",
         e[EWA], e[TRILINEAR], e[ANISO16]);
+  /* a guard on what aniso:16 reaches (0.19x trilinear's at 160², 0.20x at 96²), so
+   * that a cheaper probe pattern cannot quietly blur or alias more */
+  CHECK(e[ANISO16] <= 0.23 * e[TRILINEAR], "aniso:16 RMSE %.4f > 0.23x trilinear's %.4f", e[ANISO16], e[TRILINEAR]);
   CHECK(e[ANISO16] <= e[ANISO4] && e[ANISO4] < e[TRILINEAR], "more probes, less error: %.4f %.4f %.4f", e[ANISO16],
         e[ANISO4], e[TRILINEAR]);
   CHECK(e[NEAREST] > 1.5 * e[TRILINEAR] && e[BILINEAR] > 1.5 * e[TRILINEAR], "level 0 aliases: %.4f %.4f vs %.4f",
@@ -393,6 +491,7 @@ int main(void) {
   test_srgb();
   test_wrap();
   test_mtl_clamp(dev);
+  test_aniso_definition();
   test_filters(dev);
   rr_device_release(dev);
   return test_done();

@@ -128,7 +128,9 @@ static inline int wrap_index(int i, int n, rr_texture_wrap mode) {
     if (i < 0) i += p;
     return i < n ? i : p - 1 - i;
   }
-  i %= n;
+  i += i < 0 ? n : -n; /* a probe line crosses the seam by a period at most, mostly */
+  if ((unsigned)i < (unsigned)n) return i;
+  i %= n; /* (no division otherwise) */
   return i < 0 ? i + n : i;
 }
 
@@ -140,21 +142,73 @@ KERNEL rr_vf4 texel(const uint16_t *p) {
   return __builtin_convertvector(__builtin_convertvector(v, rr_vi4), rr_vf4);
 }
 
-/* Adds weight w times the bilinear lookup of level lv at texel coordinates (x, y)
- * (texel centres at half-integers) to acc. Hot: up to 32 a pixel with aniso:16. */
+/* Two texels side by side (one load). */
+typedef uint16_t texel2_u16 __attribute__((vector_size(16)));
+typedef int32_t texel2_i32 __attribute__((vector_size(32)));
+KERNEL void texel2(const uint16_t *p, rr_vf4 *a, rr_vf4 *b) {
+  texel2_u16 v;
+  memcpy(&v, p, sizeof v);
+  texel2_i32 i = __builtin_convertvector(v, texel2_i32);
+  rr_vi4 lo, hi;
+  memcpy(&lo, &i, sizeof lo), memcpy(&hi, (char *)&i + sizeof lo, sizeof hi);
+  *a = __builtin_convertvector(lo, rr_vf4), *b = __builtin_convertvector(hi, rr_vf4);
+}
+
+/* Adds weight w times the bilinear lookup of level lv to acc: the texels (x0, y0) to
+ * (x0 + 1, y0 + 1), (ax, ay) the position between them. Hot: up to 32 a pixel with
+ * aniso:16. Edges false: the texels are known to be inside the level, no wrapping. */
+KERNEL void bilerp_at(const rr_texture *t, const tex_level *lv, int x0, int y0, float ax, float ay, float w,
+                      bool edges, rr_vf4 *acc) {
+  int x1 = x0 + 1, y1 = y0 + 1, W = lv->width, H = lv->height;
+  rr_vf4 t00, t10, t01, t11;
+  if (edges) {
+    if ((unsigned)x0 >= (unsigned)(W - 1)) /* wrap only at the edges */
+      x1 = wrap_index(x1, W, t->wrap[0]), x0 = wrap_index(x0, W, t->wrap[0]);
+    if ((unsigned)y0 >= (unsigned)(H - 1)) y1 = wrap_index(y1, H, t->wrap[1]), y0 = wrap_index(y0, H, t->wrap[1]);
+    const uint16_t *r0 = lv->texels + (size_t)4 * y0 * W, *r1 = lv->texels + (size_t)4 * y1 * W;
+    t00 = texel(r0 + 4 * x0), t10 = texel(r0 + 4 * x1), t01 = texel(r1 + 4 * x0), t11 = texel(r1 + 4 * x1);
+  } else {
+    const uint16_t *r0 = lv->texels + 4 * ((size_t)y0 * W + x0);
+    texel2(r0, &t00, &t10), texel2(r0 + 4 * W, &t01, &t11);
+  }
+  rr_vf4 vx = rr_vf4_splat(ax), top = t00 + vx * (t10 - t00), bottom = t01 + vx * (t11 - t01);
+  *acc += rr_vf4_splat(w) * (top + rr_vf4_splat(ay) * (bottom - top));
+}
+
+/* Two bilinear lookups whose texel addressing is shared: weight wa times level la's
+ * at (p[0], p[1]) and wb times level lb's at (p[2], p[3]), texel coordinates with
+ * the texel centres at integers, floored in one vector, within ±2^30 so that
+ * footprints far outside [0, 1] wrap without overflow (NaN: -2^30). Edges false: both
+ * lookups' texels are known to be inside their levels. */
+KERNEL void bilerp2(const rr_texture *t, const tex_level *la, const tex_level *lb, rr_vf4 p, float wa, float wb,
+                    bool edges, rr_vf4 *acc) {
+  if (edges) p = rr_vf4_min(rr_vf4_max(p, rr_vf4_splat(-1073741824.0f)), rr_vf4_splat(1073741824.0f));
+  rr_vi4 i = rr_vi4_trunc(p);
+  i += p < __builtin_convertvector(i, rr_vf4); /* truncation, then down for negatives (-1 where true) */
+  rr_vf4 a = p - __builtin_convertvector(i, rr_vf4);
+  bilerp_at(t, la, i[0], i[1], a[0], a[1], wa, edges, acc);
+  bilerp_at(t, lb, i[2], i[3], a[2], a[3], wb, edges, acc);
+}
+
+/* Adds weight w times the bilinear lookup of level lv at texel coordinates (x, y). */
 KERNEL void bilerp(const rr_texture *t, const tex_level *lv, float x, float y, float w, rr_vf4 *acc) {
   x -= 0.5f, y -= 0.5f;
-  int x0 = ifloor(x), y0 = ifloor(y), W = lv->width, H = lv->height;
-  float ax = x - (float)x0, ay = y - (float)y0;
-  int x1 = x0 + 1, y1 = y0 + 1;
-  if ((unsigned)x0 >= (unsigned)(W - 1)) /* wrap only at the edges */
-    x1 = wrap_index(x1, W, t->wrap[0]), x0 = wrap_index(x0, W, t->wrap[0]);
-  if ((unsigned)y0 >= (unsigned)(H - 1)) y1 = wrap_index(y1, H, t->wrap[1]), y0 = wrap_index(y0, H, t->wrap[1]);
-  const uint16_t *r0 = lv->texels + (size_t)4 * y0 * W, *r1 = lv->texels + (size_t)4 * y1 * W;
-  float w01 = w * ay, w00 = w - w01, w11 = w01 * ax, w10 = w00 * ax;
-  w01 -= w11, w00 -= w10;
-  *acc += rr_vf4_splat(w00) * texel(r0 + 4 * x0) + rr_vf4_splat(w10) * texel(r0 + 4 * x1) +
-          rr_vf4_splat(w01) * texel(r1 + 4 * x0) + rr_vf4_splat(w11) * texel(r1 + 4 * x1);
+  int x0 = ifloor(x), y0 = ifloor(y);
+  bilerp_at(t, lv, x0, y0, x - (float)x0, y - (float)y0, w, true, acc);
+}
+
+/* log2(x) for a level of detail without libm's call: the exponent plus a polynomial
+ * in the mantissa fitted to log2 (within 3e-5 of a level, exact at powers of two, so
+ * continuous across octaves); libm's where x is not a normal positive float. */
+static inline float lod_log2(float x) {
+  if (!(x >= 1.17549435e-38f && x <= 3.4e38f)) return log2f(x);
+  uint32_t b;
+  memcpy(&b, &x, sizeof b);
+  float e = (float)((int)(b >> 23) - 127), m;
+  b = (b & 0x7fffffu) | 0x3f800000u; /* the mantissa 1 + m in [1, 2) */
+  memcpy(&m, &b, sizeof m);
+  m -= 1.0f;
+  return e + m + m * (1.0f - m) * (0.44174030f + m * (-0.26602988f + m * (0.14631434f - 0.04400469f * m)));
 }
 
 /* Two levels, their weights (the trilinear blend at a level of detail) and their
@@ -176,7 +230,9 @@ static inline lod_pair lod_levels(const rr_texture *t, float lod) {
 
 /* Adds weight w times the trilinear lookup at (s, r) (level-0 texel units) to acc. */
 KERNEL void trilerp(const rr_texture *t, const lod_pair *p, float s, float r, float w, rr_vf4 *acc) {
-  for (int k = 0; k < p->n; k++) bilerp(t, p->lv[k], s * p->sx[k], r * p->sy[k], w * p->w[k], acc);
+  if (p->n == 1) bilerp(t, p->lv[0], s * p->sx[0], r * p->sy[0], w, acc);
+  else bilerp2(t, p->lv[0], p->lv[1], (rr_vf4){s * p->sx[0] - 0.5f, r * p->sy[0] - 0.5f, s * p->sx[1] - 0.5f, r * p->sy[1] - 0.5f}, w * p->w[0],
+               w * p->w[1], true, acc);
 }
 
 /* The footprint in level-0 texels: the derivative vectors per pixel step in x (a)
@@ -204,13 +260,38 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
   if (along < (float)n * across) n = (int)ceilf(along / across); /* across > 0 here */
   if (n < 1) n = 1;
   float size = along / (float)n > across ? along / (float)n : across;
-  lod_pair p = lod_levels(t, log2f(size) + f->lod_bias);
-  /* probe k at ((k + 1/2)/n - 1/2)·along along the unit longer vector */
-  float step = along / ((float)n * lmaj), dx = mx * step, dy = my * step, w = 1.0f / (float)n;
-  float k0 = 0.5f - 0.5f * (float)n;
-  for (int k = 0; k < n; k++) {
-    float o = k0 + (float)k;
-    trilerp(t, &p, s + o * dx, r + o * dy, w, acc);
+  float lod = lod_log2(size) + f->lod_bias;
+  if (lod >= (float)(t->nlevels - 1)) n = 1; /* the top level is one texel's mean everywhere */
+  lod_pair p = lod_levels(t, lod);
+  if (n == 1) {
+    trilerp(t, &p, s, r, 1, acc);
+    return;
+  }
+  /* probe j at (j + 1/2 - n/2)·along/n along the unit longer vector, in each level;
+   * two probes of a level at a time */
+  float step = along / ((float)n * lmaj), o = 0.5f - 0.5f * (float)n;
+  float last[2][2];
+  for (int k = 0; k < p.n; k++) {
+    /* probe j at (x, y) + j (dx, dy), texel centres at integers, so that the first
+     * and last bound all in float too; the level's probes summed, then weighed */
+    float dx = mx * step * p.sx[k], dy = my * step * p.sy[k];
+    float x = s * p.sx[k] + o * dx - 0.5f, y = r * p.sy[k] + o * dy - 0.5f;
+    float xe = x + (float)(n - 1) * dx, ye = y + (float)(n - 1) * dy;
+    rr_vf4 base = {x, y, x, y}, d = {dx, dy, dx, dy}, jj = {0, 0, 1, 1}, two = rr_vf4_splat(2), sum = rr_vf4_splat(0);
+    float wl = (float)p.lv[k]->width - 1, hl = (float)p.lv[k]->height - 1;
+    if (x >= 0 && x < wl && xe >= 0 && xe < wl && y >= 0 && y < hl && ye >= 0 && ye < hl)
+      for (int j = 0; j + 1 < n; j += 2, jj += two) bilerp2(t, p.lv[k], p.lv[k], base + jj * d, 1, 1, false, &sum);
+    else /* (NaN too) */
+      for (int j = 0; j + 1 < n; j += 2, jj += two) bilerp2(t, p.lv[k], p.lv[k], base + jj * d, 1, 1, true, &sum);
+    *acc += rr_vf4_splat(p.w[k] / (float)n) * sum;
+    last[k][0] = xe, last[k][1] = ye; /* probe n - 1 when n is odd */
+  }
+  if (n & 1) {
+    if (p.n == 2)
+      bilerp2(t, p.lv[0], p.lv[1], (rr_vf4){last[0][0], last[0][1], last[1][0], last[1][1]}, p.w[0] / (float)n,
+              p.w[1] / (float)n, true, acc);
+    else
+      bilerp(t, p.lv[0], last[0][0] + 0.5f, last[0][1] + 0.5f, 1.0f / (float)n, acc);
   }
 }
 
