@@ -134,6 +134,25 @@ static void test_colmap(void) {
             strstr(rr_device_message(dev), "no image 'nope.png'"),
         "%s", rr_device_message(dev));
   CHECK(rr_camera_import(dev, dir, "9", &one, 1, &n) == RR_ERROR_ARGUMENT, "index out of range accepted");
+
+  /* a scene file's camera from the model (relative to the file), its size the render size */
+  write_file("scene.json", "{\"meshes\": [{\"builtin\": \"plane:2\"}], \"camera\": {\"colmap\": \".\", \"image\": 6}}");
+  snprintf(path, sizeof path, "%s/scene.json", dir);
+  rr_scene *scene = NULL;
+  rr_scene_settings st;
+  CHECK(rr_scene_load_file(dev, path, NULL, &scene, &st) == RR_OK, "%s", rr_device_message(dev));
+  if (scene) {
+    double d = ray_diff(&st.camera, &all[6].camera, W, H);
+    CHECK(d == 0 && (st.camera_given & RR_CAMERA_FIELD_LENS) && (st.given & RR_SETTING_SIZE) && st.render.width == W &&
+              st.render.height == H, "scene file camera: rays differ by %g, size %dx%d", d, st.render.width, st.render.height);
+    rr_scene_release(scene);
+  }
+  write_file("scene.json", "{\"meshes\": [{\"builtin\": \"plane:2\"}], \"camera\": {\"colmap\": \".\", \"image\": \"x.png\"}}");
+  CHECK(rr_scene_load_file(dev, path, NULL, &scene, &st) != RR_OK &&
+            strstr(rr_device_message(dev), "scene.json': 'camera.colmap': COLMAP model") &&
+            strstr(rr_device_message(dev), "no image 'x.png'"),
+        "%s", rr_device_message(dev));
+  unlink(path);
 }
 
 static void test_nerf(void) {
