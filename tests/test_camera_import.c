@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 enum { W = 40, H = 30 };
@@ -153,6 +154,25 @@ static void test_colmap(void) {
             strstr(rr_device_message(dev), "no image 'x.png'"),
         "%s", rr_device_message(dev));
   unlink(path);
+
+  /* the command line: --camera-file DIR:NAME, the image's size without --size */
+  char cmd[1024], png[128], saved[128];
+  snprintf(png, sizeof png, "%s/x.png", dir), snprintf(saved, sizeof saved, "%s/cam.json", dir);
+  snprintf(cmd, sizeof cmd, "%s render plane:2 --camera-file %s:img_2.png --save-camera %s -o %s -q", RR_CLI, dir, saved, png);
+  CHECK(system(cmd) == 0, "%s", cmd);
+  rr_camera c;
+  rr_camera_init(&c);
+  CHECK(rr_camera_load(dev, saved, &c, NULL) == RR_OK && ray_diff(&c, &all[2].camera, W, H) < 1e-6, "saved camera: %s",
+        rr_device_message(dev));
+  unsigned char head[24] = {0};
+  FILE *f = fopen(png, "rb");
+  if (f) fread(head, 1, sizeof head, f), fclose(f);
+  int pw = head[16] << 24 | head[17] << 16 | head[18] << 8 | head[19], ph = head[20] << 24 | head[21] << 16 | head[22] << 8 | head[23];
+  CHECK(pw == W && ph == H, "the image is %dx%d, not the model's %dx%d", pw, ph, W, H);
+  unlink(png), unlink(saved);
+  snprintf(cmd, sizeof cmd, "%s render plane:2 --camera-file %s/images.txt:nope.png -o %s 2>/dev/null", RR_CLI, dir, png);
+  int status = system(cmd);
+  CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 1 && access(png, F_OK) != 0, "an unknown image: status %d", status);
 }
 
 static void test_nerf(void) {
