@@ -207,6 +207,9 @@ static void test_nerf(void) {
   CHECK(e0 < 1e-5, "frame 0: rays differ by %g", e0);
   CHECK(e1 < 1e-5, "frame 1 (its own intrinsics): rays differ by %g", e1);
   CHECK(rr_camera_import(dev, path, "./train/r_1", c, 1, &n) == RR_OK && c[0].camera.fx == 50, "%s", rr_device_message(dev));
+  rr_camera cf;
+  CHECK(rr_camera_load(dev, path, &cf, NULL) != RR_OK && strstr(rr_device_message(dev), "'frames': a NeRF transforms file"),
+        "rr_camera_load of a NeRF file: %s", rr_device_message(dev));
   /* nerfstudio's fisheye */
   snprintf(text, sizeof text,
            "{\"camera_model\": \"OPENCV_FISHEYE\", \"fl_x\": 15, \"fl_y\": 16, \"cx\": 20, \"cy\": 15, \"w\": %d, \"h\": %d,"

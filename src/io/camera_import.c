@@ -484,6 +484,7 @@ rr_error rr_camera_import(rr_device *dev, const char *path, const char *select, 
     e = rr_fail(dev, RR_ERROR_ARGUMENT,
                 "'%s' is neither a COLMAP text model (a directory with cameras.txt and images.txt, or one of them) "
                 "nor a NeRF transforms .json", path);
+  if (!e && l.n == 0) e = rr_fail(dev, RR_ERROR_EMPTY, "%s '%s' has no images", kind, path);
   if (!e && select) {
     long k = -1, idx;
     for (int i = 0; i < l.n && k < 0; i++)
@@ -496,7 +497,6 @@ rr_error rr_camera_import(rr_device *dev, const char *path, const char *select, 
       l.v[0] = l.v[k], l.n = 1;
     }
   }
-  if (!e && l.n == 0) e = rr_fail(dev, RR_ERROR_EMPTY, "%s '%s' has no images", kind, path);
   if (!e) {
     if (cap > 0) memcpy(out, l.v, sizeof *out * (size_t)(l.n < cap ? l.n : cap));
     if (count) *count = l.n;
