@@ -891,6 +891,26 @@ RR_API rr_error rr_scene_load_file(rr_device *dev, const char *path, const rr_lo
  * change, the others stay; *fields (may be NULL) receives their RR_CAMERA_FIELD_* bits. */
 RR_API rr_error rr_camera_load(rr_device *dev, const char *path, rr_camera *cam, unsigned *fields);
 
+/* A camera of a reconstruction tool's file, with the image it belongs to. */
+typedef struct rr_imported_camera {
+  rr_camera camera; /* opencv, or opencv-fisheye for COLMAP's fisheye models and nerfstudio's OPENCV_FISHEYE */
+  int width, height; /* the image's size in pixels */
+  char name[256];    /* COLMAP: the image's NAME; NeRF: the frame's file_path (else its index) */
+} rr_imported_camera;
+/* Reads the cameras of a COLMAP text model (path: the directory holding cameras.txt
+ * and images.txt, or either file; models SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL,
+ * RADIAL, OPENCV, FULL_OPENCV, OPENCV_FISHEYE, SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE;
+ * COLMAP's pixel centres at +0.5 become OpenCV's at 0) or of a NeRF transforms .json
+ * (camera_angle_x/y or fl_x/fl_y, cx/cy (default w/2, h/2), k1 k2 p1 p2 k3 (k1..k4 with
+ * nerfstudio's "camera_model": "OPENCV_FISHEYE"), w and h, per-frame overrides, and
+ * each frame's camera-to-world transform_matrix in OpenGL's axes). select: one image
+ * by its name (file_path), else by its 0-based index in the file; NULL: all of them.
+ * Fills out[0 .. min(n, cap) - 1] in the file's order and *count (may be NULL) = n,
+ * the images selected (1 with select). cap 0 counts only. The whole file is checked:
+ * a malformed one fails with one line naming the file and the line (or JSON key). */
+RR_API rr_error rr_camera_import(rr_device *dev, const char *path, const char *select, rr_imported_camera *out,
+                                 int cap, int *count);
+
 #ifdef __cplusplus
 }
 #endif

@@ -29,9 +29,11 @@ enum {
   CAM_UP = RR_CAMERA_FIELD_UP, CAM_FOV = RR_CAMERA_FIELD_FOV, CAM_ORTHO = RR_CAMERA_FIELD_ORTHO,
   CAM_LENS = RR_CAMERA_FIELD_LENS
 };
-/* Reads a camera file (rr_camera_load) into *cam and returns the fields it gave;
- * the others keep their values. A bad file ends the program (exit 1). */
-unsigned camera_file_read(rr_device *dev, const char *path, rr_camera *cam);
+/* Reads a camera file (rr_camera_load), or a COLMAP model's or NeRF file's camera as
+ * PATH[:IMAGE] (rr_camera_import), into *cam and returns the fields it gave; the
+ * others keep their values. *width, *height: the imported camera's image, else 0.
+ * A bad file ends the program (exit 1). */
+unsigned camera_file_read(rr_device *dev, const char *arg, rr_camera *cam, int *width, int *height);
 /* Adds a camera file for an image of width × height to the output set. */
 void camera_file_add(rr_device *dev, rr_output *set, const char *path, const rr_camera *cam, int width, int height);
 

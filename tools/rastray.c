@@ -203,9 +203,11 @@ static const cli_option render_options[] = {
     {"target", OPT_TARGET, "X,Y,Z", "the point the camera looks at (goes with --eye)"},
     {"up", OPT_UP, "X,Y,Z", "the camera's up direction (default 0,1,0)"},
     {"fov", OPT_FOV, "DEG", "vertical field of view (default 45; fisheye: the full angle, up to 360)"},
-    {"camera-file", OPT_CAMERA_FILE, "FILE",
+    {"camera-file", OPT_CAMERA_FILE, "FILE[:IMAGE]",
      "read the camera from a JSON file (as --save-camera writes, or a 4x4\n"
-     "camera-to-world \"matrix\" and \"fov\"); camera flags override its values"},
+     "camera-to-world \"matrix\" and \"fov\"), or a COLMAP text model (its\n"
+     "directory) or NeRF transforms.json with an image's name or index (the\n"
+     "image's size unless --size); camera flags override its values"},
     {"save-camera", OPT_SAVE_CAMERA, "FILE", "write the camera used (after automatic framing) as JSON"},
     {"camera-from-file", OPT_CAMERA_FROM_FILE, "NAME|INDEX",
      "look through a camera the scene file defines (see info); --camera may\nchange its projection"},
@@ -1128,7 +1130,12 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~by_name & ~(opt.heat ? 0 : heat_aovs);
   if (camera_file) { /* the file's values, where no flag gave one */
     rr_camera from_file = cam;
-    unsigned fields = camera_file_read(dev, camera_file, &from_file);
+    int w, h;
+    unsigned fields = camera_file_read(dev, camera_file, &from_file, &w, &h);
+    if (w > 0 && !(flags & FLAG(OPT_SIZE))) { /* the image the imported camera belongs to */
+      opt.width = w, opt.height = h;
+      check_frame_budget(&opt);
+    }
     camera_take(&cam, &from_file, fields & ~given);
     given |= fields;
   }

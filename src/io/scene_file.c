@@ -119,6 +119,8 @@ rr_error rr_camera_load(rr_device *dev, const char *path, rr_camera *cam, unsign
   cJSON *root;
   rr_error e = rr_json_parse_file(&r, path, 1 << 20, &root);
   unsigned given = 0;
+  if (!e && cJSON_IsArray(rr_json_get(root, "frames")))
+    e = rr_json_fail(&r, "frames", "a NeRF transforms file: its cameras are read by rr_camera_import (--camera-file FILE:FRAME)");
   if (!e) e = read_camera(&r, root, cam, &given, true);
   cJSON_Delete(root);
   if (e) return e;
@@ -632,6 +634,40 @@ static void settings_init(rr_scene_settings *st) {
   st->shade.mode = RR_SHADE_LIT;
 }
 
+/* A reconstruction's camera ({"colmap": DIR, "image": NAME|INDEX} or {"nerf": FILE,
+ * "frame": FILE_PATH|INDEX}; rr_camera_import): the camera, and its image's size as
+ * the render size unless "render" gave one. */
+static rr_error import_camera(json_reader *r, const cJSON *obj, const char *base_dir, const rr_load_options *opt,
+                              rr_scene_settings *st) {
+  bool colmap = rr_json_get(obj, "colmap") != NULL;
+  const char *key = colmap ? "colmap" : "nerf", *sel_key = colmap ? "image" : "frame";
+  static const char *const colmap_keys[] = {"colmap", "image", NULL}, *const nerf_keys[] = {"nerf", "frame", NULL};
+  rr_error e = rr_json_keys(r, obj, colmap ? colmap_keys : nerf_keys);
+  const char *file = NULL;
+  if (!e) e = rr_json_string(r, obj, key, &file);
+  if (e) return e;
+  const cJSON *sel = rr_json_get(obj, sel_key);
+  char index[32];
+  const char *select = NULL;
+  if (cJSON_IsString(sel)) select = sel->valuestring;
+  else if (cJSON_IsNumber(sel) && sel->valuedouble >= 0 && sel->valuedouble <= INT_MAX && sel->valuedouble == (int)sel->valuedouble)
+    snprintf(index, sizeof index, "%d", (int)sel->valuedouble), select = index;
+  else if (sel) return rr_json_fail(r, sel_key, "expected a name or an index >= 0");
+  char path[MAX_PATH];
+  if ((e = resolve_path(r, key, base_dir, file, opt->sandbox, path))) return e;
+  rr_imported_camera ic;
+  if (rr_camera_import(r->dev, path, select ? select : "0", &ic, 1, NULL) != RR_OK) {
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", rr_device_message(r->dev));
+    return rr_json_fail(r, key, "%s", msg);
+  }
+  st->camera = ic.camera;
+  st->camera_given = RR_CAMERA_FIELD_TYPE | RR_CAMERA_FIELD_EYE | RR_CAMERA_FIELD_TARGET | RR_CAMERA_FIELD_UP |
+                     RR_CAMERA_FIELD_LENS;
+  if (!(st->given & RR_SETTING_SIZE)) st->render.width = ic.width, st->render.height = ic.height, st->given |= RR_SETTING_SIZE;
+  return RR_OK;
+}
+
 /* Everything of the file but the commit. */
 static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const char *base_dir,
                            const rr_load_options *opt, rr_scene_settings *st) {
@@ -647,7 +683,10 @@ static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const
   }
   if (!e && (item = rr_json_get(root, "camera"))) {
     size_t len = rr_json_enter(r, "camera", 0);
-    e = read_camera(r, item, &st->camera, &st->camera_given, false);
+    if (cJSON_IsObject(item) && (rr_json_get(item, "colmap") || rr_json_get(item, "nerf")))
+      e = import_camera(r, item, base_dir, opt, st);
+    else
+      e = read_camera(r, item, &st->camera, &st->camera_given, false);
     rr_json_leave(r, len);
   }
   mesh_arg ma = {s, base_dir, opt};
