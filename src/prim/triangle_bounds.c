@@ -89,6 +89,8 @@ bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
   int behind = 0;
   for (int k = 0; k < 3; k++) behind += !(v3_dot(scene_q(s, k, i, c->eye), c->fwd) > 0);
   if (behind == 3 && c->type == RR_CAMERA_PARABOLIC) return false;
+  int tight = rr_tri_curved_rect(c, ts, r);
+  if (tight >= 0) return tight > 0;
   return curved_bounds(s, i, c, ts, r);
 }
 
