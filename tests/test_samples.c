@@ -142,7 +142,7 @@ int main(void) {
       for (int a = 0; a < 3; a++) c[a] = 0.5f * (v3_get(s->bmin, a) + v3_get(s->bmax, a));
       memcpy(cam.eye, c, sizeof c);
       cam.target[0] = c[0] + 1, cam.target[1] = c[1], cam.target[2] = c[2];
-      cam.fov_deg = 200;
+      cam.fov_deg = type == RR_CAMERA_OPENCV || type == RR_CAMERA_OPENCV_FISHEYE ? 150 : 200; /* pinhole intrinsics: < 180 */
     }
     bool curved = type >= RR_CAMERA_PARABOLIC; /* exact but slow: smaller images */
     check_methods(dev, s, &cam, curved ? 32 : 64, curved ? 24 : 48, rr_camera_name(type));

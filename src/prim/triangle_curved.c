@@ -32,62 +32,57 @@ static dv3 dcross(dv3 a, dv3 b) { return dv(a.y * b.z - a.z * b.y, a.z * b.x - a
 static dv3 dscale(dv3 a, double s) { return dv(a.x * s, a.y * s, a.z * s); }
 static dv3 dsub(dv3 a, dv3 b) { return dv(a.x - b.x, a.y - b.y, a.z - b.z); }
 static double dlen(dv3 a) { return sqrt(ddot(a, a)); }
-static dv3 dnorm(dv3 a) { return dscale(a, 1.0 / dlen(a)); }
 
-/* The largest L·d over the minor arc from unit a to unit b (normal n = a × b,
- * not zero): at an end, or where L's projection on the arc's plane points when
- * that lies on the arc (then |L_p|, the great circle's maximum; taking it when in
- * doubt only loosens the bound). */
-static double arc_max(dv3 L, dv3 a, dv3 b, dv3 n) {
-  double best = fmax(ddot(L, a), ddot(L, b));
-  dv3 nn = dnorm(n), lp = dsub(L, dscale(nn, ddot(L, nn)));
-  double len = dlen(lp);
-  if (len > best && ddot(dcross(a, lp), nn) >= -1e-9 * len && ddot(dcross(lp, b), nn) >= -1e-9 * len) best = len;
-  return best;
-}
-
+static double maxd(double a, double b) { return a > b ? a : b; } /* fmax is a call without -ffast-math */
+static double mind(double a, double b) { return a < b ? a : b; }
 static double wrap_pi(double a) { return a > RR_PI ? a - 2 * RR_PI : a < -RR_PI ? a + 2 * RR_PI : a; }
 
 /* The spherical triangle's angles about unit axis P, with polar angle
  * atan2(d·e2, d·e1): α in [*alo, *ahi], ψ in [*plo, *phi] (plo > phi: any ψ),
- * all widened as the comment at the top argues. False when no bound is known (a
- * nearly degenerate setup). */
-static bool polar_range(const dv3 n[3], const dv3 v[3], double E, dv3 P, dv3 e1, dv3 e2, double *alo, double *ahi,
+ * all widened as the comment at the top argues. nu: the edges' unit normals. */
+static void polar_range(const dv3 nu[3], const dv3 v[3], double E, dv3 P, dv3 e1, dv3 e2, double *alo, double *ahi,
                         double *plo, double *phi) {
   double cmax = -1, cmin = 1; /* P·d over T */
   bool has_p = true, has_m = true; /* P (−P) inside T, with a margin */
+  double pv[3];
   for (int i = 0; i < 3; i++) {
-    double ln = dlen(n[i]), s = ddot(n[i], P);
-    has_p &= s >= -1e-6 * ln, has_m &= -s >= -1e-6 * ln;
+    double s = ddot(nu[i], P);
+    has_p &= s >= -1e-6, has_m &= s <= 1e-6;
+    pv[i] = ddot(v[i], P);
+    cmax = maxd(cmax, pv[i]), cmin = mind(cmin, pv[i]);
   }
-  for (int i = 0; i < 3; i++) {
-    dv3 a = v[(i + 1) % 3], b = v[(i + 2) % 3]; /* edge i: from vertex i+1 to i+2 */
-    dv3 ab = dcross(a, b);
-    if (!(dlen(ab) > 1e-12)) return false;
-    cmax = fmax(cmax, arc_max(P, a, b, ab));
-    cmin = fmin(cmin, -arc_max(dscale(P, -1), a, b, ab));
+  /* Each edge is the minor arc from a = v[i+1] to b = v[i+2] in the plane of nu[i].
+   * P·d along the great circle peaks at ±P's projection on the plane, |P_p|; that
+   * counts when it lies on the arc (taking it when in doubt only loosens). */
+  for (int i = 0; i < 3 && !(has_p && has_m); i++) {
+    dv3 a = v[(i + 1) % 3], b = v[(i + 2) % 3], ab = dcross(a, b);
+    dv3 lp = dsub(P, dscale(nu[i], ddot(P, nu[i])));
+    double len = dlen(lp), tol = -1e-9 * len * dlen(ab);
+    double s1 = ddot(dcross(a, lp), ab), s2 = ddot(dcross(lp, b), ab);
+    if (s1 >= tol && s2 >= tol) cmax = maxd(cmax, len);
+    if (-s1 >= tol && -s2 >= tol) cmin = mind(cmin, -len);
   }
   if (has_p) cmax = 1;
   if (has_m) cmin = -1;
-  *alo = fmax(0.0, acos(fmin(1.0, cmax)) - E), *ahi = fmin(RR_PI, acos(fmax(-1.0, cmin)) + E);
+  *alo = maxd(0.0, acos(mind(1.0, cmax)) - E), *ahi = mind(RR_PI, acos(maxd(-1.0, cmin)) + E);
   *plo = 1, *phi = 0; /* any ψ */
   const double near_axis = 2e-3;
-  double lo = fmin(*alo, RR_PI - *ahi);
-  if (lo < near_axis) return true;
+  double lo = mind(*alo, RR_PI - *ahi);
+  if (lo < near_axis) return;
   /* ψ sweeps monotonically along an arc that keeps away from the axis, by less
    * than π; three sweeps summing to ±2π would circle the axis (caught above). */
-  double p0 = atan2(ddot(v[0], e2), ddot(v[0], e1)), p = p0, mn = p0, mx = p0;
+  double ps[3];
+  for (int k = 0; k < 3; k++) ps[k] = atan2(ddot(v[k], e2), ddot(v[k], e1));
+  double p = ps[0], mn = p, mx = p;
   for (int k = 1; k <= 3; k++) {
-    dv3 q = v[k % 3];
-    double d = wrap_pi(atan2(ddot(q, e2), ddot(q, e1)) - atan2(ddot(v[k - 1], e2), ddot(v[k - 1], e1)));
-    if (fabs(d) > RR_PI - 1e-3) return true;
-    p += d, mn = fmin(mn, p), mx = fmax(mx, p);
+    double d = wrap_pi(ps[k % 3] - ps[k - 1]);
+    if (fabs(d) > RR_PI - 1e-3) return;
+    p += d, mn = mind(mn, p), mx = maxd(mx, p);
   }
-  if (fabs(p - p0) > 1.0) return true; /* circles the axis */
+  if (fabs(p - ps[0]) > 1.0) return; /* circles the axis */
   double m = 2 * E / sin(lo);
-  if (mx - mn + 2 * m >= 2 * RR_PI) return true;
+  if (mx - mn + 2 * m >= 2 * RR_PI) return;
   *plo = mn - m, *phi = mx + m;
-  return true;
 }
 
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
@@ -96,47 +91,53 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
   for (int i = 0; i < 3; i++) n[i] = dv(ts->a[i], ts->b[i], ts->c[i]);
   /* T's vertices: vertex i lies on edges i+1 and i+2, inside edge i. Its interior
    * angle θ_i is the angle between the inward normals' planes: cos θ_i = −n̂_j·n̂_k. */
-  double smin = 1;
+  double cmin_half = 1; /* the least 1 − cos θ_i: 2 sin²(θ_i / 2) */
+  for (int i = 0; i < 3; i++) {
+    double l = dlen(n[i]);
+    if (!(l > 0)) return -1;
+    n[i] = dscale(n[i], 1 / l);
+  }
   for (int i = 0; i < 3; i++) {
     dv3 nj = n[(i + 1) % 3], nk = n[(i + 2) % 3], x = dcross(nj, nk);
     double lx = dlen(x), s = ddot(x, n[i]);
-    if (!(lx > 0) || !(fabs(s) > 1e-9 * lx * dlen(n[i]))) return -1;
+    if (!(lx > 0) || !(fabs(s) > 1e-9 * lx)) return -1;
     v[i] = dscale(x, (s > 0 ? 1 : -1) / lx);
-    double cosang = -ddot(nj, nk) / (dlen(nj) * dlen(nk));
-    smin = fmin(smin, sqrt(fmax(0.0, 0.5 * (1 - cosang)))); /* sin(θ/2) */
+    cmin_half = mind(cmin_half, 1 + ddot(nj, nk));
   }
+  double smin = sqrt(maxd(0.0, 0.5 * cmin_half)); /* sin(θ_min / 2) */
   if (!(smin > 1e-3)) return -1;
   const double eps = 1e-5, E = 2 * eps / smin + eps;
   dv3 R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
   double alo, ahi, plo, phi, W = c->width, H = c->height;
   double x0, x1, y0, y1; /* sample coordinates */
   if (c->type == RR_CAMERA_LATLONG) {
-    if (!polar_range(n, v, E, U, F, R, &alo, &ahi, &plo, &phi)) return -1;
+    polar_range(n, v, E, U, F, R, &alo, &ahi, &plo, &phi);
     /* φ = 2π sx / W − π, θ = π sy / H; across the seam: the whole width */
     bool all = plo > phi || plo < -RR_PI || phi > RR_PI;
     x0 = all ? 0 : (plo + RR_PI) * W / (2 * RR_PI), x1 = all ? W : (phi + RR_PI) * W / (2 * RR_PI);
     y0 = alo * H / RR_PI, y1 = ahi * H / RR_PI;
   } else {
-    if (!polar_range(n, v, E, F, R, U, &alo, &ahi, &plo, &phi)) return -1;
+    polar_range(n, v, E, F, R, U, &alo, &ahi, &plo, &phi);
     /* image radius ρ(α) in u, v ∈ [-1, 1]: tan(α/2), or α over the fisheye's half angle */
     double k = c->fov_deg * RR_PI / 360, amax = c->type == RR_CAMERA_PARABOLIC ? RR_PI / 2 : k;
     if (alo > amax + 1e-3) return 0; /* beyond the disk: no rays */
-    ahi = fmin(ahi, amax + 1e-3);
+    ahi = mind(ahi, amax + 1e-3);
     double r0 = c->type == RR_CAMERA_PARABOLIC ? tan(alo / 2) : alo / k;
     double r1 = c->type == RR_CAMERA_PARABOLIC ? tan(ahi / 2) : ahi / k;
     double u0 = -r1, u1 = r1, v0 = -r1, v1 = r1;
     if (plo <= phi) { /* the annular sector's box: its corners and the axes it crosses */
       u0 = v0 = INFINITY, u1 = v1 = -INFINITY;
+      double cs[2] = {cos(plo), cos(phi)}, sn[2] = {sin(plo), sin(phi)};
       for (int k2 = 0; k2 < 4; k2++) {
-        double p = k2 & 1 ? phi : plo, rr = k2 & 2 ? r1 : r0;
-        u0 = fmin(u0, rr * cos(p)), u1 = fmax(u1, rr * cos(p)), v0 = fmin(v0, rr * sin(p)), v1 = fmax(v1, rr * sin(p));
+        double cp = cs[k2 & 1], sp = sn[k2 & 1], rr = k2 & 2 ? r1 : r0;
+        u0 = mind(u0, rr * cp), u1 = maxd(u1, rr * cp), v0 = mind(v0, rr * sp), v1 = maxd(v1, rr * sp);
       }
       for (int q = (int)floor(plo / (RR_PI / 2)) + 1; q * (RR_PI / 2) <= phi; q++) {
         int m = ((q % 4) + 4) % 4; /* ψ = qπ/2: +u, +v, −u, −v */
-        if (m == 0) u1 = fmax(u1, r1);
-        else if (m == 1) v1 = fmax(v1, r1);
-        else if (m == 2) u0 = fmin(u0, -r1);
-        else v0 = fmin(v0, -r1);
+        if (m == 0) u1 = maxd(u1, r1);
+        else if (m == 1) v1 = maxd(v1, r1);
+        else if (m == 2) u0 = mind(u0, -r1);
+        else v0 = mind(v0, -r1);
       }
     }
     /* u = 2 sx / W − 1, v = 1 − 2 sy / H */
@@ -145,7 +146,7 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
   /* sample x + sx0 in [x0, x1], with a hundredth of a pixel against the double rounding */
   double lx = ceil(x0 - c->sx0 - 1e-2), hx = floor(x1 - c->sx0 + 1e-2);
   double ly = ceil(y0 - c->sy0 - 1e-2), hy = floor(y1 - c->sy0 + 1e-2);
-  lx = fmax(lx, 0), ly = fmax(ly, 0), hx = fmin(hx, W - 1), hy = fmin(hy, H - 1);
+  lx = maxd(lx, 0), ly = maxd(ly, 0), hx = mind(hx, W - 1), hy = mind(hy, H - 1);
   if (!(lx <= hx && ly <= hy)) return 0;
   r[0] = (int)lx, r[1] = (int)ly, r[2] = (int)hx, r[3] = (int)hy;
   return 1;
