@@ -227,9 +227,14 @@ KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], 
 }
 
 /* The inclusive pixel rectangle a set-up triangle's samples may lie in; false when
- * none. For curved cameras it is the bounding box of the cells whose cone of
- * directions no edge plane excludes. */
+ * none. For curved cameras it is rr_tri_curved_rect's where it knows one, else the
+ * bounding box of the cells whose cone of directions no edge plane excludes. */
 bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int rect[4]);
+/* The tight rectangle of the curved views polar about an axis (lat-long, parabolic,
+ * fisheye), from the spherical triangle of the setup's edge planes
+ * (prim/triangle_curved.c): 1 with rect, 0 when no sample can pass, -1 when it
+ * knows no bound (another camera, a nearly degenerate setup). */
+int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
 /* Planar cameras bound a triangle from its corners alone, before its setup: most
  * triangles of a detailed mesh fall between samples. rr_tri_corner_bounds bounds triangles
  * ids[0..n-1] (first..first+n-1 when ids is NULL), 8 at a time with AVX2 when

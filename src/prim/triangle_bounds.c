@@ -84,8 +84,10 @@ bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
     memcpy(r, b.bb, sizeof b.bb);
     return true;
   }
-  /* Curved views have no straight-edged projection; hemispheres see nothing
-   * wholly behind the eye plane. */
+  /* Curved views have no straight-edged projection: the tight rectangle where it
+   * is known, else the cells' cones; hemispheres see nothing wholly behind the eye plane. */
+  int tight = rr_tri_curved_rect(c, ts, r);
+  if (tight >= 0) return tight > 0;
   int behind = 0;
   for (int k = 0; k < 3; k++) behind += !(v3_dot(scene_q(s, k, i, c->eye), c->fwd) > 0);
   if (behind == 3 && c->type == RR_CAMERA_PARABOLIC) return false;

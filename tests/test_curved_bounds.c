@@ -1,0 +1,142 @@
+/* Curved views' image rectangles (rr_tri_screen_bounds, rr_tri_curved_rect) are
+ * conservative: for random triangles in every curved camera, every sample whose
+ * ray passes the 3D edge test lies inside the triangle's rectangle. The triangles
+ * gather where the maps are singular or wrap: the lat-long's seam and poles, the
+ * hemisphere's rim, the fisheye's axis and (at 360°) its antipode, the cube's
+ * edges and corners. */
+#include "vis/vis.h"
+#include "io/io.h"
+#include "testutil.h"
+
+#include <math.h>
+#include <string.h>
+
+static uint32_t rng = 12345;
+static double rnd(void) { /* xorshift, uniform in [0, 1) */
+  rng ^= rng << 13, rng ^= rng >> 17, rng ^= rng << 5;
+  return (rng >> 8) * (1.0 / 16777216.0);
+}
+static vec3 rnd_unit(void) {
+  for (;;) {
+    vec3 v = v3((float)(2 * rnd() - 1), (float)(2 * rnd() - 1), (float)(2 * rnd() - 1));
+    float l = v3_len(v);
+    if (l > 0.1f && l <= 1) return v3_scale(v, 1 / l);
+  }
+}
+
+/* A direction in the camera's frame: angle a from fwd (around the axis at angle
+ * psi), or from up for the lat-long's poles. */
+static vec3 polar(vec3 axis, vec3 e1, vec3 e2, double a, double psi) {
+  return v3_add(v3_scale(axis, (float)cos(a)),
+                v3_add(v3_scale(e1, (float)(sin(a) * cos(psi))), v3_scale(e2, (float)(sin(a) * sin(psi)))));
+}
+
+/* A centre direction where the camera's map is hard, or anywhere. */
+static vec3 hard_dir(const rr_camera *rc, vec3 f, vec3 r, vec3 u) {
+  double psi = 2 * RR_PI * rnd(), jit = rnd() < 0.5 ? 0 : 0.05 * (2 * rnd() - 1);
+  switch ((int)(rnd() * 5)) {
+  case 0: return rnd_unit();
+  case 1: return polar(u, f, r, jit, psi);                  /* north pole */
+  case 2: return polar(v3_neg(u), f, r, jit, psi);          /* south pole */
+  case 3: return polar(v3_neg(f), u, r, jit, psi);          /* behind: the seam, the 360° fisheye's rim */
+  default: {                                               /* the rim of the disk, the axis */
+    double rim = rc->type == RR_CAMERA_FISHEYE ? rc->fov_deg * RR_PI / 360 : RR_PI / 2;
+    if (rc->type == RR_CAMERA_CUBE) rim = atan(sqrt(2.0)); /* a cube's corner */
+    return polar(f, r, u, rnd() < 0.3 ? jit : rim + jit, psi);
+  }
+  }
+}
+
+static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int ntri, const char *what) {
+  float pos[2] = {(float)rnd(), (float)rnd()};
+  camera c;
+  CHECK(rr_cam_setup_at(dev, rc, w, h, pos, &c) == RR_OK, "%s: camera", what);
+  /* the triangles, around hard directions, of angular sizes from 1e-3 to 1.5 rad */
+  float *p = malloc((size_t)ntri * 9 * sizeof *p);
+  uint32_t *idx = malloc((size_t)ntri * 3 * sizeof *idx);
+  for (int k = 0; k < 3 * ntri; k++) idx[k] = (uint32_t)k;
+  for (int t = 0; t < ntri; t++) {
+    vec3 centre = hard_dir(rc, c.fwd, c.right, c.up);
+    double size = exp(log(1e-3) + rnd() * (log(1.5) - log(1e-3)));
+    for (int k = 0; k < 3; k++) {
+      vec3 d = v3_norm(v3_add(centre, v3_scale(rnd_unit(), (float)size)));
+      float dist = (float)(0.5 + 10 * rnd());
+      vec3 q = v3_add(c.eye, v3_scale(d, dist));
+      memcpy(p + 9 * t + 3 * k, &q, 12);
+    }
+  }
+  rr_scene *s = NULL;
+  CHECK(rr_scene_new(dev, &s) == RR_OK, "scene");
+  CHECK(rr_scene_add_mesh(s, p, (size_t)ntri * 3, idx, (size_t)ntri, NULL) == RR_OK, "mesh: %s",
+        rr_device_message(dev));
+  CHECK(rr_scene_commit(s) == RR_OK, "commit");
+  long missed = 0, passing = 0, area = 0, tight = 0, seen = 0;
+  for (uint32_t i = 0; i < s->ntris; i++) {
+    tri_setup ts;
+    if (rr_tri_setup(s, i, &c, false, &ts) == SETUP_CULLED) continue;
+    int r[4], rt[4];
+    bool has = rr_tri_screen_bounds(s, i, &c, &ts, r);
+    tight += rr_tri_curved_rect(&c, &ts, rt) >= 0;
+    seen++;
+    long in = 0;
+    for (int y = 0; y < h; y++)
+      for (int x = 0; x < w; x++) {
+        vec3 d = camera_w(&c, x, y);
+        if (d.x == 0 && d.y == 0 && d.z == 0) continue;
+        float e[3], t, l1, l2;
+        tri_edges_w(&ts, d, e);
+        if (!sample_test_w(e, ts.w, ts.tie, ts.vol, 0, tri_den_w(&ts, d), &t, &l1, &l2)) continue;
+        in++;
+        if (!has || x < r[0] || x > r[2] || y < r[1] || y > r[3]) {
+          if (missed++ < 5)
+            fprintf(stderr, "%s: triangle %u passes at (%d, %d) outside [%d,%d]x[%d,%d]%s\n", what, i, x, y,
+                    has ? r[0] : 0, has ? r[2] : -1, has ? r[1] : 0, has ? r[3] : -1, has ? "" : " (none)");
+        }
+      }
+    passing += in;
+    if (has) area += (long)(r[2] - r[0] + 1) * (r[3] - r[1] + 1);
+  }
+  CHECK(missed == 0, "%s: %ld passing samples outside their triangle's rectangle", what, missed);
+  CHECK(passing > 0, "%s: no triangle passes anywhere (the test would prove nothing)", what);
+  bool polar_map = rc->type == RR_CAMERA_LATLONG || rc->type == RR_CAMERA_PARABOLIC || rc->type == RR_CAMERA_FISHEYE;
+  CHECK(!polar_map || tight * 10 >= seen * 9, "%s: tight bounds for only %ld of %ld triangles", what, tight, seen);
+  printf("%s: %ld triangles (%ld tight), %ld passing samples in rectangles of %ld samples (%.1f%%)\n", what, seen,
+         tight, passing, area, area ? 100.0 * passing / area : 0.0);
+  rr_scene_release(s);
+  free(p), free(idx);
+  rr_cam_release(&c);
+}
+
+int main(void) {
+  rr_device *dev = rr_device_new();
+  int ntri = test_quick() ? 150 : 1500;
+  struct {
+    rr_camera_type type;
+    float fov;
+    int w, h;
+    const char *what;
+  } cams[] = {
+      {RR_CAMERA_LATLONG, 90, 128, 64, "latlong"},
+      {RR_CAMERA_PARABOLIC, 90, 96, 80, "parabolic"},
+      {RR_CAMERA_FISHEYE, 180, 96, 96, "fisheye 180"},
+      {RR_CAMERA_FISHEYE, 100, 80, 96, "fisheye 100"},
+      {RR_CAMERA_FISHEYE, 360, 96, 96, "fisheye 360"},
+      {RR_CAMERA_CUBE, 90, 96, 72, "cube"},
+      {RR_CAMERA_OPENCV_FISHEYE, 150, 96, 80, "opencv-fisheye"},
+  };
+  for (size_t k = 0; k < sizeof cams / sizeof cams[0]; k++)
+    for (int view = 0; view < 2; view++) {
+      rr_camera rc;
+      rr_camera_init(&rc);
+      rc.type = cams[k].type, rc.fov_deg = cams[k].fov;
+      vec3 eye = view ? v3(0.3f, -1.2f, 2.5f) : v3(0, 0, 0), target = view ? v3(1, 0.5f, -0.7f) : v3(0, 0, -1);
+      vec3 up = view ? v3(0.2f, 1, 0.1f) : v3(0, 1, 0);
+      memcpy(rc.eye, &eye, 12), memcpy(rc.target, &target, 12), memcpy(rc.up, &up, 12);
+      if (rc.type == RR_CAMERA_OPENCV_FISHEYE) rc.dist[0] = 0.05f, rc.dist[1] = -0.01f;
+      char what[64];
+      snprintf(what, sizeof what, "%s, view %d", cams[k].what, view);
+      check_camera(dev, &rc, cams[k].w, cams[k].h, ntri, what);
+    }
+  rr_device_release(dev);
+  return test_done();
+}
