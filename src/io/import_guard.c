@@ -538,6 +538,24 @@ static rr_error import_guarded(rr_scene *s, const char *path, const rr_import_li
   return e;
 }
 
+#if defined(__SANITIZE_ADDRESS__)
+/* ASan's allocator (GCC 12's libasan) takes no locks around fork: a child forked
+ * while another thread allocates can block forever on the lock that thread held.
+ * So ASan builds import in process while other threads run; glibc's malloc, which
+ * other builds use, is safe across fork. */
+static bool fork_unsafe(void) {
+  FILE *f = fopen("/proc/self/status", "r");
+  char line[128];
+  int threads = 0;
+  while (f && fgets(line, sizeof line, f))
+    if (sscanf(line, "Threads: %d", &threads) == 1) break;
+  if (f) fclose(f);
+  return threads != 1;
+}
+#else
+static bool fork_unsafe(void) { return false; }
+#endif
+
 rr_error rr_scene_import_guarded(rr_scene *s, const char *path) {
   rr_device *dev = s->dev;
   rr_import_limits lim;
@@ -547,6 +565,6 @@ rr_error rr_scene_import_guarded(rr_scene *s, const char *path) {
   if ((!dev || dev->import_hook != IMPORT_HOOK_NO_CHECK) && !rr_import_check(path, why, sizeof why))
     return rr_fail(dev, RR_ERROR_PARSE, "cannot read scene '%s': %s", path, why);
   /* no device to carry the child's message: in process */
-  if (lim.in_process || !dev) return rr_scene_import_file(s, path);
+  if (lim.in_process || !dev || fork_unsafe()) return rr_scene_import_file(s, path);
   return import_guarded(s, path, &lim);
 }
