@@ -961,7 +961,8 @@ static bool parse_pystr(const char **s, char *out, size_t cap) {
   (*s)++;
   size_t n = 0;
   while (**s && **s != q) {
-    if (n + 1 >= cap) return false;
+    /* dtype strings are printable: a control character would end up in a message */
+    if (n + 1 >= cap || (unsigned char)**s < 0x20 || (unsigned char)**s >= 0x7f) return false;
     out[n++] = *(*s)++;
   }
   if (**s != q) return false;
