@@ -163,6 +163,10 @@ static bool check_ply(span f, char *why, size_t cap) {
     size_t len = end - pos < sizeof line - 1 ? end - pos : sizeof line - 1;
     memcpy(line, f.p + pos, len);
     line[len] = 0;
+    if (memchr(f.p + pos, 0, end - pos)) { /* the lines read here and the importer's would differ */
+      ok = refuse(why, cap, "a NUL byte in the PLY header");
+      break;
+    }
     pos = nl ? end + 1 : f.n;
     char a[64] = "", b[64] = "", c[64] = "", d[64] = "", g[64] = "";
     int n = sscanf(line, "%63s %63s %63s %63s %63s", a, b, c, d, g);
@@ -171,6 +175,10 @@ static bool check_ply(span f, char *why, size_t cap) {
       if (!nl) break; /* end_header with no line end: the body would start past the file */
       body_at = pos;
     } else if (strcmp(a, "format") == 0) {
+      if (format != -1) {
+        ok = refuse(why, cap, "two format lines in the PLY header");
+        break;
+      }
       format = !strcmp(b, "ascii") ? 0 : !strcmp(b, "binary_little_endian") ? 1 : !strcmp(b, "binary_big_endian") ? 2 : -2;
       if (format == -2) ok = refuse(why, cap, "unknown PLY format '%s'", b);
     } else if (strcmp(a, "element") == 0) {
@@ -201,6 +209,9 @@ static bool check_ply(span f, char *why, size_t cap) {
   }
   if (ok && !body_at) ok = refuse(why, cap, "truncated PLY header (no end_header line)");
   if (ok && format < 0) ok = refuse(why, cap, "no format line in the PLY header");
+  bool vertices = false; /* without them the file holds nothing to load, and assimp has corrupted its heap on such files */
+  for (int e = 0; e < nel; e++) vertices |= strcmp(el[e].name, "vertex") == 0;
+  if (ok && !vertices) ok = refuse(why, cap, "no vertex element in the PLY header");
   /* the least each element's records take: binary, the scalars' bytes and the lists'
    * counts; ASCII, two bytes (a digit and a separator) per value */
   span body = {f.p + body_at, f.n - body_at};
