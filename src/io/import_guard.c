@@ -538,11 +538,11 @@ static rr_error import_guarded(rr_scene *s, const char *path, const rr_import_li
   return e;
 }
 
-#if defined(__SANITIZE_ADDRESS__)
-/* ASan's allocator (GCC 12's libasan) takes no locks around fork: a child forked
- * while another thread allocates can block forever on the lock that thread held.
- * So ASan builds import in process while other threads run; glibc's malloc, which
- * other builds use, is safe across fork. */
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+/* The sanitizers' allocators (GCC 12's libasan; libtsan too, seen in test_threads)
+ * are not safe across fork: a child forked while another thread allocates can block
+ * forever on the lock that thread held. So sanitizer builds import in process while
+ * other threads run; glibc's malloc, which other builds use, is safe across fork. */
 static bool fork_unsafe(void) {
   FILE *f = fopen("/proc/self/status", "r");
   char line[128];
