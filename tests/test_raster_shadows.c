@@ -66,9 +66,13 @@ static size_t targets(const rr_scene *s, vec3 eye, vec3 light, vec3 *out, size_t
   return m;
 }
 
-/* Every ray from light to the points: rr_occluded_raster on 1, 2, 8 threads
- * against rr_occluded ray by ray. Adds the occluded and lit counts to seen[]. */
-static void check_light(const rr_scene *s, vec3 light, const vec3 *pts, size_t n, const char *what, size_t seen[2]) {
+/* The shadow rays of every point towards a light, through rr_occluded_raster on 1, 2
+ * and 8 threads against rr_occluded ray by ray. A point light (light not NULL): rays
+ * from the light to the points; a directional one: rays from every point along
+ * `towards`, unbounded (parallel rays: an orthographic camera). Adds the occluded and
+ * lit counts to seen[]. */
+static void check_rays(const rr_scene *s, const vec3 *light, vec3 towards, const vec3 *pts, size_t n,
+                       const char *what, size_t seen[2]) {
   rr_ray *rays = malloc(n * sizeof *rays);
   int *ref = malloc(n * sizeof *ref), *got = malloc(n * sizeof *got);
   if (!rays || !ref || !got) {
@@ -77,8 +81,12 @@ static void check_light(const rr_scene *s, vec3 light, const vec3 *pts, size_t n
     return;
   }
   for (size_t k = 0; k < n; k++) {
-    vec3 d = v3_sub(pts[k], light);
-    rays[k] = (rr_ray){{light.x, light.y, light.z}, {d.x, d.y, d.z}, 0, 1};
+    if (light) {
+      vec3 d = v3_sub(pts[k], *light);
+      rays[k] = (rr_ray){{light->x, light->y, light->z}, {d.x, d.y, d.z}, 0, 1};
+    } else {
+      rays[k] = (rr_ray){{pts[k].x, pts[k].y, pts[k].z}, {towards.x, towards.y, towards.z}, 0, INFINITY};
+    }
     ref[k] = 0;
     rr_occluded(NULL, s, &rays[k], &ref[k]);
     seen[ref[k] != 0]++;
@@ -91,40 +99,9 @@ static void check_light(const rr_scene *s, vec3 light, const vec3 *pts, size_t n
     size_t diff = 0, first = 0;
     for (size_t k = 0; k < n; k++)
       if ((got[k] != 0) != (ref[k] != 0)) first = diff++ ? first : k;
-    CHECK(ok && diff == 0, "%s, %d threads: %zu of %zu rays differ from rr_occluded (first: ray %zu, raster %d)", what,
-          test_threads[ti], diff, n, first, got[first]);
-    CHECK(empty || c.bins > 0, "%s: no bins", what);
-  }
-  free(rays), free(ref), free(got);
-}
-
-/* A directional light: rays from every point along `towards` (one direction,
- * unbounded), rr_occluded_raster (parallel rays: an orthographic camera) on 1, 2, 8
- * threads against rr_occluded ray by ray. */
-static void check_parallel(const rr_scene *s, vec3 towards, const vec3 *pts, size_t n, const char *what,
-                           size_t seen[2]) {
-  rr_ray *rays = malloc(n * sizeof *rays);
-  int *ref = malloc(n * sizeof *ref), *got = malloc(n * sizeof *got);
-  if (!rays || !ref || !got) {
-    CHECK(0, "out of memory");
-    free(rays), free(ref), free(got);
-    return;
-  }
-  for (size_t k = 0; k < n; k++) {
-    rays[k] = (rr_ray){{pts[k].x, pts[k].y, pts[k].z}, {towards.x, towards.y, towards.z}, 0, INFINITY};
-    ref[k] = 0;
-    rr_occluded(NULL, s, &rays[k], &ref[k]);
-    seen[ref[k] != 0]++;
-  }
-  bool empty;
-  const rr_bvh *b = rr_bvh_of(dev, s, &empty);
-  for (int ti = 0; ti < TEST_NTHREADS; ti++) {
-    bool ok = rr_occluded_raster(s, b, rays, n, test_threads[ti], got, NULL);
-    size_t diff = 0, first = 0;
-    for (size_t k = 0; k < n; k++)
-      if ((got[k] != 0) != (ref[k] != 0)) first = diff++ ? first : k;
-    CHECK(ok && diff == 0, "%s, %d threads: %zu of %zu parallel rays differ from rr_occluded (first: ray %zu)", what,
-          test_threads[ti], diff, n, first);
+    CHECK(ok && diff == 0, "%s, %d threads: %zu of %zu %srays differ from rr_occluded (first: ray %zu, raster %d)",
+          what, test_threads[ti], diff, n, light ? "" : "parallel ", first, got[first]);
+    CHECK(!light || empty || c.bins > 0, "%s: no bins", what);
   }
   free(rays), free(ref), free(got);
 }
@@ -157,14 +134,14 @@ static void check_scene(const char *name, int lights, size_t npts) {
                 : in_bounds(s, frand() * 3 - 1, frand() * 3 - 1, frand() * 3 - 1);
     size_t n = targets(s, eye, light, pts, npts);
     snprintf(what, sizeof what, "%s, light %d %s (%g, %g, %g)", name, l, where, light.x, light.y, light.z);
-    check_light(s, light, pts, n, what, seen);
+    check_rays(s, &light, light, pts, n, what, seen);
     /* the same points under a directional light from where the point light was (an
      * axis now and then: zero components) */
     vec3 towards = l % 3 == 0 ? v3(0, 1, 0) : v3_sub(light, v3_scale(v3_add(s->bmin, s->bmax), 0.5f));
     if (l % 5 == 4) towards = v3(frand() - 0.5f, 0, frand() - 0.5f);
     snprintf(what, sizeof what, "%s, directional light %d towards (%g, %g, %g)", name, l, towards.x, towards.y,
              towards.z);
-    check_parallel(s, towards, pts, n, what, seen_dir);
+    check_rays(s, NULL, towards, pts, n, what, seen_dir);
   }
   CHECK(seen[0] > 0 && seen[1] > 0, "%s: %zu lit and %zu occluded rays: the test sees only one kind", name, seen[0],
         seen[1]);

@@ -45,6 +45,16 @@ class _Device:
             raise MemoryError("rastray: out of memory for a device")
         self.ptr = ffi.gc(dev, lib.rr_device_release)
 
+    @classmethod
+    def building(cls, threads):
+        """A device whose scenes build their BVH on `threads` threads (0: all cores)."""
+        dev = cls()
+        bo = ffi.new("rr_build_options *")
+        lib.rr_build_options_init(bo)
+        bo.threads = _threads(threads)
+        dev.check(lib.rr_device_set_build_options(dev.ptr, bo))
+        return dev
+
     def check(self, code):
         if code != lib.RR_OK:
             raise Error(ffi.string(lib.rr_device_message(self.ptr)).decode("utf-8", "replace"), code)
@@ -197,11 +207,7 @@ class Scene:
     @classmethod
     def from_file(cls, path, threads=0):
         """A mesh file assimp reads (.obj .ply .gltf .glb ...) or a built-in scene name."""
-        dev = _Device()
-        bo = ffi.new("rr_build_options *")
-        lib.rr_build_options_init(bo)
-        bo.threads = _threads(threads)
-        dev.check(lib.rr_device_set_build_options(dev.ptr, bo))
+        dev = _Device.building(threads)
         out = ffi.new("rr_scene **")
         dev.check(lib.rr_scene_load(dev.ptr, str(path).encode(), out))
         return cls(out[0], dev)
@@ -218,11 +224,7 @@ class Scene:
         c = None if colors is None else _array(colors, "colors", np.float32, 3)
         if c is not None and len(c) != len(v):
             raise ValueError("colors must have one row per vertex (%d), not %d" % (len(v), len(c)))
-        dev = _Device()
-        bo = ffi.new("rr_build_options *")
-        lib.rr_build_options_init(bo)
-        bo.threads = _threads(threads)
-        dev.check(lib.rr_device_set_build_options(dev.ptr, bo))
+        dev = _Device.building(threads)
         out = ffi.new("rr_scene **")
         dev.check(lib.rr_scene_new(dev.ptr, out))
         self = cls(out[0], dev)
