@@ -8,8 +8,8 @@
  *   lookups, and MTL's -clamp reaching the material;
  * - each filter on the built-in checker scene's grazing view against a reference
  *   of 16×16 stratified bilinear level-0 lookups per pixel, in linear light: the
- *   issue's aniso target asserted with margin (aniso:16 at most 0.45× trilinear's
- *   RMSE), ewa near it, nearest and bilinear worse than trilinear (they alias);
+ *   issue's targets asserted with margin (aniso:16 at most 0.45× trilinear's
+ *   RMSE, ewa at most 0.92× aniso:16's), nearest and bilinear worse than trilinear (they alias);
  * - aniso against its definition on random footprints (its fast paths exact). */
 #define _POSIX_C_SOURCE 200809L
 #include "camera/camera.h"
@@ -464,11 +464,9 @@ static void test_filters(rr_device *dev) {
   }
   /* the issue's targets, with margin */
   CHECK(e[ANISO16] <= 0.45 * e[TRILINEAR], "aniso:16 RMSE %.4f > 0.45x trilinear's %.4f", e[ANISO16], e[TRILINEAR]);
-  /* The issue asks for ewa <= aniso:16; against a box reference a Gaussian loses
-   * to the probes' box along the footprint (about 1.3x here, docs/textures.md): what
-   * is asserted is that it is far from trilinear and not far from aniso:16. */
-  CHECK(e[EWA] <= 0.45 * e[TRILINEAR] && e[EWA] <= 1.6 * e[ANISO16], "ewa RMSE %.4f (trilinear %.4f, aniso:16 %.4f)",
-        e[EWA], e[TRILINEAR], e[ANISO16]);
+  /* ewa <= aniso:16 (0.81x here at 160², 0.87x at 96²: the hat-box weight over a
+   * fine grid, docs/textures.md) */
+  CHECK(e[EWA] <= 0.92 * e[ANISO16], "ewa RMSE %.4f > 0.92x aniso:16's %.4f", e[EWA], e[ANISO16]);
   /* a guard on what aniso:16 reaches (0.19x trilinear's at 160², 0.20x at 96²), so
    * that a cheaper probe pattern cannot quietly blur or alias more */
   CHECK(e[ANISO16] <= 0.23 * e[TRILINEAR], "aniso:16 RMSE %.4f > 0.23x trilinear's %.4f", e[ANISO16], e[TRILINEAR]);

@@ -295,86 +295,112 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
   }
 }
 
-/* The Gaussian exp(-alpha r²), r the distance in pixels mapped through the
- * footprint, truncated at r = EWA_RADIUS (pbrt-v4 takes alpha = 2 and r = 1: wider
- * than the pixel, blurrier than its box); EWA_RECON texels² of width added to the
- * footprint for the reconstruction between texels. Chosen for the least RMSE against
- * the pixel's box on the checker view (tests/test_texture.c). */
-#define EWA_ALPHA 2.0f
-#define EWA_RADIUS 0.8f
-#define EWA_RECON 2.0f
+/* EWA (docs/textures.md). The weight over the ellipse x^T M^-1 x < EWA_R², M = J Jᵀ
+ * (J the footprint: r = |J^-1 x| is the distance in pixels), is the radially
+ * symmetric w(r) ∝ 1/sqrt(EWA_R² - r²), EWA_R half a pixel: the surface of a sphere
+ * seen from afar, which every line crosses as a box (Archimedes' hat-box theorem),
+ * so that its profile along any direction is the pixel's box, as a box-filtered
+ * image has it (a Gaussian's is a Gaussian). The ellipse is read on a grid fine
+ * enough that its short axis spans EWA_STEPS steps or more: a MIP level's texels,
+ * or, finer than level 0, level 0's bilinear reconstruction sampled every 2^l
+ * texels (l < 0); each grid point weighs w's mean over its cell (the rim's infinite
+ * but integrable weight spread over the cells that cross it; q = r² taken as linear
+ * across a cell). Under EWA_MIN_AXIS texels of level 0 across, the footprint is
+ * nearly a point: aniso's probes. The eccentricity is limited to
+ * EWA_MAX_ECCENTRICITY (the short axis grown), a bound on the points read. */
+#define EWA_R 0.5f
+#define EWA_STEPS 8.0f
+#define EWA_MIN_AXIS 0.5f
+#define EWA_MAX_ECCENTRICITY 64.0f
 
-/* One level's EWA: the texels of level l inside the ellipse x^T M^-1 x < R², M = J Jᵀ
- * + EWA_RECON·I (J the footprint in this level's texels), each weighed by
- * exp(-alpha x^T M^-1 x) - exp(-alpha R²). */
-static void ewa_level(const rr_texture *t, int l, float s, float r, const footprint *fp, float w, rr_vf4 *acc) {
-  const tex_level *lv = &t->levels[l];
-  float sx = (float)lv->width / (float)t->width, sy = (float)lv->height / (float)t->height;
-  float ax = fp->ax * sx, ay = fp->ay * sy, bx = fp->bx * sx, by = fp->by * sy;
-  float m11 = ax * ax + bx * bx + EWA_RECON, m12 = ax * ay + bx * by, m22 = ay * ay + by * by + EWA_RECON;
+/* Weight w times the EWA of grid l (above) over the ellipse M (m11, m12, m22, in
+ * level-0 texels) around (s, r). */
+static void ewa_grid(const rr_texture *t, int l, float s, float r, const float m[3], float w, rr_vf4 *acc) {
+  const tex_level *lv = &t->levels[l > 0 ? l : 0];
+  bool fine = l < 0; /* level 0's reconstruction, every step texels */
+  float step = fine ? exp2f((float)l) : 1.0f;
+  float sx = fine ? 1.0f / step : (float)lv->width / (float)t->width, sy = fine ? sx : (float)lv->height / (float)t->height;
+  float m11 = m[0] * sx * sx, m12 = m[1] * sx * sy, m22 = m[2] * sy * sy; /* in grid steps */
   float det = m11 * m22 - m12 * m12;
+  /* the centre in grid steps, grid points (and texel centres) at integers */
+  float cx = fine ? (s - 0.5f) * sx : s * sx - 0.5f, cy = fine ? (r - 0.5f) * sy : r * sy - 0.5f;
+  if (!(det > 0)) { /* (the caller's short axis spans steps: a guard) */
+    bilerp(t, lv, fine ? s : s * sx, fine ? r : r * sy, w, acc);
+    return;
+  }
   float q11 = m22 / det, q12 = -m12 / det, q22 = m11 / det; /* M^-1 */
-  float cx = s * sx - 0.5f, cy = r * sy - 0.5f;             /* texel centres at integers */
-  const float R2 = EWA_RADIUS * EWA_RADIUS;
-  /* the ellipse's bounding box, at most a period of the texture each way (a thin
-   * texture's levels stop halving across: the rest would revisit the same texels) */
-  float ex = fminf(sqrtf(m11 * R2), (float)lv->width + 1), ey = fminf(sqrtf(m22 * R2), (float)lv->height + 1);
-  int x0 = ifloor(cx - ex) + 1, x1 = ifloor(cx + ex), y0 = ifloor(cy - ey) + 1, y1 = ifloor(cy + ey);
+  const float R2 = EWA_R * EWA_R, A = 0.5f;                 /* A: a cell's half-width */
+  /* the rows within the ellipse grown by a cell, at most a period of the texture
+   * each way (a thin texture's levels stop halving across: the rest would revisit
+   * the same texels); in a row, the ellipse's span over the rows within a cell,
+   * grown by a cell (the span of row ty is slope·ty ± sqrt((R² - ty²/m22) det/m22)) */
+  float wp = (float)lv->width * sx + 1, hp = (float)lv->height * sy + 1;
+  float ey = fminf(sqrtf(m22 * R2) + A, hp), slope = -q12 / q11, hh = det / m22;
+  int y0 = ifloor(cy - ey) + 1, y1 = ifloor(cy + ey);
   rr_vf4 sum = rr_vf4_splat(0);
-  float wsum = 0, floor_w = expf(-EWA_ALPHA * R2);
+  float wsum = 0;
   for (int y = y0; y <= y1; y++) {
-    float ty = (float)y - cy;
-    const uint16_t *row = lv->texels + (size_t)4 * wrap_index(y, lv->height, t->wrap[1]) * lv->width;
+    float ty = (float)y - cy, tn = fabsf(ty) > A ? fabsf(ty) - A : 0.0f; /* the row within a cell nearest the centre */
+    float h = sqrtf(fmaxf(R2 - tn * tn / m22, 0.0f) * hh), c0 = slope * (ty - A), c1 = slope * (ty + A);
+    float xl = fmaxf(fminf(c0, c1) - h - A, -wp), xr = fminf(fmaxf(c0, c1) + h + A, wp);
+    int x0 = ifloor(cx + xl) + 1, x1 = ifloor(cx + xr);
+    const uint16_t *row = lv->texels + (fine ? 0 : (size_t)4 * wrap_index(y, lv->height, t->wrap[1]) * lv->width);
+    float gy1 = q12 * ty, gy2 = q22 * ty, py = (float)y * step;
+    int iy = ifloor(py);
     for (int x = x0; x <= x1; x++) {
-      float tx = (float)x - cx, q = q11 * tx * tx + 2 * q12 * tx * ty + q22 * ty * ty;
-      if (q >= R2) continue;
-      float g = expf(-EWA_ALPHA * q) - floor_w;
-      sum += rr_vf4_splat(g) * texel(row + 4 * wrap_index(x, lv->width, t->wrap[0]));
+      float tx = (float)x - cx, g1 = q11 * tx + gy1, g2 = q12 * tx + gy2;
+      float q = tx * g1 + ty * g2, dq = A * (fabsf(g1) + fabsf(g2)); /* q = r², and its spread over the cell */
+      if (!(q - dq < R2)) continue;                                    /* (NaN too) */
+      /* w's mean over [q - dq, q + dq], 0 beyond R², times 2 (the scale cancels);
+       * dq = 0 only at the ellipse's centre */
+      float g = dq > 0 ? (sqrtf(R2 - (q - dq)) - sqrtf(R2 - fminf(q + dq, R2))) / dq : 2.0f / sqrtf(R2 - q);
+      if (fine) {
+        float px = (float)x * step;
+        int ix = ifloor(px);
+        bilerp_at(t, lv, ix, iy, px - (float)ix, py - (float)iy, g, true, &sum);
+      } else {
+        sum += rr_vf4_splat(g) * texel(row + 4 * wrap_index(x, lv->width, t->wrap[0]));
+      }
       wsum += g;
     }
   }
   if (wsum > 0)
     *acc += rr_vf4_splat(w / wsum) * sum;
-  else /* (a box always holds its centre's texel; a guard all the same) */
-    bilerp(t, lv, s * sx, r * sy, w, acc);
+  else /* (the centre's cell is always read; a guard all the same) */
+    bilerp(t, lv, fine ? s : s * sx, fine ? r : r * sy, w, acc);
 }
 
-/* EWA at the two levels around the one where the ellipse's short axis spans about
- * two texels, the ellipse's eccentricity limited to f->aniso (its short axis grown).
- * Where it spans fewer than two texels of level 0, a Gaussian sampled at texel
- * centres would be narrower than their spacing: the footprint is then read through
- * the bilinear reconstruction, by aniso's probes. */
-static void filter_ewa(const rr_texture *t, float s, float r, footprint fp, const tex_filter *f, rr_vf4 *acc) {
-  float la = fp.ax * fp.ax + fp.ay * fp.ay, lb = fp.bx * fp.bx + fp.by * fp.by;
-  if (la < lb) {
-    footprint sw = {fp.bx, fp.by, fp.ax, fp.ay};
-    fp = sw;
-    float tmp = la;
-    la = lb, lb = tmp;
+/* EWA at the two grids around the one on which the ellipse's short axis spans
+ * EWA_STEPS steps, the footprint scaled by 2^lod_bias. */
+static void filter_ewa(const rr_texture *t, float s, float r, const footprint *fp, const tex_filter *f, rr_vf4 *acc) {
+  float k = exp2f(2.0f * f->lod_bias); /* the footprint's area scale */
+  float m[3] = {k * (fp->ax * fp->ax + fp->bx * fp->bx), k * (fp->ax * fp->ay + fp->bx * fp->by),
+                k * (fp->ay * fp->ay + fp->by * fp->by)};
+  /* M's eigenvalues: the ellipse's semi-axes squared at r = 1 */
+  float half = 0.5f * (m[0] + m[2]), root = sqrtf(0.25f * (m[0] - m[2]) * (m[0] - m[2]) + m[1] * m[1]);
+  float l1 = half + root, l2 = fmaxf(half - root, 0.0f);
+  const float E2 = EWA_MAX_ECCENTRICITY * EWA_MAX_ECCENTRICITY;
+  if (l2 * E2 < l1) { /* the short axis grown: M + d P, P = (M - l1 I) / (l2 - l1) the projector onto it */
+    float c = (l1 / E2 - l2) / (l2 - l1);
+    m[0] += c * (m[0] - l1), m[1] += c * m[1], m[2] += c * (m[2] - l1);
+    l2 = l1 / E2;
   }
-  float lmaj = sqrtf(la), lmin = sqrtf(lb), limit = (float)(f->aniso > 1 ? f->aniso : 1);
-  if (lmin * limit < lmaj && lmin > 0) {
-    float k = lmaj / (lmin * limit);
-    fp.bx *= k, fp.by *= k, lmin *= k;
-  }
-  if (!(lmin > 0)) { /* a degenerate footprint */
-    lod_pair p = lod_levels(t, f->lod_bias);
-    trilerp(t, &p, s, r, 1, acc);
+  float lmin = 2.0f * EWA_R * sqrtf(l2); /* the short axis, in level-0 texels */
+  if (!(lmin >= EWA_MIN_AXIS)) {         /* nearly a point (none, NaN) */
+    tex_filter probes = {RR_TEXTURE_ANISO, f->aniso, f->lod_bias};
+    filter_aniso(t, s, r, fp, &probes, acc);
     return;
   }
-  float lod = log2f(lmin) - 1.0f + f->lod_bias;
+  float lod = lod_log2(lmin / EWA_STEPS); /* at least log2(EWA_MIN_AXIS / EWA_STEPS) */
   int top = t->nlevels - 1;
-  if (!(lod > 0)) { /* magnified: the texels' bilinear reconstruction over the footprint, as aniso reads it */
-    tex_filter probes = {RR_TEXTURE_ANISO, f->aniso, f->lod_bias};
-    filter_aniso(t, s, r, &fp, &probes, acc);
-  } else if (lod >= (float)top) { /* the ellipse covers the texture: its mean (and a bounded loop) */
+  if (lod >= (float)top) { /* the ellipse covers the texture: its mean (and a bounded loop) */
     bilerp(t, &t->levels[top], s / (float)t->width, r / (float)t->height, 1, acc);
-  } else {
-    int l = (int)lod;
-    float w = lod - (float)l;
-    ewa_level(t, l, s, r, &fp, 1 - w, acc);
-    ewa_level(t, l + 1, s, r, &fp, w, acc);
+    return;
   }
+  int l = ifloor(lod);
+  float w = lod - (float)l;
+  ewa_grid(t, l, s, r, m, 1 - w, acc);
+  if (w > 0) ewa_grid(t, l + 1, s, r, m, w, acc);
 }
 
 /* A coordinate brought near [0, 1] (repeat) or [0, 2] (mirror) so that texel
@@ -406,7 +432,7 @@ void rr_texture_sample(const rr_texture *t, const tex_coord *tc, const tex_filte
     break;
   default: {
     footprint fp = {tc->dudx * W, -tc->dvdx * H, tc->dudy * W, -tc->dvdy * H};
-    if (f->filter == RR_TEXTURE_EWA) filter_ewa(t, s, r, fp, f, &acc);
+    if (f->filter == RR_TEXTURE_EWA) filter_ewa(t, s, r, &fp, f, &acc);
     else filter_aniso(t, s, r, &fp, f, &acc); /* trilinear: one probe */
     break;
   }
