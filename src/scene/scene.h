@@ -14,6 +14,7 @@ struct rr_bvh;
  * channel (0 .. 65535 for 0 .. 1), row 0 at the top. */
 typedef struct tex_level {
   int width, height;
+  float sx, sy;     /* width and height over level 0's */
   uint16_t *texels; /* 4 per texel */
 } tex_level;
 

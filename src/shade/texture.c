@@ -83,6 +83,7 @@ bool rr_texture_prepare(rr_texture *t) {
   for (int l = 0; ok && l < n; l++) {
     lv[l].width = l ? (lv[l - 1].width > 1 ? lv[l - 1].width / 2 : 1) : t->width;
     lv[l].height = l ? (lv[l - 1].height > 1 ? lv[l - 1].height / 2 : 1) : t->height;
+    lv[l].sx = (float)lv[l].width / (float)t->width, lv[l].sy = (float)lv[l].height / (float)t->height;
     lv[l].texels = malloc((size_t)lv[l].width * lv[l].height * 4 * sizeof(uint16_t));
     ok = lv[l].texels != NULL;
   }
@@ -134,24 +135,37 @@ static inline int wrap_index(int i, int n, rr_texture_wrap mode) {
   return i < 0 ? i + n : i;
 }
 
-/* Four 16-bit channels of a texel as floats (one vector conversion). */
+/* Four 16-bit channels of a texel as floats. On x86 each 16-bit x goes under the
+ * high half 0x4b00, the float 2^23 + x exactly, less 2^23: two instructions where
+ * SSE2 has no conversion from 16 bits. */
 typedef uint16_t texel_u16 __attribute__((vector_size(8)));
 KERNEL rr_vf4 texel(const uint16_t *p) {
+#ifdef RR_SIMD_X86
+  __m128i v = _mm_loadl_epi64((const __m128i *)(const void *)p);
+  return (rr_vf4)_mm_unpacklo_epi16(v, _mm_set1_epi16(0x4b00)) - rr_vf4_splat(8388608.0f);
+#else
   texel_u16 v;
   memcpy(&v, p, sizeof v);
   return __builtin_convertvector(__builtin_convertvector(v, rr_vi4), rr_vf4);
+#endif
 }
 
 /* Two texels side by side (one load). */
 typedef uint16_t texel2_u16 __attribute__((vector_size(16)));
 typedef int32_t texel2_i32 __attribute__((vector_size(32)));
 KERNEL void texel2(const uint16_t *p, rr_vf4 *a, rr_vf4 *b) {
+#ifdef RR_SIMD_X86
+  __m128i v = _mm_loadu_si128((const __m128i *)(const void *)p), hi = _mm_set1_epi16(0x4b00);
+  *a = (rr_vf4)_mm_unpacklo_epi16(v, hi) - rr_vf4_splat(8388608.0f);
+  *b = (rr_vf4)_mm_unpackhi_epi16(v, hi) - rr_vf4_splat(8388608.0f);
+#else
   texel2_u16 v;
   memcpy(&v, p, sizeof v);
   texel2_i32 i = __builtin_convertvector(v, texel2_i32);
   rr_vi4 lo, hi;
   memcpy(&lo, &i, sizeof lo), memcpy(&hi, (char *)&i + sizeof lo, sizeof hi);
   *a = __builtin_convertvector(lo, rr_vf4), *b = __builtin_convertvector(hi, rr_vf4);
+#endif
 }
 
 /* Adds weight w times the bilinear lookup of level lv to acc: the texels (x0, y0) to
@@ -176,18 +190,19 @@ KERNEL void bilerp_at(const rr_texture *t, const tex_level *lv, int x0, int y0, 
 }
 
 /* Two bilinear lookups whose texel addressing is shared: weight wa times level la's
- * at (p[0], p[1]) and wb times level lb's at (p[2], p[3]), texel coordinates with
- * the texel centres at integers, floored in one vector, within ±2^30 so that
- * footprints far outside [0, 1] wrap without overflow (NaN: -2^30). Edges false: both
- * lookups' texels are known to be inside their levels. */
+ * at (p[0], p[1]) added to acc_a and wb times level lb's at (p[2], p[3]) to acc_b
+ * (which may be one), texel coordinates with the texel centres at integers, floored
+ * in one vector, within ±2^30 so that footprints far outside [0, 1] wrap without
+ * overflow (NaN: -2^30). Edges false: both lookups' texels are known to be inside
+ * their levels. */
 KERNEL void bilerp2(const rr_texture *t, const tex_level *la, const tex_level *lb, rr_vf4 p, float wa, float wb,
-                    bool edges, rr_vf4 *acc) {
+                    bool edges, rr_vf4 *acc_a, rr_vf4 *acc_b) {
   if (edges) p = rr_vf4_min(rr_vf4_max(p, rr_vf4_splat(-1073741824.0f)), rr_vf4_splat(1073741824.0f));
   rr_vi4 i = rr_vi4_trunc(p);
   i += p < __builtin_convertvector(i, rr_vf4); /* truncation, then down for negatives (-1 where true) */
   rr_vf4 a = p - __builtin_convertvector(i, rr_vf4);
-  bilerp_at(t, la, i[0], i[1], a[0], a[1], wa, edges, acc);
-  bilerp_at(t, lb, i[2], i[3], a[2], a[3], wb, edges, acc);
+  bilerp_at(t, la, i[0], i[1], a[0], a[1], wa, edges, acc_a);
+  bilerp_at(t, lb, i[2], i[3], a[2], a[3], wb, edges, acc_b);
 }
 
 /* Adds weight w times the bilinear lookup of level lv at texel coordinates (x, y). */
@@ -211,28 +226,26 @@ static inline float lod_log2(float x) {
   return e + m + m * (1.0f - m) * (0.44174030f + m * (-0.26602988f + m * (0.14631434f - 0.04400469f * m)));
 }
 
-/* Two levels, their weights (the trilinear blend at a level of detail) and their
- * sizes relative to level 0's. */
+/* Two levels and their weights, the trilinear blend at a level of detail. */
 typedef struct lod_pair {
   const tex_level *lv[2];
-  float w[2], sx[2], sy[2];
+  float w[2];
   int n; /* levels used: 1 or 2 */
 } lod_pair;
 
 static inline lod_pair lod_levels(const rr_texture *t, float lod) {
   int top = t->nlevels - 1, l = !(lod > 0) ? 0 : lod >= (float)top ? top : (int)lod; /* NaN: level 0 */
   float f = l == top || !(lod > 0) ? 0.0f : lod - (float)l;
-  lod_pair p = {{&t->levels[l], &t->levels[l < top ? l + 1 : l]}, {1 - f, f}, {0, 0}, {0, 0}, f > 0 ? 2 : 1};
-  for (int k = 0; k < 2; k++)
-    p.sx[k] = (float)p.lv[k]->width / (float)t->width, p.sy[k] = (float)p.lv[k]->height / (float)t->height;
-  return p;
+  return (lod_pair){{&t->levels[l], &t->levels[l < top ? l + 1 : l]}, {1 - f, f}, f > 0 ? 2 : 1};
 }
 
 /* Adds weight w times the trilinear lookup at (s, r) (level-0 texel units) to acc. */
 KERNEL void trilerp(const rr_texture *t, const lod_pair *p, float s, float r, float w, rr_vf4 *acc) {
-  if (p->n == 1) bilerp(t, p->lv[0], s * p->sx[0], r * p->sy[0], w, acc);
-  else bilerp2(t, p->lv[0], p->lv[1], (rr_vf4){s * p->sx[0] - 0.5f, r * p->sy[0] - 0.5f, s * p->sx[1] - 0.5f, r * p->sy[1] - 0.5f}, w * p->w[0],
-               w * p->w[1], true, acc);
+  const tex_level *a = p->lv[0], *b = p->lv[1];
+  if (p->n == 1) bilerp(t, a, s * a->sx, r * a->sy, w, acc);
+  else
+    bilerp2(t, a, b, (rr_vf4){s * a->sx - 0.5f, r * a->sy - 0.5f, s * b->sx - 0.5f, r * b->sy - 0.5f}, w * p->w[0],
+            w * p->w[1], true, acc, acc);
 }
 
 /* The footprint in level-0 texels: the derivative vectors per pixel step in x (a)
@@ -240,6 +253,26 @@ KERNEL void trilerp(const rr_texture *t, const lod_pair *p, float s, float r, fl
 typedef struct footprint {
   float ax, ay, bx, by;
 } footprint;
+
+/* The probes j = 0 .. n - 1 of a line at base + j d, texel coordinates with the
+ * centres at integers: with two levels, level 0's in lanes 0, 1 (summed into s0)
+ * and level 1's in lanes 2, 3 (into s1), one probe of each at a time; with one,
+ * lanes 2, 3 repeat 0, 1 and the probes go two at a time. Edges false: the line is
+ * known to be inside its levels. */
+KERNEL void probe_line(const rr_texture *t, const lod_pair *p, rr_vf4 base, rr_vf4 d, int n, bool edges, rr_vf4 *s0,
+                       rr_vf4 *s1) {
+  if (p->n == 2) {
+    rr_vf4 j = rr_vf4_splat(0), one = rr_vf4_splat(1);
+    for (int k = 0; k < n; k++, j += one) bilerp2(t, p->lv[0], p->lv[1], base + j * d, 1, 1, edges, s0, s1);
+    return;
+  }
+  rr_vf4 j = {0, 0, 1, 1}, two = rr_vf4_splat(2);
+  for (int k = 0; k + 1 < n; k += 2, j += two) bilerp2(t, p->lv[0], p->lv[0], base + j * d, 1, 1, edges, s0, s0);
+  if (n & 1) {
+    rr_vf4 last = base + rr_vf4_splat((float)(n - 1)) * d; /* (as j would reach it) */
+    bilerp(t, p->lv[0], last[0] + 0.5f, last[1] + 0.5f, 1, s0);
+  }
+}
 
 /* Up to f->aniso trilinear probes spread along the long side of the parallelogram
  * spanned by a and b, each as wide as the parallelogram across. */
@@ -257,7 +290,10 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
   /* the parallelogram's extent along the longer vector and its width across it */
   float along = lmaj + fabsf(mx * nx + my * ny) / lmaj, across = fabsf(mx * ny - my * nx) / lmaj;
   int n = f->filter == RR_TEXTURE_ANISO ? f->aniso : 1;
-  if (along < (float)n * across) n = (int)ceilf(along / across); /* across > 0 here */
+  if (along < (float)n * across) { /* n = ceil(along / across), across > 0 here */
+    float q = along / across;
+    n = (int)q, n += (float)n < q;
+  }
   if (n < 1) n = 1;
   float size = along / (float)n > across ? along / (float)n : across;
   float lod = lod_log2(size) + f->lod_bias;
@@ -267,32 +303,23 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
     trilerp(t, &p, s, r, 1, acc);
     return;
   }
-  /* probe j at (j + 1/2 - n/2)·along/n along the unit longer vector, in each level;
-   * two probes of a level at a time */
+  /* probe j at (j + 1/2 - n/2)·along/n along the unit longer vector, in each level:
+   * the line's first probe (base) and step (d) in both levels' texels, with the
+   * texel centres at integers, so that the first and last bound all in float too */
+  const tex_level *a = p.lv[0], *b = p.n == 2 ? p.lv[1] : a;
   float step = along / ((float)n * lmaj), o = 0.5f - 0.5f * (float)n;
-  float last[2][2];
-  for (int k = 0; k < p.n; k++) {
-    /* probe j at (x, y) + j (dx, dy), texel centres at integers, so that the first
-     * and last bound all in float too; the level's probes summed, then weighed */
-    float dx = mx * step * p.sx[k], dy = my * step * p.sy[k];
-    float x = s * p.sx[k] + o * dx - 0.5f, y = r * p.sy[k] + o * dy - 0.5f;
-    float xe = x + (float)(n - 1) * dx, ye = y + (float)(n - 1) * dy;
-    rr_vf4 base = {x, y, x, y}, d = {dx, dy, dx, dy}, jj = {0, 0, 1, 1}, two = rr_vf4_splat(2), sum = rr_vf4_splat(0);
-    float wl = (float)p.lv[k]->width - 1, hl = (float)p.lv[k]->height - 1;
-    if (x >= 0 && x < wl && xe >= 0 && xe < wl && y >= 0 && y < hl && ye >= 0 && ye < hl)
-      for (int j = 0; j + 1 < n; j += 2, jj += two) bilerp2(t, p.lv[k], p.lv[k], base + jj * d, 1, 1, false, &sum);
-    else /* (NaN too) */
-      for (int j = 0; j + 1 < n; j += 2, jj += two) bilerp2(t, p.lv[k], p.lv[k], base + jj * d, 1, 1, true, &sum);
-    *acc += rr_vf4_splat(p.w[k] / (float)n) * sum;
-    last[k][0] = xe, last[k][1] = ye; /* probe n - 1 when n is odd */
-  }
-  if (n & 1) {
-    if (p.n == 2)
-      bilerp2(t, p.lv[0], p.lv[1], (rr_vf4){last[0][0], last[0][1], last[1][0], last[1][1]}, p.w[0] / (float)n,
-              p.w[1] / (float)n, true, acc);
-    else
-      bilerp(t, p.lv[0], last[0][0] + 0.5f, last[0][1] + 0.5f, 1.0f / (float)n, acc);
-  }
+  rr_vf4 scale = {a->sx, a->sy, b->sx, b->sy};
+  rr_vf4 d = (rr_vf4){mx, my, mx, my} * rr_vf4_splat(step) * scale;
+  rr_vf4 base = (rr_vf4){s, r, s, r} * scale + rr_vf4_splat(o) * d - rr_vf4_splat(0.5f);
+  rr_vf4 end = base + rr_vf4_splat((float)(n - 1)) * d;
+  rr_vf4 lim = {(float)(a->width - 1), (float)(a->height - 1), (float)(b->width - 1), (float)(b->height - 1)};
+  rr_vf4 zero = rr_vf4_splat(0), s0 = zero, s1 = zero;
+  if (rr_vi4_bits((base >= zero) & (base < lim) & (end >= zero) & (end < lim)) == 15) /* (NaN: not inside) */
+    probe_line(t, &p, base, d, n, false, &s0, &s1);
+  else
+    probe_line(t, &p, base, d, n, true, &s0, &s1);
+  /* the levels' probes summed, then weighed */
+  *acc += rr_vf4_splat(p.w[0] / (float)n) * s0 + rr_vf4_splat(p.w[1] / (float)n) * s1;
 }
 
 /* EWA (docs/textures.md). The weight over the ellipse x^T M^-1 x < EWA_R², M = J Jᵀ
@@ -319,7 +346,7 @@ static void ewa_grid(const rr_texture *t, int l, float s, float r, const float m
   const tex_level *lv = &t->levels[l > 0 ? l : 0];
   bool fine = l < 0; /* level 0's reconstruction, every step texels */
   float step = fine ? exp2f((float)l) : 1.0f;
-  float sx = fine ? 1.0f / step : (float)lv->width / (float)t->width, sy = fine ? sx : (float)lv->height / (float)t->height;
+  float sx = fine ? 1.0f / step : lv->sx, sy = fine ? sx : lv->sy;
   float m11 = m[0] * sx * sx, m12 = m[1] * sx * sy, m22 = m[2] * sy * sy; /* in grid steps */
   float det = m11 * m22 - m12 * m12;
   /* the centre in grid steps, grid points (and texel centres) at integers */
