@@ -2,6 +2,7 @@
  * triangle's plane, so its derivative along the image is its gradient in the plane
  * times the hit point's derivative, which the ray differentials give. */
 #include "shade/texcoord.h"
+#include "core/simd.h"
 
 /* Corner k's UVs. */
 static void corner_uv(const rr_scene *s, int k, uint32_t i, float uv[2]) {
@@ -45,18 +46,16 @@ tex_coord rr_texcoord(const rr_scene *s, uint32_t i, float l1, float l2, float t
    * from w instead of cancelling products of large edge values, V_i,x ΣV − V_i ΣV_x. */
   float nd = v3_dot(n, d);
   if (!(nd != 0)) return tc; /* a ray in the plane sees no hit */
-  float dudv[2][2]; /* [x or y][u or v] */
+  vec3 dp[2];
   for (int k = 0; k < 2; k++) {
     vec3 w = v3_add(do_dxy[k], v3_scale(dd_dxy[k], t));
-    vec3 dp = v3_sub(w, v3_scale(d, v3_dot(n, w) / nd));
-    dudv[k][0] = v3_dot(gu, dp), dudv[k][1] = v3_dot(gv, dp);
-    /* at a grazing angle the footprint may overflow: a million texture spans per
-     * pixel cover any texture, and keep the filter's squares finite */
-    for (int c = 0; c < 2; c++) {
-      float g = dudv[k][c];
-      dudv[k][c] = g > 1e6f ? 1e6f : g < -1e6f ? -1e6f : g == g ? g : 0.0f;
-    }
+    dp[k] = v3_sub(w, v3_scale(d, v3_dot(n, w) / nd));
   }
-  tc.dudx = dudv[0][0], tc.dvdx = dudv[0][1], tc.dudy = dudv[1][0], tc.dvdy = dudv[1][1];
+  rr_vf4 g = {v3_dot(gu, dp[0]), v3_dot(gv, dp[0]), v3_dot(gu, dp[1]), v3_dot(gv, dp[1])};
+  /* at a grazing angle the footprint may overflow: a million texture spans per
+   * pixel cover any texture, and keep the filter's squares finite (NaN: 0) */
+  g = (rr_vf4)((rr_vi4)g & (g == g));
+  g = rr_vf4_min(rr_vf4_max(g, rr_vf4_splat(-1e6f)), rr_vf4_splat(1e6f));
+  tc.dudx = g[0], tc.dvdx = g[1], tc.dudy = g[2], tc.dvdy = g[3];
   return tc;
 }
