@@ -9,9 +9,12 @@
  * method auto, the median of --runs rounds in which the filters take turns, and its
  * ratio to bilinear's.
  *
- * --cost-only skips the quality part.
+ * --cost-only skips the quality part; --filter NAME times that filter alone (for
+ * callgrind: valgrind --tool=callgrind --toggle-collect=rr_shade_frame); --ref-sub N
+ * takes N×N lookups a pixel for the reference (16 by default; the reference's own
+ * noise is a floor under every filter's RMSE, docs/textures.md).
  *
- *   bench_texture [--size WxH] [--threads N] [--runs N] [--cost-only] */
+ *   bench_texture [--size WxH] [--threads N] [--runs N] [--cost-only] [--filter NAME] [--ref-sub N] */
 #include "benchutil.h"
 #include "camera/camera.h"
 #include "shade/texcoord.h"
@@ -26,7 +29,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { SUB = 16, MAX_RUNS = 64 };
+enum { MAX_RUNS = 64 };
+static int SUB = 16; /* SUB × SUB lookups a pixel for the reference */
 
 static const struct {
   const char *label;
@@ -111,7 +115,7 @@ static int cmp_float(const void *a, const void *b) {
 }
 
 int main(int argc, char **argv) {
-  int w = 1024, h = 1024, threads = 2, runs = 5, cost_only = 0;
+  int w = 1024, h = 1024, threads = 2, runs = 5, cost_only = 0, only = -1;
   for (int i = 1; i < argc; i++) {
     if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
       if (sscanf(argv[++i], "%dx%d", &w, &h) != 2 || w < 8 || h < 8 || w > RR_MAX_SIZE || h > RR_MAX_SIZE) {
@@ -132,8 +136,24 @@ int main(int argc, char **argv) {
       }
     } else if (strcmp(argv[i], "--cost-only") == 0) {
       cost_only = 1;
+    } else if (strcmp(argv[i], "--filter") == 0 && i + 1 < argc) {
+      for (int f = 0; f < NF; f++)
+        if (strcmp(argv[i + 1], filters[f].label) == 0) only = f;
+      if (only < 0) {
+        fprintf(stderr, "bench_texture: unknown --filter '%s' (nearest, bilinear, trilinear, aniso:4, aniso:16, ewa)\n",
+                argv[i + 1]);
+        return 2;
+      }
+      i++;
+    } else if (strcmp(argv[i], "--ref-sub") == 0 && i + 1 < argc) {
+      SUB = atoi(argv[++i]);
+      if (SUB < 1 || SUB > 256) {
+        fprintf(stderr, "bench_texture: bad --ref-sub '%s' (1..256)\n", argv[i]);
+        return 2;
+      }
     } else {
-      fprintf(stderr, "usage: bench_texture [--size WxH] [--threads N] [--runs N] [--cost-only]\n");
+      fprintf(stderr, "usage: bench_texture [--size WxH] [--threads N] [--runs N] [--cost-only] [--filter NAME] "
+                      "[--ref-sub N]\n");
       return 2;
     }
   }
@@ -210,6 +230,7 @@ cost: /* the cost of shading, per filter */
   static double ms[NF][MAX_RUNS];
   for (int r = 0; r < runs; r++)
     for (int f = 0; f < NF; f++) {
+      if (only >= 0 && f != only) continue;
       rr_shade_options so;
       rr_shade_options_init(&so);
       so.texture_filter = filters[f].f.filter, so.aniso = filters[f].f.aniso;
@@ -224,7 +245,9 @@ cost: /* the cost of shading, per filter */
          w, h, threads, runs);
   double med[NF];
   for (int f = 0; f < NF; f++) med[f] = bench_median(ms[f], runs);
-  for (int f = 0; f < NF; f++) printf("| %s | %.1f | %.2fx |\n", filters[f].label, med[f], med[f] / med[1]);
+  for (int f = 0; f < NF; f++)
+    if (only < 0) printf("| %s | %.1f | %.2fx |\n", filters[f].label, med[f], med[f] / med[1]);
+    else if (f == only) printf("| %s | %.1f | |\n", filters[f].label, med[f]);
   rr_frame_release(frame);
   rr_cam_release(&c);
   rr_scene_release(s);
