@@ -698,7 +698,7 @@ typedef enum rr_texture_filter {
   RR_TEXTURE_BILINEAR,    /* 2×2 texels, level 0 (aliases when minified) */
   RR_TEXTURE_TRILINEAR,   /* bilinear in the two MIP levels around the footprint's size */
   RR_TEXTURE_ANISO,       /* up to `aniso` trilinear probes along the footprint's major axis */
-  RR_TEXTURE_EWA,         /* an elliptical Gaussian over the footprint */
+  RR_TEXTURE_EWA,         /* an elliptical weighted average over the footprint (box-like) */
   RR_TEXTURE_FILTER_COUNT
 } rr_texture_filter;
 

@@ -10,9 +10,9 @@
  * (u, v) per pixel step, as the filter says: nearest and bilinear at level 0;
  * trilinear at the level where a texel is as wide as the footprint; aniso as up to
  * N trilinear probes along the footprint's long side, each the size of its short
- * side (as EXT_texture_filter_anisotropic); ewa as a Gaussian over the footprint's
- * ellipse (Heckbert's EWA, as pbrt-v4's MIPMap), its width matched to the pixel's
- * box. */
+ * side (as EXT_texture_filter_anisotropic); ewa as an elliptical weighted average
+ * over the footprint's ellipse (Heckbert's EWA), its radial weight the one whose
+ * profile along every direction is the pixel's box. */
 #include "shade/texture.h"
 #include "core/color.h"
 #include "core/simd.h"
