@@ -325,9 +325,9 @@ static void filter_aniso(const rr_texture *t, float s, float r, const footprint 
 /* EWA (docs/textures.md). The weight over the ellipse x^T M^-1 x < EWA_R², M = J Jᵀ
  * (J the footprint: r = |J^-1 x| is the distance in pixels), is the radially
  * symmetric w(r) ∝ 1/sqrt(EWA_R² - r²), EWA_R half a pixel: the surface of a sphere
- * seen from afar, which every line crosses as a box (Archimedes' hat-box theorem),
- * so that its profile along any direction is the pixel's box, as a box-filtered
- * image has it (a Gaussian's is a Gaussian). The ellipse is read on a grid fine
+ * seen from afar, whose profile along every line is a box (Archimedes' hat-box
+ * theorem), a pixel wide, as the pixel's square has along its axes (a Gaussian's
+ * is a Gaussian). The ellipse is read on a grid fine
  * enough that its short axis spans EWA_STEPS steps or more: a MIP level's texels,
  * or, finer than level 0, level 0's bilinear reconstruction sampled every 2^l
  * texels (l < 0); each grid point weighs w's mean over its cell (the rim's infinite
