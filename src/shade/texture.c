@@ -255,10 +255,10 @@ typedef struct footprint {
 } footprint;
 
 /* The probes j = 0 .. n - 1 of a line at base + j d, texel coordinates with the
- * centres at integers: with two levels, level 0's in lanes 0, 1 (summed into s0)
- * and level 1's in lanes 2, 3 (into s1), one probe of each at a time; with one,
- * lanes 2, 3 repeat 0, 1 and the probes go two at a time. Edges false: the line is
- * known to be inside its levels. */
+ * centres at integers: with two levels, the finer one's in lanes 0, 1 (summed into
+ * s0) and the coarser one's in lanes 2, 3 (into s1), one probe of each at a time;
+ * with one level, lanes 2, 3 repeat 0, 1 and the probes go two at a time. Edges
+ * false: the line is known to be inside its levels. */
 KERNEL void probe_line(const rr_texture *t, const lod_pair *p, rr_vf4 base, rr_vf4 d, int n, bool edges, rr_vf4 *s0,
                        rr_vf4 *s1) {
   if (p->n == 2) {
