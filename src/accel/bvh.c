@@ -512,14 +512,15 @@ static double node_area(const bvh_node *n) {
   return x * y + y * z + z * x;
 }
 
-/* Makes wide node w from binary node k: k's children, then the inner slot with
- * the largest area opened into its two children until four slots are used. */
-static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
-  uint32_t slot[4], n = 0;
+/* The slots of a wide node made from binary node k: k's children, then the inner
+ * slot with the largest area opened into its two children until `width` slots are
+ * used (or only leaves are left). Returns how many. */
+static uint32_t open_slots(const rr_bvh *b, uint32_t k, uint32_t width, uint32_t *slot) {
+  uint32_t n = 0;
   const bvh_node *nk = &b->nodes[k];
   if (nk->count) slot[n++] = k; /* a leaf root */
   else slot[n++] = nk->first, slot[n++] = nk->first + 1;
-  while (n < 4) {
+  while (n < width) {
     int open = -1;
     double best = -1;
     for (uint32_t i = 0; i < n; i++) {
@@ -531,6 +532,12 @@ static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
     for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1];
     slot[open] = first, slot[open + 1] = first + 1, n++;
   }
+  return n;
+}
+
+/* Makes wide node w from binary node k (open_slots with four). */
+static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
+  uint32_t slot[4], n = open_slots(b, k, 4, slot);
   bvh_wide *wn = &b->wide[w];
   for (int i = 0; i < 4; i++) {
     b->wide_node[4 * w + i] = i < (int)n ? slot[i] : UINT32_MAX;
@@ -588,9 +595,41 @@ static bool collapse_wide(rr_bvh *b) {
   return true;
 }
 
+/* ---- the 8-wide copy for the ray queries ------------------------------------------
+ * Made from the binary tree as the 4-wide one is; the nodes are written depth first
+ * (a node's children after it), so a ray's path runs forwards through memory. */
+static void collapse_node8(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
+  uint32_t slot[8], n = open_slots(b, k, 8, slot);
+  bvh_wide8 *wn = &b->wide8[w];
+  for (uint32_t i = 0; i < 8; i++) {
+    const bvh_node *c = i < n ? &b->nodes[slot[i]] : NULL;
+    for (int a = 0; a < 3; a++) wn->lo[a][i] = c ? c->lo[a] : INFINITY, wn->hi[a][i] = c ? c->hi[a] : -INFINITY;
+    wn->ref[i] = c ? c->first : UINT32_MAX, wn->count[i] = c ? c->count : 0;
+  }
+  for (uint32_t i = 0; i < n; i++)
+    if (!wn->count[i]) {
+      wn->ref[i] = (*next)++;
+      collapse_node8(b, wn->ref[i], slot[i], next);
+    }
+}
+
+static bool collapse_wide8(rr_bvh *b) {
+  uint32_t cap = (b->nnodes - 1) / 2 + 1, next = 1; /* at most one per inner binary node */
+  bvh_wide8 *room = alloc_lines((size_t)cap * sizeof(bvh_wide8));
+  if (!room) return false;
+  b->wide8 = room;
+  collapse_node8(b, 0, 0, &next);
+  b->nwide8 = next;
+  /* a fraction of the room is used: keep what is */
+  b->wide8 = alloc_lines((size_t)next * sizeof(bvh_wide8));
+  if (b->wide8) memcpy(b->wide8, room, (size_t)next * sizeof(bvh_wide8)), free(room);
+  else b->wide8 = room;
+  return true;
+}
+
 void rr_bvh_release(rr_bvh *b) {
   if (!b) return;
-  free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node), free(b->leaf_v);
+  free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node), free(b->wide8), free(b->leaf_v);
   free(b);
 }
 
@@ -769,11 +808,12 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   for (uint32_t i = 0; i < small.n; i++)
     if (small.v[i].buf)
       for (uint32_t k = small.v[i].start; k < small.v[i].start + small.v[i].count; k++) b->prims[k] = bd.buf[1][k].id;
-  if (!collapse_wide(b)) goto oom;
+  if (!collapse_wide(b) || !collapse_wide8(b)) goto oom;
   if (!copy_leaf_corners(b, s)) goto oom;
   b->sah_cost = sah_cost(b);
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
-             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) + ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
+             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) +
+             (uint64_t)b->nwide8 * sizeof(bvh_wide8) + ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
   b->build_ms = rr_now_ms() - t0;
   rr_progress(&progress, 1);
   *out = b;
