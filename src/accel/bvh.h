@@ -24,13 +24,15 @@ typedef struct rr_bvh {
   struct bvh_wide *wide; /* the same tree collapsed to 4 children per node, for single rays */
   uint32_t *wide_node;   /* per wide node, per slot: the node of `nodes` it is (UINT32_MAX: empty) */
   uint32_t nwide;
-  struct bvh_wide8 *wide8; /* the same tree collapsed to 8 children per node, for the ray queries */
+  struct bvh_wide8 *wide8; /* the tree collapsed to 8 children per node for the ray queries,
+                             subtrees of at most four triangles joined into one leaf */
   uint32_t nwide8;
   /* The triangles' corners in leaf order, for the ray queries' leaf tests: a leaf
    * holding prims [first, first + count) has corner k's axis x of its j-th triangle
    * at leaf_v[9·first + (3k + x)·count + j], then BVH_LEAF_PAD zeros at the end, so
    * that four lanes may be loaded from any triangle. */
   float *leaf_v;
+  float *leaf_v8; /* the same for the leaves of wide8, which may join a few binary leaves */
 } rr_bvh;
 
 /* A 4-wide node: up to four of the binary tree's nodes side by side, bounds as

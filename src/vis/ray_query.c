@@ -2,7 +2,7 @@
  * the committed scene's BVH, collapsed to eight children a node for them
  * (rr_bvh.wide8, traversed by vis/ray_query_tmp.h; the binary tree's leaves and
  * boxes, so the same triangles are reached as through any other form). A leaf's triangles, whose corners the tree keeps in leaf
- * order (rr_bvh.leaf_v), go four at a time through the edge signs of their setup
+ * order (rr_bvh.leaf_v8), go four at a time through the edge signs of their setup
  * (tri_ray_may_hit4); those that pass are tested with the project's one sample
  * test for the ray (a pseudo-camera at its origin, rr_cam_for_ray), so a ray
  * through a shared edge hits exactly one triangle: with the pre-test's edge values
@@ -58,7 +58,7 @@ typedef struct {
  * judge). The same triangles pass whatever the order, and depth_wins keeps the
  * nearest, lower id on a tie, so the hit does not depend on the order. */
 KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool any) {
-  const float *v = r->b->leaf_v + (size_t)9 * first;
+  const float *v = r->b->leaf_v8 + (size_t)9 * first;
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;
     rr_vf4 pre[4];
