@@ -35,6 +35,7 @@ typedef struct {
   int wn[3], wf[3]; /* per axis the byte offsets in a bvh_wide8 of the near and far planes */
   rr_vf4 o[3], d[3]; /* origin and direction broadcast (the leaf test) */
   float tlo;          /* max(tmin, 0): every hit has t > 0 */
+  float dmax;         /* max |dir| per axis (ray_t_outside) */
   float tmin;
   float t, l1, l2; /* best hit so far; t starts at tmax */
   uint32_t id;
@@ -69,6 +70,9 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
       uint32_t lane = (uint32_t)__builtin_ctz(may), id = r->b->prims[first + j + lane];
       float t, l1, l2, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
       const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
+      if (e[0] > 0 && e[1] > 0 && e[2] > 0 && !(r->s->inf && scene_inf(r->s, id)) &&
+          ray_t_outside(v + j + lane, count, r->org, r->dmax, e, r->tmin, r->t))
+        continue;
       bool hit = ray_tri_test(r->s, id, &r->rc, r->org, dir, e, r->tmin, r->t, &t, &l1, &l2);
       if (!hit) continue;
       if (any) return true;
@@ -91,6 +95,7 @@ static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const f
     r->o[a] = rr_vf4_splat(org[a]), r->d[a] = rr_vf4_splat(dir[a]);
   }
   r->tlo = tmin > 0 ? tmin : 0;
+  r->dmax = fmaxf(fabsf(dir[0]), fmaxf(fabsf(dir[1]), fabsf(dir[2])));
   r->tmin = tmin, r->t = tmax, r->id = RR_MISS, r->l1 = r->l2 = 0;
 }
 
