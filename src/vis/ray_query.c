@@ -71,7 +71,7 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
       float t, l1, l2, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
       const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
       if (e[0] > 0 && e[1] > 0 && e[2] > 0 && !(r->s->inf && scene_inf(r->s, id)) &&
-          ray_t_outside(v + j + lane, count, r->org, r->dmax, e, r->tmin, r->t))
+          ray_t_outside(ray_corner_extent(v + j + lane, count, r->org), r->dmax, e, r->tmin, r->t))
         continue;
       bool hit = ray_tri_test(r->s, id, &r->rc, r->org, dir, e, r->tmin, r->t, &t, &l1, &l2);
       if (!hit) continue;
@@ -95,7 +95,8 @@ static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const f
     r->o[a] = rr_vf4_splat(org[a]), r->d[a] = rr_vf4_splat(dir[a]);
   }
   r->tlo = tmin > 0 ? tmin : 0;
-  r->dmax = fmaxf(fabsf(dir[0]), fmaxf(fabsf(dir[1]), fabsf(dir[2])));
+  float d0 = fabsf(dir[0]), d1 = fabsf(dir[1]), d2 = fabsf(dir[2]), d01 = d0 > d1 ? d0 : d1;
+  r->dmax = d01 > d2 ? d01 : d2;
   r->tmin = tmin, r->t = tmax, r->id = RR_MISS, r->l1 = r->l2 = 0;
 }
 
