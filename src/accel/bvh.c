@@ -671,27 +671,30 @@ static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
   }
 }
 
+/* The wide8 nodes collapse_node8 makes from binary node k. */
+static uint32_t count_nodes8(const wide8_build *j, uint32_t k) {
+  uint32_t slot[8], n = open_slots8(j, k, slot), total = 1;
+  for (uint32_t i = 0; i < n; i++)
+    if (!leaf8(j, slot[i])) total += count_nodes8(j, slot[i]);
+  return total;
+}
+
 static bool collapse_wide8(rr_bvh *b, const rr_scene *s) {
-  uint32_t cap = (b->nnodes - 1) / 2 + 1; /* at most one per inner binary node */
   size_t nv = (size_t)9 * b->nprims;
   wide8_build j = {.b = b, .s = s, .next = 1};
   j.first = malloc((size_t)b->nnodes * sizeof(uint32_t));
   j.count = malloc((size_t)b->nnodes * sizeof(uint32_t));
-  bvh_wide8 *room = alloc_lines((size_t)cap * sizeof(bvh_wide8));
   b->leaf_v8 = alloc_lines((nv + BVH_LEAF_PAD) * sizeof(float));
-  bool ok = j.first && j.count && room && b->leaf_v8;
+  bool ok = j.first && j.count && b->leaf_v8;
   if (ok) {
     memset(b->leaf_v8 + nv, 0, BVH_LEAF_PAD * sizeof(float));
     subtree_range(&j, 0);
-    b->wide8 = room;
-    collapse_node8(&j, 0, 0);
-    b->nwide8 = j.next;
-    /* a fraction of the room is used: keep what is */
-    b->wide8 = alloc_lines((size_t)j.next * sizeof(bvh_wide8));
-    if (b->wide8) memcpy(b->wide8, room, (size_t)j.next * sizeof(bvh_wide8)), room = NULL;
-    else b->wide8 = room, room = NULL;
+    b->nwide8 = count_nodes8(&j, 0); /* counted first: no room to guess and trim */
+    b->wide8 = alloc_lines((size_t)b->nwide8 * sizeof(bvh_wide8));
+    ok = b->wide8 != NULL;
   }
-  free(j.first), free(j.count), free(room);
+  if (ok) collapse_node8(&j, 0, 0);
+  free(j.first), free(j.count);
   return ok;
 }
 
