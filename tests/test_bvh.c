@@ -2,7 +2,8 @@
  * enclose, the layout the traversals rely on), the same tree for any thread count,
  * rr_intersect / rr_occluded against brute force with the same sample test (rays
  * from inside, rays parallel to faces, rays through shared vertices), and bad
- * input: empty scenes, degenerate triangles, huge and tiny coordinates. */
+ * input: empty scenes, degenerate triangles, huge and tiny coordinates; the 4- and
+ * 8-wide copies (slots, boxes, the 8-wide leaves and their corners). */
 #include "vis/vis.h"
 #include "io/io.h"
 #include "testutil.h"
@@ -92,6 +93,40 @@ static bool check_tree(const rr_scene *s, const char *name) {
   for (uint32_t k = 0; k < b->nnodes; k++) wrong += slots[k] > 1 || (slots[k] == 0 && b->nodes[k].count);
   CHECK(!bad && wrong == 0, "%s: the 4-wide copy is wrong (%u nodes misplaced)", name, wrong);
   free(slots);
+  /* The 8-wide copy of the ray queries: its leaves cover prims once, in order
+   * within each, each leaf's box holds its corners, which leaf_v8 holds in its
+   * layout; every node is reached once from the root, its slots' boxes inside
+   * nothing smaller than the leaves' corners. */
+  uint32_t *cover = calloc(b->nprims + 1, sizeof *cover), *reached = calloc(b->nwide8, sizeof *reached);
+  uint32_t bad8 = 0;
+  reached[0] = 1;
+  for (uint32_t w = 0; w < b->nwide8; w++)
+    for (int i = 0; i < 8; i++) {
+      const bvh_wide8 *wn = &b->wide8[w];
+      if (wn->ref[i] == UINT32_MAX) {
+        bad8 += wn->lo[0][i] <= wn->hi[0][i] || wn->count[i];
+        continue;
+      }
+      if (!wn->count[i]) {
+        bad8 += wn->ref[i] <= w || wn->ref[i] >= b->nwide8;
+        if (wn->ref[i] > w && wn->ref[i] < b->nwide8) reached[wn->ref[i]]++;
+        continue;
+      }
+      uint32_t first = wn->ref[i], count = wn->count[i];
+      bad8 += first + count > b->nprims;
+      for (uint32_t t = 0; t < count && first + t < b->nprims; t++) {
+        cover[first + t]++;
+        for (int m = 0; m < 9; m++) {
+          float c = b->leaf_v8[(size_t)9 * first + (size_t)m * count + t];
+          bad8 += c != s->p[m / 3][m % 3][b->prims[first + t]] || c < wn->lo[m % 3][i] || c > wn->hi[m % 3][i];
+        }
+      }
+    }
+  for (uint32_t t = 0; t < b->nprims; t++) bad8 += cover[t] != 1;
+  for (uint32_t w = 0; w < b->nwide8; w++) bad8 += reached[w] != 1;
+  CHECK(bad8 == 0, "%s: the 8-wide copy is wrong (%u faults)", name, bad8);
+  bad |= bad8 != 0;
+  free(cover), free(reached);
   uint32_t missing = 0;
   for (uint32_t t = 0; t < s->ntris && !bad; t++) missing += !seen[t];
   CHECK(!bad && missing == 0, "%s: %u triangles in no leaf", name, missing);

@@ -5,9 +5,11 @@
  * of plane:8, rays from the bunny's surface, rays through leaves of up to
  * 13 triangles and through a ground with corners at infinity, in both layouts, on 1, 2 and 8
  * threads; and bad input: NaN/inf components (a miss and an error naming the
- * ray), count 0, bad strides, thread counts and NULL arrays. */
+ * ray), count 0, bad strides, thread counts and NULL arrays; the queries' bound on t
+ * before the full test (ray_t_outside) against the full test. */
 #include "vis/vis.h"
 #include "io/io.h"
+#include "vis/ray_test.h"
 #include "testutil.h"
 
 #include <string.h>
@@ -36,6 +38,46 @@ static void check_tri_paths(const rr_scene *s, const rr_ray *rays, size_t n, con
     }
   }
   CHECK(bad == 0 && hits > 0, "%s: %zu of the triangle tests differ (%zu hits)", what, bad, hits);
+}
+
+/* ray_t_outside, the queries' bound on t before the full test, against the full
+ * test (rr_tri_ray_hit) on every finite triangle of s for every ray whose edge
+ * pre-test passes with all values positive: where it says t lies outside the
+ * ray's range, the full test finds no hit in it, and it never says so of the
+ * range [t, t] around a hit's own t. Returns how often it cut a test. */
+static size_t check_t_bound(const rr_scene *s, const rr_ray *rays, size_t n, const char *what) {
+  size_t bad = 0, cut = 0, hits = 0;
+  for (size_t r = 0; r < n; r++) {
+    camera rc;
+    rr_cam_for_ray(rays[r].org, rays[r].dir, &rc);
+    rr_vf4 eye[3], dir[3];
+    float dmax = 0;
+    for (int a = 0; a < 3; a++) {
+      eye[a] = rr_vf4_splat(rays[r].org[a]), dir[a] = rr_vf4_splat(rays[r].dir[a]);
+      dmax = fmaxf(dmax, fabsf(rays[r].dir[a]));
+    }
+    for (uint32_t i = 0; i < s->ntris; i++) {
+      if (scene_inf(s, i)) continue;
+      float v[9 * 4]; /* the triangle in lane 0 of four (stride 4), as the leaves hold it */
+      for (int m = 0; m < 9; m++)
+        for (int j = 0; j < 4; j++) v[4 * m + j] = s->p[m / 3][m % 3][i];
+      rr_vf4 pre[4];
+      if (!(tri_ray_may_hit4(v, 4, eye, dir, pre) & 1)) continue;
+      const float e[4] = {pre[0][0], pre[1][0], pre[2][0], pre[3][0]};
+      if (!(e[0] > 0 && e[1] > 0 && e[2] > 0)) continue;
+      float t, l1, l2;
+      bool hit = rr_tri_ray_hit(s, i, &rc, false, 0, INFINITY, &t, &l1, &l2);
+      bool in = hit && t >= rays[r].tmin && t <= rays[r].tmax;
+      float S = ray_corner_extent(v, 4, rays[r].org);
+      bool out = ray_t_outside(S, dmax, e, rays[r].tmin, rays[r].tmax);
+      hits += hit, cut += out;
+      if (((out && in) || (hit && ray_t_outside(S, dmax, e, t, t))) && bad++ < 4)
+        CHECK(0, "%s: ray %zu, triangle %u: t %a in [%a, %a]: the bound cuts it", what, r, i, t, rays[r].tmin,
+              rays[r].tmax);
+    }
+  }
+  CHECK(bad == 0 && hits > 0, "%s: the t bound cut %zu hits (%zu hits)", what, bad, hits);
+  return cut;
 }
 
 /* The rays as separate arrays (structure of arrays). */
@@ -237,6 +279,9 @@ static void bunny_rays(rr_device *dev) {
   }
   check_rays(dev, s, rays, n, test_quick() ? 30 : 100, "bunny surface");
   check_tri_paths(s, rays, test_quick() ? 4 : 16, "bunny surface"); /* every triangle: a few rays */
+  /* rays from a surface point: the bound drops the start triangle (t about 0 < tmin) */
+  size_t cut = check_t_bound(s, rays, test_quick() ? 12 : 48, "bunny surface");
+  CHECK(cut > 0, "bunny surface: the t bound never cut a test");
   free(rays);
   rr_scene_release(s);
 }
@@ -249,6 +294,7 @@ int main(void) {
     rr_ray *rays = random_rays(s, n);
     check_rays(dev, s, rays, n, 1, "random rays");
     check_tri_paths(s, rays, n, "random rays");
+    check_t_bound(s, rays, n, "random rays");
     free(rays);
     rr_scene_release(s);
   } else {

@@ -512,14 +512,15 @@ static double node_area(const bvh_node *n) {
   return x * y + y * z + z * x;
 }
 
-/* Makes wide node w from binary node k: k's children, then the inner slot with
- * the largest area opened into its two children until four slots are used. */
-static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
-  uint32_t slot[4], n = 0;
+/* The slots of a wide node made from binary node k: k's children, then the inner
+ * slot with the largest area opened into its two children until `width` slots are
+ * used (or only leaves are left). Returns how many. */
+static uint32_t open_slots(const rr_bvh *b, uint32_t k, uint32_t width, uint32_t *slot) {
+  uint32_t n = 0;
   const bvh_node *nk = &b->nodes[k];
   if (nk->count) slot[n++] = k; /* a leaf root */
   else slot[n++] = nk->first, slot[n++] = nk->first + 1;
-  while (n < 4) {
+  while (n < width) {
     int open = -1;
     double best = -1;
     for (uint32_t i = 0; i < n; i++) {
@@ -531,6 +532,12 @@ static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
     for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1];
     slot[open] = first, slot[open + 1] = first + 1, n++;
   }
+  return n;
+}
+
+/* Makes wide node w from binary node k (open_slots with four). */
+static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
+  uint32_t slot[4], n = open_slots(b, k, 4, slot);
   bvh_wide *wn = &b->wide[w];
   for (int i = 0; i < 4; i++) {
     b->wide_node[4 * w + i] = i < (int)n ? slot[i] : UINT32_MAX;
@@ -588,9 +595,112 @@ static bool collapse_wide(rr_bvh *b) {
   return true;
 }
 
+/* ---- the 8-wide copy for the ray queries ------------------------------------------
+ * Made from the binary tree as the 4-wide one is, but a subtree of at most four
+ * triangles becomes one leaf: the ray queries test a leaf's triangles four at a
+ * time for the price of one (the binary leaves hold fewer than two on average).
+ * A subtree's triangles are consecutive in prims, so such a leaf is a range too,
+ * and its corners are copied as leaf_v's are (rr_bvh.leaf_v8). The nodes are
+ * written depth first (a node's children after it). */
+typedef struct {
+  rr_bvh *b;
+  const rr_scene *s;
+  uint32_t *first, *count; /* per binary node: its subtree's prims (count 0: not consecutive) */
+  uint32_t next;           /* the next free node */
+} wide8_build;
+
+/* The prims under binary node k into j->first[k], j->count[k]; the count is left
+ * 0 where they are not one range (never, for the builder's trees; checked). */
+static void subtree_range(wide8_build *j, uint32_t k) {
+  const bvh_node *n = &j->b->nodes[k];
+  if (n->count) {
+    j->first[k] = n->first, j->count[k] = n->count;
+    return;
+  }
+  uint32_t l = n->first, r = n->first + 1;
+  subtree_range(j, l), subtree_range(j, r);
+  bool joined = j->count[l] && j->count[r] && j->first[l] + j->count[l] == j->first[r];
+  j->first[k] = j->first[l], j->count[k] = joined ? j->count[l] + j->count[r] : 0;
+}
+
+/* Whether binary node c is a leaf of wide8: a leaf, or a subtree of at most four triangles. */
+static bool leaf8(const wide8_build *j, uint32_t c) {
+  return j->b->nodes[c].count || (j->count[c] && j->count[c] <= 4);
+}
+
+/* open_slots with eight, where leaf8 tells the leaves. */
+static uint32_t open_slots8(const wide8_build *j, uint32_t k, uint32_t *slot) {
+  const bvh_node *nodes = j->b->nodes;
+  uint32_t n = 0;
+  if (leaf8(j, k)) slot[n++] = k; /* a leaf root */
+  else slot[n++] = nodes[k].first, slot[n++] = nodes[k].first + 1;
+  while (n < 8) {
+    int open = -1;
+    double best = -1;
+    for (uint32_t i = 0; i < n; i++)
+      if (!leaf8(j, slot[i]) && node_area(&nodes[slot[i]]) > best) best = node_area(&nodes[slot[i]]), open = (int)i;
+    if (open < 0) break;
+    uint32_t first = nodes[slot[open]].first;
+    for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1];
+    slot[open] = first, slot[open + 1] = first + 1, n++;
+  }
+  return n;
+}
+
+static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
+  rr_bvh *b = j->b;
+  uint32_t slot[8], n = open_slots8(j, k, slot);
+  bvh_wide8 *wn = &b->wide8[w];
+  for (uint32_t i = 0; i < 8; i++) {
+    const bvh_node *c = i < n ? &b->nodes[slot[i]] : NULL;
+    for (int a = 0; a < 3; a++) wn->lo[a][i] = c ? c->lo[a] : INFINITY, wn->hi[a][i] = c ? c->hi[a] : -INFINITY;
+    wn->ref[i] = UINT32_MAX, wn->count[i] = 0;
+  }
+  for (uint32_t i = 0; i < n; i++) {
+    uint32_t c = slot[i];
+    if (leaf8(j, c)) { /* a leaf: its corners as leaf_v's */
+      uint32_t first = j->first[c], count = j->count[c];
+      float *v = b->leaf_v8 + (size_t)9 * first;
+      for (uint32_t m = 0; m < 9; m++)
+        for (uint32_t t = 0; t < count; t++) v[m * count + t] = j->s->p[m / 3][m % 3][b->prims[first + t]];
+      wn->ref[i] = first, wn->count[i] = count;
+    } else {
+      wn->ref[i] = j->next++;
+      collapse_node8(j, wn->ref[i], c);
+    }
+  }
+}
+
+/* The wide8 nodes collapse_node8 makes from binary node k. */
+static uint32_t count_nodes8(const wide8_build *j, uint32_t k) {
+  uint32_t slot[8], n = open_slots8(j, k, slot), total = 1;
+  for (uint32_t i = 0; i < n; i++)
+    if (!leaf8(j, slot[i])) total += count_nodes8(j, slot[i]);
+  return total;
+}
+
+static bool collapse_wide8(rr_bvh *b, const rr_scene *s) {
+  size_t nv = (size_t)9 * b->nprims;
+  wide8_build j = {.b = b, .s = s, .next = 1};
+  j.first = malloc((size_t)b->nnodes * sizeof(uint32_t));
+  j.count = malloc((size_t)b->nnodes * sizeof(uint32_t));
+  b->leaf_v8 = alloc_lines((nv + BVH_LEAF_PAD) * sizeof(float));
+  bool ok = j.first && j.count && b->leaf_v8;
+  if (ok) {
+    memset(b->leaf_v8 + nv, 0, BVH_LEAF_PAD * sizeof(float));
+    subtree_range(&j, 0);
+    b->nwide8 = count_nodes8(&j, 0); /* counted first: no room to guess and trim */
+    b->wide8 = alloc_lines((size_t)b->nwide8 * sizeof(bvh_wide8));
+    ok = b->wide8 != NULL;
+  }
+  if (ok) collapse_node8(&j, 0, 0);
+  free(j.first), free(j.count);
+  return ok;
+}
+
 void rr_bvh_release(rr_bvh *b) {
   if (!b) return;
-  free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node), free(b->leaf_v);
+  free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node), free(b->wide8), free(b->leaf_v8), free(b->leaf_v);
   free(b);
 }
 
@@ -769,11 +879,12 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   for (uint32_t i = 0; i < small.n; i++)
     if (small.v[i].buf)
       for (uint32_t k = small.v[i].start; k < small.v[i].start + small.v[i].count; k++) b->prims[k] = bd.buf[1][k].id;
-  if (!collapse_wide(b)) goto oom;
+  if (!collapse_wide(b) || !collapse_wide8(b, s)) goto oom;
   if (!copy_leaf_corners(b, s)) goto oom;
   b->sah_cost = sah_cost(b);
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
-             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) + ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
+             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) +
+             (uint64_t)b->nwide8 * sizeof(bvh_wide8) + 2 * ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
   b->build_ms = rr_now_ms() - t0;
   rr_progress(&progress, 1);
   *out = b;

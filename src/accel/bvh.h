@@ -24,11 +24,15 @@ typedef struct rr_bvh {
   struct bvh_wide *wide; /* the same tree collapsed to 4 children per node, for single rays */
   uint32_t *wide_node;   /* per wide node, per slot: the node of `nodes` it is (UINT32_MAX: empty) */
   uint32_t nwide;
+  struct bvh_wide8 *wide8; /* the tree collapsed to 8 children per node for the ray queries,
+                             subtrees of at most four triangles joined into one leaf */
+  uint32_t nwide8;
   /* The triangles' corners in leaf order, for the ray queries' leaf tests: a leaf
    * holding prims [first, first + count) has corner k's axis x of its j-th triangle
    * at leaf_v[9·first + (3k + x)·count + j], then BVH_LEAF_PAD zeros at the end, so
    * that four lanes may be loaded from any triangle. */
   float *leaf_v;
+  float *leaf_v8; /* the same for the leaves of wide8, which may join a few binary leaves */
 } rr_bvh;
 
 /* A 4-wide node: up to four of the binary tree's nodes side by side, bounds as
@@ -38,6 +42,16 @@ typedef struct bvh_wide {
   float lo[3][4], hi[3][4];
   uint32_t ref[4], count[4];
 } bvh_wide;
+
+/* An 8-wide node: up to eight of the binary tree's nodes, laid out as bvh_wide
+ * (lanes per axis, an empty slot has an empty box; count > 0: a leaf holding prims
+ * [ref, ref + count), else wide8 node `ref`). Four cache lines; the ray queries
+ * (vis/ray_query.c) test it with one eight-lane vector per plane under AVX2, two
+ * four-lane ones otherwise. Root: 0. */
+typedef struct bvh_wide8 {
+  float lo[3][8], hi[3][8];
+  uint32_t ref[8], count[8];
+} bvh_wide8;
 
 enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK = 128, BVH_LEAF_PAD = 8 };
 

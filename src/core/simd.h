@@ -149,6 +149,8 @@ RR_TARGET_AVX2 static inline rr_vf8 rr_vf8_splat(float x) { return _mm256_set1_p
 RR_TARGET_AVX2 static inline rr_vi8 rr_vi8_splat(int32_t x) { return (rr_vi8)_mm256_set1_epi32(x); }
 RR_TARGET_AVX2 static inline rr_vi8 rr_vi8_lanes(void) { return (rr_vi8){0, 1, 2, 3, 4, 5, 6, 7}; }
 RR_TARGET_AVX2 static inline rr_vf8 rr_vf8_load(const float *p) { return _mm256_loadu_ps(p); }
+/* Loads eight floats from a 32-byte aligned address. */
+RR_TARGET_AVX2 static inline rr_vf8 rr_vf8_load_aligned(const float *p) { return _mm256_load_ps(p); }
 RR_TARGET_AVX2 static inline rr_vi8 rr_vi8_load(const int32_t *p) {
   return (rr_vi8)_mm256_loadu_si256((const __m256i *)p);
 }

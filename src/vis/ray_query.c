@@ -1,7 +1,8 @@
 /* The public ray queries rr_intersect and rr_occluded: one arbitrary ray through
- * the committed scene's BVH, by the traversal of every ray caster
- * (vis/bvh_trace.h). A leaf's triangles, whose corners the tree keeps in leaf
- * order (rr_bvh.leaf_v), go four at a time through the edge signs of their setup
+ * the committed scene's BVH, collapsed to eight children a node for them
+ * (rr_bvh.wide8, traversed by vis/ray_query_tmp.h; the binary tree's leaves and
+ * boxes, so the same triangles are reached as through any other form). A leaf's triangles, whose corners the tree keeps in leaf
+ * order (rr_bvh.leaf_v8), go four at a time through the edge signs of their setup
  * (tri_ray_may_hit4); those that pass are tested with the project's one sample
  * test for the ray (a pseudo-camera at its origin, rr_cam_for_ray), so a ray
  * through a shared edge hits exactly one triangle: with the pre-test's edge values
@@ -28,10 +29,13 @@
 
 /* An arbitrary ray: its slab-test form, range, best hit and pseudo-camera. */
 typedef struct {
-  ray_q q;            /* q.inv rounded towards zero by RAY_MARGIN: the near planes' factor */
-  rr_vf4 inv_far[3];  /* the inverse direction away from zero by RAY_MARGIN: the far planes' */
-  rr_vf4 d[3];        /* the direction, broadcast (the leaf test) */
-  rr_vf4 tlo;         /* max(tmin, 0) broadcast: every hit has t > 0 */
+  float org[3];
+  float inv_n[3]; /* 1 / dir rounded towards zero by RAY_MARGIN: the near planes' factor */
+  float inv_f[3]; /* and away from zero: the far planes' */
+  int wn[3], wf[3]; /* per axis the byte offsets in a bvh_wide8 of the near and far planes */
+  rr_vf4 o[3], d[3]; /* origin and direction broadcast (the leaf test) */
+  float tlo;          /* max(tmin, 0): every hit has t > 0 */
+  float dmax;         /* max |dir| per axis (ray_t_outside) */
   float tmin;
   float t, l1, l2; /* best hit so far; t starts at tmax */
   uint32_t id;
@@ -40,26 +44,14 @@ typedef struct {
   ray_cam rc;      /* made for the first full test (vis/ray_test.h) */
 } query_ray;
 
-/* The slots whose box the ray meets within [max(tmin, 0), best t], nearest entry
- * first; the entry is also the key that drops a stacked slot. The margin is in the
- * inverse direction: a slab's entry shrinks towards 0 and its exit grows by a
- * factor 1 ∓ RAY_MARGIN (the box's interval beyond 0 widened relatively, as
- * wide_test widens it, for one multiplication fewer a plane); a negative entry
- * loses to tlo, a negative exit misses either way. NaN slabs are ignored as in
- * wide_test. */
-KERNEL int query_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s) {
-  (void)ref, (void)lanes;
-  query_ray *r = q;
-  const char *base = (const char *)w;
-  rr_vf4 t0 = r->tlo, t1 = rr_vf4_splat(r->t);
-#pragma GCC unroll 3
-  for (int a = 0; a < 3; a++) {
-    t0 = rr_vf4_max((rr_vf4_load_aligned((const float *)(base + r->q.wn[a])) - r->q.o[a]) * r->q.inv[a], t0);
-    t1 = rr_vf4_min((rr_vf4_load_aligned((const float *)(base + r->q.wf[a])) - r->q.o[a]) * r->inv_far[a], t1);
-  }
-  s->order = s->key = t0;
-  return rr_vi4_bits(t0 <= t1);
-}
+/* The traversal (vis/ray_query_tmp.h) enters the slots of a node whose box the
+ * ray meets within [max(tmin, 0), best t], with their entry, which orders them and
+ * drops a stacked slot. The margin is in the inverse direction: a slab's entry shrinks
+ * towards 0 and its exit grows by a factor 1 ∓ RAY_MARGIN (the box's interval
+ * beyond 0 widened relatively, as wide_test widens it, for one multiplication
+ * fewer a plane); a negative entry loses to tlo, a negative exit misses either
+ * way. A NaN slab (0·inf: the origin on a plane the ray runs in) is ignored: min
+ * and max keep their second operand. Empty slots (lo = inf, hi = −inf) never pass. */
 
 /* Tests a leaf's triangles, keeping the nearest hit; `any`: stops at the first.
  * Four at a time through the edge pre-test, then the full test for the lanes
@@ -67,19 +59,21 @@ KERNEL int query_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, 
  * judge). The same triangles pass whatever the order, and depth_wins keeps the
  * nearest, lower id on a tie, so the hit does not depend on the order. */
 KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool any) {
-  const float *v = r->b->leaf_v + (size_t)9 * first;
+  const float *v = r->b->leaf_v8 + (size_t)9 * first;
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;
     rr_vf4 pre[4];
-    int may = tri_ray_may_hit4(v + j, count, r->q.o, r->d, pre) & ((1 << n) - 1);
+    int may = tri_ray_may_hit4(v + j, count, r->o, r->d, pre) & ((1 << n) - 1);
     if (r->s->inf)
       for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, r->b->prims[first + j + k]) != 0) << k;
     for (; may; may &= may - 1) {
       uint32_t lane = (uint32_t)__builtin_ctz(may), id = r->b->prims[first + j + lane];
-      float t, l1, l2, org[3] = {r->q.o[0][0], r->q.o[1][0], r->q.o[2][0]},
-                       dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
+      float t, l1, l2, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
       const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
-      bool hit = ray_tri_test(r->s, id, &r->rc, org, dir, e, r->tmin, r->t, &t, &l1, &l2);
+      if (e[0] > 0 && e[1] > 0 && e[2] > 0 && !(r->s->inf && scene_inf(r->s, id)) &&
+          ray_t_outside(ray_corner_extent(v + j + lane, count, r->org), r->dmax, e, r->tmin, r->t))
+        continue;
+      bool hit = ray_tri_test(r->s, id, &r->rc, r->org, dir, e, r->tmin, r->t, &t, &l1, &l2);
       if (!hit) continue;
       if (any) return true;
       if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
@@ -88,51 +82,57 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
   return false;
 }
 
-KERNEL bool query_leaf_closest(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
-  (void)lanes;
-  return query_leaf(q, first, count, false);
-}
-
-KERNEL bool query_leaf_any(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
-  (void)lanes;
-  return query_leaf(q, first, count, true);
-}
-
-KERNEL float query_best(const void *q) { return ((const query_ray *)q)->t; }
-
 /* Prepares a valid ray against the scene's tree b (NULL: an empty scene). */
 static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const float org[3], const float dir[3],
                        float tmin, float tmax) {
   r->s = s, r->b = b, r->rc.ready = false;
-  ray_q_init(&r->q, v3_load(org), v3_load(dir));
   for (int a = 0; a < 3; a++) {
-    r->inv_far[a] = r->q.inv[a] * rr_vf4_splat(1 + RAY_MARGIN);
-    r->q.inv[a] = r->q.inv[a] * rr_vf4_splat(1 - RAY_MARGIN);
-    r->d[a] = rr_vf4_splat(dir[a]);
+    float inv = 1.0f / dir[a]; /* ±inf for a zero component, by its sign */
+    bool neg = inv < 0;
+    r->wn[a] = (int)(neg ? offsetof(bvh_wide8, hi[a]) : offsetof(bvh_wide8, lo[a]));
+    r->wf[a] = (int)(neg ? offsetof(bvh_wide8, lo[a]) : offsetof(bvh_wide8, hi[a]));
+    r->org[a] = org[a], r->inv_n[a] = inv * (1 - RAY_MARGIN), r->inv_f[a] = inv * (1 + RAY_MARGIN);
+    r->o[a] = rr_vf4_splat(org[a]), r->d[a] = rr_vf4_splat(dir[a]);
   }
-  r->tlo = rr_vf4_splat(tmin > 0 ? tmin : 0);
+  r->tlo = tmin > 0 ? tmin : 0;
+  float d0 = fabsf(dir[0]), d1 = fabsf(dir[1]), d2 = fabsf(dir[2]), d01 = d0 > d1 ? d0 : d1;
+  r->dmax = d01 > d2 ? d01 : d2;
   r->tmin = tmin, r->t = tmax, r->id = RR_MISS, r->l1 = r->l2 = 0;
 }
 
+/* The traversal, once per vector width. */
+#define RQ_LANES 4
+#define RQ_VF rr_vf4
+#define RQ_VI rr_vi4
+#define RQ_(op) rr_vf4_##op
+#define rr_vf4_bits rr_vi4_bits
+#define RQ_TARGET
+#define RQ_NAME query_trace4
+#include "vis/ray_query_tmp.h"
+#undef rr_vf4_bits
+
+#ifdef RR_SIMD_X86
+/* Eight lanes with AVX2: a node's test in one vector per plane, and the leaf's
+ * four-lane tests in AVX's encodings (three operands, blends), the same lane
+ * operations and bits. */
+#define RQ_LANES 8
+#define RQ_VF rr_vf8
+#define RQ_VI rr_vi8
+#define RQ_(op) rr_vf8_##op
+#define rr_vf8_bits rr_vi8_bits
+#define RQ_TARGET RR_TARGET_AVX2
+#define RQ_NAME query_trace8
+#include "vis/ray_query_tmp.h"
+#undef rr_vf8_bits
+#endif
+
 /* Traces a prepared ray: the nearest hit into r, or (any) whether there is one. */
-KERNEL bool query_trace_body(query_ray *r, bool any) {
-  if (!r->b) return false;
-  if (any) return bvh_trace(r->b, r, 1, query_node, query_leaf_any, query_best);
-  bvh_trace(r->b, r, 1, query_node, query_leaf_closest, query_best);
-  return r->id != RR_MISS;
-}
-
-#ifdef RR_SIMD_X86
-/* The same code with AVX2's encodings (three operands, blends): the four-lane
- * tests take fewer instructions, with the same lane operations and bits. */
-RR_TARGET_AVX2 static bool query_trace_avx2(query_ray *r, bool any) { return query_trace_body(r, any); }
-#endif
-
 static bool query_trace(query_ray *r, bool any) {
+  if (!r->b) return false;
 #ifdef RR_SIMD_X86
-  if (__builtin_cpu_supports("avx2")) return query_trace_avx2(r, any);
+  if (__builtin_cpu_supports("avx2")) return any ? query_trace8_any(r) : (query_trace8_closest(r), r->id != RR_MISS);
 #endif
-  return query_trace_body(r, any);
+  return any ? query_trace4_any(r) : (query_trace4_closest(r), r->id != RR_MISS);
 }
 
 /* The committed scene's tree (NULL for an empty scene) or an error in dev. */

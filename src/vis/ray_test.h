@@ -30,6 +30,48 @@ static inline const char *ray_problem(const float org[3], const float dir[3], fl
   return NULL;
 }
 
+/* Whether the full test (ray_tri_test) of a triangle whose pre-test values pre
+ * (tri_ray_may_hit4) are all inside, e_i > 0, surely finds its t outside [tmin,
+ * tmax], from those values alone: the start triangle of a ray from a surface, or a
+ * triangle beyond the best hit so far, then costs no plane in double; S is the
+ * triangle's lane of ray_corner_extent4, dmax = D below. The bound: with q_k = p_k − o as the pre-test
+ * rounds them, S = max |q_k|, D = max |d| (per axis), u = 2⁻²⁴, the pre-test's
+ * edge values are within 80·u·S²·D of the exact (q_{i+2} × q_{i+1})·d, its volume
+ * within 80·u·S³ of the exact q0·(q2 × q1) (cross products: |l − h| ≤ 2S, one
+ * rounding each, components within 12.1·u·S² and at most 4.01·S²; the dot
+ * products γ₃·3·max|c|·D; the rounding of q_k itself moves them by at most
+ * 12·u·S²·D and 18·u·S³), and the exact t of the plane is the exact volume over
+ * the exact sum of the edge values. The full test's t is num / den (each within a
+ * float rounding and double roundings far below u·S³ or u·S²·D of the exact, over
+ * the plane normal's components of at most 8S²) or vol / Σe: either within the
+ * bounds below, which take 128·u·S³ and 512·u·S²·D, leave a factor 1 ∓ 32u for
+ * their own roundings and hold only where nothing under- or overflows (S, D in
+ * [2⁻³⁰, 2³⁰]) and the denominator keeps at least half of Σe. tests/test_rays
+ * checks it against the full test. */
+static inline bool ray_t_outside(float S, float dmax, const float pre[4], float tmin, float tmax) {
+  if (!(S >= 0x1p-30f && S <= 0x1p30f && dmax >= 0x1p-30f && dmax <= 0x1p30f)) return false;
+  const float u = 0x1p-24f, vol = fabsf(pre[3]), sum = pre[0] + pre[1] + pre[2];
+  const float err_v = S * S * S * (128 * u), err_s = S * S * dmax * (512 * u);
+  const float den_lo = sum * (1 - 8 * u) - err_s, den_hi = sum * (1 + 8 * u) + err_s;
+  if (!(den_lo >= 0.5f * sum)) return false;
+  if ((vol + err_v) / den_lo * (1 + 32 * u) < tmin) return true;
+  return vol - err_v > 0 && (vol - err_v) / den_hi * (1 - 32 * u) > tmax;
+}
+
+/* S of ray_t_outside for a triangle laid out as tri_ray_may_hit4 reads its lanes
+ * (corner k's axis x at v[(3k + x)·stride]): max |q_k| over the corners and axes,
+ * q_k = p_k − o rounded as the pre-test rounds it. No NaN (finite corners), so a
+ * plain comparison (fmaxf is a call). */
+static inline float ray_corner_extent(const float *v, size_t stride, const float org[3]) {
+  float S = 0;
+#pragma GCC unroll 9
+  for (int m = 0; m < 9; m++, v += stride) {
+    float q = fabsf(*v - org[m % 3]);
+    S = q > S ? q : S;
+  }
+  return S;
+}
+
 /* A ray's pseudo-camera, made when its first triangle passes the pre-test (many
  * rays need none). */
 typedef struct {

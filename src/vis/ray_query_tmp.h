@@ -1,0 +1,96 @@
+/* The ray queries' traversal of the 8-wide tree (rr_bvh.wide8), written once and
+ * included by vis/ray_query.c once per vector width: with AVX2 a node's eight
+ * slots are one vector per plane, otherwise two four-lane halves. The template
+ * reads RQ_LANES (4 or 8), RQ_VF, RQ_VI (float and int vectors of that many
+ * lanes), RQ_(op) for their helpers of core/simd.h (splat, load_aligned, min,
+ * max, bits), RQ_TARGET and RQ_NAME (the functions RQ_NAME_closest and
+ * RQ_NAME_any); it clears them at the end.
+ *
+ * Front to back: the slots a node's test enters are taken nearest entry first
+ * (closest hit; an any-hit query takes them in slot order, as any hit ends it),
+ * the others stacked with their entry, and a stacked slot is dropped on pop when
+ * the best hit is already nearer (strictly: an equal t with a lower id still
+ * wins). Leaves go to query_leaf, the one place a leaf's primitives are tested. */
+
+RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _body)(query_ray *r, const bool any) {
+  struct {
+    uint32_t ref, count;
+    float key;
+  } stack[7 * BVH_STACK]; /* a level pushes at most seven; the tree is less than BVH_STACK deep */
+  RQ_VF o[3], inv_n[3], inv_f[3];
+  for (int a = 0; a < 3; a++)
+    o[a] = RQ_(splat)(r->org[a]), inv_n[a] = RQ_(splat)(r->inv_n[a]), inv_f[a] = RQ_(splat)(r->inv_f[a]);
+  const RQ_VF tlo = RQ_(splat)(r->tlo);
+  const bvh_wide8 *nodes = r->b->wide8;
+  int sp = 0;
+  uint32_t ref = 0, count = 0; /* node 0 */
+  for (;;) {
+    if (count) {
+      if (query_leaf(r, ref, count, any)) return true;
+    } else {
+      /* The slab test (vis/ray_query.c: query_ray), slots in lanes. */
+      const bvh_wide8 *w = &nodes[ref];
+      const char *base = (const char *)w;
+      const RQ_VF best = RQ_(splat)(r->t);
+      float entry[8] __attribute__((aligned(32)));
+      unsigned hits = 0;
+#pragma GCC unroll 2
+      for (int h = 0; h < 8; h += RQ_LANES) {
+        RQ_VF t0 = tlo, t1 = best;
+#pragma GCC unroll 3
+        for (int a = 0; a < 3; a++) {
+          t0 = RQ_(max)((RQ_(load_aligned)((const float *)(base + r->wn[a]) + h) - o[a]) * inv_n[a], t0);
+          t1 = RQ_(min)((RQ_(load_aligned)((const float *)(base + r->wf[a]) + h) - o[a]) * inv_f[a], t1);
+        }
+        memcpy(entry + h, &t0, sizeof t0);
+        hits |= (unsigned)RQ_(bits)(t0 <= t1) << h;
+      }
+      if (hits) {
+        int i = __builtin_ctz(hits);
+        unsigned rest = hits & (hits - 1);
+        if (rest && (any || (rest & (rest - 1)))) {
+          if (!any) { /* three or more: the nearest entered, the others stacked farthest first */
+            int order[8], n = 0;
+            for (unsigned m = hits; m; m &= m - 1) {
+              int k = __builtin_ctz(m), j = n++;
+              for (; j > 0 && entry[order[j - 1]] < entry[k]; j--) order[j] = order[j - 1];
+              order[j] = k;
+            }
+            rest = 0, i = order[n - 1];
+            for (int j = 0; j < n - 1; j++) {
+              int k = order[j];
+              stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp++].key = entry[k];
+            }
+          }
+          for (; rest; rest &= rest - 1) { /* any hit: the first entered, the others stacked */
+            int k = __builtin_ctz(rest);
+            stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp++].key = entry[k];
+          }
+        } else if (rest) { /* two (the common case): the nearer entered, the other stacked */
+          int k = __builtin_ctz(rest), far = entry[i] < entry[k] ? k : i;
+          i ^= k ^ far;
+          stack[sp].ref = w->ref[far], stack[sp].count = w->count[far], stack[sp++].key = entry[far];
+        }
+        ref = w->ref[i], count = w->count[i];
+        continue;
+      }
+    }
+    for (;;) {
+      if (!sp) return false;
+      sp--;
+      if (!(stack[sp].key > r->t)) break; /* equal t may still win on id */
+    }
+    ref = stack[sp].ref, count = stack[sp].count;
+  }
+}
+
+/* Specialised for the two queries. */
+RQ_TARGET static bool RR_CAT(RQ_NAME, _closest)(query_ray *r) { return RR_CAT(RQ_NAME, _body)(r, false); }
+RQ_TARGET static bool RR_CAT(RQ_NAME, _any)(query_ray *r) { return RR_CAT(RQ_NAME, _body)(r, true); }
+
+#undef RQ_LANES
+#undef RQ_VF
+#undef RQ_VI
+#undef RQ_
+#undef RQ_TARGET
+#undef RQ_NAME
