@@ -1,0 +1,188 @@
+/* The analytic kinds' dispatch, bounds for cameras and t floors (prim/analytic.h). */
+#include "prim/analytic.h"
+#include "prim/triangle.h"
+
+static const float *ana_of(const rr_scene *s, uint32_t i) { return s->ana + (size_t)ANA_FLOATS * i; }
+
+bool rr_ana_hit(const rr_scene *s, uint32_t i, const ana_ray *r, float *t, float *u, float *v) {
+  switch (scene_kind(s, i)) {
+  case RR_GEOMETRY_SPHERE: return rr_ana_sphere_hit(ana_of(s, i), r, t, u, v);
+  case RR_GEOMETRY_PLANE: return rr_ana_plane_hit(ana_of(s, i), r, t, u, v);
+  default: return false;
+  }
+}
+
+vec3 rr_ana_normal(const rr_scene *s, uint32_t i, float u, float v) {
+  const float *a = ana_of(s, i);
+  if (scene_kind(s, i) == RR_GEOMETRY_PLANE) return v3(a[3], a[4], a[5]);
+  double phi = ((double)u - 0.5) * 2 * RR_PI, th = (double)v * RR_PI;
+  return v3((float)(sin(th) * sin(phi)), (float)cos(th), (float)(sin(th) * cos(phi)));
+}
+
+void rr_ana_box(const rr_scene *s, uint32_t i, float lo[3], float hi[3]) {
+  const float *a = ana_of(s, i);
+  if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {
+    for (int x = 0; x < 3; x++) {
+      lo[x] = nextafterf((float)((double)a[x] - a[3]), -INFINITY);
+      hi[x] = nextafterf((float)((double)a[x] + a[3]), INFINITY);
+    }
+    return;
+  }
+  /* A plane perpendicular to an axis is flat along it; along the others, and
+   * along every axis for an oblique plane, it reaches ±PRIM_FAR. */
+  for (int x = 0; x < 3; x++) {
+    bool flat = a[3 + (x + 1) % 3] == 0 && a[3 + (x + 2) % 3] == 0;
+    lo[x] = flat ? a[x] : -PRIM_FAR, hi[x] = flat ? a[x] : PRIM_FAR;
+  }
+}
+
+void rr_ana_corner_rays(const camera *c, ana_ray r[4]) {
+  for (int k = 0; k < 4; k++) {
+    float sx = k & 1 ? (float)c->width : 0, sy = k & 2 ? (float)c->height : 0;
+    ana_sample_ray(c, v3(1, sx, sy), sx, sy, &r[k]);
+  }
+}
+
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void cross3(const double *a, const double *b, double *o) {
+  o[0] = a[1] * b[2] - a[2] * b[1], o[1] = a[2] * b[0] - a[0] * b[2], o[2] = a[0] * b[1] - a[1] * b[0];
+}
+static void d3(vec3 v, double *o) { o[0] = v.x, o[1] = v.y, o[2] = v.z; }
+
+/* Planar cameras, a sphere: every hit p lies in the sphere's box B. Write p − base
+ * = λ·e0 + μ·e1 + ν·e2 in the camera's basis (perspective: base = eye, e = d0, dx,
+ * dy, and p's sample is (μ / λ, ν / λ); orthographic: base = eye + o0, e = fwd, ox,
+ * oy, and the sample is (μ, ν)). A hit has λ = t > 0. When every corner of B has
+ * λ > 0, B lies in that half-space, where the projection maps segments to segments,
+ * so the hull of B (B itself) projects into the rectangle of its corners' samples;
+ * B wholly at λ <= 0 holds no hit. Computed in double (errors ~1e-13 pixel, far
+ * inside the 1e-3 pixel pad); the samples of pixel x lie in [x, x + 1). */
+static bool sphere_rect(const float *a, const camera *c, int rect[4]) {
+  double base[3], e[3][3], ex[3], ey[3], ez[3];
+  bool persp = c->type == RR_CAMERA_PERSPECTIVE;
+  d3(c->eye, base);
+  if (persp) d3(c->d0, e[0]), d3(c->dx, e[1]), d3(c->dy, e[2]);
+  else {
+    double o0[3];
+    d3(c->o0, o0);
+    for (int k = 0; k < 3; k++) base[k] += o0[k];
+    d3(c->fwd, e[0]), d3(c->ox, e[1]), d3(c->oy, e[2]);
+  }
+  cross3(e[1], e[2], ex), cross3(e[2], e[0], ey), cross3(e[0], e[1], ez);
+  double det = dot3(e[0], ex);
+  if (!(fabs(det) > 0)) return false;
+  double X0 = INFINITY, X1 = -INFINITY, Y0 = INFINITY, Y1 = -INFINITY;
+  int ahead = 0;
+  double r = (double)a[3] * (1 + 1e-9);
+  for (int k = 0; k < 8; k++) {
+    double q[3];
+    for (int x = 0; x < 3; x++) q[x] = (double)a[x] + (k >> x & 1 ? r : -r) - base[x];
+    double lam = dot3(q, ex) / det, mu = dot3(q, ey) / det, nu = dot3(q, ez) / det;
+    if (!(lam > 1e-12 * sqrt(dot3(q, q)))) continue; /* at or behind the eye's plane */
+    ahead++;
+    double sx = persp ? mu / lam : mu, sy = persp ? nu / lam : nu;
+    X0 = fmin(X0, sx), X1 = fmax(X1, sx), Y0 = fmin(Y0, sy), Y1 = fmax(Y1, sy);
+  }
+  int W = c->width, H = c->height;
+  if (ahead == 0) return false;
+  if (ahead < 8) {
+    rect[0] = 0, rect[1] = 0, rect[2] = W - 1, rect[3] = H - 1;
+    return true;
+  }
+  double pad = 1e-3 + 1e-9 * fmax(fmax(fabs(X0), fabs(X1)), fmax(fabs(Y0), fabs(Y1)));
+  X0 = floor(X0 - pad - 1), X1 = floor(X1 + pad), Y0 = floor(Y0 - pad - 1), Y1 = floor(Y1 + pad);
+  rect[0] = X0 < 0 ? 0 : (int)X0, rect[1] = Y0 < 0 ? 0 : (int)Y0;
+  rect[2] = X1 > W - 1 ? W - 1 : (int)X1, rect[3] = Y1 > H - 1 ? H - 1 : (int)Y1;
+  return rect[0] <= rect[2] && rect[1] <= rect[3];
+}
+
+bool rr_ana_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int rect[4]) {
+  if (rr_ana_t_floor(s, i, c) == INFINITY) return false;
+  if (c->planar && scene_kind(s, i) == RR_GEOMETRY_SPHERE) return sphere_rect(ana_of(s, i), c, rect);
+  rect[0] = 0, rect[1] = 0, rect[2] = c->width - 1, rect[3] = c->height - 1;
+  return c->width > 0 && c->height > 0;
+}
+
+bool rr_ana_cone_excludes(const rr_scene *s, uint32_t i, const camera *c, vec3 axis, float angle) {
+  const float *a = ana_of(s, i);
+  double e[3], ax[3];
+  d3(c->eye, e), d3(axis, ax);
+  double la = sqrt(dot3(ax, ax));
+  if (!(la > 0) || !(angle < CAMERA_NO_CONE)) return false;
+  if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {
+    double q[3] = {a[0] - e[0], a[1] - e[1], a[2] - e[2]}, dist = sqrt(dot3(q, q)), r = a[3];
+    if (!(dist > r * (1 + 1e-9))) return false; /* the eye inside: every direction */
+    double beta = asin(r / dist), cs = dot3(q, ax) / (dist * la);
+    double phi = acos(cs < -1 ? -1 : cs > 1 ? 1 : cs);
+    return phi > (double)angle + beta + 1e-6;
+  }
+  /* A plane is hit along d only where n·d has the sign of n·(P − eye): the cone
+   * misses that half-space when its axis is more than 90° + angle from it. */
+  double n[3] = {a[3], a[4], a[5]}, side = n[0] * (a[0] - e[0]) + n[1] * (a[1] - e[1]) + n[2] * (a[2] - e[2]);
+  if (side == 0) return true; /* the eye on the plane: t = 0 everywhere, no hit */
+  double cs = (side > 0 ? 1 : -1) * dot3(n, ax) / la, phi = acos(cs < -1 ? -1 : cs > 1 ? 1 : cs);
+  return phi > RR_PI / 2 + (double)angle + 1e-6;
+}
+
+/* Floors. A hit at distance L from the origin along d has t = L / |d|.
+ * Sphere: L >= |q| − r (q = C − eye), so t >= (|q| − r) / max|d| for curved
+ * cameras (dir_len_max: their longest ray). Perspective: t = (p − eye)·fwd /
+ * (d·fwd) with (p − eye)·fwd >= q·fwd − r·|fwd| and d·fwd, linear in the sample,
+ * at most its largest value at the image's corners. Orthographic: t = (p − o)·fwd
+ * / |fwd|² with o = eye + o0 + sx·ox + sy·oy, (o − eye)·fwd again largest at a corner.
+ * Plane (c = n·(P − eye)): perspective t = c / (n·d) with n·d linear in the sample,
+ * so over the image it is least where c·(n·d) is greatest, at a corner, and no
+ * corner with c·(n·d) > 0 means no sample hits; orthographic t = n·(P − o) / n·fwd
+ * is linear, least at a corner (no positive corner: no hit); curved t >= |c| / |n|
+ * / dir_len_max. Each in double, then rounded down (ana_floor_f). */
+float rr_ana_t_floor(const rr_scene *s, uint32_t i, const camera *c) {
+  const float *a = ana_of(s, i);
+  double e[3], f[3];
+  d3(c->eye, e), d3(c->fwd, f);
+  bool sphere = scene_kind(s, i) == RR_GEOMETRY_SPHERE;
+  if (!c->planar) {
+    double L;
+    if (sphere) {
+      double q[3] = {a[0] - e[0], a[1] - e[1], a[2] - e[2]};
+      L = sqrt(dot3(q, q)) - a[3];
+    } else {
+      L = fabs(a[3] * (a[0] - e[0]) + a[4] * (a[1] - e[1]) + a[5] * (a[2] - e[2]));
+      if (L == 0) return INFINITY;
+      L /= sqrt((double)a[3] * a[3] + (double)a[4] * a[4] + (double)a[5] * a[5]);
+    }
+    return L > 0 ? ana_floor_f(L / ((double)c->dir_len_max * (1 + 1e-6))) : 0;
+  }
+  ana_ray r[4];
+  rr_ana_corner_rays(c, r);
+  if (sphere) {
+    double q[3] = {a[0] - e[0], a[1] - e[1], a[2] - e[2]};
+    double z = dot3(q, f) - a[3] * sqrt(dot3(f, f)), top = -INFINITY;
+    if (c->type == RR_CAMERA_PERSPECTIVE) {
+      for (int k = 0; k < 4; k++) top = fmax(top, dot3(r[k].d, f));
+      return top > 0 ? ana_floor_f(z / top) : 0;
+    }
+    for (int k = 0; k < 4; k++) {
+      double oe[3] = {r[k].o[0] - e[0], r[k].o[1] - e[1], r[k].o[2] - e[2]};
+      top = fmax(top, dot3(oe, f));
+    }
+    return ana_floor_f((z - top) / dot3(f, f));
+  }
+  double least = INFINITY;
+  for (int k = 0; k < 4; k++) {
+    double n[3] = {a[3], a[4], a[5]}, p[3] = {a[0] - r[k].o[0], a[1] - r[k].o[1], a[2] - r[k].o[2]};
+    double num = dot3(n, p), den = dot3(n, r[k].d);
+    if (c->type == RR_CAMERA_PERSPECTIVE) {
+      if (num != 0 && num * den > 0) least = fmin(least, num / den);
+    } else {
+      least = fmin(least, num / den);
+    }
+  }
+  if (c->type == RR_CAMERA_PERSPECTIVE) return least == INFINITY ? INFINITY : ana_floor_f(least);
+  /* orthographic: no positive corner, no positive t anywhere */
+  double most = -INFINITY;
+  for (int k = 0; k < 4; k++) {
+    double n[3] = {a[3], a[4], a[5]}, p[3] = {a[0] - r[k].o[0], a[1] - r[k].o[1], a[2] - r[k].o[2]};
+    most = fmax(most, dot3(n, p) / dot3(n, r[k].d));
+  }
+  return !(most > 0) ? INFINITY : ana_floor_f(least);
+}

@@ -1,0 +1,327 @@
+/* Analytic spheres and planes (prim/analytic.h) beside triangles:
+ * - every method gives rc's bits on scenes mixing the three kinds, at random views
+ *   and views from inside, for every camera, on 1 and 2 threads, and at several
+ *   sample positions per pixel;
+ * - rr_intersect gives brute force's bits (test_brute_ray) on camera rays;
+ * - depth against a closed-form reference in long double (perspective,
+ *   orthographic, lat-long): p99.9 relative error <= 1e-6;
+ * - a sphere resting on a plane: every sample looking at the plane is claimed,
+ *   by the nearer of the two (depth_wins), in every method;
+ * - bad input (radius <= 0, NaN, zero normal) refused, naming the primitive. */
+#include "vis/vis.h"
+#include "io/io.h"
+#include "testutil.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Random triangles, spheres (some overlapping, some crossing the plane) and a ground
+ * plane y = 0 plus an oblique one far off. */
+static rr_scene *mixed_scene(rr_device *dev, int ntri, int nsph) {
+  rr_scene *s = NULL;
+  if (rr_scene_new(dev, &s) != RR_OK) return NULL;
+  float *pos = malloc(sizeof(float) * 9 * (size_t)ntri);
+  uint32_t *idx = malloc(sizeof(uint32_t) * 3 * (size_t)ntri);
+  for (int t = 0; t < ntri; t++) {
+    float cx = test_randf(-4, 4), cy = test_randf(0, 3), cz = test_randf(-4, 4), sz = test_randf(0.5f, 2);
+    for (int k = 0; k < 3; k++) {
+      pos[9 * t + 3 * k] = cx + sz * test_randf(-1, 1), pos[9 * t + 3 * k + 1] = cy + sz * test_randf(-1, 1);
+      pos[9 * t + 3 * k + 2] = cz + sz * test_randf(-1, 1);
+      idx[3 * t + k] = (uint32_t)(3 * t + k);
+    }
+  }
+  CHECK(rr_scene_add_mesh(s, pos, (size_t)3 * ntri, idx, (size_t)ntri, NULL) == RR_OK, "add mesh");
+  float *sp = malloc(sizeof(float) * 4 * (size_t)nsph);
+  for (int k = 0; k < nsph; k++)
+    sp[4 * k] = test_randf(-4, 4), sp[4 * k + 1] = test_randf(-0.5f, 3), sp[4 * k + 2] = test_randf(-4, 4),
+            sp[4 * k + 3] = test_randf(0.1f, 1.2f);
+  const float red[3] = {0.8f, 0.2f, 0.2f};
+  CHECK(rr_scene_add_spheres(s, sp, (size_t)nsph, red) == RR_OK, "add spheres: %s", rr_device_message(dev));
+  const float planes[12] = {0, 0, 0, 0, 1, 0, 0, 0, -9, 0.3f, 0.2f, 1};
+  CHECK(rr_scene_add_planes(s, planes, 2, NULL) == RR_OK, "add planes: %s", rr_device_message(dev));
+  /* more triangles after the analytic geometries: ids interleave kinds */
+  for (int k = 0; k < 9 * ntri; k++) pos[k] *= 0.5f;
+  CHECK(rr_scene_add_mesh(s, pos, (size_t)3 * ntri, idx, (size_t)ntri, NULL) == RR_OK, "add mesh 2");
+  free(pos), free(idx), free(sp);
+  CHECK(rr_scene_commit(s) == RR_OK, "commit");
+  return s;
+}
+
+static const rr_method methods3d[] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
+                                      RR_METHOD_3DR_FC, RR_METHOD_3DR_FS, RR_METHOD_3DR_FULL};
+
+/* Counts the samples of f that hit each kind. */
+static void kind_hits(const rr_scene *s, const rr_frame *f, int n[3]) {
+  n[0] = n[1] = n[2] = 0;
+  size_t m = (size_t)f->vb.width * f->vb.height * (size_t)f->samples;
+  for (size_t k = 0; k < m; k++)
+    if (f->vb.id[k] != RR_MISS) n[scene_kind(s, f->vb.id[k])]++;
+}
+
+static int agree_total, agree_frames;
+
+static void check_methods(rr_device *dev, const rr_scene *s, int views) {
+  int hits[3] = {0, 0, 0};
+  for (int v = 0; v < views; v++) {
+    for (int type = 0; type < RR_CAMERA_COUNT; type++) {
+      float fov = type == RR_CAMERA_FISHEYE ? 200 : 70;
+      bool inside = v % 2;
+      rr_camera cam = test_random_view(s, inside ? 0.05f : 1.2f, inside ? 0.5f : 2.5f, 0.3f, fov, fov);
+      cam.type = (rr_camera_type)type;
+      cam.ortho_height = 8;
+      int w = type == RR_CAMERA_CUBE ? 64 : 56, h = 48;
+      rr_frame *ref = test_render(dev, s, &cam, RR_METHOD_RC, 2, w, h, 0);
+      if (!ref) continue;
+      int kh[3];
+      kind_hits(s, ref, kh);
+      for (int k = 0; k < 3; k++) hits[k] += kh[k];
+      char what[256];
+      snprintf(what, sizeof what, "view %d (%s), %s camera", v, inside ? "inside" : "outside", rr_camera_name(type));
+      for (size_t m = 0; m < sizeof methods3d / sizeof methods3d[0]; m++) {
+        int threads = 1 + (int)((v + type + m) % 2);
+        rr_frame *f = test_render(dev, s, &cam, methods3d[m], threads, w, h, 0);
+        if (!f) continue;
+        int d = test_frames_differ(ref, f);
+        CHECK(d == 0, "%s: %s on %d threads differs from rc at %d samples", what, rr_method_name(methods3d[m]),
+              threads, d);
+        agree_frames++, agree_total += d == 0;
+        rr_frame_release(f);
+      }
+      rr_frame_release(ref);
+    }
+  }
+  printf("rc hits over the views: %d triangle, %d sphere, %d plane samples\n", hits[0], hits[1], hits[2]);
+  CHECK(hits[0] > 0 && hits[1] > 0 && hits[2] > 0, "every kind is seen");
+}
+
+/* Several sample positions at once (the 3D methods take them in one pass): each
+ * layer is rc's frame at that position. */
+static void check_patterns(rr_device *dev, const rr_scene *s) {
+  const float pos[4][2] = {{0.375f, 0.125f}, {0.875f, 0.375f}, {0.125f, 0.625f}, {0.625f, 0.875f}};
+  for (int v = 0; v < 2; v++) {
+    rr_camera cam = test_random_view(s, v ? 0.2f : 1.5f, v ? 0.4f : 2.0f, 0.3f, 60, 60);
+    cam.type = v ? RR_CAMERA_LATLONG : RR_CAMERA_PERSPECTIVE;
+    for (size_t m = 2; m < sizeof methods3d / sizeof methods3d[0]; m++) {
+      rr_render_options o = test_pattern(methods3d[m], 40, 32, 1 + (int)(m % 2), 4, pos);
+      rr_frame *f = test_render_opt(dev, s, &cam, &o);
+      if (!f) continue;
+      char what[128];
+      snprintf(what, sizeof what, "4 positions, view %d, %s", v, rr_method_name(methods3d[m]));
+      test_check_layers(dev, s, &cam, &o, RR_METHOD_RC, f, what);
+      rr_frame_release(f);
+    }
+  }
+}
+
+/* rr_intersect against brute force over every primitive, on camera rays. */
+static void check_rays(rr_device *dev, const rr_scene *s) {
+  int bad = 0, hits = 0, n = 0;
+  for (int v = 0; v < 6; v++) {
+    rr_camera cam = test_random_view(s, v % 2 ? 0.1f : 1.2f, v % 2 ? 0.6f : 2.5f, 0.3f, 70, 70);
+    camera c;
+    if (rr_cam_setup(dev, &cam, 24, 18, &c) != RR_OK) continue;
+    for (int y = 0; y < 18; y++)
+      for (int x = 0; x < 24; x++) {
+        vec3 o, d;
+        if (!rr_cam_ray(&c, x, y, &o, &d)) continue;
+        rr_ray ray = {{o.x, o.y, o.z}, {d.x, d.y, d.z}, 0, INFINITY};
+        if (v == 5) ray.tmin = test_randf(0, 5), ray.tmax = ray.tmin + test_randf(0, 10);
+        rr_hit a, b;
+        int any;
+        CHECK(rr_intersect(dev, s, &ray, &a) == RR_OK, "rr_intersect");
+        b = test_brute_ray(s, &ray, &any);
+        n++, hits += a.prim != RR_MISS;
+        if (memcmp(&a, &b, sizeof a) != 0 && bad++ < 4)
+          CHECK(0, "view %d ray (%d, %d): rr_intersect %u t %a, brute force %u t %a", v, x, y, a.prim, a.t, b.prim, b.t);
+        int occ = -1;
+        CHECK(rr_occluded(dev, s, &ray, &occ) == RR_OK && occ == any, "rr_occluded %d, brute force %d", occ, any);
+      }
+    rr_cam_release(&c);
+  }
+  CHECK(bad == 0, "%d of %d rays differ from brute force", bad, n);
+  printf("rays: %d of %d hit, %d differ from brute force\n", hits, n, bad);
+}
+
+/* ---- depth against a closed-form reference ------------------------------- */
+
+typedef long double ld;
+
+/* The exact hit of the ray o + t·d (long double) with primitive i, by the
+ * textbook formulas on a unit direction: t along d. */
+static ld ref_hit(const rr_scene *s, uint32_t i, const ld o[3], const ld d[3]) {
+  const float *a = s->ana + (size_t)ANA_FLOATS * i;
+  ld len = sqrtl(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), u[3] = {d[0] / len, d[1] / len, d[2] / len};
+  if (scene_kind(s, i) == RR_GEOMETRY_PLANE) {
+    ld num = 0, den = 0;
+    for (int k = 0; k < 3; k++) num += (ld)a[3 + k] * ((ld)a[k] - o[k]), den += (ld)a[3 + k] * d[k];
+    return num / den;
+  }
+  ld q[3] = {(ld)a[0] - o[0], (ld)a[1] - o[1], (ld)a[2] - o[2]};
+  ld b = q[0] * u[0] + q[1] * u[1] + q[2] * u[2], perp2 = 0;
+  for (int k = 0; k < 3; k++) {
+    ld f = q[k] - b * u[k];
+    perp2 += f * f;
+  }
+  ld h = sqrtl(fmaxl((ld)a[3] * a[3] - perp2, 0));
+  ld t = b - h > 0 ? b - h : b + h; /* near root, or the far one from inside */
+  return t / len;
+}
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : x > y;
+}
+
+static void check_depth(rr_device *dev, const rr_scene *s) {
+  const rr_camera_type types[3] = {RR_CAMERA_PERSPECTIVE, RR_CAMERA_ORTHOGRAPHIC, RR_CAMERA_LATLONG};
+  const int W = 160, H = 120;
+  for (int ty = 0; ty < 3; ty++) {
+    size_t cap = (size_t)W * H * 8, n = 0;
+    double *err = malloc(cap * sizeof *err);
+    for (int v = 0; v < 8; v++) {
+      rr_camera cam = test_random_view(s, v % 2 ? 0.2f : 1.2f, v % 2 ? 0.6f : 2.5f, 0.3f, 30, 90);
+      cam.type = types[ty], cam.ortho_height = test_randf(2, 12);
+      rr_frame *f = test_render(dev, s, &cam, v % 2 ? RR_METHOD_3DR_FULL : RR_METHOD_RC_BVH, 1, W, H, 0);
+      camera c;
+      if (!f || rr_cam_setup(dev, &cam, W, H, &c) != RR_OK) {
+        rr_frame_release(f);
+        continue;
+      }
+      for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+          size_t k = (size_t)y * W + x;
+          uint32_t id = f->vb.id[k];
+          if (id == RR_MISS || scene_kind(s, id) == RR_GEOMETRY_TRIANGLE) continue;
+          /* the sample's ray from the camera's own basis (as rr_depth_errors takes it) */
+          ld o[3], d[3], sx = (ld)x + c.sx0, sy = (ld)y + c.sy0;
+          const float e[3] = {c.eye.x, c.eye.y, c.eye.z};
+          const float d0[3] = {c.d0.x, c.d0.y, c.d0.z}, dx[3] = {c.dx.x, c.dx.y, c.dx.z}, dy[3] = {c.dy.x, c.dy.y, c.dy.z};
+          const float o0[3] = {c.o0.x, c.o0.y, c.o0.z}, ox[3] = {c.ox.x, c.ox.y, c.ox.z}, oy[3] = {c.oy.x, c.oy.y, c.oy.z};
+          const float fw[3] = {c.fwd.x, c.fwd.y, c.fwd.z};
+          for (int a = 0; a < 3; a++) {
+            if (types[ty] == RR_CAMERA_PERSPECTIVE) o[a] = e[a], d[a] = (ld)d0[a] + sx * dx[a] + sy * dy[a];
+            else if (types[ty] == RR_CAMERA_ORTHOGRAPHIC) o[a] = (ld)e[a] + o0[a] + sx * ox[a] + sy * oy[a], d[a] = fw[a];
+          }
+          if (types[ty] == RR_CAMERA_LATLONG) {
+            const vec3 w = c.dirs[k];
+            o[0] = e[0], o[1] = e[1], o[2] = e[2], d[0] = w.x, d[1] = w.y, d[2] = w.z;
+          }
+          ld t = ref_hit(s, id, o, d);
+          if (n < cap) err[n++] = (double)fabsl(((ld)f->vb.t[k] - t) / t);
+        }
+      rr_cam_release(&c);
+      rr_frame_release(f);
+    }
+    qsort(err, n, sizeof *err, cmp_double);
+    double p50 = n ? err[n / 2] : 0, p999 = n ? err[(size_t)((double)(n - 1) * 0.999)] : 0, mx = n ? err[n - 1] : 0;
+    printf("depth, %s: %zu analytic samples, relative error p50 %.3g p99.9 %.3g max %.3g\n", rr_camera_name(types[ty]),
+           n, p50, p999, mx);
+    CHECK(n > 1000, "%s: %zu samples hit analytic primitives", rr_camera_name(types[ty]), n);
+    CHECK(p999 <= 1e-6, "%s: p99.9 relative depth error %.3g over 1e-6", rr_camera_name(types[ty]), p999);
+    free(err);
+  }
+}
+
+/* ---- a sphere resting on a plane ------------------------------------------ */
+
+static void check_tangent(rr_device *dev) {
+  rr_scene *s = NULL;
+  CHECK(rr_scene_new(dev, &s) == RR_OK, "new");
+  const float plane[6] = {0, 0, 0, 0, 1, 0}, sphere[4] = {0, 1, 0, 1};
+  CHECK(rr_scene_add_spheres(s, sphere, 1, NULL) == RR_OK, "sphere");
+  CHECK(rr_scene_add_planes(s, plane, 1, NULL) == RR_OK, "plane");
+  CHECK(rr_scene_commit(s) == RR_OK, "commit");
+  int claimed = 0, near_contact = 0, samples = 0;
+  for (int v = 0; v < 4; v++) {
+    /* grazing views at the contact point from all sides, slightly above the plane */
+    float ang = (float)v * 1.5708f + 0.3f;
+    vec3 eye = v3(3 * cosf(ang), 0.2f + 0.1f * (float)v, 3 * sinf(ang));
+    rr_camera cam = test_camera(RR_CAMERA_PERSPECTIVE, eye, v3(0, 0, 0), 1.5f);
+    rr_frame *ref = test_render(dev, s, &cam, RR_METHOD_RC, 1, 64, 64, 0);
+    camera c;
+    if (!ref || rr_cam_setup(dev, &cam, 64, 64, &c) != RR_OK) {
+      rr_frame_release(ref);
+      continue;
+    }
+    for (int y = 0; y < 64; y++)
+      for (int x = 0; x < 64; x++) {
+        size_t k = (size_t)y * 64 + x;
+        ana_ray r;
+        float sx = (float)x + c.sx0, sy = (float)y + c.sy0, t[2], u, w;
+        ana_sample_ray(&c, camera_w(&c, x, y), sx, sy, &r);
+        bool h0 = rr_ana_hit(s, 0, &r, &t[0], &u, &w), h1 = rr_ana_hit(s, 1, &r, &t[1], &u, &w);
+        samples++;
+        /* a ray going down meets the plane: it must be claimed */
+        if (r.d[1] < 0) CHECK(ref->vb.id[k] != RR_MISS, "view %d: a gap at (%d, %d)", v, x, y);
+        uint32_t want = !h0 && !h1 ? RR_MISS : !h1 ? 0 : !h0 ? 1 : depth_wins(t[0], 0, t[1], 1) ? 0 : 1;
+        CHECK(ref->vb.id[k] == want, "view %d (%d, %d): claimed by %u, the nearer is %u", v, x, y, ref->vb.id[k], want);
+        claimed += ref->vb.id[k] != RR_MISS;
+        if (want != RR_MISS) { /* the claimed hit within 0.05 of the contact point (the origin) */
+          double th = t[want], p2 = 0;
+          for (int a = 0; a < 3; a++) p2 += (r.o[a] + th * r.d[a]) * (r.o[a] + th * r.d[a]);
+          near_contact += p2 < 0.05 * 0.05;
+        }
+      }
+    for (size_t m = 0; m < sizeof methods3d / sizeof methods3d[0]; m++) {
+      rr_frame *f = test_render(dev, s, &cam, methods3d[m], 2, 64, 64, 0);
+      if (f) CHECK(test_frames_differ(ref, f) == 0, "tangent view %d: %s differs", v, rr_method_name(methods3d[m]));
+      rr_frame_release(f);
+    }
+    rr_cam_release(&c);
+    rr_frame_release(ref);
+  }
+  printf("tangent: %d of %d samples claimed, %d hit within 0.05 of the contact\n", claimed, samples, near_contact);
+  CHECK(near_contact > 0, "the views reach the contact");
+  rr_scene_release(s);
+}
+
+/* ---- bad input ------------------------------------------------------------ */
+
+static void expect_refused(rr_device *dev, rr_scene *s, rr_error e, const char *needle) {
+  const char *msg = rr_device_message(dev);
+  CHECK(e == RR_ERROR_ARGUMENT, "refused (%d)", (int)e);
+  CHECK(msg && strstr(msg, needle), "message \"%s\" names \"%s\"", msg ? msg : "", needle);
+  rr_scene_info info;
+  rr_scene_get_info(s, &info);
+  CHECK(info.spheres == 1 && info.planes == 1 && info.geometries == 2, "nothing added (%llu spheres, %u geometries)",
+        (unsigned long long)info.spheres, info.geometries);
+}
+
+static void check_bad_input(rr_device *dev) {
+  rr_scene *s = NULL;
+  CHECK(rr_scene_new(dev, &s) == RR_OK, "new");
+  const float good[4] = {0, 0, 0, 1}, plane[6] = {0, 0, 0, 0, 1, 0};
+  CHECK(rr_scene_add_spheres(s, good, 1, NULL) == RR_OK && rr_scene_add_planes(s, plane, 1, NULL) == RR_OK, "good");
+  float sp[12] = {0, 0, 0, 1, 1, 1, 1, 1, 2, 2, 2, -1};
+  expect_refused(dev, s, rr_scene_add_spheres(s, sp, 3, NULL), "sphere 2 has radius -1");
+  sp[11] = 0;
+  expect_refused(dev, s, rr_scene_add_spheres(s, sp, 3, NULL), "sphere 2 has radius 0");
+  sp[11] = 1, sp[5] = NAN;
+  expect_refused(dev, s, rr_scene_add_spheres(s, sp, 3, NULL), "sphere 1 has a value that is not finite");
+  float pl[12] = {0, 0, 0, 0, 1, 0, 1, 1, 1, 0, 0, 0};
+  expect_refused(dev, s, rr_scene_add_planes(s, pl, 2, NULL), "plane 1 has a zero normal");
+  pl[9] = INFINITY;
+  expect_refused(dev, s, rr_scene_add_planes(s, pl, 2, NULL), "plane 1 has a value that is not finite");
+  expect_refused(dev, s, rr_scene_add_planes(s, NULL, 2, NULL), "NULL");
+  rr_scene_release(s);
+}
+
+int main(void) {
+  rr_device *dev = rr_device_new();
+  rr_scene *s = mixed_scene(dev, test_quick() ? 40 : 120, test_quick() ? 12 : 30);
+  if (s) {
+    rr_scene_info info;
+    rr_scene_get_info(s, &info);
+    CHECK(info.spheres == (test_quick() ? 12u : 30u) && info.planes == 2 && info.geometries == 4, "info counts kinds");
+    check_methods(dev, s, test_quick() ? 2 : 4);
+    printf("agreement: %d of %d frames bit-identical to rc\n", agree_total, agree_frames);
+    check_patterns(dev, s);
+    check_rays(dev, s);
+    check_depth(dev, s);
+    rr_scene_release(s);
+  }
+  check_tangent(dev);
+  check_bad_input(dev);
+  rr_device_release(dev);
+  return test_done();
+}
