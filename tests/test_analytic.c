@@ -14,6 +14,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* Random triangles, spheres (some overlapping, some crossing the plane) and a ground
  * plane y = 0 plus an oblique one far off. */
@@ -343,6 +344,79 @@ static void check_bad_input(rr_device *dev) {
   rr_scene_release(s);
 }
 
+/* ---- scene files ------------------------------------------------------------ */
+
+static char dir[] = "/tmp/rr_analytic_XXXXXX";
+
+/* Loads the scene file `text`; NULL on failure, the message in msg. */
+static rr_scene *load_json(rr_device *dev, const char *text, char *msg, size_t cap) {
+  rr_scene *s = NULL;
+  rr_error e = rr_scene_load(dev, test_write_file(dir, "a.json", text), &s);
+  snprintf(msg, cap, "%s", e ? rr_device_message(dev) : "");
+  return e ? NULL : s;
+}
+
+static void check_scene_file(rr_device *dev) {
+  if (!mkdtemp(dir)) {
+    CHECK(0, "mkdtemp");
+    return;
+  }
+  char msg[512];
+  rr_scene *s = load_json(dev,
+                          "{\"spheres\": [{\"center\": [0, 1, 0], \"radius\": 1, \"name\": \"ball\", "
+                          "\"material\": {\"color\": [1, 0, 0]}}, {\"center\": [3, 0.5, 0], \"radius\": 0.5}],"
+                          " \"planes\": [{\"point\": [0, 0, 0], \"normal\": [0, 2, 0]}],"
+                          " \"meshes\": [{\"builtin\": \"sphere\", \"scale\": 2, \"translate\": [0, 0, -5]},"
+                          " {\"builtin\": \"ground\", \"rotate\": [0, 0, 90], \"translate\": [9, 0, 0]}]}",
+                          msg, sizeof msg);
+  CHECK(s != NULL, "scene file: %s", msg);
+  if (s) {
+    rr_scene_info in;
+    rr_scene_get_info(s, &in);
+    rr_geometry_info g0, g4;
+    rr_scene_get_geometry_info(s, 0, &g0), rr_scene_get_geometry_info(s, 4, &g4);
+    CHECK(in.spheres == 4 && in.planes == 2 && in.geometries == 7, "%llu spheres, %llu planes, %u geometries",
+          (unsigned long long)in.spheres, (unsigned long long)in.planes, in.geometries);
+    /* meshes first (the built-in sphere scaled by 2 at z = -5, ground turned about z), then spheres, planes */
+    CHECK(g0.kind == RR_GEOMETRY_SPHERE && g4.kind == RR_GEOMETRY_SPHERE && g4.name && strcmp(g4.name, "ball") == 0,
+          "order and names");
+    const float *a = s->ana;
+    CHECK(a[0] == 0 && a[1] == 0 && a[2] == -5 && a[3] == 2, "the built-in sphere moved: (%g %g %g) r %g", a[0], a[1],
+          a[2], a[3]);
+    const float *pl = s->ana + (size_t)ANA_FLOATS * 1; /* ground's plane, turned: normal -x, through (9, 0, 0) */
+    CHECK(scene_kind(s, 1) == RR_GEOMETRY_PLANE && fabsf(pl[3] + 1) < 1e-6f && fabsf(pl[4]) < 1e-6f && pl[0] == 9,
+          "the built-in plane turned: (%g %g %g) n (%g %g %g)", pl[0], pl[1], pl[2], pl[3], pl[4], pl[5]);
+    rr_camera cam = test_camera(RR_CAMERA_PERSPECTIVE, v3(0, 3, 8), v3(0, 1, 0), 50);
+    rr_frame *f = test_render(dev, s, &cam, RR_METHOD_RC_BVH, 1, 16, 16, 0);
+    /* the centre sample sees the red ball (geometry 4's one primitive) */
+    CHECK(f && f->vb.id[8 * 16 + 8] == g4.first, "the centre sees the ball: %u, not %u", f ? f->vb.id[8 * 16 + 8] : 0,
+          g4.first);
+    rr_frame_release(f);
+    rr_scene_release(s);
+  }
+  const struct {
+    const char *text, *needle;
+  } bad[] = {
+      {"{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": -1}]}", "'spheres[0].radius': must be positive"},
+      {"{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1}, {\"center\": [0, 0, 0], \"radius\": 0}]}",
+       "'spheres[1].radius': must be positive"},
+      {"{\"spheres\": [{\"center\": [0, 0], \"radius\": 1}]}", "'spheres[0].center'"},
+      {"{\"spheres\": [{\"radius\": 1}]}", "'spheres[0]': missing 'center'"},
+      {"{\"planes\": [{\"point\": [0, 0, 0], \"normal\": [0, 0, 0]}]}", "'planes[0].normal': a zero normal"},
+      {"{\"planes\": [{\"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"size\": 3}]}", "'planes[0]'"},
+      {"{\"meshes\": [{\"builtin\": \"sphere\", \"scale\": [1, 2, 1]}]}", "'meshes[0]': a sphere takes only a uniform scale"},
+      {"{\"spheres\": [{\"center\": [0, 0, 1e31], \"radius\": 1}]}", "'spheres[0].center'"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    rr_scene *b = load_json(dev, bad[k].text, msg, sizeof msg);
+    CHECK(!b && strstr(msg, bad[k].needle) && !strchr(msg, '\n'), "bad file %zu: \"%s\" should name \"%s\"", k, msg,
+          bad[k].needle);
+    rr_scene_release(b);
+  }
+  unlink(test_write_file(dir, "a.json", ""));
+  rmdir(dir);
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
   rr_scene *s = mixed_scene(dev, test_quick() ? 40 : 120, test_quick() ? 12 : 30);
@@ -362,6 +436,7 @@ int main(void) {
   }
   check_tangent(dev);
   check_bad_input(dev);
+  check_scene_file(dev);
   rr_device_release(dev);
   return test_done();
 }

@@ -19,6 +19,18 @@ vec3 rr_ana_normal(const rr_scene *s, uint32_t i, float u, float v) {
   return v3((float)(sin(th) * sin(phi)), (float)cos(th), (float)(sin(th) * cos(phi)));
 }
 
+vec3 rr_ana_point(const rr_scene *s, uint32_t i, float u, float v) {
+  const float *a = ana_of(s, i);
+  if (scene_kind(s, i) == RR_GEOMETRY_PLANE) {
+    double ua[3], va[3], p[3];
+    rr_ana_plane_axes(a + 3, ua, va);
+    for (int k = 0; k < 3; k++) p[k] = a[k] + (double)u * ua[k] + (double)v * va[k];
+    return v3((float)p[0], (float)p[1], (float)p[2]);
+  }
+  vec3 n = rr_ana_normal(s, i, u, v);
+  return v3((float)(a[0] + (double)a[3] * n.x), (float)(a[1] + (double)a[3] * n.y), (float)(a[2] + (double)a[3] * n.z));
+}
+
 void rr_ana_box(const rr_scene *s, uint32_t i, float lo[3], float hi[3]) {
   const float *a = ana_of(s, i);
   if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {

@@ -84,6 +84,11 @@ void rr_ana_plane_axes(const float n[3], double u[3], double v[3]);
  * the plane's as stored), for shading. */
 vec3 rr_ana_normal(const rr_scene *s, uint32_t i, float u, float v);
 
+/* The point with coordinates u, v on primitive i: what shading takes for the hit
+ * (from the coordinates, like a triangle's from its barycentrics, so a hit that
+ * averages samples' coordinates stays on the surface). */
+vec3 rr_ana_point(const rr_scene *s, uint32_t i, float u, float v);
+
 /* The world box of analytic primitive i, for the BVH (rounded outwards). */
 void rr_ana_box(const rr_scene *s, uint32_t i, float lo[3], float hi[3]);
 

@@ -218,7 +218,9 @@ static void hit_surface(const rr_scene *s, const hit *h, const tex_filter *tf, s
   vec3 ng = geometric_normal(s, i, h->l1, h->l2);
   sf->ng = v3_dot(ng, h->dir) > 0 ? v3_neg(ng) : ng;
   sf->n = h->normal, sf->v = v3_neg(h->dir);
-  if (scene_inf(s, i) || scene_kind(s, i) != RR_GEOMETRY_TRIANGLE) { /* corners at infinity, analytic: along the ray */
+  if (scene_kind(s, i) != RR_GEOMETRY_TRIANGLE) { /* analytic: from its coordinates */
+    sf->p = rr_ana_point(s, i, h->l1, h->l2);
+  } else if (scene_inf(s, i)) { /* corners at infinity: along the ray */
     sf->p = v3_add(h->org, v3_scale(h->dir, h->dist));
   } else { /* from the corners: as exact as the triangle, wherever the ray came from */
     sf->p = v3_add(v3_add(v3_scale(scene_vertex(s, 0, i), h->l0), v3_scale(scene_vertex(s, 1, i), h->l1)),
