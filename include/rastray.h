@@ -82,9 +82,11 @@ RR_API rr_error rr_device_set_progress(rr_device *dev, rr_progress_fn fn, void *
 
 /* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...),
  * a scene file (a path ending in ".json": rr_scene_load_file with default options)
- * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]", "torus[:N]",
- * "grid:PATH:N" (N×N copies of a mesh on the XZ plane), "ground" (an infinite
- * plane with vertices at infinity, and objects on it), "checker" (an infinite
+ * or from a built-in name: "demo", "plane[:N]", "sphere:N", "box[:N]", "torus[:N]"
+ * (meshes), "sphere" (the analytic unit sphere), "grid:PATH:N" (N×N copies of a
+ * mesh on the XZ plane), "ground" (an analytic infinite plane with an analytic
+ * sphere and a box mesh on it), "ground:inf" (the same with the plane of vertices
+ * at infinity), "checker" (an infinite
  * checkerboard-textured plane, with a grazing view of its own). "demo" reads meshes from
  * the first directory holding them: $RASTRAY_DATA, the installed share/rastray,
  * the source tree's data/. */
