@@ -486,8 +486,8 @@ static rr_error add_analytic(rr_scene *s, const char *api, prim_kind kind, const
       if (!isfinite(a[c])) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: %s %zu has a value that is not finite", api, what, k);
     if (kind == RR_GEOMETRY_SPHERE && !(a[3] > 0))
       return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: sphere %zu has radius %g (must be positive)", api, k, (double)a[3]);
-    double n2 = (double)a[3] * a[3] + (double)a[4] * a[4] + (double)a[5] * a[5];
-    if (kind == RR_GEOMETRY_PLANE && !(n2 > 0 && n2 < INFINITY))
+    if (kind == RR_GEOMETRY_PLANE &&
+        !((double)a[3] * a[3] + (double)a[4] * a[4] + (double)a[5] * a[5] > 0)) /* (finite: checked above) */
       return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: plane %zu has a zero normal", api, k);
   }
   for (size_t c = 0; rgb && c < 3; c++)
