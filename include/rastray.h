@@ -122,6 +122,13 @@ RR_API rr_error rr_scene_add_spheres(rr_scene *scene, const float *spheres, size
  * along two axes of the plane (u across the normal in the plane of its two largest
  * components, v = n × u). */
 RR_API rr_error rr_scene_add_planes(rr_scene *scene, const float *planes, size_t count, const float rgb[3]);
+/* Appends `count` analytic boxes as one geometry, like rr_scene_add_spheres. boxes:
+ * 12 floats each: the centre x, y, z, the half sizes along the box's axes (positive),
+ * and its x and y axes in world space (any lengths, not parallel: made unit and
+ * orthogonal, x first; z = x × y). An axis-aligned box has axes 1,0,0 and 0,1,0. A
+ * hit's l1 is face + u (face = 2·axis + 1 on the positive side, 0 .. 5), l2 is v,
+ * (u, v) the hit's position on the face over [0, 1]². */
+RR_API rr_error rr_scene_add_boxes(rr_scene *scene, const float *boxes, size_t count, const float rgb[3]);
 /* Builds what rendering needs (the BVH); called implicitly by rr_scene_load.
  * Uses the device's build options (rr_device_set_build_options). */
 RR_API rr_error rr_scene_commit(rr_scene *scene);
@@ -177,7 +184,7 @@ typedef struct rr_scene_info {
   float up[3];    /* the model's up direction: +Y unless the file says otherwise (Z-up files: +Z) */
   float front[3]; /* the side the model faces, seen by rr_camera_frame: +Z for Y-up, -Y for Z-up files */
   uint64_t texture_bytes; /* the textures' texels as read and their MIP chains (16-bit linear RGBA) */
-  uint64_t spheres, planes; /* analytic primitives (not counted in triangles) */
+  uint64_t spheres, planes, boxes; /* analytic primitives (not counted in triangles) */
 } rr_scene_info;
 
 /* Fills what is known about a scene. */
@@ -202,6 +209,7 @@ typedef enum rr_geometry_kind {
   RR_GEOMETRY_TRIANGLE = 0, /* a triangle mesh */
   RR_GEOMETRY_SPHERE,       /* analytic spheres (centre, radius): rr_scene_add_spheres */
   RR_GEOMETRY_PLANE,        /* analytic infinite planes (point, normal): rr_scene_add_planes */
+  RR_GEOMETRY_BOX,          /* analytic boxes, axis-aligned or oriented: rr_scene_add_boxes */
   RR_GEOMETRY_KIND_COUNT
 } rr_geometry_kind;
 

@@ -38,6 +38,15 @@ static rr_scene *mixed_scene(rr_device *dev, int ntri, int nsph) {
             sp[4 * k + 3] = test_randf(0.1f, 1.2f);
   const float red[3] = {0.8f, 0.2f, 0.2f};
   CHECK(rr_scene_add_spheres(s, sp, (size_t)nsph, red) == RR_OK, "add spheres: %s", rr_device_message(dev));
+  /* boxes: half of them axis-aligned, the others turned at random */
+  float bx[12 * 8];
+  for (int k = 0; k < 8; k++) {
+    float *b = bx + 12 * k;
+    b[0] = test_randf(-4, 4), b[1] = test_randf(0, 2.5f), b[2] = test_randf(-4, 4);
+    b[3] = test_randf(0.3f, 1.5f), b[4] = test_randf(0.3f, 1.5f), b[5] = test_randf(0.3f, 1.5f);
+    for (int c = 0; c < 6; c++) b[6 + c] = k % 2 ? test_randf(-1, 1) : (c == 0 || c == 4);
+  }
+  CHECK(rr_scene_add_boxes(s, bx, 8, NULL) == RR_OK, "add boxes: %s", rr_device_message(dev));
   const float planes[12] = {0, 0, 0, 0, 1, 0, 0, 0, -9, 0.3f, 0.2f, 1};
   CHECK(rr_scene_add_planes(s, planes, 2, NULL) == RR_OK, "add planes: %s", rr_device_message(dev));
   /* more triangles after the analytic geometries: ids interleave kinds */
@@ -52,8 +61,8 @@ static const rr_method methods3d[] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_
                                       RR_METHOD_3DR_FC, RR_METHOD_3DR_FS, RR_METHOD_3DR_FULL};
 
 /* Counts the samples of f that hit each kind. */
-static void kind_hits(const rr_scene *s, const rr_frame *f, int n[3]) {
-  n[0] = n[1] = n[2] = 0;
+static void kind_hits(const rr_scene *s, const rr_frame *f, int n[4]) {
+  n[0] = n[1] = n[2] = n[3] = 0;
   size_t m = (size_t)f->vb.width * f->vb.height * (size_t)f->samples;
   for (size_t k = 0; k < m; k++)
     if (f->vb.id[k] != RR_MISS) n[scene_kind(s, f->vb.id[k])]++;
@@ -62,7 +71,7 @@ static void kind_hits(const rr_scene *s, const rr_frame *f, int n[3]) {
 static int agree_total, agree_frames;
 
 static void check_methods(rr_device *dev, const rr_scene *s, int views) {
-  int hits[3] = {0, 0, 0};
+  int hits[4] = {0, 0, 0, 0};
   for (int v = 0; v < views; v++) {
     for (int type = 0; type < RR_CAMERA_COUNT; type++) {
       float fov = type == RR_CAMERA_FISHEYE ? 200 : 70;
@@ -73,9 +82,9 @@ static void check_methods(rr_device *dev, const rr_scene *s, int views) {
       int w = type == RR_CAMERA_CUBE ? 64 : 56, h = 48;
       rr_frame *ref = test_render(dev, s, &cam, RR_METHOD_RC, 2, w, h, 0);
       if (!ref) continue;
-      int kh[3];
+      int kh[4];
       kind_hits(s, ref, kh);
-      for (int k = 0; k < 3; k++) hits[k] += kh[k];
+      for (int k = 0; k < 4; k++) hits[k] += kh[k];
       char what[256];
       snprintf(what, sizeof what, "view %d (%s), %s camera", v, inside ? "inside" : "outside", rr_camera_name(type));
       for (size_t m = 0; m < sizeof methods3d / sizeof methods3d[0]; m++) {
@@ -91,8 +100,9 @@ static void check_methods(rr_device *dev, const rr_scene *s, int views) {
       rr_frame_release(ref);
     }
   }
-  printf("rc hits over the views: %d triangle, %d sphere, %d plane samples\n", hits[0], hits[1], hits[2]);
-  CHECK(hits[0] > 0 && hits[1] > 0 && hits[2] > 0, "every kind is seen");
+  printf("rc hits over the views: %d triangle, %d sphere, %d plane, %d box samples\n", hits[0], hits[1], hits[2],
+         hits[3]);
+  CHECK(hits[0] > 0 && hits[1] > 0 && hits[2] > 0 && hits[3] > 0, "every kind is seen");
 }
 
 /* Several sample positions at once (the 3D methods take them in one pass): each
@@ -189,6 +199,21 @@ typedef long double ld;
 static ld ref_hit(const rr_scene *s, uint32_t i, const ld o[3], const ld d[3]) {
   const float *a = s->ana + (size_t)ANA_FLOATS * i;
   ld len = sqrtl(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), u[3] = {d[0] / len, d[1] / len, d[2] / len};
+  if (scene_kind(s, i) == RR_GEOMETRY_BOX) {
+    /* the six planes of the box's frame (rows x, y and z = x × y of the stored axes):
+     * the entry is the largest of the near planes' t, the exit the least far one */
+    ld R[3][3] = {{a[6], a[7], a[8]}, {a[9], a[10], a[11]}, {0, 0, 0}};
+    R[2][0] = R[0][1] * R[1][2] - R[0][2] * R[1][1], R[2][1] = R[0][2] * R[1][0] - R[0][0] * R[1][2];
+    R[2][2] = R[0][0] * R[1][1] - R[0][1] * R[1][0];
+    ld tn = -INFINITY, tf = INFINITY;
+    for (int ax = 0; ax < 3; ax++) {
+      ld oo = 0, dd = 0;
+      for (int k = 0; k < 3; k++) oo += R[ax][k] * (o[k] - (ld)a[k]), dd += R[ax][k] * d[k];
+      ld t0 = (-(ld)a[3 + ax] - oo) / dd, t1 = ((ld)a[3 + ax] - oo) / dd;
+      tn = fmaxl(tn, fminl(t0, t1)), tf = fminl(tf, fmaxl(t0, t1));
+    }
+    return tn > 0 ? tn : tf;
+  }
   if (scene_kind(s, i) == RR_GEOMETRY_PLANE) {
     ld num = 0, den = 0;
     for (int k = 0; k < 3; k++) num += (ld)a[3 + k] * ((ld)a[k] - o[k]), den += (ld)a[3 + k] * d[k];
@@ -336,6 +361,10 @@ static void check_bad_input(rr_device *dev) {
   expect_refused(dev, s, rr_scene_add_spheres(s, sp, 3, NULL), "sphere 2 has radius 0");
   sp[11] = 1, sp[5] = NAN;
   expect_refused(dev, s, rr_scene_add_spheres(s, sp, 3, NULL), "sphere 1 has a value that is not finite");
+  float bx[24] = {0, 0, 0, 1, 1, 1, 1, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 1, 1, 1, 0, 2, 2, 0};
+  expect_refused(dev, s, rr_scene_add_boxes(s, bx, 2, NULL), "box 1 has a half size that is not positive");
+  bx[16] = 1;
+  expect_refused(dev, s, rr_scene_add_boxes(s, bx, 2, NULL), "box 1 has axes that are zero or parallel");
   float pl[12] = {0, 0, 0, 0, 1, 0, 1, 1, 1, 0, 0, 0};
   expect_refused(dev, s, rr_scene_add_planes(s, pl, 2, NULL), "plane 1 has a zero normal");
   pl[9] = INFINITY;
@@ -423,7 +452,8 @@ int main(void) {
   if (s) {
     rr_scene_info info;
     rr_scene_get_info(s, &info);
-    CHECK(info.spheres == (test_quick() ? 12u : 30u) && info.planes == 2 && info.geometries == 4, "info counts kinds");
+    CHECK(info.spheres == (test_quick() ? 12u : 30u) && info.planes == 2 && info.boxes == 8 && info.geometries == 5,
+          "info counts kinds");
     check_methods(dev, s, test_quick() ? 2 : 4);
     printf("agreement: %d of %d frames bit-identical to rc\n", agree_total, agree_frames);
     check_patterns(dev, s);

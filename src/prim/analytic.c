@@ -8,13 +8,28 @@ bool rr_ana_hit(const rr_scene *s, uint32_t i, const ana_ray *r, float *t, float
   switch (scene_kind(s, i)) {
   case RR_GEOMETRY_SPHERE: return rr_ana_sphere_hit(ana_of(s, i), r, t, u, v);
   case RR_GEOMETRY_PLANE: return rr_ana_plane_hit(ana_of(s, i), r, t, u, v);
+  case RR_GEOMETRY_BOX: return rr_ana_box_hit(ana_of(s, i), r, t, u, v);
   default: return false;
   }
+}
+
+/* A box's face from the integer part of u (rr_ana_box_hit), clamped to 0..5. */
+static int box_face(float u) {
+  int f = (int)floorf(u);
+  return f < 0 ? 0 : f > 5 ? 5 : f;
 }
 
 vec3 rr_ana_normal(const rr_scene *s, uint32_t i, float u, float v) {
   const float *a = ana_of(s, i);
   if (scene_kind(s, i) == RR_GEOMETRY_PLANE) return v3(a[3], a[4], a[5]);
+  if (scene_kind(s, i) == RR_GEOMETRY_BOX) {
+    double R[3][3];
+    rr_ana_box_frame(a, R);
+    int f = box_face(u);
+    double sg = f & 1 ? 1 : -1;
+    (void)v;
+    return v3((float)(sg * R[f / 2][0]), (float)(sg * R[f / 2][1]), (float)(sg * R[f / 2][2]));
+  }
   double phi = ((double)u - 0.5) * 2 * RR_PI, th = (double)v * RR_PI;
   return v3((float)(sin(th) * sin(phi)), (float)cos(th), (float)(sin(th) * cos(phi)));
 }
@@ -27,16 +42,55 @@ vec3 rr_ana_point(const rr_scene *s, uint32_t i, float u, float v) {
     for (int k = 0; k < 3; k++) p[k] = a[k] + (double)u * ua[k] + (double)v * va[k];
     return v3((float)p[0], (float)p[1], (float)p[2]);
   }
+  if (scene_kind(s, i) == RR_GEOMETRY_BOX) {
+    double R[3][3], q[3];
+    rr_ana_box_frame(a, R);
+    int f = box_face(u), ax = f / 2, b1 = (ax + 1) % 3, b2 = (ax + 2) % 3;
+    q[ax] = (f & 1 ? 1.0 : -1.0) * a[3 + ax];
+    q[b1] = (((double)u - f) / (1 - 0x1p-16) * 2 - 1) * a[3 + b1], q[b2] = ((double)v * 2 - 1) * a[3 + b2];
+    double p[3];
+    for (int k = 0; k < 3; k++) p[k] = a[k] + R[0][k] * q[0] + R[1][k] * q[1] + R[2][k] * q[2];
+    return v3((float)p[0], (float)p[1], (float)p[2]);
+  }
   vec3 n = rr_ana_normal(s, i, u, v);
   return v3((float)(a[0] + (double)a[3] * n.x), (float)(a[1] + (double)a[3] * n.y), (float)(a[2] + (double)a[3] * n.z));
 }
 
-void rr_ana_box(const rr_scene *s, uint32_t i, float lo[3], float hi[3]) {
+/* The half extents of a sphere's or a box's world box about its centre: the
+ * radius, or Σ_a h_a·|axis_a| (a box's corners reach no further), widened by 1e-6:
+ * the stored axes are unit and orthogonal to float rounding only, so the box the
+ * slab test sees is R⁻¹ of the cube, R⁻¹ = Rᵀ to within ~1e-7. */
+static void box_extent(const rr_scene *s, uint32_t i, double ext[3]) {
   const float *a = ana_of(s, i);
   if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {
+    ext[0] = ext[1] = ext[2] = a[3];
+    return;
+  }
+  double R[3][3];
+  rr_ana_box_frame(a, R);
+  for (int x = 0; x < 3; x++)
+    ext[x] = a[3] * fabs(R[0][x]) + a[4] * fabs(R[1][x]) + a[5] * fabs(R[2][x]) + 1e-6 * ((double)a[3] + a[4] + a[5]);
+}
+
+/* The sphere around a box (centre, half diagonal widened by 1e-6) or a sphere itself:
+ * what cones and floors bound a box by. */
+static void bounding_sphere(const rr_scene *s, uint32_t i, float out[4]) {
+  const float *a = ana_of(s, i);
+  out[0] = a[0], out[1] = a[1], out[2] = a[2];
+  out[3] = scene_kind(s, i) == RR_GEOMETRY_BOX
+               ? nextafterf((float)((sqrt((double)a[3] * a[3] + (double)a[4] * a[4] + (double)a[5] * a[5]) + 1e-6 * ((double)a[3] + a[4] + a[5]))),
+                            INFINITY)
+               : a[3];
+}
+
+void rr_ana_box(const rr_scene *s, uint32_t i, float lo[3], float hi[3]) {
+  const float *a = ana_of(s, i);
+  if (scene_kind(s, i) == RR_GEOMETRY_SPHERE || scene_kind(s, i) == RR_GEOMETRY_BOX) {
+    double ext[3];
+    box_extent(s, i, ext);
     for (int x = 0; x < 3; x++) {
-      lo[x] = nextafterf((float)((double)a[x] - a[3]), -INFINITY);
-      hi[x] = nextafterf((float)((double)a[x] + a[3]), INFINITY);
+      lo[x] = nextafterf((float)((double)a[x] - ext[x]), -INFINITY);
+      hi[x] = nextafterf((float)((double)a[x] + ext[x]), INFINITY);
     }
     return;
   }
@@ -69,7 +123,11 @@ static void d3(vec3 v, double *o) { o[0] = v.x, o[1] = v.y, o[2] = v.z; }
  * so the hull of B (B itself) projects into the rectangle of its corners' samples;
  * B wholly at λ <= 0 holds no hit. Computed in double (errors ~1e-13 pixel, far
  * inside the 1e-3 pixel pad); the samples of pixel x lie in [x, x + 1). */
-static bool sphere_rect(const float *a, const camera *c, int rect[4]) {
+static bool sphere_rect(const rr_scene *s, uint32_t i, const camera *c, int rect[4]) {
+  const float *a = ana_of(s, i);
+  bool box = scene_kind(s, i) == RR_GEOMETRY_BOX;
+  double ext[3];
+  box_extent(s, i, ext);
   double base[3], e[3][3], ex[3], ey[3], ez[3];
   bool persp = c->type == RR_CAMERA_PERSPECTIVE;
   d3(c->eye, base);
@@ -89,6 +147,8 @@ static bool sphere_rect(const float *a, const camera *c, int rect[4]) {
   for (int k = 0; k < 8; k++) {
     double q[3];
     for (int x = 0; x < 3; x++) q[x] = (double)a[x] + (k >> x & 1 ? r : -r) - base[x];
+    if (box) /* the corners of its world box (box_extent) */
+      for (int x = 0; x < 3; x++) q[x] = (double)a[x] + (k >> x & 1 ? ext[x] : -ext[x]) - base[x];
     double lam = dot3(q, ex) / det, mu = dot3(q, ey) / det, nu = dot3(q, ez) / det;
     if (!(lam > 1e-12 * sqrt(dot3(q, q)))) continue; /* at or behind the eye's plane */
     ahead++;
@@ -110,18 +170,20 @@ static bool sphere_rect(const float *a, const camera *c, int rect[4]) {
 
 bool rr_ana_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int rect[4]) {
   if (rr_ana_t_floor(s, i, c) == INFINITY) return false;
-  if (c->planar && scene_kind(s, i) == RR_GEOMETRY_SPHERE) return sphere_rect(ana_of(s, i), c, rect);
+  if (c->planar && scene_kind(s, i) != RR_GEOMETRY_PLANE) return sphere_rect(s, i, c, rect);
   rect[0] = 0, rect[1] = 0, rect[2] = c->width - 1, rect[3] = c->height - 1;
   return c->width > 0 && c->height > 0;
 }
 
 bool rr_ana_cone_excludes(const rr_scene *s, uint32_t i, const camera *c, vec3 axis, float angle) {
-  const float *a = ana_of(s, i);
+  float bs[4];
+  bounding_sphere(s, i, bs);
+  const float *a = scene_kind(s, i) == RR_GEOMETRY_PLANE ? ana_of(s, i) : bs;
   double e[3], ax[3];
   d3(c->eye, e), d3(axis, ax);
   double la = sqrt(dot3(ax, ax));
   if (!(la > 0) || !(angle < CAMERA_NO_CONE)) return false;
-  if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {
+  if (scene_kind(s, i) != RR_GEOMETRY_PLANE) {
     double q[3] = {a[0] - e[0], a[1] - e[1], a[2] - e[2]}, dist = sqrt(dot3(q, q)), r = a[3];
     if (!(dist > r * (1 + 1e-9))) return false; /* the eye inside: every direction */
     double beta = asin(r / dist), cs = dot3(q, ax) / (dist * la);
@@ -148,10 +210,12 @@ bool rr_ana_cone_excludes(const rr_scene *s, uint32_t i, const camera *c, vec3 a
  * is linear, least at a corner (no positive corner: no hit); curved t >= |c| / |n|
  * / dir_len_max. Each in double, then rounded down (ana_floor_f). */
 float rr_ana_t_floor(const rr_scene *s, uint32_t i, const camera *c) {
-  const float *a = ana_of(s, i);
+  float bs[4]; /* a box's hits lie in its bounding sphere: that sphere's floor holds */
+  bounding_sphere(s, i, bs);
+  bool sphere = scene_kind(s, i) != RR_GEOMETRY_PLANE;
+  const float *a = sphere ? bs : ana_of(s, i);
   double e[3], f[3];
   d3(c->eye, e), d3(c->fwd, f);
-  bool sphere = scene_kind(s, i) == RR_GEOMETRY_SPHERE;
   if (!c->planar) {
     double L;
     if (sphere) {

@@ -1,9 +1,11 @@
-/* The analytic kinds: spheres (prim/sphere.c) and infinite planes (prim/plane.c).
+/* The analytic kinds: spheres (prim/sphere.c), infinite planes (prim/plane.c) and
+ * boxes, axis-aligned or oriented (prim/box.c).
  *
  * Storage. They share the triangles' index space (ids, geometries, materials, the
  * BVH's references, the visibility buffer): primitive i of an analytic geometry
  * keeps its parameters in s->ana[i] (sphere: centre, radius; plane: a point and
- * the unit normal) and its kind in s->kind[i], and its three triangle corners
+ * the unit normal; box: centre, half sizes, unit axes x and y, z = x × y) and its
+ * kind in s->kind[i], and its three triangle corners
  * all at the centre (point). That degenerate triangle has volume 0, so every
  * triangle path (setup, corner bounds, edge pre-tests, the 2D pipeline, shadow
  * tests) drops it as edge-on by itself; the methods add the kind's own test
@@ -28,7 +30,7 @@
 #include "camera/camera.h"
 
 /* Floats a primitive keeps in s->ana. */
-enum { ANA_FLOATS = 6 };
+enum { ANA_FLOATS = 12 };
 
 /* The kind of primitive i (triangles unless the scene holds analytic ones). */
 static inline prim_kind scene_kind(const rr_scene *s, uint32_t i) {
@@ -77,6 +79,10 @@ static inline ana_ray ana_ray_of(const float org[3], const float dir[3]) {
 bool rr_ana_hit(const rr_scene *s, uint32_t i, const ana_ray *r, float *t, float *u, float *v);
 bool rr_ana_sphere_hit(const float *sp, const ana_ray *r, float *t, float *u, float *v);
 bool rr_ana_plane_hit(const float *pl, const ana_ray *r, float *t, float *u, float *v);
+/* (box: u = face + position along the face's first axis, face = 2·axis + (side > 0)) */
+bool rr_ana_box_hit(const float *b, const ana_ray *r, float *t, float *u, float *v);
+/* A box's rotation: rows x, y, z of its frame in world space. */
+void rr_ana_box_frame(const float *b, double R[3][3]);
 /* The plane's axes in it (unit, right-handed with the normal): what u, v measure along. */
 void rr_ana_plane_axes(const float n[3], double u[3], double v[3]);
 

@@ -22,7 +22,7 @@ typedef rr_geometry_kind prim_kind;
 
 /* The kind's name, NULL when out of range. */
 static inline const char *prim_kind_name(int kind) {
-  static const char *const names[RR_GEOMETRY_KIND_COUNT] = {"triangle", "sphere", "plane"};
+  static const char *const names[RR_GEOMETRY_KIND_COUNT] = {"triangle", "sphere", "plane", "box"};
   return kind >= 0 && kind < RR_GEOMETRY_KIND_COUNT ? names[kind] : NULL;
 }
 

@@ -392,7 +392,7 @@ void rr_scene_update_bounds(rr_scene *s) {
       hi = v3_max(hi, p);
     }
   for (uint32_t i = 0; s->kind && i < s->ntris; i++)
-    if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {
+    if (scene_kind(s, i) == RR_GEOMETRY_SPHERE || scene_kind(s, i) == RR_GEOMETRY_BOX) {
       float blo[3], bhi[3];
       rr_ana_box(s, i, blo, bhi);
       lo = v3_min(lo, v3_load(blo)), hi = v3_max(hi, v3_load(bhi));
@@ -470,14 +470,30 @@ static rr_error reserve_kinds(rr_scene *s) {
   return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for analytic primitives");
 }
 
+/* A box's axes (floats 6..11 of its input) made unit and orthogonal, x first (Gram–
+ * Schmidt in double; the store rounds them to float, and rr_ana_box_frame's z = x × y
+ * keeps the frame right-handed); false when x is zero or y is parallel to it. */
+static bool box_axes(const float *a, double ax[3][3]) {
+  double x[3] = {a[6], a[7], a[8]}, y[3] = {a[9], a[10], a[11]};
+  double lx = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+  if (!(lx > 0 && lx < INFINITY)) return false;
+  for (int k = 0; k < 3; k++) x[k] /= lx;
+  double d = x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+  for (int k = 0; k < 3; k++) y[k] -= d * x[k];
+  double ly = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]), ly0 = sqrt((double)a[9] * a[9] + (double)a[10] * a[10] + (double)a[11] * a[11]);
+  if (!(ly > 1e-6 * ly0 && ly < INFINITY)) return false;
+  for (int k = 0; k < 3; k++) ax[0][k] = x[k], ax[1][k] = y[k] / ly;
+  return true;
+}
+
 /* Appends `count` analytic primitives of one kind, `per` floats each, as one
  * geometry; every one is checked first (finite; a positive radius; a non-zero
  * normal), so bad input adds nothing and the message names the primitive. */
 static rr_error add_analytic(rr_scene *s, const char *api, prim_kind kind, const float *v, size_t count,
                              const float rgb[3]) {
   if (!s) return RR_ERROR_ARGUMENT;
-  const char *what = kind == RR_GEOMETRY_SPHERE ? "sphere" : "plane";
-  int per = kind == RR_GEOMETRY_SPHERE ? 4 : 6;
+  const char *what = kind == RR_GEOMETRY_SPHERE ? "sphere" : kind == RR_GEOMETRY_PLANE ? "plane" : "box";
+  int per = kind == RR_GEOMETRY_SPHERE ? 4 : kind == RR_GEOMETRY_PLANE ? 6 : 12;
   if (!v && count) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: NULL array", api);
   if (count > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: too many %ss", api, what);
   for (size_t k = 0; k < count; k++) {
@@ -489,6 +505,13 @@ static rr_error add_analytic(rr_scene *s, const char *api, prim_kind kind, const
     if (kind == RR_GEOMETRY_PLANE &&
         !((double)a[3] * a[3] + (double)a[4] * a[4] + (double)a[5] * a[5] > 0)) /* (finite: checked above) */
       return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: plane %zu has a zero normal", api, k);
+    if (kind == RR_GEOMETRY_BOX) {
+      if (!(a[3] > 0 && a[4] > 0 && a[5] > 0))
+        return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: box %zu has a half size that is not positive", api, k);
+      double ax[3][3];
+      if (!box_axes(a, ax))
+        return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: box %zu has axes that are zero or parallel", api, k);
+    }
   }
   for (size_t c = 0; rgb && c < 3; c++)
     if (!(rgb[c] >= 0 && isfinite(rgb[c]))) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: a colour that is negative or not finite", api);
@@ -520,10 +543,16 @@ static rr_error add_analytic(rr_scene *s, const char *api, prim_kind kind, const
     s->material[i] = mat;
     s->kind[i] = (uint8_t)kind;
     float *out = s->ana + (size_t)ANA_FLOATS * i;
+    for (int c = 0; c < ANA_FLOATS; c++) out[c] = 0;
     if (kind == RR_GEOMETRY_SPHERE) {
       for (int c = 0; c < 4; c++) out[c] = a[c];
-      out[4] = out[5] = 0;
       s->nspheres++;
+    } else if (kind == RR_GEOMETRY_BOX) {
+      double ax[3][3];
+      box_axes(a, ax);
+      for (int c = 0; c < 6; c++) out[c] = a[c];
+      for (int c = 0; c < 3; c++) out[6 + c] = (float)ax[0][c], out[9 + c] = (float)ax[1][c];
+      s->nboxes++;
     } else {
       double l = sqrt((double)a[3] * a[3] + (double)a[4] * a[4] + (double)a[5] * a[5]);
       for (int c = 0; c < 3; c++) out[c] = a[c], out[3 + c] = (float)(a[3 + c] / l);
@@ -542,11 +571,15 @@ rr_error rr_scene_add_planes(rr_scene *s, const float *planes, size_t count, con
   return add_analytic(s, "rr_scene_add_planes", RR_GEOMETRY_PLANE, planes, count, rgb);
 }
 
+rr_error rr_scene_add_boxes(rr_scene *s, const float *boxes, size_t count, const float rgb[3]) {
+  return add_analytic(s, "rr_scene_add_boxes", RR_GEOMETRY_BOX, boxes, count, rgb);
+}
+
 rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
   if (!s || !info) return RR_ERROR_ARGUMENT;
   memset(info, 0, sizeof *info);
-  info->triangles = s->ntris - s->nspheres - s->nplanes;
-  info->spheres = s->nspheres, info->planes = s->nplanes;
+  info->triangles = s->ntris - s->nspheres - s->nplanes - s->nboxes;
+  info->spheres = s->nspheres, info->planes = s->nplanes, info->boxes = s->nboxes;
   info->skipped = s->skipped;
   info->materials = s->nmaterials;
   info->geometries = s->ngeoms;
@@ -708,7 +741,7 @@ rr_error rr_scene_get_normals(const rr_scene *s, const uint32_t *prims, size_t n
     uint32_t i = rr_scene_index_of(s, prims[k]);
     prim_kind kind = i == RR_MISS ? RR_GEOMETRY_TRIANGLE : scene_kind(s, i);
     /* a sphere's normal depends on the hit (rr_ana_normal): zero here, like a miss */
-    vec3 n = i == RR_MISS || kind == RR_GEOMETRY_SPHERE ? v3(0, 0, 0)
+    vec3 n = i == RR_MISS || kind == RR_GEOMETRY_SPHERE || kind == RR_GEOMETRY_BOX ? v3(0, 0, 0)
              : kind == RR_GEOMETRY_PLANE ? rr_ana_normal(s, i, 0, 0) : v3_norm(rr_scene_tri_normal(s, i));
     v3_store(normals + 3 * k, n);
   }
