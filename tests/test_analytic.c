@@ -395,6 +395,7 @@ static void check_scene_file(rr_device *dev) {
                           "{\"spheres\": [{\"center\": [0, 1, 0], \"radius\": 1, \"name\": \"ball\", "
                           "\"material\": {\"color\": [1, 0, 0]}}, {\"center\": [3, 0.5, 0], \"radius\": 0.5}],"
                           " \"planes\": [{\"point\": [0, 0, 0], \"normal\": [0, 2, 0]}],"
+                          " \"boxes\": [{\"center\": [-3, 0.5, 0], \"size\": [1, 2, 4], \"rotate\": [0, 90, 0]}],"
                           " \"meshes\": [{\"builtin\": \"sphere\", \"scale\": 2, \"translate\": [0, 0, -5]},"
                           " {\"builtin\": \"ground\", \"rotate\": [0, 0, 90], \"translate\": [9, 0, 0]}]}",
                           msg, sizeof msg);
@@ -404,8 +405,14 @@ static void check_scene_file(rr_device *dev) {
     rr_scene_get_info(s, &in);
     rr_geometry_info g0, g4;
     rr_scene_get_geometry_info(s, 0, &g0), rr_scene_get_geometry_info(s, 4, &g4);
-    CHECK(in.spheres == 4 && in.planes == 2 && in.geometries == 7, "%llu spheres, %llu planes, %u geometries",
-          (unsigned long long)in.spheres, (unsigned long long)in.planes, in.geometries);
+    CHECK(in.spheres == 4 && in.planes == 2 && in.boxes == 1 && in.geometries == 8,
+          "%llu spheres, %llu planes, %u geometries", (unsigned long long)in.spheres, (unsigned long long)in.planes,
+          in.geometries);
+    /* the box: half sizes 0.5, 1, 2, its x axis turned by 90° about y to -z */
+    const float *bx = s->ana + (size_t)ANA_FLOATS * (s->ntris - 1);
+    CHECK(scene_kind(s, s->ntris - 1) == RR_GEOMETRY_BOX && bx[3] == 0.5f && bx[4] == 1 && bx[5] == 2 &&
+              fabsf(bx[8] + 1) < 1e-6f && fabsf(bx[6]) < 1e-6f && bx[10] == 1,
+          "the box: half sizes %g %g %g, x axis (%g %g %g)", bx[3], bx[4], bx[5], bx[6], bx[7], bx[8]);
     /* meshes first (the built-in sphere scaled by 2 at z = -5, ground turned about z), then spheres, planes */
     CHECK(g0.kind == RR_GEOMETRY_SPHERE && g4.kind == RR_GEOMETRY_SPHERE && g4.name && strcmp(g4.name, "ball") == 0,
           "order and names");
@@ -435,6 +442,9 @@ static void check_scene_file(rr_device *dev) {
       {"{\"planes\": [{\"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"size\": 3}]}", "'planes[0]'"},
       {"{\"meshes\": [{\"builtin\": \"sphere\", \"scale\": [1, 2, 1]}]}", "'meshes[0]': a sphere takes only a uniform scale"},
       {"{\"spheres\": [{\"center\": [0, 0, 1e31], \"radius\": 1}]}", "'spheres[0].center'"},
+      {"{\"boxes\": [{\"center\": [0, 0, 0], \"size\": [1, 0, 1]}]}", "'boxes[0].size': every size must be positive"},
+      {"{\"boxes\": [{\"center\": [0, 0, 0], \"size\": [1, -1, 1]}]}", "'boxes[0].size'"},
+      {"{\"boxes\": [{\"center\": [0, 0, 0], \"size\": [1, 1, 1], \"scale\": 2}]}", "'boxes[0]'"},
   };
   for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
     rr_scene *b = load_json(dev, bad[k].text, msg, sizeof msg);
