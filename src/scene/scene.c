@@ -145,6 +145,9 @@ static bool resize(rr_scene *s, uint32_t cap, bool add_n, bool add_uv) {
     float *a = k ? realloc(s->ana, (size_t)cap * ANA_FLOATS * sizeof *a) : NULL;
     if (a) s->ana = a;
     ok = a != NULL;
+    /* new room is triangles: loaders that write primitives straight into the arrays
+     * (copies of a mesh) then need not know about kinds */
+    if (ok && cap > s->cap) memset(s->kind + s->cap, RR_GEOMETRY_TRIANGLE, cap - s->cap);
   }
   if (ok && s->file_id && cap != s->cap) {
     uint32_t *f = realloc(s->file_id, (size_t)cap * sizeof *f);
