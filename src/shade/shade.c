@@ -50,7 +50,7 @@ static hit hit_make(const rr_scene *s, uint32_t id, float l1, float l2, float t,
   h.dist = t * len;
   h.l1 = l1, h.l2 = l2, h.l0 = 1.0f - l1 - l2;
   vec3 n = geometric_normal(s, id, l1, l2);
-  if (s->n[0][0]) {
+  if (s->n[0][0] && scene_kind(s, id) == RR_GEOMETRY_TRIANGLE) {
     vec3 sn = v3(0, 0, 0);
     float w[3] = {h.l0, h.l1, h.l2};
     for (int v = 0; v < 3; v++)
