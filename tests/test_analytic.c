@@ -1,13 +1,15 @@
-/* Analytic spheres and planes (prim/analytic.h) beside triangles:
- * - every method gives rc's bits on scenes mixing the three kinds, at random views
- *   and views from inside, for every camera, on 1 and 2 threads, and at several
- *   sample positions per pixel;
- * - rr_intersect gives brute force's bits (test_brute_ray) on camera rays;
+/* Analytic spheres, planes and boxes (prim/analytic.h) beside triangles:
+ * - every 3D method gives rc's bits on scenes mixing the four kinds, at random views
+ *   and views from inside, for every camera, on 1 and 2 threads, with and without
+ *   back-face culling, and at several sample positions per pixel;
+ * - the 2D pipeline draws them as impostors with the same bits;
+ * - rr_intersect / rr_occluded give brute force's bits (test_brute_ray) on camera rays;
  * - depth against a closed-form reference in long double (perspective,
  *   orthographic, lat-long): p99.9 relative error <= 1e-6;
  * - a sphere resting on a plane: every sample looking at the plane is claimed,
  *   by the nearer of the two (depth_wins), in every method;
- * - bad input (radius <= 0, NaN, zero normal) refused, naming the primitive. */
+ * - bad input (radius <= 0, NaN, zero normal, degenerate box) refused, naming the
+ *   primitive, in the API and in scene files. */
 #include "vis/vis.h"
 #include "io/io.h"
 #include "testutil.h"
@@ -80,7 +82,8 @@ static void check_methods(rr_device *dev, const rr_scene *s, int views) {
       cam.type = (rr_camera_type)type;
       cam.ortho_height = 8;
       int w = type == RR_CAMERA_CUBE ? 64 : 56, h = 48;
-      rr_frame *ref = test_render(dev, s, &cam, RR_METHOD_RC, 2, w, h, 0);
+      int cull = type % 2; /* back faces culled (triangles only: analytic primitives show what the ray meets) */
+      rr_frame *ref = test_render(dev, s, &cam, RR_METHOD_RC, 2, w, h, cull);
       if (!ref) continue;
       int kh[4];
       kind_hits(s, ref, kh);
@@ -89,7 +92,7 @@ static void check_methods(rr_device *dev, const rr_scene *s, int views) {
       snprintf(what, sizeof what, "view %d (%s), %s camera", v, inside ? "inside" : "outside", rr_camera_name(type));
       for (size_t m = 0; m < sizeof methods3d / sizeof methods3d[0]; m++) {
         int threads = 1 + (int)((v + type + m) % 2);
-        rr_frame *f = test_render(dev, s, &cam, methods3d[m], threads, w, h, 0);
+        rr_frame *f = test_render(dev, s, &cam, methods3d[m], threads, w, h, cull);
         if (!f) continue;
         int d = test_frames_differ(ref, f);
         CHECK(d == 0, "%s: %s on %d threads differs from rc at %d samples", what, rr_method_name(methods3d[m]),
