@@ -123,6 +123,36 @@ static void d3(vec3 v, double *o) { o[0] = v.x, o[1] = v.y, o[2] = v.z; }
  * so the hull of B (B itself) projects into the rectangle of its corners' samples;
  * B wholly at λ <= 0 holds no hit. Computed in double (errors ~1e-13 pixel, far
  * inside the 1e-3 pixel pad); the samples of pixel x lie in [x, x + 1). */
+/* Perspective cameras, a sphere wholly ahead of the eye's plane: the tight bounds of
+ * its image, the conic of its silhouette. The rays d = M·w (w = (1, sx, sy), M the
+ * columns d0, dx, dy) that meet the sphere are those where (q·d)² − c·|d|² >= 0
+ * (c = |q|² − r² > 0, the eye outside; the hit test's discriminant a·h² in other
+ * words), the quadratic form wᵀAw with A = u·uᵀ − c·MᵀM, u = Mᵀq: an ellipse in the
+ * image. A line l·w = 0 touches it where lᵀ·adj(A)·l = 0 (the dual conic), so the
+ * columns sx = X bounding it solve B00·X² − 2·B01·X + B11 = 0 and the rows
+ * B00·Y² − 2·B02·Y + B22 = 0 (B = adj(A)). In double; the rectangle of the box's
+ * corners is narrowed to it (both hold every sample that can pass), the caller pads. */
+static void conic_rect(const float *a, const double base[3], double M[3][3], double *X0, double *X1, double *Y0,
+                       double *Y1) {
+  double q[3] = {a[0] - base[0], a[1] - base[1], a[2] - base[2]}, r = a[3];
+  double c = dot3(q, q) - r * r, u[3], A[3][3], B[3][3];
+  if (!(c > 0)) return;
+  for (int i = 0; i < 3; i++) u[i] = dot3(M[i], q);
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) A[i][j] = u[i] * u[j] - c * dot3(M[i], M[j]);
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      int i1 = (j + 1) % 3, i2 = (j + 2) % 3, j1 = (i + 1) % 3, j2 = (i + 2) % 3;
+      B[i][j] = A[i1][j1] * A[i2][j2] - A[i1][j2] * A[i2][j1]; /* adj(A) = cofactors transposed */
+    }
+  double dx = B[0][1] * B[0][1] - B[0][0] * B[1][1], dy = B[0][2] * B[0][2] - B[0][0] * B[2][2];
+  if (!(B[0][0] != 0 && dx >= 0 && dy >= 0 && isfinite(dx) && isfinite(dy))) return;
+  double xa = (B[0][1] - sqrt(dx)) / B[0][0], xb = (B[0][1] + sqrt(dx)) / B[0][0];
+  double ya = (B[0][2] - sqrt(dy)) / B[0][0], yb = (B[0][2] + sqrt(dy)) / B[0][0];
+  *X0 = fmax(*X0, fmin(xa, xb)), *X1 = fmin(*X1, fmax(xa, xb));
+  *Y0 = fmax(*Y0, fmin(ya, yb)), *Y1 = fmin(*Y1, fmax(ya, yb));
+}
+
 static bool sphere_rect(const rr_scene *s, uint32_t i, const camera *c, int rect[4]) {
   const float *a = ana_of(s, i);
   bool box = scene_kind(s, i) == RR_GEOMETRY_BOX;
@@ -161,6 +191,7 @@ static bool sphere_rect(const rr_scene *s, uint32_t i, const camera *c, int rect
     rect[0] = 0, rect[1] = 0, rect[2] = W - 1, rect[3] = H - 1;
     return true;
   }
+  if (persp && !box) conic_rect(a, base, e, &X0, &X1, &Y0, &Y1);
   double pad = 1e-3 + 1e-9 * fmax(fmax(fabs(X0), fabs(X1)), fmax(fabs(Y0), fabs(Y1)));
   X0 = floor(X0 - pad - 1), X1 = floor(X1 + pad), Y0 = floor(Y0 - pad - 1), Y1 = floor(Y1 + pad);
   rect[0] = X0 < 0 ? 0 : (int)X0, rect[1] = Y0 < 0 ? 0 : (int)Y0;
