@@ -82,9 +82,11 @@ RR_API rr_error rr_device_set_progress(rr_device *dev, rr_progress_fn fn, void *
 
 /* Loads a scene from a file that assimp reads (OBJ, PLY, glTF, COLLADA, 3DS...),
  * a scene file (a path ending in ".json": rr_scene_load_file with default options)
- * or from a built-in name: "demo", "plane[:N]", "sphere[:N]", "box[:N]", "torus[:N]",
- * "grid:PATH:N" (N×N copies of a mesh on the XZ plane), "ground" (an infinite
- * plane with vertices at infinity, and objects on it), "checker" (an infinite
+ * or from a built-in name: "demo", "plane[:N]", "sphere:N", "box[:N]", "torus[:N]"
+ * (meshes), "sphere" (the analytic unit sphere), "grid:PATH:N" (N×N copies of a
+ * mesh on the XZ plane), "ground" (an analytic infinite plane with an analytic
+ * sphere and a box mesh on it), "ground:inf" (the same with the plane of vertices
+ * at infinity), "checker" (an infinite
  * checkerboard-textured plane, with a grazing view of its own). "demo" reads meshes from
  * the first directory holding them: $RASTRAY_DATA, the installed share/rastray,
  * the source tree's data/. */
@@ -106,6 +108,27 @@ RR_API rr_error rr_scene_add_mesh_colors(rr_scene *scene, const float *positions
 /* The same with homogeneous xyzw vertices: w != 0 is divided out, w = 0 is a point at infinity in direction xyz (3D methods only). */
 RR_API rr_error rr_scene_add_mesh4(rr_scene *scene, const float *xyzw, size_t nvertices, const uint32_t *indices,
                                    size_t ntriangles, const float rgb[3]);
+/* Appends `count` analytic spheres as one new geometry (numbered after the scene's
+ * others, one id per sphere like a mesh's triangles) with a new material of base
+ * colour rgb (NULL: grey). spheres: 4 floats each, centre x, y, z and radius. A
+ * radius that is not positive, or a value that is not finite, refuses the whole
+ * call (RR_ERROR_ARGUMENT, the message naming the sphere) and adds nothing. A hit's
+ * l1, l2 (rr_hit, the visibility buffer) are its longitude / 2π + 0.5 (atan2 of x
+ * over z) and colatitude / π from +y. */
+RR_API rr_error rr_scene_add_spheres(rr_scene *scene, const float *spheres, size_t count, const float rgb[3]);
+/* Appends `count` analytic infinite planes as one geometry, like rr_scene_add_spheres.
+ * planes: 6 floats each, a point x, y, z on the plane and its normal (any length
+ * but zero; both sides are seen). A hit's l1, l2 are its offsets from the point
+ * along two axes of the plane (u across the normal in the plane of its two largest
+ * components, v = n × u). */
+RR_API rr_error rr_scene_add_planes(rr_scene *scene, const float *planes, size_t count, const float rgb[3]);
+/* Appends `count` analytic boxes as one geometry, like rr_scene_add_spheres. boxes:
+ * 12 floats each: the centre x, y, z, the half sizes along the box's axes (positive),
+ * and its x and y axes in world space (any lengths, not parallel: made unit and
+ * orthogonal, x first; z = x × y). An axis-aligned box has axes 1,0,0 and 0,1,0. A
+ * hit's l1 is face + u (face = 2·axis + 1 on the positive side, 0 .. 5), l2 is v,
+ * (u, v) the hit's position on the face over [0, 1]². */
+RR_API rr_error rr_scene_add_boxes(rr_scene *scene, const float *boxes, size_t count, const float rgb[3]);
 /* Builds what rendering needs (the BVH); called implicitly by rr_scene_load.
  * Uses the device's build options (rr_device_set_build_options). */
 RR_API rr_error rr_scene_commit(rr_scene *scene);
@@ -161,6 +184,7 @@ typedef struct rr_scene_info {
   float up[3];    /* the model's up direction: +Y unless the file says otherwise (Z-up files: +Z) */
   float front[3]; /* the side the model faces, seen by rr_camera_frame: +Z for Y-up, -Y for Z-up files */
   uint64_t texture_bytes; /* the textures' texels as read and their MIP chains (16-bit linear RGBA) */
+  uint64_t spheres, planes, boxes; /* analytic primitives (not counted in triangles) */
 } rr_scene_info;
 
 /* Fills what is known about a scene. */
@@ -183,6 +207,9 @@ RR_API rr_error rr_scene_get_info(const rr_scene *scene, rr_scene_info *info);
 /* What a geometry is made of (like Embree's RTC_GEOMETRY_TYPE_*). */
 typedef enum rr_geometry_kind {
   RR_GEOMETRY_TRIANGLE = 0, /* a triangle mesh */
+  RR_GEOMETRY_SPHERE,       /* analytic spheres (centre, radius): rr_scene_add_spheres */
+  RR_GEOMETRY_PLANE,        /* analytic infinite planes (point, normal): rr_scene_add_planes */
+  RR_GEOMETRY_BOX,          /* analytic boxes, axis-aligned or oriented: rr_scene_add_boxes */
   RR_GEOMETRY_KIND_COUNT
 } rr_geometry_kind;
 

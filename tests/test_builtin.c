@@ -321,7 +321,7 @@ int main(void) {
   test_plane("plane:1", 1);
   test_plane("plane:5", 5);
   test_plane("plane:10", 10);
-  test_sphere("sphere", 32);
+  test_sphere("sphere:32", 32);
   test_sphere("sphere:4", 4);
   test_sphere("sphere:7", 7);
   test_sphere("sphere:100", 100);

@@ -58,7 +58,7 @@ int main(void) {
   bool quick = test_quick();
   int views = quick ? 2 : 4;
   check_scene(dev, "rooms:4", views, 256, false);
-  check_scene(dev, "ground", 2, 128, true);
+  check_scene(dev, "ground:inf", 2, 128, true);
   char grid[1024];
   snprintf(grid, sizeof grid, "grid:%s/teapot.obj:3", RR_DATA_DIR);
   check_scene(dev, grid, views, 256, false);

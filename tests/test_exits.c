@@ -99,7 +99,7 @@ int main(void) {
       {"render sphere --method 2dr-bb --camera latlong --size 64x32 -o r.png", 2},
       {"render sphere --camera cube --size 64x64 -o r.png", 2},
       {"render sphere --method 3dr-bin --oracles bin=0 --size 32x32 -o r.png", 2},
-      {"render ground --method 2dr-bb --size 32x32 -o r.png", 2},
+      {"render ground:inf --method 2dr-bb --size 32x32 -o r.png", 2},
       {"render sphere --method 3dr-bin --oracles leaves=2 --size 32x32 -o r.png", 2},
       {"render sphere --fov 1e-30 --size 32x32 -o r.png", 2},
       {"render sphere --size 32x32 --aov depth=r.png", 1},

@@ -24,7 +24,7 @@ static void check_table(const rr_scene *s, const char *what) {
   rr_scene_get_info(s, &in);
   CHECK(in.geometries == s->ngeoms && (in.triangles == 0 || in.geometries > 0), "%s: %u geometries for %llu triangles",
         what, in.geometries, (unsigned long long)in.triangles);
-  uint64_t faces = in.triangles + in.skipped;
+  uint64_t faces = in.triangles + in.skipped + in.spheres + in.planes; /* every primitive has an id */
   uint32_t next = 0, bad_range = 0, bad_lookup = 0, bad_material = 0, bad_order = 0;
   for (uint32_t g = 0; g < in.geometries; g++) {
     rr_geometry_info gi;
@@ -32,7 +32,7 @@ static void check_table(const rr_scene *s, const char *what) {
       CHECK(0, "%s: geometry %u: %s", what, g, rr_device_message(s->dev));
       return;
     }
-    bad_range += gi.first != next || gi.kind != RR_GEOMETRY_TRIANGLE || (in.materials && gi.material >= in.materials);
+    bad_range += gi.first != next || (unsigned)gi.kind >= RR_GEOMETRY_KIND_COUNT || (in.materials && gi.material >= in.materials);
     next = gi.first + gi.count;
     for (uint32_t i = gi.first; i < next && i < faces; i++) {
       uint32_t geom, local;

@@ -219,12 +219,12 @@ static void check_api(rr_device *dev) {
 int main(void) {
   rr_device *dev = rr_device_new();
   rr_scene *s = NULL;
-  if (rr_scene_load(dev, "ground", &s) != RR_OK) {
+  if (rr_scene_load(dev, "ground:inf", &s) != RR_OK) {
     CHECK(0, "load ground: %s", rr_device_message(dev));
   } else {
     CHECK(s->inf && scene_inf(s, 0) == 6u && s->ntris > 4, "ground: four triangles with corners at infinity first");
     CHECK(s->bmax.x < 10 && s->bmin.z > -10, "bounds hold the finite corners only");
-    check_views(dev, s, 4, "ground");
+    check_views(dev, s, 4, "ground:inf");
     rr_scene_release(s);
   }
   check_api(dev);

@@ -317,11 +317,11 @@ int main(void) {
     for (int k = 0; k < 3; k++) idx[3 * i + k] = (uint32_t)(3 * i + k);
   }
   for (int k = 0; k < 2; k++) {
-    rr_error e = k ? rr_scene_load(dev, "ground", &s) : rr_scene_new(dev, &s);
+    rr_error e = k ? rr_scene_load(dev, "ground:inf", &s) : rr_scene_new(dev, &s);
     if (!k && !e) e = rr_scene_add_mesh(s, fan, 3 * FAN, idx, FAN, NULL);
     if (!k && !e) e = rr_scene_commit(s);
     if (e) {
-      CHECK(0, "%s: %s", k ? "ground" : "fan", rr_device_message(dev));
+      CHECK(0, "%s: %s", k ? "ground:inf" : "fan", rr_device_message(dev));
       continue;
     }
     uint32_t widest = 0;

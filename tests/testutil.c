@@ -236,7 +236,10 @@ rr_hit test_brute_ray(const rr_scene *s, const rr_ray *ray, int *any) {
   *any = 0;
   for (uint32_t i = 0; i < s->ntris; i++) {
     float t, l1, l2;
-    if (!rr_tri_ray_hit(s, i, &rc, false, ray->tmin, ray->tmax, &t, &l1, &l2)) continue;
+    if (scene_kind(s, i) != RR_GEOMETRY_TRIANGLE) { /* analytic: the one test on the float ray */
+      ana_ray ar = ana_ray_of(ray->org, ray->dir);
+      if (!rr_ana_hit(s, i, &ar, &t, &l1, &l2) || !(t >= ray->tmin && t <= ray->tmax)) continue;
+    } else if (!rr_tri_ray_hit(s, i, &rc, false, ray->tmin, ray->tmax, &t, &l1, &l2)) continue;
     *any = 1;
     if (depth_wins(t, i, h.t, h.prim)) h = rr_scene_hit(s, i, t, l1, l2);
   }

@@ -836,6 +836,9 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
   printf("scene        %s\n", scene_name);
   printf("triangles    %llu (%llu degenerate or non-finite skipped)\n", (unsigned long long)in.triangles,
          (unsigned long long)in.skipped);
+  if (in.spheres || in.planes || in.boxes)
+    printf("analytic     %llu spheres, %llu planes, %llu boxes\n", (unsigned long long)in.spheres,
+           (unsigned long long)in.planes, (unsigned long long)in.boxes);
   printf("materials    %u\n", in.materials);
   printf("geometries   %u\n", in.geometries);
   enum { LISTED = 32 }; /* a scene of more lists none: the list would drown the rest */

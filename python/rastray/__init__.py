@@ -213,10 +213,18 @@ class Scene:
         return cls(out[0], dev)
 
     @classmethod
-    def from_arrays(cls, vertices, faces, colors=None, threads=0):
+    def from_arrays(cls, vertices, faces, colors=None, threads=0, spheres=None, planes=None, boxes=None):
         """One mesh: vertices (N, 3) float32, faces (M, 3) uint32, colors (N, 3)
         linear RGB per vertex or None. Degenerate and non-finite triangles are
-        skipped (they keep their ids)."""
+        skipped (they keep their ids). Analytic primitives after it, one geometry
+        per kind: spheres (K, 4) centre and radius, planes (K, 6) point and normal,
+        boxes (K, 12) centre, half sizes, x and y axes (rr_scene_add_boxes)."""
+        analytic = []
+        for arr, name, cols, fn in ((spheres, "spheres", 4, "rr_scene_add_spheres"),
+                                    (planes, "planes", 6, "rr_scene_add_planes"),
+                                    (boxes, "boxes", 12, "rr_scene_add_boxes")):
+            if arr is not None:
+                analytic.append((_array(arr, name, np.float32, cols), getattr(lib, fn)))
         v = _array(vertices, "vertices", np.float32, 3)
         f = _array(faces, "faces", np.uint32, 3)
         if f.size and int(f.max()) >= len(v):
@@ -232,6 +240,8 @@ class Scene:
             vp, fp = ffi.from_buffer("float[]", v), ffi.from_buffer("uint32_t[]", f)
             cp = ffi.NULL if c is None else ffi.from_buffer("float[]", c)
             dev.check(lib.rr_scene_add_mesh_colors(self._ptr, vp, len(v), fp, len(f), ffi.NULL, cp))
+            for a, add in analytic:
+                dev.check(add(self._ptr, ffi.from_buffer("float[]", a), len(a), ffi.NULL))
             dev.check(lib.rr_scene_commit(self._ptr))
         except BaseException:
             self.close()
@@ -264,6 +274,7 @@ class Scene:
         i = ffi.new("rr_scene_info *")
         self._dev.check(lib.rr_scene_get_info(self._scene(), i))
         return {"triangles": i.triangles, "skipped": i.skipped, "geometries": i.geometries,
+                "spheres": i.spheres, "planes": i.planes, "boxes": i.boxes,
                 "bounds": (np.array(list(i.bounds_min)), np.array(list(i.bounds_max)))}
 
     def frame_camera(self, size, fov=45.0):

@@ -491,7 +491,8 @@ static void make_refs(int c, int thread, void *arg) {
   box4 b = box_empty(), cb = box_empty();
   for (uint32_t i = a; i < e; i++) {
     pref *r = &j->refs[i];
-    rr_tri_box(s, i, r->lo, r->hi);
+    if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE) rr_tri_box(s, i, r->lo, r->hi);
+    else rr_ana_box(s, i, r->lo, r->hi);
     r->id = i, r->pad = 0;
     rr_vf4 lo, hi;
     ref_load(r, &lo, &hi);

@@ -2,6 +2,7 @@
 #ifndef RR_BVH_H
 #define RR_BVH_H
 
+#include "prim/analytic.h"
 #include "prim/triangle.h"
 
 /* 32-byte node with its own bounds. A leaf (count > 0) holds triangles

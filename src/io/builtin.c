@@ -237,6 +237,16 @@ static rr_error gen_torus(rr_scene *s, int nu, int nv, float R, float r, vec3 ce
   return RR_OK;
 }
 
+/* ---- analytic primitives ---------------------------------------------------------- */
+
+/* Analytic spheres (4 floats each) or planes (6) as one geometry named `name`. */
+static rr_error add_analytic(rr_scene *s, prim_kind kind, const float *v, size_t n, const char *name, float r,
+                             float g, float b) {
+  const float rgb[3] = {r, g, b};
+  rr_error e = kind == RR_GEOMETRY_SPHERE ? rr_scene_add_spheres(s, v, n, rgb) : rr_scene_add_planes(s, v, n, rgb);
+  return e ? e : rr_scene_name_geometry(s, s->ngeoms - 1, name);
+}
+
 /* ---- infinite ground (homogeneous vertices) ------------------------------------- */
 
 /* The plane y = 0 without end: four triangles fanning from the origin to the
@@ -244,6 +254,17 @@ static rr_error gen_torus(rr_scene *s, int nu, int nv, float R, float r, vec3 ce
  * seen from +y, so triangle q holds quadrant q: 0 (x > 0, z < 0), 1 (x < 0,
  * z < 0), 2 (x < 0, z > 0), 3 (x > 0, z > 0). On it, clear of the plane so that
  * nothing is coplanar with it: a sphere and a box (the generators' meshes, moved). */
+/* `ground`: the same objects with the plane y = 0 and the sphere analytic (the box
+ * stays a mesh), so its silhouettes and its contact with the plane are exact;
+ * `ground:inf` is the plane as homogeneous triangles. */
+static rr_error gen_box_on_ground(rr_scene *s);
+static rr_error gen_ground_analytic(rr_scene *s) {
+  const float plane[6] = {0, 0, 0, 0, 1, 0}, ball[4] = {-1.5f, 1.05f, 0.5f, 1.0f};
+  rr_error e = add_analytic(s, RR_GEOMETRY_PLANE, plane, 1, "ground", 0.55f, 0.62f, 0.45f);
+  if (!e) e = add_analytic(s, RR_GEOMETRY_SPHERE, ball, 1, "sphere", 0.20f, 0.45f, 0.85f);
+  return e ? e : gen_box_on_ground(s);
+}
+
 static rr_error gen_ground(rr_scene *s) {
   uint32_t ground_m, ball_m;
   rr_error e = add_material(s, 0.55f, 0.62f, 0.45f, &ground_m);
@@ -258,8 +279,12 @@ static rr_error gen_ground(rr_scene *s) {
     rr_scene_push_inf(s, p, 6u, NULL, NULL, NULL, ground_m); /* corners 1 and 2 at infinity */
   }
   e = gen_sphere(s, 24, v3(-1.5f, 1.05f, 0.5f), 1.0f, ball_m);
+  return e ? e : gen_box_on_ground(s);
+}
+
+static rr_error gen_box_on_ground(rr_scene *s) {
   uint32_t t0 = s->ntris;
-  if (!e) e = gen_box(s, 1);
+  rr_error e = gen_box(s, 1);
   if (e) return e;
   /* the unit box [-1,1]^3 to half size, standing 0.05 above the plane at (1.5, -0.5):
    * the same map for every corner keeps shared corners identical */
@@ -640,6 +665,9 @@ rr_error rr_scene_load_builtin(rr_scene *s, const char *name) {
   } else if ((arg = builtin_arg(name, "plane"))) {
     e = size_arg(s, name, arg, 64, 1, 4096, &n);
     if (!e) e = gen_plane(s, (int)n);
+  } else if (strcmp(name, "sphere") == 0) { /* the analytic unit sphere; sphere:N is a mesh */
+    const float unit[4] = {0, 0, 0, 1};
+    e = add_analytic(s, RR_GEOMETRY_SPHERE, unit, 1, "sphere", SCENE_GREY, SCENE_GREY, SCENE_GREY);
   } else if ((arg = builtin_arg(name, "sphere"))) {
     uint32_t mat;
     e = size_arg(s, name, arg, 32, 4, 4096, &n);
@@ -657,6 +685,8 @@ rr_error rr_scene_load_builtin(rr_scene *s, const char *name) {
     e = size_arg(s, name, arg, 4, 1, 100, &n);
     if (!e) e = gen_rooms(s, (int)n);
   } else if (strcmp(name, "ground") == 0) {
+    e = gen_ground_analytic(s);
+  } else if (strcmp(name, "ground:inf") == 0) {
     e = gen_ground(s);
   } else if (strcmp(name, "checker") == 0) {
     e = gen_checker(s);

@@ -10,6 +10,7 @@
 #define _XOPEN_SOURCE 700 /* realpath */
 #include "io/io.h"
 #include "io/json_read.h"
+#include "prim/analytic.h"
 
 #include <limits.h>
 #include <math.h>
@@ -303,6 +304,17 @@ static double det3(const double m[3][3]) {
 
 /* The mesh's transform: "matrix" (4 rows of 4, acting on column vectors, bottom row
  * 0 0 0 1), or scale, then rotate (degrees about X, then Y, then Z), then translate. */
+/* m turned by deg degrees about X, then Y, then Z (the fixed world axes): Rz·Ry·Rx·m. */
+static void rotate_by(const double deg[3], double m[3][3]) {
+  for (int axis = 0; axis < 3; axis++) {
+    double a = deg[axis] * (RR_PI / 180), c = cos(a), sn = sin(a);
+    int p = (axis + 1) % 3, q = (axis + 2) % 3; /* rotates p towards q: right-handed about `axis` */
+    double rm[3][3] = {{0}};
+    rm[axis][axis] = 1, rm[p][p] = c, rm[q][q] = c, rm[p][q] = -sn, rm[q][p] = sn;
+    mat_mul(m, rm, m);
+  }
+}
+
 static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
   *x = (xform){{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
   const cJSON *matrix = rr_json_get(obj, "matrix");
@@ -341,13 +353,7 @@ static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
         (e = rr_json_doubles(r, obj, "translate", 3, -MAX_COORD, MAX_COORD, x->t)))
       return e;
     double m[3][3] = {{s[0], 0, 0}, {0, s[1], 0}, {0, 0, s[2]}};
-    for (int axis = 0; axis < 3; axis++) {
-      double a = deg[axis] * (RR_PI / 180), c = cos(a), sn = sin(a);
-      int p = (axis + 1) % 3, q = (axis + 2) % 3; /* rotates p towards q: right-handed about `axis` */
-      double rm[3][3] = {{0}};
-      rm[axis][axis] = 1, rm[p][p] = c, rm[q][q] = c, rm[p][q] = -sn, rm[q][p] = sn;
-      mat_mul(m, rm, m);
-    }
+    rotate_by(deg, m);
     memcpy(x->m, m, sizeof m);
   }
   double d = det3(x->m);
@@ -383,6 +389,37 @@ static bool is_identity(const xform *x) {
   return memcmp(x, &id, sizeof id) == 0;
 }
 
+/* An analytic primitive i (a built-in's) moved by x (nm: its cofactor matrix): a
+ * plane's point and normal (by the inverse transpose); a sphere's centre, and its
+ * radius by the scale, which must be uniform (a sphere stays a sphere). */
+static rr_error xform_analytic(json_reader *r, rr_scene *s, const xform *x, const double nm[3][3], uint32_t i) {
+  float *a = s->ana + (size_t)ANA_FLOATS * i;
+  vec3 c = xf_point(x, v3(a[0], a[1], a[2]), false);
+  if (!(fabsf(c.x) <= 1e30f && fabsf(c.y) <= 1e30f && fabsf(c.z) <= 1e30f))
+    return rr_json_fail(r, NULL, "the transform takes vertices beyond 1e30");
+  for (int k = 0; k < 3; k++) s->p[k][0][i] = c.x, s->p[k][1][i] = c.y, s->p[k][2][i] = c.z;
+  a[0] = c.x, a[1] = c.y, a[2] = c.z;
+  if (scene_kind(s, i) == RR_GEOMETRY_BOX) return rr_json_fail(r, NULL, "boxes are placed by 'boxes', not moved");
+  if (scene_kind(s, i) == RR_GEOMETRY_PLANE) {
+    vec3 n = xf_unit(nm, v3(a[3], a[4], a[5]));
+    a[3] = n.x, a[4] = n.y, a[5] = n.z;
+    return RR_OK;
+  }
+  /* uniform: the columns of m orthogonal and of one length */
+  double len[3], dev = 0;
+  for (int j = 0; j < 3; j++) len[j] = sqrt(x->m[0][j] * x->m[0][j] + x->m[1][j] * x->m[1][j] + x->m[2][j] * x->m[2][j]);
+  for (int j = 0; j < 3; j++) {
+    int k = (j + 1) % 3;
+    double dot = x->m[0][j] * x->m[0][k] + x->m[1][j] * x->m[1][k] + x->m[2][j] * x->m[2][k];
+    dev = fmax(dev, fmax(fabs(len[j] - len[0]), fabs(dot) / len[0]));
+  }
+  if (!(dev <= 1e-6 * len[0])) return rr_json_fail(r, NULL, "a sphere takes only a uniform scale (rotation, translation)");
+  double rad = a[3] * len[0];
+  if (!(rad > 0 && rad <= 1e30)) return rr_json_fail(r, NULL, "the transform takes a sphere's radius out of range");
+  a[3] = (float)rad;
+  return RR_OK;
+}
+
 static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_t t0, uint32_t c0, uint32_t l0) {
   if (is_identity(x)) return RR_OK; /* the mesh as its file has it, normals' bits too */
   double d = det3(x->m), nm[3][3]; /* the cofactor matrix: the inverse transpose times det */
@@ -392,6 +429,11 @@ static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_
       nm[i][j] = (x->m[i1][j1] * x->m[i2][j2] - x->m[i1][j2] * x->m[i2][j1]) * (d < 0 ? -1 : 1);
     }
   for (uint32_t i = t0; i < s->ntris; i++) {
+    if (scene_kind(s, i) != RR_GEOMETRY_TRIANGLE) {
+      rr_error e = xform_analytic(r, s, x, nm, i);
+      if (e) return e;
+      continue;
+    }
     unsigned inf = scene_inf(s, i);
     for (int k = 0; k < 3; k++) {
       vec3 p = xf_point(x, scene_vertex(s, k, i), inf >> k & 1u);
@@ -512,7 +554,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
     e = rr_scene_load_builtin(s, builtin);
     if (e == RR_ERROR_UNSUPPORTED)
       return rr_json_fail(r, "builtin", "unknown built-in '%.64s' (expected demo, plane[:N], sphere[:N], box[:N], "
-                                     "torus[:N], rooms[:N], ground, checker or grid:PATH:N)", builtin);
+                                     "torus[:N], rooms[:N], ground, ground:inf, checker or grid:PATH:N)", builtin);
   } else {
     if (!file[0]) return rr_json_fail(r, "file", "empty path");
     if (strlen(file) >= MAX_PATH) return rr_json_fail(r, "file", "path too long");
@@ -535,6 +577,73 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
     rr_json_leave(r, len);
   }
   return e;
+}
+
+/* ---- analytic primitives ----------------------------------------------------------- */
+
+/* A sphere ("center", "radius"), a plane ("point", "normal") or a box ("center",
+ * "size", "rotate"), with "name" and "material": one geometry of one primitive,
+ * after the meshes. */
+static rr_error read_analytic(json_reader *r, const cJSON *obj, rr_scene *s, prim_kind kind) {
+  static const char *const sphere_keys[] = {"center", "radius", "name", "material", NULL};
+  static const char *const plane_keys[] = {"point", "normal", "name", "material", NULL};
+  static const char *const box_keys[] = {"center", "size", "rotate", "name", "material", NULL};
+  bool sphere = kind == RR_GEOMETRY_SPHERE, box = kind == RR_GEOMETRY_BOX;
+  rr_error e = rr_json_keys(r, obj, sphere ? sphere_keys : box ? box_keys : plane_keys);
+  if (e) return e;
+  const char *need[2] = {sphere || box ? "center" : "point", sphere ? "radius" : box ? "size" : "normal"}, *name = NULL;
+  for (int k = 0; k < 2; k++)
+    if (!rr_json_get(obj, need[k])) return rr_json_fail(r, NULL, "missing '%s'", need[k]);
+  float v[12] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  if ((e = rr_json_floats(r, obj, need[0], 3, -MAX_COORD, MAX_COORD, v)) || (e = rr_json_string(r, obj, "name", &name)))
+    return e;
+  if (box) {
+    double size[3], deg[3] = {0, 0, 0}, m[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    if ((e = rr_json_doubles(r, obj, "size", 3, 0, MAX_COORD, size)) ||
+        (e = rr_json_doubles(r, obj, "rotate", 3, -1e6, 1e6, deg)))
+      return e;
+    rotate_by(deg, m);
+    for (int k = 0; k < 3; k++) {
+      v[3 + k] = (float)(size[k] / 2);
+      if (!(v[3 + k] > 0)) return rr_json_fail(r, "size", "every size must be positive");
+      v[6 + k] = (float)m[k][0], v[9 + k] = (float)m[k][1]; /* the turned x and y axes */
+    }
+  } else if (sphere) {
+    const cJSON *rad = rr_json_get(obj, "radius");
+    if (cJSON_IsNumber(rad) && !(rad->valuedouble > 0))
+      return rr_json_fail(r, "radius", "must be positive, not %g", rad->valuedouble);
+    e = rr_json_float(r, obj, "radius", 0, MAX_COORD, &v[3]);
+    if (!e && !(v[3] > 0)) e = rr_json_fail(r, "radius", "must be positive");
+  } else {
+    e = rr_json_floats(r, obj, "normal", 3, -MAX_COORD, MAX_COORD, v + 3);
+    if (!e && v[3] == 0 && v[4] == 0 && v[5] == 0) e = rr_json_fail(r, "normal", "a zero normal");
+  }
+  if (e) return e;
+  uint32_t m0 = s->nmaterials, g0 = s->ngeoms;
+  e = sphere ? rr_scene_add_spheres(s, v, 1, NULL) : box ? rr_scene_add_boxes(s, v, 1, NULL) : rr_scene_add_planes(s, v, 1, NULL);
+  if (e) {
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", rr_device_message(s->dev));
+    return rr_json_fail(r, NULL, "%s", msg);
+  }
+  if (name && (e = rr_scene_name_geometry(s, g0, name))) return e;
+  const cJSON *material = rr_json_get(obj, "material");
+  if (material) {
+    size_t len = rr_json_enter(r, "material", 0);
+    e = read_material(r, material, s, m0);
+    rr_json_leave(r, len);
+  }
+  return e;
+}
+
+static rr_error sphere_item(json_reader *r, const cJSON *item, void *arg) {
+  return read_analytic(r, item, arg, RR_GEOMETRY_SPHERE);
+}
+static rr_error plane_item(json_reader *r, const cJSON *item, void *arg) {
+  return read_analytic(r, item, arg, RR_GEOMETRY_PLANE);
+}
+static rr_error box_item(json_reader *r, const cJSON *item, void *arg) {
+  return read_analytic(r, item, arg, RR_GEOMETRY_BOX);
 }
 
 /* ---- lights ---------------------------------------------------------------------- */
@@ -671,7 +780,7 @@ static rr_error import_camera(json_reader *r, const cJSON *obj, const char *base
 /* Everything of the file but the commit. */
 static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const char *base_dir,
                            const rr_load_options *opt, rr_scene_settings *st) {
-  static const char *const keys[] = {"meshes", "lights", "camera", "render", "comment", NULL};
+  static const char *const keys[] = {"meshes", "spheres", "planes", "boxes", "lights", "camera", "render", "comment", NULL};
   rr_error e = rr_json_keys(r, root, keys);
   const char *comment;
   if (!e) e = rr_json_string(r, root, "comment", &comment);
@@ -690,7 +799,12 @@ static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const
     rr_json_leave(r, len);
   }
   mesh_arg ma = {s, base_dir, opt};
-  if (!e) e = each(r, root, "meshes", true, mesh_item, &ma);
+  /* meshes may be left out when spheres or planes are given */
+  bool analytic = rr_json_get(root, "spheres") || rr_json_get(root, "planes") || rr_json_get(root, "boxes");
+  if (!e) e = each(r, root, "meshes", !analytic, mesh_item, &ma);
+  if (!e) e = each(r, root, "spheres", false, sphere_item, s);
+  if (!e) e = each(r, root, "planes", false, plane_item, s);
+  if (!e) e = each(r, root, "boxes", false, box_item, s);
   /* the scene file's world is Y-up, its front +Z, whatever the files' axes */
   s->up = v3(0, 1, 0), s->front = v3(0, 0, 1);
   if (!e) e = each(r, root, "lights", false, light_item, s);

@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200809L /* strdup */
 
 #include "accel/bvh.h"
+#include "prim/analytic.h"
 
 #include <string.h>
 
@@ -28,6 +29,7 @@ void rr_scene_release(rr_scene *s) {
   free(s->material);
   free(s->file_id);
   free(s->inf);
+  free(s->kind), free(s->ana);
   for (uint32_t m = 0; m < s->nmaterials; m++) {
     free(s->materials[m].name);
     free(s->materials[m].texture_path);
@@ -137,6 +139,16 @@ static bool resize(rr_scene *s, uint32_t cap, bool add_n, bool add_uv) {
     if (f) s->inf = f;
     ok = f != NULL;
   }
+  if (ok && s->kind && cap != s->cap) {
+    uint8_t *k = realloc(s->kind, cap);
+    if (k) s->kind = k;
+    float *a = k ? realloc(s->ana, (size_t)cap * ANA_FLOATS * sizeof *a) : NULL;
+    if (a) s->ana = a;
+    ok = a != NULL;
+    /* new room is triangles: loaders that write primitives straight into the arrays
+     * (copies of a mesh) then need not know about kinds */
+    if (ok && cap > s->cap) memset(s->kind + s->cap, RR_GEOMETRY_TRIANGLE, cap - s->cap);
+  }
   if (ok && s->file_id && cap != s->cap) {
     uint32_t *f = realloc(s->file_id, (size_t)cap * sizeof *f);
     if (f) s->file_id = f;
@@ -218,6 +230,7 @@ bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n
     s->bmax = v3_max(s->bmax, p[k]);
   }
   s->material[i] = mat;
+  if (s->kind) s->kind[i] = RR_GEOMETRY_TRIANGLE;
   return true;
 }
 
@@ -381,6 +394,12 @@ void rr_scene_update_bounds(rr_scene *s) {
       lo = v3_min(lo, p);
       hi = v3_max(hi, p);
     }
+  for (uint32_t i = 0; s->kind && i < s->ntris; i++)
+    if (scene_kind(s, i) == RR_GEOMETRY_SPHERE || scene_kind(s, i) == RR_GEOMETRY_BOX) {
+      float blo[3], bhi[3];
+      rr_ana_box(s, i, blo, bhi);
+      lo = v3_min(lo, v3_load(blo)), hi = v3_max(hi, v3_load(bhi));
+    }
   s->bmin = lo;
   s->bmax = hi;
 }
@@ -442,10 +461,128 @@ rr_error rr_scene_add_mesh4(rr_scene *s, const float *xyzw, size_t nvert, const 
   return add_mesh(s, "rr_scene_add_mesh4", xyzw, 4, nvert, idx, ntri, rgb, NULL);
 }
 
+/* Starts the kinds and parameters of analytic primitives (those so far are
+ * triangles), which then grow with the other arrays. */
+static rr_error reserve_kinds(rr_scene *s) {
+  if (s->kind) return RR_OK;
+  size_t cap = s->cap ? s->cap : 1;
+  s->kind = calloc(cap, 1); /* RR_GEOMETRY_TRIANGLE is 0 */
+  s->ana = calloc(cap * ANA_FLOATS, sizeof *s->ana);
+  if (s->kind && s->ana) return RR_OK;
+  free(s->kind), free(s->ana), s->kind = NULL, s->ana = NULL;
+  return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for analytic primitives");
+}
+
+/* A box's axes (floats 6..11 of its input) made unit and orthogonal, x first (Gram–
+ * Schmidt in double; the store rounds them to float, and rr_ana_box_frame's z = x × y
+ * keeps the frame right-handed); false when x is zero or y is parallel to it. */
+static bool box_axes(const float *a, double ax[3][3]) {
+  double x[3] = {a[6], a[7], a[8]}, y[3] = {a[9], a[10], a[11]};
+  double lx = sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+  if (!(lx > 0 && lx < INFINITY)) return false;
+  for (int k = 0; k < 3; k++) x[k] /= lx;
+  double d = x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+  for (int k = 0; k < 3; k++) y[k] -= d * x[k];
+  double ly = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]), ly0 = sqrt((double)a[9] * a[9] + (double)a[10] * a[10] + (double)a[11] * a[11]);
+  if (!(ly > 1e-6 * ly0 && ly < INFINITY)) return false;
+  for (int k = 0; k < 3; k++) ax[0][k] = x[k], ax[1][k] = y[k] / ly;
+  return true;
+}
+
+/* Appends `count` analytic primitives of one kind, `per` floats each, as one
+ * geometry; every one is checked first (finite; a positive radius; a non-zero
+ * normal), so bad input adds nothing and the message names the primitive. */
+static rr_error add_analytic(rr_scene *s, const char *api, prim_kind kind, const float *v, size_t count,
+                             const float rgb[3]) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  const char *what = kind == RR_GEOMETRY_SPHERE ? "sphere" : kind == RR_GEOMETRY_PLANE ? "plane" : "box";
+  int per = kind == RR_GEOMETRY_SPHERE ? 4 : kind == RR_GEOMETRY_PLANE ? 6 : 12;
+  if (!v && count) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: NULL array", api);
+  if (count > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: too many %ss", api, what);
+  for (size_t k = 0; k < count; k++) {
+    const float *a = v + per * k;
+    for (int c = 0; c < per; c++)
+      if (!isfinite(a[c])) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: %s %zu has a value that is not finite", api, what, k);
+    if (kind == RR_GEOMETRY_SPHERE && !(a[3] > 0))
+      return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: sphere %zu has radius %g (must be positive)", api, k, (double)a[3]);
+    if (kind == RR_GEOMETRY_PLANE &&
+        !((double)a[3] * a[3] + (double)a[4] * a[4] + (double)a[5] * a[5] > 0)) /* (finite: checked above) */
+      return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: plane %zu has a zero normal", api, k);
+    if (kind == RR_GEOMETRY_BOX) {
+      if (!(a[3] > 0 && a[4] > 0 && a[5] > 0))
+        return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: box %zu has a half size that is not positive", api, k);
+      double ax[3][3];
+      if (!box_axes(a, ax))
+        return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: box %zu has axes that are zero or parallel", api, k);
+    }
+  }
+  for (size_t c = 0; rgb && c < 3; c++)
+    if (!(rgb[c] >= 0 && isfinite(rgb[c]))) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%s: a colour that is negative or not finite", api);
+  float grey[3] = {SCENE_GREY, SCENE_GREY, SCENE_GREY};
+  uint32_t mat = rr_scene_add_material(s, rgb ? rgb : grey, NULL);
+  if (mat == UINT32_MAX) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory adding a material");
+  rr_error e = rr_scene_reserve(s, (uint32_t)count, false, false);
+  if (!e) e = reserve_kinds(s);
+  if (!e && s->skipped) e = rr_scene_reserve_ids(s);
+  if (!e) e = rr_scene_open_geometry(s, kind, mat, NULL);
+  if (e) return e;
+  for (size_t k = 0; k < count; k++) {
+    const float *a = v + per * k;
+    uint32_t i = s->ntris;
+    if (s->file_id) s->file_id[i] = (uint32_t)scene_faces(s);
+    s->ntris++;
+    /* the triangle corners all at the centre (point): a triangle every triangle path drops */
+    for (int c = 0; c < 3; c++)
+      for (int j = 0; j < 3; j++) s->p[c][j][i] = a[j];
+    for (int c = 0; c < 3; c++) {
+      for (int j = 0; j < 3; j++) {
+        if (s->n[c][j]) s->n[c][j][i] = 0;
+        if (s->col[c][j]) s->col[c][j][i] = 1;
+      }
+      for (int j = 0; j < 2; j++)
+        if (s->uv[c][j]) s->uv[c][j][i] = 0;
+    }
+    if (s->inf) s->inf[i] = 0;
+    s->material[i] = mat;
+    s->kind[i] = (uint8_t)kind;
+    float *out = s->ana + (size_t)ANA_FLOATS * i;
+    for (int c = 0; c < ANA_FLOATS; c++) out[c] = 0;
+    if (kind == RR_GEOMETRY_SPHERE) {
+      for (int c = 0; c < 4; c++) out[c] = a[c];
+      s->nspheres++;
+    } else if (kind == RR_GEOMETRY_BOX) {
+      double ax[3][3];
+      box_axes(a, ax);
+      for (int c = 0; c < 6; c++) out[c] = a[c];
+      for (int c = 0; c < 3; c++) out[6 + c] = (float)ax[0][c], out[9 + c] = (float)ax[1][c];
+      s->nboxes++;
+    } else {
+      double l = sqrt((double)a[3] * a[3] + (double)a[4] * a[4] + (double)a[5] * a[5]);
+      for (int c = 0; c < 3; c++) out[c] = a[c], out[3 + c] = (float)(a[3 + c] / l);
+      s->nplanes++;
+    }
+  }
+  rr_scene_update_bounds(s);
+  return rr_ok(s->dev);
+}
+
+rr_error rr_scene_add_spheres(rr_scene *s, const float *spheres, size_t count, const float rgb[3]) {
+  return add_analytic(s, "rr_scene_add_spheres", RR_GEOMETRY_SPHERE, spheres, count, rgb);
+}
+
+rr_error rr_scene_add_planes(rr_scene *s, const float *planes, size_t count, const float rgb[3]) {
+  return add_analytic(s, "rr_scene_add_planes", RR_GEOMETRY_PLANE, planes, count, rgb);
+}
+
+rr_error rr_scene_add_boxes(rr_scene *s, const float *boxes, size_t count, const float rgb[3]) {
+  return add_analytic(s, "rr_scene_add_boxes", RR_GEOMETRY_BOX, boxes, count, rgb);
+}
+
 rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
   if (!s || !info) return RR_ERROR_ARGUMENT;
   memset(info, 0, sizeof *info);
-  info->triangles = s->ntris;
+  info->triangles = s->ntris - s->nspheres - s->nplanes - s->nboxes;
+  info->spheres = s->nspheres, info->planes = s->nplanes, info->boxes = s->nboxes;
   info->skipped = s->skipped;
   info->materials = s->nmaterials;
   info->geometries = s->ngeoms;
@@ -605,7 +742,11 @@ rr_error rr_scene_get_normals(const rr_scene *s, const uint32_t *prims, size_t n
   if (n && (!prims || !normals)) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_normals: NULL array");
   for (size_t k = 0; k < n; k++) {
     uint32_t i = rr_scene_index_of(s, prims[k]);
-    v3_store(normals + 3 * k, i == RR_MISS ? v3(0, 0, 0) : v3_norm(rr_scene_tri_normal(s, i)));
+    prim_kind kind = i == RR_MISS ? RR_GEOMETRY_TRIANGLE : scene_kind(s, i);
+    /* a sphere's normal depends on the hit (rr_ana_normal): zero here, like a miss */
+    vec3 n = i == RR_MISS || kind == RR_GEOMETRY_SPHERE || kind == RR_GEOMETRY_BOX ? v3(0, 0, 0)
+             : kind == RR_GEOMETRY_PLANE ? rr_ana_normal(s, i, 0, 0) : v3_norm(rr_scene_tri_normal(s, i));
+    v3_store(normals + 3 * k, n);
   }
   return rr_ok(s->dev);
 }

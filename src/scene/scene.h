@@ -102,6 +102,11 @@ struct rr_scene {
   /* Homogeneous input: bit k of inf[i] set when corner k of triangle i is a point at
    * infinity (w = 0), whose p then holds its direction; NULL when there is none. */
   uint8_t *inf;
+  /* Analytic primitives (prim/analytic.h): kind[i] the kind of primitive i and
+   * ana[12i .. 12i+11] its parameters; both NULL while every primitive is a triangle. */
+  uint8_t *kind;
+  float *ana;
+  uint32_t nspheres, nplanes, nboxes;
   vec3 bmin, bmax; /* of the finite corners */
   vec3 up, front;  /* unit: the model's up and the side it faces (+Y, +Z unless the file says) */
   bool has_view;              /* a built-in's own default view, which rr_camera_frame takes */

@@ -305,7 +305,9 @@ static void direct(lit_batch *b, const level *lv, const rr_scene *s, const light
     }
     if (!nr) continue;
     double t0 = rr_now_ms();
-    bool raster = L->shadows == RR_SHADOWS_RASTER || (L->shadows == RR_SHADOWS_AUTO && !far && nr >= SHADOW_RASTER_MIN);
+    /* analytic primitives (prim/analytic.h) are not rasterized from the light yet: rays */
+    bool raster = !s->kind && (L->shadows == RR_SHADOWS_RASTER ||
+                               (L->shadows == RR_SHADOWS_AUTO && !far && nr >= SHADOW_RASTER_MIN));
     if (!raster || !rr_occluded_raster(s, bvh, b->ray, (size_t)nr, 1, b->occluded, NULL)) {
       rr_ray_stream rs = rr_ray_stream_aos(b->ray, (size_t)nr);
       rr_occluded_stream(NULL, s, &rs, 1, b->occluded); /* a refused ray (zero length) counts as lit */

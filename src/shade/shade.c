@@ -29,7 +29,9 @@ typedef struct hit {
   float footprint; /* the pixel steps the sample's texture footprint spans (ssaa: 1/√N) */
 } hit;
 
-static vec3 geometric_normal(const rr_scene *s, uint32_t i) {
+/* (l1, l2: the hit's coordinates, which give an analytic primitive's normal) */
+static vec3 geometric_normal(const rr_scene *s, uint32_t i, float l1, float l2) {
+  if (scene_kind(s, i) != RR_GEOMETRY_TRIANGLE) return rr_ana_normal(s, i, l1, l2);
   if (scene_inf(s, i)) return v3_norm(rr_scene_tri_normal(s, i)); /* corners at infinity */
   vec3 p0 = scene_vertex(s, 0, i);
   return v3_norm(v3_cross(v3_sub(scene_vertex(s, 1, i), p0), v3_sub(scene_vertex(s, 2, i), p0)));
@@ -47,8 +49,8 @@ static hit hit_make(const rr_scene *s, uint32_t id, float l1, float l2, float t,
   h.dir = v3_scale(d, 1.0f / len);
   h.dist = t * len;
   h.l1 = l1, h.l2 = l2, h.l0 = 1.0f - l1 - l2;
-  vec3 n = geometric_normal(s, id);
-  if (s->n[0][0]) {
+  vec3 n = geometric_normal(s, id, l1, l2);
+  if (s->n[0][0] && scene_kind(s, id) == RR_GEOMETRY_TRIANGLE) {
     vec3 sn = v3(0, 0, 0);
     float w[3] = {h.l0, h.l1, h.l2};
     for (int v = 0; v < 3; v++)
@@ -213,10 +215,12 @@ static void shade_hit(const rr_scene *s, const hit *h, rr_shade_mode mode, const
 /* The surface the lit mode shades at a valid hit h. */
 static void hit_surface(const rr_scene *s, const hit *h, const tex_filter *tf, surface *sf) {
   uint32_t i = h->id;
-  vec3 ng = geometric_normal(s, i);
+  vec3 ng = geometric_normal(s, i, h->l1, h->l2);
   sf->ng = v3_dot(ng, h->dir) > 0 ? v3_neg(ng) : ng;
   sf->n = h->normal, sf->v = v3_neg(h->dir);
-  if (scene_inf(s, i)) { /* corners at infinity: along the ray */
+  if (scene_kind(s, i) != RR_GEOMETRY_TRIANGLE) { /* analytic: from its coordinates */
+    sf->p = rr_ana_point(s, i, h->l1, h->l2);
+  } else if (scene_inf(s, i)) { /* corners at infinity: along the ray */
     sf->p = v3_add(h->org, v3_scale(h->dir, h->dist));
   } else { /* from the corners: as exact as the triangle, wherever the ray came from */
     sf->p = v3_add(v3_add(v3_scale(scene_vertex(s, 0, i), h->l0), v3_scale(scene_vertex(s, 1, i), h->l1)),

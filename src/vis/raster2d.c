@@ -800,10 +800,80 @@ static rr_error run2d(rr_device *dev, const progress_span *progress, const rr_sc
   return ok ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for 2D rasterization");
 }
 
+/* ---- impostors: analytic primitives (prim/analytic.h) ------------------------ */
+
+/* As GPUs draw spheres: a screen rectangle per primitive (rr_ana_screen_bounds,
+ * which holds every sample where it can pass), and at each of its samples the
+ * kind's one exact test (rr_ana_hit, the ray from the camera as every method
+ * takes it) against the z-buffer with the depth test of every method. The
+ * triangles went first; depth_wins does not depend on the order, so a sample an
+ * analytic primitive wins holds the bits the 3D methods give it. 2dr-bin adds
+ * early-z: a sample whose stored t lies below the primitive's floor
+ * (rr_ana_t_floor) is not tested. Bands of rows are dealt to the threads. */
+enum { IMPOSTOR_BAND = 16 };
+
+typedef struct {
+  const rr_scene *s;
+  const camera *cams;
+  int samples;
+  bool bin;
+  visbuf *vb;
+  uint32_t n, *ids;
+  int (*rect)[4];
+  float *floor;
+  uint64_t evals[RR_MAX_THREADS];
+} impostors;
+
+static void impostor_band(int b, int thread, void *arg) {
+  impostors *im = arg;
+  int y0 = b * IMPOSTOR_BAND, y1 = y0 + IMPOSTOR_BAND < im->vb->height ? y0 + IMPOSTOR_BAND : im->vb->height;
+  uint64_t evals = 0;
+  for (uint32_t j = 0; j < im->n; j++) {
+    const int *r = im->rect[j];
+    int ya = r[1] > y0 ? r[1] : y0, yb = r[3] + 1 < y1 ? r[3] + 1 : y1;
+    for (int s = 0; s < im->samples; s++) {
+      const camera *c = &im->cams[s];
+      visbuf vb = visbuf_layer(im->vb, s);
+      for (int y = ya; y < yb; y++)
+        for (int x = r[0]; x <= r[2]; x++) {
+          size_t k = (size_t)y * vb.width + x;
+          if (im->bin && vb.t[k] < im->floor[j]) continue;
+          evals++;
+          ana_shade_sample(im->s, c, im->ids[j], camera_w(c, x, y), (float)x + c->sx0, (float)y + c->sy0, &vb, k);
+        }
+    }
+  }
+  im->evals[thread] += evals;
+}
+
+static rr_error draw_impostors(rr_device *dev, render_ctx *ctx, bool bin) {
+  const rr_scene *s = ctx->scene;
+  impostors im = {.s = s, .cams = ctx->cams, .samples = ctx->samples, .bin = bin, .vb = ctx->vb};
+  im.ids = malloc((size_t)s->ntris * sizeof *im.ids + 1);
+  im.rect = malloc((size_t)s->ntris * sizeof *im.rect + 1);
+  im.floor = malloc((size_t)s->ntris * sizeof *im.floor + 1);
+  if (!im.ids || !im.rect || !im.floor) {
+    free(im.ids), free(im.rect), free(im.floor);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %u impostors", s->ntris);
+  }
+  for (uint32_t i = 0; i < s->ntris; i++) {
+    if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE) continue;
+    ctx->stats->setups++;
+    if (!rr_ana_screen_bounds(s, i, ctx->cam, im.rect[im.n])) continue;
+    im.floor[im.n] = rr_ana_t_floor(s, i, ctx->cam);
+    im.ids[im.n++] = i;
+  }
+  rr_parallel_for((ctx->vb->height + IMPOSTOR_BAND - 1) / IMPOSTOR_BAND, ctx->threads, impostor_band, &im);
+  for (int t = 0; t < RR_MAX_THREADS; t++) ctx->stats->edge_evals += im.evals[t];
+  free(im.ids), free(im.rect), free(im.floor);
+  return RR_OK;
+}
+
 static rr_error render2d(rr_device *dev, render_ctx *ctx, bool bin) {
   target tg = {.vb = ctx->vb, .heat = ctx->heat_e};
-  return run2d(dev, &ctx->progress, ctx->scene, ctx->cams, ctx->samples, ctx->opt->cull_backfaces, bin, ctx->threads,
-               tg, ctx->stats);
+  rr_error e = run2d(dev, &ctx->progress, ctx->scene, ctx->cams, ctx->samples, ctx->opt->cull_backfaces, bin,
+                     ctx->threads, tg, ctx->stats);
+  return e || !ctx->scene->kind ? e : draw_impostors(dev, ctx, bin);
 }
 
 rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx) { return render2d(dev, ctx, false); }

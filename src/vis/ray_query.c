@@ -79,6 +79,18 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
       if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
     }
   }
+  if (r->s->kind) { /* analytic primitives, which the pre-test rejects as edge-on: their own test */
+    const float org[3] = {r->q.o[0][0], r->q.o[1][0], r->q.o[2][0]}, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
+    ana_ray ar = ana_ray_of(org, dir);
+    for (uint32_t j = 0; j < count; j++) {
+      uint32_t id = r->b->prims[first + j];
+      float t, u, v;
+      if (scene_kind(r->s, id) == RR_GEOMETRY_TRIANGLE || !rr_ana_hit(r->s, id, &ar, &t, &u, &v)) continue;
+      if (!(t >= r->tmin && t <= r->t)) continue;
+      if (any) return true;
+      if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = u, r->l2 = v;
+    }
+  }
   return false;
 }
 

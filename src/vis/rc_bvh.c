@@ -85,6 +85,7 @@ typedef struct {
 } frame_setups;
 
 enum { SETUP_CHUNK = 1024, SEEN_CHUNK = 1024, BATCH = 2 * BVH_MAX_LEAF };
+enum { SETUP_ANALYTIC = -2 }; /* leaf_batch.setup of an analytic primitive */
 
 /* A batch of leaves (leaves[]: wide node · 4 + slot) and their triangles ids[k],
  * and of the ones set up (setup[k] >= 0: their index in ts/face) the pixel
@@ -105,18 +106,23 @@ typedef struct {
  * and cost no setup. */
 static void batch_setup(frame_setups *fs, leaf_batch *lb, int thread) {
   int ns = 0;
+  /* analytic primitives (SETUP_ANALYTIC) are bounded in batch_finish, not set up */
+  const rr_scene *s = fs->s;
   if (fs->cam->planar) {
     uint32_t near[BATCH], nn = 0; /* seen_chunk's survivors, bounded again for their rectangles */
     for (int k = 0; k < lb->n; k++)
-      if (!fs->seen || fs->seen[lb->ids[k]]) near[nn++] = lb->ids[k];
+      if ((!fs->seen || fs->seen[lb->ids[k]]) && scene_kind(s, lb->ids[k]) == RR_GEOMETRY_TRIANGLE)
+        near[nn++] = lb->ids[k];
     uint32_t nf = rr_tri_corner_bounds(fs->s, 0, near, nn, fs->cam, fs->simd, lb->found);
     for (int k = 0, q = 0; k < lb->n; k++) {
       bool kept = q < (int)nf && lb->found[q].id == lb->ids[k]; /* in order; ids in a tree are distinct */
-      lb->setup[k] = kept ? ns : -1;
+      lb->setup[k] = scene_kind(s, lb->ids[k]) != RR_GEOMETRY_TRIANGLE ? SETUP_ANALYTIC : kept ? ns : -1;
       if (kept) memcpy(lb->bb[k], lb->found[q++].bb, sizeof lb->bb[k]), lb->sid[ns++] = lb->ids[k];
     }
   } else {
-    for (int k = 0; k < lb->n; k++) lb->setup[k] = ns, lb->sid[ns++] = lb->ids[k];
+    for (int k = 0; k < lb->n; k++)
+      if (scene_kind(s, lb->ids[k]) != RR_GEOMETRY_TRIANGLE) lb->setup[k] = SETUP_ANALYTIC;
+      else lb->setup[k] = ns, lb->sid[ns++] = lb->ids[k];
   }
   rr_tri_setup_run(fs->s, lb->sid, ns, fs->cam, fs->cull, fs->simd, lb->ts, lb->face);
   fs->st[thread].setups += (uint64_t)ns;
@@ -146,7 +152,8 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
    * finds no sample stays an unused entry). Where the run lands depends on the
    * threads' timing; what it holds does not. */
   int nout = 0;
-  for (int k = 0; k < lb->n; k++) nout += lb->setup[k] >= 0 && lb->face[lb->setup[k]] != SETUP_CULLED;
+  for (int k = 0; k < lb->n; k++)
+    nout += lb->setup[k] == SETUP_ANALYTIC || (lb->setup[k] >= 0 && lb->face[lb->setup[k]] != SETUP_CULLED);
   uint32_t base = atomic_fetch_add_explicit(&fs->nts, (unsigned)nout, memory_order_relaxed);
   leaf_tri *out = fs->ts + base;
   nout = 0;
@@ -156,11 +163,17 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
     for (uint32_t i = first; i < first + b->wide[w].count[s]; i++, k++) {
       int j = lb->setup[k];
       fs->slot[i] = UINT32_MAX;
-      if (j < 0 || lb->face[j] == SETUP_CULLED) continue;
+      if (j != SETUP_ANALYTIC && (j < 0 || lb->face[j] == SETUP_CULLED)) continue;
       leaf_tri *lt = &out[nout];
-      lt->ts = lb->ts[j], lt->id = b->prims[i];
+      lt->id = b->prims[i];
       float t, *tr = lt->rect;
-      if (c->planar) {
+      if (j == SETUP_ANALYTIC) {
+        /* its samples (rr_ana_screen_bounds) and its floor over the image (rr_ana_t_floor) */
+        int bb[4] = {0, 0, -1, -1};
+        t = rr_ana_screen_bounds(fs->s, lt->id, c, bb) ? rr_ana_t_floor(fs->s, lt->id, c) : INFINITY;
+        tr[0] = (float)bb[0] + c->sx0, tr[1] = (float)bb[1] + c->sy0;
+        tr[2] = (float)bb[2] + c->sx0, tr[3] = (float)bb[3] + c->sy0;
+      } else if (lt->ts = lb->ts[j], c->planar) {
         /* the extreme samples, as the rays compute their coordinates */
         tr[0] = (float)lb->bb[k][0] + c->sx0, tr[1] = (float)lb->bb[k][1] + c->sy0;
         tr[2] = (float)lb->bb[k][2] + c->sx0, tr[3] = (float)lb->bb[k][3] + c->sy0;
@@ -450,7 +463,10 @@ KERNEL bool ray_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
     const float *tr = lt->rect;
     if (!(tr[0] <= r->sx && r->sx <= tr[2] && tr[1] <= r->sy && r->sy <= tr[3])) continue;
     r->evals++;
-    shade_sample_w(&lt->ts, lt->id, r->w, r->sx, r->sy, &one, 0);
+    if (scene_kind(r->fs->s, lt->id) != RR_GEOMETRY_TRIANGLE)
+      ana_shade_sample(r->fs->s, r->fs->cam, lt->id, r->w, r->sx, r->sy, &one, 0);
+    else
+      shade_sample_w(&lt->ts, lt->id, r->w, r->sx, r->sy, &one, 0);
   }
   return false;
 }
@@ -548,12 +564,14 @@ KERNEL bool packet_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes)
     const leaf_tri *lt = &fs->ts[fs->slot[i]];
     const float *tr = lt->rect;
     uint64_t in = lanes & rect_lanes(p, tr[0], tr[1], tr[2], tr[3]);
+    bool ana = scene_kind(fs->s, lt->id) != RR_GEOMETRY_TRIANGLE;
     p->evals += (uint64_t)__builtin_popcountll(in);
     for (; in; in &= in - 1) {
       int k = __builtin_ctzll(in);
       p->heat_e[k] += 1;
       float sx = (float)(p->x0 + (k & 7)) + fs->cam->sx0, sy = (float)(p->y0 + (k >> 3)) + fs->cam->sy0;
-      shade_sample_w(&lt->ts, lt->id, v3(1.0f, sx, sy), sx, sy, &pvb, k);
+      if (ana) ana_shade_sample(fs->s, fs->cam, lt->id, v3(1.0f, sx, sy), sx, sy, &pvb, k);
+      else shade_sample_w(&lt->ts, lt->id, v3(1.0f, sx, sy), sx, sy, &pvb, k);
     }
   }
   rr_vf4 m = rr_vf4_load_aligned(p->t);

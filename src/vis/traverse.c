@@ -65,8 +65,9 @@ typedef struct trav {
 /* Two cache lines, the setup in the first: drawing reads a job that another
  * thread set up, and each line it touches is a miss. */
 typedef struct tri_job {
-  _Alignas(64) tri_setup ts;
+  _Alignas(64) tri_setup ts; /* (not used by an analytic primitive) */
   uint32_t id;
+  bool ana;        /* an analytic primitive (prim/analytic.h): its own test, bounds and floor */
   float zmin;      /* a floor under any t computed for the triangle (0: none known) */
   int bb[4];       /* inclusive screen bounds */
   union {
@@ -79,11 +80,25 @@ typedef struct tri_job {
 /* Tests every sample of r at every position (at: the setup moved to each, NULL
  * for one); the one kernel every generateSamples path ends in. Returns the
  * samples the triangle covers. */
+/* An analytic primitive at every sample of r at every position. */
+static uint64_t ana_raster(trav *t, uint32_t id, tile_rect r, uint64_t *covered) {
+  for (int s = 0; s < t->ns; s++) {
+    const camera *c = &t->cams[s];
+    visbuf vb = t->ns > 1 ? visbuf_layer(t->vb, s) : *t->vb;
+    for (int y = r.y0; y < r.y1; y++)
+      for (int x = r.x0; x < r.x1; x++)
+        *covered += ana_shade_sample(t->s, c, id, camera_w(c, x, y), (float)x + c->sx0, (float)y + c->sy0, &vb,
+                                     (size_t)y * vb.width + x) != 0;
+  }
+  return (uint64_t)(r.x1 - r.x0) * (uint64_t)(r.y1 - r.y0) * (uint64_t)t->ns;
+}
+
 KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_at *at, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
-  t->st.edge_evals += !at ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
-                           : rr_raster_rect_samples(&j->ts, at, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
+  t->st.edge_evals += j->ana ? ana_raster(t, j->id, r, &covered)
+                      : !at  ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
+                             : rr_raster_rect_samples(&j->ts, at, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
   if (t->heat_e)
     heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0) * t->ns));
   if (t->hiz_used) hiz_mark(t->hz, r.x0, r.y0, r.x1, r.y1);
@@ -107,7 +122,8 @@ static int cone_rejects(trav *t, const tri_job *j, tile_rect b) {
     t->st.edge_evals += 1;
     int cx = (b.x0 + b.x1) / 2, cy = (b.y0 + b.y1) / 2;
     heat_charge(t->heat_e, t->vb->width, cx, cy, cx + 1, cy + 1, 1.0f);
-    if (!rr_cone_excludes(&j->cone, &j->ts, axis, angle)) return 0;
+    if (j->ana ? !rr_ana_cone_excludes(t->s, j->id, &t->cams[s], axis, angle) : !rr_cone_excludes(&j->cone, &j->ts, axis, angle))
+      return 0;
   }
   return rays ? 1 : -1;
 }
@@ -129,7 +145,9 @@ static uint64_t bin_raster(trav *t, const tri_job *j, const tri_at *at, tile_rec
         continue;
       }
       bool out = false;
-      if (t->c->planar) {
+      if (t->c->planar && j->ana) {
+        /* an analytic primitive's bins are bounded by its rectangle and early-z */
+      } else if (t->c->planar) {
         /* the corners of the bin's samples */
         float xs[2] = {(float)b.x0 + t->span[0], (float)(b.x1 - 1) + t->span[2]};
         float ys[2] = {(float)b.y0 + t->span[1], (float)(b.y1 - 1) + t->span[3]};
@@ -189,7 +207,7 @@ static float max_pa(const trav *t, const tri_job *j) {
 /* Completes a set-up triangle j with what binning and early-z need. */
 static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
   const camera *c = t->c;
-  j->id = id;
+  j->id = id, j->ana = false;
   if (!t->o->binning) return;
   if (c->planar) {
     float zmin = INFINITY;
@@ -270,8 +288,36 @@ static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, int b
  * (into scratch, room for n), so the many that fall between samples or beside r (a
  * leaf's box reaches into frusta its triangles do not) cost no setup; curved
  * cameras bound a set-up triangle by its cone. S counts the setups done. */
+static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
+                           tri_bound *scratch, tri_job *out);
+/* The analytic primitives among ids[0..n-1] (first..first+n-1) into out: their
+ * rectangle (over every position: rr_ana_screen_bounds holds for any) and floor
+ * (rr_ana_t_floor, likewise). Their triangle corners, all at one point, never pass
+ * the triangles' setup (prim/analytic.h), so the two together fit in room for n. */
+static uint32_t setup_analytic(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
+                               tri_job *out) {
+  uint32_t kept = 0;
+  for (uint32_t k = 0; k < n; k++) {
+    uint32_t id = ids ? ids[k] : first + k;
+    if (scene_kind(t->s, id) == RR_GEOMETRY_TRIANGLE) continue;
+    tri_job *j = out + kept;
+    t->st.setups++;
+    if (!rr_ana_screen_bounds(t->s, id, t->c, j->bb) || (r && !meets(j->bb, *r))) continue;
+    j->id = id, j->ana = true;
+    j->zmin = rr_ana_t_floor(t->s, id, t->c);
+    kept++;
+  }
+  return kept;
+}
+
 static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
                                 tri_bound *scratch, tri_job *out) {
+  uint32_t kept = setup_tris(t, first, ids, n, r, scratch, out);
+  return t->s->kind ? kept + setup_analytic(t, first, ids, n, r, out + kept) : kept;
+}
+
+static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
+                           tri_bound *scratch, tri_job *out) {
   if (t->c->planar) {
     uint32_t nb = rr_tri_corner_bounds_at(t->s, first, ids, n, t->c, t->ns, t->pos, t->simd, scratch), kept = 0;
     if (r) {
@@ -318,7 +364,7 @@ KERNEL void draw(trav *t, const tri_job *j, tile_rect f) {
   tile_rect r = {j->bb[0] > f.x0 ? j->bb[0] : f.x0, j->bb[1] > f.y0 ? j->bb[1] : f.y0,
                  j->bb[2] + 1 < f.x1 ? j->bb[2] + 1 : f.x1, j->bb[3] + 1 < f.y1 ? j->bb[3] + 1 : f.y1};
   if (r.x0 >= r.x1 || r.y0 >= r.y1) return;
-  if (t->ns > 1) draw_moved(t, j, r);
+  if (t->ns > 1 && !j->ana) draw_moved(t, j, r);
   else draw_rect(t, j, NULL, r);
 }
 

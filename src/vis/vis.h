@@ -3,6 +3,7 @@
 #define RR_VIS_H
 
 #include "accel/bvh.h"
+#include "prim/analytic.h"
 #include "prim/triangle.h"
 
 /* Per sample: the hit's triangle index, t and barycentrics. A buffer of several
@@ -41,6 +42,21 @@ KERNEL int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, fl
   vb->id[k] = id;
   vb->l1[k] = l1;
   vb->l2[k] = l2;
+  return 2;
+}
+
+/* The same for analytic primitive id (prim/analytic.h) of scene s seen by camera c:
+ * the sample's ray in double, the kind's one test, the same depth test. */
+KERNEL int ana_shade_sample(const rr_scene *s, const camera *c, uint32_t id, vec3 w, float sx, float sy, visbuf *vb,
+                            size_t k) {
+  ana_ray r;
+  float t, u, v;
+  if (!ana_sample_ray(c, w, sx, sy, &r) || !rr_ana_hit(s, id, &r, &t, &u, &v)) return 0;
+  if (!depth_wins(t, id, vb->t[k], vb->id[k])) return 1;
+  vb->t[k] = t;
+  vb->id[k] = id;
+  vb->l1[k] = u;
+  vb->l2[k] = v;
   return 2;
 }
 
