@@ -80,8 +80,8 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
     }
   }
   if (r->s->kind) { /* analytic primitives, which the pre-test rejects as edge-on: their own test */
-    const float org[3] = {r->q.o[0][0], r->q.o[1][0], r->q.o[2][0]}, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
-    ana_ray ar = ana_ray_of(org, dir);
+    const float dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
+    ana_ray ar = ana_ray_of(r->org, dir);
     for (uint32_t j = 0; j < count; j++) {
       uint32_t id = r->b->prims[first + j];
       float t, u, v;
