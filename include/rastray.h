@@ -764,11 +764,13 @@ typedef struct rr_shade_stats {
                         0.5 each pixel is resolved as its samples are shaded: that time is here) */
   double resolve_ms; /* wall time of a separate resolve, per-sample colours to pixels (the wide filters;
                         about 0 for the box) */
-  uint64_t shadow_rays;     /* lit: shadow rays traced (one per point, light facing it) */
-  uint64_t reflection_rays; /* lit: mirror reflection rays traced, all bounces */
-  double shadow_ms;         /* lit: time tracing shadow rays, summed over the shading threads */
-  double reflection_ms;     /* lit: time tracing reflection rays and making their hits' surfaces, summed
-                               over the shading threads */
+  uint64_t shadow_rays;        /* lit: shadow rays tested (one per point, light facing it) */
+  uint64_t shadow_rays_raster; /* lit: of those, the ones rasterized from their light (--shadows raster, auto) */
+  uint64_t reflection_rays;    /* lit: mirror reflection rays traced, all bounces */
+  /* lit, wall times of the passes (docs/shading.md); shade_ms holds them */
+  double direct_ms;     /* the light passes: each light's shadow rays made, tested, its light added */
+  double shadow_ms;     /* of which the occlusion tests (rasterized or traced) */
+  double reflection_ms; /* the bounces: reflection rays traced and their hits' surfaces made */
 } rr_shade_stats;
 
 /* Shades a frame and resolves its samples to one colour per pixel (opt NULL: the
