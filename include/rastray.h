@@ -785,6 +785,16 @@ RR_API rr_error rr_shade_frame(rr_device *dev, const rr_scene *scene, const rr_c
 /* Extracts an AOV of a frame into a new image of kind RR_IMAGE_AOV + aov. */
 RR_API rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                              const rr_frame *frame, rr_aov aov, rr_image *out);
+/* rr_shade_frame with opt->mode RR_SHADE_LIT, and from the same passes the lit
+ * AOVs whose bit (1u << aov, aov in RR_AOV_ALBEDO .. RR_AOV_EMISSION) is set in
+ * `aovs`, each into a new image aov_images[aov] (the other entries untouched), as
+ * rr_frame_aov makes them but under opt's lights and shadow mode: the parts of the
+ * point shaded for each pixel's sample nearest its centre (in msaa and csaa the
+ * point of that sample's primitive in the pixel). With one sample per pixel they
+ * equal rr_frame_aov's bit for bit, whatever opt->shadows. On failure no image is made. */
+RR_API rr_error rr_shade_frame_aovs(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                                    const rr_frame *frame, const rr_shade_options *opt, unsigned aovs,
+                                    rr_image aov_images[RR_AOV_COUNT], rr_image *out, rr_shade_stats *stats);
 /* Frees the pixels of an image made by rastray. */
 RR_API void rr_image_free(rr_image *img);
 

@@ -778,11 +778,18 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
   run.images = images, run.nimages = RR_AOV_COUNT + 1;
   progress_stage("shading");
   double t = now_ms();
+  /* lit: the lit AOVs come from the colour's own passes (its lights and shadow mode) */
+  unsigned lit_parts = 0;
+  for (int a = RR_AOV_ALBEDO; a <= RR_AOV_EMISSION; a++) lit_parts |= 1u << a;
+  bool together = shading->mode == RR_SHADE_LIT && (need & lit_parts);
+  if (together) need |= COLOR_BIT;
   for (int a = 0; a <= RR_AOV_COUNT; a++) {
-    if (!(need & 1u << a)) continue;
+    if (!(need & 1u << a) || (together && (lit_parts & 1u << a))) continue;
     rr_shade_stats st = {0};
-    rr_error e = a == RR_AOV_COUNT ? rr_shade_frame(dev, scene, cam, frame, shading, colour, &st)
-                                   : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
+    rr_error e = a == RR_AOV_COUNT && together
+                     ? rr_shade_frame_aovs(dev, scene, cam, frame, shading, need & lit_parts, images, colour, &st)
+                 : a == RR_AOV_COUNT ? rr_shade_frame(dev, scene, cam, frame, shading, colour, &st)
+                                     : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
     ms->resolve += st.resolve_ms, ms->shades += st.shades;
     ms->shadow_rays += st.shadow_rays, ms->reflection_rays += st.reflection_rays;
     ms->shadow += st.shadow_ms, ms->reflection += st.reflection_ms;

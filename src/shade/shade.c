@@ -754,8 +754,9 @@ void rr_shade_options_init(rr_shade_options *opt) {
                               .shadows = RR_SHADOWS_RAYS, .max_depth = 2, .default_lights = 1};
 }
 
-rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
-                        const rr_shade_options *opt, rr_image *out, rr_shade_stats *stats) {
+static rr_error shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                            const rr_shade_options *opt, unsigned aovs, rr_image *aov_images, rr_image *out,
+                            rr_shade_stats *stats) {
   rr_shade_options def;
   if (!opt) rr_shade_options_init(&def), opt = &def;
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
@@ -788,12 +789,48 @@ rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   if (e) return e;
   camera cams[RR_MAX_SAMPLES];
   e = frame_cameras(dev, cam, f, cams);
-  if (!e) {
-    e = shade_samples(dev, s, cams, f, opt, lit ? &lights : NULL, NULL, out, stats);
-    for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
+  bool have_cams = !e, shaded = false;
+  size_t npix = (size_t)f->vb.width * f->vb.height;
+  float *parts = !e && aovs ? calloc(npix, LIT_PARTS * sizeof(float)) : NULL;
+  if (!e && aovs && !parts) e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the lit AOVs");
+  if (!e) e = shade_samples(dev, s, cams, f, opt, lit ? &lights : NULL, parts, out, stats), shaded = !e;
+  for (int k = 0; have_cams && k < f->samples; k++) rr_cam_release(&cams[k]);
+  /* the AOVs asked for, from the parts */
+  static const int part[] = {LIT_ALBEDO, LIT_DIRECT, LIT_REFLECTION, LIT_SHADOW, LIT_EMISSION};
+  rr_image made[RR_AOV_COUNT] = {{0}};
+  for (int a = RR_AOV_ALBEDO; !e && a <= RR_AOV_EMISSION; a++) {
+    if (!(aovs & 1u << a)) continue;
+    int ch = a == RR_AOV_SHADOW ? 1 : 3, first = part[a - RR_AOV_ALBEDO];
+    e = image_alloc(dev, &made[a], f->vb.width, f->vb.height, ch, RR_PIXEL_F32, RR_IMAGE_AOV + a);
+    for (size_t k = 0; !e && k < npix; k++)
+      memcpy((float *)made[a].data + k * ch, parts + k * LIT_PARTS + first, ch * sizeof(float));
   }
+  for (int a = RR_AOV_ALBEDO; a <= RR_AOV_EMISSION; a++)
+    if (aovs & 1u << a) {
+      if (e) rr_image_free(&made[a]);
+      else aov_images[a] = made[a];
+    }
+  if (e && shaded) rr_image_free(out);
+  free(parts);
   if (lit) rr_lighting_release(&lights);
-  return e;
+  return e ? e : rr_ok(dev);
+}
+
+rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                        const rr_shade_options *opt, rr_image *out, rr_shade_stats *stats) {
+  return shade_frame(dev, s, cam, f, opt, 0, NULL, out, stats);
+}
+
+rr_error rr_shade_frame_aovs(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                             const rr_shade_options *opt, unsigned aovs, rr_image aov_images[RR_AOV_COUNT],
+                             rr_image *out, rr_shade_stats *stats) {
+  if (!opt || opt->mode != RR_SHADE_LIT)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade_frame_aovs: the lit AOVs need options with the lit mode");
+  unsigned lit_bits = 0;
+  for (int a = RR_AOV_ALBEDO; a <= RR_AOV_EMISSION; a++) lit_bits |= 1u << a;
+  if (aovs & ~lit_bits) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade_frame_aovs: AOVs other than the lit parts asked for");
+  if (aovs && !aov_images) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade_frame_aovs: NULL argument");
+  return shade_frame(dev, s, cam, f, opt, aovs, aov_images, out, stats);
 }
 
 rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_shade_mode mode,
