@@ -17,7 +17,8 @@
  * of the bunny. Auto-framed at --size (default 1024x1024) on --threads (default 2),
  * method auto, medians of --runs rounds (default 3) in which the modes take turns.
  *
- *   bench_shading [--size WxH] [--threads N] [--runs N] [--shadows rays|raster|auto] [--rays-only] */
+ *   bench_shading [--size WxH] [--threads N] [--runs N] [--shadows rays|raster|auto] [--wave SAMPLES]
+ *                 [--rays-only] */
 #include "benchutil.h"
 #include "camera/camera.h"
 #include "vis/shadow_raster.h"
@@ -284,13 +285,13 @@ static void frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const
 }
 
 static void measure(rr_device *dev, const char *name, const rr_scene *s, const rr_camera *cam, int w, int h,
-                    int threads, int runs, rr_shadow_mode shadows) {
+                    int threads, int runs, rr_shadow_mode shadows, int wave) {
   static double ms[NMODES][NPARTS][MAX_RUNS];
   uint64_t rays[NMODES][3];
   rr_shade_options so;
   rr_shade_options_init(&so);
   so.mode = RR_SHADE_LIT, so.max_depth = 1; /* one reflection ray per shaded sample on a mirror */
-  so.shadows = shadows;
+  so.shadows = shadows, so.wave_samples = wave;
   bool counting = bench_on_valgrind();
   if (counting) runs = 1, threads = 1;
   for (int r = 0; r < runs; r++)
@@ -322,7 +323,7 @@ static void measure(rr_device *dev, const char *name, const rr_scene *s, const r
 }
 
 int main(int argc, char **argv) {
-  int w = 1024, h = 1024, threads = 2, runs = 3, shadows = RR_SHADOWS_RAYS;
+  int w = 1024, h = 1024, threads = 2, runs = 3, shadows = RR_SHADOWS_RAYS, wave = 0;
   bool rays_only = false;
   for (int i = 1; i < argc; i++) {
     if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
@@ -348,10 +349,16 @@ int main(int argc, char **argv) {
         fprintf(stderr, "bench_shading: bad --shadows '%s'\n", argv[i]);
         return 2;
       }
+    } else if (strcmp(argv[i], "--wave") == 0 && i + 1 < argc) {
+      wave = atoi(argv[++i]);
+      if (wave < 0) {
+        fprintf(stderr, "bench_shading: bad --wave '%s'\n", argv[i]);
+        return 2;
+      }
     } else if (strcmp(argv[i], "--rays-only") == 0) {
       rays_only = true;
     } else {
-      fprintf(stderr, "usage: bench_shading [--size WxH] [--threads N] [--runs N] [--shadows MODE] [--rays-only]\n");
+      fprintf(stderr, "usage: bench_shading [--size WxH] [--threads N] [--runs N] [--shadows MODE] [--wave SAMPLES] [--rays-only]\n");
       return 2;
     }
   }
@@ -395,7 +402,7 @@ int main(int argc, char **argv) {
     printf("| scene | AA | visibility | points | light passes | of which occlusion tests | reflection pass | resolve | "
            "passes | total | passes / none | paper (Fig. 7) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int i = 0; i < 2; i++)
-      if (sc[i]) measure(dev, i ? "bunny on a mirror" : "demo", sc[i], &cams[i], w, h, threads, runs, (rr_shadow_mode)shadows);
+      if (sc[i]) measure(dev, i ? "bunny on a mirror" : "demo", sc[i], &cams[i], w, h, threads, runs, (rr_shadow_mode)shadows, wave);
   }
   for (int i = 0; i < 2; i++) rr_scene_release(sc[i]);
   rr_device_release(dev);

@@ -58,10 +58,6 @@ typedef struct lit_stats {
   double reflection_ms;        /* the bounces: reflection rays and their hits' surfaces */
 } lit_stats;
 
-/* Most samples (shaded points or not) a wave of the lit mode holds: a frame of
- * 2048² at one sample per pixel, 512² at 16. */
-enum { LIT_WAVE = 1 << 22 };
-
 /* A point's colour in parts (the lit AOVs, named as Blender Cycles' passes): offsets
  * into an array of LIT_PARTS floats. The colour is direct + reflection + emission. */
 enum {
