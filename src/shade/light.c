@@ -414,11 +414,14 @@ static void job_light_add(int job, int thread, void *arg) {
   }
 }
 
-/* --shadows auto rasterizes a light's shadow rays when its pass holds at least
- * this many of them (point and spot lights; a directional light's parallel rays
- * keep each its own edge setup and are traced). Measured by bench/bench_shading's
- * sweep of the demo's and the bunny's shadow rays in runs of N (docs/shading.md). */
-#define SHADOW_RASTER_MIN 65536
+/* --shadows auto rasterizes a point or spot light's shadow rays when its pass
+ * holds at least this many. bench/bench_shading's sweep (callgrind, one thread,
+ * 1024²; docs/shading.md): rasterizing runs of N rays costs, against the streams,
+ * 0.99x (N = 1024), 0.94x (4096) and 0.94x from 16384 on (the gain has saturated)
+ * on the demo, 1.12x, 1.10x and 1.08x on the bunny over a mirror. A directional
+ * light's parallel rays keep each its own edge setup: rasterized they cost 1.4x
+ * to 2.1x the streams at every N, so auto traces them. */
+#define SHADOW_RASTER_MIN 16384
 
 /* One pass per light: its shadow rays made in parallel, tested together (one
  * rasterization from the light, or one stream: the same bits), then added. */
