@@ -439,7 +439,7 @@ static void lit_gather_rows(int job, int thread, void *arg) {
 /* Lit, last: the shaded colours given to the samples that share them, then stored. */
 static void lit_finish_run(shade_pass *p, sample_run *r, int thread, int y, int x0, int len) {
   (void)thread;
-  run_load(p, r, y, x0, len);
+  if (p->has_alpha) run_load(p, r, y, x0, len); /* the ids give alpha */
   size_t q0 = (size_t)(y - p->y0) * p->vb->width + x0;
   for (int i = 0; i < p->samples; i++) {
     size_t e = i * p->wave_pix + q0;
