@@ -11,10 +11,9 @@
  * the streams and rtcIntersect8; with a sweep of run lengths N (the crossover that
  * --shadows auto uses). Under callgrind (one thread, one run) every part is
  * counted in instructions, named by CALLGRIND_DUMP_STATS_AT.
- * Scenes: the demo under its default rig (a key light with shadows and a sky; no
- * mirror, so no reflection rays), and the Stanford bunny on a mirror plane (MTL
- * illum 3) under one point light, which the bench writes as an OBJ beside a copy
- * of the bunny. Auto-framed at --size (default 1024x1024) on --threads (default 2),
+ * Scenes, each under one point light and a sky: the built-in demo (no mirror, so
+ * no reflection rays), and the Stanford bunny on a mirror plane (MTL illum 3),
+ * which the bench writes as an OBJ beside a copy of the bunny. Auto-framed at --size (default 1024x1024) on --threads (default 2),
  * method auto, medians of --runs rounds (default 3) in which the modes take turns.
  *
  *   bench_shading [--size WxH] [--threads N] [--runs N] [--shadows rays|raster|auto] [--wave SAMPLES]
