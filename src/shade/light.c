@@ -203,16 +203,17 @@ typedef struct lit_point {
   float *out, *parts, *refl;
 } lit_point;
 
-/* Points side by side: a sink of the first bounce, or a later bounce's points
- * (one per reflection ray of the bounce before). */
-typedef struct seg {
-  lit_point *p;
-  size_t n, cap;
-} seg;
-
-/* CHUNK points are a job of a pass; a chunk's rays lie together in the pass's
- * arrays, from `first` on (its points in order). */
+/* CHUNK points are a block of a segment and a job of a pass; a chunk's rays lie
+ * together in the pass's arrays, from `first` on (its points in order). */
 enum { CHUNK = 4096 };
+
+/* Points in blocks of CHUNK (kept from wave to wave; never moved, so growing
+ * copies nothing): a sink of the first bounce, or a later bounce's points (point
+ * k for reflection ray k of the bounce before). */
+typedef struct seg {
+  lit_point **block;
+  size_t n, nblocks, cap; /* points; blocks made; room for block pointers */
+} seg;
 typedef struct chunk {
   lit_point *p;
   size_t n, first, rays;
@@ -233,28 +234,40 @@ struct lit_wave {
 
 lit_wave *rr_lit_wave_new(void) { return calloc(1, sizeof(lit_wave)); }
 
+static void seg_free(seg *g) {
+  for (size_t b = 0; b < g->nblocks; b++) free(g->block[b]);
+  free(g->block);
+}
+
 void rr_lit_wave_free(lit_wave *w) {
   if (!w) return;
-  for (int t = 0; t < RR_MAX_THREADS; t++) free(w->sink[t].p);
-  free(w->bounce[0].p), free(w->bounce[1].p), free(w->ch);
+  for (int t = 0; t < RR_MAX_THREADS; t++) seg_free(&w->sink[t]);
+  seg_free(&w->bounce[0]), seg_free(&w->bounce[1]), free(w->ch);
   free(w->ray), free(w->who), free(w->add), free(w->occluded), free(w->hit);
   free(w);
 }
 
+/* Room for n points in g. */
 static bool seg_reserve(seg *g, size_t n) {
-  if (n <= g->cap) return true;
-  size_t cap = g->cap ? g->cap : 1024;
-  while (cap < n) cap *= 2;
-  lit_point *p = realloc(g->p, cap * sizeof *p);
-  if (!p) return false;
-  g->p = p, g->cap = cap;
+  size_t need = (n + CHUNK - 1) / CHUNK;
+  if (need > g->cap) {
+    size_t cap = g->cap ? 2 * g->cap : 16;
+    cap = cap < need ? need : cap;
+    lit_point **b = realloc(g->block, cap * sizeof *b);
+    if (!b) return false;
+    g->block = b, g->cap = cap;
+  }
+  for (; g->nblocks < need; g->nblocks++)
+    if (!(g->block[g->nblocks] = malloc(CHUNK * sizeof(lit_point)))) return false;
   return true;
 }
 
+static lit_point *seg_at(const seg *g, size_t i) { return &g->block[i / CHUNK][i % CHUNK]; }
+
 bool rr_lit_wave_add(lit_wave *w, int thread, const surface *sf, float *out, float *parts) {
   seg *g = &w->sink[thread];
-  if (!seg_reserve(g, g->n + 1)) return false;
-  lit_point *q = &g->p[g->n++];
+  if (g->n == g->nblocks * CHUNK && !seg_reserve(g, g->n + 1)) return false;
+  lit_point *q = seg_at(g, g->n++);
   q->sf = *sf, q->out = out, q->parts = parts, q->refl = NULL;
   q->w[0] = q->w[1] = q->w[2] = 1;
   out[0] = out[1] = out[2] = 0;
@@ -287,7 +300,7 @@ static bool chunks_of(lit_wave *w, const seg *g, int n) {
   w->nch = 0;
   for (int k = 0; k < n; k++)
     for (size_t i = 0; i < g[k].n; i += CHUNK)
-      w->ch[w->nch++] = (chunk){g[k].p + i, g[k].n - i < CHUNK ? g[k].n - i : CHUNK, 0, 0};
+      w->ch[w->nch++] = (chunk){g[k].block[i / CHUNK], g[k].n - i < CHUNK ? g[k].n - i : CHUNK, 0, 0};
   return true;
 }
 
@@ -512,7 +525,7 @@ static void job_mirror_hits(int job, int thread, void *arg) {
     uint32_t idx = rr_scene_index_of(ps->s, w->hit[k].prim);
     vec3 org = v3_load(w->ray[k].org), dir = v3_load(w->ray[k].dir);
     const lit_point *q = w->who[k];
-    lit_point *nq = &ps->next->p[k];
+    lit_point *nq = seg_at(ps->next, k);
     if (idx == RR_MISS) {
       float sky[3];
       sky_along(ps->L, dir, sky);
