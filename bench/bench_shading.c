@@ -290,7 +290,7 @@ static void measure(rr_device *dev, const char *name, const rr_scene *s, const r
   rr_shade_options so;
   rr_shade_options_init(&so);
   so.mode = RR_SHADE_LIT, so.max_depth = 1; /* one reflection ray per shaded sample on a mirror */
-  so.shadows = shadows, so.wave_samples = wave;
+  so.shadows = shadows, so.wave_points = wave;
   bool counting = bench_on_valgrind();
   if (counting) runs = 1, threads = 1;
   for (int r = 0; r < runs; r++)

@@ -751,13 +751,14 @@ typedef struct rr_shade_options {
   int has_background;               /* nonzero: background is the colour behind misses (default 0: a quiet
                                        grey-blue gradient) */
   float background[3];              /* linear RGB, finite, at least 0 */
-  int wave_samples;                 /* lit: most samples shaded in one wave of passes (whole rows; at least a
-                                       row), 0: RR_LIT_WAVE. Memory grows with it (about 17 bytes a sample,
-                                       110 a shaded point, 90 a ray), the occlusion passes' speed barely
-                                       beyond 16K points (docs/shading.md); the image does not depend on it */
+  int wave_points;                  /* lit: most points shaded in one wave of passes, counted as every sample
+                                       in ssaa and one per pixel in msaa and csaa (whole rows, at least one),
+                                       0: RR_LIT_WAVE. Memory grows with it (about 17 bytes a sample, 110 a
+                                       shaded point, 90 a ray), the occlusion passes' speed barely beyond
+                                       16K rays a light (docs/shading.md); the image does not depend on it */
 } rr_shade_options;
 
-#define RR_LIT_WAVE (1 << 18) /* the lit mode's samples per wave by default */
+#define RR_LIT_WAVE (1 << 18) /* the lit mode's points per wave by default */
 
 /* Fills options with defaults: Lambert, box filter, no alpha, aniso:16 textures. */
 RR_API void rr_shade_options_init(rr_shade_options *opt);

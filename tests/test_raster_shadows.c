@@ -187,7 +187,7 @@ static void check_lit(const char *name, bool inside) {
         rr_shade_options so;
         rr_shade_options_init(&so);
         so.mode = RR_SHADE_LIT, so.shadows = modes[m], so.max_depth = 1;
-        if (m == 1) so.wave_samples = 96 * 13; /* waves of 13 rows, the last of 7; ssaa:16 one row */
+        if (m == 1) so.wave_points = 96 * 13; /* waves of 13 rows, the last of 7; ssaa:16 one row */
         rr_image im = {0};
         rr_shade_stats st;
         CHECK(rr_shade_frame(dev, s, &cam, f, &so, &im, &st) == RR_OK, "%s", rr_device_message(dev));

@@ -460,9 +460,10 @@ static void lit_finish_rows(int job, int thread, void *arg) {
 /* The lit mode's frame, a wave of rows at a time: every shaded point of the wave
  * made (per sample in ssaa, per pixel and primitive in msaa and csaa), then the
  * passes over all of them (light.h), then the samples coloured and stored. */
-static void lit_frame(shade_pass *p, int wave_samples, int threads) {
+static void lit_frame(shade_pass *p, int wave_points, int threads) {
   const visbuf *vb = p->vb;
-  size_t row = (size_t)vb->width * p->samples, want = wave_samples > 0 ? (size_t)wave_samples : RR_LIT_WAVE;
+  bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA; /* about one point a pixel */
+  size_t row = (size_t)vb->width * (grouped ? 1 : p->samples), want = wave_points > 0 ? (size_t)wave_points : RR_LIT_WAVE;
   int rows = want / row < 1 ? 1 : want / row >= (size_t)vb->height ? vb->height : (int)(want / row);
   p->wave_pix = (size_t)rows * vb->width;
   size_t n = p->wave_pix * p->samples;
@@ -568,7 +569,7 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
     double t0 = rr_now_ms();
     if (opt->mode == RR_SHADE_DEPTH) depth_range(p, &p->dmin, &p->dmax);
     int threads = f->stats.threads > 0 ? f->stats.threads : 1;
-    if (p->lit) lit_frame(p, opt->wave_samples, threads);
+    if (p->lit) lit_frame(p, opt->wave_points, threads);
     else rr_parallel_for((vb->height + SHADE_ROWS - 1) / SHADE_ROWS, threads, shade_rows, p);
     double t1 = rr_now_ms();
     resolve_input in = {vb->width, vb->height, p->samples, pos, p->rgb, p->weight, p->alpha};
@@ -779,7 +780,7 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *
   bool lit = opt->mode == RR_SHADE_LIT;
   if (lit && ((int)opt->shadows < 0 || opt->shadows >= RR_SHADOWS_COUNT))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shadow mode %d", (int)opt->shadows);
-  if (lit && opt->wave_samples < 0) return rr_fail(dev, RR_ERROR_ARGUMENT, "negative wave size %d", opt->wave_samples);
+  if (lit && opt->wave_points < 0) return rr_fail(dev, RR_ERROR_ARGUMENT, "negative wave size %d", opt->wave_points);
   if (lit && (opt->max_depth < 0 || opt->max_depth > RR_MAX_DEPTH))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "max depth %d out of range (0 .. %d)", opt->max_depth, RR_MAX_DEPTH);
   bool empty;
