@@ -16,7 +16,7 @@
  * which the bench writes as an OBJ beside a copy of the bunny. Auto-framed at --size (default 1024x1024) on --threads (default 2),
  * method auto, medians of --runs rounds (default 3) in which the modes take turns.
  *
- *   bench_shading [--size WxH] [--threads N] [--runs N] [--shadows rays|raster|auto] [--wave SAMPLES]
+ *   bench_shading [--size WxH] [--threads N] [--runs N] [--shadows rays|raster|auto] [--wave POINTS]
  *                 [--rays-only] */
 #include "benchutil.h"
 #include "camera/camera.h"
@@ -357,7 +357,7 @@ int main(int argc, char **argv) {
     } else if (strcmp(argv[i], "--rays-only") == 0) {
       rays_only = true;
     } else {
-      fprintf(stderr, "usage: bench_shading [--size WxH] [--threads N] [--runs N] [--shadows MODE] [--wave SAMPLES] [--rays-only]\n");
+      fprintf(stderr, "usage: bench_shading [--size WxH] [--threads N] [--runs N] [--shadows MODE] [--wave POINTS] [--rays-only]\n");
       return 2;
     }
   }
