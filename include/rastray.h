@@ -722,7 +722,8 @@ typedef enum rr_shadow_mode {
                           light to the point offset along its geometric normal (docs/shading.md) */
   RR_SHADOWS_RASTER,   /* the same rays rasterized, the same bits: from a point or spot light (a camera at the
                           light), along a directional light (an orthographic camera) */
-  RR_SHADOWS_AUTO,     /* raster where a point or spot light has enough points at once to repay it, else rays */
+  RR_SHADOWS_AUTO,     /* per light and pass: raster for a point or spot light with at least 16384 shadow rays
+                          in the pass (docs/shading.md), else rays */
   RR_SHADOWS_COUNT
 } rr_shadow_mode;
 

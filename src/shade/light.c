@@ -1,4 +1,4 @@
-/* The lit shade mode: lights, the material model and the passes over a batch of
+/* The lit shade mode: lights, the material model and the passes over a wave of
  * points (docs/shading.md is the reference for every formula here). */
 #include "shade/light.h"
 #include "vis/shadow_raster.h"
