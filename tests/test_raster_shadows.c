@@ -170,13 +170,16 @@ static void check_lit(const char *name, bool inside) {
   int views = test_quick() ? 1 : 3;
   for (int v = 0; v < views; v++) {
     rr_camera cam = inside ? test_random_view(s, 0.1f, 0.3f, 0.2f, 60, 90) : test_random_view(s, 1.5f, 3, 0.3f, 30, 60);
-    for (int ti = 0; ti < TEST_NTHREADS + 1; ti++) {
-      /* the last: 16 samples per pixel, whose batches are long enough for auto to rasterize */
+    for (int ti = 0; ti < TEST_NTHREADS + 2; ti++) {
+      /* then ssaa:16 (a pass long enough for auto to rasterize) and msaa:8 */
       rr_render_options o;
       rr_render_options_init(&o);
       o.method = RR_METHOD_3DR_BB, o.width = 96, o.height = 72, o.threads = test_threads[ti % TEST_NTHREADS];
       if (ti == TEST_NTHREADS)
         CHECK(rr_render_options_set_aa(dev, &o, RR_AA_SSAA, 16, 0, RR_AA_STANDARD, 0) == RR_OK, "%s",
+              rr_device_message(dev));
+      if (ti == TEST_NTHREADS + 1) /* groups of samples shaded once, waves of 13 rows for raster */
+        CHECK(rr_render_options_set_aa(dev, &o, RR_AA_MSAA, 8, 0, RR_AA_STANDARD, 0) == RR_OK, "%s",
               rr_device_message(dev));
       rr_frame *f = test_render_opt(dev, s, &cam, &o);
       if (!f) continue;
@@ -203,7 +206,7 @@ static void check_lit(const char *name, bool inside) {
         size_t diff = 0;
         for (size_t k = 0; img[0] && img[m] && k < (size_t)96 * 72 * 3; k++) diff += memcmp(&img[0][k], &img[m][k], 4) != 0;
         CHECK(img[0] && img[m] && diff == 0, "%s view %d, %d threads%s: %zu channels of the %s image differ from rays",
-              name, v, test_threads[ti % TEST_NTHREADS], ti == TEST_NTHREADS ? ", ssaa:16" : "", diff,
+              name, v, test_threads[ti % TEST_NTHREADS], ti == TEST_NTHREADS ? ", ssaa:16" : ti > TEST_NTHREADS ? ", msaa:8" : "", diff,
               m == 1 ? "raster" : "auto");
       }
       CHECK(rays > 0, "%s view %d: no shadow rays", name, v);
