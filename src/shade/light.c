@@ -200,8 +200,13 @@ static void sky_light(const surface *sf, const lighting *L, float o[3]) {
 typedef struct lit_point {
   surface sf;
   float w[3];
+  uint32_t reach; /* bit l < REACH_BITS: light l reaches it (facing, in its cone); bit MIRROR_BIT: a mirror */
   float *out, *parts, *refl;
 } lit_point;
+
+/* A bit per point and light, set by the ambient pass, spares each light pass a
+ * sweep to count its rays; lights past the first REACH_BITS count theirs. */
+enum { REACH_BITS = 31, MIRROR_BIT = 31 };
 
 /* CHUNK points are a block of a segment and a job of a pass; a chunk's rays lie
  * together in the pass's arrays, from `first` on (its points in order). */
@@ -217,6 +222,7 @@ typedef struct seg {
 typedef struct chunk {
   lit_point *p;
   size_t n, first, rays;
+  uint32_t reached[32]; /* the ambient pass's count of points with bit b of reach set */
 } chunk;
 
 struct lit_wave {
@@ -300,7 +306,7 @@ static bool chunks_of(lit_wave *w, const seg *g, int n) {
   w->nch = 0;
   for (int k = 0; k < n; k++)
     for (size_t i = 0; i < g[k].n; i += CHUNK)
-      w->ch[w->nch++] = (chunk){g[k].block[i / CHUNK], g[k].n - i < CHUNK ? g[k].n - i : CHUNK, 0, 0};
+      w->ch[w->nch++] = (chunk){g[k].block[i / CHUNK], g[k].n - i < CHUNK ? g[k].n - i : CHUNK, 0, 0, {0}};
   return true;
 }
 
@@ -336,6 +342,7 @@ typedef struct pass {
   const rr_scene *s;
   const lighting *L;
   const light *lt; /* the light of a light pass */
+  int bit;         /* its bit of reach (REACH_BITS: none, with shadows none or past the first lights) */
   float share;     /* of the shadow part, per light */
   bool last;       /* reflection: the last bounce (the sky instead of rays) */
   seg *next;       /* reflection: the next bounce's points, one per ray */
@@ -343,20 +350,32 @@ typedef struct pass {
   void *ctx;
 } pass;
 
+static bool light_on(const light *lt, const lit_point *q, vec3 *l, float c3[3]);
+static bool mirror_dir(const lit_point *q, float R[3], vec3 *r);
+
 /* The light that needs no ray: the sky, emission; and with no punctual light,
- * nothing to block. */
+ * nothing to block. Marks which lights reach each point and which are mirrors,
+ * and counts them. */
 static void job_ambient(int job, int thread, void *arg) {
   (void)thread;
   const pass *ps = arg;
-  const chunk *c = &ps->w->ch[job];
+  const lighting *L = ps->L;
+  chunk *c = &ps->w->ch[job];
+  int bits = L->shadows == RR_SHADOWS_NONE ? 0 : L->nlights < REACH_BITS ? L->nlights : REACH_BITS;
+  memset(c->reached, 0, sizeof c->reached);
   for (size_t i = 0; i < c->n; i++) {
-    const lit_point *q = &c->p[i];
+    lit_point *q = &c->p[i];
+    q->reach = 0;
     if (!q->out) continue;
-    float sky[3];
-    sky_light(&q->sf, ps->L, sky);
+    float sky[3], R[3];
+    sky_light(&q->sf, L, sky);
     credit(q, LIT_DIRECT, q->w, sky);
     if (q->sf.m) credit(q, LIT_EMISSION, q->w, q->sf.m->params.emission);
-    if (q->parts && !ps->L->nlights) q->parts[LIT_SHADOW] = 1;
+    if (q->parts && !L->nlights) q->parts[LIT_SHADOW] = 1;
+    vec3 l;
+    for (int b = 0; b < bits; b++)
+      if (light_on(&L->lights[b], q, &l, NULL)) q->reach |= 1u << b, c->reached[b]++;
+    if (mirror_dir(q, R, &l)) q->reach |= 1u << MIRROR_BIT, c->reached[MIRROR_BIT]++;
   }
 }
 
@@ -391,12 +410,13 @@ static void job_light_rays(int job, int thread, void *arg) {
   const pass *ps = arg;
   lit_wave *w = ps->w;
   const chunk *c = &w->ch[job];
-  bool far = ps->lt->type == RR_LIGHT_DIRECTIONAL;
+  bool far = ps->lt->type == RR_LIGHT_DIRECTIONAL, marked = ps->bit < REACH_BITS;
   size_t k = c->first;
   for (size_t i = 0; i < c->n; i++) {
     const lit_point *q = &c->p[i];
     vec3 l;
     float c3[3];
+    if (marked && !(q->reach >> ps->bit & 1)) continue;
     if (!light_on(ps->lt, q, &l, c3)) continue;
     if (ps->L->shadows == RR_SHADOWS_NONE) {
       credit(q, LIT_DIRECT, q->w, c3);
@@ -447,9 +467,12 @@ static bool direct(lit_wave *w, pass *ps, int threads, lit_stats *st) {
   for (int li = 0; li < L->nlights; li++) {
     ps->lt = &L->lights[li];
     bool far = ps->lt->type == RR_LIGHT_DIRECTIONAL;
-    if (L->shadows != RR_SHADOWS_NONE) rr_parallel_for((int)w->nch, threads, job_light_count, ps);
-    else
+    ps->bit = L->shadows != RR_SHADOWS_NONE && li < REACH_BITS ? li : REACH_BITS;
+    if (L->shadows == RR_SHADOWS_NONE)
       for (size_t c = 0; c < w->nch; c++) w->ch[c].rays = 0;
+    else if (ps->bit < REACH_BITS) /* counted by the ambient pass */
+      for (size_t c = 0; c < w->nch; c++) w->ch[c].rays = w->ch[c].reached[li];
+    else rr_parallel_for((int)w->nch, threads, job_light_count, ps);
     size_t nr = rays_place(w);
     if (!rays_reserve(w, nr)) return false;
     rr_parallel_for((int)w->nch, threads, job_light_rays, ps);
@@ -479,16 +502,6 @@ static bool mirror_dir(const lit_point *q, float R[3], vec3 *r) {
   return true;
 }
 
-static void job_mirror_count(int job, int thread, void *arg) {
-  (void)thread;
-  const pass *ps = arg;
-  chunk *c = &ps->w->ch[job];
-  float R[3];
-  vec3 r;
-  c->rays = 0;
-  for (size_t i = 0; i < c->n && !ps->last; i++) c->rays += mirror_dir(&c->p[i], R, &r);
-}
-
 /* The chunk's reflection rays; at the last bounce, the sky they would see. */
 static void job_mirror_rays(int job, int thread, void *arg) {
   (void)thread;
@@ -500,7 +513,7 @@ static void job_mirror_rays(int job, int thread, void *arg) {
     const lit_point *q = &c->p[i];
     float R[3];
     vec3 r;
-    if (!mirror_dir(q, R, &r)) continue;
+    if (!(q->reach >> MIRROR_BIT & 1) || !mirror_dir(q, R, &r)) continue;
     float t[3] = {q->w[0] * R[0], q->w[1] * R[1], q->w[2] * R[2]};
     if (ps->last) {
       float sky[3];
@@ -544,7 +557,7 @@ static void job_mirror_hits(int job, int thread, void *arg) {
  * points (ps->next). */
 static bool reflect(lit_wave *w, pass *ps, int threads, lit_stats *st) {
   double t0 = rr_now_ms();
-  rr_parallel_for((int)w->nch, threads, job_mirror_count, ps);
+  for (size_t c = 0; c < w->nch; c++) w->ch[c].rays = ps->last ? 0 : w->ch[c].reached[MIRROR_BIT];
   size_t nr = rays_place(w);
   ps->next->n = 0;
   if (!rays_reserve(w, nr) || !seg_reserve(ps->next, nr)) return false;
