@@ -749,7 +749,8 @@ typedef enum rr_shadow_mode {
                           light to the point offset along its geometric normal (docs/shading.md) */
   RR_SHADOWS_RASTER,   /* the same rays rasterized, the same bits: from a point or spot light (a camera at the
                           light), along a directional light (an orthographic camera) */
-  RR_SHADOWS_AUTO,     /* raster where a point or spot light has enough points at once to repay it, else rays */
+  RR_SHADOWS_AUTO,     /* per light and pass: raster for a point or spot light with at least 16384 shadow rays
+                          in the pass (docs/shading.md), else rays */
   RR_SHADOWS_COUNT
 } rr_shadow_mode;
 
@@ -778,7 +779,14 @@ typedef struct rr_shade_options {
   int has_background;               /* nonzero: background is the colour behind misses (default 0: a quiet
                                        grey-blue gradient) */
   float background[3];              /* linear RGB, finite, at least 0 */
+  int wave_points;                  /* lit: most points shaded in one wave of passes, counted as every sample
+                                       in ssaa and one per pixel in msaa and csaa (whole rows, at least one),
+                                       0: RR_LIT_WAVE. Memory grows with it (about 17 bytes a sample, 110 a
+                                       shaded point, 90 a ray), the occlusion passes' speed barely beyond
+                                       16K rays a light (docs/shading.md); the image does not depend on it */
 } rr_shade_options;
+
+#define RR_LIT_WAVE (1 << 18) /* the lit mode's points per wave by default */
 
 /* Fills options with defaults: Lambert, box filter, no alpha, aniso:16 textures. */
 RR_API void rr_shade_options_init(rr_shade_options *opt);
@@ -791,11 +799,13 @@ typedef struct rr_shade_stats {
                         0.5 each pixel is resolved as its samples are shaded: that time is here) */
   double resolve_ms; /* wall time of a separate resolve, per-sample colours to pixels (the wide filters;
                         about 0 for the box) */
-  uint64_t shadow_rays;     /* lit: shadow rays traced (one per point, light facing it) */
-  uint64_t reflection_rays; /* lit: mirror reflection rays traced, all bounces */
-  double shadow_ms;         /* lit: time tracing shadow rays, summed over the shading threads */
-  double reflection_ms;     /* lit: time tracing reflection rays and making their hits' surfaces, summed
-                               over the shading threads */
+  uint64_t shadow_rays;        /* lit: shadow rays tested (one per point, light facing it) */
+  uint64_t shadow_rays_raster; /* lit: of those, the ones rasterized from their light (--shadows raster, auto) */
+  uint64_t reflection_rays;    /* lit: mirror reflection rays traced, all bounces */
+  /* lit, wall times of the passes (docs/shading.md); shade_ms holds them */
+  double direct_ms;     /* the light passes: each light's shadow rays made, tested, its light added */
+  double shadow_ms;     /* of which the occlusion tests (rasterized or traced) */
+  double reflection_ms; /* the bounces: reflection rays traced and their hits' surfaces made */
 } rr_shade_stats;
 
 /* Shades a frame and resolves its samples to one colour per pixel (opt NULL: the
@@ -810,6 +820,16 @@ RR_API rr_error rr_shade_frame(rr_device *dev, const rr_scene *scene, const rr_c
 /* Extracts an AOV of a frame into a new image of kind RR_IMAGE_AOV + aov. */
 RR_API rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                              const rr_frame *frame, rr_aov aov, rr_image *out);
+/* rr_shade_frame with opt->mode RR_SHADE_LIT, and from the same passes the lit
+ * AOVs whose bit (1u << aov, aov in RR_AOV_ALBEDO .. RR_AOV_EMISSION) is set in
+ * `aovs`, each into a new image aov_images[aov] (the other entries untouched), as
+ * rr_frame_aov makes them but under opt's lights and shadow mode: the parts of the
+ * point shaded for each pixel's sample nearest its centre (in msaa and csaa the
+ * point of that sample's primitive in the pixel). With one sample per pixel they
+ * equal rr_frame_aov's bit for bit, whatever opt->shadows. On failure no image is made. */
+RR_API rr_error rr_shade_frame_aovs(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
+                                    const rr_frame *frame, const rr_shade_options *opt, unsigned aovs,
+                                    rr_image aov_images[RR_AOV_COUNT], rr_image *out, rr_shade_stats *stats);
 /* Frees the pixels of an image made by rastray. */
 RR_API void rr_image_free(rr_image *img);
 

@@ -152,7 +152,9 @@ static void check_scene(const char *name, int lights, size_t npts) {
 }
 
 /* Lit images: shadows by rays, raster and auto give the same bits on random views
- * (inside ones too) with a point and a spot light, frames on 1, 2, 8 threads. */
+ * (inside ones too) with a point and a spot light, frames on 1, 2, 8 threads;
+ * raster in waves of a few rows (one at 16 samples) too. The lit AOVs made with
+ * the colour (rr_shade_frame_aovs, raster) equal rr_frame_aov's (rays). */
 static void check_lit(const char *name, bool inside) {
   rr_scene *s = load(name);
   if (!s) return;
@@ -168,13 +170,16 @@ static void check_lit(const char *name, bool inside) {
   int views = test_quick() ? 1 : 3;
   for (int v = 0; v < views; v++) {
     rr_camera cam = inside ? test_random_view(s, 0.1f, 0.3f, 0.2f, 60, 90) : test_random_view(s, 1.5f, 3, 0.3f, 30, 60);
-    for (int ti = 0; ti < TEST_NTHREADS + 1; ti++) {
-      /* the last: 16 samples per pixel, whose batches are long enough for auto to rasterize */
+    for (int ti = 0; ti < TEST_NTHREADS + 2; ti++) {
+      /* then ssaa:16 (a pass long enough for auto to rasterize) and msaa:8 */
       rr_render_options o;
       rr_render_options_init(&o);
       o.method = RR_METHOD_3DR_BB, o.width = 96, o.height = 72, o.threads = test_threads[ti % TEST_NTHREADS];
       if (ti == TEST_NTHREADS)
         CHECK(rr_render_options_set_aa(dev, &o, RR_AA_SSAA, 16, 0, RR_AA_STANDARD, 0) == RR_OK, "%s",
+              rr_device_message(dev));
+      if (ti == TEST_NTHREADS + 1) /* groups of samples shaded once, waves of 13 rows for raster */
+        CHECK(rr_render_options_set_aa(dev, &o, RR_AA_MSAA, 8, 0, RR_AA_STANDARD, 0) == RR_OK, "%s",
               rr_device_message(dev));
       rr_frame *f = test_render_opt(dev, s, &cam, &o);
       if (!f) continue;
@@ -185,6 +190,7 @@ static void check_lit(const char *name, bool inside) {
         rr_shade_options so;
         rr_shade_options_init(&so);
         so.mode = RR_SHADE_LIT, so.shadows = modes[m], so.max_depth = 1;
+        if (m == 1) so.wave_points = 96 * 13; /* waves of 13 rows, the last of 7; ssaa:16 one row */
         rr_image im = {0};
         rr_shade_stats st;
         CHECK(rr_shade_frame(dev, s, &cam, f, &so, &im, &st) == RR_OK, "%s", rr_device_message(dev));
@@ -192,15 +198,38 @@ static void check_lit(const char *name, bool inside) {
         if (m == 0) rays = st.shadow_rays;
         CHECK(st.shadow_rays == rays, "%s: mode %d traced %llu shadow rays, rays %llu", name, m,
               (unsigned long long)st.shadow_rays, (unsigned long long)rays);
+        CHECK(st.shadow_rays_raster == (m == 1 ? rays : m == 0 ? 0 : st.shadow_rays_raster),
+              "%s: mode %d rasterized %llu of %llu shadow rays", name, m, (unsigned long long)st.shadow_rays_raster,
+              (unsigned long long)rays);
       }
       for (int m = 1; m < 3; m++) {
         size_t diff = 0;
         for (size_t k = 0; img[0] && img[m] && k < (size_t)96 * 72 * 3; k++) diff += memcmp(&img[0][k], &img[m][k], 4) != 0;
         CHECK(img[0] && img[m] && diff == 0, "%s view %d, %d threads%s: %zu channels of the %s image differ from rays",
-              name, v, test_threads[ti % TEST_NTHREADS], ti == TEST_NTHREADS ? ", ssaa:16" : "", diff,
+              name, v, test_threads[ti % TEST_NTHREADS], ti == TEST_NTHREADS ? ", ssaa:16" : ti > TEST_NTHREADS ? ", msaa:8" : "", diff,
               m == 1 ? "raster" : "auto");
       }
       CHECK(rays > 0, "%s view %d: no shadow rays", name, v);
+      if (ti == 0) { /* one sample per pixel */
+        rr_shade_options so;
+        rr_shade_options_init(&so);
+        so.mode = RR_SHADE_LIT, so.shadows = RR_SHADOWS_RASTER, so.max_depth = 1;
+        rr_image im = {0}, aovs[RR_AOV_COUNT] = {{0}};
+        unsigned want = 1u << RR_AOV_SHADOW | 1u << RR_AOV_DIRECT;
+        CHECK(rr_shade_frame_aovs(dev, s, &cam, f, &so, want, aovs, &im, NULL) == RR_OK, "%s", rr_device_message(dev));
+        CHECK(im.data && img[0] && memcmp(im.data, img[0], sizeof(float) * 96 * 72 * 3) == 0,
+              "%s view %d: the colour of rr_shade_frame_aovs differs", name, v);
+        for (int a = RR_AOV_DIRECT; a <= RR_AOV_SHADOW; a += RR_AOV_SHADOW - RR_AOV_DIRECT) {
+          rr_image ref = {0};
+          int ch = a == RR_AOV_SHADOW ? 1 : 3;
+          CHECK(rr_frame_aov(dev, s, &cam, f, (rr_aov)a, &ref) == RR_OK, "%s", rr_device_message(dev));
+          CHECK(ref.data && aovs[a].data && aovs[a].channels == ch &&
+                    memcmp(ref.data, aovs[a].data, sizeof(float) * 96 * 72 * ch) == 0,
+                "%s view %d: AOV %d from the raster pass differs from rr_frame_aov's", name, v, a);
+          rr_image_free(&ref), rr_image_free(&aovs[a]);
+        }
+        rr_image_free(&im);
+      }
       for (int m = 0; m < 3; m++) free(img[m]);
       rr_frame_release(f);
     }

@@ -762,8 +762,8 @@ static void add_cube_faces(rr_device *dev, rr_output *set, const rr_image *cross
 typedef struct {
   double load, build, frame, cpu, shade, resolve, write, total;
   uint64_t shades; /* shading invocations of the colour image */
-  uint64_t shadow_rays, reflection_rays; /* lit: rays shading traced, and their time summed over threads */
-  double shadow, reflection;
+  uint64_t shadow_rays, shadow_rays_raster, reflection_rays; /* lit: rays shading tested, and the passes' times */
+  double direct, shadow, reflection;
 } timings;
 
 /* Adds the run's images to its output set. The colour image and each AOV are made
@@ -778,14 +778,22 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
   run.images = images, run.nimages = RR_AOV_COUNT + 1;
   progress_stage("shading");
   double t = now_ms();
+  /* lit: the lit AOVs come from the colour's own passes (its lights and shadow mode) */
+  unsigned lit_parts = 0;
+  for (int a = RR_AOV_ALBEDO; a <= RR_AOV_EMISSION; a++) lit_parts |= 1u << a;
+  bool together = shading->mode == RR_SHADE_LIT && (need & lit_parts);
+  if (together) need |= COLOR_BIT;
   for (int a = 0; a <= RR_AOV_COUNT; a++) {
-    if (!(need & 1u << a)) continue;
+    if (!(need & 1u << a) || (together && (lit_parts & 1u << a))) continue;
     rr_shade_stats st = {0};
-    rr_error e = a == RR_AOV_COUNT ? rr_shade_frame(dev, scene, cam, frame, shading, colour, &st)
-                                   : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
+    rr_error e = a == RR_AOV_COUNT && together
+                     ? rr_shade_frame_aovs(dev, scene, cam, frame, shading, need & lit_parts, images, colour, &st)
+                 : a == RR_AOV_COUNT ? rr_shade_frame(dev, scene, cam, frame, shading, colour, &st)
+                                     : rr_frame_aov(dev, scene, cam, frame, (rr_aov)a, &images[a]);
     ms->resolve += st.resolve_ms, ms->shades += st.shades;
     ms->shadow_rays += st.shadow_rays, ms->reflection_rays += st.reflection_rays;
     ms->shadow += st.shadow_ms, ms->reflection += st.reflection_ms;
+    ms->direct += st.direct_ms, ms->shadow_rays_raster += st.shadow_rays_raster;
     if (e) die(EXIT_INPUT, "%s", rr_device_message(dev));
   }
   ms->shade = now_ms() - t - ms->resolve; /* shading the samples and the AOVs */
@@ -936,7 +944,8 @@ static void add_stats_json(rr_device *dev, rr_output *set, const char *path, con
                  {"samples", opt->samples}, {"load_ms", ms->load}, {"build_ms", ms->build}, {"frame_ms", ms->frame},
                  {"vis_ms", ms->frame}, {"cpu_ms", ms->cpu}, {"shade_ms", ms->shade}, {"resolve_ms", ms->resolve},
                  {"write_ms", ms->write}, {"total_ms", ms->total}, {"shades", (double)ms->shades},
-                 {"shadow_rays", (double)ms->shadow_rays}, {"shadow_ms", ms->shadow},
+                 {"direct_ms", ms->direct}, {"shadow_rays", (double)ms->shadow_rays},
+                 {"shadow_rays_raster", (double)ms->shadow_rays_raster}, {"shadow_ms", ms->shadow},
                  {"reflection_rays", (double)ms->reflection_rays}, {"reflection_ms", ms->reflection},
                  {"setups", (double)st->setups}, {"edge_evals", (double)st->edge_evals}, {"nodes", (double)st->nodes},
                  {"bins", (double)st->bins}, {"bins_empty", (double)st->bins_empty}};
@@ -1216,11 +1225,13 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
     fprintf(stderr,
             "method=%s camera=%s triangles=%llu width=%d height=%d threads=%d aa=%s samples=%d frame_ms=%.3f "
             "vis_ms=%.3f cpu_ms=%.3f load_ms=%.1f build_ms=%.1f shade_ms=%.1f resolve_ms=%.1f write_ms=%.1f "
-            "total_ms=%.1f shades=%llu shadow_rays=%llu shadow_ms=%.1f reflection_rays=%llu reflection_ms=%.1f "
+            "total_ms=%.1f shades=%llu direct_ms=%.1f shadow_rays=%llu shadow_rays_raster=%llu shadow_ms=%.1f "
+            "reflection_rays=%llu reflection_ms=%.1f "
             "setups=%llu edge_evals=%llu nodes=%llu bins=%llu bins_empty=%llu\n",
             method, rr_camera_name(cam.type), (unsigned long long)info.triangles, opt.width, opt.height, st.threads,
             rr_aa_mode_name(opt.aa), opt.samples, ms.frame, ms.frame, ms.cpu, ms.load, ms.build, ms.shade, ms.resolve,
-            ms.write, ms.total, (unsigned long long)ms.shades, (unsigned long long)ms.shadow_rays, ms.shadow,
+            ms.write, ms.total, (unsigned long long)ms.shades, ms.direct, (unsigned long long)ms.shadow_rays,
+            (unsigned long long)ms.shadow_rays_raster, ms.shadow,
             (unsigned long long)ms.reflection_rays, ms.reflection, (unsigned long long)st.setups,
             (unsigned long long)st.edge_evals, (unsigned long long)st.nodes, (unsigned long long)st.bins,
             (unsigned long long)st.bins_empty);

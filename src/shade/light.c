@@ -1,4 +1,4 @@
-/* The lit shade mode: lights, the material model and the passes over a batch of
+/* The lit shade mode: lights, the material model and the passes over a wave of
  * points (docs/shading.md is the reference for every formula here). */
 #include "shade/light.h"
 #include "vis/shadow_raster.h"
@@ -191,47 +191,130 @@ static void sky_light(const surface *sf, const lighting *L, float o[3]) {
   }
 }
 
-/* ---- batches --------------------------------------------------------------- */
+/* ---- waves: the passes ------------------------------------------------------ */
 
-/* The points of one bounce: their surfaces, what they pass on to the pixel
- * (throughput, rgb) and where their colour goes: out, and the parts of the first
- * bounce's points (parts) or the reflection part of the point they are seen in (refl). */
-typedef struct level {
-  int n;
-  surface pt[LIT_BATCH];
-  float w[LIT_BATCH][3];
-  float *out[LIT_BATCH], *parts[LIT_BATCH], *refl[LIT_BATCH];
-} level;
+/* A point of one bounce: its surface, what it passes on to the pixel (throughput
+ * w), and where its colour goes: out, and the parts of a first bounce's point
+ * (parts) or the reflection part of the point it is seen in (refl). out NULL: no
+ * point (a reflection ray that left the scene). */
+typedef struct lit_point {
+  surface sf;
+  float w[3];
+  uint32_t reach; /* bit l < REACH_BITS: light l reaches it (facing, in its cone); bit MIRROR_BIT: a mirror */
+  float *out, *parts, *refl;
+} lit_point;
 
-struct lit_batch {
-  level lv[2]; /* this bounce's points and the next's */
-  int cur;
-  rr_ray ray[LIT_BATCH];
-  int who[LIT_BATCH];           /* the point ray k belongs to */
-  float add[LIT_BATCH][3];      /* what ray k brings when it is not blocked (shadows), its throughput (mirrors) */
-  int occluded[LIT_BATCH];
-  rr_hit hit[LIT_BATCH];
+/* A bit per point and light, set by the ambient pass, spares each light pass a
+ * sweep to count its rays; lights past the first REACH_BITS count theirs. */
+enum { REACH_BITS = 31, MIRROR_BIT = 31 };
+
+/* CHUNK points are a block of a segment and a job of a pass; a chunk's rays lie
+ * together in the pass's arrays, from `first` on (its points in order). */
+enum { CHUNK = 4096 };
+
+/* Points in blocks of CHUNK (kept from wave to wave; never moved, so growing
+ * copies nothing): a sink of the first bounce, or a later bounce's points (point
+ * k for reflection ray k of the bounce before). */
+typedef struct seg {
+  lit_point **block;
+  size_t n, nblocks, cap; /* points; blocks made; room for block pointers */
+} seg;
+typedef struct chunk {
+  lit_point *p;
+  size_t n, first, rays;
+  uint32_t reached[32]; /* the ambient pass's count of points with bit b of reach set */
+} chunk;
+
+struct lit_wave {
+  seg sink[RR_MAX_THREADS]; /* the first bounce's points, by the thread that queued them */
+  seg bounce[2];            /* the later bounces' points, alternately */
+  chunk *ch;                /* the current pass's chunks */
+  size_t nch, chcap;
+  rr_ray *ray; /* the current pass's rays, ray k leaving point who[k] and bringing add[k] (shadows: */
+  lit_point **who; /* its light unless blocked; mirrors: its throughput) */
+  float (*add)[3];
+  int *occluded;
+  rr_hit *hit;
+  size_t raycap;
 };
 
-lit_batch *rr_lit_batch_new(void) {
-  lit_batch *b = malloc(sizeof *b); /* not zeroed: ~300 KB, of which the counts say what is set */
-  if (b) b->lv[0].n = b->lv[1].n = 0, b->cur = 0;
-  return b;
-}
-void rr_lit_batch_free(lit_batch *b) { free(b); }
+lit_wave *rr_lit_wave_new(void) { return calloc(1, sizeof(lit_wave)); }
 
-bool rr_lit_batch_add(lit_batch *b, const surface *sf, float *out, float *parts) {
-  level *lv = &b->lv[b->cur];
-  if (lv->n == LIT_BATCH) return false;
-  lv->pt[lv->n] = *sf, lv->out[lv->n] = out, lv->parts[lv->n] = parts, lv->refl[lv->n] = NULL;
-  lv->w[lv->n][0] = lv->w[lv->n][1] = lv->w[lv->n][2] = 1;
+static void seg_free(seg *g) {
+  for (size_t b = 0; b < g->nblocks; b++) free(g->block[b]);
+  free(g->block);
+}
+
+void rr_lit_wave_free(lit_wave *w) {
+  if (!w) return;
+  for (int t = 0; t < RR_MAX_THREADS; t++) seg_free(&w->sink[t]);
+  seg_free(&w->bounce[0]), seg_free(&w->bounce[1]), free(w->ch);
+  free(w->ray), free(w->who), free(w->add), free(w->occluded), free(w->hit);
+  free(w);
+}
+
+/* Room for n points in g. */
+static bool seg_reserve(seg *g, size_t n) {
+  size_t need = (n + CHUNK - 1) / CHUNK;
+  if (need > g->cap) {
+    size_t cap = g->cap ? 2 * g->cap : 16;
+    cap = cap < need ? need : cap;
+    lit_point **b = realloc(g->block, cap * sizeof *b);
+    if (!b) return false;
+    g->block = b, g->cap = cap;
+  }
+  for (; g->nblocks < need; g->nblocks++)
+    if (!(g->block[g->nblocks] = malloc(CHUNK * sizeof(lit_point)))) return false;
+  return true;
+}
+
+static lit_point *seg_at(const seg *g, size_t i) { return &g->block[i / CHUNK][i % CHUNK]; }
+
+bool rr_lit_wave_add(lit_wave *w, int thread, const surface *sf, float *out, float *parts) {
+  seg *g = &w->sink[thread];
+  if (g->n == g->nblocks * CHUNK && !seg_reserve(g, g->n + 1)) return false;
+  lit_point *q = seg_at(g, g->n++);
+  q->sf = *sf, q->out = out, q->parts = parts, q->refl = NULL;
+  q->w[0] = q->w[1] = q->w[2] = 1;
   out[0] = out[1] = out[2] = 0;
   if (parts) {
     memset(parts, 0, LIT_PARTS * sizeof *parts);
     albedo_of(sf, parts + LIT_ALBEDO);
   }
-  lv->n++;
   return true;
+}
+
+/* Room for n rays in the pass arrays. */
+static bool rays_reserve(lit_wave *w, size_t n) {
+  if (n <= w->raycap) return true;
+  free(w->ray), free(w->who), free(w->add), free(w->occluded), free(w->hit);
+  w->ray = malloc(n * sizeof *w->ray), w->who = malloc(n * sizeof *w->who), w->add = malloc(n * sizeof *w->add);
+  w->occluded = malloc(n * sizeof *w->occluded), w->hit = malloc(n * sizeof *w->hit);
+  w->raycap = w->ray && w->who && w->add && w->occluded && w->hit ? n : 0;
+  return w->raycap != 0;
+}
+
+/* The chunks of the segments g[0..n-1]. */
+static bool chunks_of(lit_wave *w, const seg *g, int n) {
+  size_t nch = 0;
+  for (int k = 0; k < n; k++) nch += (g[k].n + CHUNK - 1) / CHUNK;
+  if (nch > w->chcap) {
+    chunk *c = realloc(w->ch, nch * sizeof *c);
+    if (!c) return false;
+    w->ch = c, w->chcap = nch;
+  }
+  w->nch = 0;
+  for (int k = 0; k < n; k++)
+    for (size_t i = 0; i < g[k].n; i += CHUNK)
+      w->ch[w->nch++] = (chunk){g[k].block[i / CHUNK], g[k].n - i < CHUNK ? g[k].n - i : CHUNK, 0, 0, {0}};
+  return true;
+}
+
+/* Numbers the chunks' rays one after the other; their total. */
+static size_t rays_place(lit_wave *w) {
+  size_t total = 0;
+  for (size_t c = 0; c < w->nch; c++) w->ch[c].first = total, total += w->ch[c].rays;
+  return total;
 }
 
 /* A ray leaving p on the side of the geometric normal ng that dir goes to: its
@@ -243,143 +326,265 @@ static rr_ray leave(const lighting *L, vec3 p, vec3 ng, vec3 dir, float tmax) {
   return (rr_ray){{o.x, o.y, o.z}, {dir.x, dir.y, dir.z}, 0, tmax};
 }
 
-/* Adds w·v to point i's colour and to the part it belongs to: `part` for a point
+/* Adds w·v to point q's colour and to the part it belongs to: `part` for a point
  * of the first bounce, the reflection of the point it is seen in for the others. */
-static void credit(const level *lv, int i, int part, const float w[3], const float v[3]) {
-  float *p = lv->parts[i] ? lv->parts[i] + part : lv->refl[i];
+static void credit(const lit_point *q, int part, const float w[3], const float v[3]) {
+  float *p = q->parts ? q->parts + part : q->refl;
   for (int c = 0; c < 3; c++) {
-    lv->out[i][c] += w[c] * v[c];
+    q->out[c] += w[c] * v[c];
     if (p) p[c] += w[c] * v[c];
   }
 }
 
-/* --shadows auto rasterizes a point or spot light's shadow rays when a batch
- * holds at least this many of them. bench/bench_shading's sweep (instructions,
- * 1024²): in runs of 1024 rays raster costs 0.99x the streams on the demo and
- * 1.12x on the bunny over a plane (whole frames 0.94x and 1.09x); in the lit
- * mode's batches of 64 points (one sample per pixel) 1.20x, of 1024 (16 samples)
- * 0.94x on the demo. A directional light's parallel rays rasterized cost about
- * 2.0x and 1.6x (each ray keeps its own edge setup): auto traces them. */
-#define SHADOW_RASTER_MIN 512
+/* What a pass's jobs share. */
+typedef struct pass {
+  lit_wave *w;
+  const rr_scene *s;
+  const lighting *L;
+  const light *lt; /* the light of a light pass */
+  int bit;         /* its bit of reach (REACH_BITS: none, with shadows none or past the first lights) */
+  float share;     /* of the shadow part, per light */
+  bool last;       /* reflection: the last bounce (the sky instead of rays) */
+  seg *next;       /* reflection: the next bounce's points, one per ray */
+  surface_fn fn;
+  void *ctx;
+} pass;
 
-/* Direct light on a level's points: one pass per light, its shadow rays in one
- * stream, or rasterized from the light (vis/shadow_raster.c: the same bits). */
-static void direct(lit_batch *b, const level *lv, const rr_scene *s, const lighting *L, lit_stats *st) {
-  for (int i = 0; i < lv->n; i++) {
-    float sky[3];
-    sky_light(&lv->pt[i], L, sky);
-    credit(lv, i, LIT_DIRECT, lv->w[i], sky);
-    if (lv->pt[i].m) credit(lv, i, LIT_EMISSION, lv->w[i], lv->pt[i].m->params.emission);
-    if (lv->parts[i] && !L->nlights) lv->parts[i][LIT_SHADOW] = 1; /* nothing to block */
+static bool light_on(const light *lt, const lit_point *q, vec3 *l, float c3[3]);
+static bool mirror_dir(const lit_point *q, float R[3], vec3 *r);
+
+/* The light that needs no ray: the sky, emission; and with no punctual light,
+ * nothing to block. Marks which lights reach each point and which are mirrors,
+ * and counts them. */
+static void job_ambient(int job, int thread, void *arg) {
+  (void)thread;
+  const pass *ps = arg;
+  const lighting *L = ps->L;
+  chunk *c = &ps->w->ch[job];
+  int bits = L->shadows == RR_SHADOWS_NONE ? 0 : L->nlights < REACH_BITS ? L->nlights : REACH_BITS;
+  memset(c->reached, 0, sizeof c->reached);
+  for (size_t i = 0; i < c->n; i++) {
+    lit_point *q = &c->p[i];
+    q->reach = 0;
+    if (!q->out) continue;
+    float sky[3], R[3];
+    sky_light(&q->sf, L, sky);
+    credit(q, LIT_DIRECT, q->w, sky);
+    if (q->sf.m) credit(q, LIT_EMISSION, q->w, q->sf.m->params.emission);
+    if (q->parts && !L->nlights) q->parts[LIT_SHADOW] = 1;
+    vec3 l;
+    for (int b = 0; b < bits; b++)
+      if (light_on(&L->lights[b], q, &l, NULL)) q->reach |= 1u << b, c->reached[b]++;
+    if (mirror_dir(q, R, &l)) q->reach |= 1u << MIRROR_BIT, c->reached[MIRROR_BIT]++;
   }
-  float share = L->nlights ? 1.0f / (float)L->nlights : 0; /* of the shadow part, per light */
-  bool empty;
-  const rr_bvh *bvh = rr_bvh_of(NULL, s, &empty); /* (checked current by rr_shade_frame) */
-  for (int li = 0; li < L->nlights; li++) {
-    const light *lt = &L->lights[li];
-    bool far = lt->type == RR_LIGHT_DIRECTIONAL;
-    int nr = 0;
-    for (int i = 0; i < lv->n; i++) {
-      const surface *sf = &lv->pt[i];
-      vec3 l;
-      float E[3], f[3];
-      if (!light_at(lt, sf->p, &l, E)) continue;
-      float cos = v3_dot(sf->n, l);
-      if (!(cos > 0)) continue;
-      brdf(sf, l, f);
-      float c3[3];
-      for (int c = 0; c < 3; c++) c3[c] = f[c] * E[c] * cos;
-      if (L->shadows == RR_SHADOWS_NONE) {
-        credit(lv, i, LIT_DIRECT, lv->w[i], c3);
-        if (lv->parts[i]) lv->parts[i][LIT_SHADOW] += share;
-        continue;
-      }
-      b->ray[nr] = leave(L, sf->p, sf->ng, l, far ? INFINITY : 1.0f);
-      if (!far) { /* from the light to the ray's origin, reached at t = 1: the light's rays share their origin */
-        vec3 d = v3_sub(v3_load(b->ray[nr].org), lt->pos);
-        v3_store(b->ray[nr].org, lt->pos), v3_store(b->ray[nr].dir, d);
-      }
-      b->who[nr] = i;
-      memcpy(b->add[nr], c3, sizeof c3);
-      nr++;
+}
+
+/* The light's direction l and what it brings, c3 = f·E·cos, at point q; false
+ * when none arrives or q faces away. */
+static bool light_on(const light *lt, const lit_point *q, vec3 *l, float c3[3]) {
+  float E[3], f[3];
+  if (!q->out || !light_at(lt, q->sf.p, l, E)) return false;
+  float cos = v3_dot(q->sf.n, *l);
+  if (!(cos > 0)) return false;
+  if (c3) {
+    brdf(&q->sf, *l, f);
+    for (int c = 0; c < 3; c++) c3[c] = f[c] * E[c] * cos;
+  }
+  return true;
+}
+
+static void job_light_count(int job, int thread, void *arg) {
+  (void)thread;
+  const pass *ps = arg;
+  chunk *c = &ps->w->ch[job];
+  vec3 l;
+  c->rays = 0;
+  for (size_t i = 0; i < c->n; i++) c->rays += light_on(ps->lt, &c->p[i], &l, NULL);
+}
+
+/* The chunk's shadow rays: from a point or spot light to the point offset towards
+ * it (rays from one light share their origin: the light is a camera), from the
+ * point along a directional light's direction; without shadows, the light itself. */
+static void job_light_rays(int job, int thread, void *arg) {
+  (void)thread;
+  const pass *ps = arg;
+  lit_wave *w = ps->w;
+  const chunk *c = &w->ch[job];
+  bool far = ps->lt->type == RR_LIGHT_DIRECTIONAL, marked = ps->bit < REACH_BITS;
+  size_t k = c->first;
+  for (size_t i = 0; i < c->n; i++) {
+    const lit_point *q = &c->p[i];
+    vec3 l;
+    float c3[3];
+    if (marked && !(q->reach >> ps->bit & 1)) continue;
+    if (!light_on(ps->lt, q, &l, c3)) continue;
+    if (ps->L->shadows == RR_SHADOWS_NONE) {
+      credit(q, LIT_DIRECT, q->w, c3);
+      if (q->parts) q->parts[LIT_SHADOW] += ps->share;
+      continue;
     }
+    w->ray[k] = leave(ps->L, q->sf.p, q->sf.ng, l, far ? INFINITY : 1.0f);
+    if (!far) { /* from the light to the ray's origin, reached at t = 1 */
+      vec3 d = v3_sub(v3_load(w->ray[k].org), ps->lt->pos);
+      v3_store(w->ray[k].org, ps->lt->pos), v3_store(w->ray[k].dir, d);
+    }
+    w->who[k] = (lit_point *)q;
+    memcpy(w->add[k], c3, sizeof c3);
+    k++;
+  }
+}
+
+static void job_light_add(int job, int thread, void *arg) {
+  (void)thread;
+  const pass *ps = arg;
+  const lit_wave *w = ps->w;
+  const chunk *c = &w->ch[job];
+  for (size_t k = c->first; k < c->first + c->rays; k++) {
+    if (w->occluded[k]) continue;
+    const lit_point *q = w->who[k];
+    credit(q, LIT_DIRECT, q->w, w->add[k]);
+    if (q->parts) q->parts[LIT_SHADOW] += ps->share;
+  }
+}
+
+/* --shadows auto rasterizes a point or spot light's shadow rays when its pass
+ * holds at least this many. bench/bench_shading's sweep (callgrind, one thread,
+ * 1024²; docs/shading.md): rasterizing runs of N rays costs, against the streams,
+ * 0.99x (N = 1024), 0.94x (4096) and 0.94x from 16384 on (the gain has saturated)
+ * on the demo, 1.12x, 1.10x and 1.08x on the bunny over a mirror. A directional
+ * light's parallel rays keep each its own edge setup: rasterized they cost 1.4x
+ * to 2.1x the streams at every N, so auto traces them. */
+#define SHADOW_RASTER_MIN 16384
+
+/* One pass per light: its shadow rays made in parallel, tested together (one
+ * rasterization from the light, or one stream: the same bits), then added. */
+static bool direct(lit_wave *w, pass *ps, int threads, lit_stats *st) {
+  const lighting *L = ps->L;
+  rr_parallel_for((int)w->nch, threads, job_ambient, ps);
+  ps->share = L->nlights ? 1.0f / (float)L->nlights : 0;
+  bool empty;
+  const rr_bvh *bvh = rr_bvh_of(NULL, ps->s, &empty); /* (checked current by rr_shade_frame) */
+  for (int li = 0; li < L->nlights; li++) {
+    ps->lt = &L->lights[li];
+    bool far = ps->lt->type == RR_LIGHT_DIRECTIONAL;
+    ps->bit = L->shadows != RR_SHADOWS_NONE && li < REACH_BITS ? li : REACH_BITS;
+    if (L->shadows == RR_SHADOWS_NONE)
+      for (size_t c = 0; c < w->nch; c++) w->ch[c].rays = 0;
+    else if (ps->bit < REACH_BITS) /* counted by the ambient pass */
+      for (size_t c = 0; c < w->nch; c++) w->ch[c].rays = w->ch[c].reached[li];
+    else rr_parallel_for((int)w->nch, threads, job_light_count, ps);
+    size_t nr = rays_place(w);
+    if (!rays_reserve(w, nr)) return false;
+    rr_parallel_for((int)w->nch, threads, job_light_rays, ps);
     if (!nr) continue;
     double t0 = rr_now_ms();
     /* analytic primitives (prim/analytic.h) are not rasterized from the light yet: rays */
-    bool raster = !s->kind && (L->shadows == RR_SHADOWS_RASTER ||
-                               (L->shadows == RR_SHADOWS_AUTO && !far && nr >= SHADOW_RASTER_MIN));
-    if (!raster || !rr_occluded_raster(s, bvh, b->ray, (size_t)nr, 1, b->occluded, NULL)) {
-      rr_ray_stream rs = rr_ray_stream_aos(b->ray, (size_t)nr);
-      rr_occluded_stream(NULL, s, &rs, 1, b->occluded); /* a refused ray (zero length) counts as lit */
+    bool raster = !ps->s->kind && (L->shadows == RR_SHADOWS_RASTER ||
+                                   (L->shadows == RR_SHADOWS_AUTO && !far && nr >= SHADOW_RASTER_MIN));
+    if (raster && rr_occluded_raster(ps->s, bvh, w->ray, nr, threads, w->occluded, NULL)) {
+      st->shadow_rays_raster += nr;
+    } else {
+      rr_ray_stream rs = rr_ray_stream_aos(w->ray, nr);
+      rr_occluded_stream(NULL, ps->s, &rs, threads, w->occluded); /* a refused ray (zero length) counts as lit */
     }
-    st->shadow_ms += rr_now_ms() - t0, st->shadow_rays += (uint64_t)nr;
-    for (int k = 0; k < nr; k++) {
-      int i = b->who[k];
-      if (b->occluded[k]) continue;
-      credit(lv, i, LIT_DIRECT, lv->w[i], b->add[k]);
-      if (lv->parts[i]) lv->parts[i][LIT_SHADOW] += share;
+    st->shadow_ms += rr_now_ms() - t0, st->shadow_rays += nr;
+    rr_parallel_for((int)w->nch, threads, job_light_add, ps);
+  }
+  return true;
+}
+
+/* The mirror bounce of point q: its reflectance R (false: not a mirror) and the
+ * view mirrored about the shading normal, or about the geometric one when that
+ * would leave through the surface. */
+static bool mirror_dir(const lit_point *q, float R[3], vec3 *r) {
+  const surface *sf = &q->sf;
+  if (!q->out || !mirror_of(sf, R)) return false;
+  *r = v3_sub(v3_scale(sf->n, 2 * v3_dot(sf->n, sf->v)), sf->v);
+  if (!(v3_dot(*r, sf->ng) > 0)) *r = v3_sub(v3_scale(sf->ng, 2 * v3_dot(sf->ng, sf->v)), sf->v);
+  return true;
+}
+
+/* The chunk's reflection rays; at the last bounce, the sky they would see. */
+static void job_mirror_rays(int job, int thread, void *arg) {
+  (void)thread;
+  const pass *ps = arg;
+  lit_wave *w = ps->w;
+  const chunk *c = &w->ch[job];
+  size_t k = c->first;
+  for (size_t i = 0; i < c->n; i++) {
+    const lit_point *q = &c->p[i];
+    float R[3];
+    vec3 r;
+    if (!(q->reach >> MIRROR_BIT & 1) || !mirror_dir(q, R, &r)) continue;
+    float t[3] = {q->w[0] * R[0], q->w[1] * R[1], q->w[2] * R[2]};
+    if (ps->last) {
+      float sky[3];
+      sky_along(ps->L, r, sky);
+      credit(q, LIT_REFLECTION, t, sky);
+      continue;
     }
+    w->ray[k] = leave(ps->L, q->sf.p, q->sf.ng, r, INFINITY);
+    w->who[k] = (lit_point *)q;
+    memcpy(w->add[k], t, sizeof t);
+    k++;
   }
 }
 
-/* Mirror bounces: the reflected rays of a level's mirrors in one stream; the
- * surfaces they hit become the next level (the sky where they miss, and beyond
- * the last bounce). */
-static void reflect(lit_batch *b, const level *lv, level *next, bool last, const rr_scene *s, const lighting *L,
-                    surface_fn fn, void *ctx, lit_stats *st) {
-  int nr = 0;
-  next->n = 0;
-  for (int i = 0; i < lv->n; i++) {
-    const surface *sf = &lv->pt[i];
-    float R[3];
-    if (!mirror_of(sf, R)) continue;
-    /* the view mirrored about the shading normal, or about the geometric one when
-     * that would leave through the surface */
-    vec3 r = v3_sub(v3_scale(sf->n, 2 * v3_dot(sf->n, sf->v)), sf->v);
-    if (!(v3_dot(r, sf->ng) > 0)) r = v3_sub(v3_scale(sf->ng, 2 * v3_dot(sf->ng, sf->v)), sf->v);
-    float w[3] = {lv->w[i][0] * R[0], lv->w[i][1] * R[1], lv->w[i][2] * R[2]};
-    if (last) {
-      float sky[3];
-      sky_along(L, r, sky);
-      credit(lv, i, LIT_REFLECTION, w, sky);
-      continue;
-    }
-    b->ray[nr] = leave(L, sf->p, sf->ng, r, INFINITY);
-    b->who[nr] = i;
-    memcpy(b->add[nr], w, sizeof w);
-    nr++;
-  }
-  if (!nr) return;
-  double t0 = rr_now_ms();
-  rr_ray_stream rs = rr_ray_stream_aos(b->ray, (size_t)nr);
-  rr_intersect_stream(NULL, s, &rs, 1, b->hit);
-  for (int k = 0; k < nr; k++) {
-    uint32_t idx = rr_scene_index_of(s, b->hit[k].prim);
-    vec3 org = v3_load(b->ray[k].org), dir = v3_load(b->ray[k].dir);
-    int i = b->who[k];
+/* The chunk's reflected hits: the next bounce's points (the sky where they miss). */
+static void job_mirror_hits(int job, int thread, void *arg) {
+  (void)thread;
+  const pass *ps = arg;
+  const lit_wave *w = ps->w;
+  const chunk *c = &w->ch[job];
+  for (size_t k = c->first; k < c->first + c->rays; k++) {
+    uint32_t idx = rr_scene_index_of(ps->s, w->hit[k].prim);
+    vec3 org = v3_load(w->ray[k].org), dir = v3_load(w->ray[k].dir);
+    const lit_point *q = w->who[k];
+    lit_point *nq = seg_at(ps->next, k);
     if (idx == RR_MISS) {
       float sky[3];
-      sky_along(L, dir, sky);
-      credit(lv, i, LIT_REFLECTION, b->add[k], sky);
+      sky_along(ps->L, dir, sky);
+      credit(q, LIT_REFLECTION, w->add[k], sky);
+      nq->out = NULL;
       continue;
     }
-    int j = next->n++;
-    fn(ctx, idx, b->hit[k].l1, b->hit[k].l2, b->hit[k].t, org, dir, &next->pt[j]);
-    memcpy(next->w[j], b->add[k], sizeof b->add[k]);
-    next->out[j] = lv->out[i], next->parts[j] = NULL;
-    next->refl[j] = lv->parts[i] ? lv->parts[i] + LIT_REFLECTION : lv->refl[i];
+    ps->fn(ps->ctx, idx, w->hit[k].l1, w->hit[k].l2, w->hit[k].t, org, dir, &nq->sf);
+    memcpy(nq->w, w->add[k], sizeof nq->w);
+    nq->out = q->out, nq->parts = NULL;
+    nq->refl = q->parts ? q->parts + LIT_REFLECTION : q->refl;
   }
-  st->reflection_ms += rr_now_ms() - t0, st->reflection_rays += (uint64_t)nr;
 }
 
-void rr_lit_batch_shade(lit_batch *b, const rr_scene *s, const lighting *L, surface_fn fn, void *ctx, lit_stats *st) {
-  for (int depth = 0;; depth++) {
-    level *lv = &b->lv[b->cur], *next = &b->lv[1 - b->cur];
-    if (!lv->n) break;
-    direct(b, lv, s, L, st);
-    reflect(b, lv, next, depth >= L->max_depth, s, L, fn, ctx, st);
-    lv->n = 0;
-    b->cur = 1 - b->cur;
+/* The bounce's reflection rays in one stream; their hits become the next bounce's
+ * points (ps->next). */
+static bool reflect(lit_wave *w, pass *ps, int threads, lit_stats *st) {
+  double t0 = rr_now_ms();
+  for (size_t c = 0; c < w->nch; c++) w->ch[c].rays = ps->last ? 0 : w->ch[c].reached[MIRROR_BIT];
+  size_t nr = rays_place(w);
+  ps->next->n = 0;
+  if (!rays_reserve(w, nr) || !seg_reserve(ps->next, nr)) return false;
+  rr_parallel_for((int)w->nch, threads, job_mirror_rays, ps);
+  if (!nr) return true;
+  rr_ray_stream rs = rr_ray_stream_aos(w->ray, nr);
+  rr_intersect_stream(NULL, ps->s, &rs, threads, w->hit);
+  ps->next->n = nr;
+  rr_parallel_for((int)w->nch, threads, job_mirror_hits, ps);
+  st->reflection_ms += rr_now_ms() - t0, st->reflection_rays += nr;
+  return true;
+}
+
+bool rr_lit_wave_shade(lit_wave *w, const rr_scene *s, const lighting *L, surface_fn fn, void *ctx, int threads,
+                       lit_stats *st) {
+  pass ps = {.w = w, .s = s, .L = L, .fn = fn, .ctx = ctx};
+  bool ok = chunks_of(w, w->sink, RR_MAX_THREADS);
+  for (int depth = 0; ok && w->nch; depth++) {
+    double t0 = rr_now_ms();
+    ok = direct(w, &ps, threads, st);
+    st->direct_ms += rr_now_ms() - t0;
+    ps.last = depth >= L->max_depth, ps.next = &w->bounce[depth & 1];
+    ok = ok && reflect(w, &ps, threads, st) && chunks_of(w, ps.next, 1);
   }
-  b->lv[0].n = b->lv[1].n = 0, b->cur = 0;
+  for (int t = 0; t < RR_MAX_THREADS; t++) w->sink[t].n = 0;
+  w->bounce[0].n = w->bounce[1].n = 0;
+  return ok;
 }

@@ -1,8 +1,10 @@
 /* The lit shade mode (docs/shading.md): direct light from point, spot, directional
  * and sky lights, emission and mirror reflections over a material's diffuse and
- * specular lobes. Points are shaded a batch at a time (a run of pixels), so that
- * each light's shadow rays and each bounce's reflection rays go through the ray
- * streams together. Shading of one point never knows which method saw it. */
+ * specular lobes. Points are shaded in passes over a wave (the frame's shaded
+ * points, or as many as fit LIT_WAVE): per light one occlusion pass over all the
+ * wave's shadow rays (rasterized from the light or one ray stream), then one pass
+ * of reflection rays per bounce whose hits are the next level's points. Shading of
+ * one point never knows which method saw it. */
 #ifndef RR_LIGHT_H
 #define RR_LIGHT_H
 
@@ -47,13 +49,14 @@ void rr_lighting_release(lighting *l);
  * barycentrics and t along dir (shade.c gives it; ctx is its own). */
 typedef void (*surface_fn)(void *ctx, uint32_t index, float l1, float l2, float t, vec3 org, vec3 dir, surface *out);
 
-/* Rays a batch traced and the time they took. */
+/* What a wave's passes traced and the wall time they took. */
 typedef struct lit_stats {
   uint64_t shadow_rays, reflection_rays;
-  double shadow_ms, reflection_ms;
+  uint64_t shadow_rays_raster; /* of shadow_rays, those rasterized from their light */
+  double direct_ms;            /* the light passes: making the shadow rays, testing them, adding the light */
+  double shadow_ms;            /* of which the occlusion tests */
+  double reflection_ms;        /* the bounces: reflection rays and their hits' surfaces */
 } lit_stats;
-
-enum { LIT_BATCH = 1024 }; /* most points of a batch */
 
 /* A point's colour in parts (the lit AOVs, named as Blender Cycles' passes): offsets
  * into an array of LIT_PARTS floats. The colour is direct + reflection + emission. */
@@ -65,17 +68,23 @@ enum {
   LIT_SHADOW = 12,     /* the fraction of the punctual lights that reach it (1 when there is none) */
   LIT_PARTS = 13
 };
-typedef struct lit_batch lit_batch;
 
-/* A batch, empty (NULL when out of memory); one per thread. */
-lit_batch *rr_lit_batch_new(void);
-void rr_lit_batch_free(lit_batch *b);
-/* Queues a point whose linear colour goes to out[0..2] when the batch is shaded,
- * and its parts to parts[0 .. LIT_PARTS - 1] unless parts is NULL; false when the
- * batch is full. */
-bool rr_lit_batch_add(lit_batch *b, const surface *sf, float *out, float *parts);
-/* Shades the queued points under L, writes their colours and empties the batch;
- * rays through s's streams on this thread, reflected hits made by fn(ctx). */
-void rr_lit_batch_shade(lit_batch *b, const rr_scene *s, const lighting *L, surface_fn fn, void *ctx, lit_stats *st);
+/* The points of a wave, queued by up to RR_MAX_THREADS threads at once (each
+ * through its own sink), then shaded together in passes. */
+typedef struct lit_wave lit_wave;
+
+/* An empty wave (NULL when out of memory). */
+lit_wave *rr_lit_wave_new(void);
+void rr_lit_wave_free(lit_wave *w);
+/* Queues a point through sink `thread` (one thread per sink at a time); its linear
+ * colour goes to out[0..2] and its parts to parts[0 .. LIT_PARTS - 1] unless parts
+ * is NULL, when the wave is shaded. False when out of memory. */
+bool rr_lit_wave_add(lit_wave *w, int thread, const surface *sf, float *out, float *parts);
+/* Shades the queued points under L in passes on `threads` threads (rays through
+ * s's tree; reflected hits made by fn(ctx), which may run on any of them), writes
+ * their colours and empties the wave; adds to st. False when out of memory (the
+ * colours are then incomplete). */
+bool rr_lit_wave_shade(lit_wave *w, const rr_scene *s, const lighting *L, surface_fn fn, void *ctx, int threads,
+                       lit_stats *st);
 
 #endif

@@ -248,10 +248,20 @@ typedef struct shade_pass {
   float *out; /* a filter of each pixel's own samples: the image, resolved as shading goes (no rgb kept) */
   uint64_t shades[RR_MAX_THREADS];
   bool failed; /* a job found no memory */
-  bool lit;          /* RR_SHADE_LIT: the run's points are shaded together (light.h) */
+  /* RR_SHADE_LIT: the points of a wave of rows (light.h) are made first, their
+   * colours going to the wave's per-sample arrays, then shaded together in passes,
+   * then copied to the samples that share them and resolved */
+  bool lit;
   lighting lights;
-  lit_stats lit_st[RR_MAX_THREADS];
-  lit_batch *batch[RR_MAX_THREADS]; /* each thread's, made by its first job and kept for the pass */
+  lit_wave *wave;
+  lit_stats lit_st;
+  int y0, rows;     /* the wave's rows */
+  float *wave_rgb;  /* sample i of the wave's pixel q at 3(i·wave_pix + q) */
+  float *wave_w;    /* and its weight at i·wave_pix + q */
+  signed char *wave_lead; /* and the sample whose colour it shares */
+  size_t wave_pix;  /* the wave's room in pixels */
+  float *parts;     /* NULL, or the lit parts of each pixel's centre sample (LIT_PARTS floats a pixel) */
+  int centre;       /* the sample nearest the pixel's centre */
 } shade_pass;
 
 /* A reflection ray's hit as the lit mode's surface (light.h's surface_fn). Texture
@@ -276,7 +286,6 @@ static void background(int y, int height, float o[3]) {
  * power of two apart, so reading a pixel's samples in place would map them all to
  * the same cache sets. */
 enum { RUN = 64 };
-_Static_assert(RUN * RR_MAX_SAMPLES <= LIT_BATCH, "a run's points fit one batch of the lit mode");
 typedef struct sample_run {
   uint32_t id[RR_MAX_SAMPLES][RUN];
   float l1[RR_MAX_SAMPLES][RUN], l2[RR_MAX_SAMPLES][RUN], t[RR_MAX_SAMPLES][RUN];
@@ -285,8 +294,7 @@ typedef struct sample_run {
 } sample_run;
 
 /* Shades pixel (x, y), run entry j: see rr_aa_mode for what each mode does. */
-static uint64_t shade_pixel(const shade_pass *p, sample_run *r, lit_batch *lb, int j, int x, int y,
-                            const float bg[3]) {
+static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int x, int y, const float bg[3]) {
   const rr_scene *s = p->s;
   int n = p->samples, K = p->stored;
   bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
@@ -300,7 +308,6 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, lit_batch *lb, i
     uint32_t id = r->id[i][j];
     int last = grouped ? n : i + 1;
     float col[3] = {0, 0, 0};
-    bool queued = false;
     vec3 o, d;
     if (id < s->ntris) {
       float l1 = 0, l2 = 0, t = 0;
@@ -311,10 +318,14 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, lit_batch *lb, i
         float inv = 1.0f / (float)members;
         hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, o, d, &p->cams[i], x, y);
         h.footprint = p->footprint;
-        if (p->lit) { /* shaded with the run's other points; the colour arrives in r->rgb[i] */
+        if (p->lit) { /* shaded with the wave's other points; the colour arrives in the wave's arrays */
           surface sf;
           hit_surface(s, &h, &p->tex, &sf);
-          queued = rr_lit_batch_add(lb, &sf, &r->rgb[i][3 * j], NULL);
+          size_t q = (size_t)(y - p->y0) * p->vb->width + x;
+          /* the lit AOVs: the point of the centre sample (of its group in msaa, csaa) */
+          bool centre = grouped ? r->id[p->centre][j] == id : i == p->centre;
+          float *parts = p->parts && centre ? p->parts + LIT_PARTS * ((size_t)y * p->vb->width + x) : NULL;
+          if (!rr_lit_wave_add(p->wave, thread, &sf, p->wave_rgb + 3 * (i * p->wave_pix + q), parts)) p->failed = true;
         } else {
           shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
         }
@@ -325,7 +336,7 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, lit_batch *lb, i
     }
     for (int m = i; m < (last < K ? last : K); m++)
       if (r->id[m][j] == id) {
-        if (m > i || !queued) memcpy(&r->rgb[m][3 * j], col, sizeof col);
+        memcpy(&r->rgb[m][3 * j], col, sizeof col); /* (queued: 0 until the wave is shaded) */
         done[m] = true, r->w[m][j] = 1.0f, r->lead[m][j] = (signed char)i;
       }
   }
@@ -343,60 +354,138 @@ static uint64_t shade_pixel(const shade_pass *p, sample_run *r, lit_batch *lb, i
   return shades;
 }
 
-static void shade_rows(int job, int thread, void *arg) {
-  shade_pass *p = arg;
+/* The run of pixels x0 .. x0 + len - 1 of row y, from the visibility buffer. */
+static void run_load(const shade_pass *p, sample_run *r, int y, int x0, int len) {
   const visbuf *vb = p->vb;
-  size_t npix = (size_t)vb->width * vb->height;
+  size_t npix = (size_t)vb->width * vb->height, k0 = (size_t)y * vb->width + x0;
+  for (int i = 0; i < p->samples; i++) {
+    size_t e = i * npix + k0;
+    memcpy(r->id[i], vb->id + e, len * sizeof(uint32_t));
+    memcpy(r->l1[i], vb->l1 + e, len * sizeof(float));
+    memcpy(r->l2[i], vb->l2 + e, len * sizeof(float));
+    memcpy(r->t[i], vb->t + e, len * sizeof(float));
+  }
+}
+
+/* The run's coloured samples: resolved into the image (the box of each pixel's own
+ * samples), or kept for the resolve. */
+static void run_store(shade_pass *p, sample_run *r, int y, int x0, int len) {
+  const visbuf *vb = p->vb;
+  size_t npix = (size_t)vb->width * vb->height, k0 = (size_t)y * vb->width + x0;
   int n = p->samples;
-  uint64_t shades = 0;
-  sample_run *r = malloc(sizeof *r);
-  if (p->lit && !p->batch[thread]) p->batch[thread] = rr_lit_batch_new();
-  lit_batch *lb = p->lit ? p->batch[thread] : NULL;
-  if (!r || (p->lit && !lb)) { /* a job without room leaves its rows for shade_frame to report */
-    p->failed = true;
-    free(r);
+  for (int i = 0; p->has_alpha && i < n; i++)
+    for (int j = 0; j < len; j++) r->a[i][j] = r->id[i][j] < p->s->ntris ? 1.0f : 0.0f;
+  const float *w = p->aa == RR_AA_CSAA ? r->w[0] : NULL, *a = p->has_alpha ? r->a[0] : NULL;
+  if (p->out) {
+    int ch = p->has_alpha ? 4 : 3;
+    for (int j = 0; j < len; j++)
+      resolve_own(n, &r->rgb[0][3 * j], 3 * RUN, w ? w + j : NULL, a ? a + j : NULL, RUN, ch, p->out + ch * (k0 + j));
     return;
   }
-  for (int y = job * SHADE_ROWS; y < vb->height && y < (job + 1) * SHADE_ROWS; y++) {
-    float bg[3];
-    if (p->background) memcpy(bg, p->background, sizeof bg);
-    else background(y, vb->height, bg);
-    for (int x0 = 0; x0 < vb->width; x0 += RUN) {
-      int len = vb->width - x0 < RUN ? vb->width - x0 : RUN;
-      size_t k0 = (size_t)y * vb->width + x0;
-      for (int i = 0; i < n; i++) {
-        size_t e = i * npix + k0;
-        memcpy(r->id[i], vb->id + e, len * sizeof(uint32_t));
-        memcpy(r->l1[i], vb->l1 + e, len * sizeof(float));
-        memcpy(r->l2[i], vb->l2 + e, len * sizeof(float));
-        memcpy(r->t[i], vb->t + e, len * sizeof(float));
-      }
-      for (int j = 0; j < len; j++) shades += shade_pixel(p, r, lb, j, x0 + j, y, bg);
-      if (p->lit) { /* the run's points at once (a run holds at most LIT_BATCH), then their groups */
-        rr_lit_batch_shade(lb, p->s, &p->lights, reflected_surface, p, &p->lit_st[thread]);
-        for (int i = 0; i < p->stored; i++)
-          for (int j = 0; j < len; j++)
-            if (r->lead[i][j] != i) memcpy(&r->rgb[i][3 * j], &r->rgb[r->lead[i][j]][3 * j], 3 * sizeof(float));
-      }
-      for (int i = 0; p->has_alpha && i < n; i++)
-        for (int j = 0; j < len; j++) r->a[i][j] = r->id[i][j] < p->s->ntris ? 1.0f : 0.0f;
-      const float *w = p->aa == RR_AA_CSAA ? r->w[0] : NULL, *a = p->has_alpha ? r->a[0] : NULL;
-      if (p->out) { /* resolved here: the box of the pixel's own samples */
-        int ch = p->has_alpha ? 4 : 3;
-        for (int j = 0; j < len; j++)
-          resolve_own(n, &r->rgb[0][3 * j], 3 * RUN, w ? w + j : NULL, a ? a + j : NULL, RUN, ch,
-                      p->out + ch * (k0 + j));
-        continue;
-      }
-      for (int i = 0; i < n; i++) {
-        memcpy(p->rgb + 3 * (i * npix + k0), r->rgb[i], 3 * len * sizeof(float));
-        if (w) memcpy(p->weight + i * npix + k0, r->w[i], len * sizeof(float));
-        if (a) memcpy(p->alpha + i * npix + k0, r->a[i], len * sizeof(float));
-      }
-    }
+  for (int i = 0; i < n; i++) {
+    memcpy(p->rgb + 3 * (i * npix + k0), r->rgb[i], 3 * len * sizeof(float));
+    if (w) memcpy(p->weight + i * npix + k0, r->w[i], len * sizeof(float));
+    if (a) memcpy(p->alpha + i * npix + k0, r->a[i], len * sizeof(float));
   }
+}
+
+/* The background of row y. */
+static void row_background(const shade_pass *p, int y, float bg[3]) {
+  if (p->background) memcpy(bg, p->background, 3 * sizeof *bg);
+  else background(y, p->vb->height, bg);
+}
+
+/* Rows y0 + job·SHADE_ROWS on, at most to row `end`, run by run through fn. */
+typedef void (*run_fn)(shade_pass *p, sample_run *r, int thread, int y, int x0, int len);
+static void rows_by_runs(shade_pass *p, int y0, int end, int job, int thread, run_fn fn) {
+  sample_run *r = malloc(sizeof *r);
+  if (!r) { /* a job without room leaves its rows for shade_frame to report */
+    p->failed = true;
+    return;
+  }
+  for (int y = y0 + job * SHADE_ROWS; y < end && y < y0 + (job + 1) * SHADE_ROWS; y++)
+    for (int x0 = 0; x0 < p->vb->width; x0 += RUN) fn(p, r, thread, y, x0, p->vb->width - x0 < RUN ? p->vb->width - x0 : RUN);
   free(r);
-  p->shades[thread] += shades;
+}
+
+/* The modes other than lit: each run shaded and stored. */
+static void shade_run(shade_pass *p, sample_run *r, int thread, int y, int x0, int len) {
+  float bg[3];
+  row_background(p, y, bg);
+  run_load(p, r, y, x0, len);
+  for (int j = 0; j < len; j++) p->shades[thread] += shade_pixel(p, r, thread, j, x0 + j, y, bg);
+  run_store(p, r, y, x0, len);
+}
+static void shade_rows(int job, int thread, void *arg) {
+  shade_pass *p = arg;
+  rows_by_runs(p, 0, p->vb->height, job, thread, shade_run);
+}
+
+/* Lit, first: the run's points queued in the wave, its samples' weights and leads kept. */
+static void lit_gather_run(shade_pass *p, sample_run *r, int thread, int y, int x0, int len) {
+  float bg[3];
+  row_background(p, y, bg);
+  run_load(p, r, y, x0, len);
+  for (int j = 0; j < len; j++) p->shades[thread] += shade_pixel(p, r, thread, j, x0 + j, y, bg);
+  size_t q0 = (size_t)(y - p->y0) * p->vb->width + x0;
+  for (int i = 0; i < p->samples; i++) {
+    size_t e = i * p->wave_pix + q0;
+    memcpy(p->wave_rgb + 3 * e, r->rgb[i], 3 * len * sizeof(float));
+    memcpy(p->wave_w + e, r->w[i], len * sizeof(float));
+    memcpy(p->wave_lead + e, r->lead[i], len);
+  }
+}
+static void lit_gather_rows(int job, int thread, void *arg) {
+  shade_pass *p = arg;
+  rows_by_runs(p, p->y0, p->y0 + p->rows, job, thread, lit_gather_run);
+}
+
+/* Lit, last: the shaded colours given to the samples that share them, then stored. */
+static void lit_finish_run(shade_pass *p, sample_run *r, int thread, int y, int x0, int len) {
+  (void)thread;
+  if (p->has_alpha) run_load(p, r, y, x0, len); /* the ids give alpha */
+  size_t q0 = (size_t)(y - p->y0) * p->vb->width + x0;
+  for (int i = 0; i < p->samples; i++) {
+    size_t e = i * p->wave_pix + q0;
+    memcpy(r->rgb[i], p->wave_rgb + 3 * e, 3 * len * sizeof(float));
+    memcpy(r->w[i], p->wave_w + e, len * sizeof(float));
+    memcpy(r->lead[i], p->wave_lead + e, len);
+  }
+  for (int i = 0; i < p->stored; i++)
+    for (int j = 0; j < len; j++)
+      if (r->lead[i][j] != i) memcpy(&r->rgb[i][3 * j], &r->rgb[r->lead[i][j]][3 * j], 3 * sizeof(float));
+  run_store(p, r, y, x0, len);
+}
+static void lit_finish_rows(int job, int thread, void *arg) {
+  shade_pass *p = arg;
+  rows_by_runs(p, p->y0, p->y0 + p->rows, job, thread, lit_finish_run);
+}
+
+/* The lit mode's frame, a wave of rows at a time: every shaded point of the wave
+ * made (per sample in ssaa, per pixel and primitive in msaa and csaa), then the
+ * passes over all of them (light.h), then the samples coloured and stored. */
+static void lit_frame(shade_pass *p, int wave_points, int threads) {
+  const visbuf *vb = p->vb;
+  bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA; /* about one point a pixel */
+  size_t row = (size_t)vb->width * (grouped ? 1 : p->samples), want = wave_points > 0 ? (size_t)wave_points : RR_LIT_WAVE;
+  int rows = want / row < 1 ? 1 : want / row >= (size_t)vb->height ? vb->height : (int)(want / row);
+  p->wave_pix = (size_t)rows * vb->width;
+  size_t n = p->wave_pix * p->samples;
+  p->wave = rr_lit_wave_new();
+  p->wave_rgb = rr_alloc_large(3 * n * sizeof(float));
+  p->wave_w = rr_alloc_large(n * sizeof(float));
+  p->wave_lead = rr_alloc_large(n);
+  if (!p->wave || !p->wave_rgb || !p->wave_w || !p->wave_lead) p->failed = true;
+  for (p->y0 = 0; !p->failed && p->y0 < vb->height; p->y0 += rows) {
+    p->rows = vb->height - p->y0 < rows ? vb->height - p->y0 : rows;
+    int jobs = (p->rows + SHADE_ROWS - 1) / SHADE_ROWS;
+    rr_parallel_for(jobs, threads, lit_gather_rows, p);
+    if (p->failed) break;
+    if (!rr_lit_wave_shade(p->wave, p->s, &p->lights, reflected_surface, p, threads, &p->lit_st)) p->failed = true;
+    rr_parallel_for(jobs, threads, lit_finish_rows, p);
+  }
+  rr_lit_wave_free(p->wave);
+  free(p->wave_rgb), free(p->wave_w), free(p->wave_lead);
 }
 
 /* The frame's range of eye distances over every shaded sample (the depth mode's scale). */
@@ -429,10 +518,13 @@ static rr_error shade_heat_frame(rr_device *dev, const rr_frame *f, rr_shade_mod
   return rr_ok(dev);
 }
 
+static int centre_sample(const rr_frame *f);
+
 /* Shades the samples as the frame's AA mode says (cams: one per sample position),
- * then resolves them into out with the options' filter. */
+ * then resolves them into out with the options' filter; lit, the parts of each
+ * pixel's centre sample go to parts (LIT_PARTS floats a pixel) unless it is NULL. */
 static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f,
-                              const rr_shade_options *opt, const lighting *lights, rr_image *out,
+                              const rr_shade_options *opt, const lighting *lights, float *parts, rr_image *out,
                               rr_shade_stats *st) {
   const visbuf *vb = &f->vb;
   size_t npix = (size_t)vb->width * vb->height;
@@ -441,6 +533,7 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
   *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = opt->mode, .aa = f->aa, .samples = f->samples,
                       .tex = {opt->texture_filter, opt->aniso, opt->lod_bias}, .lit = lights != NULL};
   if (lights) p->lights = *lights;
+  p->parts = parts, p->centre = centre_sample(f);
   p->background = opt->has_background ? opt->background : NULL;
   p->stored = f->aa == RR_AA_CSAA ? f->aa_stored : p->samples;
   /* Derivatives are per pixel step. A sample shaded for the whole pixel (one per
@@ -480,7 +573,8 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
     double t0 = rr_now_ms();
     if (opt->mode == RR_SHADE_DEPTH) depth_range(p, &p->dmin, &p->dmax);
     int threads = f->stats.threads > 0 ? f->stats.threads : 1;
-    rr_parallel_for((vb->height + SHADE_ROWS - 1) / SHADE_ROWS, threads, shade_rows, p);
+    if (p->lit) lit_frame(p, opt->wave_points, threads);
+    else rr_parallel_for((vb->height + SHADE_ROWS - 1) / SHADE_ROWS, threads, shade_rows, p);
     double t1 = rr_now_ms();
     resolve_input in = {vb->width, vb->height, p->samples, pos, p->rgb, p->weight, p->alpha};
     e = p->failed ? rr_fail(dev, RR_ERROR_MEMORY, "out of memory for shading")
@@ -489,15 +583,13 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
     if (e && own) free(out->data), out->data = NULL;
     if (st) {
       *st = (rr_shade_stats){.shade_ms = t1 - t0, .resolve_ms = rr_now_ms() - t1};
-      for (int t = 0; t < RR_MAX_THREADS; t++) {
-        const lit_stats *l = &p->lit_st[t];
-        st->shades += p->shades[t];
-        st->shadow_rays += l->shadow_rays, st->reflection_rays += l->reflection_rays;
-        st->shadow_ms += l->shadow_ms, st->reflection_ms += l->reflection_ms;
-      }
+      for (int t = 0; t < RR_MAX_THREADS; t++) st->shades += p->shades[t];
+      const lit_stats *l = &p->lit_st;
+      st->shadow_rays = l->shadow_rays, st->shadow_rays_raster = l->shadow_rays_raster;
+      st->reflection_rays = l->reflection_rays, st->direct_ms = l->direct_ms, st->shadow_ms = l->shadow_ms;
+      st->reflection_ms = l->reflection_ms;
     }
   }
-  for (int t = 0; t < RR_MAX_THREADS; t++) rr_lit_batch_free(p->batch[t]);
   free(p->rgb), free(p->weight), free(p->alpha), free(p);
   return e ? e : rr_ok(dev);
 }
@@ -631,31 +723,31 @@ static rr_error lit_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   const visbuf vb = visbuf_layer(&f->vb, centre);
   size_t npix = (size_t)vb.width * vb.height;
   shade_pass *p = calloc(1, sizeof *p); /* what reflected_surface reads */
-  float *parts = calloc(npix, LIT_PARTS * sizeof(float)), (*colour)[3] = malloc(LIT_BATCH * sizeof *colour);
-  lit_batch *lb = rr_lit_batch_new();
-  rr_error e = p && parts && colour && lb ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for AOV %d", (int)aov);
+  float *parts = calloc(npix, LIT_PARTS * sizeof(float)), *colour = malloc(npix * 3 * sizeof(float));
+  lit_wave *wave = rr_lit_wave_new();
+  rr_error e = p && parts && colour && wave ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for AOV %d", (int)aov);
   if (!e) e = rr_lighting_make(dev, s, cam, &opt, &p->lights);
   if (!e) {
     p->s = s, p->tex = (tex_filter){opt.texture_filter, opt.aniso, opt.lod_bias};
     lit_stats st = {0};
-    int queued = 0;
-    for (size_t k = 0; k < npix; k++) {
+    bool ok = true;
+    for (size_t k = 0; ok && k < npix; k++) {
       int x = (int)(k % vb.width), y = (int)(k / vb.width);
       vec3 o, d;
       if (vb.id[k] >= s->ntris || !rr_cam_ray(&cams[centre], x, y, &o, &d)) continue; /* 0 */
       hit h = hit_make(s, vb.id[k], vb.l1[k], vb.l2[k], vb.t[k], o, d, &cams[centre], x, y);
       surface sf;
       hit_surface(s, &h, &p->tex, &sf);
-      rr_lit_batch_add(lb, &sf, colour[queued++], parts + k * LIT_PARTS);
-      if (queued == LIT_BATCH) rr_lit_batch_shade(lb, s, &p->lights, reflected_surface, p, &st), queued = 0;
+      ok = rr_lit_wave_add(wave, 0, &sf, colour + 3 * k, parts + k * LIT_PARTS);
     }
-    rr_lit_batch_shade(lb, s, &p->lights, reflected_surface, p, &st);
+    ok = ok && rr_lit_wave_shade(wave, s, &p->lights, reflected_surface, p, 1, &st);
     rr_lighting_release(&p->lights);
-    e = image_alloc(dev, out, vb.width, vb.height, ch, RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov);
+    e = ok ? image_alloc(dev, out, vb.width, vb.height, ch, RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov)
+           : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for AOV %d", (int)aov);
   }
   for (size_t k = 0; !e && k < npix; k++)
     memcpy((float *)out->data + k * ch, parts + k * LIT_PARTS + first, ch * sizeof(float));
-  free(p), free(parts), free(colour), rr_lit_batch_free(lb);
+  free(p), free(parts), free(colour), rr_lit_wave_free(wave);
   return e ? e : rr_ok(dev);
 }
 
@@ -666,8 +758,9 @@ void rr_shade_options_init(rr_shade_options *opt) {
                               .shadows = RR_SHADOWS_RAYS, .max_depth = 2, .default_lights = 1};
 }
 
-rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
-                        const rr_shade_options *opt, rr_image *out, rr_shade_stats *stats) {
+static rr_error shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                            const rr_shade_options *opt, unsigned aovs, rr_image *aov_images, rr_image *out,
+                            rr_shade_stats *stats) {
   rr_shade_options def;
   if (!opt) rr_shade_options_init(&def), opt = &def;
   if (!s || !cam || !f || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade: NULL argument");
@@ -691,6 +784,7 @@ rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   bool lit = opt->mode == RR_SHADE_LIT;
   if (lit && ((int)opt->shadows < 0 || opt->shadows >= RR_SHADOWS_COUNT))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "unknown shadow mode %d", (int)opt->shadows);
+  if (lit && opt->wave_points < 0) return rr_fail(dev, RR_ERROR_ARGUMENT, "negative wave size %d", opt->wave_points);
   if (lit && (opt->max_depth < 0 || opt->max_depth > RR_MAX_DEPTH))
     return rr_fail(dev, RR_ERROR_ARGUMENT, "max depth %d out of range (0 .. %d)", opt->max_depth, RR_MAX_DEPTH);
   bool empty;
@@ -700,12 +794,48 @@ rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   if (e) return e;
   camera cams[RR_MAX_SAMPLES];
   e = frame_cameras(dev, cam, f, cams);
-  if (!e) {
-    e = shade_samples(dev, s, cams, f, opt, lit ? &lights : NULL, out, stats);
-    for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
+  bool have_cams = !e, shaded = false;
+  size_t npix = (size_t)f->vb.width * f->vb.height;
+  float *parts = !e && aovs ? calloc(npix, LIT_PARTS * sizeof(float)) : NULL;
+  if (!e && aovs && !parts) e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the lit AOVs");
+  if (!e) e = shade_samples(dev, s, cams, f, opt, lit ? &lights : NULL, parts, out, stats), shaded = !e;
+  for (int k = 0; have_cams && k < f->samples; k++) rr_cam_release(&cams[k]);
+  /* the AOVs asked for, from the parts */
+  static const int part[] = {LIT_ALBEDO, LIT_DIRECT, LIT_REFLECTION, LIT_SHADOW, LIT_EMISSION};
+  rr_image made[RR_AOV_COUNT] = {{0}};
+  for (int a = RR_AOV_ALBEDO; !e && a <= RR_AOV_EMISSION; a++) {
+    if (!(aovs & 1u << a)) continue;
+    int ch = a == RR_AOV_SHADOW ? 1 : 3, first = part[a - RR_AOV_ALBEDO];
+    e = image_alloc(dev, &made[a], f->vb.width, f->vb.height, ch, RR_PIXEL_F32, RR_IMAGE_AOV + a);
+    for (size_t k = 0; !e && k < npix; k++)
+      memcpy((float *)made[a].data + k * ch, parts + k * LIT_PARTS + first, ch * sizeof(float));
   }
+  for (int a = RR_AOV_ALBEDO; a <= RR_AOV_EMISSION; a++)
+    if (aovs & 1u << a) {
+      if (e) rr_image_free(&made[a]);
+      else aov_images[a] = made[a];
+    }
+  if (e && shaded) rr_image_free(out);
+  free(parts);
   if (lit) rr_lighting_release(&lights);
-  return e;
+  return e ? e : rr_ok(dev);
+}
+
+rr_error rr_shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                        const rr_shade_options *opt, rr_image *out, rr_shade_stats *stats) {
+  return shade_frame(dev, s, cam, f, opt, 0, NULL, out, stats);
+}
+
+rr_error rr_shade_frame_aovs(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f,
+                             const rr_shade_options *opt, unsigned aovs, rr_image aov_images[RR_AOV_COUNT],
+                             rr_image *out, rr_shade_stats *stats) {
+  if (!opt || opt->mode != RR_SHADE_LIT)
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade_frame_aovs: the lit AOVs need options with the lit mode");
+  unsigned lit_bits = 0;
+  for (int a = RR_AOV_ALBEDO; a <= RR_AOV_EMISSION; a++) lit_bits |= 1u << a;
+  if (aovs & ~lit_bits) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade_frame_aovs: AOVs other than the lit parts asked for");
+  if (aovs && !aov_images) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade_frame_aovs: NULL argument");
+  return shade_frame(dev, s, cam, f, opt, aovs, aov_images, out, stats);
 }
 
 rr_error rr_shade(rr_device *dev, const rr_scene *s, const rr_camera *cam, const rr_frame *f, rr_shade_mode mode,
