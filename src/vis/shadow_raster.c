@@ -12,7 +12,8 @@
  *   reject those an edge plane keeps from the whole bin (its four corner
  *   directions, the bin test of 3D rasterization), and test each live sample of
  *   the bin with the one test of a ray (vis/ray_test.h) until every sample is
- *   occluded.
+ *   occluded; the leaf's analytic primitives (which those steps drop as edge-on)
+ *   through rr_ana_hit with each live sample's ray, as query_leaf tests them.
  *
  * The test of each (sample, triangle) pair is rr_occluded's, operation for
  * operation: the pre-test's edge values come from the same normals of the same
