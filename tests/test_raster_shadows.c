@@ -4,7 +4,11 @@
  * surface) and target points (surface points seen from random views, inside views
  * too, and rays through vertices and edges, where the tie rule decides), on 1, 2
  * and 8 threads; lit images with point and spot lights the same bits with
- * --shadows rays, raster and auto; an empty scene. */
+ * --shadows rays, raster and auto; an empty scene. The same on a scene mixing
+ * triangles with analytic spheres, boxes and infinite planes (prim/analytic.h),
+ * lights inside spheres and boxes too, where some rays are occluded only by an
+ * analytic primitive. */
+#include "prim/analytic.h"
 #include "vis/shadow_raster.h"
 #include "testutil.h"
 
@@ -70,9 +74,10 @@ static size_t targets(const rr_scene *s, vec3 eye, vec3 light, vec3 *out, size_t
  * and 8 threads against rr_occluded ray by ray. A point light (light not NULL): rays
  * from the light to the points; a directional one: rays from every point along
  * `towards`, unbounded (parallel rays: an orthographic camera). Adds the occluded and
- * lit counts to seen[]. */
+ * lit counts to seen[0..1], and to seen[2] the occluded rays whose nearest hit is an
+ * analytic primitive. */
 static void check_rays(const rr_scene *s, const vec3 *light, vec3 towards, const vec3 *pts, size_t n,
-                       const char *what, size_t seen[2]) {
+                       const char *what, size_t seen[3]) {
   rr_ray *rays = malloc(n * sizeof *rays);
   int *ref = malloc(n * sizeof *ref), *got = malloc(n * sizeof *got);
   if (!rays || !ref || !got) {
@@ -90,6 +95,10 @@ static void check_rays(const rr_scene *s, const vec3 *light, vec3 towards, const
     ref[k] = 0;
     rr_occluded(NULL, s, &rays[k], &ref[k]);
     seen[ref[k] != 0]++;
+    rr_hit h;
+    if (ref[k] && s->kind && rr_intersect(NULL, s, &rays[k], &h) == RR_OK && h.prim != RR_MISS &&
+        scene_kind(s, h.prim) != RR_GEOMETRY_TRIANGLE)
+      seen[2]++;
   }
   bool empty;
   const rr_bvh *b = rr_bvh_of(dev, s, &empty);
@@ -106,12 +115,10 @@ static void check_rays(const rr_scene *s, const vec3 *light, vec3 towards, const
   free(rays), free(ref), free(got);
 }
 
-/* Random lights and targets in scene `name`. */
-static void check_scene(const char *name, int lights, size_t npts) {
-  rr_scene *s = load(name);
-  if (!s) return;
+/* Random lights and targets in scene s. */
+static void check_lights(const rr_scene *s, const char *name, int lights, size_t npts) {
   vec3 *pts = malloc(npts * sizeof *pts);
-  size_t seen[2] = {0, 0}, seen_dir[2] = {0, 0};
+  size_t seen[3] = {0, 0, 0}, seen_dir[3] = {0, 0, 0};
   char what[160];
   for (int l = 0; l < lights && pts; l++) {
     vec3 light, eye;
@@ -147,17 +154,93 @@ static void check_scene(const char *name, int lights, size_t npts) {
         seen[1]);
   CHECK(seen_dir[0] > 0 && seen_dir[1] > 0, "%s: %zu lit and %zu occluded parallel rays: only one kind", name,
         seen_dir[0], seen_dir[1]);
+  CHECK(!s->kind || (seen[2] > 0 && seen_dir[2] > 0),
+        "%s: %zu point and %zu parallel rays occluded first by an analytic primitive: the test misses them", name,
+        seen[2], seen_dir[2]);
   free(pts);
+}
+
+static void check_scene(const char *name, int lights, size_t npts) {
+  rr_scene *s = load(name);
+  if (!s) return;
+  check_lights(s, name, lights, npts);
   rr_scene_release(s);
+}
+
+/* Random triangles, spheres (some crossing the ground), boxes (half of them turned),
+ * a ground plane y = 0 and an oblique plane off to the side, ids interleaving kinds. */
+static rr_scene *mixed_scene(int ntri, int nsph) {
+  rr_scene *s = NULL;
+  CHECK(rr_scene_new(dev, &s) == RR_OK, "%s", rr_device_message(dev));
+  float *pos = malloc(sizeof(float) * 9 * (size_t)ntri), *sp = malloc(sizeof(float) * 4 * (size_t)nsph);
+  uint32_t *idx = malloc(sizeof(uint32_t) * 3 * (size_t)ntri);
+  if (!s || !pos || !sp || !idx) {
+    CHECK(0, "out of memory");
+    free(pos), free(sp), free(idx);
+    if (s) rr_scene_release(s);
+    return NULL;
+  }
+  for (int t = 0; t < ntri; t++) {
+    float cx = test_randf(-4, 4), cy = test_randf(0, 3), cz = test_randf(-4, 4), sz = test_randf(0.3f, 1.5f);
+    for (int k = 0; k < 9; k++) pos[9 * t + k] = (k % 3 == 0 ? cx : k % 3 == 1 ? cy : cz) + sz * test_randf(-1, 1);
+    for (int k = 0; k < 3; k++) idx[3 * t + k] = (uint32_t)(3 * t + k);
+  }
+  CHECK(rr_scene_add_mesh(s, pos, (size_t)3 * ntri, idx, (size_t)ntri, NULL) == RR_OK, "%s", rr_device_message(dev));
+  for (int k = 0; k < nsph; k++)
+    sp[4 * k] = test_randf(-4, 4), sp[4 * k + 1] = test_randf(-0.5f, 3), sp[4 * k + 2] = test_randf(-4, 4),
+            sp[4 * k + 3] = test_randf(0.2f, 1.2f);
+  CHECK(rr_scene_add_spheres(s, sp, (size_t)nsph, NULL) == RR_OK, "%s", rr_device_message(dev));
+  float bx[12 * 8];
+  for (int k = 0; k < 8; k++) {
+    float *b = bx + 12 * k;
+    b[0] = test_randf(-4, 4), b[1] = test_randf(0, 2.5f), b[2] = test_randf(-4, 4);
+    for (int c = 3; c < 6; c++) b[c] = test_randf(0.3f, 1.2f);
+    for (int c = 0; c < 6; c++) b[6 + c] = k % 2 ? test_randf(-1, 1) : (c == 0 || c == 4);
+  }
+  CHECK(rr_scene_add_boxes(s, bx, 8, NULL) == RR_OK, "%s", rr_device_message(dev));
+  const float planes[12] = {0, 0, 0, 0, 1, 0, 0, 0, -9, 0.3f, 0.2f, 1};
+  CHECK(rr_scene_add_planes(s, planes, 2, NULL) == RR_OK, "%s", rr_device_message(dev));
+  for (int k = 0; k < 9 * ntri; k++) pos[k] *= 0.5f; /* more triangles after the analytic geometries */
+  CHECK(rr_scene_add_mesh(s, pos, (size_t)3 * ntri, idx, (size_t)ntri, NULL) == RR_OK, "%s", rr_device_message(dev));
+  free(pos), free(sp), free(idx);
+  CHECK(rr_scene_commit(s) == RR_OK, "%s", rr_device_message(dev));
+  return s;
+}
+
+/* Point lights at the centres of spheres and boxes (inside them: every ray that
+ * leaves is occluded by its own primitive, unless its target is inside too) and a
+ * directional light on points inside them, against rr_occluded. */
+static void check_inside_ana(const rr_scene *s, size_t npts) {
+  vec3 *pts = malloc(npts * sizeof *pts);
+  size_t seen[3] = {0, 0, 0}, seen_dir[3] = {0, 0, 0}, lights = 0;
+  char what[160];
+  for (uint32_t i = 0; pts && i < s->ntris && lights < 6; i++) {
+    prim_kind k = scene_kind(s, i);
+    if (k != RR_GEOMETRY_SPHERE && k != RR_GEOMETRY_BOX) continue;
+    if (lights >= 3 && k == RR_GEOMETRY_SPHERE) continue; /* three of each */
+    vec3 light = corner(s, 0, i), eye = in_bounds(s, frand(), frand(), frand());
+    size_t n = targets(s, eye, light, pts, npts);
+    for (size_t m = 0; m < n / 8; m++) /* and points around the light, inside or just outside */
+      pts[m] = v3_add(light, v3((frand() - 0.5f) * 2, (frand() - 0.5f) * 2, (frand() - 0.5f) * 2));
+    lights++;
+    snprintf(what, sizeof what, "mixed, light inside %s %u", k == RR_GEOMETRY_SPHERE ? "sphere" : "box", i);
+    check_rays(s, &light, light, pts, n, what, seen);
+    vec3 towards = v3(frand() - 0.5f, frand(), frand() - 0.5f);
+    for (size_t m = 0; m < n; m++) pts[m] = v3_add(light, v3((frand() - 0.5f) * 0.5f, (frand() - 0.5f) * 0.5f, 0));
+    snprintf(what, sizeof what, "mixed, directional light from inside %s %u", k == RR_GEOMETRY_SPHERE ? "sphere" : "box", i);
+    check_rays(s, NULL, towards, pts, n, what, seen_dir);
+  }
+  CHECK(lights == 6 && seen[2] > 0 && seen_dir[2] > 0,
+        "lights inside analytic primitives: %zu lights, %zu and %zu rays occluded first by an analytic one", lights,
+        seen[2], seen_dir[2]);
+  free(pts);
 }
 
 /* Lit images: shadows by rays, raster and auto give the same bits on random views
  * (inside ones too) with a point and a spot light, frames on 1, 2, 8 threads;
  * raster in waves of a few rows (one at 16 samples) too. The lit AOVs made with
  * the colour (rr_shade_frame_aovs, raster) equal rr_frame_aov's (rays). */
-static void check_lit(const char *name, bool inside) {
-  rr_scene *s = load(name);
-  if (!s) return;
+static void check_lit_scene(rr_scene *s, const char *name, bool inside) {
   vec3 c = v3_scale(v3_add(s->bmin, s->bmax), 0.5f), ext = v3_sub(s->bmax, s->bmin);
   rr_light_info pt = {.type = RR_LIGHT_POINT, .color = {2, 2, 2}};
   v3_store(pt.position, inside ? v3_add(c, v3_scale(ext, 0.2f)) : v3_add(c, v3(0.3f * ext.x, ext.y, 0.4f * ext.z)));
@@ -167,8 +250,10 @@ static void check_lit(const char *name, bool inside) {
   rr_light_info dl = {.type = RR_LIGHT_DIRECTIONAL, .direction = {0.3f, -1, -0.2f}, .color = {0.5f, 0.5f, 0.6f}};
   CHECK(rr_scene_add_light(s, &pt) == RR_OK && rr_scene_add_light(s, &sp) == RR_OK && rr_scene_add_light(s, &dl) == RR_OK,
         "%s", rr_device_message(dev));
-  int views = test_quick() ? 1 : 3;
+  /* a view without shadow rays (from inside a closed primitive) is replaced, a few times */
+  int views = test_quick() ? 1 : 3, lit_views = 0;
   for (int v = 0; v < views; v++) {
+    bool shadowed = false;
     rr_camera cam = inside ? test_random_view(s, 0.1f, 0.3f, 0.2f, 60, 90) : test_random_view(s, 1.5f, 3, 0.3f, 30, 60);
     for (int ti = 0; ti < TEST_NTHREADS + 2; ti++) {
       /* then ssaa:16 (a pass long enough for auto to rasterize) and msaa:8 */
@@ -209,7 +294,7 @@ static void check_lit(const char *name, bool inside) {
               name, v, test_threads[ti % TEST_NTHREADS], ti == TEST_NTHREADS ? ", ssaa:16" : ti > TEST_NTHREADS ? ", msaa:8" : "", diff,
               m == 1 ? "raster" : "auto");
       }
-      CHECK(rays > 0, "%s view %d: no shadow rays", name, v);
+      shadowed |= rays > 0;
       if (ti == 0) { /* one sample per pixel */
         rr_shade_options so;
         rr_shade_options_init(&so);
@@ -233,7 +318,16 @@ static void check_lit(const char *name, bool inside) {
       for (int m = 0; m < 3; m++) free(img[m]);
       rr_frame_release(f);
     }
+    lit_views += shadowed;
+    if (!shadowed && views < 8) views++;
   }
+  CHECK(lit_views >= (test_quick() ? 1 : 3), "%s: %d views with shadow rays", name, lit_views);
+}
+
+static void check_lit(const char *name, bool inside) {
+  rr_scene *s = load(name);
+  if (!s) return;
+  check_lit_scene(s, name, inside);
   rr_scene_release(s);
 }
 
@@ -277,6 +371,14 @@ int main(void) {
   }
   check_lit("demo", false);
   check_lit("sphere:24", true);
+  rr_scene *mixed = mixed_scene(quick ? 60 : 200, quick ? 16 : 40);
+  if (mixed) {
+    check_lights(mixed, "mixed", quick ? 4 : 16, npts);
+    check_inside_ana(mixed, npts / 2);
+    check_lit_scene(mixed, "mixed", false);
+    check_lit_scene(mixed, "mixed", true);
+    rr_scene_release(mixed);
+  }
   check_empty();
   rr_device_release(dev);
   return test_done();

@@ -478,9 +478,7 @@ static bool direct(lit_wave *w, pass *ps, int threads, lit_stats *st) {
     rr_parallel_for((int)w->nch, threads, job_light_rays, ps);
     if (!nr) continue;
     double t0 = rr_now_ms();
-    /* analytic primitives (prim/analytic.h) are not rasterized from the light yet: rays */
-    bool raster = !ps->s->kind && (L->shadows == RR_SHADOWS_RASTER ||
-                                   (L->shadows == RR_SHADOWS_AUTO && !far && nr >= SHADOW_RASTER_MIN));
+    bool raster = L->shadows == RR_SHADOWS_RASTER || (L->shadows == RR_SHADOWS_AUTO && !far && nr >= SHADOW_RASTER_MIN);
     if (raster && rr_occluded_raster(ps->s, bvh, w->ray, nr, threads, w->occluded, NULL)) {
       st->shadow_rays_raster += nr;
     } else {

@@ -12,7 +12,8 @@
  *   reject those an edge plane keeps from the whole bin (its four corner
  *   directions, the bin test of 3D rasterization), and test each live sample of
  *   the bin with the one test of a ray (vis/ray_test.h) until every sample is
- *   occluded.
+ *   occluded; the leaf's analytic primitives (which those steps drop as edge-on)
+ *   through rr_ana_hit with each live sample's ray, as query_leaf tests them.
  *
  * The test of each (sample, triangle) pair is rr_occluded's, operation for
  * operation: the pre-test's edge values come from the same normals of the same
@@ -28,6 +29,7 @@
  * direction, a bin's frustum is the prism of four planes along it, and each ray
  * keeps its own edge pre-test (tri_ray_may_hit4 from its origin: the edge normals
  * depend on it), so only the traversal is shared. */
+#include "prim/analytic.h"
 #include "vis/bvh_trace.h"
 #include "vis/ray_test.h"
 #include "vis/shadow_raster.h"
@@ -117,10 +119,36 @@ KERNEL float sr_best(const void *q) {
   return INFINITY;
 }
 
-/* A leaf's triangles against the bin's live samples, four triangles at a time. */
+/* A leaf's analytic primitives (prim/analytic.h), which every triangle path above
+ * drops as edge-on, against the bin's live samples: each pair through rr_ana_hit
+ * with the sample's own ray and query_leaf's range rule (t in [tmin, tmax]), so the
+ * bit is rr_occluded's. True when every sample is occluded. */
+static bool sr_leaf_ana(sr_state *b, uint32_t first, uint32_t count, uint64_t lanes) {
+  const rr_scene *s = b->s;
+  for (uint32_t j = 0; j < count; j++) {
+    uint32_t id = b->b->prims[first + j];
+    if (scene_kind(s, id) == RR_GEOMETRY_TRIANGLE) continue;
+    b->st.setups++;
+    for (uint64_t live = b->live & lanes; live; live &= live - 1) {
+      int k = __builtin_ctzll(live);
+      const rr_ray *r = &b->rays[b->idx[k]];
+      ana_ray ar = ana_ray_of(r->org, r->dir);
+      float t, u, v;
+      if (!rr_ana_hit(s, id, &ar, &t, &u, &v) || !(t >= r->tmin && t <= r->tmax)) continue;
+      b->occluded[b->idx[k]] = 1;
+      b->live &= ~(1ull << k);
+    }
+    if (!b->live) return true;
+  }
+  return false;
+}
+
+/* A leaf's triangles against the bin's live samples, four triangles at a time,
+ * then its analytic primitives. */
 KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes, const bool parallel) {
   sr_state *b = q;
   const rr_scene *s = b->s;
+  if (s->kind && sr_leaf_ana(b, first, count, lanes)) return true;
   const float *v = b->b->leaf_v + (size_t)9 * first;
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;

@@ -5,7 +5,8 @@
 #include "accel/bvh.h"
 
 /* What a rasterization from the light did: bins of samples, BVH slots tested,
- * triangles set up for a bin (S), edge tests at a sample or a bin's corners (E). */
+ * triangles and analytic primitives set up for a bin (S), edge tests at a sample or
+ * a bin's corners (E). */
 typedef struct rr_shadow_counts {
   uint64_t bins, nodes, setups, edge_evals;
 } rr_shadow_counts;
