@@ -293,6 +293,14 @@ typedef struct sample_run {
   signed char lead[RR_MAX_SAMPLES][RUN]; /* lit: the sample whose colour this one shares */
 } sample_run;
 
+/* Whether samples a and b of run entry j saw the same surface: the same primitive,
+ * and of a box the same face (l1's integer part), so msaa shades each face it covers. */
+static inline bool same_surface(const rr_scene *s, const sample_run *r, int a, int b, int j) {
+  uint32_t id = r->id[a][j];
+  if (r->id[b][j] != id) return false;
+  return id >= s->ntris || scene_kind(s, id) != RR_GEOMETRY_BOX || (int)r->l1[a][j] == (int)r->l1[b][j];
+}
+
 /* Shades pixel (x, y), run entry j: see rr_aa_mode for what each mode does. */
 static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int x, int y, const float bg[3]) {
   const rr_scene *s = p->s;
@@ -302,7 +310,8 @@ static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int
   uint64_t shades = 0;
   /* Each stored sample not yet coloured starts a group: the samples that saw its
    * primitive. ssaa and none: every sample its own group. msaa, csaa: shaded once,
-   * at the group's mean barycentrics and ray parameter along its first sample's ray. */
+   * at the group's mean barycentrics and ray parameter along its first sample's ray
+   * (a triangle's), or at its first sample's hit (an analytic primitive's). */
   for (int i = 0; i < K; i++) {
     if (done[i]) continue;
     uint32_t id = r->id[i][j];
@@ -312,8 +321,11 @@ static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int
     if (id < s->ntris) {
       float l1 = 0, l2 = 0, t = 0;
       int members = 0;
-      for (int m = i; m < last; m++)
-        if (r->id[m][j] == id) l1 += r->l1[m][j], l2 += r->l2[m][j], t += r->t[m][j], members++;
+      /* An analytic primitive's coordinates are not linear over it (a box's face in
+       * l1's integer part, a sphere's u wrapping at its seam): its first sample's hit. */
+      int upto = scene_kind(s, id) == RR_GEOMETRY_TRIANGLE ? last : i + 1;
+      for (int m = i; m < upto; m++)
+        if (same_surface(s, r, m, i, j)) l1 += r->l1[m][j], l2 += r->l2[m][j], t += r->t[m][j], members++;
       if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
         float inv = 1.0f / (float)members;
         hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, o, d, &p->cams[i], x, y);
@@ -323,7 +335,7 @@ static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int
           hit_surface(s, &h, &p->tex, &sf);
           size_t q = (size_t)(y - p->y0) * p->vb->width + x;
           /* the lit AOVs: the point of the centre sample (of its group in msaa, csaa) */
-          bool centre = grouped ? r->id[p->centre][j] == id : i == p->centre;
+          bool centre = grouped ? same_surface(s, r, p->centre, i, j) : i == p->centre;
           float *parts = p->parts && centre ? p->parts + LIT_PARTS * ((size_t)y * p->vb->width + x) : NULL;
           if (!rr_lit_wave_add(p->wave, thread, &sf, p->wave_rgb + 3 * (i * p->wave_pix + q), parts)) p->failed = true;
         } else {
@@ -335,7 +347,7 @@ static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int
       memcpy(col, bg, sizeof col);
     }
     for (int m = i; m < (last < K ? last : K); m++)
-      if (r->id[m][j] == id) {
+      if (same_surface(s, r, m, i, j)) {
         memcpy(&r->rgb[m][3 * j], col, sizeof col); /* (queued: 0 until the wave is shaded) */
         done[m] = true, r->w[m][j] = 1.0f, r->lead[m][j] = (signed char)i;
       }
@@ -344,7 +356,7 @@ static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int
    * its own colour counts for nothing */
   for (int c = K; c < n; c++) {
     for (int v = 0; v < K; v++)
-      if (r->id[p->nearest[c][v]][j] == r->id[c][j]) {
+      if (same_surface(s, r, p->nearest[c][v], c, j)) {
         r->w[p->nearest[c][v]][j] += 1.0f;
         break;
       }
