@@ -655,8 +655,12 @@ typedef enum rr_aov {
   RR_AOV_EMISSION,     /* 3 floats: the radiance it emits */
   RR_AOV_ZDEPTH,       /* 1 float: the hit's distance along the camera's forward axis (the optical axis;
                           depth sensors' convention), +inf on a miss; with several samples the nearest */
+  RR_AOV_SHADOW_LIGHTS, /* L floats (L = the punctual lights, 1 .. RR_MAX_SHADOW_LIGHTS): channel i is 1 where
+                           light i reaches the point (facing it, inside its cone, unblocked), else 0 (and on a
+                           miss): from the same occlusion passes as shadow, which is their mean */
   RR_AOV_COUNT
 } rr_aov;
+#define RR_MAX_SHADOW_LIGHTS 16 /* most lights the shadow-lights AOV holds (a channel each) */
 /* With several samples per pixel the per-pixel AOVs follow one rule each: id, mesh,
  * material, normal, bary, uv and uv-deriv are those of the sample nearest the pixel's centre (the
  * lowest such s on a tie; the same s in every pixel), so they belong to one
@@ -665,7 +669,7 @@ typedef enum rr_aov {
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
  * "material", "coverage", "sample-id", "sample-depth", "sample-mesh", "uv", "uv-deriv",
- * "albedo", "direct", "reflection", "shadow", "emission", "z-depth"); -1 when unknown. */
+ * "albedo", "direct", "reflection", "shadow", "emission", "z-depth", "shadow-lights"); -1 when unknown. */
 RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;
@@ -681,7 +685,8 @@ typedef enum rr_image_kind {
                           depth Z, normal N.X N.Y N.Z, bary bary.u bary.v (λ1, λ2), id, mesh and
                           material (32-bit UINT), evals, nodes, coverage, albedo.R/G/B, direct.R/G/B,
                           reflection.R/G/B, shadow, emission.R/G/B; per sample s (2 digits): id.sNN,
-                          Z.sNN, mesh.sNN; uv uv.u uv.v, uv-deriv uvdx.u uvdx.v uvdy.u uvdy.v; z-depth zdepth */
+                          Z.sNN, mesh.sNN; uv uv.u uv.v, uv-deriv uvdx.u uvdx.v uvdy.u uvdy.v; z-depth zdepth;
+                          per light i (2 digits): shadow.lNN */
 } rr_image_kind;
 
 /* An image owned by the caller or by rastray (rr_image_free). */
@@ -821,7 +826,9 @@ RR_API rr_error rr_shade_frame(rr_device *dev, const rr_scene *scene, const rr_c
 RR_API rr_error rr_frame_aov(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                              const rr_frame *frame, rr_aov aov, rr_image *out);
 /* rr_shade_frame with opt->mode RR_SHADE_LIT, and from the same passes the lit
- * AOVs whose bit (1u << aov, aov in RR_AOV_ALBEDO .. RR_AOV_EMISSION) is set in
+ * AOVs whose bit (1u << aov, aov in RR_AOV_ALBEDO .. RR_AOV_EMISSION or
+ * RR_AOV_SHADOW_LIGHTS, which fails when there is no punctual light or more than
+ * RR_MAX_SHADOW_LIGHTS) is set in
  * `aovs`, each into a new image aov_images[aov] (the other entries untouched), as
  * rr_frame_aov makes them but under opt's lights and shadow mode: the parts of the
  * point shaded for each pixel's sample nearest its centre (in msaa and csaa the

@@ -251,6 +251,125 @@ static void check_shadows(void) {
 
 static const char *write_file(const char *name, const char *text) { return test_write_file(dir, name, text); }
 
+/* The shadow-lights AOV: a plane and a quad over it under a point light (blocked
+ * where a double-precision segment test meets the quad), a directional light
+ * along (-2, -1, 0) (blocked where the quad, shifted by -1 in x, covers the plane) and a spot pointing away (reaching
+ * nothing); shadow is their mean, bit for bit as the passes add it; rays and
+ * raster give the same bits, and asking for it changes no other image. */
+static void check_shadow_lights(void) {
+  static const float q[2][4][3] = {{{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}},
+                                   {{-0.5f, 0.5f, -0.5f}, {-0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, -0.5f}}};
+  static const float white[2][3] = {{1, 1, 1}, {1, 1, 1}};
+  rr_scene *s = quads(2, q, white);
+  if (!s) return;
+  const float L[3] = {1.0f, 2.0f, 0.6f};
+  add_light(s, (rr_light_info){.type = RR_LIGHT_POINT, .position = {L[0], L[1], L[2]}, .color = {4, 4, 4}});
+  add_light(s, (rr_light_info){.type = RR_LIGHT_DIRECTIONAL, .direction = {-2, -1, 0}, .color = {1, 1, 1}});
+  add_light(s, (rr_light_info){.type = RR_LIGHT_SPOT, .position = {0, 2, 0}, .direction = {0, 1, 0},
+                               .color = {5, 5, 5}, .inner_cone_deg = 10, .outer_cone_deg = 30});
+  rr_camera cam = view(0.1f, 5, 0.2f, 0, 0, 0, 0, 0, -1);
+  enum { W = 96, NL = 3 };
+  rr_frame *f = test_render(dev, s, &cam, RR_METHOD_3DR_BB, 2, W, W, 0);
+  rr_image vis = {0};
+  float *shadow = f ? aov(s, &cam, f, RR_AOV_SHADOW) : NULL;
+  CHECK(f && rr_frame_aov(dev, s, &cam, f, RR_AOV_SHADOW_LIGHTS, &vis) == RR_OK && vis.channels == NL &&
+            vis.type == RR_PIXEL_F32 && vis.kind == RR_IMAGE_AOV + RR_AOV_SHADOW_LIGHTS,
+        "shadow-lights: %s", rr_device_message(dev));
+  const float *v = vis.data;
+  int judged = 0, blocked[2] = {0, 0}, wrong = 0, mean_wrong = 0;
+  for (int k = 0; v && shadow && k < W * W; k++) {
+    uint32_t id = rr_frame_ids(f)[k];
+    const float *vk = v + NL * k;
+    float mean = 0; /* as the passes add it: 1/L per light reaching, in order */
+    for (int i = 0; i < NL; i++) mean += vk[i] != 0 ? 1.0f / NL : 0;
+    mean_wrong += shadow[k] != (id == RR_MISS ? 0 : mean);
+    if (id == RR_MISS) {
+      wrong += vk[0] != 0 || vk[1] != 0 || vk[2] != 0;
+      continue;
+    }
+    bool want[NL] = {true, true, false};
+    if (id < 2) { /* the plane: blocked by the quad, judged away from its shadows' borders */
+      double p[3], d[3];
+      sample_point(f, k, q, p);
+      for (int a = 0; a < 3; a++) d[a] = L[a] - p[a];
+      double x = p[0] + (0.5 - p[1]) / d[1] * d[0], z = p[2] + (0.5 - p[1]) / d[1] * d[2];
+      if (fabs(0.5 - fabs(x)) < 1e-4 || fabs(0.5 - fabs(z)) < 1e-4 || fabs(0.5 - fabs(p[0] + 1)) < 1e-4 ||
+          fabs(0.5 - fabs(p[2])) < 1e-4)
+        continue;
+      want[0] = !(fmax(ray_tri(p, d, q[1][0], q[1][1], q[1][2]), ray_tri(p, d, q[1][0], q[1][2], q[1][3])) > 0);
+      want[1] = !(fabs(p[0] + 1) < 0.5 && fabs(p[2]) < 0.5); /* the quad moved by 0.5 (2, 1, 0) */
+    }
+    judged++, blocked[0] += !want[0], blocked[1] += !want[1];
+    for (int i = 0; i < NL; i++) wrong += vk[i] != (float)want[i];
+  }
+  printf("shadow-lights: %d pixels judged, %d and %d blocked from lights 0 and 1\n", judged, blocked[0], blocked[1]);
+  CHECK(judged > W * W / 2 && blocked[0] > 100 && blocked[1] > 100 && wrong == 0,
+        "%d wrong light visibilities of %d pixels (blocked %d, %d)", wrong, judged, blocked[0], blocked[1]);
+  CHECK(mean_wrong == 0, "%d pixels where shadow is not the mean of shadow-lights", mean_wrong);
+  /* from the colour's own passes: rays and raster the same bits as rr_frame_aov's; the
+   * colour and shadow as without it */
+  rr_shade_options so;
+  rr_shade_options_init(&so);
+  so.mode = RR_SHADE_LIT;
+  rr_image plain = {0};
+  CHECK(f && rr_shade_frame(dev, s, &cam, f, &so, &plain, NULL) == RR_OK, "%s", rr_device_message(dev));
+  for (int m = 0; f && m < 2; m++) {
+    so.shadows = m ? RR_SHADOWS_RASTER : RR_SHADOWS_RAYS;
+    rr_image aovs[RR_AOV_COUNT] = {{0}}, col = {0};
+    unsigned want = 1u << RR_AOV_SHADOW | 1u << RR_AOV_SHADOW_LIGHTS;
+    CHECK(rr_shade_frame_aovs(dev, s, &cam, f, &so, want, aovs, &col, NULL) == RR_OK, "%s", rr_device_message(dev));
+    rr_image *sl = &aovs[RR_AOV_SHADOW_LIGHTS], *sh = &aovs[RR_AOV_SHADOW];
+    CHECK(sl->data && sl->channels == NL && v && !memcmp(sl->data, v, sizeof(float) * NL * W * W),
+          "shadows %d: shadow-lights differ from rr_frame_aov's", m);
+    CHECK(sh->data && shadow && !memcmp(sh->data, shadow, sizeof(float) * W * W), "shadows %d: shadow differs", m);
+    CHECK(col.data && plain.data && !memcmp(col.data, plain.data, sizeof(float) * 3 * W * W),
+          "shadows %d: the colour changed with shadow-lights asked for", m);
+    rr_image_free(sl), rr_image_free(sh), rr_image_free(&col);
+  }
+  rr_image_free(&plain), rr_image_free(&vis), free(shadow);
+  /* no punctual light, or more than a channel each: refused, no image */
+  rr_scene *bare = quads(1, q, white), *many = quads(1, q, white);
+  for (int i = 0; many && i <= RR_MAX_SHADOW_LIGHTS; i++)
+    add_light(many, (rr_light_info){.type = RR_LIGHT_DIRECTIONAL, .direction = {0, -1, 0}, .color = {0.1f, 0.1f, 0.1f}});
+  so.shadows = RR_SHADOWS_RAYS, so.default_lights = 0;
+  for (int k = 0; k < 2; k++) {
+    rr_scene *t = k ? many : bare;
+    rr_frame *g = t ? test_render(dev, t, &cam, RR_METHOD_3DR_BB, 1, 8, 8, 0) : NULL;
+    rr_image aovs[RR_AOV_COUNT] = {{0}}, col = {0};
+    CHECK(g && rr_shade_frame_aovs(dev, t, &cam, g, &so, 1u << RR_AOV_SHADOW_LIGHTS, aovs, &col, NULL) ==
+                   RR_ERROR_ARGUMENT && !col.data && !aovs[RR_AOV_SHADOW_LIGHTS].data &&
+              strstr(rr_device_message(dev), "shadow-lights"),
+          "%s: %s", k ? "17 lights" : "no light", rr_device_message(dev));
+    rr_frame_release(g);
+  }
+  rr_scene_release(bare), rr_scene_release(many);
+  rr_frame_release(f);
+  rr_scene_release(s);
+  /* the CLI: an H×W×L .npy, an EXR layer, refused in PNG */
+  write_file("sl.obj", "v -2 0 -2\nv -2 0 2\nv 2 0 2\nv 2 0 -2\nv -0.5 0.5 -0.5\nv -0.5 0.5 0.5\nv 0.5 0.5 0.5\n"
+                       "v 0.5 0.5 -0.5\nf 1 2 3 4\nf 5 6 7 8\n");
+  char out[4096], path[600];
+  int rc = test_run_cli(dir,
+                        "render sl.obj --size 40x30 --shade lit --eye 0,5,0.2 --target 0,0,0 --up 0,0,-1 "
+                        "--light point:1,2,0.6:1,1,1:4 --light dir:0,-1,0:1,1,1 --aov shadow-lights=sl.npy "
+                        "--aov shadow,shadow-lights=sl.exr -o sl.png",
+                        true, out, sizeof out);
+  snprintf(path, sizeof path, "%s/sl.npy", dir);
+  FILE *fp = fopen(path, "rb");
+  char head[129] = {0};
+  size_t n = fp ? fread(head, 1, 128, fp) : 0;
+  long size = fp && fseek(fp, 0, SEEK_END) == 0 ? ftell(fp) : -1;
+  if (fp) fclose(fp);
+  CHECK(rc == 0 && n == 128 && strstr(head + 10, "'descr': '<f4'") && strstr(head + 10, "'shape': (30, 40, 2)") &&
+            size == 128 + 30 * 40 * 2 * 4,
+        "shadow-lights .npy: exit %d (%s), header '%s', %ld bytes", rc, out, head + 10, size);
+  snprintf(path, sizeof path, "%s/sl.exr", dir);
+  CHECK(access(path, F_OK) == 0, "no sl.exr");
+  rc = test_run_cli(dir, "render sl.obj --size 8x8 --shade lit --aov shadow-lights=slb.png", true, out, sizeof out);
+  snprintf(path, sizeof path, "%s/slb.png", dir);
+  CHECK(rc != 0 && strstr(out, "PNG") && access(path, F_OK) != 0, "shadow-lights as PNG: exit %d: %s", rc, out);
+}
+
 /* OBJ text: a box [-0.4, 0.4] × [y0, y1] × [-0.4, 0.4] with material mtl (y0 > y1 mirrors it). */
 static void box_obj(char *out, size_t cap, float y0, float y1, const char *mtl, int first_vertex) {
   int n = snprintf(out, cap, "o box\nusemtl %s\n", mtl);
@@ -743,6 +862,7 @@ int main(void) {
   check_inverse_square();
   check_spot();
   check_shadows();
+  check_shadow_lights();
   check_mirror();
   check_mtl();
   check_gltf();

@@ -260,7 +260,9 @@ static const cli_option render_options[] = {
      "sample nearest the centre's, depth the nearest.\n"
      "The lit shading's parts, as Blender Cycles' passes (the centre sample's, default\n"
      "shadows and depth): albedo, direct, reflection, emission (EXR NAME.R/G/B; colour =\n"
-     "direct + reflection + emission), shadow (fraction of the lights reaching a point).\n"
+     "direct + reflection + emission), shadow (fraction of the lights reaching a point),\n"
+     "shadow-lights (H×W×L, 1 where light i reaches it: EXR shadow.l00..; shadow is\n"
+     "their mean; at most " VALUE(RR_MAX_SHADOW_LIGHTS) " lights).\n"
      "z-depth: distance along the optical axis (EXR zdepth; depth is the eye distance).\n"
      "Outputs are all or nothing"},
     {"threads", OPT_THREADS, "N", "threads, at most " VALUE(RR_MAX_THREADS) " (default 0: all cores)"},
@@ -579,7 +581,7 @@ static aov_out parse_aov(const char *arg) {
       die(EXIT_USAGE,
           "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes, coverage, "
           "sample-id, sample-depth, sample-mesh, uv, uv-deriv, albedo, direct, reflection, shadow, emission, "
-          "z-depth or all)",
+          "z-depth, shadow-lights or all)",
           name);
   }
   if (!a.images && !a.all) die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
@@ -781,6 +783,7 @@ static void add_images(rr_device *dev, rr_output *set, const rr_scene *scene, co
   /* lit: the lit AOVs come from the colour's own passes (its lights and shadow mode) */
   unsigned lit_parts = 0;
   for (int a = RR_AOV_ALBEDO; a <= RR_AOV_EMISSION; a++) lit_parts |= 1u << a;
+  lit_parts |= 1u << RR_AOV_SHADOW_LIGHTS;
   bool together = shading->mode == RR_SHADE_LIT && (need & lit_parts);
   if (together) need |= COLOR_BIT;
   for (int a = 0; a <= RR_AOV_COUNT; a++) {
@@ -1136,7 +1139,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
   const unsigned by_name = 1u << RR_AOV_COVERAGE | 1u << RR_AOV_SAMPLE_ID | 1u << RR_AOV_SAMPLE_DEPTH |
                            1u << RR_AOV_SAMPLE_MESH | 1u << RR_AOV_UV | 1u << RR_AOV_UV_DERIV |
                            1u << RR_AOV_ALBEDO | 1u << RR_AOV_DIRECT | 1u << RR_AOV_REFLECTION |
-                           1u << RR_AOV_SHADOW | 1u << RR_AOV_EMISSION | 1u << RR_AOV_ZDEPTH; /* the AA and texture outputs and
+                           1u << RR_AOV_SHADOW | 1u << RR_AOV_EMISSION | 1u << RR_AOV_ZDEPTH |
+                           1u << RR_AOV_SHADOW_LIGHTS; /* the AA and texture outputs and
                                                                            the lit parts: asked for by name */
   for (int k = 0; k < naov; k++) /* all: every per-pixel AOV of the visibility the frame has */
     if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~by_name & ~(opt.heat ? 0 : heat_aovs);

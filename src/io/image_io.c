@@ -218,7 +218,7 @@ static bool encode_pfm(const rr_image *img, bytes *out) {
 static bool per_sample_kind(int kind);
 
 /* NPY holds the samples as they are, in the image's own type: (H, W) or (H, W, C); a
- * per-sample AOV is always (H, W, N). */
+ * per-sample AOV is always (H, W, N), shadow-lights (H, W, L). */
 static bool encode_npy(const rr_image *img, bytes *out) {
   const char *descr = img->type == RR_PIXEL_U8 ? "|u1" : img->type == RR_PIXEL_F32 ? "<f4" : "<u4";
   char dict[128];
@@ -293,14 +293,18 @@ static const struct {
     [RR_AOV_SHADOW] = {1, {"shadow"}},
     [RR_AOV_EMISSION] = {3, {"emission.R", "emission.G", "emission.B"}},
     [RR_AOV_ZDEPTH] = {1, {"zdepth"}},
+    /* a light per channel, as the samples are */
+    [RR_AOV_SHADOW_LIGHTS] = PER_SAMPLE("shadow.l"),
 };
+_Static_assert(RR_MAX_SHADOW_LIGHTS == RR_MAX_SAMPLES, "PER_SAMPLE names the lights too");
 _Static_assert(RR_MAX_SAMPLES == 16, "PER_SAMPLE names 16 samples");
 
 static bool is_aov_kind(int kind) {
   return kind >= RR_IMAGE_AOV && kind < RR_IMAGE_AOV + RR_AOV_COUNT;
 }
 
-/* Whether images of kind `kind` have a channel per sample (the sample-* AOVs). */
+/* Whether images of kind `kind` have a channel per sample (the sample-* AOVs) or per
+ * light (shadow-lights). */
 static bool per_sample_kind(int kind) {
   return is_aov_kind(kind) && !aov_channels[kind - RR_IMAGE_AOV].channels;
 }

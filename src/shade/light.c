@@ -202,6 +202,7 @@ typedef struct lit_point {
   float w[3];
   uint32_t reach; /* bit l < REACH_BITS: light l reaches it (facing, in its cone); bit MIRROR_BIT: a mirror */
   float *out, *parts, *refl;
+  float *vis; /* NULL, or per light 1 where it reaches the point (a first bounce's) */
 } lit_point;
 
 /* A bit per point and light, set by the ambient pass, spares each light pass a
@@ -270,11 +271,11 @@ static bool seg_reserve(seg *g, size_t n) {
 
 static lit_point *seg_at(const seg *g, size_t i) { return &g->block[i / CHUNK][i % CHUNK]; }
 
-bool rr_lit_wave_add(lit_wave *w, int thread, const surface *sf, float *out, float *parts) {
+bool rr_lit_wave_add(lit_wave *w, int thread, const surface *sf, float *out, float *parts, float *vis) {
   seg *g = &w->sink[thread];
   if (g->n == g->nblocks * CHUNK && !seg_reserve(g, g->n + 1)) return false;
   lit_point *q = seg_at(g, g->n++);
-  q->sf = *sf, q->out = out, q->parts = parts, q->refl = NULL;
+  q->sf = *sf, q->out = out, q->parts = parts, q->refl = NULL, q->vis = vis;
   q->w[0] = q->w[1] = q->w[2] = 1;
   out[0] = out[1] = out[2] = 0;
   if (parts) {
@@ -342,6 +343,7 @@ typedef struct pass {
   const rr_scene *s;
   const lighting *L;
   const light *lt; /* the light of a light pass */
+  int li;          /* its index */
   int bit;         /* its bit of reach (REACH_BITS: none, with shadows none or past the first lights) */
   float share;     /* of the shadow part, per light */
   bool last;       /* reflection: the last bounce (the sky instead of rays) */
@@ -372,6 +374,7 @@ static void job_ambient(int job, int thread, void *arg) {
     credit(q, LIT_DIRECT, q->w, sky);
     if (q->sf.m) credit(q, LIT_EMISSION, q->w, q->sf.m->params.emission);
     if (q->parts && !L->nlights) q->parts[LIT_SHADOW] = 1;
+    if (q->vis) memset(q->vis, 0, L->nlights * sizeof *q->vis);
     vec3 l;
     for (int b = 0; b < bits; b++)
       if (light_on(&L->lights[b], q, &l, NULL)) q->reach |= 1u << b, c->reached[b]++;
@@ -421,6 +424,7 @@ static void job_light_rays(int job, int thread, void *arg) {
     if (ps->L->shadows == RR_SHADOWS_NONE) {
       credit(q, LIT_DIRECT, q->w, c3);
       if (q->parts) q->parts[LIT_SHADOW] += ps->share;
+      if (q->vis) q->vis[ps->li] = 1;
       continue;
     }
     w->ray[k] = leave(ps->L, q->sf.p, q->sf.ng, l, far ? INFINITY : 1.0f);
@@ -444,6 +448,7 @@ static void job_light_add(int job, int thread, void *arg) {
     const lit_point *q = w->who[k];
     credit(q, LIT_DIRECT, q->w, w->add[k]);
     if (q->parts) q->parts[LIT_SHADOW] += ps->share;
+    if (q->vis) q->vis[ps->li] = 1;
   }
 }
 
@@ -465,7 +470,7 @@ static bool direct(lit_wave *w, pass *ps, int threads, lit_stats *st) {
   bool empty;
   const rr_bvh *bvh = rr_bvh_of(NULL, ps->s, &empty); /* (checked current by rr_shade_frame) */
   for (int li = 0; li < L->nlights; li++) {
-    ps->lt = &L->lights[li];
+    ps->lt = &L->lights[li], ps->li = li;
     bool far = ps->lt->type == RR_LIGHT_DIRECTIONAL;
     ps->bit = L->shadows != RR_SHADOWS_NONE && li < REACH_BITS ? li : REACH_BITS;
     if (L->shadows == RR_SHADOWS_NONE)
@@ -548,7 +553,7 @@ static void job_mirror_hits(int job, int thread, void *arg) {
     }
     ps->fn(ps->ctx, idx, w->hit[k].l1, w->hit[k].l2, w->hit[k].t, org, dir, &nq->sf);
     memcpy(nq->w, w->add[k], sizeof nq->w);
-    nq->out = q->out, nq->parts = NULL;
+    nq->out = q->out, nq->parts = NULL, nq->vis = NULL;
     nq->refl = q->parts ? q->parts + LIT_REFLECTION : q->refl;
   }
 }

@@ -77,9 +77,11 @@ typedef struct lit_wave lit_wave;
 lit_wave *rr_lit_wave_new(void);
 void rr_lit_wave_free(lit_wave *w);
 /* Queues a point through sink `thread` (one thread per sink at a time); its linear
- * colour goes to out[0..2] and its parts to parts[0 .. LIT_PARTS - 1] unless parts
- * is NULL, when the wave is shaded. False when out of memory. */
-bool rr_lit_wave_add(lit_wave *w, int thread, const surface *sf, float *out, float *parts);
+ * colour goes to out[0..2], its parts to parts[0 .. LIT_PARTS - 1] unless parts is
+ * NULL, and whether each light reaches it (1 or 0, the terms of LIT_SHADOW) to
+ * vis[0 .. nlights - 1] unless vis is NULL, when the wave is shaded. False when out
+ * of memory. */
+bool rr_lit_wave_add(lit_wave *w, int thread, const surface *sf, float *out, float *parts, float *vis);
 /* Shades the queued points under L in passes on `threads` threads (rays through
  * s's tree; reflected hits made by fn(ctx), which may run on any of them), writes
  * their colours and empties the wave; adds to st. False when out of memory (the

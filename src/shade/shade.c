@@ -261,6 +261,7 @@ typedef struct shade_pass {
   signed char *wave_lead; /* and the sample whose colour it shares */
   size_t wave_pix;  /* the wave's room in pixels */
   float *parts;     /* NULL, or the lit parts of each pixel's centre sample (LIT_PARTS floats a pixel) */
+  float *vis;       /* NULL, or which lights reach it (lights.nlights floats a pixel) */
   int centre;       /* the sample nearest the pixel's centre */
 } shade_pass;
 
@@ -336,8 +337,11 @@ static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int
           size_t q = (size_t)(y - p->y0) * p->vb->width + x;
           /* the lit AOVs: the point of the centre sample (of its group in msaa, csaa) */
           bool centre = grouped ? same_surface(s, r, p->centre, i, j) : i == p->centre;
-          float *parts = p->parts && centre ? p->parts + LIT_PARTS * ((size_t)y * p->vb->width + x) : NULL;
-          if (!rr_lit_wave_add(p->wave, thread, &sf, p->wave_rgb + 3 * (i * p->wave_pix + q), parts)) p->failed = true;
+          size_t pix = (size_t)y * p->vb->width + x;
+          float *parts = p->parts && centre ? p->parts + LIT_PARTS * pix : NULL;
+          float *vis = p->vis && centre ? p->vis + (size_t)p->lights.nlights * pix : NULL;
+          if (!rr_lit_wave_add(p->wave, thread, &sf, p->wave_rgb + 3 * (i * p->wave_pix + q), parts, vis))
+            p->failed = true;
         } else {
           shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
         }
@@ -534,10 +538,11 @@ static int centre_sample(const rr_frame *f);
 
 /* Shades the samples as the frame's AA mode says (cams: one per sample position),
  * then resolves them into out with the options' filter; lit, the parts of each
- * pixel's centre sample go to parts (LIT_PARTS floats a pixel) unless it is NULL. */
+ * pixel's centre sample go to parts (LIT_PARTS floats a pixel) unless it is NULL,
+ * and which lights reach it to vis (lights->nlights floats a pixel) unless it is NULL. */
 static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f,
-                              const rr_shade_options *opt, const lighting *lights, float *parts, rr_image *out,
-                              rr_shade_stats *st) {
+                              const rr_shade_options *opt, const lighting *lights, float *parts, float *vis,
+                              rr_image *out, rr_shade_stats *st) {
   const visbuf *vb = &f->vb;
   size_t npix = (size_t)vb->width * vb->height;
   shade_pass *p = calloc(1, sizeof *p);
@@ -545,7 +550,7 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
   *p = (shade_pass){.s = s, .cams = cams, .vb = vb, .mode = opt->mode, .aa = f->aa, .samples = f->samples,
                       .tex = {opt->texture_filter, opt->aniso, opt->lod_bias}, .lit = lights != NULL};
   if (lights) p->lights = *lights;
-  p->parts = parts, p->centre = centre_sample(f);
+  p->parts = parts, p->vis = vis, p->centre = centre_sample(f);
   p->background = opt->has_background ? opt->background : NULL;
   p->stored = f->aa == RR_AA_CSAA ? f->aa_stored : p->samples;
   /* Derivatives are per pixel step. A sample shaded for the whole pixel (one per
@@ -721,12 +726,33 @@ const char *rr_texture_filter_name(int filter) {
   return filter >= 0 && filter < RR_TEXTURE_FILTER_COUNT ? texture_filter_names[filter] : NULL;
 }
 
-/* The lit mode's parts (AOVs albedo .. emission) at the sample nearest each pixel's
- * centre, under the lights of the default lit shading. */
+static bool is_lit_aov(int a) { return (a >= RR_AOV_ALBEDO && a <= RR_AOV_EMISSION) || a == RR_AOV_SHADOW_LIGHTS; }
+
+/* The image of lit AOV a, from the parts (LIT_PARTS floats a pixel) or, shadow-lights,
+ * from vis (nlights floats a pixel); fails for shadow-lights without punctual lights
+ * or with more than an image holds. */
+static rr_error lit_image(rr_device *dev, int a, int width, int height, const float *parts, const float *vis,
+                          int nlights, rr_image *out) {
+  static const int part[] = {LIT_ALBEDO, LIT_DIRECT, LIT_REFLECTION, LIT_SHADOW, LIT_EMISSION};
+  bool per_light = a == RR_AOV_SHADOW_LIGHTS;
+  if (per_light && (nlights < 1 || nlights > RR_MAX_SHADOW_LIGHTS))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "the shadow-lights AOV needs 1 to %d punctual lights, the frame has %d",
+                   RR_MAX_SHADOW_LIGHTS, nlights);
+  int ch = per_light ? nlights : a == RR_AOV_SHADOW ? 1 : 3, first = per_light ? 0 : part[a - RR_AOV_ALBEDO];
+  int stride = per_light ? nlights : LIT_PARTS;
+  const float *from = per_light ? vis : parts;
+  rr_error e = image_alloc(dev, out, width, height, ch, RR_PIXEL_F32, RR_IMAGE_AOV + a);
+  size_t npix = (size_t)width * height;
+  for (size_t k = 0; !e && k < npix; k++)
+    memcpy((float *)out->data + k * ch, from + k * stride + first, ch * sizeof(float));
+  return e;
+}
+
+/* The lit mode's parts (AOVs albedo .. emission, shadow-lights) at the sample nearest
+ * each pixel's centre, under the lights of the default lit shading. */
 static rr_error lit_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, const camera *cams,
                         const rr_frame *f, rr_aov aov, rr_image *out) {
-  static const int part[] = {LIT_ALBEDO, LIT_DIRECT, LIT_REFLECTION, LIT_SHADOW, LIT_EMISSION};
-  int ch = aov == RR_AOV_SHADOW ? 1 : 3, first = part[aov - RR_AOV_ALBEDO], centre = centre_sample(f);
+  int centre = centre_sample(f);
   rr_shade_options opt;
   rr_shade_options_init(&opt);
   opt.mode = RR_SHADE_LIT;
@@ -737,8 +763,14 @@ static rr_error lit_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam,
   shade_pass *p = calloc(1, sizeof *p); /* what reflected_surface reads */
   float *parts = calloc(npix, LIT_PARTS * sizeof(float)), *colour = malloc(npix * 3 * sizeof(float));
   lit_wave *wave = rr_lit_wave_new();
+  float *vis = NULL;
   rr_error e = p && parts && colour && wave ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for AOV %d", (int)aov);
   if (!e) e = rr_lighting_make(dev, s, cam, &opt, &p->lights);
+  int nl = e ? 0 : p->lights.nlights;
+  if (!e && aov == RR_AOV_SHADOW_LIGHTS && nl > 0 && !(vis = calloc(npix * nl, sizeof *vis))) {
+    rr_lighting_release(&p->lights);
+    e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for AOV %d", (int)aov);
+  }
   if (!e) {
     p->s = s, p->tex = (tex_filter){opt.texture_filter, opt.aniso, opt.lod_bias};
     lit_stats st = {0};
@@ -750,16 +782,14 @@ static rr_error lit_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam,
       hit h = hit_make(s, vb.id[k], vb.l1[k], vb.l2[k], vb.t[k], o, d, &cams[centre], x, y);
       surface sf;
       hit_surface(s, &h, &p->tex, &sf);
-      ok = rr_lit_wave_add(wave, 0, &sf, colour + 3 * k, parts + k * LIT_PARTS);
+      ok = rr_lit_wave_add(wave, 0, &sf, colour + 3 * k, parts + k * LIT_PARTS, vis ? vis + k * nl : NULL);
     }
     ok = ok && rr_lit_wave_shade(wave, s, &p->lights, reflected_surface, p, 1, &st);
     rr_lighting_release(&p->lights);
-    e = ok ? image_alloc(dev, out, vb.width, vb.height, ch, RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov)
+    e = ok ? lit_image(dev, aov, vb.width, vb.height, parts, vis, nl, out)
            : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for AOV %d", (int)aov);
   }
-  for (size_t k = 0; !e && k < npix; k++)
-    memcpy((float *)out->data + k * ch, parts + k * LIT_PARTS + first, ch * sizeof(float));
-  free(p), free(parts), free(colour), rr_lit_wave_free(wave);
+  free(p), free(parts), free(vis), free(colour), rr_lit_wave_free(wave);
   return e ? e : rr_ok(dev);
 }
 
@@ -810,25 +840,28 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *
   size_t npix = (size_t)f->vb.width * f->vb.height;
   float *parts = !e && aovs ? calloc(npix, LIT_PARTS * sizeof(float)) : NULL;
   if (!e && aovs && !parts) e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the lit AOVs");
-  if (!e) e = shade_samples(dev, s, cams, f, opt, lit ? &lights : NULL, parts, out, stats), shaded = !e;
+  /* which lights reach each pixel's point: checked for a size before any shading */
+  int nl = lit ? lights.nlights : 0;
+  float *vis = NULL;
+  if (!e && (aovs & 1u << RR_AOV_SHADOW_LIGHTS)) {
+    if (nl < 1 || nl > RR_MAX_SHADOW_LIGHTS)
+      e = rr_fail(dev, RR_ERROR_ARGUMENT, "the shadow-lights AOV needs 1 to %d punctual lights, the frame has %d",
+                  RR_MAX_SHADOW_LIGHTS, nl);
+    else if (!(vis = calloc(npix * nl, sizeof *vis))) e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the lit AOVs");
+  }
+  if (!e) e = shade_samples(dev, s, cams, f, opt, lit ? &lights : NULL, parts, vis, out, stats), shaded = !e;
   for (int k = 0; have_cams && k < f->samples; k++) rr_cam_release(&cams[k]);
   /* the AOVs asked for, from the parts */
-  static const int part[] = {LIT_ALBEDO, LIT_DIRECT, LIT_REFLECTION, LIT_SHADOW, LIT_EMISSION};
   rr_image made[RR_AOV_COUNT] = {{0}};
-  for (int a = RR_AOV_ALBEDO; !e && a <= RR_AOV_EMISSION; a++) {
-    if (!(aovs & 1u << a)) continue;
-    int ch = a == RR_AOV_SHADOW ? 1 : 3, first = part[a - RR_AOV_ALBEDO];
-    e = image_alloc(dev, &made[a], f->vb.width, f->vb.height, ch, RR_PIXEL_F32, RR_IMAGE_AOV + a);
-    for (size_t k = 0; !e && k < npix; k++)
-      memcpy((float *)made[a].data + k * ch, parts + k * LIT_PARTS + first, ch * sizeof(float));
-  }
-  for (int a = RR_AOV_ALBEDO; a <= RR_AOV_EMISSION; a++)
+  for (int a = 0; !e && a < RR_AOV_COUNT; a++)
+    if (aovs & 1u << a) e = lit_image(dev, a, f->vb.width, f->vb.height, parts, vis, nl, &made[a]);
+  for (int a = 0; a < RR_AOV_COUNT; a++)
     if (aovs & 1u << a) {
       if (e) rr_image_free(&made[a]);
       else aov_images[a] = made[a];
     }
   if (e && shaded) rr_image_free(out);
-  free(parts);
+  free(parts), free(vis);
   if (lit) rr_lighting_release(&lights);
   return e ? e : rr_ok(dev);
 }
@@ -844,7 +877,7 @@ rr_error rr_shade_frame_aovs(rr_device *dev, const rr_scene *s, const rr_camera 
   if (!opt || opt->mode != RR_SHADE_LIT)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade_frame_aovs: the lit AOVs need options with the lit mode");
   unsigned lit_bits = 0;
-  for (int a = RR_AOV_ALBEDO; a <= RR_AOV_EMISSION; a++) lit_bits |= 1u << a;
+  for (int a = 0; a < RR_AOV_COUNT; a++) lit_bits |= is_lit_aov(a) ? 1u << a : 0;
   if (aovs & ~lit_bits) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade_frame_aovs: AOVs other than the lit parts asked for");
   if (aovs && !aov_images) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_shade_frame_aovs: NULL argument");
   return shade_frame(dev, s, cam, f, opt, aovs, aov_images, out, stats);
@@ -865,7 +898,7 @@ rr_error rr_frame_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam, c
   camera cams[RR_MAX_SAMPLES];
   rr_error e = frame_cameras(dev, cam, f, cams);
   if (e) return e;
-  e = aov >= RR_AOV_ALBEDO && aov <= RR_AOV_EMISSION ? lit_aov(dev, s, cam, cams, f, aov, out) : frame_aov(dev, s, cams, f, aov, out);
+  e = is_lit_aov(aov) ? lit_aov(dev, s, cam, cams, f, aov, out) : frame_aov(dev, s, cams, f, aov, out);
   for (int k = 0; k < f->samples; k++) rr_cam_release(&cams[k]);
   return e;
 }
