@@ -88,8 +88,13 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
   lx = VF_(select)(bounded, lx, zero), ly = VF_(select)(bounded, ly, zero);
   hx = VF_(select)(bounded, hx, last_x), hy = VF_(select)(bounded, hy, last_y);
   const VI bx0 = VI_(trunc)(lx), by0 = VI_(trunc)(ly), bx1 = VI_(trunc)(hx), by1 = VI_(trunc)(hy);
+  /* each position's own rectangle follows from the hull (tri_pos_rect) */
+  x0 = VF_(select)(bounded, x0, -inf_f), y0 = VF_(select)(bounded, y0, -inf_f);
+  x1 = VF_(select)(bounded, x1, inf_f), y1 = VF_(select)(bounded, y1, inf_f);
+  const VF mh = VF_(select)(bounded, m, zero);
   uint32_t kept = 0;
   for (int l = 0; l < n; l++)
-    if (keep >> l & 1) out[kept++] = (tri_bound){(uint32_t)lane_id[l], {bx0[l], by0[l], bx1[l], by1[l]}};
+    if (keep >> l & 1)
+      out[kept++] = (tri_bound){(uint32_t)lane_id[l], {bx0[l], by0[l], bx1[l], by1[l]}, {x0[l], y0[l], x1[l], y1[l], mh[l]}};
   return kept;
 }

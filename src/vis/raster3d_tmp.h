@@ -3,17 +3,18 @@
  *
  * Every sample of rectangle r against one set-up triangle, W samples of a row at
  * a time, columns then rows (the terms in sx are the same on every row), for each
- * of the ns sample positions in turn (cams[s], layer s of vb): the triangle's
- * constants are loaded once, and at[s] (NULL for one position: ts's own) gives
- * the four setup values that move with the position. A lane is
+ * of ns sample positions in turn: the triangle's constants are loaded once. One
+ * position (at NULL): ts's own over r. Several: the k-th is position s = act[k]
+ * (cams[s], layer s of vb) over its own rectangle rs[k] (inside r), at[s] the four
+ * setup values that move with it. A lane is
  * the sample test of prim/triangle.h (sample_test_w) and the depth test of
  * vis/vis.h (depth_wins), with the depth of TRI_DEPTH: the same operations in the same order on IEEE single
  * floats (no FMA, a true division), so every width gives their bits. Lanes past
  * r[2] are masked off and touch no memory. */
 
-TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at *at, uint32_t id,
-                                                     const int r[4], const camera *cams, int ns, visbuf *vb,
-                                                     const bool planar) {
+TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at *at, const uint8_t *act,
+                                                     const int (*rs)[4], uint32_t id, const int r0[4],
+                                                     const camera *cams, int ns, visbuf *vb, const bool planar) {
   VF a[3], b[3], cc[3];
   VI tie[3];
 #pragma GCC unroll 3
@@ -28,12 +29,13 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at 
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
   const VI idv = VI_(splat)((int32_t)id), bias = VI_(splat)(INT32_MIN), id_biased = idv ^ bias;
-  const VI end = VI_(splat)(r[2] + 1);
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
   uint64_t covered = 0;
-  for (int s = 0; s < ns; s++) {
+  for (int k = 0; k < ns; k++) {
+  const int s = at ? act[k] : 0, *r = at ? rs[k] : r0;
   const camera *c = &cams[s];
-  const tri_at p = at ? at[s] : (tri_at){ts->pa, ts->num0, ts->cx, ts->cy};
+  const tri_at p = at ? at[s] : (tri_at){ts->pa, ts->num0, ts->cx, ts->cy, {0, 0, 0, 0}};
+  const VI end = VI_(splat)(r[2] + 1);
   const VF pa = VF_(splat)(p.pa), num0 = VF_(splat)(p.num0), cx = VF_(splat)(p.cx), cy = VF_(splat)(p.cy);
   float *best_t = vb->t + s * layer, *l1 = vb->l1 + s * layer, *l2 = vb->l2 + s * layer;
   int32_t *best_id = (int32_t *)vb->id + s * layer;
@@ -86,11 +88,12 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at 
  * so the one-position frame pays nothing for the loop over positions. */
 TARGET static uint64_t RR_CAT(raster_one, W)(const tri_setup *ts, uint32_t id, const int r[4], const camera *c,
                                              visbuf *vb, const bool planar) {
-  return planar ? RR_CAT(raster_loop, W)(ts, NULL, id, r, c, 1, vb, true)
-                : RR_CAT(raster_loop, W)(ts, NULL, id, r, c, 1, vb, false);
+  return planar ? RR_CAT(raster_loop, W)(ts, NULL, NULL, NULL, id, r, c, 1, vb, true)
+                : RR_CAT(raster_loop, W)(ts, NULL, NULL, NULL, id, r, c, 1, vb, false);
 }
-TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_at *at, uint32_t id, const int r[4],
-                                              const camera *cams, int ns, visbuf *vb, const bool planar) {
-  return planar ? RR_CAT(raster_loop, W)(ts, at, id, r, cams, ns, vb, true)
-                : RR_CAT(raster_loop, W)(ts, at, id, r, cams, ns, vb, false);
+TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_at *at, const uint8_t *act,
+                                              const int (*rs)[4], uint32_t id, const camera *cams, int n,
+                                              visbuf *vb, const bool planar) {
+  return planar ? RR_CAT(raster_loop, W)(ts, at, act, rs, id, rs[0], cams, n, vb, true)
+                : RR_CAT(raster_loop, W)(ts, at, act, rs, id, rs[0], cams, n, vb, false);
 }

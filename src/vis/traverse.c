@@ -70,7 +70,10 @@ typedef struct tri_job {
   float zmin;      /* a floor under any t computed for the triangle (0: none known) */
   int bb[4];       /* inclusive screen bounds */
   union {
-    float slack[3];  /* planar: how far below zero a rounded corner value may fall for an inside sample */
+    struct {         /* planar: */
+      float slack[3]; /* how far below zero a rounded corner value may fall for an inside sample */
+      tri_hull hull;  /* several positions: where each position's samples may meet it */
+    };
     tri_cone cone;   /* curved: what bounds the triangle's directions */
   };
   tri_plane pl;      /* planar, several positions: how ts moves to each (rr_tri_setup_at) */
@@ -84,8 +87,13 @@ KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_at *at, tile
   uint64_t covered = 0;
   t->st.edge_evals += !at ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
                            : rr_raster_rect_samples(&j->ts, at, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
-  if (t->heat_e)
-    heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0) * t->ns));
+  if (t->heat_e && !at) heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
+  for (int s = 0; t->heat_e && at && s < t->ns; s++) { /* each position over its own rectangle */
+    const int *q = at[s].r;
+    int x0 = q[0] > r.x0 ? q[0] : r.x0, y0 = q[1] > r.y0 ? q[1] : r.y0;
+    int x1 = q[2] + 1 < r.x1 ? q[2] + 1 : r.x1, y1 = q[3] + 1 < r.y1 ? q[3] + 1 : r.y1;
+    if (x0 < x1 && y0 < y1) heat_charge(t->heat_e, t->vb->width, x0, y0, x1, y1, (float)((x1 - x0) * (y1 - y0)));
+  }
   if (t->hiz_used) hiz_mark(t->hz, r.x0, r.y0, r.x1, r.y1);
   return covered;
 }
@@ -175,11 +183,14 @@ static float tri_t_floor(float zmin, float mag, float mag_p, const tri_setup *ts
   return minf(computed_t_floor(zmin, mag, ts->vol), computed_t_floor(zmin, mag_p, ts->num0));
 }
 
-/* The largest |pa| of a planar setup over the positions: the size of den's terms. */
+/* The largest |pa| of a planar setup over the positions whose samples may meet
+ * it (the others test none): the size of den's terms. */
 static float max_pa(const trav *t, const tri_job *j) {
   float pa = fabsf(j->ts.pa);
   for (int s = 1; s < t->ns; s++) {
     tri_setup at;
+    int r[4];
+    if (!tri_pos_rect(&j->hull, t->pos[s][0], t->pos[s][1], t->c->width, t->c->height, r)) continue;
     rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &at);
     pa = maxf(pa, fabsf(at.pa));
   }
@@ -236,7 +247,7 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
       if (face[l] == SETUP_CULLED) continue;
       tri_job *j = out + kept++;
       j->ts = ts[l];
-      if (pl) j->pl = pl[l];
+      if (pl) j->pl = pl[l], j->hull = b[q + l].hull;
       memcpy(j->bb, b[q + l].bb, sizeof j->bb);
       finish_setup(t, ids[l], j);
     }
@@ -302,15 +313,30 @@ KERNEL void draw_rect(trav *t, const tri_job *j, const tri_at *at, tile_rect r) 
   else raster_samples(t, j, at, r);
 }
 
-/* Several positions: the setup moved to each once per draw, not per bin. */
+/* Several positions: the setup moved to each once per draw, not per bin, and
+ * each position's own rectangle (planar: from the hull, the rectangle of a
+ * one-position frame; curved: the union), which the kernel keeps to. A position
+ * whose rectangle misses r is not moved. */
 static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
   tri_at at[RR_MAX_SAMPLES];
+  int live = 0;
   for (int s = 0; s < t->ns; s++) {
+    tri_at *a = &at[s];
+    if (t->c->planar) {
+      if (!tri_pos_rect(&j->hull, t->pos[s][0], t->pos[s][1], t->c->width, t->c->height, a->r) ||
+          !meets(a->r, r)) {
+        a->r[0] = 1, a->r[2] = 0;
+        continue;
+      }
+    } else {
+      memcpy(a->r, j->bb, sizeof a->r);
+    }
     tri_setup m;
     rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &m);
-    at[s] = (tri_at){m.pa, m.num0, m.cx, m.cy};
+    a->pa = m.pa, a->num0 = m.num0, a->cx = m.cx, a->cy = m.cy;
+    live++;
   }
-  draw_rect(t, j, at, r);
+  if (live) draw_rect(t, j, at, r);
 }
 
 /* Rasterizes a prepared triangle into the samples of f it may cover. */

@@ -160,13 +160,16 @@ bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx,
 uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb,
                         uint64_t *covered, bool simd);
 
-/* The setup values that move with the sample position (rr_tri_setup_at). */
+/* The setup values that move with the sample position (rr_tri_setup_at), and the
+ * position's own rectangle (tri_pos_rect; r[0] > r[2] when it holds no sample). */
 typedef struct tri_at {
   float pa, num0, cx, cy;
+  int r[4];
 } tri_at;
 /* rr_raster_rect at ns sample positions at once: cams[s] and layer s of vb (of
  * vb->width × vb->height each), with ts's values moved to position s by at[s] (at
- * NULL when ns is 1). Returns the evaluations, ns per sample of the rectangle. */
+ * NULL when ns is 1), each position over rect ∩ at[s].r only. Returns the
+ * evaluations, one per sample of those rectangles. */
 uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_at *at, uint32_t id, const int rect[4],
                                 const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd);
 
