@@ -54,6 +54,21 @@ void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const ca
 /* The setup ts (from rr_tri_setup_planes with a camera that differs from c only in
  * its sample position) for camera c: the bits rr_tri_setup gives for c. */
 void rr_tri_setup_at(const tri_setup *ts, const tri_plane *pl, const camera *c, tri_setup *out);
+/* What rr_tri_setup_at changes, without the copy: ts's pa, num0, cx, cy for c
+ * into m[0..3] (the setup template's clamp, as minps and maxps, and floor). */
+static inline void tri_moved(const tri_setup *ts, const tri_plane *pl, const camera *c, float m[4]) {
+  m[0] = ts->pa, m[1] = ts->num0, m[2] = ts->cx, m[3] = ts->cy;
+  if (!c->planar) return; /* (cx, cy) = (0, 0) at every position */
+  const float lo_x = c->sx0, hi_x = (float)(c->width - 1) + c->sx0;
+  const float lo_y = c->sy0, hi_y = (float)(c->height - 1) + c->sy0;
+  float cx = pl->px < hi_x ? pl->px : hi_x, cy = pl->py < hi_y ? pl->py : hi_y;
+  cx = cx > lo_x ? cx : lo_x, cy = cy > lo_y ? cy : lo_y;
+  cx = floorf(cx - lo_x) + lo_x, cy = floorf(cy - lo_y) + lo_y;
+  const double dcx = cx, dcy = cy;
+  const float p = (float)(pl->base + dcx * pl->u + dcy * pl->v);
+  m[2] = cx, m[3] = cy;
+  m[c->type == RR_CAMERA_PERSPECTIVE ? 0 : 1] = p;
+}
 /* The three edge functions of a set-up triangle for evaluation vector w. The
  * order of operations is fixed (the build uses -ffp-contract=off: a fused
  * multiply-add would change the bits) so every method computes the same values

@@ -3,6 +3,15 @@
 #include "vis/vis.h"
 #include "core/simd.h"
 
+/* A list of samples of any positions (planar cameras), by component for the
+ * lanes: the sample (sx, sy), the setup values moved to its position, and its
+ * place in the visibility buffer. Room for LIST_MAX, padded to eight. */
+enum { LIST_MAX = 32 };
+typedef struct sample_list {
+  float sx[LIST_MAX + 8], sy[LIST_MAX + 8], pa[LIST_MAX + 8], num0[LIST_MAX + 8], cx[LIST_MAX + 8], cy[LIST_MAX + 8];
+  size_t off[LIST_MAX + 8];
+} sample_list;
+
 /* The sample loop, one lane at a time (any camera) and, with AVX2, eight. */
 #define RR_TEMPLATE "vis/raster3d_tmp.h"
 #include "core/simd_widths.h"
@@ -43,14 +52,42 @@ uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_at *at, uint32_t 
   if (!n) return 0;
   uint64_t got;
   const bool planar = cams[0].planar;
+  const bool avx2 = simd && __builtin_cpu_supports("avx2");
+  if (planar && samples <= LIST_MAX) {
+    /* a few samples: lanes over them, whatever their positions, rather than a
+     * loop of one or two samples per position */
+    sample_list L;
+    const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
+    int m = 0;
+    for (int k = 0; k < n; k++) {
+      const int s = act[k], *q = rs[k];
+      const tri_at *p = &at[s];
+      const float ox = cams[s].sx0, oy = cams[s].sy0;
+      for (int y = q[1]; y <= q[3]; y++)
+        for (int x = q[0]; x <= q[2]; x++, m++) {
+          L.sx[m] = (float)x + ox, L.sy[m] = (float)y + oy;
+          L.pa[m] = p->pa, L.num0[m] = p->num0, L.cx[m] = p->cx, L.cy[m] = p->cy;
+          L.off[m] = (size_t)s * layer + (size_t)y * width + (size_t)x;
+        }
+    }
+    for (int k = m; k < m + 8; k++) /* the padding lanes repeat the last sample (masked off) */
+      L.sx[k] = L.sx[m - 1], L.sy[k] = L.sy[m - 1], L.pa[k] = L.pa[m - 1], L.num0[k] = L.num0[m - 1],
+      L.cx[k] = L.cx[m - 1], L.cy[k] = L.cy[m - 1], L.off[k] = L.off[m - 1];
+#ifdef RR_SIMD_X86
+    if (avx2 && m > 1) got = raster_list8(ts, id, &L, m, vb);
+    else
+#endif
+      got = raster_list1(ts, id, &L, m, vb);
+    if (covered) *covered += got;
+    return samples;
+  }
 #ifdef RR_SIMD_X86
   /* as rr_raster_rect, by the positions' mean rectangle */
-  if (simd && planar && samples > 2 * (uint64_t)n && __builtin_cpu_supports("avx2"))
+  if (avx2 && planar && samples > 2 * (uint64_t)n)
     got = raster_many8(ts, at, act, (const int (*)[4])rs, id, cams, n, vb, true);
   else
 #endif
     got = raster_many1(ts, at, act, (const int (*)[4])rs, id, cams, n, vb, planar);
-  (void)simd;
   if (covered) *covered += got;
   return samples;
 }

@@ -97,3 +97,55 @@ TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_at 
   return planar ? RR_CAT(raster_loop, W)(ts, at, act, rs, id, rs[0], cams, n, vb, true)
                 : RR_CAT(raster_loop, W)(ts, at, act, rs, id, rs[0], cams, n, vb, false);
 }
+
+/* A few samples of several positions (a triangle smaller than a pixel holds a
+ * sample of only some of them): lanes over the list L's n samples, whatever their
+ * position, W at a time, planar cameras. The same operations in the same order as
+ * the loop above, lane by lane, so the same bits; the depth test of the lanes that
+ * pass reads and writes each sample's own layer one lane at a time (no two lanes
+ * share a sample). */
+TARGET static uint64_t RR_CAT(raster_list, W)(const tri_setup *ts, uint32_t id, const sample_list *L, int n,
+                                              visbuf *vb) {
+  VF a[3], b[3], cc[3];
+  VI tie[3];
+#pragma GCC unroll 3
+  for (int e = 0; e < 3; e++) {
+    a[e] = VF_(splat)(ts->a[e]), b[e] = VF_(splat)(ts->b[e]), cc[e] = VF_(splat)(ts->c[e]);
+    tie[e] = VI_(splat)(ts->tie >> e & 1u ? -1 : 0);
+  }
+  const VF w0 = VF_(splat)(ts->w[0]), w1 = VF_(splat)(ts->w[1]), w2 = VF_(splat)(ts->w[2]);
+  const VF vol = VF_(splat)(ts->vol), vol_x = VF_(splat)(ts->vol_x), vol_y = VF_(splat)(ts->vol_y);
+  const VF pb = VF_(splat)(ts->pb), pc = VF_(splat)(ts->pc);
+  const VF num_x = VF_(splat)(ts->num_x), num_y = VF_(splat)(ts->num_y);
+  const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
+  uint64_t covered = 0;
+  for (int i = 0; i < n; i += W) {
+    VI in = VI_(splat)(n - i) > VI_(lanes)();
+    const VF sx = VF_(load)(L->sx + i), sy = VF_(load)(L->sy + i);
+    VF ev[3];
+#pragma GCC unroll 3
+    for (int e = 0; e < 3; e++) {
+      ev[e] = (a[e] * one + b[e] * sx) + cc[e] * sy;
+      in &= TRI_EDGE_INSIDE(ev[e], tie[e], zero);
+    }
+    if (!VI_(bits)(in)) continue;
+    const VF sum = ev[0] * w0 + ev[1] * w1 + ev[2] * w2, v = (vol + sx * vol_x) + sy * vol_y;
+    in &= TRI_HIT_AHEAD(sum, v, zero);
+    int hit = VI_(bits)(in);
+    if (!hit) continue;
+    const VF pa = VF_(load)(L->pa + i), num0 = VF_(load)(L->num0 + i);
+    const VF cx = VF_(load)(L->cx + i), cy = VF_(load)(L->cy + i);
+    const VF den = (pa * one + pb * (sx - cx)) + pc * (sy - cy);
+    const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * num_x) + (sy - cy) * num_y, den, v, inv, zero,
+                                            VF_(select));
+    const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
+    for (; hit; hit &= hit - 1) {
+      const int l = __builtin_ctz((unsigned)hit);
+      const size_t k = L->off[i + l];
+      covered++;
+      if (t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
+        vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
+    }
+  }
+  return covered;
+}

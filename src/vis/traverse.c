@@ -188,11 +188,11 @@ static float tri_t_floor(float zmin, float mag, float mag_p, const tri_setup *ts
 static float max_pa(const trav *t, const tri_job *j) {
   float pa = fabsf(j->ts.pa);
   for (int s = 1; s < t->ns; s++) {
-    tri_setup at;
+    float m[4];
     int r[4];
     if (!tri_pos_rect(&j->hull, t->pos[s][0], t->pos[s][1], t->c->width, t->c->height, r)) continue;
-    rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &at);
-    pa = maxf(pa, fabsf(at.pa));
+    tri_moved(&j->ts, &j->pl, &t->cams[s], m);
+    pa = maxf(pa, fabsf(m[0]));
   }
   return pa;
 }
@@ -331,9 +331,9 @@ static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
     } else {
       memcpy(a->r, j->bb, sizeof a->r);
     }
-    tri_setup m;
-    rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &m);
-    a->pa = m.pa, a->num0 = m.num0, a->cx = m.cx, a->cy = m.cy;
+    float m[4];
+    tri_moved(&j->ts, &j->pl, &t->cams[s], m);
+    a->pa = m[0], a->num0 = m[1], a->cx = m[2], a->cy = m[3];
     live++;
   }
   if (live) draw_rect(t, j, at, r);
