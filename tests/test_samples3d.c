@@ -154,7 +154,7 @@ static void check_watertight(rr_device *dev) {
         rr_tri_setup_at(&ts, &pl, &cams[k], &at);
         int r[4];
         memcpy(r, b.bb, sizeof r);
-        if (m == 2 && !tri_pos_rect(&b.hull, on[k][0], on[k][1], N, N, r)) continue;
+        if (m == 2 && !tri_pos_rect(&b.pos, b.bb, k, r)) continue;
         for (int y = r[1]; y <= r[3]; y++)
           for (int x = r[0]; x <= r[2]; x++) {
             float sx = (float)x + on[k][0], sy = (float)y + on[k][1], e[3], t, l1, l2;

@@ -254,25 +254,26 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
  * triangles of a detailed mesh fall between samples. rr_tri_corner_bounds bounds triangles
  * ids[0..n-1] (first..first+n-1 when ids is NULL), 8 at a time with AVX2 when
  * simd, and writes those whose rectangle holds a sample to out; returns how many. */
-/* The corners' projected extent (x0, y0)–(x1, y1) and its margin m, from which
- * each sample position's rectangle follows (tri_pos_rect); an unbounded triangle
- * has ±inf and m = 0, every position the whole image. */
-typedef struct tri_hull {
-  float x0, y0, x1, y1, m;
-} tri_hull;
+/* Which part of a triangle's rectangle each sample position's own rectangle (the
+ * one a one-position frame tests) takes, bit p for position p: none, when it holds
+ * no sample; x0, y0: it starts a column right of, a row below bb's start; x1, y1:
+ * it ends a column left of, a row above bb's end. Positions lie in one pixel, so
+ * their rectangles differ by at most that (and were it more, the rectangle these
+ * bits give still holds the position's own). */
+typedef struct tri_pos_bits {
+  uint16_t none, x0, y0, x1, y1;
+} tri_pos_bits;
+_Static_assert(RR_MAX_SAMPLES <= 16, "tri_pos_bits holds a bit per position");
 typedef struct tri_bound {
   uint32_t id;
   int bb[4]; /* inclusive pixel rectangle, as rr_tri_screen_bounds */
-  tri_hull hull;
+  tri_pos_bits pos; /* several positions: each one's rectangle within bb */
 } tri_bound;
-/* The inclusive rectangle of the pixels of a w × h image whose sample at position
- * (ox, oy) (the camera's sx0, sy0) may lie in hull: the operations of the corner
- * bounds' template, so the rectangle a one-position frame tests. False when empty. */
-static inline bool tri_pos_rect(const tri_hull *h, float ox, float oy, int w, int hgt, int r[4]) {
-  float lx = fmaxf(ceilf(h->x0 - ox - h->m), 0.0f), hx = fminf(floorf(h->x1 - ox + h->m), (float)(w - 1));
-  float ly = fmaxf(ceilf(h->y0 - oy - h->m), 0.0f), hy = fminf(floorf(h->y1 - oy + h->m), (float)(hgt - 1));
-  if (lx > hx || ly > hy) return false;
-  r[0] = (int)lx, r[1] = (int)ly, r[2] = (int)hx, r[3] = (int)hy;
+/* Position p's rectangle within the inclusive rectangle bb (false: none). */
+static inline bool tri_pos_rect(const tri_pos_bits *b, const int bb[4], int p, int r[4]) {
+  if (b->none >> p & 1) return false;
+  r[0] = bb[0] + (b->x0 >> p & 1), r[1] = bb[1] + (b->y0 >> p & 1);
+  r[2] = bb[2] - (b->x1 >> p & 1), r[3] = bb[3] - (b->y1 >> p & 1);
   return true;
 }
 uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,

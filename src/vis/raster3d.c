@@ -33,16 +33,16 @@ uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const 
   return samples;
 }
 
-uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_at *at, uint32_t id, const int r[4],
-                                const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd) {
-  if (ns == 1) return rr_raster_rect(ts, id, r, cams, vb, covered, simd);
+uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int r[4],
+                                const camera *cams, visbuf *vb, uint64_t *covered, bool simd) {
   /* each position over its own part of r: a sub-pixel triangle's rectangle holds
-   * a sample of only a few of the positions, and the others cost a compare */
+   * a sample of only a few of the positions */
+  const tri_at *at = mv->at;
   uint8_t act[RR_MAX_SAMPLES];
   int rs[RR_MAX_SAMPLES][4], n = 0;
   uint64_t samples = 0;
-  for (int s = 0; s < ns; s++) {
-    const int *q = at[s].r;
+  for (uint32_t live = mv->live; live; live &= live - 1) {
+    const int s = __builtin_ctz(live), *q = at[s].r;
     int x0 = q[0] > r[0] ? q[0] : r[0], y0 = q[1] > r[1] ? q[1] : r[1];
     int x1 = q[2] < r[2] ? q[2] : r[2], y1 = q[3] < r[3] ? q[3] : r[3];
     if (x0 > x1 || y0 > y1) continue;

@@ -72,24 +72,24 @@ typedef struct tri_job {
   union {
     struct {         /* planar: */
       float slack[3]; /* how far below zero a rounded corner value may fall for an inside sample */
-      tri_hull hull;  /* several positions: where each position's samples may meet it */
+      tri_pos_bits pos; /* several positions: each one's rectangle within bb */
     };
     tri_cone cone;   /* curved: what bounds the triangle's directions */
   };
   tri_plane pl;      /* planar, several positions: how ts moves to each (rr_tri_setup_at) */
 } tri_job;
 
-/* Tests every sample of r at every position (at: the setup moved to each, NULL
+/* Tests every sample of r at every position (mv: the setup moved to each, NULL
  * for one); the one kernel every generateSamples path ends in. Returns the
  * samples the triangle covers. */
-KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_at *at, tile_rect r) {
+KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
-  t->st.edge_evals += !at ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
-                           : rr_raster_rect_samples(&j->ts, at, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
-  if (t->heat_e && !at) heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
-  for (int s = 0; t->heat_e && at && s < t->ns; s++) { /* each position over its own rectangle */
-    const int *q = at[s].r;
+  t->st.edge_evals += !mv ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
+                           : rr_raster_rect_samples(&j->ts, mv, j->id, rect, t->cams, t->vb, &covered, t->simd);
+  if (t->heat_e && !mv) heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
+  for (uint32_t live = t->heat_e && mv ? mv->live : 0; live; live &= live - 1) { /* each position over its own rectangle */
+    const int *q = mv->at[__builtin_ctz(live)].r;
     int x0 = q[0] > r.x0 ? q[0] : r.x0, y0 = q[1] > r.y0 ? q[1] : r.y0;
     int x1 = q[2] + 1 < r.x1 ? q[2] + 1 : r.x1, y1 = q[3] + 1 < r.y1 ? q[3] + 1 : r.y1;
     if (x0 < x1 && y0 < y1) heat_charge(t->heat_e, t->vb->width, x0, y0, x1, y1, (float)((x1 - x0) * (y1 - y0)));
@@ -126,14 +126,14 @@ static int cone_rejects(trav *t, const tri_job *j, tile_rect b) {
  * early-z shows it is hidden; otherwise it is refined by 4 in each direction down
  * to single pixels. Accepted samples still go through the sample test, which keeps
  * the result bit-identical. */
-static uint64_t bin_raster(trav *t, const tri_job *j, const tri_at *at, tile_rect r, int size) {
+static uint64_t bin_raster(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r, int size) {
   uint64_t covered = 0;
   for (int by = r.y0 - r.y0 % size; by < r.y1; by += size)
     for (int bx = r.x0 - r.x0 % size; bx < r.x1; bx += size) {
       tile_rect b = {bx > r.x0 ? bx : r.x0, by > r.y0 ? by : r.y0, bx + size < r.x1 ? bx + size : r.x1,
                      by + size < r.y1 ? by + size : r.y1};
       if (size <= t->o->bin_min || (b.x1 - b.x0) * (b.y1 - b.y0) <= 4) {
-        covered += raster_samples(t, j, at, b);
+        covered += raster_samples(t, j, mv, b);
         continue;
       }
       bool out = false;
@@ -157,7 +157,7 @@ static uint64_t bin_raster(trav *t, const tri_job *j, const tri_at *at, tile_rec
       if (out) continue;
       if (t->o->early_z && hiz_nearer(t->hz, b.x0, b.y0, b.x1, b.y1, j->zmin)) continue;
       /* refined: count the bins that turn out to hold none of the triangle */
-      uint64_t in = bin_raster(t, j, at, b, size / 4 > 1 ? size / 4 : 1);
+      uint64_t in = bin_raster(t, j, mv, b, size / 4 > 1 ? size / 4 : 1);
       t->st.bins++;
       t->st.bins_empty += in == 0;
       covered += in;
@@ -189,8 +189,7 @@ static float max_pa(const trav *t, const tri_job *j) {
   float pa = fabsf(j->ts.pa);
   for (int s = 1; s < t->ns; s++) {
     float m[4];
-    int r[4];
-    if (!tri_pos_rect(&j->hull, t->pos[s][0], t->pos[s][1], t->c->width, t->c->height, r)) continue;
+    if (j->pos.none >> s & 1) continue;
     tri_moved(&j->ts, &j->pl, &t->cams[s], m);
     pa = maxf(pa, fabsf(m[0]));
   }
@@ -247,7 +246,7 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
       if (face[l] == SETUP_CULLED) continue;
       tri_job *j = out + kept++;
       j->ts = ts[l];
-      if (pl) j->pl = pl[l], j->hull = b[q + l].hull;
+      if (pl) j->pl = pl[l], j->pos = b[q + l].pos;
       memcpy(j->bb, b[q + l].bb, sizeof j->bb);
       finish_setup(t, ids[l], j);
     }
@@ -308,35 +307,31 @@ static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, ui
 
 /* Rasterizes a prepared triangle into the samples r, with its setup moved to
  * each position (at; NULL for one position). */
-KERNEL void draw_rect(trav *t, const tri_job *j, const tri_at *at, tile_rect r) {
-  if (t->o->binning) bin_raster(t, j, at, r, t->o->bin_size);
-  else raster_samples(t, j, at, r);
+KERNEL void draw_rect(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r) {
+  if (t->o->binning) bin_raster(t, j, mv, r, t->o->bin_size);
+  else raster_samples(t, j, mv, r);
 }
 
-/* Several positions: the setup moved to each once per draw, not per bin, and
- * each position's own rectangle (planar: from the hull, the rectangle of a
- * one-position frame; curved: the union), which the kernel keeps to. A position
- * whose rectangle misses r is not moved. */
+/* Several positions: the setup moved to each once per draw, not per bin, with
+ * each position's own rectangle (planar: the one-position frame's, tri_pos_rect;
+ * curved: the union), which the kernel keeps to. A position whose rectangle misses
+ * r is not moved. */
 static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
-  tri_at at[RR_MAX_SAMPLES];
-  int live = 0;
-  for (int s = 0; s < t->ns; s++) {
-    tri_at *a = &at[s];
-    if (t->c->planar) {
-      if (!tri_pos_rect(&j->hull, t->pos[s][0], t->pos[s][1], t->c->width, t->c->height, a->r) ||
-          !meets(a->r, r)) {
-        a->r[0] = 1, a->r[2] = 0;
-        continue;
-      }
-    } else {
-      memcpy(a->r, j->bb, sizeof a->r);
-    }
+  tri_moves mv;
+  const bool planar = t->c->planar;
+  mv.live = 0;
+  for (uint32_t todo = planar ? ~(uint32_t)j->pos.none & ((1u << t->ns) - 1) : (1u << t->ns) - 1; todo;
+       todo &= todo - 1) {
+    const int s = __builtin_ctz(todo);
+    tri_at *a = &mv.at[s];
+    if (!planar) memcpy(a->r, j->bb, sizeof a->r);
+    else if (!tri_pos_rect(&j->pos, j->bb, s, a->r) || !meets(a->r, r)) continue;
     float m[4];
     tri_moved(&j->ts, &j->pl, &t->cams[s], m);
     a->pa = m[0], a->num0 = m[1], a->cx = m[2], a->cy = m[3];
-    live++;
+    mv.live |= 1u << s;
   }
-  if (live) draw_rect(t, j, at, r);
+  if (mv.live) draw_rect(t, j, &mv, r);
 }
 
 /* Rasterizes a prepared triangle into the samples of f it may cover. */

@@ -161,17 +161,23 @@ uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], con
                         uint64_t *covered, bool simd);
 
 /* The setup values that move with the sample position (rr_tri_setup_at), and the
- * position's own rectangle (tri_pos_rect; r[0] > r[2] when it holds no sample). */
+ * position's own rectangle (tri_pos_rect). */
 typedef struct tri_at {
   float pa, num0, cx, cy;
   int r[4];
 } tri_at;
-/* rr_raster_rect at ns sample positions at once: cams[s] and layer s of vb (of
- * vb->width × vb->height each), with ts's values moved to position s by at[s] (at
- * NULL when ns is 1), each position over rect ∩ at[s].r only. Returns the
- * evaluations, one per sample of those rectangles. */
-uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_at *at, uint32_t id, const int rect[4],
-                                const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd);
+/* A triangle at several positions: at[s] for each position s of live (bit s),
+ * the positions whose rectangle may hold a sample; the others test none. */
+typedef struct tri_moves {
+  uint32_t live;
+  tri_at at[RR_MAX_SAMPLES];
+} tri_moves;
+/* rr_raster_rect at several sample positions at once: position s of mv->live over
+ * rect ∩ mv->at[s].r, with cams[s] and layer s of vb (of vb->width × vb->height
+ * each), and ts's values moved there by mv->at[s]. Returns the evaluations, one
+ * per sample of those rectangles. */
+uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int rect[4],
+                                const camera *cams, visbuf *vb, uint64_t *covered, bool simd);
 
 /* Test and benchmark hook: the relative error of depths t (one per sample of the
  * planar camera c's image; ids: the hit triangle, RR_MISS for none) against the
