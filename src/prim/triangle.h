@@ -54,6 +54,11 @@ void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const ca
 /* The setup ts (from rr_tri_setup_planes with a camera that differs from c only in
  * its sample position) for camera c: the bits rr_tri_setup gives for c. */
 void rr_tri_setup_at(const tri_setup *ts, const tri_plane *pl, const camera *c, tri_setup *out);
+/* tri_moved at n positions of a planar camera c, whose sample offsets are ox[k],
+ * oy[k]: ts's pa, num0, cx, cy there into pa[k], num0[k], cx[k], cy[k], with the
+ * same bits; with simd, eight at a time where the processor has AVX2. */
+void rr_tri_moved_all(const tri_setup *ts, const tri_plane *pl, const camera *c, int n, const float *ox,
+                      const float *oy, bool simd, float *pa, float *num0, float *cx, float *cy);
 /* What rr_tri_setup_at changes, without the copy: ts's pa, num0, cx, cy for c
  * into m[0..3] (the setup template's clamp, as minps and maxps, and floor). */
 static inline void tri_moved(const tri_setup *ts, const tri_plane *pl, const camera *c, float m[4]) {

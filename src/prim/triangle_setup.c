@@ -80,6 +80,17 @@ void rr_tri_setup_at(const tri_setup *ts, const tri_plane *pl, const camera *c, 
   out->pa = m[0], out->num0 = m[1], out->cx = m[2], out->cy = m[3];
 }
 
+void rr_tri_moved_all(const tri_setup *ts, const tri_plane *pl, const camera *c, int n, const float *ox,
+                      const float *oy, bool simd, float *pa, float *num0, float *cx, float *cy) {
+  int k = 0;
+#ifdef RR_SIMD_X86
+  if (simd && __builtin_cpu_supports("avx2"))
+    for (; k + 8 <= n; k += 8) moved_lanes8(ts, pl, c, ox + k, oy + k, pa + k, num0 + k, cx + k, cy + k);
+#endif
+  (void)simd;
+  for (; k < n; k++) moved_lanes1(ts, pl, c, ox + k, oy + k, pa + k, num0 + k, cx + k, cy + k);
+}
+
 bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull, float tmin, float tmax, float *t,
                  float *l1, float *l2) {
   tri_setup ts;

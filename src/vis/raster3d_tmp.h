@@ -4,15 +4,15 @@
  * Every sample of rectangle r against one set-up triangle, W samples of a row at
  * a time, columns then rows (the terms in sx are the same on every row), for each
  * of ns sample positions in turn: the triangle's constants are loaded once. One
- * position (at NULL): ts's own over r. Several: the k-th is position s = act[k]
- * (cams[s], layer s of vb) over its own rectangle rs[k] (inside r), at[s] the four
+ * position (mv NULL): ts's own over r. Several: the k-th is position s = act[k]
+ * (cams[s], layer s of vb) over its own rectangle rs[k] (inside r), with mv's four
  * setup values that move with it. A lane is
  * the sample test of prim/triangle.h (sample_test_w) and the depth test of
  * vis/vis.h (depth_wins), with the depth of TRI_DEPTH: the same operations in the same order on IEEE single
  * floats (no FMA, a true division), so every width gives their bits. Lanes past
  * r[2] are masked off and touch no memory. */
 
-TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at *at, const uint8_t *act,
+TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_moves *mv, const uint8_t *act,
                                                      const int (*rs)[4], uint32_t id, const int r0[4],
                                                      const camera *cams, int ns, visbuf *vb, const bool planar) {
   VF a[3], b[3], cc[3];
@@ -32,9 +32,10 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at 
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
   uint64_t covered = 0;
   for (int k = 0; k < ns; k++) {
-  const int s = at ? act[k] : 0, *r = at ? rs[k] : r0;
+  const int s = mv ? act[k] : 0, *r = mv ? rs[k] : r0;
   const camera *c = &cams[s];
-  const tri_at p = at ? at[s] : (tri_at){ts->pa, ts->num0, ts->cx, ts->cy, {0, 0, 0, 0}};
+  const struct { float pa, num0, cx, cy; } p = {mv ? mv->pa[s] : ts->pa, mv ? mv->num0[s] : ts->num0,
+                                               mv ? mv->cx[s] : ts->cx, mv ? mv->cy[s] : ts->cy};
   const VI end = VI_(splat)(r[2] + 1);
   const VF pa = VF_(splat)(p.pa), num0 = VF_(splat)(p.num0), cx = VF_(splat)(p.cx), cy = VF_(splat)(p.cy);
   float *best_t = vb->t + s * layer, *l1 = vb->l1 + s * layer, *l2 = vb->l2 + s * layer;
@@ -91,21 +92,20 @@ TARGET static uint64_t RR_CAT(raster_one, W)(const tri_setup *ts, uint32_t id, c
   return planar ? RR_CAT(raster_loop, W)(ts, NULL, NULL, NULL, id, r, c, 1, vb, true)
                 : RR_CAT(raster_loop, W)(ts, NULL, NULL, NULL, id, r, c, 1, vb, false);
 }
-TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_at *at, const uint8_t *act,
+TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_moves *mv, const uint8_t *act,
                                               const int (*rs)[4], uint32_t id, const camera *cams, int n,
                                               visbuf *vb, const bool planar) {
-  return planar ? RR_CAT(raster_loop, W)(ts, at, act, rs, id, rs[0], cams, n, vb, true)
-                : RR_CAT(raster_loop, W)(ts, at, act, rs, id, rs[0], cams, n, vb, false);
+  return planar ? RR_CAT(raster_loop, W)(ts, mv, act, rs, id, rs[0], cams, n, vb, true)
+                : RR_CAT(raster_loop, W)(ts, mv, act, rs, id, rs[0], cams, n, vb, false);
 }
 
-/* A few samples of several positions (a triangle smaller than a pixel holds a
- * sample of only some of them): lanes over the list L's n samples, whatever their
- * position, W at a time, planar cameras. The same operations in the same order as
- * the loop above, lane by lane, so the same bits; the depth test of the lanes that
- * pass reads and writes each sample's own layer one lane at a time (no two lanes
- * share a sample). */
-TARGET static uint64_t RR_CAT(raster_list, W)(const tri_setup *ts, uint32_t id, const sample_list *L, int n,
-                                              visbuf *vb) {
+/* A rectangle r of a few pixels at several positions (planar cameras): for each
+ * pixel, lanes over the positions whose own rectangle holds it (mv), W at a time.
+ * The same operations in the same order as the loop above, lane by lane, so the
+ * same bits; the lanes that pass take the depth test one at a time, each in its
+ * own layer. Adds the samples tested to *tested. */
+TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
+                                                const int r[4], int ns, visbuf *vb, uint64_t *tested) {
   VF a[3], b[3], cc[3];
   VI tie[3];
 #pragma GCC unroll 3
@@ -118,34 +118,51 @@ TARGET static uint64_t RR_CAT(raster_list, W)(const tri_setup *ts, uint32_t id, 
   const VF pb = VF_(splat)(ts->pb), pc = VF_(splat)(ts->pc);
   const VF num_x = VF_(splat)(ts->num_x), num_y = VF_(splat)(ts->num_y);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
-  uint64_t covered = 0;
-  for (int i = 0; i < n; i += W) {
-    VI in = VI_(splat)(n - i) > VI_(lanes)();
-    const VF sx = VF_(load)(L->sx + i), sy = VF_(load)(L->sy + i);
-    VF ev[3];
+  const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
+  uint64_t covered = 0, evals = 0;
+  for (int p0 = 0; p0 < ns; p0 += W) {
+    if (!(mv->live >> p0 & ((1u << W) - 1))) continue; /* (W <= 16) */
+    const VI rx0 = VI_(load)(mv->r[0] + p0), ry0 = VI_(load)(mv->r[1] + p0);
+    const VI rx1 = VI_(load)(mv->r[2] + p0), ry1 = VI_(load)(mv->r[3] + p0);
+    const VF ox = VF_(load)(mv->ox + p0), oy = VF_(load)(mv->oy + p0);
+    for (int y = r[1]; y <= r[3]; y++) {
+      const VI yi = VI_(splat)(y), in_y = (yi >= ry0) & (yi <= ry1);
+      if (!VI_(bits)(in_y)) continue;
+      const VF sy = VF_(from_int)(yi) + oy;
+      for (int x = r[0]; x <= r[2]; x++) {
+        const VI xi = VI_(splat)(x);
+        VI in = in_y & (xi >= rx0) & (xi <= rx1);
+        const int tried = VI_(bits)(in);
+        if (!tried) continue;
+        evals += (uint64_t)__builtin_popcount((unsigned)tried);
+        const VF sx = VF_(from_int)(xi) + ox;
+        VF ev[3];
 #pragma GCC unroll 3
-    for (int e = 0; e < 3; e++) {
-      ev[e] = (a[e] * one + b[e] * sx) + cc[e] * sy;
-      in &= TRI_EDGE_INSIDE(ev[e], tie[e], zero);
-    }
-    if (!VI_(bits)(in)) continue;
-    const VF sum = ev[0] * w0 + ev[1] * w1 + ev[2] * w2, v = (vol + sx * vol_x) + sy * vol_y;
-    in &= TRI_HIT_AHEAD(sum, v, zero);
-    int hit = VI_(bits)(in);
-    if (!hit) continue;
-    const VF pa = VF_(load)(L->pa + i), num0 = VF_(load)(L->num0 + i);
-    const VF cx = VF_(load)(L->cx + i), cy = VF_(load)(L->cy + i);
-    const VF den = (pa * one + pb * (sx - cx)) + pc * (sy - cy);
-    const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * num_x) + (sy - cy) * num_y, den, v, inv, zero,
-                                            VF_(select));
-    const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
-    for (; hit; hit &= hit - 1) {
-      const int l = __builtin_ctz((unsigned)hit);
-      const size_t k = L->off[i + l];
-      covered++;
-      if (t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
-        vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
+        for (int e = 0; e < 3; e++) {
+          ev[e] = (a[e] * one + b[e] * sx) + cc[e] * sy;
+          in &= TRI_EDGE_INSIDE(ev[e], tie[e], zero);
+        }
+        if (!VI_(bits)(in)) continue;
+        const VF sum = ev[0] * w0 + ev[1] * w1 + ev[2] * w2, v = (vol + sx * vol_x) + sy * vol_y;
+        in &= TRI_HIT_AHEAD(sum, v, zero);
+        int hit = VI_(bits)(in);
+        if (!hit) continue;
+        const VF pa = VF_(load)(mv->pa + p0), num0 = VF_(load)(mv->num0 + p0);
+        const VF cx = VF_(load)(mv->cx + p0), cy = VF_(load)(mv->cy + p0);
+        const VF den = (pa * one + pb * (sx - cx)) + pc * (sy - cy);
+        const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * num_x) + (sy - cy) * num_y, den, v, inv, zero,
+                                                VF_(select));
+        const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
+        for (; hit; hit &= hit - 1) {
+          const int l = __builtin_ctz((unsigned)hit);
+          const size_t k = (size_t)(p0 + l) * layer + (size_t)y * width + (size_t)x;
+          covered++;
+          if (t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
+            vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
+        }
+      }
     }
   }
+  *tested += evals;
   return covered;
 }

@@ -86,10 +86,10 @@ KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_moves *mv, t
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
   t->st.edge_evals += !mv ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
-                           : rr_raster_rect_samples(&j->ts, mv, j->id, rect, t->cams, t->vb, &covered, t->simd);
+                           : rr_raster_rect_samples(&j->ts, mv, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
   if (t->heat_e && !mv) heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
   for (uint32_t live = t->heat_e && mv ? mv->live : 0; live; live &= live - 1) { /* each position over its own rectangle */
-    const int *q = mv->at[__builtin_ctz(live)].r;
+    const int p = __builtin_ctz(live), q[4] = {mv->r[0][p], mv->r[1][p], mv->r[2][p], mv->r[3][p]};
     int x0 = q[0] > r.x0 ? q[0] : r.x0, y0 = q[1] > r.y0 ? q[1] : r.y0;
     int x1 = q[2] + 1 < r.x1 ? q[2] + 1 : r.x1, y1 = q[3] + 1 < r.y1 ? q[3] + 1 : r.y1;
     if (x0 < x1 && y0 < y1) heat_charge(t->heat_e, t->vb->width, x0, y0, x1, y1, (float)((x1 - x0) * (y1 - y0)));
@@ -319,16 +319,20 @@ KERNEL void draw_rect(trav *t, const tri_job *j, const tri_moves *mv, tile_rect 
 static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
   tri_moves mv;
   const bool planar = t->c->planar;
+  const int lanes = (t->ns + 7) & ~7; /* what the kernels' lanes read */
+  for (int s = 0; s < lanes; s++) mv.r[0][s] = mv.r[1][s] = INT32_MAX, mv.r[2][s] = mv.r[3][s] = INT32_MIN;
+  for (int s = 0; s < lanes; s++) mv.ox[s] = s < t->ns ? t->pos[s][0] : t->pos[0][0], mv.oy[s] = s < t->ns ? t->pos[s][1] : t->pos[0][1];
+  if (planar) rr_tri_moved_all(&j->ts, &j->pl, t->c, lanes, mv.ox, mv.oy, t->simd, mv.pa, mv.num0, mv.cx, mv.cy);
+  else
+    for (int s = 0; s < lanes; s++) mv.pa[s] = j->ts.pa, mv.num0[s] = j->ts.num0, mv.cx[s] = j->ts.cx, mv.cy[s] = j->ts.cy;
   mv.live = 0;
   for (uint32_t todo = planar ? ~(uint32_t)j->pos.none & ((1u << t->ns) - 1) : (1u << t->ns) - 1; todo;
        todo &= todo - 1) {
     const int s = __builtin_ctz(todo);
-    tri_at *a = &mv.at[s];
-    if (!planar) memcpy(a->r, j->bb, sizeof a->r);
-    else if (!tri_pos_rect(&j->pos, j->bb, s, a->r) || !meets(a->r, r)) continue;
-    float m[4];
-    tri_moved(&j->ts, &j->pl, &t->cams[s], m);
-    a->pa = m[0], a->num0 = m[1], a->cx = m[2], a->cy = m[3];
+    int q[4];
+    if (!planar) memcpy(q, j->bb, sizeof q);
+    else if (!tri_pos_rect(&j->pos, j->bb, s, q) || !meets(q, r)) continue;
+    for (int k = 0; k < 4; k++) mv.r[k][s] = q[k];
     mv.live |= 1u << s;
   }
   if (mv.live) draw_rect(t, j, &mv, r);

@@ -160,24 +160,23 @@ bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx,
 uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb,
                         uint64_t *covered, bool simd);
 
-/* The setup values that move with the sample position (rr_tri_setup_at), and the
- * position's own rectangle (tri_pos_rect). */
-typedef struct tri_at {
-  float pa, num0, cx, cy;
-  int r[4];
-} tri_at;
-/* A triangle at several positions: at[s] for each position s of live (bit s),
- * the positions whose rectangle may hold a sample; the others test none. */
+/* A triangle at several sample positions, by component for the lanes: for each
+ * position s, its offset (ox, oy) (the camera's sx0, sy0), the setup values that
+ * move with it (rr_tri_setup_at: pa, num0, cx, cy) and its own rectangle
+ * (tri_pos_rect: x0 = r[0][s] .. x1 = r[2][s], y0 = r[1][s] .. y1 = r[3][s]); live
+ * bit s: the rectangle may hold a sample. A position not live has an empty
+ * rectangle and tests none. */
 typedef struct tri_moves {
   uint32_t live;
-  tri_at at[RR_MAX_SAMPLES];
+  float ox[RR_MAX_SAMPLES], oy[RR_MAX_SAMPLES], pa[RR_MAX_SAMPLES], num0[RR_MAX_SAMPLES];
+  float cx[RR_MAX_SAMPLES], cy[RR_MAX_SAMPLES];
+  int32_t r[4][RR_MAX_SAMPLES];
 } tri_moves;
-/* rr_raster_rect at several sample positions at once: position s of mv->live over
- * rect ∩ mv->at[s].r, with cams[s] and layer s of vb (of vb->width × vb->height
- * each), and ts's values moved there by mv->at[s]. Returns the evaluations, one
- * per sample of those rectangles. */
+/* rr_raster_rect at ns sample positions at once: position s of mv->live over
+ * rect ∩ its rectangle, with cams[s] and layer s of vb (of vb->width × vb->height
+ * each). Returns the evaluations, one per sample of those rectangles. */
 uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int rect[4],
-                                const camera *cams, visbuf *vb, uint64_t *covered, bool simd);
+                                const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd);
 
 /* Test and benchmark hook: the relative error of depths t (one per sample of the
  * planar camera c's image; ids: the hit triangle, RR_MISS for none) against the
