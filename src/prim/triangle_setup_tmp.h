@@ -212,14 +212,12 @@ TARGET static void RR_CAT(moved_lanes, W)(const tri_setup *ts, const tri_plane *
   const VF hi_x = VF_(splat)((float)(c->width - 1)) + lo_x, hi_y = VF_(splat)((float)(c->height - 1)) + lo_y;
   VF x = VF_(max)(VF_(min)(VF_(splat)(pl->px), hi_x), lo_x), y = VF_(max)(VF_(min)(VF_(splat)(pl->py), hi_y), lo_y);
   x = VF_(floor)(x - lo_x) + lo_x, y = VF_(floor)(y - lo_y) + lo_y;
-  VD base = TO_D(VF_(splat)(0.0f)); /* (0.0 + base would turn a -0 into +0) */
-  for (int l = 0; l < W; l++) base[l] = pl->base;
+  const VD base = pl->base - TO_D(VF_(splat)(0.0f)); /* (base - 0 keeps a -0) */
   const VF p = TO_F(base + TO_D(x) * pl->u + TO_D(y) * pl->v);
   const bool persp = c->type == RR_CAMERA_PERSPECTIVE;
-  for (int l = 0; l < W; l++) {
-    pa[l] = persp ? p[l] : ts->pa, num0[l] = persp ? ts->num0 : p[l];
-    cx[l] = x[l], cy[l] = y[l];
-  }
+  const VF pav = persp ? p : VF_(splat)(ts->pa), n0v = persp ? VF_(splat)(ts->num0) : p;
+  memcpy(pa, &pav, W * sizeof(float)), memcpy(num0, &n0v, W * sizeof(float));
+  memcpy(cx, &x, W * sizeof(float)), memcpy(cy, &y, W * sizeof(float));
 }
 
 #undef SPLAT3

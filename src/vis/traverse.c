@@ -43,6 +43,7 @@ typedef struct trav {
   int ns;
   float span[4];      /* the positions' extent: x0, y0, x1, y1 of their (sx0, sy0) */
   float pos[RR_MAX_SAMPLES][2]; /* the positions: (sx0, sy0) of each camera */
+  float ox[RR_MAX_SAMPLES], oy[RR_MAX_SAMPLES]; /* the same by component, padded with the first */
   const oracles *o;
   visbuf *vb;
   bool cull_back, simd;
@@ -321,7 +322,7 @@ static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
   const bool planar = t->c->planar;
   const int lanes = (t->ns + 7) & ~7; /* what the kernels' lanes read */
   for (int s = 0; s < lanes; s++) mv.r[0][s] = mv.r[1][s] = INT32_MAX, mv.r[2][s] = mv.r[3][s] = INT32_MIN;
-  for (int s = 0; s < lanes; s++) mv.ox[s] = s < t->ns ? t->pos[s][0] : t->pos[0][0], mv.oy[s] = s < t->ns ? t->pos[s][1] : t->pos[0][1];
+  memcpy(mv.ox, t->ox, sizeof mv.ox), memcpy(mv.oy, t->oy, sizeof mv.oy);
   if (planar) rr_tri_moved_all(&j->ts, &j->pl, t->c, lanes, mv.ox, mv.oy, t->simd, mv.pa, mv.num0, mv.cx, mv.cy);
   else
     for (int s = 0; s < lanes; s++) mv.pa[s] = j->ts.pa, mv.num0[s] = j->ts.num0, mv.cx[s] = j->ts.cx, mv.cy[s] = j->ts.cy;
@@ -715,6 +716,8 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
                 .heat_n = ctx->heat_n};
   proto.span[0] = proto.span[2] = ctx->cams[0].sx0, proto.span[1] = proto.span[3] = ctx->cams[0].sy0;
   for (int s = 0; s < ctx->samples; s++) proto.pos[s][0] = ctx->cams[s].sx0, proto.pos[s][1] = ctx->cams[s].sy0;
+  for (int s = 0; s < RR_MAX_SAMPLES; s++)
+    proto.ox[s] = proto.pos[s < ctx->samples ? s : 0][0], proto.oy[s] = proto.pos[s < ctx->samples ? s : 0][1];
   for (int s = 1; s < ctx->samples; s++) {
     proto.span[0] = minf(proto.span[0], ctx->cams[s].sx0), proto.span[1] = minf(proto.span[1], ctx->cams[s].sy0);
     proto.span[2] = maxf(proto.span[2], ctx->cams[s].sx0), proto.span[3] = maxf(proto.span[3], ctx->cams[s].sy0);
