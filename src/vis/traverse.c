@@ -88,8 +88,10 @@ KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_moves *mv, t
   uint64_t covered = 0;
   t->st.edge_evals += !mv ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
                            : rr_raster_rect_samples(&j->ts, mv, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
-  if (t->heat_e && !mv) heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
-  for (uint32_t live = t->heat_e && mv ? mv->live : 0; live; live &= live - 1) { /* each position over its own rectangle */
+  if (t->heat_e && !mv)
+    heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
+  /* several positions: each over its own rectangle */
+  for (uint32_t live = t->heat_e && mv ? mv->live : 0; live; live &= live - 1) {
     const int p = __builtin_ctz(live), q[4] = {mv->r[0][p], mv->r[1][p], mv->r[2][p], mv->r[3][p]};
     int x0 = q[0] > r.x0 ? q[0] : r.x0, y0 = q[1] > r.y0 ? q[1] : r.y0;
     int x1 = q[2] + 1 < r.x1 ? q[2] + 1 : r.x1, y1 = q[3] + 1 < r.y1 ? q[3] + 1 : r.y1;
@@ -307,7 +309,7 @@ static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, ui
 }
 
 /* Rasterizes a prepared triangle into the samples r, with its setup moved to
- * each position (at; NULL for one position). */
+ * each position (mv; NULL for one position). */
 KERNEL void draw_rect(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r) {
   if (t->o->binning) bin_raster(t, j, mv, r, t->o->bin_size);
   else raster_samples(t, j, mv, r);
@@ -323,9 +325,12 @@ static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
   const int lanes = (t->ns + 7) & ~7; /* what the kernels' lanes read */
   for (int s = 0; s < lanes; s++) mv.r[0][s] = mv.r[1][s] = INT32_MAX, mv.r[2][s] = mv.r[3][s] = INT32_MIN;
   memcpy(mv.ox, t->ox, sizeof mv.ox), memcpy(mv.oy, t->oy, sizeof mv.oy);
-  if (planar) rr_tri_moved_all(&j->ts, &j->pl, t->c, lanes, mv.ox, mv.oy, t->simd, mv.pa, mv.num0, mv.cx, mv.cy);
-  else
-    for (int s = 0; s < lanes; s++) mv.pa[s] = j->ts.pa, mv.num0[s] = j->ts.num0, mv.cx[s] = j->ts.cx, mv.cy[s] = j->ts.cy;
+  if (planar) {
+    rr_tri_moved_all(&j->ts, &j->pl, t->c, lanes, mv.ox, mv.oy, t->simd, mv.pa, mv.num0, mv.cx, mv.cy);
+  } else {
+    for (int s = 0; s < lanes; s++)
+      mv.pa[s] = j->ts.pa, mv.num0[s] = j->ts.num0, mv.cx[s] = j->ts.cx, mv.cy[s] = j->ts.cy;
+  }
   mv.live = 0;
   for (uint32_t todo = planar ? ~(uint32_t)j->pos.none & ((1u << t->ns) - 1) : (1u << t->ns) - 1; todo;
        todo &= todo - 1) {
