@@ -3,7 +3,7 @@
 #include "vis/vis.h"
 #include "core/simd.h"
 
-enum { PIXELS_MAX = 8 }; /* rectangles of at most this many pixels: lanes over positions */
+enum { PIXELS_MAX = 16 }; /* rectangles of at most this many pixels: lanes over positions */
 
 /* The sample loop, one lane at a time (any camera) and, with AVX2, eight. */
 #define RR_TEMPLATE "vis/raster3d_tmp.h"
