@@ -3,8 +3,6 @@
 #include "vis/vis.h"
 #include "core/simd.h"
 
-enum { PIXELS_MAX = 16 }; /* rectangles of at most this many pixels: lanes over positions */
-
 /* The sample loop, one lane at a time (any camera) and, with AVX2, eight. */
 #define RR_TEMPLATE "vis/raster3d_tmp.h"
 #include "core/simd_widths.h"
@@ -31,9 +29,11 @@ uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_moves *mv, uint32
   const bool planar = cams[0].planar, avx2 = simd && __builtin_cpu_supports("avx2");
   uint64_t got = 0, samples = 0;
   (void)avx2;
-  if (planar && (r[2] - r[0] + 1) * (r[3] - r[1] + 1) <= PIXELS_MAX) {
-    /* a triangle of a pixel or two (most of a detailed mesh): lanes over the
-     * positions of each pixel rather than a scanline of a sample or two per position */
+  if (planar && (r[2] - r[0] + 1) * (r[3] - r[1] + 1) <= 2 * ns) {
+    /* a triangle of a few pixels (most of a detailed mesh): lanes over the positions
+     * of each pixel rather than a scanline of a sample or two per position (up to
+     * 2·ns pixels: by callgrind on the bunny and the teapot grid, fewer lanes to
+     * fill want fewer pixels) */
 #ifdef RR_SIMD_X86
     if (avx2) got = raster_pixels8(ts, mv, id, r, ns, vb, &samples);
     else
