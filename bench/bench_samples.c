@@ -6,7 +6,9 @@
  * --instructions: instead, the instructions of one frame of each, counted by
  * running this again under callgrind (use a smaller --size).
  *
- * usage: bench_samples [--size N|WxH] [--threads N] [--reps N] [--instructions] [SCENE...]
+ * --method NAME (repeatable): only these 3dr methods.
+ *
+ * usage: bench_samples [--size N|WxH] [--threads N] [--reps N] [--method NAME] [--instructions] [SCENE...]
  * SCENE as bench_raster's (default: stanford-bunny.obj grid:teapot.obj:19). */
 #include "benchutil.h"
 
@@ -15,9 +17,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const rr_method methods[] = {RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FS,
-                                    RR_METHOD_3DR_FULL};
-enum { NM = sizeof methods / sizeof methods[0], NC = 3 };
+static rr_method methods[] = {RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FS,
+                              RR_METHOD_3DR_FULL};
+enum { NM_ALL = sizeof methods / sizeof methods[0], NC = 3 };
+static int NM = NM_ALL;
 static const int counts[NC] = {1, 4, 16};
 
 /* counts[c] positions: the centre, the 4 rotated-grid positions, or a 4x4 grid
@@ -38,7 +41,8 @@ static void positions(rr_render_options *o, int n) {
 }
 
 static void usage(void) {
-  fprintf(stderr, "usage: bench_samples [--size N|WxH] [--threads N] [--reps N] [--instructions] [SCENE...]\n");
+  fprintf(stderr,
+          "usage: bench_samples [--size N|WxH] [--threads N] [--reps N] [--method NAME] [--instructions] [SCENE...]\n");
   exit(2);
 }
 
@@ -46,7 +50,8 @@ int main(int argc, char **argv) {
   int w = 1024, h = 1024, threads = 2, reps = 5;
   bool count = false;
   const char *scenes[16];
-  int nscenes = 0;
+  int nscenes = 0, nchosen = 0;
+  rr_method chosen[NM_ALL];
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i];
     if (strcmp(a, "--size") == 0 && i + 1 < argc) {
@@ -55,6 +60,12 @@ int main(int argc, char **argv) {
       threads = atoi(argv[++i]);
     } else if (strcmp(a, "--reps") == 0 && i + 1 < argc) {
       reps = atoi(argv[++i]);
+    } else if (strcmp(a, "--method") == 0 && i + 1 < argc) {
+      int m = rr_method_from_name(argv[++i]);
+      bool known = false;
+      for (int k = 0; k < NM_ALL; k++) known |= (int)methods[k] == m;
+      if (!known || nchosen == NM_ALL) usage();
+      chosen[nchosen++] = (rr_method)m;
     } else if (strcmp(a, "--instructions") == 0) {
       count = true;
     } else if (a[0] == '-' || nscenes == 16) {
@@ -64,6 +75,7 @@ int main(int argc, char **argv) {
     }
   }
   if (w < 1 || h < 1 || threads < 1 || threads > 256 || reps < 1 || reps > 64) usage();
+  if (nchosen) memcpy(methods, chosen, sizeof chosen[0] * (size_t)(NM = nchosen));
   if (count && !bench_on_valgrind()) return bench_instructions_main(argv);
   if (count) reps = 1;
   if (nscenes == 0) scenes[nscenes++] = "stanford-bunny.obj", scenes[nscenes++] = "grid:teapot.obj:19";
@@ -74,8 +86,8 @@ int main(int argc, char **argv) {
     rr_scene *s = bench_load(dev, scenes[si], &load_ms);
     rr_camera cam;
     bench_view(dev, scenes[si], s, w, h, &cam);
-    double t[NM][NC][64];
-    rr_stats st[NM][NC];
+    double t[NM_ALL][NC][64];
+    rr_stats st[NM_ALL][NC];
     for (int rep = 0; rep <= reps; rep++) /* round 0 warms up */
       for (int m = 0; m < NM; m++)
         for (int c = 0; c < NC; c++) {

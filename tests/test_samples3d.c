@@ -135,7 +135,7 @@ static void check_watertight(rr_device *dev) {
   camera cams[4];
   for (int k = 0; k < 4; k++) CHECK(rr_cam_setup_at(dev, &rc, N, N, on[k], &cams[k]) == RR_OK, "camera");
   CHECK(cams[0].tan_half_h == 1.0f, "tan(45°) rounds to %.9g", cams[0].tan_half_h);
-  static uint8_t claims[2][4][N * N];
+  static uint8_t claims[3][4][N * N];
   memset(claims, 0, sizeof claims);
   int on_edge = 0;
   for (uint32_t i = 0; i < plane->ntris; i++) {
@@ -144,14 +144,19 @@ static void check_watertight(rr_device *dev) {
     int face;
     rr_tri_setup_planes(plane, &i, 1, &cams[0], false, false, &ts, &face, &pl);
     if (face == SETUP_CULLED) continue;
-    tri_bound b = {0, {0, 0, N - 1, N - 1}};
-    for (int m = 0; m < 2; m++) { /* m = 0: every pixel (rc); 1: the bounds over the positions */
-      if (m == 1 && !rr_tri_corner_bounds_at(plane, i, NULL, 1, &cams[0], 4, on, false, &b)) continue;
+    tri_bound b = {0, {0, 0, N - 1, N - 1}, {0, 0, 0, 0, 0}};
+    /* m = 0: every pixel (rc); 1: the bounds over the positions; 2: each position's
+     * own rectangle within them (what the kernel tests) */
+    for (int m = 0; m < 3; m++) {
+      if (m == 1 && !rr_tri_corner_bounds_at(plane, i, NULL, 1, &cams[0], 4, on, false, &b)) break;
       for (int k = 0; k < 4; k++) {
         tri_setup at;
         rr_tri_setup_at(&ts, &pl, &cams[k], &at);
-        for (int y = b.bb[1]; y <= b.bb[3]; y++)
-          for (int x = b.bb[0]; x <= b.bb[2]; x++) {
+        int r[4];
+        memcpy(r, b.bb, sizeof r);
+        if (m == 2 && !tri_pos_rect(&b.pos, b.bb, k, r)) continue;
+        for (int y = r[1]; y <= r[3]; y++)
+          for (int x = r[0]; x <= r[2]; x++) {
             float sx = (float)x + on[k][0], sy = (float)y + on[k][1], e[3], t, l1, l2;
             tri_edges(&at, sx, sy, e);
             if (!sample_test(&at, e, sx, sy, &t, &l1, &l2)) continue;
@@ -161,12 +166,12 @@ static void check_watertight(rr_device *dev) {
       }
     }
   }
-  for (int m = 0; m < 2; m++) {
+  for (int m = 0; m < 3; m++) {
     int holes = 0, doubles = 0;
     for (int k = 0; k < 4; k++)
       for (int p = 0; p < N * N; p++) holes += claims[m][k][p] == 0, doubles += claims[m][k][p] > 1;
     CHECK(holes == 0 && doubles == 0, "plane at sample level (%s): %d holes, %d double claims",
-          m ? "bounds over the positions" : "every pixel", holes, doubles);
+          m == 2 ? "each position's rectangle" : m ? "bounds over the positions" : "every pixel", holes, doubles);
   }
   CHECK(on_edge >= 3 * N * N, "only %d of %d samples fell on an edge or vertex", on_edge, 4 * N * N);
   printf("plane: %d of %d samples decided on an edge or vertex\n", on_edge, 4 * N * N);

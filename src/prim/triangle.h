@@ -54,6 +54,26 @@ void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const ca
 /* The setup ts (from rr_tri_setup_planes with a camera that differs from c only in
  * its sample position) for camera c: the bits rr_tri_setup gives for c. */
 void rr_tri_setup_at(const tri_setup *ts, const tri_plane *pl, const camera *c, tri_setup *out);
+/* tri_moved at n positions of a planar camera c, whose sample offsets are ox[k],
+ * oy[k]: ts's pa, num0, cx, cy there into pa[k], num0[k], cx[k], cy[k], with the
+ * same bits; with simd, eight at a time where the processor has AVX2. */
+void rr_tri_moved_all(const tri_setup *ts, const tri_plane *pl, const camera *c, int n, const float *ox,
+                      const float *oy, bool simd, float *pa, float *num0, float *cx, float *cy);
+/* What rr_tri_setup_at changes, without the copy: ts's pa, num0, cx, cy for c
+ * into m[0..3] (the setup template's clamp, as minps and maxps, and floor). */
+static inline void tri_moved(const tri_setup *ts, const tri_plane *pl, const camera *c, float m[4]) {
+  m[0] = ts->pa, m[1] = ts->num0, m[2] = ts->cx, m[3] = ts->cy;
+  if (!c->planar) return; /* (cx, cy) = (0, 0) at every position */
+  const float lo_x = c->sx0, hi_x = (float)(c->width - 1) + c->sx0;
+  const float lo_y = c->sy0, hi_y = (float)(c->height - 1) + c->sy0;
+  float cx = pl->px < hi_x ? pl->px : hi_x, cy = pl->py < hi_y ? pl->py : hi_y;
+  cx = cx > lo_x ? cx : lo_x, cy = cy > lo_y ? cy : lo_y;
+  cx = floorf(cx - lo_x) + lo_x, cy = floorf(cy - lo_y) + lo_y;
+  const double dcx = cx, dcy = cy;
+  const float p = (float)(pl->base + dcx * pl->u + dcy * pl->v);
+  m[2] = cx, m[3] = cy;
+  m[c->type == RR_CAMERA_PERSPECTIVE ? 0 : 1] = p;
+}
 /* The three edge functions of a set-up triangle for evaluation vector w. The
  * order of operations is fixed (the build uses -ffp-contract=off: a fused
  * multiply-add would change the bits) so every method computes the same values
@@ -239,10 +259,28 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
  * triangles of a detailed mesh fall between samples. rr_tri_corner_bounds bounds triangles
  * ids[0..n-1] (first..first+n-1 when ids is NULL), 8 at a time with AVX2 when
  * simd, and writes those whose rectangle holds a sample to out; returns how many. */
+/* Which part of a triangle's rectangle each sample position's own rectangle (the
+ * one a one-position frame tests) takes, bit p for position p: none, when it holds
+ * no sample; x0, y0: it starts a column right of, a row below bb's start; x1, y1:
+ * it ends a column left of, a row above bb's end. Positions lie in one pixel, so
+ * their rectangles differ by at most that (and were it more, the rectangle these
+ * bits give still holds the position's own). */
+typedef struct tri_pos_bits {
+  uint16_t none, x0, y0, x1, y1;
+} tri_pos_bits;
+_Static_assert(RR_MAX_SAMPLES <= 16, "tri_pos_bits holds a bit per position");
 typedef struct tri_bound {
   uint32_t id;
   int bb[4]; /* inclusive pixel rectangle, as rr_tri_screen_bounds */
+  tri_pos_bits pos; /* several positions: each one's rectangle within bb */
 } tri_bound;
+/* Position p's rectangle within the inclusive rectangle bb (false: none). */
+static inline bool tri_pos_rect(const tri_pos_bits *b, const int bb[4], int p, int r[4]) {
+  if (b->none >> p & 1) return false;
+  r[0] = bb[0] + (b->x0 >> p & 1), r[1] = bb[1] + (b->y0 >> p & 1);
+  r[2] = bb[2] - (b->x1 >> p & 1), r[3] = bb[3] - (b->y1 >> p & 1);
+  return true;
+}
 uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
                            bool simd, tri_bound *out);
 /* The same for the npos sample positions pos[k] (sx0, sy0 of each; c's own is

@@ -81,15 +81,30 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
     }
     lx = ux, ly = uy, hx = vx, hy = vy;
   }
-#undef POS_RECT
   const int keep = VI_(bits)(ahead_any & ~(bounded & empty)) & ((1 << n) - 1);
   if (!keep) return 0;
   /* not bounded: the whole screen */
   lx = VF_(select)(bounded, lx, zero), ly = VF_(select)(bounded, ly, zero);
   hx = VF_(select)(bounded, hx, last_x), hy = VF_(select)(bounded, hy, last_y);
   const VI bx0 = VI_(trunc)(lx), by0 = VI_(trunc)(ly), bx1 = VI_(trunc)(hx), by1 = VI_(trunc)(hy);
+  /* each position's own rectangle within the union, a bit per position (tri_pos_bits) */
+  VI none = VI_(splat)(0), in_x0 = none, in_y0 = none, in_x1 = none, in_y1 = none;
+  for (int p = 0; p < npos && npos > 1; p++) {
+    VF ux = lx, uy = ly, vx = hx, vy = hy;
+    {
+      POS_RECT(VF_(splat)(pos[p][0]), VF_(splat)(pos[p][1]))
+      const VI bit = VI_(splat)(1 << p) & bounded;
+      none |= ((lx > hx) | (ly > hy)) & bit;
+      in_x0 |= (lx > ux) & bit, in_y0 |= (ly > uy) & bit, in_x1 |= (hx < vx) & bit, in_y1 |= (hy < vy) & bit;
+    }
+  }
+#undef POS_RECT
   uint32_t kept = 0;
   for (int l = 0; l < n; l++)
-    if (keep >> l & 1) out[kept++] = (tri_bound){(uint32_t)lane_id[l], {bx0[l], by0[l], bx1[l], by1[l]}};
+    if (keep >> l & 1)
+      out[kept++] = (tri_bound){(uint32_t)lane_id[l],
+                                {bx0[l], by0[l], bx1[l], by1[l]},
+                                {(uint16_t)none[l], (uint16_t)in_x0[l], (uint16_t)in_y0[l], (uint16_t)in_x1[l],
+                                 (uint16_t)in_y1[l]}};
   return kept;
 }

@@ -74,19 +74,21 @@ void rr_tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camer
 }
 
 void rr_tri_setup_at(const tri_setup *ts, const tri_plane *pl, const camera *c, tri_setup *out) {
+  float m[4];
+  tri_moved(ts, pl, c, m);
   *out = *ts;
-  if (!c->planar) return; /* (cx, cy) = (0, 0) at every position */
-  /* the template's clamp (min, max as minps, maxps: a NaN gives the bound) and floor */
-  const float lo_x = c->sx0, hi_x = (float)(c->width - 1) + c->sx0;
-  const float lo_y = c->sy0, hi_y = (float)(c->height - 1) + c->sy0;
-  float cx = pl->px < hi_x ? pl->px : hi_x, cy = pl->py < hi_y ? pl->py : hi_y;
-  cx = cx > lo_x ? cx : lo_x, cy = cy > lo_y ? cy : lo_y;
-  cx = floorf(cx - lo_x) + lo_x, cy = floorf(cy - lo_y) + lo_y;
-  const double dcx = cx, dcy = cy;
-  const float p = (float)(pl->base + dcx * pl->u + dcy * pl->v);
-  out->cx = cx, out->cy = cy;
-  if (c->type == RR_CAMERA_PERSPECTIVE) out->pa = p;
-  else out->num0 = p;
+  out->pa = m[0], out->num0 = m[1], out->cx = m[2], out->cy = m[3];
+}
+
+void rr_tri_moved_all(const tri_setup *ts, const tri_plane *pl, const camera *c, int n, const float *ox,
+                      const float *oy, bool simd, float *pa, float *num0, float *cx, float *cy) {
+  int k = 0;
+#ifdef RR_SIMD_X86
+  if (simd && __builtin_cpu_supports("avx2"))
+    for (; k + 8 <= n; k += 8) moved_lanes8(ts, pl, c, ox + k, oy + k, pa + k, num0 + k, cx + k, cy + k);
+#endif
+  (void)simd;
+  for (; k < n; k++) moved_lanes1(ts, pl, c, ox + k, oy + k, pa + k, num0 + k, cx + k, cy + k);
 }
 
 bool rr_tri_ray_hit(const rr_scene *s, uint32_t i, const camera *ray, bool cull, float tmin, float tmax, float *t,

@@ -3,17 +3,18 @@
  *
  * Every sample of rectangle r against one set-up triangle, W samples of a row at
  * a time, columns then rows (the terms in sx are the same on every row), for each
- * of the ns sample positions in turn (cams[s], layer s of vb): the triangle's
- * constants are loaded once, and at[s] (NULL for one position: ts's own) gives
- * the four setup values that move with the position. A lane is
+ * of ns sample positions in turn: the triangle's constants are loaded once. One
+ * position (mv NULL): ts's own over r. Several: the k-th is position s = act[k]
+ * (cams[s], layer s of vb) over its own rectangle rs[k] (inside r), with mv's four
+ * setup values that move with it. A lane is
  * the sample test of prim/triangle.h (sample_test_w) and the depth test of
  * vis/vis.h (depth_wins), with the depth of TRI_DEPTH: the same operations in the same order on IEEE single
  * floats (no FMA, a true division), so every width gives their bits. Lanes past
  * r[2] are masked off and touch no memory. */
 
-TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at *at, uint32_t id,
-                                                     const int r[4], const camera *cams, int ns, visbuf *vb,
-                                                     const bool planar) {
+TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_moves *mv, const uint8_t *act,
+                                                     const int (*rs)[4], uint32_t id, const int r0[4],
+                                                     const camera *cams, int ns, visbuf *vb, const bool planar) {
   VF a[3], b[3], cc[3];
   VI tie[3];
 #pragma GCC unroll 3
@@ -28,12 +29,14 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at 
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
   const VI idv = VI_(splat)((int32_t)id), bias = VI_(splat)(INT32_MIN), id_biased = idv ^ bias;
-  const VI end = VI_(splat)(r[2] + 1);
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
   uint64_t covered = 0;
-  for (int s = 0; s < ns; s++) {
+  for (int k = 0; k < ns; k++) {
+  const int s = mv ? act[k] : 0, *r = mv ? rs[k] : r0;
   const camera *c = &cams[s];
-  const tri_at p = at ? at[s] : (tri_at){ts->pa, ts->num0, ts->cx, ts->cy};
+  const struct { float pa, num0, cx, cy; } p = {mv ? mv->pa[s] : ts->pa, mv ? mv->num0[s] : ts->num0,
+                                               mv ? mv->cx[s] : ts->cx, mv ? mv->cy[s] : ts->cy};
+  const VI end = VI_(splat)(r[2] + 1);
   const VF pa = VF_(splat)(p.pa), num0 = VF_(splat)(p.num0), cx = VF_(splat)(p.cx), cy = VF_(splat)(p.cy);
   float *best_t = vb->t + s * layer, *l1 = vb->l1 + s * layer, *l2 = vb->l2 + s * layer;
   int32_t *best_id = (int32_t *)vb->id + s * layer;
@@ -86,11 +89,80 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_at 
  * so the one-position frame pays nothing for the loop over positions. */
 TARGET static uint64_t RR_CAT(raster_one, W)(const tri_setup *ts, uint32_t id, const int r[4], const camera *c,
                                              visbuf *vb, const bool planar) {
-  return planar ? RR_CAT(raster_loop, W)(ts, NULL, id, r, c, 1, vb, true)
-                : RR_CAT(raster_loop, W)(ts, NULL, id, r, c, 1, vb, false);
+  return planar ? RR_CAT(raster_loop, W)(ts, NULL, NULL, NULL, id, r, c, 1, vb, true)
+                : RR_CAT(raster_loop, W)(ts, NULL, NULL, NULL, id, r, c, 1, vb, false);
 }
-TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_at *at, uint32_t id, const int r[4],
-                                              const camera *cams, int ns, visbuf *vb, const bool planar) {
-  return planar ? RR_CAT(raster_loop, W)(ts, at, id, r, cams, ns, vb, true)
-                : RR_CAT(raster_loop, W)(ts, at, id, r, cams, ns, vb, false);
+TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_moves *mv, const uint8_t *act,
+                                              const int (*rs)[4], uint32_t id, const camera *cams, int n,
+                                              visbuf *vb, const bool planar) {
+  return planar ? RR_CAT(raster_loop, W)(ts, mv, act, rs, id, rs[0], cams, n, vb, true)
+                : RR_CAT(raster_loop, W)(ts, mv, act, rs, id, rs[0], cams, n, vb, false);
+}
+
+/* A rectangle r of a few pixels at several positions (planar cameras): for each
+ * pixel, lanes over the positions whose own rectangle holds it (mv), W at a time.
+ * The same operations in the same order as the loop above, lane by lane, so the
+ * same bits; the lanes that pass take the depth test one at a time, each in its
+ * own layer. Adds the samples tested to *tested. */
+TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
+                                                const int r[4], int ns, visbuf *vb, uint64_t *tested) {
+  VF a[3], b[3], cc[3];
+  VI tie[3];
+#pragma GCC unroll 3
+  for (int e = 0; e < 3; e++) {
+    a[e] = VF_(splat)(ts->a[e]), b[e] = VF_(splat)(ts->b[e]), cc[e] = VF_(splat)(ts->c[e]);
+    tie[e] = VI_(splat)(ts->tie >> e & 1u ? -1 : 0);
+  }
+  const VF w0 = VF_(splat)(ts->w[0]), w1 = VF_(splat)(ts->w[1]), w2 = VF_(splat)(ts->w[2]);
+  const VF vol = VF_(splat)(ts->vol), vol_x = VF_(splat)(ts->vol_x), vol_y = VF_(splat)(ts->vol_y);
+  const VF pb = VF_(splat)(ts->pb), pc = VF_(splat)(ts->pc);
+  const VF num_x = VF_(splat)(ts->num_x), num_y = VF_(splat)(ts->num_y);
+  const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
+  const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
+  uint64_t covered = 0, evals = 0;
+  for (int p0 = 0; p0 < ns; p0 += W) {
+    if (!(mv->live >> p0 & ((1u << W) - 1))) continue; /* (W <= 16) */
+    const VI rx0 = VI_(load)(mv->r[0] + p0), ry0 = VI_(load)(mv->r[1] + p0);
+    const VI rx1 = VI_(load)(mv->r[2] + p0), ry1 = VI_(load)(mv->r[3] + p0);
+    const VF ox = VF_(load)(mv->ox + p0), oy = VF_(load)(mv->oy + p0);
+    for (int y = r[1]; y <= r[3]; y++) {
+      const VI yi = VI_(splat)(y), in_y = (yi >= ry0) & (yi <= ry1);
+      if (!VI_(bits)(in_y)) continue;
+      const VF sy = VF_(from_int)(yi) + oy;
+      for (int x = r[0]; x <= r[2]; x++) {
+        const VI xi = VI_(splat)(x);
+        VI in = in_y & (xi >= rx0) & (xi <= rx1);
+        const int tried = VI_(bits)(in);
+        if (!tried) continue;
+        evals += (uint64_t)__builtin_popcount((unsigned)tried);
+        const VF sx = VF_(from_int)(xi) + ox;
+        VF ev[3];
+#pragma GCC unroll 3
+        for (int e = 0; e < 3; e++) {
+          ev[e] = (a[e] * one + b[e] * sx) + cc[e] * sy;
+          in &= TRI_EDGE_INSIDE(ev[e], tie[e], zero);
+        }
+        if (!VI_(bits)(in)) continue;
+        const VF sum = ev[0] * w0 + ev[1] * w1 + ev[2] * w2, v = (vol + sx * vol_x) + sy * vol_y;
+        in &= TRI_HIT_AHEAD(sum, v, zero);
+        int hit = VI_(bits)(in);
+        if (!hit) continue;
+        const VF pa = VF_(load)(mv->pa + p0), num0 = VF_(load)(mv->num0 + p0);
+        const VF cx = VF_(load)(mv->cx + p0), cy = VF_(load)(mv->cy + p0);
+        const VF den = (pa * one + pb * (sx - cx)) + pc * (sy - cy);
+        const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * num_x) + (sy - cy) * num_y, den, v, inv, zero,
+                                                VF_(select));
+        const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
+        for (; hit; hit &= hit - 1) {
+          const int l = __builtin_ctz((unsigned)hit);
+          const size_t k = (size_t)(p0 + l) * layer + (size_t)y * width + (size_t)x;
+          covered++;
+          if (t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
+            vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
+        }
+      }
+    }
+  }
+  *tested += evals;
+  return covered;
 }

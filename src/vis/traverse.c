@@ -43,6 +43,7 @@ typedef struct trav {
   int ns;
   float span[4];      /* the positions' extent: x0, y0, x1, y1 of their (sx0, sy0) */
   float pos[RR_MAX_SAMPLES][2]; /* the positions: (sx0, sy0) of each camera */
+  float ox[RR_MAX_SAMPLES], oy[RR_MAX_SAMPLES]; /* the same by component, padded with the first */
   const oracles *o;
   visbuf *vb;
   bool cull_back, simd;
@@ -71,13 +72,16 @@ typedef struct tri_job {
   float zmin;      /* a floor under any t computed for the triangle (0: none known) */
   int bb[4];       /* inclusive screen bounds */
   union {
-    float slack[3];  /* planar: how far below zero a rounded corner value may fall for an inside sample */
+    struct {         /* planar: */
+      float slack[3]; /* how far below zero a rounded corner value may fall for an inside sample */
+      tri_pos_bits pos; /* several positions: each one's rectangle within bb */
+    };
     tri_cone cone;   /* curved: what bounds the triangle's directions */
   };
   tri_plane pl;      /* planar, several positions: how ts moves to each (rr_tri_setup_at) */
 } tri_job;
 
-/* Tests every sample of r at every position (at: the setup moved to each, NULL
+/* Tests every sample of r at every position (mv: the setup moved to each, NULL
  * for one); the one kernel every generateSamples path ends in. Returns the
  * samples the triangle covers. */
 /* An analytic primitive at every sample of r at every position. */
@@ -93,14 +97,27 @@ static uint64_t ana_raster(trav *t, uint32_t id, tile_rect r, uint64_t *covered)
   return (uint64_t)(r.x1 - r.x0) * (uint64_t)(r.y1 - r.y0) * (uint64_t)t->ns;
 }
 
-KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_at *at, tile_rect r) {
+KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
-  t->st.edge_evals += j->ana ? ana_raster(t, j->id, r, &covered)
-                      : !at  ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
-                             : rr_raster_rect_samples(&j->ts, at, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
-  if (t->heat_e)
-    heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0) * t->ns));
+  if (j->ana) { /* every position over the whole rectangle: no moved setup */
+    t->st.edge_evals += ana_raster(t, j->id, r, &covered);
+    if (t->heat_e)
+      heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0) * t->ns));
+    if (t->hiz_used) hiz_mark(t->hz, r.x0, r.y0, r.x1, r.y1);
+    return covered;
+  }
+  t->st.edge_evals += !mv ? rr_raster_rect(&j->ts, j->id, rect, t->c, t->vb, &covered, t->simd)
+                           : rr_raster_rect_samples(&j->ts, mv, j->id, rect, t->cams, t->ns, t->vb, &covered, t->simd);
+  if (t->heat_e && !mv)
+    heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
+  /* several positions: each over its own rectangle */
+  for (uint32_t live = t->heat_e && mv ? mv->live : 0; live; live &= live - 1) {
+    const int p = __builtin_ctz(live), q[4] = {mv->r[0][p], mv->r[1][p], mv->r[2][p], mv->r[3][p]};
+    int x0 = q[0] > r.x0 ? q[0] : r.x0, y0 = q[1] > r.y0 ? q[1] : r.y0;
+    int x1 = q[2] + 1 < r.x1 ? q[2] + 1 : r.x1, y1 = q[3] + 1 < r.y1 ? q[3] + 1 : r.y1;
+    if (x0 < x1 && y0 < y1) heat_charge(t->heat_e, t->vb->width, x0, y0, x1, y1, (float)((x1 - x0) * (y1 - y0)));
+  }
   if (t->hiz_used) hiz_mark(t->hz, r.x0, r.y0, r.x1, r.y1);
   return covered;
 }
@@ -134,14 +151,14 @@ static int cone_rejects(trav *t, const tri_job *j, tile_rect b) {
  * early-z shows it is hidden; otherwise it is refined by 4 in each direction down
  * to single pixels. Accepted samples still go through the sample test, which keeps
  * the result bit-identical. */
-static uint64_t bin_raster(trav *t, const tri_job *j, const tri_at *at, tile_rect r, int size) {
+static uint64_t bin_raster(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r, int size) {
   uint64_t covered = 0;
   for (int by = r.y0 - r.y0 % size; by < r.y1; by += size)
     for (int bx = r.x0 - r.x0 % size; bx < r.x1; bx += size) {
       tile_rect b = {bx > r.x0 ? bx : r.x0, by > r.y0 ? by : r.y0, bx + size < r.x1 ? bx + size : r.x1,
                      by + size < r.y1 ? by + size : r.y1};
       if (size <= t->o->bin_min || (b.x1 - b.x0) * (b.y1 - b.y0) <= 4) {
-        covered += raster_samples(t, j, at, b);
+        covered += raster_samples(t, j, mv, b);
         continue;
       }
       bool out = false;
@@ -167,7 +184,7 @@ static uint64_t bin_raster(trav *t, const tri_job *j, const tri_at *at, tile_rec
       if (out) continue;
       if (t->o->early_z && hiz_nearer(t->hz, b.x0, b.y0, b.x1, b.y1, j->zmin)) continue;
       /* refined: count the bins that turn out to hold none of the triangle */
-      uint64_t in = bin_raster(t, j, at, b, size / 4 > 1 ? size / 4 : 1);
+      uint64_t in = bin_raster(t, j, mv, b, size / 4 > 1 ? size / 4 : 1);
       t->st.bins++;
       t->st.bins_empty += in == 0;
       covered += in;
@@ -193,13 +210,15 @@ static float tri_t_floor(float zmin, float mag, float mag_p, const tri_setup *ts
   return minf(computed_t_floor(zmin, mag, ts->vol), computed_t_floor(zmin, mag_p, ts->num0));
 }
 
-/* The largest |pa| of a planar setup over the positions: the size of den's terms. */
+/* The largest |pa| of a planar setup over the positions whose samples may meet
+ * it (the others test none): the size of den's terms. */
 static float max_pa(const trav *t, const tri_job *j) {
   float pa = fabsf(j->ts.pa);
   for (int s = 1; s < t->ns; s++) {
-    tri_setup at;
-    rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &at);
-    pa = maxf(pa, fabsf(at.pa));
+    float m[4];
+    if (j->pos.none >> s & 1) continue;
+    tri_moved(&j->ts, &j->pl, &t->cams[s], m);
+    pa = maxf(pa, fabsf(m[0]));
   }
   return pa;
 }
@@ -254,7 +273,7 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
       if (face[l] == SETUP_CULLED) continue;
       tri_job *j = out + kept++;
       j->ts = ts[l];
-      if (pl) j->pl = pl[l];
+      if (pl) j->pl = pl[l], j->pos = b[q + l].pos;
       memcpy(j->bb, b[q + l].bb, sizeof j->bb);
       finish_setup(t, ids[l], j);
     }
@@ -342,21 +361,39 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
 }
 
 /* Rasterizes a prepared triangle into the samples r, with its setup moved to
- * each position (at; NULL for one position). */
-KERNEL void draw_rect(trav *t, const tri_job *j, const tri_at *at, tile_rect r) {
-  if (t->o->binning) bin_raster(t, j, at, r, t->o->bin_size);
-  else raster_samples(t, j, at, r);
+ * each position (mv; NULL for one position). */
+KERNEL void draw_rect(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r) {
+  if (t->o->binning) bin_raster(t, j, mv, r, t->o->bin_size);
+  else raster_samples(t, j, mv, r);
 }
 
-/* Several positions: the setup moved to each once per draw, not per bin. */
+/* Several positions: the setup moved to each once per draw, not per bin, with
+ * each position's own rectangle (planar: the one-position frame's, tri_pos_rect;
+ * curved: the union), which the kernel keeps to. A position whose rectangle misses
+ * r is not moved. */
 static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
-  tri_at at[RR_MAX_SAMPLES];
-  for (int s = 0; s < t->ns; s++) {
-    tri_setup m;
-    rr_tri_setup_at(&j->ts, &j->pl, &t->cams[s], &m);
-    at[s] = (tri_at){m.pa, m.num0, m.cx, m.cy};
+  tri_moves mv;
+  const bool planar = t->c->planar;
+  const int lanes = (t->ns + 7) & ~7; /* what the kernels' lanes read */
+  for (int s = 0; s < lanes; s++) mv.r[0][s] = mv.r[1][s] = INT32_MAX, mv.r[2][s] = mv.r[3][s] = INT32_MIN;
+  memcpy(mv.ox, t->ox, sizeof mv.ox), memcpy(mv.oy, t->oy, sizeof mv.oy);
+  if (planar) {
+    rr_tri_moved_all(&j->ts, &j->pl, t->c, lanes, mv.ox, mv.oy, t->simd, mv.pa, mv.num0, mv.cx, mv.cy);
+  } else {
+    for (int s = 0; s < lanes; s++)
+      mv.pa[s] = j->ts.pa, mv.num0[s] = j->ts.num0, mv.cx[s] = j->ts.cx, mv.cy[s] = j->ts.cy;
   }
-  draw_rect(t, j, at, r);
+  mv.live = 0;
+  for (uint32_t todo = planar ? ~(uint32_t)j->pos.none & ((1u << t->ns) - 1) : (1u << t->ns) - 1; todo;
+       todo &= todo - 1) {
+    const int s = __builtin_ctz(todo);
+    int q[4];
+    if (!planar) memcpy(q, j->bb, sizeof q);
+    else if (!tri_pos_rect(&j->pos, j->bb, s, q) || !meets(q, r)) continue;
+    for (int k = 0; k < 4; k++) mv.r[k][s] = q[k];
+    mv.live |= 1u << s;
+  }
+  if (mv.live) draw_rect(t, j, &mv, r);
 }
 
 /* Rasterizes a prepared triangle into the samples of f it may cover. */
@@ -736,6 +773,8 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
                 .heat_n = ctx->heat_n};
   proto.span[0] = proto.span[2] = ctx->cams[0].sx0, proto.span[1] = proto.span[3] = ctx->cams[0].sy0;
   for (int s = 0; s < ctx->samples; s++) proto.pos[s][0] = ctx->cams[s].sx0, proto.pos[s][1] = ctx->cams[s].sy0;
+  for (int s = 0; s < RR_MAX_SAMPLES; s++)
+    proto.ox[s] = proto.pos[s < ctx->samples ? s : 0][0], proto.oy[s] = proto.pos[s < ctx->samples ? s : 0][1];
   for (int s = 1; s < ctx->samples; s++) {
     proto.span[0] = minf(proto.span[0], ctx->cams[s].sx0), proto.span[1] = minf(proto.span[1], ctx->cams[s].sy0);
     proto.span[2] = maxf(proto.span[2], ctx->cams[s].sx0), proto.span[3] = maxf(proto.span[3], ctx->cams[s].sy0);

@@ -176,14 +176,22 @@ bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx,
 uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb,
                         uint64_t *covered, bool simd);
 
-/* The setup values that move with the sample position (rr_tri_setup_at). */
-typedef struct tri_at {
-  float pa, num0, cx, cy;
-} tri_at;
-/* rr_raster_rect at ns sample positions at once: cams[s] and layer s of vb (of
- * vb->width × vb->height each), with ts's values moved to position s by at[s] (at
- * NULL when ns is 1). Returns the evaluations, ns per sample of the rectangle. */
-uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_at *at, uint32_t id, const int rect[4],
+/* A triangle at several sample positions, by component for the lanes: for each
+ * position s, its offset (ox, oy) (the camera's sx0, sy0), the setup values that
+ * move with it (rr_tri_setup_at: pa, num0, cx, cy) and its own rectangle
+ * (tri_pos_rect: x0 = r[0][s] .. x1 = r[2][s], y0 = r[1][s] .. y1 = r[3][s]); live
+ * bit s: the rectangle may hold a sample. A position not live has an empty
+ * rectangle and tests none. */
+typedef struct tri_moves {
+  uint32_t live;
+  float ox[RR_MAX_SAMPLES], oy[RR_MAX_SAMPLES], pa[RR_MAX_SAMPLES], num0[RR_MAX_SAMPLES];
+  float cx[RR_MAX_SAMPLES], cy[RR_MAX_SAMPLES];
+  int32_t r[4][RR_MAX_SAMPLES];
+} tri_moves;
+/* rr_raster_rect at ns sample positions at once: position s of mv->live over
+ * rect ∩ its rectangle, with cams[s] and layer s of vb (of vb->width × vb->height
+ * each). Returns the evaluations, one per sample of those rectangles. */
+uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int rect[4],
                                 const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd);
 
 /* Test and benchmark hook: the relative error of depths t (one per sample of the
