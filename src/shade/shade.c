@@ -857,10 +857,10 @@ static rr_error shade_frame(rr_device *dev, const rr_scene *s, const rr_camera *
     if (aovs & 1u << a) e = lit_image(dev, a, f->vb.width, f->vb.height, parts, vis, nl, &made[a]);
   for (int a = 0; a < RR_AOV_COUNT; a++)
     if (aovs & 1u << a) {
-      if (e) rr_image_free(&made[a]);
+      if (e) free(made[a].data); /* (rr_image_free is io's: shading does not call io) */
       else aov_images[a] = made[a];
     }
-  if (e && shaded) rr_image_free(out);
+  if (e && shaded) free(out->data), *out = (rr_image){0};
   free(parts), free(vis);
   if (lit) rr_lighting_release(&lights);
   return e ? e : rr_ok(dev);

@@ -26,9 +26,12 @@ uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const 
 
 uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int r[4],
                                 const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd) {
-  const bool planar = cams[0].planar, avx2 = simd && __builtin_cpu_supports("avx2");
+  const bool planar = cams[0].planar;
+#ifdef RR_SIMD_X86
+  const bool avx2 = simd && __builtin_cpu_supports("avx2");
+#endif
   uint64_t got = 0, samples = 0;
-  (void)avx2;
+  (void)simd;
   if (planar && (r[2] - r[0] + 1) * (r[3] - r[1] + 1) <= 2 * ns) {
     /* a triangle of a few pixels (most of a detailed mesh): lanes over the positions
      * of each pixel rather than a scanline of a sample or two per position (up to
