@@ -1,3 +1,24 @@
+/* A setup's values in lanes, as both loops below read them. */
+typedef struct {
+  VF a[3], b[3], cc[3];
+  VI tie[3];
+  VF w0, w1, w2, vol, vol_x, vol_y, pb, pc, num_x, num_y;
+} RR_CAT(tri_lanes, W);
+
+TARGET static inline __attribute__((always_inline)) RR_CAT(tri_lanes, W) RR_CAT(lanes_of, W)(const tri_setup *ts) {
+  RR_CAT(tri_lanes, W) L;
+#pragma GCC unroll 3
+  for (int e = 0; e < 3; e++) {
+    L.a[e] = VF_(splat)(ts->a[e]), L.b[e] = VF_(splat)(ts->b[e]), L.cc[e] = VF_(splat)(ts->c[e]);
+    L.tie[e] = VI_(splat)(ts->tie >> e & 1u ? -1 : 0);
+  }
+  L.w0 = VF_(splat)(ts->w[0]), L.w1 = VF_(splat)(ts->w[1]), L.w2 = VF_(splat)(ts->w[2]);
+  L.vol = VF_(splat)(ts->vol), L.vol_x = VF_(splat)(ts->vol_x), L.vol_y = VF_(splat)(ts->vol_y);
+  L.pb = VF_(splat)(ts->pb), L.pc = VF_(splat)(ts->pc);
+  L.num_x = VF_(splat)(ts->num_x), L.num_y = VF_(splat)(ts->num_y);
+  return L;
+}
+
 /* The 3D rasterizer's sample loop for W lanes: a kernel template (core/simd.h)
  * that raster3d.c instantiates per width through core/simd_widths.h.
  *
@@ -15,17 +36,7 @@
 TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_moves *mv, const uint8_t *act,
                                                      const int (*rs)[4], uint32_t id, const int r0[4],
                                                      const camera *cams, int ns, visbuf *vb, const bool planar) {
-  VF a[3], b[3], cc[3];
-  VI tie[3];
-#pragma GCC unroll 3
-  for (int e = 0; e < 3; e++) {
-    a[e] = VF_(splat)(ts->a[e]), b[e] = VF_(splat)(ts->b[e]), cc[e] = VF_(splat)(ts->c[e]);
-    tie[e] = VI_(splat)(ts->tie >> e & 1u ? -1 : 0);
-  }
-  const VF w0 = VF_(splat)(ts->w[0]), w1 = VF_(splat)(ts->w[1]), w2 = VF_(splat)(ts->w[2]);
-  const VF vol = VF_(splat)(ts->vol), vol_x = VF_(splat)(ts->vol_x), vol_y = VF_(splat)(ts->vol_y);
-  const VF pb = VF_(splat)(ts->pb), pc = VF_(splat)(ts->pc);
-  const VF num_x = VF_(splat)(ts->num_x), num_y = VF_(splat)(ts->num_y);
+  const RR_CAT(tri_lanes, W) L = RR_CAT(lanes_of, W)(ts);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
   const VI idv = VI_(splat)((int32_t)id), bias = VI_(splat)(INT32_MIN), id_biased = idv ^ bias;
@@ -45,8 +56,8 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_mov
     const VF sx = VF_(from_int)(xi) + VF_(splat)(c->sx0);
     VF ax[3]; /* planar: a·1 + b·sx, the part of each edge function that rows share */
 #pragma GCC unroll 3
-    for (int e = 0; e < 3; e++) ax[e] = a[e] * one + b[e] * sx;
-    const VF vx = vol + sx * vol_x, px = pa * one + pb * (sx - cx), nx = num0 + (sx - cx) * num_x;
+    for (int e = 0; e < 3; e++) ax[e] = L.a[e] * one + L.b[e] * sx;
+    const VF vx = L.vol + sx * L.vol_x, px = pa * one + L.pb * (sx - cx), nx = num0 + (sx - cx) * L.num_x;
     for (int y = r[1]; y <= r[3]; y++) {
       const VF sy = VF_(splat)((float)y + c->sy0);
       const size_t k = (size_t)y * width + (size_t)x;
@@ -60,17 +71,17 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_mov
       VI in = valid;
 #pragma GCC unroll 3
       for (int e = 0; e < 3; e++) {
-        ev[e] = planar ? ax[e] + cc[e] * sy : a[e] * wx + b[e] * wy + cc[e] * wz;
-        in &= TRI_EDGE_INSIDE(ev[e], tie[e], zero);
+        ev[e] = planar ? ax[e] + L.cc[e] * sy : L.a[e] * wx + L.b[e] * wy + L.cc[e] * wz;
+        in &= TRI_EDGE_INSIDE(ev[e], L.tie[e], zero);
       }
       if (!VI_(bits)(in)) continue;
-      const VF sum = ev[0] * w0 + ev[1] * w1 + ev[2] * w2, v = vx + sy * vol_y;
+      const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = vx + sy * L.vol_y;
       in &= TRI_HIT_AHEAD(sum, v, zero);
       int hit = VI_(bits)(in);
       if (!hit) continue;
       covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
-      const VF den = planar ? px + pc * (sy - cy) : pa * wx + pb * (wy - cx) + pc * (wz - cy);
-      const VF inv = one / sum, t = TRI_DEPTH(nx + (sy - cy) * num_y, den, v, inv, zero, VF_(select));
+      const VF den = planar ? px + L.pc * (sy - cy) : pa * wx + L.pb * (wy - cx) + L.pc * (wz - cy);
+      const VF inv = one / sum, t = TRI_DEPTH(nx + (sy - cy) * L.num_y, den, v, inv, zero, VF_(select));
       const VF bt = VF_(load_masked)(best_t + k, in);
       const VI bid = VI_(load_masked)(best_id + k, in);
       const VI wins = in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased)));
@@ -106,17 +117,7 @@ TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_mov
  * own layer. Adds the samples tested to *tested. */
 TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
                                                 const int r[4], int ns, visbuf *vb, uint64_t *tested) {
-  VF a[3], b[3], cc[3];
-  VI tie[3];
-#pragma GCC unroll 3
-  for (int e = 0; e < 3; e++) {
-    a[e] = VF_(splat)(ts->a[e]), b[e] = VF_(splat)(ts->b[e]), cc[e] = VF_(splat)(ts->c[e]);
-    tie[e] = VI_(splat)(ts->tie >> e & 1u ? -1 : 0);
-  }
-  const VF w0 = VF_(splat)(ts->w[0]), w1 = VF_(splat)(ts->w[1]), w2 = VF_(splat)(ts->w[2]);
-  const VF vol = VF_(splat)(ts->vol), vol_x = VF_(splat)(ts->vol_x), vol_y = VF_(splat)(ts->vol_y);
-  const VF pb = VF_(splat)(ts->pb), pc = VF_(splat)(ts->pc);
-  const VF num_x = VF_(splat)(ts->num_x), num_y = VF_(splat)(ts->num_y);
+  const RR_CAT(tri_lanes, W) L = RR_CAT(lanes_of, W)(ts);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
   uint64_t covered = 0, evals = 0;
@@ -139,18 +140,18 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
         VF ev[3];
 #pragma GCC unroll 3
         for (int e = 0; e < 3; e++) {
-          ev[e] = (a[e] * one + b[e] * sx) + cc[e] * sy;
-          in &= TRI_EDGE_INSIDE(ev[e], tie[e], zero);
+          ev[e] = (L.a[e] * one + L.b[e] * sx) + L.cc[e] * sy;
+          in &= TRI_EDGE_INSIDE(ev[e], L.tie[e], zero);
         }
         if (!VI_(bits)(in)) continue;
-        const VF sum = ev[0] * w0 + ev[1] * w1 + ev[2] * w2, v = (vol + sx * vol_x) + sy * vol_y;
+        const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = (L.vol + sx * L.vol_x) + sy * L.vol_y;
         in &= TRI_HIT_AHEAD(sum, v, zero);
         int hit = VI_(bits)(in);
         if (!hit) continue;
         const VF pa = VF_(load)(mv->pa + p0), num0 = VF_(load)(mv->num0 + p0);
         const VF cx = VF_(load)(mv->cx + p0), cy = VF_(load)(mv->cy + p0);
-        const VF den = (pa * one + pb * (sx - cx)) + pc * (sy - cy);
-        const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * num_x) + (sy - cy) * num_y, den, v, inv, zero,
+        const VF den = (pa * one + L.pb * (sx - cx)) + L.pc * (sy - cy);
+        const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * L.num_x) + (sy - cy) * L.num_y, den, v, inv, zero,
                                                 VF_(select));
         const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
         for (; hit; hit &= hit - 1) {
