@@ -96,16 +96,9 @@ int main(int argc, char **argv) {
   const char *scenes[16];
   for (int i = 1; i < argc; i++) {
     if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
-      if (sscanf(argv[++i], "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > RR_MAX_SIZE || h > RR_MAX_SIZE) {
-        fprintf(stderr, "bench_overdraw: bad --size '%s' (expected WxH)\n", argv[i]);
-        return 2;
-      }
+      if (!bench_arg_size("bench_overdraw", argv[++i], 1, &w, &h)) return 2;
     } else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc) {
-      runs = atoi(argv[++i]);
-      if (runs < 1 || runs > 64) {
-        fprintf(stderr, "bench_overdraw: bad --runs '%s' (1..64)\n", argv[i]);
-        return 2;
-      }
+      if (!bench_arg_int("bench_overdraw", "--runs", argv[++i], 1, 64, &runs)) return 2;
     } else if (argv[i][0] != '-' && nscenes < 16) {
       scenes[nscenes++] = argv[i];
     } else {

@@ -326,22 +326,11 @@ int main(int argc, char **argv) {
   bool rays_only = false;
   for (int i = 1; i < argc; i++) {
     if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
-      if (sscanf(argv[++i], "%dx%d", &w, &h) != 2 || w < 1 || h < 1 || w > RR_MAX_SIZE || h > RR_MAX_SIZE) {
-        fprintf(stderr, "bench_shading: bad --size '%s' (expected WxH)\n", argv[i]);
-        return 2;
-      }
+      if (!bench_arg_size("bench_shading", argv[++i], 1, &w, &h)) return 2;
     } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
-      threads = atoi(argv[++i]);
-      if (threads < 1 || threads > RR_MAX_THREADS) {
-        fprintf(stderr, "bench_shading: bad --threads '%s'\n", argv[i]);
-        return 2;
-      }
+      if (!bench_arg_int("bench_shading", "--threads", argv[++i], 1, RR_MAX_THREADS, &threads)) return 2;
     } else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc) {
-      runs = atoi(argv[++i]);
-      if (runs < 1 || runs > MAX_RUNS) {
-        fprintf(stderr, "bench_shading: bad --runs '%s' (1..%d)\n", argv[i], MAX_RUNS);
-        return 2;
-      }
+      if (!bench_arg_int("bench_shading", "--runs", argv[++i], 1, MAX_RUNS, &runs)) return 2;
     } else if (strcmp(argv[i], "--shadows") == 0 && i + 1 < argc) {
       shadows = rr_shadows_from_name(argv[++i]);
       if (shadows < 0) {

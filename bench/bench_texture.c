@@ -198,22 +198,11 @@ int main(int argc, char **argv) {
   const char *scene = "checker";
   for (int i = 1; i < argc; i++) {
     if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
-      if (sscanf(argv[++i], "%dx%d", &w, &h) != 2 || w < 8 || h < 8 || w > RR_MAX_SIZE || h > RR_MAX_SIZE) {
-        fprintf(stderr, "bench_texture: bad --size '%s' (expected WxH, at least 8x8)\n", argv[i]);
-        return 2;
-      }
+      if (!bench_arg_size("bench_texture", argv[++i], 8, &w, &h)) return 2;
     } else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc) {
-      threads = atoi(argv[++i]);
-      if (threads < 1 || threads > RR_MAX_THREADS) {
-        fprintf(stderr, "bench_texture: bad --threads '%s'\n", argv[i]);
-        return 2;
-      }
+      if (!bench_arg_int("bench_texture", "--threads", argv[++i], 1, RR_MAX_THREADS, &threads)) return 2;
     } else if (strcmp(argv[i], "--runs") == 0 && i + 1 < argc) {
-      runs = atoi(argv[++i]);
-      if (runs < 1 || runs > MAX_RUNS) {
-        fprintf(stderr, "bench_texture: bad --runs '%s' (1..%d)\n", argv[i], MAX_RUNS);
-        return 2;
-      }
+      if (!bench_arg_int("bench_texture", "--runs", argv[++i], 1, MAX_RUNS, &runs)) return 2;
     } else if (strcmp(argv[i], "--cost-only") == 0) {
       cost_only = 1;
     } else if (strcmp(argv[i], "--filter") == 0 && i + 1 < argc) {

@@ -291,3 +291,25 @@ int bench_instructions_main(char *const argv[]) {
   printf("%d parts in %s (callgrind_annotate FILE shows where they went)\n", n, dir);
   return 0;
 }
+
+bool bench_arg_size(const char *prog, const char *v, int min, int *w, int *h) {
+  int a, b;
+  char end;
+  if (sscanf(v, "%dx%d%c", &a, &b, &end) == 2 && a >= min && b >= min && a <= RR_MAX_SIZE && b <= RR_MAX_SIZE) {
+    *w = a, *h = b;
+    return true;
+  }
+  fprintf(stderr, "%s: bad --size '%s' (expected WxH, %d to %d a side)\n", prog, v, min, RR_MAX_SIZE);
+  return false;
+}
+
+bool bench_arg_int(const char *prog, const char *opt, const char *v, int lo, int hi, int *out) {
+  char *end;
+  long n = strtol(v, &end, 10);
+  if (end != v && !*end && n >= lo && n <= hi) {
+    *out = (int)n;
+    return true;
+  }
+  fprintf(stderr, "%s: bad %s '%s' (%d..%d)\n", prog, opt, v, lo, hi);
+  return false;
+}

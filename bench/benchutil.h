@@ -74,4 +74,10 @@ int bench_callgrind_parts(const char *dir, void (*fn)(const char *name, uint64_t
  * callgrind (where it counts one frame per method with bench_count_*), then
  * prints every part and its instructions. Returns the exit code for main. */
 int bench_instructions_main(char *const argv[]);
+
+/* Command-line values of the benchmarks, checked: false after a one-line message
+ * naming the program and the option. --size WxH, each side min .. RR_MAX_SIZE; a
+ * whole number lo .. hi. */
+bool bench_arg_size(const char *prog, const char *v, int min, int *w, int *h);
+bool bench_arg_int(const char *prog, const char *opt, const char *v, int lo, int hi, int *out);
 #endif
