@@ -8,6 +8,7 @@
  *   at sample positions ±h around a base position away from the pixel's centre, on
  *   random views with every camera: perspective, orthographic, parabolic, lat-long,
  *   fisheye and cube;
+ * - the same for the analytic kinds' maps (a sphere, an oriented box, a tilted plane);
  * - the texture filters' names and rr_shade_frame's refusal of bad texture options. */
 #include "vis/vis.h"
 #include "io/io.h"
@@ -157,6 +158,7 @@ static void test_ray_differentials(rr_device *dev) {
 
 typedef struct view_frames {
   rr_image uv[5], deriv, depth, mesh; /* uv: base, x − h, x + h, y − h, y + h */
+  rr_image base_mesh;                  /* the base frame's geometries (mesh: RR_MISS where the frames differ) */
 } view_frames;
 
 static bool render_view(rr_device *dev, const rr_scene *s, const rr_camera *cam, int W, int Hh, const float pos[2],
@@ -170,7 +172,8 @@ static bool render_view(rr_device *dev, const rr_scene *s, const rr_camera *cam,
     ok = f && rr_frame_aov(dev, s, cam, f, RR_AOV_UV, &v->uv[k]) == RR_OK;
     if (ok && k == 0)
       ok = rr_frame_aov(dev, s, cam, f, RR_AOV_UV_DERIV, &v->deriv) == RR_OK &&
-           rr_frame_aov(dev, s, cam, f, RR_AOV_DEPTH, &v->depth) == RR_OK;
+           rr_frame_aov(dev, s, cam, f, RR_AOV_DEPTH, &v->depth) == RR_OK &&
+           rr_frame_aov(dev, s, cam, f, RR_AOV_MESH, &v->base_mesh) == RR_OK;
     if (ok) { /* the mesh of every frame must agree: keep the base's, mark disagreement */
       rr_image m;
       ok = rr_frame_aov(dev, s, cam, f, RR_AOV_MESH, &m) == RR_OK;
@@ -190,13 +193,39 @@ static bool render_view(rr_device *dev, const rr_scene *s, const rr_camera *cam,
 
 static void free_view(view_frames *v) {
   for (int k = 0; k < 5; k++) rr_image_free(&v->uv[k]);
-  rr_image_free(&v->deriv), rr_image_free(&v->depth), rr_image_free(&v->mesh);
+  rr_image_free(&v->deriv), rr_image_free(&v->depth), rr_image_free(&v->mesh), rr_image_free(&v->base_mesh);
 }
 
-/* One view of a plane scene: uv against the map at the hit, uv-deriv against
+/* What a view's uv values are checked against: the coordinates at world point p on
+ * geometry `mesh` and their rounding tolerance (dir, distance: the unit ray and the hit's
+ * distance along it);
+ * false where the point is left out (a seam, an edge). */
+typedef struct uv_ref {
+  bool (*at)(const struct uv_ref *ref, uint32_t mesh, vec3 p, vec3 dir, float distance, float uv[2], double *tol);
+  const uv_map *m; /* plane scenes: the map, and the quad's half side (0: infinite) */
+  float L;
+  const float *prims; /* analytic scenes: geometry g's one primitive (sphere, box, plane), */
+  long *seen;         /* ANA_FLOATS each, and the pixels checked on each */
+  double rel_tol;     /* of the derivatives: REL_TOL for planes; curved surfaces' paths bend
+                         more within ±H than a projective map's (a sphere: the third
+                         derivative), so their central differences are looser */
+} uv_ref;
+
+static bool plane_ref(const uv_ref *ref, uint32_t mesh, vec3 p, vec3 dir, float distance, float uv[2], double *tol) {
+  const uv_map *m = ref->m;
+  (void)mesh, (void)dir;
+  map_uv(m, p.x, p.z, uv);
+  /* rounding: the uv values are good to some 1e-6 of the map's span over the
+   * plane seen (corners, hit, distance): the barycentrics and the hit are floats */
+  *tol = 2e-6 * ((fabs(m->a) + fabs(m->b) + fabs(m->d) + fabs(m->e)) * (v3_len(p) + distance + ref->L) +
+                 fabs(m->c) + fabs(m->f));
+  return true;
+}
+
+/* One view of a scene: uv against the reference at the hit, uv-deriv against
  * central differences; returns the pixel directions whose derivatives were compared. */
-static int check_view(rr_device *dev, const rr_scene *s, const uv_map *m, float L, const rr_camera *cam, int W,
-                      int Hh, const float pos[2], const char *what) {
+static int check_view(rr_device *dev, const rr_scene *s, const uv_ref *ref, const rr_camera *cam, int W, int Hh,
+                      const float pos[2], const char *what) {
   view_frames v;
   memset(&v, 0, sizeof v);
   camera c;
@@ -220,15 +249,12 @@ static int check_view(rr_device *dev, const rr_scene *s, const uv_map *m, float 
       /* the map at the hit: eye + depth along the unit ray */
       vec3 o, d;
       rr_cam_ray(&c, x, y, &o, &d);
-      vec3 p = v3_add(o, v3_scale(d, depth[i] / v3_len(d)));
+      vec3 dir = v3_scale(d, 1.0f / v3_len(d)), p = v3_add(o, v3_scale(dir, depth[i]));
       float want[2];
-      map_uv(m, p.x, p.z, want);
-      /* rounding: the uv values are good to some 1e-6 of the map's span over the
-       * plane seen (corners, hit, distance): the barycentrics and the hit are floats */
-      double span = (fabs(m->a) + fabs(m->b) + fabs(m->d) + fabs(m->e)) * (v3_len(p) + depth[i] + L) +
-                    fabs(m->c) + fabs(m->f);
+      double tol;
+      if (!ref->at(ref, ((const uint32_t *)v.base_mesh.data)[i], p, dir, depth[i], want, &tol)) continue;
       for (int a = 0; a < 2; a++)
-        if (fabs(uv[2 * i + a] - want[a]) > 2e-6 * span && bad_uv++ < 3)
+        if (fabs(uv[2 * i + a] - want[a]) > tol && bad_uv++ < 3)
           CHECK(0, "%s (%d,%d): %c = %.7g, the map gives %.7g", what, x, y, "uv"[a], uv[2 * i + a], want[a]);
       /* derivatives: where the five frames saw the plane, along each direction a whose
        * depth changes by at most RHO_MAX per pixel: for a projective map u''/u' = −2ρ,
@@ -237,7 +263,7 @@ static int check_view(rr_device *dev, const rr_scene *s, const uv_map *m, float 
       if (mesh[i] == RR_MISS) continue;
       const float *lo[2] = {v.uv[1].data, v.uv[3].data}, *hi[2] = {v.uv[2].data, v.uv[4].data};
       /* their rounding, divided by 2h */
-      double round = 2e-6 * span / (2 * H);
+      double round = tol / (2 * H);
       for (int a = 0; a < 2; a++) {
         float D = fabsf(der[4 * i + 2 * a]) + fabsf(der[4 * i + 2 * a + 1]);
         bool smooth = true;
@@ -251,11 +277,11 @@ static int check_view(rr_device *dev, const rr_scene *s, const uv_map *m, float 
           int k = 2 * a + comp;
           double fd = (hi[a][2 * i + comp] - (double)lo[a][2 * i + comp]) / (2 * H);
           double err = fabs(fd - der[4 * i + k]);
-          worst = fmax(worst, err / (REL_TOL * D + round));
-          if (err > REL_TOL * D + round && bad_d++ < 3)
+          worst = fmax(worst, err / (ref->rel_tol * D + round));
+          if (err > ref->rel_tol * D + round && bad_d++ < 3)
             CHECK(0, "%s (%d,%d) at (%g,%g): %s = %.6g, central difference %.6g (tolerance %.3g)", what, x, y,
                   pos[0], pos[1], (const char *[]){"du/dx", "dv/dx", "du/dy", "dv/dy"}[k], der[4 * i + k], fd,
-                  REL_TOL * D + round);
+                  ref->rel_tol * D + round);
         }
       }
     }
@@ -290,11 +316,94 @@ static void test_plane_views(rr_device *dev, bool infinite) {
       if (view == 0) pos[0] = pos[1] = 0.5f; /* the centre too */
       char what[96];
       snprintf(what, sizeof what, "%s plane, %s view %d", infinite ? "infinite" : "finite", rr_camera_name(types[t]), view);
-      int n = check_view(dev, s, &m, infinite ? 0 : L, &cam, W, Hh, pos, what);
+      uv_ref ref = {plane_ref, &m, infinite ? 0 : L, NULL, NULL, REL_TOL};
+      int n = check_view(dev, s, &ref, &cam, W, Hh, pos, what);
       CHECK(n > W * Hh / 20, "%s: only %d pixels' derivatives compared", what, n);
     }
     rr_scene_release(s);
   }
+}
+
+/* The analytic kinds' maps, from the hit point and the primitive as given (texcoord.c
+ * defines them): sphere (geometry 0) equirectangular with the +y pole at the top,
+ * box (1) the whole texture on each face, plane (2) offsets in world units along the
+ * plane's axes. Seams, poles and box edges are left out: the maps jump there. */
+static bool ana_ref(const uv_ref *ref, uint32_t mesh, vec3 p, vec3 dir, float distance, float uv[2], double *tol) {
+  if (mesh > 2) return false;
+  const float *a = ref->prims + ANA_FLOATS * mesh;
+  vec3 c = v3(a[0], a[1], a[2]), q = v3_sub(p, c);
+  if (mesh == 0) {
+    vec3 m = v3_scale(q, 1.0f / a[3]);
+    double rho2 = (double)m.x * m.x + (double)m.z * m.z;
+    uv[0] = (float)(atan2(m.x, m.z) / (2 * RR_PI) + 0.5), uv[1] = (float)(1 - acos(fmax(-1, fmin(1, m.y))) / RR_PI);
+    /* and where the ray grazes the sphere: the central differences' truncation,
+     * which grows with the curvature of the hit's path, passes the tolerance */
+    if (rho2 < 0.4 || uv[0] < 0.01f || uv[0] > 0.99f || fabsf(v3_dot(m, dir)) < 0.3f) return false;
+    *tol = 3e-6 * (1 + distance / a[3]) / rho2;
+  } else if (mesh == 1) {
+    double R[3][3], f[3];
+    rr_ana_box_frame(a, R);
+    int ax = 0;
+    for (int k = 0; k < 3; k++) {
+      f[k] = (R[k][0] * q.x + R[k][1] * q.y + R[k][2] * q.z) / a[3 + k];
+      if (fabs(f[k]) > fabs(f[ax])) ax = k;
+    }
+    int b1 = (ax + 1) % 3, b2 = (ax + 2) % 3;
+    if (fabs(f[b1]) > 0.97 || fabs(f[b2]) > 0.97) return false;
+    uv[0] = (float)((f[b1] + 1) / 2), uv[1] = (float)((f[b2] + 1) / 2);
+    *tol = 3e-6 * (1 + distance / fmin(a[3], fmin(a[4], a[5])));
+  } else {
+    double ua[3], va[3];
+    rr_ana_plane_axes(a + 3, ua, va);
+    uv[0] = (float)(ua[0] * q.x + ua[1] * q.y + ua[2] * q.z), uv[1] = (float)(va[0] * q.x + va[1] * q.y + va[2] * q.z);
+    *tol = 3e-6 * (v3_len(q) + distance + 1);
+  }
+  ref->seen[mesh]++;
+  return true;
+}
+
+/* A sphere, an oriented box and a tilted plane, random views with every camera: their
+ * uv AOV against the maps at the hit, the uv-deriv AOV against central differences. */
+static void test_analytic_views(rr_device *dev) {
+  int views = test_quick() ? 2 : 4;
+  const rr_camera_type types[] = {RR_CAMERA_PERSPECTIVE, RR_CAMERA_ORTHOGRAPHIC, RR_CAMERA_PARABOLIC,
+                                  RR_CAMERA_LATLONG,     RR_CAMERA_FISHEYE,      RR_CAMERA_CUBE};
+  long seen[3] = {0, 0, 0};
+  for (int view = 0; view < views; view++) {
+    float prims[3][ANA_FLOATS] = {{0, 1, 0, test_randf(0.7f, 1.3f)}};
+    float yaw = test_randf(0, 6.2832f), tilt = test_randf(-0.4f, 0.4f);
+    float box[ANA_FLOATS] = {2.6f, 0.9f, 0.4f, test_randf(0.5f, 1), test_randf(0.4f, 0.8f), test_randf(0.5f, 1),
+                             cosf(yaw) * cosf(tilt), sinf(tilt), sinf(yaw) * cosf(tilt), -sinf(tilt) * cosf(yaw),
+                             cosf(tilt), -sinf(tilt) * sinf(yaw)};
+    float plane[ANA_FLOATS] = {test_randf(-1, 1), 0, test_randf(-1, 1), test_randf(-0.2f, 0.2f), 1, test_randf(-0.2f, 0.2f)};
+    memcpy(prims[1], box, sizeof box), memcpy(prims[2], plane, sizeof plane);
+    rr_scene *s;
+    if (rr_scene_new(dev, &s) != RR_OK) return;
+    if (rr_scene_add_spheres(s, prims[0], 1, NULL) != RR_OK || rr_scene_add_boxes(s, prims[1], 1, NULL) != RR_OK ||
+        rr_scene_add_planes(s, prims[2], 1, NULL) != RR_OK || rr_scene_commit(s) != RR_OK) {
+      CHECK(0, "analytic scene: %s", rr_device_message(dev));
+      rr_scene_release(s);
+      return;
+    }
+    /* the stored parameters: the box's axes made unit and orthogonal, the plane's normal unit */
+    for (int g = 0; g < 3; g++) memcpy(prims[g], s->ana + ANA_FLOATS * g, sizeof prims[g]);
+    uv_ref ref = {ana_ref, NULL, 0, prims[0], seen, 1e-2};
+    for (size_t t = 0; t < sizeof types / sizeof types[0]; t++) {
+      float ang = test_randf(0, 6.2832f), dist = test_randf(3.5f, 7);
+      vec3 target = v3(1.3f, 0.6f, 0.2f);
+      vec3 eye = v3(target.x + dist * cosf(ang), test_randf(1, 4), target.z + dist * sinf(ang));
+      rr_camera cam = test_camera(types[t], eye, target, types[t] == RR_CAMERA_FISHEYE ? 200 : test_randf(40, 70));
+      if (types[t] == RR_CAMERA_ORTHOGRAPHIC) cam.ortho_height = test_randf(4, 7);
+      int W = types[t] == RR_CAMERA_CUBE ? 96 : types[t] == RR_CAMERA_LATLONG ? 128 : 80, Hh = types[t] == RR_CAMERA_CUBE ? 72 : 64;
+      float pos[2] = {test_randf(H, 1 - H), test_randf(H, 1 - H)};
+      char what[96];
+      snprintf(what, sizeof what, "analytic, %s view %d", rr_camera_name(types[t]), view);
+      int n = check_view(dev, s, &ref, &cam, W, Hh, pos, what);
+      CHECK(n > W * Hh / 20, "%s: only %d pixels' derivatives compared", what, n);
+    }
+    rr_scene_release(s);
+  }
+  for (int g = 0; g < 3; g++) CHECK(seen[g] > 300, "analytic views: only %ld pixels checked on geometry %d", seen[g], g);
 }
 
 static void test_options(rr_device *dev) {
@@ -335,6 +444,7 @@ int main(void) {
   test_ray_differentials(dev);
   test_plane_views(dev, false);
   test_plane_views(dev, true);
+  test_analytic_views(dev);
   rr_device_release(dev);
   return test_done();
 }

@@ -22,5 +22,9 @@ void rr_scene_load_textures(rr_scene *s, const char *base_dir);
 /* Decodes a compressed image in memory (PNG, JPEG, ... as stb_image reads) into tex;
  * false (tex untouched) when it cannot. */
 bool rr_texture_decode(rr_texture *tex, const void *bytes, size_t len);
+/* Gives material m the texture in image file `path` (named `name`), in place of any
+ * it had; false (m untouched) when the file cannot be read or decoded, or memory
+ * runs out. */
+bool rr_material_texture_file(rr_material *m, const char *path, const char *name);
 
 #endif

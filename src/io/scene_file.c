@@ -475,16 +475,34 @@ static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_
 
 /* ---- meshes ---------------------------------------------------------------------- */
 
-/* The material override of a mesh, applied to materials m0.. (those its load added):
- * each key given replaces that value, the rest (and the texture) stay. */
+/* What the items of a scene file read besides their JSON: the scene, and where
+ * their files are found. */
+typedef struct mesh_arg {
+  rr_scene *s;
+  const char *base_dir;
+  const rr_load_options *opt;
+} mesh_arg;
+
+static rr_error resolve_path(json_reader *r, const char *key, const char *base_dir, const char *rel, bool sandbox,
+                             char out[MAX_PATH]);
+
+/* The material override of a mesh or primitive, applied to materials m0.. (those
+ * its load added): each key given replaces that value, the rest stay. A "texture"
+ * (an image file, relative to the scene file) replaces the base colour texture and
+ * must be readable: a scene that names one is not drawn without it. */
 static int model_from_name(const char *name) {
   return find_name(name, rr_material_model_name, RR_MATERIAL_MODEL_COUNT);
 }
 
-static rr_error read_material(json_reader *r, const cJSON *obj, rr_scene *s, uint32_t m0) {
+static rr_error read_material(json_reader *r, const cJSON *obj, const mesh_arg *a, uint32_t m0) {
   static const char *const keys[] = {"model", "color", "specular", "shininess", "emission", "opacity", "metallic",
-                                     "roughness", "mirror", NULL};
+                                     "roughness", "mirror", "texture", NULL};
+  rr_scene *s = a->s;
+  const char *texture = NULL;
+  char path[MAX_PATH];
   rr_error e = rr_json_keys(r, obj, keys);
+  if (!e) e = rr_json_string(r, obj, "texture", &texture);
+  if (!e && texture) e = resolve_path(r, "texture", a->base_dir, texture, a->opt->sandbox, path);
   for (uint32_t m = m0; !e && m < s->nmaterials; m++) {
     rr_material_info mi;
     rr_scene_get_material_info(s, m, &mi);
@@ -505,7 +523,8 @@ static rr_error read_material(json_reader *r, const cJSON *obj, rr_scene *s, uin
       char msg[256];
       snprintf(msg, sizeof msg, "%s", rr_device_message(s->dev));
       e = rr_json_fail(r, NULL, "%s", msg);
-    }
+    } else if (texture && !rr_material_texture_file(&s->materials[m], path, texture))
+      e = rr_json_fail(r, "texture", "cannot read the image '%.200s'", texture);
   }
   return e;
 }
@@ -528,8 +547,10 @@ static rr_error resolve_path(json_reader *r, const char *key, const char *base_d
 }
 
 /* A mesh: "file" or "builtin", "name", a transform, "material". */
-static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const char *base_dir,
-                          const rr_load_options *opt) {
+static rr_error read_mesh(json_reader *r, const cJSON *obj, const mesh_arg *a) {
+  rr_scene *s = a->s;
+  const char *base_dir = a->base_dir;
+  const rr_load_options *opt = a->opt;
   static const char *const keys[] = {"file",   "builtin", "name",     "translate", "rotate",
                                      "scale",  "matrix",  "material", "smooth",    NULL};
   rr_error e = rr_json_keys(r, obj, keys);
@@ -573,7 +594,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
   if (smooth && (e = rr_scene_smooth_normals(s, t0, s->ntris))) return e;
   if (material) {
     size_t len = rr_json_enter(r, "material", 0);
-    e = read_material(r, material, s, m0);
+    e = read_material(r, material, a, m0);
     rr_json_leave(r, len);
   }
   return e;
@@ -584,7 +605,8 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
 /* A sphere ("center", "radius"), a plane ("point", "normal") or a box ("center",
  * "size", "rotate"), with "name" and "material": one geometry of one primitive,
  * after the meshes. */
-static rr_error read_analytic(json_reader *r, const cJSON *obj, rr_scene *s, prim_kind kind) {
+static rr_error read_analytic(json_reader *r, const cJSON *obj, const mesh_arg *ma, prim_kind kind) {
+  rr_scene *s = ma->s;
   static const char *const sphere_keys[] = {"center", "radius", "name", "material", NULL};
   static const char *const plane_keys[] = {"point", "normal", "name", "material", NULL};
   static const char *const box_keys[] = {"center", "size", "rotate", "name", "material", NULL};
@@ -630,7 +652,7 @@ static rr_error read_analytic(json_reader *r, const cJSON *obj, rr_scene *s, pri
   const cJSON *material = rr_json_get(obj, "material");
   if (material) {
     size_t len = rr_json_enter(r, "material", 0);
-    e = read_material(r, material, s, m0);
+    e = read_material(r, material, ma, m0);
     rr_json_leave(r, len);
   }
   return e;
@@ -720,15 +742,8 @@ static rr_error each(json_reader *r, const cJSON *root, const char *key, bool re
   return e;
 }
 
-typedef struct mesh_arg {
-  rr_scene *s;
-  const char *base_dir;
-  const rr_load_options *opt;
-} mesh_arg;
-
 static rr_error mesh_item(json_reader *r, const cJSON *item, void *arg) {
-  const mesh_arg *a = arg;
-  return read_mesh(r, item, a->s, a->base_dir, a->opt);
+  return read_mesh(r, item, arg);
 }
 
 static rr_error light_item(json_reader *r, const cJSON *item, void *arg) { return read_light(r, item, arg); }
@@ -802,8 +817,8 @@ static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const
   /* meshes may be left out when spheres or planes are given */
   bool analytic = rr_json_get(root, "spheres") || rr_json_get(root, "planes") || rr_json_get(root, "boxes");
   if (!e) e = each(r, root, "meshes", !analytic, mesh_item, &ma);
-  if (!e) e = each(r, root, "spheres", false, sphere_item, s);
-  if (!e) e = each(r, root, "planes", false, plane_item, s);
+  if (!e) e = each(r, root, "spheres", false, sphere_item, &ma);
+  if (!e) e = each(r, root, "planes", false, plane_item, &ma);
   if (!e) e = each(r, root, "boxes", false, box_item, s);
   /* the scene file's world is Y-up, its front +Z, whatever the files' axes */
   s->up = v3(0, 1, 0), s->front = v3(0, 0, 1);

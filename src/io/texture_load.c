@@ -129,3 +129,17 @@ void rr_scene_load_textures(rr_scene *s, const char *base_dir) {
     free(file);
   }
 }
+
+bool rr_material_texture_file(rr_material *m, const char *path, const char *name) {
+  int w = 0, h = 0, n;
+  rr_texture tex = {0};
+  char *copy = malloc(strlen(name) + 1);
+  if (!copy || !take_rgb(&tex, stbi_load(path, &w, &h, &n, 4), w, h)) {
+    free(copy);
+    return false;
+  }
+  rr_texture_clear(&m->texture);
+  free(m->texture_path);
+  m->texture = tex, m->texture_path = strcpy(copy, name), m->texture_status = RR_TEXTURE_FILE;
+  return true;
+}

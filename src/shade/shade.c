@@ -93,7 +93,7 @@ static void base_color(const rr_scene *s, const hit *h, const tex_filter *tf, fl
   rgb[0] = rgb[1] = rgb[2] = SCENE_GREY;
   if (!m) return;
   memcpy(rgb, m->color, sizeof m->color);
-  if (m->texture.width > 0 && s->uv[0][0]) {
+  if (m->texture.width > 0 && rr_has_texcoord(s, h->id)) {
     /* only textured materials pay for derivatives, and only filters with a footprint */
     bool footprint = tf->filter != RR_TEXTURE_NEAREST && tf->filter != RR_TEXTURE_BILINEAR;
     tex_coord tc = hit_texcoord(s, h, footprint);
@@ -703,7 +703,7 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
         else if (base == RR_AOV_ZDEPTH) *p = fminf(*p, h.valid ? h.dist * v3_dot(h.dir, cams[smp].fwd) : INFINITY);
         else if (base == RR_AOV_NORMAL && h.valid) p[0] = h.normal.x, p[1] = h.normal.y, p[2] = h.normal.z;
         else if (base == RR_AOV_BARY && h.valid) p[0] = h.l1, p[1] = h.l2;
-        else if ((base == RR_AOV_UV || base == RR_AOV_UV_DERIV) && h.valid && s->uv[0][0]) {
+        else if ((base == RR_AOV_UV || base == RR_AOV_UV_DERIV) && h.valid && rr_has_texcoord(s, h.id)) {
           tex_coord tc = hit_texcoord(s, &h, base == RR_AOV_UV_DERIV);
           if (base == RR_AOV_UV) p[0] = tc.u, p[1] = tc.v;
           else p[0] = tc.dudx, p[1] = tc.dvdx, p[2] = tc.dudy, p[3] = tc.dvdy;
