@@ -427,6 +427,56 @@ static void options(void) {
 
 /* ---- malformed files ------------------------------------------------------------------ */
 
+/* ---- textures on analytic primitives ------------------------------------------------ */
+
+/* A material's "texture" on a sphere and a box seen head-on: a 2×1 texture, red then
+ * blue along u, shows red left of the centre and blue right of it (the sphere's
+ * longitude and the +z face's u both grow with x there); the material info names
+ * the file. */
+static void textures(void) {
+  uint8_t texels[6] = {255, 0, 0, 0, 0, 255};
+  rr_image tex = {.width = 2, .height = 1, .channels = 3, .type = RR_PIXEL_U8, .data = texels};
+  char png[300];
+  snprintf(png, sizeof png, "%s/rb.png", dir);
+  CHECK(rr_image_write(dev, &tex, png) == RR_OK, "write the texture: %s", rr_device_message(dev));
+  const char *kinds[2] = {"{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1, ",
+                          "{\"boxes\": [{\"center\": [0, 0, 0], \"size\": [2, 2, 2], "};
+  for (int k = 0; k < 2; k++) {
+    char text[400];
+    snprintf(text, sizeof text, "%s\"material\": {\"color\": [1, 1, 1], \"texture\": \"rb.png\"}}]}", kinds[k]);
+    rr_scene *s = load_text("tex.json", text, NULL, NULL);
+    CHECK(s != NULL, "textured %s: %s", k ? "box" : "sphere", rr_device_message(dev));
+    if (!s) continue;
+    rr_material_info mi;
+    rr_scene_get_material_info(s, 0, &mi);
+    CHECK(mi.texture && !strcmp(mi.texture, "rb.png") && mi.texture_status == RR_TEXTURE_FILE && mi.texture_width == 2,
+          "the material's texture: %s, status %d", mi.texture ? mi.texture : "none", mi.texture_status);
+    rr_camera cam;
+    rr_camera_init(&cam);
+    cam.eye[2] = 5, cam.fov_deg = 30;
+    rr_render_options ro;
+    rr_render_options_init(&ro);
+    ro.width = 64, ro.height = 48, ro.method = RR_METHOD_3DR_BB;
+    rr_shade_options so;
+    rr_shade_options_init(&so);
+    so.texture_filter = RR_TEXTURE_NEAREST;
+    rr_image img = render(s, &cam, &ro, &so);
+    const float *px = img.type == RR_PIXEL_F32 ? img.data : NULL; /* linear colour */
+    int red = 0, blue = 0, wrong = 0;
+    for (int y = 18; px && y < 30; y++)
+      for (int x = 20; x < 44; x++) {
+        if (x == 31 || x == 32) continue; /* the texel edge at the centre */
+        const float *c = px + ((size_t)y * img.width + x) * img.channels;
+        bool r = c[0] > 0.05f && c[2] < 0.01f, b = c[2] > 0.05f && c[0] < 0.01f;
+        red += r, blue += b, wrong += (x < 32) != r || (x > 32) != b;
+      }
+    CHECK(red > 100 && blue > 100 && wrong == 0, "textured %s: %d red, %d blue, %d on the wrong side",
+          k ? "box" : "sphere", red, blue, wrong);
+    rr_image_free(&img);
+    rr_scene_release(s);
+  }
+}
+
 static bool one_line(const char *m) { return m && *m && !strchr(m, '\n'); }
 /* The output of a command: one line, ending in its line break. */
 static bool printed_one_line(const char *out) {
@@ -473,6 +523,12 @@ static void errors(void) {
       {"{\"meshes\": [{\"builtin\": \"box\", \"matrix\": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], \"scale\": 2}]}",
        "not both"},
       {"{\"meshes\": [{\"builtin\": \"box\", \"material\": []}]}", "'meshes[0].material': expected an object"},
+      {"{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1, \"material\": {\"texture\": \"nowhere.png\"}}]}",
+       "'spheres[0].material.texture': cannot read the image 'nowhere.png'"},
+      {"{\"boxes\": [{\"center\": [0, 0, 0], \"size\": [1, 1, 1], \"material\": {\"texture\": \"bad.json\"}}]}",
+       "'boxes[0].material.texture': cannot read the image 'bad.json'"},
+      {"{\"meshes\": [{\"builtin\": \"box\", \"material\": {\"texture\": 7}}]}",
+       "'meshes[0].material.texture': expected a string"},
       {"{\"meshes\": [{\"builtin\": \"box\", \"material\": {\"color\": [1, -1, 0]}}]}", "'meshes[0].material.color'"},
       {"{\"meshes\": [{\"builtin\": \"box\", \"material\": {\"roughness\": 2}}]}", "'meshes[0].material.roughness'"},
       {"{\"meshes\": [{\"builtin\": \"box\", \"material\": {\"model\": \"glass\"}}]}", "phong or pbr"},
@@ -577,6 +633,7 @@ int main(void) {
   same_as_api();
   options();
   errors();
+  textures();
   rr_device_release(dev);
   char cmd[300];
   snprintf(cmd, sizeof cmd, "rm -rf %s", dir);

@@ -819,7 +819,7 @@ static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const
   if (!e) e = each(r, root, "meshes", !analytic, mesh_item, &ma);
   if (!e) e = each(r, root, "spheres", false, sphere_item, &ma);
   if (!e) e = each(r, root, "planes", false, plane_item, &ma);
-  if (!e) e = each(r, root, "boxes", false, box_item, s);
+  if (!e) e = each(r, root, "boxes", false, box_item, &ma);
   /* the scene file's world is Y-up, its front +Z, whatever the files' axes */
   s->up = v3(0, 1, 0), s->front = v3(0, 0, 1);
   if (!e) e = each(r, root, "lights", false, light_item, s);

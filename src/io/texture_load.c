@@ -134,7 +134,9 @@ bool rr_material_texture_file(rr_material *m, const char *path, const char *name
   int w = 0, h = 0, n;
   rr_texture tex = {0};
   char *copy = malloc(strlen(name) + 1);
-  if (!copy || !take_rgb(&tex, stbi_load(path, &w, &h, &n, 4), w, h)) {
+  uint8_t *px = stbi_load(path, &w, &h, &n, 4); /* before take_rgb reads w, h */
+  if (!copy || !take_rgb(&tex, px, w, h)) { /* take_rgb frees px */
+    if (!copy) stbi_image_free(px);
     free(copy);
     return false;
   }
