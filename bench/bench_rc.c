@@ -11,7 +11,9 @@
  * Embree's rtcIntersect1 (same hit/miss; depth within 1e-4 relative where both
  * hit; same triangle) and whether the visibility buffer is bit-identical to 3dr-bb.
  * --instructions: instead, the instructions of one frame (or cast) of each mode,
- * counted by running this again under callgrind (use a smaller --size). */
+ * counted by running this again under callgrind (use a smaller --size).
+ * Analytic spheres go to Embree as its own spheres (RTC_GEOMETRY_TYPE_SPHERE_POINT):
+ * `bench_rc spheres:10000` is issue 17's sphere benchmark. */
 #include "benchutil.h"
 #include "vis/vis.h"
 #ifdef RR_HAVE_EMBREE

@@ -9,6 +9,7 @@
 struct peer_embree {
   RTCDevice dev;
   RTCScene scene;
+  uint32_t *sphere_ids; /* Embree's sphere primID k (geometry 1) is rastray's primitive sphere_ids[k] */
   atomic_llong bytes, peak; /* reported by Embree's memory monitor, from any of its threads */
   peer_embree_memory mem;
 };
@@ -61,8 +62,33 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
   e->scene = rtcNewScene(e->dev);
   rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_NONE);
   rtcSetSceneBuildQuality(e->scene, quality >= 2 ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
-  rtcAttachGeometry(e->scene, g);
+  /* geometry 0, left out when every primitive is analytic (their stand-ins never hit) */
+  bool any_triangle = false;
+  for (uint32_t i = 0; i < s->ntris && !any_triangle; i++) any_triangle = scene_kind(s, i) == RR_GEOMETRY_TRIANGLE;
+  if (any_triangle) rtcAttachGeometryByID(e->scene, g, 0);
   rtcReleaseGeometry(g);
+  /* Analytic spheres as Embree's own (RTC_GEOMETRY_TYPE_SPHERE_POINT: centre and
+   * radius), geometry 1. */
+  size_t nsph = 0;
+  for (uint32_t i = 0; i < s->ntris; i++) nsph += scene_kind(s, i) == RR_GEOMETRY_SPHERE;
+  if (nsph) {
+    RTCGeometry sg = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    float *sv = rtcSetNewGeometryBuffer(sg, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), nsph);
+    e->sphere_ids = malloc(nsph * sizeof *e->sphere_ids);
+    if (!sv || !e->sphere_ids) {
+      rtcReleaseGeometry(sg);
+      peer_embree_release(e);
+      return NULL;
+    }
+    for (uint32_t i = 0, k = 0; i < s->ntris; i++)
+      if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {
+        memcpy(sv + 4 * (size_t)k, s->ana + (size_t)ANA_FLOATS * i, 4 * sizeof(float));
+        e->sphere_ids[k++] = i;
+      }
+    rtcCommitGeometry(sg);
+    rtcAttachGeometryByID(e->scene, sg, 1);
+    rtcReleaseGeometry(sg);
+  }
   long long before = atomic_load(&e->bytes);
   atomic_store(&e->peak, before);
   double t0 = rr_now_ms();
@@ -79,7 +105,13 @@ void peer_embree_release(peer_embree *e) {
   if (!e) return;
   if (e->scene) rtcReleaseScene(e->scene);
   if (e->dev) rtcReleaseDevice(e->dev);
+  free(e->sphere_ids);
   free(e);
+}
+
+/* rastray's primitive index of Embree's hit (geometry 0: triangles by index, 1: spheres). */
+static uint32_t hit_id(const peer_embree *e, unsigned geom, unsigned prim) {
+  return geom == RTC_INVALID_GEOMETRY_ID ? RR_MISS : geom == 0 ? prim : e->sphere_ids[prim];
 }
 
 enum { EMB_TILE = 32 };
@@ -111,7 +143,7 @@ static void cast1_tile(int job, int thread, void *arg) {
       rtcIntersect1(j->e->scene, &ctx, &rh);
       size_t k = (size_t)y * c->width + x;
       bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-      j->ids[k] = hit ? rh.hit.primID : RR_MISS;
+      j->ids[k] = hit_id(j->e, rh.hit.geomID, rh.hit.primID);
       j->t[k] = hit ? rh.ray.tfar : INFINITY;
     }
 }
@@ -142,7 +174,7 @@ static void cast8_tile(int job, int thread, void *arg) {
         if (!valid[l]) continue;
         size_t k = (size_t)(py + (l >> 2)) * c->width + px + (l & 3);
         bool hit = rh.hit.geomID[l] != RTC_INVALID_GEOMETRY_ID;
-        j->ids[k] = hit ? rh.hit.primID[l] : RR_MISS;
+        j->ids[k] = hit_id(j->e, rh.hit.geomID[l], rh.hit.primID[l]);
         j->t[k] = hit ? rh.ray.tfar[l] : INFINITY;
       }
     }
@@ -185,7 +217,7 @@ static void rays1_chunk(int job, int thread, void *arg) {
     }
     rtcIntersect1(j->e->scene, &ctx, &rh);
     bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-    j->ids[i] = hit ? rh.hit.primID : RR_MISS;
+    j->ids[i] = hit_id(j->e, rh.hit.geomID, rh.hit.primID);
     j->t[i] = hit ? rh.ray.tfar : INFINITY;
   }
 }
@@ -214,7 +246,7 @@ static void rays8_chunk(int job, int thread, void *arg) {
       rtcIntersect8(valid, j->e->scene, &ctx, &rh);
     for (int l = 0; l < 8 && i0 + l < j->n; l++) {
       bool hit = j->any ? rh.ray.tfar[l] == -INFINITY : rh.hit.geomID[l] != RTC_INVALID_GEOMETRY_ID;
-      j->ids[i0 + l] = !hit ? RR_MISS : j->any ? 0 : rh.hit.primID[l];
+      j->ids[i0 + l] = !hit ? RR_MISS : j->any ? 0 : hit_id(j->e, rh.hit.geomID[l], rh.hit.primID[l]);
       if (!j->any) j->t[i0 + l] = hit ? rh.ray.tfar[l] : INFINITY;
     }
   }

@@ -243,7 +243,9 @@ static void test_names(void) {
   expect_error("sphere:3", RR_ERROR_ARGUMENT, "'3'");
   expect_error("box:0", RR_ERROR_ARGUMENT, "'0'");
   expect_error("rooms:0", RR_ERROR_ARGUMENT, "'0'");
-  const char *unknown[] = {"", "teapot.obj", RR_DATA_DIR "/teapot.obj", "planet", "spheres",
+  expect_error("spheres:0", RR_ERROR_ARGUMENT, "'0'");
+  expect_error("spheres:1000001", RR_ERROR_ARGUMENT, "'1000001'");
+  const char *unknown[] = {"", "teapot.obj", RR_DATA_DIR "/teapot.obj", "planet", "spheres2",
                            "box.obj", "demo2", "grid", "Plane"};
   for (size_t i = 0; i < sizeof unknown / sizeof *unknown; i++) {
     rr_error e;
@@ -252,6 +254,36 @@ static void test_names(void) {
           unknown[i], e);
     rr_scene_release(s);
   }
+}
+
+/* ---- spheres:N ----------------------------------------------------------------------- */
+
+/* N analytic spheres, radii 0.15 .. 0.45, centres inside the cube of side 2.2·∛N, in
+ * min(N, 8) geometries, the same scene at every load. */
+static void test_spheres(const char *name, long n) {
+  rr_error e;
+  rr_scene *s = load(name, &e), *again = load(name, &e);
+  CHECK(s && again, "'%s': %s", name, rr_device_message(dev));
+  if (!s || !again) {
+    rr_scene_release(s), rr_scene_release(again);
+    return;
+  }
+  rr_scene_info info;
+  rr_scene_get_info(s, &info);
+  CHECK(s->ntris == (uint32_t)n && info.triangles == 0 && s->ngeoms == (uint32_t)(n < 8 ? n : 8),
+        "'%s': %u primitives (%llu triangles) in %u geometries", name, s->ntris, (unsigned long long)info.triangles,
+        s->ngeoms);
+  float half = 1.1f * cbrtf((float)n);
+  uint32_t bad = 0;
+  for (uint32_t i = 0; i < s->ntris; i++) {
+    const float *a = s->ana + (size_t)ANA_FLOATS * i;
+    bad += scene_kind(s, i) != RR_GEOMETRY_SPHERE || !(a[3] >= 0.15f && a[3] <= 0.45f) || !(fabsf(a[0]) <= half) ||
+           !(fabsf(a[1]) <= half) || !(fabsf(a[2]) <= half);
+  }
+  CHECK(bad == 0, "'%s': %u spheres out of range", name, bad);
+  CHECK(again->ntris == s->ntris && !memcmp(again->ana, s->ana, (size_t)ANA_FLOATS * s->ntris * sizeof(float)),
+        "'%s': two loads differ", name);
+  rr_scene_release(s), rr_scene_release(again);
 }
 
 /* ---- rooms and demo ------------------------------------------------------------------ */
@@ -331,6 +363,9 @@ int main(void) {
   test_box("box:7", 7);
   test_grid(1);
   test_grid(3);
+  test_spheres("spheres", 1000);
+  test_spheres("spheres:5", 5);
+  test_spheres("spheres:10000", 10000);
   test_names();
   test_rooms();
   test_demo();

@@ -247,6 +247,33 @@ static rr_error add_analytic(rr_scene *s, prim_kind kind, const float *v, size_t
   return e ? e : rr_scene_name_geometry(s, s->ngeoms - 1, name);
 }
 
+/* spheres:N — N analytic spheres of radii 0.15 .. 0.45 scattered uniformly through a
+ * cube whose side grows as ∛N (about one sphere per 11 unit cubes, so a view of the
+ * cloud sees a few layers deep whatever N), in eight colours, each a geometry
+ * ("spheres.0" .. "spheres.7"). A fixed generator: the same scene every time. */
+static rr_error gen_spheres(rr_scene *s, long n) {
+  static const float colors[8][3] = {{0.85f, 0.30f, 0.24f}, {0.20f, 0.45f, 0.85f}, {0.95f, 0.70f, 0.25f},
+                                     {0.30f, 0.70f, 0.35f}, {0.60f, 0.35f, 0.75f}, {0.90f, 0.90f, 0.92f},
+                                     {0.25f, 0.70f, 0.75f}, {0.85f, 0.50f, 0.60f}};
+  float side = 2.2f * cbrtf((float)n), *v = malloc((size_t)n * 4 * sizeof *v);
+  if (!v) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for %ld spheres", n);
+  uint64_t x = 0x9e3779b97f4a7c15u; /* xorshift64*: uniform in [0, 1) */
+  for (long i = 0; i < 4 * n; i++) {
+    x ^= x >> 12, x ^= x << 25, x ^= x >> 27;
+    float u = (float)((x * 0x2545f4914f6cdd1du) >> 40) / 16777216.0f;
+    v[i] = i % 4 == 3 ? 0.15f + 0.3f * u : (u - 0.5f) * side;
+  }
+  rr_error e = RR_OK;
+  for (int g = 0; g < 8 && !e; g++) {
+    long a = n * g / 8, b = n * (g + 1) / 8;
+    char name[16];
+    snprintf(name, sizeof name, "spheres.%d", g);
+    if (b > a) e = add_analytic(s, RR_GEOMETRY_SPHERE, v + 4 * a, (size_t)(b - a), name, colors[g][0], colors[g][1], colors[g][2]);
+  }
+  free(v);
+  return e;
+}
+
 /* ---- infinite ground (homogeneous vertices) ------------------------------------- */
 
 /* The plane y = 0 without end: four triangles fanning from the origin to the
@@ -668,6 +695,9 @@ rr_error rr_scene_load_builtin(rr_scene *s, const char *name) {
   } else if (strcmp(name, "sphere") == 0) { /* the analytic unit sphere; sphere:N is a mesh */
     const float unit[4] = {0, 0, 0, 1};
     e = add_analytic(s, RR_GEOMETRY_SPHERE, unit, 1, "sphere", SCENE_GREY, SCENE_GREY, SCENE_GREY);
+  } else if ((arg = builtin_arg(name, "spheres"))) {
+    e = size_arg(s, name, arg, 1000, 1, 1000000, &n);
+    if (!e) e = gen_spheres(s, n);
   } else if ((arg = builtin_arg(name, "sphere"))) {
     uint32_t mat;
     e = size_arg(s, name, arg, 32, 4, 4096, &n);

@@ -575,7 +575,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, const mesh_arg *a) {
     e = rr_scene_load_builtin(s, builtin);
     if (e == RR_ERROR_UNSUPPORTED)
       return rr_json_fail(r, "builtin", "unknown built-in '%.64s' (expected demo, plane[:N], sphere[:N], box[:N], "
-                                     "torus[:N], rooms[:N], ground, ground:inf, checker or grid:PATH:N)", builtin);
+                                     "torus[:N], rooms[:N], spheres[:N], ground, ground:inf, checker or grid:PATH:N)", builtin);
   } else {
     if (!file[0]) return rr_json_fail(r, "file", "empty path");
     if (strlen(file) >= MAX_PATH) return rr_json_fail(r, "file", "path too long");
