@@ -1,6 +1,7 @@
 /* The lit shade mode: radiometry against closed forms (the E/π identity, the
  * inverse square law), shadows against an independent double-precision ray
- * test, mirror reflections against the mirrored scene rendered directly, the
+ * test, mirror reflections against the mirrored scene rendered directly (a
+ * textured one too, through the reflection rays' differentials), the
  * materials and lights of MTL, glTF and COLLADA files, and --light refusals. */
 #include "testutil.h"
 
@@ -855,6 +856,60 @@ static void check_cli(void) {
   }
 }
 
+/* A textured plane seen in a mirror plane looks as its mirror image seen directly: the
+ * reflection rays carry the camera's differentials (reflected), so the texture
+ * filters read the same footprints. The texture (8 texels a unit, one per square)
+ * is minified well below a texel a pixel, where a lookup without a footprint
+ * aliases; the sky lights both sides alike. */
+static void check_mirror_texture(void) {
+  uint8_t texels[8 * 8 * 3];
+  for (int k = 0; k < 64; k++) memset(texels + 3 * k, ((k % 8) + (k / 8)) % 2 ? 230 : 20, 3);
+  rr_image tex = {.width = 8, .height = 8, .channels = 3, .type = RR_PIXEL_U8, .data = texels};
+  char png[700];
+  snprintf(png, sizeof png, "%s/fine.png", dir);
+  CHECK(rr_image_write(dev, &tex, png) == RR_OK, "texture: %s", rr_device_message(dev));
+  const char *textured = "{\"point\": [0, %d, 0], \"normal\": [0, 1, 0], \"material\": {\"texture\": \"fine.png\"}}";
+  char plane_a[256], plane_b[256], a[1024], b[1024];
+  snprintf(plane_a, sizeof plane_a, textured, 3), snprintf(plane_b, sizeof plane_b, textured, -3);
+  const char *sky = "\"lights\": [{\"type\": \"sky\", \"color\": [1, 1, 1], \"ground\": [1, 1, 1]}]";
+  snprintf(a, sizeof a, "{\"planes\": [{\"point\": [0, 0, 0], \"normal\": [0, 1, 0], \"material\": {\"color\": [0, 0, 0], "
+           "\"specular\": [1, 1, 1], \"mirror\": true}}, %s], %s}", plane_a, sky);
+  snprintf(b, sizeof b, "{\"planes\": [%s], %s}", plane_b, sky);
+  rr_scene *sa = NULL, *sb = NULL;
+  CHECK(rr_scene_load_file(dev, write_file("ma.json", a), NULL, &sa, NULL) == RR_OK &&
+            rr_scene_load_file(dev, write_file("mb.json", b), NULL, &sb, NULL) == RR_OK,
+        "mirror texture scenes: %s", rr_device_message(dev));
+  rr_camera cam = view(0, 0.5f, 0, 0.3f, 0, 3, 0, 1, 0);
+  enum { W = 96 };
+  for (int f = 0; sa && sb && f < 2; f++) {
+    rr_shade_options so;
+    rr_shade_options_init(&so);
+    so.mode = RR_SHADE_LIT, so.texture_filter = f ? RR_TEXTURE_ANISO : RR_TEXTURE_TRILINEAR;
+    rr_shade_stats st;
+    rr_frame *fa = NULL;
+    float *ia = lit(sa, &cam, W, W, &so, &fa, &st), *ib = lit(sb, &cam, W, W, &so, NULL, NULL);
+    int off = 0, compared = 0;
+    double worst = 0;
+    for (int k = 0; ia && ib && fa && k < W * W; k++) {
+      uint32_t g = RR_MISS;
+      rr_scene_get_geometry(sa, rr_frame_ids(fa)[k], &g, NULL);
+      if (g != 0) continue; /* the mirror's pixels (above the horizon A sees the plane itself) */
+      compared++;
+      for (int c = 0; c < 3; c++) {
+        double e = fabs(ia[3 * k + c] - ib[3 * k + c]);
+        worst = fmax(worst, e);
+        off += e > 0.01 + 0.01 * ib[3 * k + c];
+      }
+    }
+    CHECK(compared > W * W / 3 && st.reflection_rays >= (uint64_t)compared && off <= compared / 100,
+          "%s: %d of %d mirror pixels' channels differ from the mirrored plane seen directly (worst %g)",
+          rr_texture_filter_name(so.texture_filter), off, compared, worst);
+    rr_frame_release(fa);
+    free(ia), free(ib);
+  }
+  rr_scene_release(sa), rr_scene_release(sb);
+}
+
 int main(void) {
   if (!mkdtemp(dir)) return 1;
   dev = rr_device_new();
@@ -864,6 +919,7 @@ int main(void) {
   check_shadows();
   check_shadow_lights();
   check_mirror();
+  check_mirror_texture();
   check_mtl();
   check_gltf();
   check_ggx();

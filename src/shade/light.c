@@ -145,16 +145,21 @@ static void brdf(const surface *sf, vec3 l, float f[3]) {
 /* PBR surfaces this smooth are mirrors. */
 #define MIRROR_ROUGHNESS 0.1f
 
+bool rr_material_mirror(const rr_material *m) {
+  if (!m) return false;
+  const float *ks = m->params.specular;
+  if (m->params.model == RR_MATERIAL_PHONG) return m->params.illum == 3 && (ks[0] > 0 || ks[1] > 0 || ks[2] > 0);
+  return m->params.roughness < MIRROR_ROUGHNESS;
+}
+
 /* The mirror reflectance of the surface seen along v (0: not a mirror). */
 static bool mirror_of(const surface *sf, float R[3]) {
   const rr_material *m = sf->m;
   R[0] = R[1] = R[2] = 0;
-  if (!m) return false;
+  if (!rr_material_mirror(m)) return false;
   if (m->params.model == RR_MATERIAL_PHONG) {
-    if (m->params.illum != 3) return false;
     memcpy(R, m->params.specular, 3 * sizeof(float));
   } else {
-    if (!(m->params.roughness < MIRROR_ROUGHNESS)) return false;
     float fw = powf(1 - fminf(fmaxf(v3_dot(sf->n, sf->v), 0.0f), 1.0f), 5);
     for (int c = 0; c < 3; c++) R[c] = f0_of(sf, c) + (1 - f0_of(sf, c)) * fw;
   }
@@ -236,6 +241,7 @@ struct lit_wave {
   float (*add)[3];
   int *occluded;
   rr_hit *hit;
+  vec3 (*diff)[4]; /* reflections: ray k's differentials (when who[k]->sf.diff) */
   size_t raycap;
 };
 
@@ -250,7 +256,7 @@ void rr_lit_wave_free(lit_wave *w) {
   if (!w) return;
   for (int t = 0; t < RR_MAX_THREADS; t++) seg_free(&w->sink[t]);
   seg_free(&w->bounce[0]), seg_free(&w->bounce[1]), free(w->ch);
-  free(w->ray), free(w->who), free(w->add), free(w->occluded), free(w->hit);
+  free(w->ray), free(w->who), free(w->add), free(w->occluded), free(w->hit), free(w->diff);
   free(w);
 }
 
@@ -288,10 +294,11 @@ bool rr_lit_wave_add(lit_wave *w, int thread, const surface *sf, float *out, flo
 /* Room for n rays in the pass arrays. */
 static bool rays_reserve(lit_wave *w, size_t n) {
   if (n <= w->raycap) return true;
-  free(w->ray), free(w->who), free(w->add), free(w->occluded), free(w->hit);
+  free(w->ray), free(w->who), free(w->add), free(w->occluded), free(w->hit), free(w->diff);
   w->ray = malloc(n * sizeof *w->ray), w->who = malloc(n * sizeof *w->who), w->add = malloc(n * sizeof *w->add);
   w->occluded = malloc(n * sizeof *w->occluded), w->hit = malloc(n * sizeof *w->hit);
-  w->raycap = w->ray && w->who && w->add && w->occluded && w->hit ? n : 0;
+  w->diff = malloc(n * sizeof *w->diff);
+  w->raycap = w->ray && w->who && w->add && w->occluded && w->hit && w->diff ? n : 0;
   return w->raycap != 0;
 }
 
@@ -353,7 +360,7 @@ typedef struct pass {
 } pass;
 
 static bool light_on(const light *lt, const lit_point *q, vec3 *l, float c3[3]);
-static bool mirror_dir(const lit_point *q, float R[3], vec3 *r);
+static bool mirror_dir(const lit_point *q, float R[3], vec3 *r, vec3 diff[4]);
 
 /* The light that needs no ray: the sky, emission; and with no punctual light,
  * nothing to block. Marks which lights reach each point and which are mirrors,
@@ -378,7 +385,7 @@ static void job_ambient(int job, int thread, void *arg) {
     vec3 l;
     for (int b = 0; b < bits; b++)
       if (light_on(&L->lights[b], q, &l, NULL)) q->reach |= 1u << b, c->reached[b]++;
-    if (mirror_dir(q, R, &l)) q->reach |= 1u << MIRROR_BIT, c->reached[MIRROR_BIT]++;
+    if (mirror_dir(q, R, &l, NULL)) q->reach |= 1u << MIRROR_BIT, c->reached[MIRROR_BIT]++;
   }
 }
 
@@ -498,12 +505,28 @@ static bool direct(lit_wave *w, pass *ps, int threads, lit_stats *st) {
 
 /* The mirror bounce of point q: its reflectance R (false: not a mirror) and the
  * view mirrored about the shading normal, or about the geometric one when that
- * would leave through the surface. */
-static bool mirror_dir(const lit_point *q, float R[3], vec3 *r) {
+ * would leave through the surface; with diff (NULL: not wanted), the reflected ray's
+ * differentials when q has its own (sf.diff): the origin moves with the point, the
+ * direction r = 2 (n·v) n − v by ∂r = 2 ((∂n·v + n·∂v) n + (n·v) ∂n) − ∂v (Igehy;
+ * the geometric normal does not turn). */
+static bool mirror_dir(const lit_point *q, float R[3], vec3 *r, vec3 diff[4]) {
   const surface *sf = &q->sf;
   if (!q->out || !mirror_of(sf, R)) return false;
+  bool shading = true;
   *r = v3_sub(v3_scale(sf->n, 2 * v3_dot(sf->n, sf->v)), sf->v);
-  if (!(v3_dot(*r, sf->ng) > 0)) *r = v3_sub(v3_scale(sf->ng, 2 * v3_dot(sf->ng, sf->v)), sf->v);
+  if (!(v3_dot(*r, sf->ng) > 0)) {
+    *r = v3_sub(v3_scale(sf->ng, 2 * v3_dot(sf->ng, sf->v)), sf->v);
+    shading = false;
+  }
+  if (!diff || !sf->diff) return true;
+  vec3 n = shading ? sf->n : sf->ng;
+  float nv = v3_dot(n, sf->v);
+  for (int k = 0; k < 2; k++) {
+    vec3 dn = shading ? sf->dn[k] : v3(0, 0, 0);
+    float dnv = v3_dot(dn, sf->v) + v3_dot(n, sf->dv[k]);
+    diff[k] = sf->dp[k];
+    diff[2 + k] = v3_sub(v3_scale(v3_add(v3_scale(n, dnv), v3_scale(dn, nv)), 2), sf->dv[k]);
+  }
   return true;
 }
 
@@ -518,7 +541,7 @@ static void job_mirror_rays(int job, int thread, void *arg) {
     const lit_point *q = &c->p[i];
     float R[3];
     vec3 r;
-    if (!(q->reach >> MIRROR_BIT & 1) || !mirror_dir(q, R, &r)) continue;
+    if (!(q->reach >> MIRROR_BIT & 1) || !mirror_dir(q, R, &r, ps->last ? NULL : w->diff[k])) continue;
     float t[3] = {q->w[0] * R[0], q->w[1] * R[1], q->w[2] * R[2]};
     if (ps->last) {
       float sky[3];
@@ -551,7 +574,7 @@ static void job_mirror_hits(int job, int thread, void *arg) {
       nq->out = NULL;
       continue;
     }
-    ps->fn(ps->ctx, idx, w->hit[k].l1, w->hit[k].l2, w->hit[k].t, org, dir, &nq->sf);
+    ps->fn(ps->ctx, idx, w->hit[k].l1, w->hit[k].l2, w->hit[k].t, org, dir, q->sf.diff ? w->diff[k] : NULL, &nq->sf);
     memcpy(nq->w, w->add[k], sizeof nq->w);
     nq->out = q->out, nq->parts = NULL, nq->vis = NULL;
     nq->refl = q->parts ? q->parts + LIT_REFLECTION : q->refl;

@@ -18,7 +18,13 @@ typedef struct surface {
   vec3 v;               /* unit direction towards the viewer */
   float base[3];        /* base colour: the material's times its texture and vertex colours */
   const rr_material *m; /* NULL: the default grey, Lambert alone */
+  bool diff;             /* a mirror seen by a ray with differentials: how p, v and n move per */
+  vec3 dp[2], dv[2], dn[2]; /* pixel step in x ([0]) and y ([1]), for its reflection's differentials */
 } surface;
+
+/* Whether material m is a mirror (phong: illum 3 with a specular colour; pbr: a
+ * roughness below MIRROR_ROUGHNESS). */
+bool rr_material_mirror(const rr_material *m);
 
 /* A punctual light as shading uses it. */
 typedef struct light {
@@ -46,8 +52,11 @@ rr_error rr_lighting_make(rr_device *dev, const rr_scene *s, const rr_camera *ca
 void rr_lighting_release(lighting *l);
 
 /* Fills out with the surface a reflection ray (org, dir) hit: triangle index, its
- * barycentrics and t along dir (shade.c gives it; ctx is its own). */
-typedef void (*surface_fn)(void *ctx, uint32_t index, float l1, float l2, float t, vec3 org, vec3 dir, surface *out);
+ * barycentrics and t along dir, and the ray's differentials (diff[0..1]: origin,
+ * diff[2..3]: direction, per pixel step in x and y; NULL: none), which give its
+ * texture footprint (shade.c gives it; ctx is its own). */
+typedef void (*surface_fn)(void *ctx, uint32_t index, float l1, float l2, float t, vec3 org, vec3 dir,
+                           const vec3 diff[4], surface *out);
 
 /* What a wave's passes traced and the wall time they took. */
 typedef struct lit_stats {

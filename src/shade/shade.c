@@ -25,7 +25,8 @@ typedef struct hit {
   float t;           /* along the ray org + t·ray (ray unnormalised) */
   vec3 org, ray;
   const camera *cam; /* the ray is camera cam's at pixel (x, y), whose differentials give the */
-  int x, y;          /* texture footprint; NULL for other rays (reflections): no footprint */
+  int x, y;          /* texture footprint; NULL for other rays (reflections): */
+  const vec3 *diff;  /* their differentials (origin x, y, direction x, y), NULL: none */
   float footprint; /* the pixel steps the sample's texture footprint spans (ssaa: 1/√N) */
 } hit;
 
@@ -77,15 +78,75 @@ static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, i
   return sample_hit(s, c, vb, (size_t)y * vb->width + x, x, y);
 }
 
+/* The hit's ray's differentials over the sample's footprint (a camera's, scaled to
+ * it, or a reflection's as carried); false when it has none. */
+static bool hit_diffs(const hit *h, vec3 do_dxy[2], vec3 dd_dxy[2]) {
+  vec3 o, d;
+  if (h->diff) {
+    do_dxy[0] = h->diff[0], do_dxy[1] = h->diff[1], dd_dxy[0] = h->diff[2], dd_dxy[1] = h->diff[3];
+    return true;
+  }
+  if (!h->cam) return false;
+  rr_cam_ray_diff(h->cam, h->x, h->y, &o, &d, do_dxy, dd_dxy);
+  for (int k = 0; k < 2; k++)
+    do_dxy[k] = v3_scale(do_dxy[k], h->footprint), dd_dxy[k] = v3_scale(dd_dxy[k], h->footprint);
+  return true;
+}
+
 /* The texture coordinates of a valid hit on a triangle with UVs; with derivs, their
  * derivatives over the sample's footprint too (else 0). */
 static tex_coord hit_texcoord(const rr_scene *s, const hit *h, bool derivs) {
-  vec3 o, d, do_dxy[2], dd_dxy[2];
-  if (!derivs || !h->cam) return rr_texcoord(s, h->id, h->l1, h->l2, h->t, h->org, h->ray, NULL, NULL);
-  rr_cam_ray_diff(h->cam, h->x, h->y, &o, &d, do_dxy, dd_dxy);
-  tex_coord tc = rr_texcoord(s, h->id, h->l1, h->l2, h->t, o, d, do_dxy, dd_dxy);
-  tc.dudx *= h->footprint, tc.dvdx *= h->footprint, tc.dudy *= h->footprint, tc.dvdy *= h->footprint;
-  return tc;
+  vec3 do_dxy[2], dd_dxy[2];
+  derivs = derivs && hit_diffs(h, do_dxy, dd_dxy);
+  return rr_texcoord(s, h->id, h->l1, h->l2, h->t, h->org, h->ray, derivs ? do_dxy : NULL, derivs ? dd_dxy : NULL);
+}
+
+/* How a mirror's point, view direction and shading normal move per pixel step
+ * (Igehy's ray differentials), for its reflection ray's: the hit slides on the
+ * tangent plane, ∂p = w − d (n_g·w)/(n_g·d) with w = ∂o + t ∂d; the unit view
+ * v = −d/|d| turns by ∂v = −(∂d − d̂ (d̂·∂d))/|d|; the normal turns with the surface:
+ * a sphere's by ∂p/r, an interpolated one by its corners' normals weighed by the
+ * barycentrics' change along ∂p; flat faces (planes, boxes, triangles without
+ * corner normals) not at all. */
+static void mirror_diffs(const rr_scene *s, const hit *h, surface *sf) {
+  vec3 do_dxy[2], dd_dxy[2], d = h->ray;
+  sf->diff = rr_material_mirror(sf->m) && hit_diffs(h, do_dxy, dd_dxy);
+  float nd = v3_dot(sf->ng, d), len = v3_len(d);
+  if (!sf->diff || !(nd != 0)) {
+    sf->diff = false;
+    return;
+  }
+  uint32_t i = h->id;
+  bool smooth = scene_kind(s, i) == RR_GEOMETRY_TRIANGLE && s->n[0][0] && !scene_inf(s, i);
+  vec3 ga, gb, e1n, e2n, big_n;
+  if (smooth) { /* the barycentrics' gradients in the plane (texcoord.c's dual basis) */
+    vec3 p0 = scene_vertex(s, 0, i), e1 = v3_sub(scene_vertex(s, 1, i), p0), e2 = v3_sub(scene_vertex(s, 2, i), p0);
+    vec3 n = v3_cross(e1, e2);
+    float nn = v3_dot(n, n);
+    ga = v3_scale(v3_cross(e2, n), 1.0f / nn), gb = v3_scale(v3_cross(n, e1), 1.0f / nn);
+    vec3 c[3];
+    for (int v = 0; v < 3; v++) c[v] = v3(s->n[v][0][i], s->n[v][1][i], s->n[v][2][i]);
+    e1n = v3_sub(c[1], c[0]), e2n = v3_sub(c[2], c[0]);
+    big_n = v3_add(v3_add(v3_scale(c[0], h->l0), v3_scale(c[1], h->l1)), v3_scale(c[2], h->l2));
+  }
+  for (int k = 0; k < 2; k++) {
+    vec3 w = v3_add(do_dxy[k], v3_scale(dd_dxy[k], h->t));
+    sf->dp[k] = v3_sub(w, v3_scale(d, v3_dot(sf->ng, w) / nd));
+    vec3 dd = v3_scale(dd_dxy[k], 1.0f / len);
+    sf->dv[k] = v3_neg(v3_sub(dd, v3_scale(h->dir, v3_dot(h->dir, dd))));
+    sf->dn[k] = v3(0, 0, 0);
+    if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {
+      const float *a = s->ana + (size_t)ANA_FLOATS * i;
+      float side = v3_dot(sf->n, v3_sub(sf->p, v3(a[0], a[1], a[2]))) >= 0 ? 1.0f : -1.0f;
+      sf->dn[k] = v3_scale(sf->dp[k], side / a[3]);
+    } else if (smooth) {
+      float len_n = v3_len(big_n);
+      vec3 dN = v3_add(v3_scale(e1n, v3_dot(ga, sf->dp[k])), v3_scale(e2n, v3_dot(gb, sf->dp[k])));
+      vec3 nh = v3_scale(big_n, 1.0f / len_n);
+      float side = v3_dot(sf->n, nh) >= 0 ? 1.0f : -1.0f;
+      sf->dn[k] = v3_scale(v3_sub(dN, v3_scale(nh, v3_dot(nh, dN))), side / len_n);
+    }
+  }
 }
 
 static void base_color(const rr_scene *s, const hit *h, const tex_filter *tf, float rgb[3]) {
@@ -228,6 +289,7 @@ static void hit_surface(const rr_scene *s, const hit *h, const tex_filter *tf, s
   }
   sf->m = s->nmaterials ? &s->materials[s->material[i] % s->nmaterials] : NULL;
   base_color(s, h, tf, sf->base);
+  mirror_diffs(s, h, sf);
 }
 
 /* One shading pass over the samples of a frame (rows dealt out in jobs). */
@@ -265,12 +327,13 @@ typedef struct shade_pass {
   int centre;       /* the sample nearest the pixel's centre */
 } shade_pass;
 
-/* A reflection ray's hit as the lit mode's surface (light.h's surface_fn). Texture
- * lookups there have no footprint (the reflected rays carry no differentials). */
+/* A reflection ray's hit as the lit mode's surface (light.h's surface_fn): its
+ * differentials, when it has them, give its texture footprint. */
 static void reflected_surface(void *ctx, uint32_t index, float l1, float l2, float t, vec3 org, vec3 dir,
-                              surface *out) {
+                              const vec3 diff[4], surface *out) {
   const shade_pass *p = ctx;
   hit h = hit_make(p->s, index, l1, l2, t, org, dir, NULL, 0, 0);
+  h.diff = diff;
   hit_surface(p->s, &h, &p->tex, out);
 }
 
