@@ -43,6 +43,18 @@ typedef struct camera {
  * without a useful cone stores this half-angle. */
 #define CAMERA_NO_CONE 1.5f
 
+/* The cube camera is six perspective cameras of 90°, one per face of F×F samples
+ * (F = c->face) in the horizontal cross: a ray of face f is that face's planar
+ * d0 + sx·dx + sy·dy with (sx, sy) the sample's position within the face, so every
+ * method tests a face's samples as a perspective camera's (and may share the part of
+ * a triangle's setup that depends on the eye alone between the faces).
+ * rr_cam_cube_face: face f (0..5: front, right, back, left, top, bottom) of cube
+ * camera c, at c's sample position; rr_cam_cube_face_origin: where its samples
+ * start in the cross; rr_cam_cube_face_at: the face of pixel (x, y), -1 in a gap. */
+void rr_cam_cube_face(const camera *c, int f, camera *out);
+void rr_cam_cube_face_origin(const camera *c, int f, int *x0, int *y0);
+int rr_cam_cube_face_at(const camera *c, int x, int y);
+
 /* Resolves a public camera for an image size; rr_cam_release frees it. */
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *out);
 /* The same for the sample at `sample` (x, y in [0, 1)) inside every pixel. */
