@@ -283,7 +283,7 @@ static rr_error render_cube(rr_device *dev, rr_method m, render_ctx ctx, progres
   }
   for (int f = 0; f < 6; f++) faces[f] = visbuf_layer(&fvb, f * ns); /* face f: ns layers of F × F */
   rr_error e = RR_OK;
-  if (0 && methods[m].fn == rr_vis_traverse && !ctx.oracles->leaves) {
+  if (methods[m].fn == rr_vis_traverse && !ctx.oracles->leaves) {
     ctx.faces = 6, ctx.face_cams = fc, ctx.face_vb = faces;
     ctx.face_heat_e = heat, ctx.face_heat_n = heat ? heat + 6 * FF : NULL;
     ctx.cam = ctx.cams = fc, ctx.vb = &faces[0];

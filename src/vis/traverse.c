@@ -59,7 +59,27 @@ typedef struct trav {
   uint32_t pend[PEND_DRAW + BVH_MAX_LEAF];
   uint32_t npend;
   tile_rect pend_r;
+  /* A cube camera in one pass (render_ctx.faces): c, cams, vb, hz and the charges
+   * point at face `face`'s (use_face); face f at position s is face_cams[f·ns + s],
+   * at position 0 also face_cams0[f] (for the setups, which share the eye). */
+  int faces, face;
+  const camera *face_cams, *face_cams0;
+  visbuf *face_vb;
+  hiz *face_hz;
+  float *face_heat_e, *face_heat_n;
+  int face_rows; /* rows of the stack of faces the root pass sorts into bands, per face */
 } trav;
+
+/* Points t at face f of a cube camera drawn in one pass (nothing otherwise). */
+static void use_face(trav *t, int f) {
+  if (!t->faces || t->face == f) return;
+  const size_t n = (size_t)t->face_vb[0].width * t->face_vb[0].height;
+  t->face = f;
+  t->c = t->cams = &t->face_cams[f * t->ns];
+  t->vb = &t->face_vb[f];
+  t->hz = &t->face_hz[f];
+  if (t->heat_e) t->heat_e = t->face_heat_e + f * n, t->heat_n = t->face_heat_n + f * n;
+}
 
 /* ---- rasterizing one triangle into a frustum ---------------------------- */
 
@@ -69,6 +89,8 @@ typedef struct tri_job {
   _Alignas(64) tri_setup ts; /* (not used by an analytic primitive) */
   uint32_t id;
   bool ana;        /* an analytic primitive (prim/analytic.h): its own test, bounds and floor */
+  uint8_t face;    /* a cube camera in one pass: the face (trav.faces), whose rows start */
+  int face_y;      /* at face_y in the stack of faces the pass sorts into bands */
   float zmin;      /* a floor under any t computed for the triangle (0: none known) */
   int bb[4];       /* inclusive screen bounds */
   union {
@@ -226,7 +248,7 @@ static float max_pa(const trav *t, const tri_job *j) {
 /* Completes a set-up triangle j with what binning and early-z need. */
 static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
   const camera *c = t->c;
-  j->id = id, j->ana = false;
+  j->id = id, j->ana = false, j->face = (uint8_t)t->face, j->face_y = t->face * t->face_rows;
   if (!t->o->binning) return;
   if (c->planar) {
     float zmin = INFINITY;
@@ -322,15 +344,72 @@ static uint32_t setup_analytic(trav *t, uint32_t first, const uint32_t *ids, uin
     tri_job *j = out + kept;
     t->st.setups++;
     if (!rr_ana_screen_bounds(t->s, id, t->c, j->bb) || (r && !meets(j->bb, *r))) continue;
-    j->id = id, j->ana = true;
+    j->id = id, j->ana = true, j->face = (uint8_t)t->face, j->face_y = t->face * t->face_rows;
     j->zmin = rr_ana_t_floor(t->s, id, t->c);
     kept++;
   }
   return kept;
 }
 
+/* A cube camera's triangles first..first+n-1 (trav.faces): each one's rectangle in
+ * every face from its corners, then, for those that meet a face, the part of the
+ * setup that depends on the eye once and the rest for each face met
+ * (rr_tri_setup_views): one job per triangle and face, S once per triangle. */
+static uint32_t setup_faces(trav *t, uint32_t first, uint32_t n, tri_job *out) {
+  enum { GROUP = 64 };
+  uint32_t kept = 0;
+  for (uint32_t g = first; g < first + n; g += GROUP) {
+    const uint32_t m = first + n - g < GROUP ? first + n - g : GROUP;
+    tri_bound b[6][GROUP];
+    uint8_t views[GROUP] = {0}, slot[6][GROUP];
+    for (int f = 0; f < 6; f++) {
+      uint32_t nb = rr_tri_corner_bounds_at(t->s, g, NULL, m, &t->face_cams[f * t->ns], t->ns, t->pos, t->simd, b[f]);
+      for (uint32_t k = 0; k < nb; k++) views[b[f][k].id - g] |= (uint8_t)(1u << f), slot[f][b[f][k].id - g] = (uint8_t)k;
+    }
+    uint32_t ids[GROUP];
+    uint8_t v[GROUP], at[GROUP];
+    int q = 0;
+    for (uint32_t i = 0; i < m; i++)
+      if (views[i]) ids[q] = g + i, v[q] = views[i], at[q++] = (uint8_t)i;
+    if (!q) continue;
+    t->st.setups += (uint64_t)q;
+    tri_setup ts[6 * GROUP];
+    int face[6 * GROUP];
+    tri_plane pls[6 * GROUP], *pl = t->ns > 1 ? pls : NULL;
+    rr_tri_setup_views(t->s, ids, q, t->face_cams0, 6, v, t->cull_back, t->simd, ts, face, pl);
+    for (int f = 0; f < 6; f++)
+      for (int i = 0; i < q; i++) {
+        const int k = f * q + i;
+        if (face[k] == SETUP_CULLED) continue;
+        const tri_bound *tb = &b[f][slot[f][at[i]]];
+        tri_job *j = out + kept++;
+        use_face(t, f);
+        j->ts = ts[k];
+        if (pl) j->pl = pl[k], j->pos = tb->pos;
+        memcpy(j->bb, tb->bb, sizeof j->bb);
+        finish_setup(t, ids[i], j);
+      }
+  }
+  if (t->s->kind) { /* analytic primitives: bounded in every face, S once */
+    for (uint32_t id = first; id < first + n; id++) {
+      if (scene_kind(t->s, id) == RR_GEOMETRY_TRIANGLE) continue;
+      t->st.setups++;
+      for (int f = 0; f < 6; f++) {
+        use_face(t, f);
+        tri_job *j = out + kept;
+        if (!rr_ana_screen_bounds(t->s, id, t->c, j->bb)) continue;
+        j->id = id, j->ana = true, j->face = (uint8_t)f, j->face_y = f * t->face_rows;
+        j->zmin = rr_ana_t_floor(t->s, id, t->c);
+        kept++;
+      }
+    }
+  }
+  return kept;
+}
+
 static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
                                 tri_bound *scratch, tri_job *out) {
+  if (t->faces) return setup_faces(t, first, n, out);
   uint32_t kept = setup_tris(t, first, ids, n, r, scratch, out);
   return t->s->kind ? kept + setup_analytic(t, first, ids, n, r, out + kept) : kept;
 }
@@ -687,11 +766,14 @@ static uint32_t root_setup(void *arg, int thread, uint32_t first, uint32_t n, vo
 
 static void root_rows(const void *prim, int *y0, int *y1) {
   const tri_job *j = prim;
-  *y0 = j->bb[1], *y1 = j->bb[3];
+  *y0 = j->bb[1] + j->face_y, *y1 = j->bb[3] + j->face_y;
 }
 
-KERNEL void draw_rows(void *t, const void *j, int y0, int y1) {
-  draw(t, j, (tile_rect){0, y0, ((trav *)t)->vb->width, y1});
+KERNEL void draw_rows(void *state, const void *prim, int y0, int y1) {
+  trav *t = state;
+  const tri_job *j = prim;
+  use_face(t, j->face);
+  draw(t, j, (tile_rect){0, y0 - j->face_y, t->vb->width, y1 - j->face_y});
 }
 
 static void root_band(int b, int thread, void *arg) {
@@ -708,9 +790,9 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
   rp->proto = *proto;
   sortmiddle sm = {.arg = rp,
                    .size = sizeof(tri_job),
-                   .batch = ROOT_BATCH,
+                   .batch = proto->faces ? ROOT_BATCH / 4 : ROOT_BATCH,
                    .chunk = ROOT_CHUNK,
-                   .out_max = 1,
+                   .out_max = proto->faces ? 6 : 1, /* a cube's triangle meets at most five faces */
                    .setup = root_setup,
                    .rows = root_rows,
                    .band = root_band,
@@ -718,7 +800,11 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
   /* blocks of whole top-level bins, else of 8 z tiles */
   const oracles *o = ctx->oracles;
   int align = o->binning && o->bin_size > HIZ ? (o->bin_size + HIZ - 1) / HIZ * HIZ : 8 * HIZ;
-  bool ok = rr_sortmiddle(&sm, ctx->scene->ntris, ctx->vb->height, align, ctx->threads);
+  /* a cube's faces stacked, each from a block's first row: no block, z tile or bin
+   * holds rows of two faces */
+  int height = ctx->vb->height;
+  if (proto->faces) rp->proto.face_rows = (height + align - 1) / align * align, height = 6 * rp->proto.face_rows;
+  bool ok = rr_sortmiddle(&sm, ctx->scene->ntris, height, align, ctx->threads);
   for (int i = 0; i < RR_MAX_THREADS; i++) add_stats(ctx->stats, &rp->st[i]);
   free(rp);
   return ok ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for triangle setups");
@@ -755,10 +841,20 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
   if (ctx->scene->ntris == 0) return RR_OK; /* nothing to see: the cleared buffer is the image */
   if (!ctx->scene->bvh && o->leaves)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "this method needs the scene's BVH (call rr_scene_commit)");
-  hiz hz;
-  if (!rr_hiz_init(&hz, vb, HIZ_SHIFT, 1))
-    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the hierarchical z-buffer");
-  hz.layers = ctx->samples; /* a tile's farthest depth over every position */
+  if (ctx->faces && (o->leaves || ctx->faces != 6))
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED, "a cube's faces in one pass are drawn from the root only");
+  /* z tiles: one set per face of a cube drawn in one pass */
+  hiz hz[6];
+  const int nhz = ctx->faces ? 6 : 1;
+  camera cams0[6];
+  for (int f = 0; f < nhz; f++) {
+    if (!rr_hiz_init(&hz[f], ctx->faces ? &ctx->face_vb[f] : vb, HIZ_SHIFT, 1)) {
+      while (f > 0) rr_hiz_free(&hz[--f]);
+      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the hierarchical z-buffer");
+    }
+    hz[f].layers = ctx->samples; /* a tile's farthest depth over every position */
+    if (ctx->faces) cams0[f] = ctx->face_cams[f * ctx->samples];
+  }
   trav proto = {.s = ctx->scene,
                 .c = ctx->cam,
                 .cams = ctx->cams,
@@ -768,9 +864,19 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
                 .cull_back = ctx->opt->cull_backfaces != 0,
                 .simd = !ctx->opt->scalar,
                 .hiz_used = o->cull_occluded || (o->binning && o->early_z),
-                .hz = &hz,
+                .hz = &hz[0],
                 .heat_e = ctx->heat_e,
-                .heat_n = ctx->heat_n};
+                .heat_n = ctx->heat_n,
+                .faces = ctx->faces,
+                .face_cams = ctx->face_cams,
+                .face_cams0 = cams0,
+                .face_vb = ctx->face_vb,
+                .face_hz = hz,
+                .face_heat_e = ctx->face_heat_e,
+                .face_heat_n = ctx->face_heat_n};
+  if (ctx->faces) /* face 0 to start with */
+    proto.c = proto.cams = ctx->face_cams, proto.vb = &ctx->face_vb[0],
+    proto.heat_e = ctx->face_heat_e, proto.heat_n = ctx->face_heat_n;
   proto.span[0] = proto.span[2] = ctx->cams[0].sx0, proto.span[1] = proto.span[3] = ctx->cams[0].sy0;
   for (int s = 0; s < ctx->samples; s++) proto.pos[s][0] = ctx->cams[s].sx0, proto.pos[s][1] = ctx->cams[s].sy0;
   for (int s = 0; s < RR_MAX_SAMPLES; s++)
@@ -788,7 +894,7 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
      * writers); frustum_size forces a tile size. */
     trav_job *tj = calloc(1, sizeof *tj);
     if (!tj) {
-      rr_hiz_free(&hz);
+      rr_hiz_free(&hz[0]);
       return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the traversal");
     }
     int whole = vb->width > vb->height ? vb->width : vb->height;
@@ -805,6 +911,6 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
     for (int i = 0; i < RR_MAX_THREADS; i++) add_stats(ctx->stats, &tj->st[i]);
     free(tj);
   }
-  rr_hiz_free(&hz);
+  for (int f = 0; f < nhz; f++) rr_hiz_free(&hz[f]);
   return err;
 }
