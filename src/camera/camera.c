@@ -189,6 +189,32 @@ static vec3 curved_dir(const camera *c, int x, int y, vec3 *dd) {
   }
 }
 
+bool rr_cam_dir_at(const camera *c, double sx, double sy, double d[3]) {
+  double W = c->width, H = c->height, u = 2 * sx / W - 1, v = 1 - 2 * sy / H, cr, cu, cf;
+  switch (c->type) {
+  case RR_CAMERA_PARABOLIC:
+    cr = u, cu = v, cf = 0.5 - 0.5 * (u * u + v * v);
+    break;
+  case RR_CAMERA_LATLONG: {
+    double phi = 2 * RR_PI * sx / W - RR_PI, theta = RR_PI * sy / H;
+    cr = sin(theta) * sin(phi), cu = cos(theta), cf = sin(theta) * cos(phi);
+    break;
+  }
+  case RR_CAMERA_FISHEYE: {
+    double k = c->fov_deg * RR_PI / 360, rad = sqrt(u * u + v * v), s = rad > 0 ? sin(k * rad) / rad : k;
+    cr = s * u, cu = s * v, cf = cos(k * rad);
+    break;
+  }
+  default:
+    return false;
+  }
+  const vec3 r = c->right, up = c->up, f = c->fwd;
+  d[0] = cr * r.x + cu * up.x + cf * f.x;
+  d[1] = cr * r.y + cu * up.y + cf * f.y;
+  d[2] = cr * r.z + cu * up.z + cf * f.z;
+  return true;
+}
+
 /* The largest angle between the rays of two samples one pixel apart (in x or y) of
  * a curved camera, over the whole image: along a staircase path of such steps the
  * angle between any two samples is at most that times their L1 distance, so √2
@@ -303,6 +329,28 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     break;
   }
   c->lipschitz *= 1.001f;
+  /* The maps' second derivatives, for binning (vis/traverse.c): per sample step,
+   * the square of u, v's (2/W, 2/H) or φ, θ's (2π/W, π/H) step times the bound in
+   * those variables. Parabolic: d is quadratic in (u, v), d_uu = d_vv = −fwd.
+   * Lat-long: |d_φφ| = sin θ, |d_θθ| = 1. Fisheye, d = (s u, s v, cos kρ) with
+   * s = sin(kρ)/ρ = k sinc(kρ): d_uu = (s_uu u + 2 s_u, s_uu v, (cos kρ)_uu), where
+   * |s_u| <= |s'| <= 0.44 k², |s_uu| <= max(|s''|, |s'/ρ|) <= k³/3 (sinc's bounds),
+   * |(cos kρ)_uu| <= k²; so |d_uu| <= k² (kρ/3 + 1.9) with ρ <= √2 in the image. */
+  switch (in->type) {
+  case RR_CAMERA_PARABOLIC:
+    c->bend_x = 4.0 / ((double)width * width), c->bend_y = 4.0 / ((double)height * height);
+    break;
+  case RR_CAMERA_LATLONG:
+    c->bend_x = 4 * RR_PI * RR_PI / ((double)width * width), c->bend_y = RR_PI * RR_PI / ((double)height * height);
+    break;
+  case RR_CAMERA_FISHEYE: {
+    double k = in->fov_deg * RR_PI / 360, b = k * k * (k * sqrt(2.0) / 3 + 1.9);
+    c->bend_x = 4 * b / ((double)width * width), c->bend_y = 4 * b / ((double)height * height);
+    break;
+  }
+  default:
+    break;
+  }
   /* Cones of coarse cells, for the screen bounds of triangles in curved views. */
   c->cells_x = (width + CAMERA_CELL - 1) / CAMERA_CELL, c->cells_y = (height + CAMERA_CELL - 1) / CAMERA_CELL;
   c->cells = malloc((size_t)c->cells_x * c->cells_y * 4 * sizeof *c->cells);

@@ -29,6 +29,8 @@ typedef struct camera {
   float fov_deg; /* as given: the fisheye's angle */
   vec3 *dirs;
   float lipschitz;
+  double bend_x, bend_y; /* polar curved maps: bounds on |∂²d/∂sx²|, |∂²d/∂sy²| over the */
+                         /* image (rr_cam_dir_at's d); 0 when none is known */
   float dir_len_max; /* longest |d| of the camera's rays */
   int face;          /* cube: side of a face in pixels */
   int cells_x, cells_y; /* curved: cones of CAMERA_CELL² cells of samples, 4 floats each: */
@@ -78,6 +80,11 @@ bool rr_cam_ray_diff(const camera *c, int x, int y, vec3 *origin, vec3 *dir, vec
 static inline vec3 camera_w(const camera *c, int x, int y) {
   return c->planar ? v3(1.0f, (float)x + c->sx0, (float)y + c->sy0) : c->dirs[(size_t)y * c->width + x];
 }
+/* The direction of a polar curved camera (parabolic, lat-long, fisheye) at any
+ * sample position (sx, sy) in double, the map extended smoothly beyond the disk
+ * where it has one: the rays of the samples with rays, without their float
+ * rounding. False for the other cameras. */
+bool rr_cam_dir_at(const camera *c, double sx, double sy, double d[3]);
 /* Projects a point given relative to the eye to sample coordinates (planar
  * cameras); false when it is not strictly in front of the image plane. */
 bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy);

@@ -167,6 +167,41 @@ static int cone_rejects(trav *t, const tri_job *j, tile_rect b) {
   return rays ? 1 : -1;
 }
 
+/* Curved views whose map bends boundedly (camera.bend_x, bend_y: the polar maps):
+ * over a bin of samples spanning hx × hy, an edge function V = n·d differs from the
+ * bilinear interpolation of its four corner values by at most
+ * |n| (bend_x·hx² + bend_y·hy²) / 8 (the error of linear interpolation, along x
+ * then y), and that interpolation never exceeds the greatest corner value. An edge
+ * whose corner values all lie below minus that, and minus the rounding of the
+ * stored rays and of the sample test (1e-5 |n| |d|), is negative at every sample
+ * of the bin (paper sect. 4.1: the corners shifted by the bend). The bound shrinks
+ * with the square of the bin, where a cone shrinks with its side. 1: rejected,
+ * 0: kept, -1: no rays in the bin (wholly outside the disk). */
+static int bend_rejects(trav *t, const tri_job *j, tile_rect b) {
+  const camera *c = t->c;
+  const double xs[2] = {(double)b.x0 + t->span[0], (double)(b.x1 - 1) + t->span[2]};
+  const double ys[2] = {(double)b.y0 + t->span[1], (double)(b.y1 - 1) + t->span[3]};
+  if (c->type != RR_CAMERA_LATLONG) { /* the disk: the bin's point nearest the centre */
+    double u0 = 2 * xs[0] / c->width - 1, u1 = 2 * xs[1] / c->width - 1;
+    double v0 = 1 - 2 * ys[1] / c->height, v1 = 1 - 2 * ys[0] / c->height;
+    double u = u0 > 0 ? u0 : u1 < 0 ? u1 : 0, v = v0 > 0 ? v0 : v1 < 0 ? v1 : 0;
+    if (u * u + v * v > 1 + 1e-6) return -1;
+  }
+  double d[4][3];
+  for (int k = 0; k < 4; k++) rr_cam_dir_at(c, xs[k & 1], ys[k >> 1], d[k]);
+  const double hx = xs[1] - xs[0], hy = ys[1] - ys[0];
+  const double slack = (c->bend_x * hx * hx + c->bend_y * hy * hy) / 8 + 1e-5 * c->dir_len_max;
+  t->st.edge_evals += 4;
+  heat_charge_corners(t->heat_e, t->vb->width, b.x0, b.y0, b.x1, b.y1);
+  for (int e = 0; e < 3; e++) {
+    const double n[3] = {j->ts.a[e], j->ts.b[e], j->ts.c[e]}, lim = -slack * j->cone.len[e];
+    bool all_out = true;
+    for (int k = 0; k < 4 && all_out; k++) all_out = n[0] * d[k][0] + n[1] * d[k][1] + n[2] * d[k][2] < lim;
+    if (all_out) return 1;
+  }
+  return 0;
+}
+
 /* Hierarchical binning: a bin is rejected when one edge function is negative at
  * all four corners of its samples (the edges are linear in the sample position
  * for planar cameras; with several positions, the corners of their extent) or when
@@ -199,7 +234,7 @@ static uint64_t bin_raster(trav *t, const tri_job *j, const tri_moves *mv, tile_
         t->st.edge_evals += 4;
         heat_charge_corners(t->heat_e, t->vb->width, b.x0, b.y0, b.x1, b.y1);
       } else {
-        int rejects = cone_rejects(t, j, b);
+        int rejects = t->c->bend_x > 0 && !j->ana ? bend_rejects(t, j, b) : cone_rejects(t, j, b);
         if (rejects < 0) continue; /* no rays here: nothing to refine */
         out = rejects > 0;
       }
