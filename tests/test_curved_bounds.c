@@ -119,9 +119,57 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   rr_cam_release(&c);
 }
 
+/* The bend bound of curved binning (vis/traverse.c): over a rectangle of samples
+ * spanning hx × hy, n·d stays within |n| (bend_x·hx² + bend_y·hy²) / 8 of the
+ * bilinear interpolation of its corner values, so below the greatest of them plus
+ * that (and the rays' rounding); rr_cam_dir_at gives the stored rays. Random
+ * rectangles and normals, every sample with a ray. */
+static void check_bend(rr_device *dev, rr_camera_type type, float fov, int w, int h) {
+  rr_camera rc;
+  rr_camera_init(&rc);
+  rc.type = type, rc.fov_deg = fov;
+  camera c;
+  const float pos[2] = {(float)rnd(), (float)rnd()};
+  CHECK(rr_cam_setup_at(dev, &rc, w, h, pos, &c) == RR_OK, "camera");
+  CHECK(c.bend_x > 0 && c.bend_y > 0, "%s: no bend bound", rr_camera_name(type));
+  long bad = 0, tested = 0;
+  double worst = 0; /* the largest excess over the interpolation, as a share of the bound */
+  for (int k = 0; k < 3000; k++) {
+    int bw = 2 + (int)(rnd() * 30), bh = 2 + (int)(rnd() * 30);
+    int x0 = (int)(rnd() * (w - bw)), y0 = (int)(rnd() * (h - bh));
+    vec3 n = rnd_unit();
+    double xs[2] = {x0 + (double)c.sx0, x0 + bw - 1 + (double)c.sx0}, ys[2] = {y0 + (double)c.sy0, y0 + bh - 1 + (double)c.sy0};
+    double cv[4], dd[3];
+    for (int q = 0; q < 4; q++) {
+      rr_cam_dir_at(&c, xs[q & 1], ys[q >> 1], dd);
+      cv[q] = n.x * dd[0] + n.y * dd[1] + n.z * dd[2];
+    }
+    double hx = bw - 1, hy = bh - 1, bend = (c.bend_x * hx * hx + c.bend_y * hy * hy) / 8;
+    for (int y = y0; y < y0 + bh; y++)
+      for (int x = x0; x < x0 + bw; x++) {
+        vec3 d = c.dirs[(size_t)y * w + x];
+        if (d.x == 0 && d.y == 0 && d.z == 0) continue;
+        double fx = (x - x0) / hx, fy = (y - y0) / hy;
+        double lin = (1 - fy) * ((1 - fx) * cv[0] + fx * cv[1]) + fy * ((1 - fx) * cv[2] + fx * cv[3]);
+        double v = (double)n.x * d.x + (double)n.y * d.y + (double)n.z * d.z;
+        tested++;
+        bad += fabs(v - lin) > bend + 1e-5 * c.dir_len_max;
+        if (bend > 0) worst = fmax(worst, fabs(v - lin) / bend);
+      }
+  }
+  CHECK(bad == 0 && tested > 0, "%s: %ld of %ld samples beyond the bend bound", rr_camera_name(type), bad, tested);
+  printf("%s %g: bend bound holds at %ld samples (at most %.2f of it used)\n", rr_camera_name(type), (double)fov,
+         tested, worst);
+  rr_cam_release(&c);
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
   int ntri = test_quick() ? 150 : 1500;
+  check_bend(dev, RR_CAMERA_PARABOLIC, 90, 96, 80);
+  check_bend(dev, RR_CAMERA_LATLONG, 90, 128, 64);
+  check_bend(dev, RR_CAMERA_FISHEYE, 180, 96, 96);
+  check_bend(dev, RR_CAMERA_FISHEYE, 360, 80, 64);
   struct {
     rr_camera_type type;
     float fov;
