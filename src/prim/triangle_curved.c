@@ -105,7 +105,7 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
     cmin_half = mind(cmin_half, 1 + ddot(nj, nk));
   }
   double smin = sqrt(maxd(0.0, 0.5 * cmin_half)); /* sin(θ_min / 2) */
-  if (!(smin > 1e-3)) return -1;
+  if (!(smin > 1e-6)) return -1; /* E below 0.02 rad until 1e-3, then growing */
   const double eps = 1e-5, E = 2 * eps / smin + eps;
   dv3 R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
   double alo, ahi, plo, phi, W = c->width, H = c->height;

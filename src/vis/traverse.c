@@ -190,13 +190,23 @@ static int bend_rejects(trav *t, const tri_job *j, tile_rect b) {
   double d[4][3];
   for (int k = 0; k < 4; k++) rr_cam_dir_at(c, xs[k & 1], ys[k >> 1], d[k]);
   const double hx = xs[1] - xs[0], hy = ys[1] - ys[0];
-  const double slack = (c->bend_x * hx * hx + c->bend_y * hy * hy) / 8 + 1e-5 * c->dir_len_max;
+  const double bend = (c->bend_x * hx * hx + c->bend_y * hy * hy) / 8, round = 1e-5 * c->dir_len_max;
   t->st.edge_evals += 4;
   heat_charge_corners(t->heat_e, t->vb->width, b.x0, b.y0, b.x1, b.y1);
+  /* the three edges, and their sum Σ w_i n_i: a hit needs Σ w_i e_i > 0 too, and
+   * where each edge is only a little negative (around the triangle's antipode,
+   * which every one of its great circles passes near) the sum is strongly so; its
+   * rounding is that of the three edge values */
+  double n[4][3] = {{0}}, lim[4];
   for (int e = 0; e < 3; e++) {
-    const double n[3] = {j->ts.a[e], j->ts.b[e], j->ts.c[e]}, lim = -slack * j->cone.len[e];
+    n[e][0] = j->ts.a[e], n[e][1] = j->ts.b[e], n[e][2] = j->ts.c[e];
+    for (int a = 0; a < 3; a++) n[3][a] += j->ts.w[e] * n[e][a];
+    lim[e] = -(bend + round) * j->cone.len[e];
+  }
+  lim[3] = -bend * j->cone.len[3] - round * (j->cone.len[0] + j->cone.len[1] + j->cone.len[2]);
+  for (int e = 0; e < 4; e++) {
     bool all_out = true;
-    for (int k = 0; k < 4 && all_out; k++) all_out = n[0] * d[k][0] + n[1] * d[k][1] + n[2] * d[k][2] < lim;
+    for (int k = 0; k < 4 && all_out; k++) all_out = n[e][0] * d[k][0] + n[e][1] * d[k][1] + n[e][2] * d[k][2] < lim[e];
     if (all_out) return 1;
   }
   return 0;
@@ -214,7 +224,9 @@ static uint64_t bin_raster(trav *t, const tri_job *j, const tri_moves *mv, tile_
     for (int bx = r.x0 - r.x0 % size; bx < r.x1; bx += size) {
       tile_rect b = {bx > r.x0 ? bx : r.x0, by > r.y0 ? by : r.y0, bx + size < r.x1 ? bx + size : r.x1,
                      by + size < r.y1 ? by + size : r.y1};
-      if (size <= t->o->bin_min || (b.x1 - b.x0) * (b.y1 - b.y0) <= 4) {
+      /* small bins go to the samples: a curved bin's test costs as much as about
+       * sixteen samples (four rays in double, sines for the lat-long and fisheye) */
+      if (size <= t->o->bin_min || (b.x1 - b.x0) * (b.y1 - b.y0) <= (t->c->planar ? 4 : 16)) {
         covered += raster_samples(t, j, mv, b);
         continue;
       }
@@ -234,7 +246,10 @@ static uint64_t bin_raster(trav *t, const tri_job *j, const tri_moves *mv, tile_
         t->st.edge_evals += 4;
         heat_charge_corners(t->heat_e, t->vb->width, b.x0, b.y0, b.x1, b.y1);
       } else {
-        int rejects = t->c->bend_x > 0 && !j->ana ? bend_rejects(t, j, b) : cone_rejects(t, j, b);
+        /* the cone (with the triangle's cap: slivers seen edge-on, whose three
+         * planes nearly coincide, are bounded by it alone), then the bend */
+        int rejects = cone_rejects(t, j, b);
+        if (rejects == 0 && t->c->bend_x > 0 && !j->ana) rejects = bend_rejects(t, j, b);
         if (rejects < 0) continue; /* no rays here: nothing to refine */
         out = rejects > 0;
       }
@@ -477,7 +492,10 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
 /* Rasterizes a prepared triangle into the samples r, with its setup moved to
  * each position (mv; NULL for one position). */
 KERNEL void draw_rect(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r) {
-  if (t->o->binning) bin_raster(t, j, mv, r, t->o->bin_size);
+  /* Curved views start from bins of at most 16² samples: the bend bound grows with
+   * the square of the bin, and a lat-long bin of 64² spans a quarter of the sphere. */
+  if (t->o->binning)
+    bin_raster(t, j, mv, r, !t->c->planar && t->c->bend_x > 0 && t->o->bin_size > 16 ? 16 : t->o->bin_size);
   else raster_samples(t, j, mv, r);
 }
 
