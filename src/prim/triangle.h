@@ -260,8 +260,9 @@ KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], 
 bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int rect[4]);
 /* The tight rectangle of the curved views polar about an axis (lat-long, parabolic,
  * fisheye), from the spherical triangle of the setup's edge planes
- * (prim/triangle_curved.c): 1 with rect, 0 when no sample can pass, -1 when it
- * knows no bound (another camera, a nearly degenerate setup). */
+ * (prim/triangle_curved.c): 1 with rect, 2 with a rect whose margin is wide (a
+ * sliver: the cells may bound it better), 0 when no sample can pass, -1 when it
+ * knows no bound (another camera, a degenerate setup). */
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
 /* Planar cameras bound a triangle from its corners alone, before its setup: most
  * triangles of a detailed mesh fall between samples. rr_tri_corner_bounds bounds triangles
