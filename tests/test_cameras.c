@@ -114,13 +114,14 @@ static void check_methods(rr_device *dev, const char *name, int views) {
         int d = test_frames_differ(ref, f);
         CHECK(d == 0, "%s: %s on %d threads differs from rc at %d samples", what, rr_method_name(methods3d[m]),
               threads, d);
-        if (type != RR_CAMERA_PERSPECTIVE && type != RR_CAMERA_ORTHOGRAPHIC) bins += f->stats.bins, empty += f->stats.bins_empty;
+        if (type == RR_CAMERA_PARABOLIC || type == RR_CAMERA_LATLONG || type == RR_CAMERA_FISHEYE)
+          bins += f->stats.bins, empty += f->stats.bins_empty;
         rr_frame_release(f);
       }
       rr_frame_release(ref);
     }
   }
-  printf("%s: curved binning refined %llu bins, %llu (%.1f%%) without the triangle\n", name,
+  printf("%s: binning of the polar views refined %llu bins, %llu (%.1f%%) without the triangle\n", name,
          (unsigned long long)bins, (unsigned long long)empty, bins ? 100.0 * empty / bins : 0.0);
   rr_scene_release(s);
 }
