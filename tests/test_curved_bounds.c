@@ -3,7 +3,8 @@
  * ray passes the 3D edge test lies inside the triangle's rectangle. The triangles
  * gather where the maps are singular or wrap: the lat-long's seam and poles, the
  * hemisphere's rim, the fisheye's axis and (at 360°) its antipode, the cube's
- * edges and corners. */
+ * edges and corners (the cube: each face's perspective rectangle, from the
+ * corners, against the face's own samples). */
 #include "vis/vis.h"
 #include "io/io.h"
 #include "testutil.h"
@@ -41,7 +42,11 @@ static vec3 hard_dir(const rr_camera *rc, vec3 f, vec3 r, vec3 u) {
   case 3: return polar(v3_neg(f), u, r, jit, psi);          /* behind: the seam, the 360° fisheye's rim */
   default: {                                               /* the rim of the disk, the axis */
     double rim = rc->type == RR_CAMERA_FISHEYE ? rc->fov_deg * RR_PI / 360 : RR_PI / 2;
-    if (rc->type == RR_CAMERA_CUBE) rim = atan(sqrt(2.0)); /* a cube's corner */
+    if (rc->type == RR_CAMERA_CUBE) { /* a corner of the cube, or the middle of an edge */
+      bool corner = rnd() < 0.5;
+      rim = corner ? atan(sqrt(2.0)) : RR_PI / 4;
+      psi = (floor(rnd() * 4) + (corner ? 0.5 : 0)) * RR_PI / 2 + jit;
+    }
     return polar(f, r, u, rnd() < 0.3 ? jit : rim + jit, psi);
   }
   }
@@ -71,30 +76,37 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
         rr_device_message(dev));
   CHECK(rr_scene_commit(s) == RR_OK, "commit");
   long missed = 0, passing = 0, area = 0, tight = 0, seen = 0;
-  for (uint32_t i = 0; i < s->ntris; i++) {
-    tri_setup ts;
-    if (rr_tri_setup(s, i, &c, false, &ts) == SETUP_CULLED) continue;
-    int r[4], rt[4];
-    bool has = rr_tri_screen_bounds(s, i, &c, &ts, r);
-    tight += rr_tri_curved_rect(&c, &ts, rt) >= 0;
-    seen++;
-    long in = 0;
-    for (int y = 0; y < h; y++)
-      for (int x = 0; x < w; x++) {
-        vec3 d = camera_w(&c, x, y);
-        if (d.x == 0 && d.y == 0 && d.z == 0) continue;
-        float e[3], t, l1, l2;
-        tri_edges_w(&ts, d, e);
-        if (!sample_test_w(e, ts.w, ts.tie, ts.vol, 0, tri_den_w(&ts, d), &t, &l1, &l2)) continue;
-        in++;
-        if (!has || x < r[0] || x > r[2] || y < r[1] || y > r[3]) {
-          if (missed++ < 5)
-            fprintf(stderr, "%s: triangle %u passes at (%d, %d) outside [%d,%d]x[%d,%d]%s\n", what, i, x, y,
-                    has ? r[0] : 0, has ? r[2] : -1, has ? r[1] : 0, has ? r[3] : -1, has ? "" : " (none)");
+  /* a cube's samples are those of its six perspective faces (camera/camera.h) */
+  const bool cube = rc->type == RR_CAMERA_CUBE;
+  for (int f = 0; f < (cube ? 6 : 1); f++) {
+    camera fc;
+    if (cube) rr_cam_cube_face(&c, f, &fc);
+    const camera *cc = cube ? &fc : &c;
+    for (uint32_t i = 0; i < s->ntris; i++) {
+      tri_setup ts;
+      if (rr_tri_setup(s, i, cc, false, &ts) == SETUP_CULLED) continue;
+      int r[4], rt[4];
+      bool has = rr_tri_screen_bounds(s, i, cc, &ts, r);
+      tight += cube || rr_tri_curved_rect(cc, &ts, rt) >= 0;
+      seen++;
+      long in = 0;
+      for (int y = 0; y < cc->height; y++)
+        for (int x = 0; x < cc->width; x++) {
+          vec3 d = camera_w(cc, x, y);
+          if (d.x == 0 && d.y == 0 && d.z == 0) continue;
+          float e[3], t, l1, l2;
+          tri_edges_w(&ts, d, e);
+          if (!sample_test_w(e, ts.w, ts.tie, tri_vol(&ts, d.y, d.z), 0, tri_den_w(&ts, d), &t, &l1, &l2)) continue;
+          in++;
+          if (!has || x < r[0] || x > r[2] || y < r[1] || y > r[3]) {
+            if (missed++ < 5)
+              fprintf(stderr, "%s: triangle %u passes at (%d, %d) of face %d outside [%d,%d]x[%d,%d]%s\n", what, i, x,
+                      y, f, has ? r[0] : 0, has ? r[2] : -1, has ? r[1] : 0, has ? r[3] : -1, has ? "" : " (none)");
+          }
         }
-      }
-    passing += in;
-    if (has) area += (long)(r[2] - r[0] + 1) * (r[3] - r[1] + 1);
+      passing += in;
+      if (has) area += (long)(r[2] - r[0] + 1) * (r[3] - r[1] + 1);
+    }
   }
   CHECK(missed == 0, "%s: %ld passing samples outside their triangle's rectangle", what, missed);
   CHECK(passing > 0, "%s: no triangle passes anywhere (the test would prove nothing)", what);
@@ -107,9 +119,57 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   rr_cam_release(&c);
 }
 
+/* The bend bound of curved binning (vis/traverse.c): over a rectangle of samples
+ * spanning hx × hy, n·d stays within |n| (bend_x·hx² + bend_y·hy²) / 8 of the
+ * bilinear interpolation of its corner values, so below the greatest of them plus
+ * that (and the rays' rounding); rr_cam_dir_at gives the stored rays. Random
+ * rectangles and normals, every sample with a ray. */
+static void check_bend(rr_device *dev, rr_camera_type type, float fov, int w, int h) {
+  rr_camera rc;
+  rr_camera_init(&rc);
+  rc.type = type, rc.fov_deg = fov;
+  camera c;
+  const float pos[2] = {(float)rnd(), (float)rnd()};
+  CHECK(rr_cam_setup_at(dev, &rc, w, h, pos, &c) == RR_OK, "camera");
+  CHECK(c.bend_x > 0 && c.bend_y > 0, "%s: no bend bound", rr_camera_name(type));
+  long bad = 0, tested = 0;
+  double worst = 0; /* the largest excess over the interpolation, as a share of the bound */
+  for (int k = 0; k < 3000; k++) {
+    int bw = 2 + (int)(rnd() * 30), bh = 2 + (int)(rnd() * 30);
+    int x0 = (int)(rnd() * (w - bw)), y0 = (int)(rnd() * (h - bh));
+    vec3 n = rnd_unit();
+    double xs[2] = {x0 + (double)c.sx0, x0 + bw - 1 + (double)c.sx0}, ys[2] = {y0 + (double)c.sy0, y0 + bh - 1 + (double)c.sy0};
+    double cv[4], dd[3];
+    for (int q = 0; q < 4; q++) {
+      rr_cam_dir_at(&c, xs[q & 1], ys[q >> 1], dd);
+      cv[q] = n.x * dd[0] + n.y * dd[1] + n.z * dd[2];
+    }
+    double hx = bw - 1, hy = bh - 1, bend = (c.bend_x * hx * hx + c.bend_y * hy * hy) / 8;
+    for (int y = y0; y < y0 + bh; y++)
+      for (int x = x0; x < x0 + bw; x++) {
+        vec3 d = c.dirs[(size_t)y * w + x];
+        if (d.x == 0 && d.y == 0 && d.z == 0) continue;
+        double fx = (x - x0) / hx, fy = (y - y0) / hy;
+        double lin = (1 - fy) * ((1 - fx) * cv[0] + fx * cv[1]) + fy * ((1 - fx) * cv[2] + fx * cv[3]);
+        double v = (double)n.x * d.x + (double)n.y * d.y + (double)n.z * d.z;
+        tested++;
+        bad += fabs(v - lin) > bend + 1e-5 * c.dir_len_max;
+        if (bend > 0) worst = fmax(worst, fabs(v - lin) / bend);
+      }
+  }
+  CHECK(bad == 0 && tested > 0, "%s: %ld of %ld samples beyond the bend bound", rr_camera_name(type), bad, tested);
+  printf("%s %g: bend bound holds at %ld samples (at most %.2f of it used)\n", rr_camera_name(type), (double)fov,
+         tested, worst);
+  rr_cam_release(&c);
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
   int ntri = test_quick() ? 150 : 1500;
+  check_bend(dev, RR_CAMERA_PARABOLIC, 90, 96, 80);
+  check_bend(dev, RR_CAMERA_LATLONG, 90, 128, 64);
+  check_bend(dev, RR_CAMERA_FISHEYE, 180, 96, 96);
+  check_bend(dev, RR_CAMERA_FISHEYE, 360, 80, 64);
   struct {
     rr_camera_type type;
     float fov;

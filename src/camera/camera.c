@@ -74,6 +74,51 @@ rr_error rr_camera_check(rr_device *dev, const rr_camera *c) {
   return rr_ok(dev);
 }
 
+/* A perspective camera's rays and side planes from its basis and image size. */
+static void perspective_basis(camera *c) {
+  /* d(sx, sy) = fwd + (2 sx / W - 1) tw right + (1 - 2 sy / H) th up */
+  c->d0 = v3_add(c->fwd, v3_sub(v3_scale(c->up, c->tan_half_h), v3_scale(c->right, c->tan_half_w)));
+  c->dx = v3_scale(c->right, 2.0f * c->tan_half_w / (float)c->width);
+  c->dy = v3_scale(c->up, -2.0f * c->tan_half_h / (float)c->height);
+  /* the planes through the eye and a column x (a row y) of the image have normals
+   * linear in x (y); the sign makes them face increasing x (y) */
+  float s = v3_dot(v3_cross(c->dx, c->dy), c->d0) > 0 ? 1.0f : -1.0f;
+  c->col_n0 = v3_scale(v3_cross(c->d0, c->dy), -s), c->col_n1 = v3_scale(v3_cross(c->dx, c->dy), -s);
+  c->row_n0 = v3_scale(v3_cross(c->d0, c->dx), s), c->row_n1 = v3_scale(v3_cross(c->dy, c->dx), s);
+}
+
+/* The cube's faces in the horizontal cross: row 1 holds left, front, right, back,
+ * row 0 the top face above the front, row 2 the bottom one below it. */
+static const int cube_cols[6] = {1, 2, 3, 0, 1, 1}, cube_rows[6] = {1, 1, 1, 1, 0, 2};
+
+int rr_cam_cube_face_at(const camera *c, int x, int y) {
+  int col = x / c->face, row = y / c->face;
+  for (int f = 0; f < 6; f++)
+    if (cube_cols[f] == col && cube_rows[f] == row) return f;
+  return -1;
+}
+
+void rr_cam_cube_face_origin(const camera *c, int f, int *x0, int *y0) {
+  *x0 = cube_cols[f] * c->face, *y0 = cube_rows[f] * c->face;
+}
+
+void rr_cam_cube_face(const camera *c, int f, camera *out) {
+  /* forward and right of each face in the cube's basis; up = right × forward */
+  const vec3 r = c->right, u = c->up, w = c->fwd;
+  const vec3 fwd[6] = {w, r, v3_neg(w), v3_neg(r), u, v3_neg(u)};
+  const vec3 right[6] = {r, v3_neg(w), v3_neg(r), w, r, r};
+  const vec3 up[6] = {u, u, u, u, v3_neg(w), w};
+  memset(out, 0, sizeof *out);
+  out->type = RR_CAMERA_PERSPECTIVE, out->planar = true;
+  out->width = out->height = c->face;
+  out->sx0 = c->sx0, out->sy0 = c->sy0;
+  out->eye = c->eye, out->fwd = fwd[f], out->right = right[f], out->up = up[f];
+  out->tan_half_h = out->tan_half_w = 1.0f; /* 90° exactly */
+  out->fov_deg = 90.0f;
+  out->dir_len_max = 1;
+  perspective_basis(out);
+}
+
 /* The direction of pixel (x, y) of a curved camera; zero where it has no ray.
  * With dd, also its derivatives with respect to the sample position, per pixel
  * step in x (dd[0]) and y (dd[1]): each mapping differentiated in closed form. */
@@ -120,18 +165,13 @@ static vec3 curved_dir(const camera *c, int x, int y, vec3 *dd) {
     return v3_add(v3_scale(radial, (float)sin(a)), v3_scale(f, (float)cos(a)));
   }
   case RR_CAMERA_CUBE: {
-    /* horizontal cross: row 0 top face, row 1 left/front/right/back, row 2 bottom */
-    int F = c->face, col = x / F, row = y / F;
-    if (col > 3 || row > 2 || (row != 1 && col != 1)) return v3(0, 0, 0);
-    float a = (float)(2 * (x - col * F + (double)c->sx0) / F - 1), b = (float)(1 - 2 * (y - row * F + (double)c->sy0) / F);
-    vec3 ff = f, fr = r, fu = up;
-    if (row == 0) ff = up, fu = v3_neg(f);
-    else if (row == 2) ff = v3_neg(up), fu = f;
-    else if (col == 0) ff = v3_neg(r), fr = f;
-    else if (col == 2) ff = r, fr = v3_neg(f);
-    else if (col == 3) ff = v3_neg(f), fr = v3_neg(r);
-    if (dd) dd[0] = v3_scale(fr, 2.0f / (float)F), dd[1] = v3_scale(fu, -2.0f / (float)F); /* within the face */
-    return v3_add(ff, v3_add(v3_scale(fr, a), v3_scale(fu, b)));
+    /* the ray of the face's own perspective camera (rr_cam_cube_face), in camera_dir's operations */
+    int f = rr_cam_cube_face_at(c, x, y);
+    if (f < 0) return v3(0, 0, 0);
+    camera fc;
+    rr_cam_cube_face(c, f, &fc);
+    if (dd) dd[0] = fc.dx, dd[1] = fc.dy;
+    return camera_dir(&fc, (float)(x - cube_cols[f] * c->face) + c->sx0, (float)(y - cube_rows[f] * c->face) + c->sy0);
   }
   case RR_CAMERA_OPENCV:
   case RR_CAMERA_OPENCV_FISHEYE: {
@@ -147,6 +187,32 @@ static vec3 curved_dir(const camera *c, int x, int y, vec3 *dd) {
   default:
     return v3(0, 0, 0);
   }
+}
+
+bool rr_cam_dir_at(const camera *c, double sx, double sy, double d[3]) {
+  double W = c->width, H = c->height, u = 2 * sx / W - 1, v = 1 - 2 * sy / H, cr, cu, cf;
+  switch (c->type) {
+  case RR_CAMERA_PARABOLIC:
+    cr = u, cu = v, cf = 0.5 - 0.5 * (u * u + v * v);
+    break;
+  case RR_CAMERA_LATLONG: {
+    double phi = 2 * RR_PI * sx / W - RR_PI, theta = RR_PI * sy / H;
+    cr = sin(theta) * sin(phi), cu = cos(theta), cf = sin(theta) * cos(phi);
+    break;
+  }
+  case RR_CAMERA_FISHEYE: {
+    double k = c->fov_deg * RR_PI / 360, rad = sqrt(u * u + v * v), s = rad > 0 ? sin(k * rad) / rad : k;
+    cr = s * u, cu = s * v, cf = cos(k * rad);
+    break;
+  }
+  default:
+    return false;
+  }
+  const vec3 r = c->right, up = c->up, f = c->fwd;
+  d[0] = cr * r.x + cu * up.x + cf * f.x;
+  d[1] = cr * r.y + cu * up.y + cf * f.y;
+  d[2] = cr * r.z + cu * up.z + cf * f.z;
+  return true;
 }
 
 /* The largest angle between the rays of two samples one pixel apart (in x or y) of
@@ -203,15 +269,7 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
   c->planar = in->type == RR_CAMERA_PERSPECTIVE || in->type == RR_CAMERA_ORTHOGRAPHIC;
   c->dir_len_max = 1;
   if (in->type == RR_CAMERA_PERSPECTIVE) {
-    /* d(sx, sy) = fwd + (2 sx / W - 1) tw right + (1 - 2 sy / H) th up */
-    c->d0 = v3_add(c->fwd, v3_sub(v3_scale(c->up, c->tan_half_h), v3_scale(c->right, c->tan_half_w)));
-    c->dx = v3_scale(c->right, 2.0f * c->tan_half_w / (float)width);
-    c->dy = v3_scale(c->up, -2.0f * c->tan_half_h / (float)height);
-    /* the planes through the eye and a column x (a row y) of the image have normals
-     * linear in x (y); the sign makes them face increasing x (y) */
-    float s = v3_dot(v3_cross(c->dx, c->dy), c->d0) > 0 ? 1.0f : -1.0f;
-    c->col_n0 = v3_scale(v3_cross(c->d0, c->dy), -s), c->col_n1 = v3_scale(v3_cross(c->dx, c->dy), -s);
-    c->row_n0 = v3_scale(v3_cross(c->d0, c->dx), s), c->row_n1 = v3_scale(v3_cross(c->dy, c->dx), s);
+    perspective_basis(c);
     return rr_ok(dev);
   }
   if (in->type == RR_CAMERA_ORTHOGRAPHIC) {
@@ -237,8 +295,20 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
       c->lens.cx = 0.5f * (float)width - 0.5f, c->lens.cy = 0.5f * (float)height - 0.5f;
     }
   }
-  for (int y = 0; y < height; y++)
-    for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);
+  if (in->type == RR_CAMERA_CUBE) { /* the faces' rays; the cross's gaps have none */
+    memset(c->dirs, 0, (size_t)width * height * sizeof *c->dirs);
+    for (int f = 0; f < 6; f++) {
+      camera fc;
+      rr_cam_cube_face(c, f, &fc);
+      for (int y = 0; y < c->face; y++)
+        for (int x = 0; x < c->face; x++)
+          c->dirs[(size_t)(cube_rows[f] * c->face + y) * width + cube_cols[f] * c->face + x] =
+              camera_dir(&fc, (float)x + c->sx0, (float)y + c->sy0);
+    }
+  } else {
+    for (int y = 0; y < height; y++)
+      for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);
+  }
   switch (in->type) {
   case RR_CAMERA_PARABOLIC: /* conformal, angle = 2 atan(r): at most 2 radians per unit of u */
     c->lipschitz = 2.0f * 2.0f / (float)(width < height ? width : height);
@@ -259,6 +329,28 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     break;
   }
   c->lipschitz *= 1.001f;
+  /* The maps' second derivatives, for binning (vis/traverse.c): per sample step,
+   * the square of u, v's (2/W, 2/H) or φ, θ's (2π/W, π/H) step times the bound in
+   * those variables. Parabolic: d is quadratic in (u, v), d_uu = d_vv = −fwd.
+   * Lat-long: |d_φφ| = sin θ, |d_θθ| = 1. Fisheye, d = (s u, s v, cos kρ) with
+   * s = sin(kρ)/ρ = k sinc(kρ): d_uu = (s_uu u + 2 s_u, s_uu v, (cos kρ)_uu), where
+   * |s_u| <= |s'| <= 0.44 k², |s_uu| <= max(|s''|, |s'/ρ|) <= k³/3 (sinc's bounds),
+   * |(cos kρ)_uu| <= k²; so |d_uu| <= k² (kρ/3 + 1.9) with ρ <= √2 in the image. */
+  switch (in->type) {
+  case RR_CAMERA_PARABOLIC:
+    c->bend_x = 4.0 / ((double)width * width), c->bend_y = 4.0 / ((double)height * height);
+    break;
+  case RR_CAMERA_LATLONG:
+    c->bend_x = 4 * RR_PI * RR_PI / ((double)width * width), c->bend_y = RR_PI * RR_PI / ((double)height * height);
+    break;
+  case RR_CAMERA_FISHEYE: {
+    double k = in->fov_deg * RR_PI / 360, b = k * k * (k * sqrt(2.0) / 3 + 1.9);
+    c->bend_x = 4 * b / ((double)width * width), c->bend_y = 4 * b / ((double)height * height);
+    break;
+  }
+  default:
+    break;
+  }
   /* Cones of coarse cells, for the screen bounds of triangles in curved views. */
   c->cells_x = (width + CAMERA_CELL - 1) / CAMERA_CELL, c->cells_y = (height + CAMERA_CELL - 1) / CAMERA_CELL;
   c->cells = malloc((size_t)c->cells_x * c->cells_y * 4 * sizeof *c->cells);

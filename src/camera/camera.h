@@ -29,6 +29,8 @@ typedef struct camera {
   float fov_deg; /* as given: the fisheye's angle */
   vec3 *dirs;
   float lipschitz;
+  double bend_x, bend_y; /* polar curved maps: bounds on |∂²d/∂sx²|, |∂²d/∂sy²| over the */
+                         /* image (rr_cam_dir_at's d); 0 when none is known */
   float dir_len_max; /* longest |d| of the camera's rays */
   int face;          /* cube: side of a face in pixels */
   int cells_x, cells_y; /* curved: cones of CAMERA_CELL² cells of samples, 4 floats each: */
@@ -42,6 +44,18 @@ typedef struct camera {
  * hold for half-angles under 90° only (a little more than 1.5 radians). A cell
  * without a useful cone stores this half-angle. */
 #define CAMERA_NO_CONE 1.5f
+
+/* The cube camera is six perspective cameras of 90°, one per face of F×F samples
+ * (F = c->face) in the horizontal cross: a ray of face f is that face's planar
+ * d0 + sx·dx + sy·dy with (sx, sy) the sample's position within the face, so every
+ * method tests a face's samples as a perspective camera's (and may share the part of
+ * a triangle's setup that depends on the eye alone between the faces).
+ * rr_cam_cube_face: face f (0..5: front, right, back, left, top, bottom) of cube
+ * camera c, at c's sample position; rr_cam_cube_face_origin: where its samples
+ * start in the cross; rr_cam_cube_face_at: the face of pixel (x, y), -1 in a gap. */
+void rr_cam_cube_face(const camera *c, int f, camera *out);
+void rr_cam_cube_face_origin(const camera *c, int f, int *x0, int *y0);
+int rr_cam_cube_face_at(const camera *c, int x, int y);
 
 /* Resolves a public camera for an image size; rr_cam_release frees it. */
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *out);
@@ -66,6 +80,11 @@ bool rr_cam_ray_diff(const camera *c, int x, int y, vec3 *origin, vec3 *dir, vec
 static inline vec3 camera_w(const camera *c, int x, int y) {
   return c->planar ? v3(1.0f, (float)x + c->sx0, (float)y + c->sy0) : c->dirs[(size_t)y * c->width + x];
 }
+/* The direction of a polar curved camera (parabolic, lat-long, fisheye) at any
+ * sample position (sx, sy) in double, the map extended smoothly beyond the disk
+ * where it has one: the rays of the samples with rays, without their float
+ * rounding. False for the other cameras. */
+bool rr_cam_dir_at(const camera *c, double sx, double sy, double d[3]);
 /* Projects a point given relative to the eye to sample coordinates (planar
  * cameras); false when it is not strictly in front of the image plane. */
 bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy);

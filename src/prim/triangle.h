@@ -51,6 +51,14 @@ typedef struct tri_plane {
 /* rr_tri_setup_run that also writes each kept triangle's tri_plane to pl[k]. */
 void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces,
                          bool simd, tri_setup *out, int *face, tri_plane *pl);
+/* rr_tri_setup_planes for cameras cams[0..ncams-1] that share one eye (a cube's
+ * faces): what depends on the eye alone is computed once per triangle, the rest per
+ * camera, with the bits each camera alone gives. Camera k's setup of triangle i goes
+ * to out[k·n + i], face[k·n + i] (pl likewise when not NULL), for the triangles whose
+ * bit k of views[i] is set (every one when views is NULL); face is SETUP_CULLED for
+ * the others. */
+void rr_tri_setup_views(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
+                        const uint8_t *views, bool cull_backfaces, bool simd, tri_setup *out, int *face, tri_plane *pl);
 /* The setup ts (from rr_tri_setup_planes with a camera that differs from c only in
  * its sample position) for camera c: the bits rr_tri_setup gives for c. */
 void rr_tri_setup_at(const tri_setup *ts, const tri_plane *pl, const camera *c, tri_setup *out);
@@ -252,8 +260,9 @@ KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], 
 bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int rect[4]);
 /* The tight rectangle of the curved views polar about an axis (lat-long, parabolic,
  * fisheye), from the spherical triangle of the setup's edge planes
- * (prim/triangle_curved.c): 1 with rect, 0 when no sample can pass, -1 when it
- * knows no bound (another camera, a nearly degenerate setup). */
+ * (prim/triangle_curved.c): 1 with rect, 2 with a rect whose margin is wide (a
+ * sliver: the cells may bound it better), 0 when no sample can pass, -1 when it
+ * knows no bound (another camera, a degenerate setup). */
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
 /* Planar cameras bound a triangle from its corners alone, before its setup: most
  * triangles of a detailed mesh fall between samples. rr_tri_corner_bounds bounds triangles

@@ -87,11 +87,17 @@ bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
   /* Curved views have no straight-edged projection: the tight rectangle where it
    * is known, else the cells' cones; hemispheres see nothing wholly behind the eye plane. */
   int tight = rr_tri_curved_rect(c, ts, r);
-  if (tight >= 0) return tight > 0;
+  if (tight == 0 || tight == 1) return tight > 0;
   int behind = 0;
   for (int k = 0; k < 3; k++) behind += !(v3_dot(scene_q(s, k, i, c->eye), c->fwd) > 0);
   if (behind == 3 && c->type == RR_CAMERA_PARABOLIC) return false;
-  return curved_bounds(s, i, c, ts, r);
+  int q[4];
+  if (tight < 0) return curved_bounds(s, i, c, ts, r);
+  /* a sliver's wide rectangle, and the cells': both hold its samples */
+  if (!curved_bounds(s, i, c, ts, q)) return false;
+  r[0] = q[0] > r[0] ? q[0] : r[0], r[1] = q[1] > r[1] ? q[1] : r[1];
+  r[2] = q[2] < r[2] ? q[2] : r[2], r[3] = q[3] < r[3] ? q[3] : r[3];
+  return r[0] <= r[2] && r[1] <= r[3];
 }
 
 uint32_t rr_tri_corner_bounds_at(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,

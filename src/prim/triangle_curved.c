@@ -105,7 +105,7 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
     cmin_half = mind(cmin_half, 1 + ddot(nj, nk));
   }
   double smin = sqrt(maxd(0.0, 0.5 * cmin_half)); /* sin(θ_min / 2) */
-  if (!(smin > 1e-3)) return -1;
+  if (!(smin > 1e-6)) return -1; /* E below 0.02 rad until 1e-3, then growing: a sliver */
   const double eps = 1e-5, E = 2 * eps / smin + eps;
   dv3 R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
   double alo, ahi, plo, phi, W = c->width, H = c->height;
@@ -149,5 +149,5 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
   lx = maxd(lx, 0), ly = maxd(ly, 0), hx = mind(hx, W - 1), hy = mind(hy, H - 1);
   if (!(lx <= hx && ly <= hy)) return 0;
   r[0] = (int)lx, r[1] = (int)ly, r[2] = (int)hx, r[3] = (int)hy;
-  return 1;
+  return smin > 1e-3 ? 1 : 2;
 }

@@ -240,6 +240,84 @@ static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_came
   return e;
 }
 
+/* A method's passes over ctx: one for every position, or one per position, each
+ * writing its own layer (S grows with N). */
+static rr_error run_passes(rr_device *dev, rr_method m, render_ctx ctx, progress_span whole) {
+  if (methods[m].all_samples) {
+    ctx.progress = whole;
+    return methods[m].fn(dev, &ctx);
+  }
+  const camera *cams = ctx.cams;
+  visbuf *vb = ctx.vb;
+  const int ns = ctx.samples;
+  rr_error e = RR_OK;
+  for (int s = 0; s < ns && !e; s++) {
+    ctx.progress = rr_progress_part(&whole, (double)s / ns, (double)(s + 1) / ns);
+    visbuf layer = visbuf_layer(vb, s);
+    ctx.cam = ctx.cams = &cams[s];
+    ctx.samples = 1;
+    ctx.vb = &layer;
+    e = methods[m].fn(dev, &ctx);
+  }
+  return e;
+}
+
+/* The cube camera: its six faces are perspective cameras (camera/camera.h), each
+ * drawn into a buffer of its own and copied into the cross. The rasterizing
+ * methods that draw from the root (3dr-bb, 3dr-bin) draw the six in one pass,
+ * which sets each triangle up once for the eye (vis/traverse.c); the others run
+ * once per face. */
+static rr_error render_cube(rr_device *dev, rr_method m, render_ctx ctx, progress_span whole) {
+  const camera *cube = ctx.cam;
+  visbuf *cross = ctx.vb;
+  const int ns = ctx.samples, F = cube->face, W = cross->width;
+  const size_t FF = (size_t)F * F;
+  camera fc[6 * RR_MAX_SAMPLES];
+  for (int f = 0; f < 6; f++)
+    for (int s = 0; s < ns; s++) rr_cam_cube_face(&ctx.cams[s], f, &fc[f * ns + s]);
+  visbuf fvb, faces[6];
+  float *heat = NULL;
+  if (!visbuf_alloc(&fvb, F, F, 6 * ns) || (ctx.heat_e && !(heat = calloc(12 * FF, sizeof *heat)))) {
+    visbuf_free(&fvb);
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a cube camera's faces of %dx%d", F, F);
+  }
+  for (int f = 0; f < 6; f++) faces[f] = visbuf_layer(&fvb, f * ns); /* face f: ns layers of F × F */
+  rr_error e = RR_OK;
+  if (methods[m].fn == rr_vis_traverse && !ctx.oracles->leaves) {
+    ctx.faces = 6, ctx.face_cams = fc, ctx.face_vb = faces;
+    ctx.face_heat_e = heat, ctx.face_heat_n = heat ? heat + 6 * FF : NULL;
+    ctx.cam = ctx.cams = fc, ctx.vb = &faces[0];
+    e = run_passes(dev, m, ctx, whole);
+  } else {
+    for (int f = 0; f < 6 && !e; f++) {
+      render_ctx sub = ctx;
+      sub.cam = sub.cams = &fc[f * ns], sub.vb = &faces[f];
+      sub.heat_e = heat ? heat + f * FF : NULL, sub.heat_n = heat ? heat + (6 + f) * FF : NULL;
+      e = run_passes(dev, m, sub, rr_progress_part(&whole, f / 6.0, (f + 1) / 6.0));
+    }
+  }
+  for (int f = 0; f < 6 && !e; f++) {
+    int x0, y0;
+    rr_cam_cube_face_origin(cube, f, &x0, &y0);
+    for (int s = 0; s < ns; s++) {
+      visbuf to = visbuf_layer(cross, s), from = visbuf_layer(&faces[f], s);
+      for (int y = 0; y < F; y++) {
+        size_t k = (size_t)(y0 + y) * W + x0, j = (size_t)y * F;
+        memcpy(to.id + k, from.id + j, F * sizeof *to.id), memcpy(to.t + k, from.t + j, F * sizeof *to.t);
+        memcpy(to.l1 + k, from.l1 + j, F * sizeof *to.l1), memcpy(to.l2 + k, from.l2 + j, F * sizeof *to.l2);
+      }
+    }
+    for (int y = 0; heat && y < F; y++)
+      for (int x = 0; x < F; x++) {
+        size_t k = (size_t)(y0 + y) * W + x0 + x, j = f * FF + (size_t)y * F + x;
+        ctx.heat_e[k] += heat[j], ctx.heat_n[k] += heat[6 * FF + j];
+      }
+  }
+  visbuf_free(&fvb);
+  free(heat);
+  return e;
+}
+
 rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                    const rr_render_options *opt, rr_frame **out) {
   if (!scene || !cam || !opt || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "rr_render: NULL argument");
@@ -316,18 +394,7 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   double t0 = rr_now_ms(), c0 = rr_cpu_ms();
   progress_span whole = {dev, RR_PROGRESS_RENDER, 0, 1};
   rr_progress(&whole, 0);
-  if (methods[opt->method].all_samples) {
-    ctx.progress = whole;
-    e = methods[opt->method].fn(dev, &ctx);
-  } else /* one pass per position, each writing its own layer (S grows with N) */
-    for (int s = 0; s < opt->samples && !e; s++) {
-      ctx.progress = rr_progress_part(&whole, (double)s / opt->samples, (double)(s + 1) / opt->samples);
-      visbuf layer = visbuf_layer(&f->vb, s);
-      ctx.cam = ctx.cams = &cams[s];
-      ctx.samples = 1;
-      ctx.vb = &layer;
-      e = methods[opt->method].fn(dev, &ctx);
-    }
+  e = cam->type == RR_CAMERA_CUBE ? render_cube(dev, opt->method, ctx, whole) : run_passes(dev, opt->method, ctx, whole);
   f->stats.frame_ms = rr_now_ms() - t0, f->stats.cpu_ms = rr_cpu_ms() - c0;
   while (ncams > 0) rr_cam_release(&cams[--ncams]);
   /* The methods write triangle indices; users see ids (scene.h), which differ after

@@ -59,7 +59,27 @@ typedef struct trav {
   uint32_t pend[PEND_DRAW + BVH_MAX_LEAF];
   uint32_t npend;
   tile_rect pend_r;
+  /* A cube camera in one pass (render_ctx.faces): c, cams, vb, hz and the charges
+   * point at face `face`'s (use_face); face f at position s is face_cams[f·ns + s],
+   * at position 0 also face_cams0[f] (for the setups, which share the eye). */
+  int faces, face;
+  const camera *face_cams, *face_cams0;
+  visbuf *face_vb;
+  hiz *face_hz;
+  float *face_heat_e, *face_heat_n;
+  int face_rows; /* rows of the stack of faces the root pass sorts into bands, per face */
 } trav;
+
+/* Points t at face f of a cube camera drawn in one pass (nothing otherwise). */
+static void use_face(trav *t, int f) {
+  if (!t->faces || t->face == f) return;
+  const size_t n = (size_t)t->face_vb[0].width * t->face_vb[0].height;
+  t->face = f;
+  t->c = t->cams = &t->face_cams[f * t->ns];
+  t->vb = &t->face_vb[f];
+  t->hz = &t->face_hz[f];
+  if (t->heat_e) t->heat_e = t->face_heat_e + f * n, t->heat_n = t->face_heat_n + f * n;
+}
 
 /* ---- rasterizing one triangle into a frustum ---------------------------- */
 
@@ -69,6 +89,8 @@ typedef struct tri_job {
   _Alignas(64) tri_setup ts; /* (not used by an analytic primitive) */
   uint32_t id;
   bool ana;        /* an analytic primitive (prim/analytic.h): its own test, bounds and floor */
+  uint8_t face;    /* a cube camera in one pass: the face (trav.faces), whose rows start */
+  int face_y;      /* at face_y in the stack of faces the pass sorts into bands */
   float zmin;      /* a floor under any t computed for the triangle (0: none known) */
   int bb[4];       /* inclusive screen bounds */
   union {
@@ -145,6 +167,51 @@ static int cone_rejects(trav *t, const tri_job *j, tile_rect b) {
   return rays ? 1 : -1;
 }
 
+/* Curved views whose map bends boundedly (camera.bend_x, bend_y: the polar maps):
+ * over a bin of samples spanning hx × hy, an edge function V = n·d differs from the
+ * bilinear interpolation of its four corner values by at most
+ * |n| (bend_x·hx² + bend_y·hy²) / 8 (the error of linear interpolation, along x
+ * then y), and that interpolation never exceeds the greatest corner value. An edge
+ * whose corner values all lie below minus that, and minus the rounding of the
+ * stored rays and of the sample test (1e-5 |n| |d|), is negative at every sample
+ * of the bin (paper sect. 4.1: the corners shifted by the bend). The bound shrinks
+ * with the square of the bin, where a cone shrinks with its side. 1: rejected,
+ * 0: kept, -1: no rays in the bin (wholly outside the disk). */
+static int bend_rejects(trav *t, const tri_job *j, tile_rect b) {
+  const camera *c = t->c;
+  const double xs[2] = {(double)b.x0 + t->span[0], (double)(b.x1 - 1) + t->span[2]};
+  const double ys[2] = {(double)b.y0 + t->span[1], (double)(b.y1 - 1) + t->span[3]};
+  if (c->type != RR_CAMERA_LATLONG) { /* the disk: the bin's point nearest the centre */
+    double u0 = 2 * xs[0] / c->width - 1, u1 = 2 * xs[1] / c->width - 1;
+    double v0 = 1 - 2 * ys[1] / c->height, v1 = 1 - 2 * ys[0] / c->height;
+    double u = u0 > 0 ? u0 : u1 < 0 ? u1 : 0, v = v0 > 0 ? v0 : v1 < 0 ? v1 : 0;
+    if (u * u + v * v > 1 + 1e-6) return -1;
+  }
+  double d[4][3];
+  for (int k = 0; k < 4; k++) rr_cam_dir_at(c, xs[k & 1], ys[k >> 1], d[k]);
+  const double hx = xs[1] - xs[0], hy = ys[1] - ys[0];
+  const double bend = (c->bend_x * hx * hx + c->bend_y * hy * hy) / 8, round = 1e-5 * c->dir_len_max;
+  t->st.edge_evals += 4;
+  heat_charge_corners(t->heat_e, t->vb->width, b.x0, b.y0, b.x1, b.y1);
+  /* the three edges, and their sum Σ w_i n_i: a hit needs Σ w_i e_i > 0 too, and
+   * where each edge is only a little negative (around the triangle's antipode,
+   * which every one of its great circles passes near) the sum is strongly so; its
+   * rounding is that of the three edge values */
+  double n[4][3] = {{0}}, lim[4];
+  for (int e = 0; e < 3; e++) {
+    n[e][0] = j->ts.a[e], n[e][1] = j->ts.b[e], n[e][2] = j->ts.c[e];
+    for (int a = 0; a < 3; a++) n[3][a] += j->ts.w[e] * n[e][a];
+    lim[e] = -(bend + round) * j->cone.len[e];
+  }
+  lim[3] = -bend * j->cone.len[3] - round * (j->cone.len[0] + j->cone.len[1] + j->cone.len[2]);
+  for (int e = 0; e < 4; e++) {
+    bool all_out = true;
+    for (int k = 0; k < 4 && all_out; k++) all_out = n[e][0] * d[k][0] + n[e][1] * d[k][1] + n[e][2] * d[k][2] < lim[e];
+    if (all_out) return 1;
+  }
+  return 0;
+}
+
 /* Hierarchical binning: a bin is rejected when one edge function is negative at
  * all four corners of its samples (the edges are linear in the sample position
  * for planar cameras; with several positions, the corners of their extent) or when
@@ -157,7 +224,9 @@ static uint64_t bin_raster(trav *t, const tri_job *j, const tri_moves *mv, tile_
     for (int bx = r.x0 - r.x0 % size; bx < r.x1; bx += size) {
       tile_rect b = {bx > r.x0 ? bx : r.x0, by > r.y0 ? by : r.y0, bx + size < r.x1 ? bx + size : r.x1,
                      by + size < r.y1 ? by + size : r.y1};
-      if (size <= t->o->bin_min || (b.x1 - b.x0) * (b.y1 - b.y0) <= 4) {
+      /* small bins go to the samples: a curved bin's test costs as much as about
+       * sixteen samples (four rays in double, sines for the lat-long and fisheye) */
+      if (size <= t->o->bin_min || (b.x1 - b.x0) * (b.y1 - b.y0) <= (t->c->planar ? 4 : 16)) {
         covered += raster_samples(t, j, mv, b);
         continue;
       }
@@ -177,7 +246,10 @@ static uint64_t bin_raster(trav *t, const tri_job *j, const tri_moves *mv, tile_
         t->st.edge_evals += 4;
         heat_charge_corners(t->heat_e, t->vb->width, b.x0, b.y0, b.x1, b.y1);
       } else {
+        /* the cone (with the triangle's cap: slivers seen edge-on, whose three
+         * planes nearly coincide, are bounded by it alone), then the bend */
         int rejects = cone_rejects(t, j, b);
+        if (rejects == 0 && t->c->bend_x > 0 && !j->ana) rejects = bend_rejects(t, j, b);
         if (rejects < 0) continue; /* no rays here: nothing to refine */
         out = rejects > 0;
       }
@@ -226,7 +298,7 @@ static float max_pa(const trav *t, const tri_job *j) {
 /* Completes a set-up triangle j with what binning and early-z need. */
 static void finish_setup(const trav *t, uint32_t id, tri_job *j) {
   const camera *c = t->c;
-  j->id = id, j->ana = false;
+  j->id = id, j->ana = false, j->face = (uint8_t)t->face, j->face_y = t->face * t->face_rows;
   if (!t->o->binning) return;
   if (c->planar) {
     float zmin = INFINITY;
@@ -322,15 +394,72 @@ static uint32_t setup_analytic(trav *t, uint32_t first, const uint32_t *ids, uin
     tri_job *j = out + kept;
     t->st.setups++;
     if (!rr_ana_screen_bounds(t->s, id, t->c, j->bb) || (r && !meets(j->bb, *r))) continue;
-    j->id = id, j->ana = true;
+    j->id = id, j->ana = true, j->face = (uint8_t)t->face, j->face_y = t->face * t->face_rows;
     j->zmin = rr_ana_t_floor(t->s, id, t->c);
     kept++;
   }
   return kept;
 }
 
+/* A cube camera's triangles first..first+n-1 (trav.faces): each one's rectangle in
+ * every face from its corners, then, for those that meet a face, the part of the
+ * setup that depends on the eye once and the rest for each face met
+ * (rr_tri_setup_views): one job per triangle and face, S once per triangle. */
+static uint32_t setup_faces(trav *t, uint32_t first, uint32_t n, tri_job *out) {
+  enum { GROUP = 64 };
+  uint32_t kept = 0;
+  for (uint32_t g = first; g < first + n; g += GROUP) {
+    const uint32_t m = first + n - g < GROUP ? first + n - g : GROUP;
+    tri_bound b[6][GROUP];
+    uint8_t views[GROUP] = {0}, slot[6][GROUP];
+    for (int f = 0; f < 6; f++) {
+      uint32_t nb = rr_tri_corner_bounds_at(t->s, g, NULL, m, &t->face_cams[f * t->ns], t->ns, t->pos, t->simd, b[f]);
+      for (uint32_t k = 0; k < nb; k++) views[b[f][k].id - g] |= (uint8_t)(1u << f), slot[f][b[f][k].id - g] = (uint8_t)k;
+    }
+    uint32_t ids[GROUP];
+    uint8_t v[GROUP], at[GROUP];
+    int q = 0;
+    for (uint32_t i = 0; i < m; i++)
+      if (views[i]) ids[q] = g + i, v[q] = views[i], at[q++] = (uint8_t)i;
+    if (!q) continue;
+    t->st.setups += (uint64_t)q;
+    tri_setup ts[6 * GROUP];
+    int face[6 * GROUP];
+    tri_plane pls[6 * GROUP], *pl = t->ns > 1 ? pls : NULL;
+    rr_tri_setup_views(t->s, ids, q, t->face_cams0, 6, v, t->cull_back, t->simd, ts, face, pl);
+    for (int f = 0; f < 6; f++)
+      for (int i = 0; i < q; i++) {
+        const int k = f * q + i;
+        if (face[k] == SETUP_CULLED) continue;
+        const tri_bound *tb = &b[f][slot[f][at[i]]];
+        tri_job *j = out + kept++;
+        use_face(t, f);
+        j->ts = ts[k];
+        if (pl) j->pl = pl[k], j->pos = tb->pos;
+        memcpy(j->bb, tb->bb, sizeof j->bb);
+        finish_setup(t, ids[i], j);
+      }
+  }
+  if (t->s->kind) { /* analytic primitives: bounded in every face, S once */
+    for (uint32_t id = first; id < first + n; id++) {
+      if (scene_kind(t->s, id) == RR_GEOMETRY_TRIANGLE) continue;
+      t->st.setups++;
+      for (int f = 0; f < 6; f++) {
+        use_face(t, f);
+        tri_job *j = out + kept;
+        if (!rr_ana_screen_bounds(t->s, id, t->c, j->bb)) continue;
+        j->id = id, j->ana = true, j->face = (uint8_t)f, j->face_y = f * t->face_rows;
+        j->zmin = rr_ana_t_floor(t->s, id, t->c);
+        kept++;
+      }
+    }
+  }
+  return kept;
+}
+
 static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
                                 tri_bound *scratch, tri_job *out) {
+  if (t->faces) return setup_faces(t, first, n, out);
   uint32_t kept = setup_tris(t, first, ids, n, r, scratch, out);
   return t->s->kind ? kept + setup_analytic(t, first, ids, n, r, out + kept) : kept;
 }
@@ -363,7 +492,10 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
 /* Rasterizes a prepared triangle into the samples r, with its setup moved to
  * each position (mv; NULL for one position). */
 KERNEL void draw_rect(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r) {
-  if (t->o->binning) bin_raster(t, j, mv, r, t->o->bin_size);
+  /* Curved views start from bins of at most 16² samples: the bend bound grows with
+   * the square of the bin, and a lat-long bin of 64² spans a quarter of the sphere. */
+  if (t->o->binning)
+    bin_raster(t, j, mv, r, !t->c->planar && t->c->bend_x > 0 && t->o->bin_size > 16 ? 16 : t->o->bin_size);
   else raster_samples(t, j, mv, r);
 }
 
@@ -687,11 +819,14 @@ static uint32_t root_setup(void *arg, int thread, uint32_t first, uint32_t n, vo
 
 static void root_rows(const void *prim, int *y0, int *y1) {
   const tri_job *j = prim;
-  *y0 = j->bb[1], *y1 = j->bb[3];
+  *y0 = j->bb[1] + j->face_y, *y1 = j->bb[3] + j->face_y;
 }
 
-KERNEL void draw_rows(void *t, const void *j, int y0, int y1) {
-  draw(t, j, (tile_rect){0, y0, ((trav *)t)->vb->width, y1});
+KERNEL void draw_rows(void *state, const void *prim, int y0, int y1) {
+  trav *t = state;
+  const tri_job *j = prim;
+  use_face(t, j->face);
+  draw(t, j, (tile_rect){0, y0 - j->face_y, t->vb->width, y1 - j->face_y});
 }
 
 static void root_band(int b, int thread, void *arg) {
@@ -708,9 +843,9 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
   rp->proto = *proto;
   sortmiddle sm = {.arg = rp,
                    .size = sizeof(tri_job),
-                   .batch = ROOT_BATCH,
+                   .batch = proto->faces ? ROOT_BATCH / 4 : ROOT_BATCH,
                    .chunk = ROOT_CHUNK,
-                   .out_max = 1,
+                   .out_max = proto->faces ? 6 : 1, /* a cube's triangle meets at most five faces */
                    .setup = root_setup,
                    .rows = root_rows,
                    .band = root_band,
@@ -718,7 +853,11 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
   /* blocks of whole top-level bins, else of 8 z tiles */
   const oracles *o = ctx->oracles;
   int align = o->binning && o->bin_size > HIZ ? (o->bin_size + HIZ - 1) / HIZ * HIZ : 8 * HIZ;
-  bool ok = rr_sortmiddle(&sm, ctx->scene->ntris, ctx->vb->height, align, ctx->threads);
+  /* a cube's faces stacked, each from a block's first row: no block, z tile or bin
+   * holds rows of two faces */
+  int height = ctx->vb->height;
+  if (proto->faces) rp->proto.face_rows = (height + align - 1) / align * align, height = 6 * rp->proto.face_rows;
+  bool ok = rr_sortmiddle(&sm, ctx->scene->ntris, height, align, ctx->threads);
   for (int i = 0; i < RR_MAX_THREADS; i++) add_stats(ctx->stats, &rp->st[i]);
   free(rp);
   return ok ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for triangle setups");
@@ -755,10 +894,20 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
   if (ctx->scene->ntris == 0) return RR_OK; /* nothing to see: the cleared buffer is the image */
   if (!ctx->scene->bvh && o->leaves)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "this method needs the scene's BVH (call rr_scene_commit)");
-  hiz hz;
-  if (!rr_hiz_init(&hz, vb, HIZ_SHIFT, 1))
-    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the hierarchical z-buffer");
-  hz.layers = ctx->samples; /* a tile's farthest depth over every position */
+  if (ctx->faces && (o->leaves || ctx->faces != 6))
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED, "a cube's faces in one pass are drawn from the root only");
+  /* z tiles: one set per face of a cube drawn in one pass */
+  hiz hz[6];
+  const int nhz = ctx->faces ? 6 : 1;
+  camera cams0[6];
+  for (int f = 0; f < nhz; f++) {
+    if (!rr_hiz_init(&hz[f], ctx->faces ? &ctx->face_vb[f] : vb, HIZ_SHIFT, 1)) {
+      while (f > 0) rr_hiz_free(&hz[--f]);
+      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the hierarchical z-buffer");
+    }
+    hz[f].layers = ctx->samples; /* a tile's farthest depth over every position */
+    if (ctx->faces) cams0[f] = ctx->face_cams[f * ctx->samples];
+  }
   trav proto = {.s = ctx->scene,
                 .c = ctx->cam,
                 .cams = ctx->cams,
@@ -768,9 +917,19 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
                 .cull_back = ctx->opt->cull_backfaces != 0,
                 .simd = !ctx->opt->scalar,
                 .hiz_used = o->cull_occluded || (o->binning && o->early_z),
-                .hz = &hz,
+                .hz = &hz[0],
                 .heat_e = ctx->heat_e,
-                .heat_n = ctx->heat_n};
+                .heat_n = ctx->heat_n,
+                .faces = ctx->faces,
+                .face_cams = ctx->face_cams,
+                .face_cams0 = cams0,
+                .face_vb = ctx->face_vb,
+                .face_hz = hz,
+                .face_heat_e = ctx->face_heat_e,
+                .face_heat_n = ctx->face_heat_n};
+  if (ctx->faces) /* face 0 to start with */
+    proto.c = proto.cams = ctx->face_cams, proto.vb = &ctx->face_vb[0],
+    proto.heat_e = ctx->face_heat_e, proto.heat_n = ctx->face_heat_n;
   proto.span[0] = proto.span[2] = ctx->cams[0].sx0, proto.span[1] = proto.span[3] = ctx->cams[0].sy0;
   for (int s = 0; s < ctx->samples; s++) proto.pos[s][0] = ctx->cams[s].sx0, proto.pos[s][1] = ctx->cams[s].sy0;
   for (int s = 0; s < RR_MAX_SAMPLES; s++)
@@ -788,7 +947,7 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
      * writers); frustum_size forces a tile size. */
     trav_job *tj = calloc(1, sizeof *tj);
     if (!tj) {
-      rr_hiz_free(&hz);
+      rr_hiz_free(&hz[0]);
       return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the traversal");
     }
     int whole = vb->width > vb->height ? vb->width : vb->height;
@@ -805,6 +964,6 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
     for (int i = 0; i < RR_MAX_THREADS; i++) add_stats(ctx->stats, &tj->st[i]);
     free(tj);
   }
-  rr_hiz_free(&hz);
+  for (int f = 0; f < nhz; f++) rr_hiz_free(&hz[f]);
   return err;
 }

@@ -104,6 +104,13 @@ typedef struct render_ctx {
   float *heat_e, *heat_n; /* optional per-pixel E and N charges */
   const struct oracles *oracles; /* the traversal's settings, for the 3dr methods */
   progress_span progress;        /* this pass's share of the frame's progress: for its main loop */
+  /* A cube camera drawn in one pass (render.c, rr_vis_traverse): its 6 faces, else 0;
+   * face f at position s is the perspective camera face_cams[f·samples + s], drawn
+   * into face_vb[f] (samples layers of F × F) and charging face_heat_e/n + f·F². */
+  int faces;
+  const camera *face_cams;
+  visbuf *face_vb;
+  float *face_heat_e, *face_heat_n;
 } render_ctx;
 
 /* The oracles of the continuum's traversal (paper Fig. 8), as settings. */
