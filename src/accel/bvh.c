@@ -518,20 +518,22 @@ static double node_area(const bvh_node *n) {
  * used (or only leaves are left). Returns how many. */
 static uint32_t open_slots(const rr_bvh *b, uint32_t k, uint32_t width, uint32_t *slot) {
   uint32_t n = 0;
+  double area[8]; /* per slot: its area, or -1 for a leaf (never opened) */
   const bvh_node *nk = &b->nodes[k];
   if (nk->count) slot[n++] = k; /* a leaf root */
   else slot[n++] = nk->first, slot[n++] = nk->first + 1;
+  for (uint32_t i = 0; i < n; i++) area[i] = b->nodes[slot[i]].count ? -1 : node_area(&b->nodes[slot[i]]);
   while (n < width) {
     int open = -1;
     double best = -1;
-    for (uint32_t i = 0; i < n; i++) {
-      const bvh_node *c = &b->nodes[slot[i]];
-      if (!c->count && node_area(c) > best) best = node_area(c), open = (int)i;
-    }
+    for (uint32_t i = 0; i < n; i++)
+      if (area[i] > best) best = area[i], open = (int)i;
     if (open < 0) break;
     uint32_t first = b->nodes[slot[open]].first;
-    for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1];
+    for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1], area[i] = area[i - 1];
     slot[open] = first, slot[open + 1] = first + 1, n++;
+    for (uint32_t i = (uint32_t)open; i < (uint32_t)open + 2; i++)
+      area[i] = b->nodes[slot[i]].count ? -1 : node_area(&b->nodes[slot[i]]);
   }
   return n;
 }
@@ -558,6 +560,20 @@ static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
   }
 }
 
+/* The corners of the triangles prims[first .. first + count) into v: corner k's
+ * axis x of the j-th at v[(3k + x)·count + j] (the layout of rr_bvh.leaf_v). */
+static void copy_corners(const rr_scene *s, const uint32_t *prims, uint32_t first, uint32_t count, float *v) {
+  const float *p[9]; /* in locals: the stores into v cannot change them */
+  for (int m = 0; m < 9; m++) p[m] = s->p[m / 3][m % 3];
+  for (uint32_t j = 0; j < count; j++) {
+    uint32_t t = prims[first + j];
+    float *o = v + j;
+    o[0] = p[0][t], o[count] = p[1][t], o[2 * count] = p[2][t];
+    o[3 * count] = p[3][t], o[4 * count] = p[4][t], o[5 * count] = p[5][t];
+    o[6 * count] = p[6][t], o[7 * count] = p[7][t], o[8 * count] = p[8][t];
+  }
+}
+
 /* The corners of the leaves' triangles, leaf by leaf (rr_bvh.leaf_v). */
 static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
   size_t n = (size_t)9 * b->nprims;
@@ -566,9 +582,7 @@ static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
   memset(b->leaf_v + n, 0, BVH_LEAF_PAD * sizeof(float));
   for (uint32_t i = 0; i < b->nnodes; i++) {
     const bvh_node *nd = &b->nodes[i];
-    float *v = b->leaf_v + (size_t)9 * nd->first;
-    for (uint32_t m = 0; nd->count && m < 9; m++)
-      for (uint32_t j = 0; j < nd->count; j++) v[m * nd->count + j] = s->p[m / 3][m % 3][b->prims[nd->first + j]];
+    if (nd->count) copy_corners(s, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
   }
   return true;
 }
@@ -633,17 +647,21 @@ static bool leaf8(const wide8_build *j, uint32_t c) {
 static uint32_t open_slots8(const wide8_build *j, uint32_t k, uint32_t *slot) {
   const bvh_node *nodes = j->b->nodes;
   uint32_t n = 0;
+  double area[8]; /* per slot: its area, or -1 for a leaf of wide8 (never opened) */
   if (leaf8(j, k)) slot[n++] = k; /* a leaf root */
   else slot[n++] = nodes[k].first, slot[n++] = nodes[k].first + 1;
+  for (uint32_t i = 0; i < n; i++) area[i] = leaf8(j, slot[i]) ? -1 : node_area(&nodes[slot[i]]);
   while (n < 8) {
     int open = -1;
     double best = -1;
     for (uint32_t i = 0; i < n; i++)
-      if (!leaf8(j, slot[i]) && node_area(&nodes[slot[i]]) > best) best = node_area(&nodes[slot[i]]), open = (int)i;
+      if (area[i] > best) best = area[i], open = (int)i;
     if (open < 0) break;
     uint32_t first = nodes[slot[open]].first;
-    for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1];
+    for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1], area[i] = area[i - 1];
     slot[open] = first, slot[open + 1] = first + 1, n++;
+    for (uint32_t i = (uint32_t)open; i < (uint32_t)open + 2; i++)
+      area[i] = leaf8(j, slot[i]) ? -1 : node_area(&nodes[slot[i]]);
   }
   return n;
 }
@@ -661,9 +679,7 @@ static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
     uint32_t c = slot[i];
     if (leaf8(j, c)) { /* a leaf: its corners as leaf_v's */
       uint32_t first = j->first[c], count = j->count[c];
-      float *v = b->leaf_v8 + (size_t)9 * first;
-      for (uint32_t m = 0; m < 9; m++)
-        for (uint32_t t = 0; t < count; t++) v[m * count + t] = j->s->p[m / 3][m % 3][b->prims[first + t]];
+      copy_corners(j->s, b->prims, first, count, b->leaf_v8 + (size_t)9 * first);
       wn->ref[i] = first, wn->count[i] = count;
     } else {
       wn->ref[i] = j->next++;
@@ -737,6 +753,22 @@ static double sah_cost(const struct rr_bvh *b) {
   double x = (double)r->hi[0] - r->lo[0], y = (double)r->hi[1] - r->lo[1], z = (double)r->hi[2] - r->lo[2];
   double ra = x * y + y * z + z * x;
   return ra > 0 ? sum / ra : 0;
+}
+
+/* The copies made from the finished binary tree, side by side: each reads the
+ * tree and writes its own arrays. */
+typedef struct {
+  rr_bvh *b;
+  const rr_scene *s;
+  bool ok[3];
+} finish_job;
+
+static void finish_part(int part, int thread, void *arg) {
+  (void)thread;
+  finish_job *j = arg;
+  if (part == 0) j->ok[0] = collapse_wide8(j->b, j->s); /* the biggest first */
+  else if (part == 1) j->ok[1] = collapse_wide(j->b);
+  else j->ok[2] = copy_leaf_corners(j->b, j->s), j->b->sah_cost = sah_cost(j->b);
 }
 
 rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out) {
@@ -880,9 +912,9 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   for (uint32_t i = 0; i < small.n; i++)
     if (small.v[i].buf)
       for (uint32_t k = small.v[i].start; k < small.v[i].start + small.v[i].count; k++) b->prims[k] = bd.buf[1][k].id;
-  if (!collapse_wide(b) || !collapse_wide8(b, s)) goto oom;
-  if (!copy_leaf_corners(b, s)) goto oom;
-  b->sah_cost = sah_cost(b);
+  finish_job fj = {b, s, {false, false, false}};
+  rr_parallel_for(3, bd.threads, finish_part, &fj);
+  if (!fj.ok[0] || !fj.ok[1] || !fj.ok[2]) goto oom;
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
              (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) +
              (uint64_t)b->nwide8 * sizeof(bvh_wide8) + 2 * ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
