@@ -31,12 +31,14 @@ enum {
 #define BVH_COST_NODE 1.0
 #define BVH_COST_TRI 1.0
 
-/* A triangle reference: its bounds; the id sits in a lane that is masked off. */
+/* A triangle reference: its bounds; the id and the bins sit in lanes that are
+ * masked off. bin: its bin on each axis, as the binning of the range it is in put
+ * it, so that the partition that follows need not bin it again. */
 typedef struct {
   float lo[3];
   uint32_t id;
   float hi[3];
-  uint32_t pad;
+  uint8_t bin[4];
 } pref;
 
 typedef struct {
@@ -116,13 +118,15 @@ static void bins_clear(bins *b, int nb) {
     for (int i = 0; i < nb; i++) b->box[a][i] = box_empty(), b->n[a][i] = 0;
 }
 
-static void bin_range(const pref *r, uint32_t n, const binmap *m, bins *b) {
+/* Bins a range, noting each reference's bins in it (pref.bin). */
+static void bin_range(pref *r, uint32_t n, const binmap *m, bins *b) {
   bins_clear(b, m->nb);
   for (uint32_t i = 0; i < n; i++) {
     rr_vf4 lo, hi;
     ref_load(&r[i], &lo, &hi);
     rr_vi4 idx = bin_of(m, centroid(lo, hi));
     int i0 = idx[0], i1 = idx[1], i2 = idx[2]; /* the three axes written out: no loop to run */
+    r[i].bin[0] = (uint8_t)i0, r[i].bin[1] = (uint8_t)i1, r[i].bin[2] = (uint8_t)i2;
     box_grow(&b->box[0][i0], lo, hi), b->n[0][i0]++;
     box_grow(&b->box[1][i1], lo, hi), b->n[1][i1]++;
     box_grow(&b->box[2][i2], lo, hi), b->n[2][i2]++;
@@ -185,13 +189,12 @@ static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, doub
   return found;
 }
 
-/* Whether a reference goes right of the split (bin >= pos on `axis`); *c is its centroid. */
-static inline bool ref_right(const pref *r, const binmap *m, int axis, int pos, rr_vf4 *c) {
+/* Whether a binned reference goes right of the split (bin >= pos on `axis`); *c is its centroid. */
+static inline bool ref_right(const pref *r, int axis, int pos, rr_vf4 *c) {
   rr_vf4 lo, hi;
   ref_load(r, &lo, &hi);
   *c = centroid(lo, hi);
-  rr_vi4 idx = bin_of(m, *c);
-  return idx[axis] >= pos;
+  return r->bin[axis] >= pos;
 }
 
 /* Bounds and centroid bounds of a range. */
@@ -208,13 +211,13 @@ static void range_bounds(const pref *r, uint32_t n, box4 *box, box4 *cbox) {
 
 /* In-place partition of a small range (one thread): left = bin < pos. Two-sided:
  * each reference is looked at once, and only those on the wrong side move. */
-static uint32_t partition_small(pref *r, uint32_t n, const binmap *m, int axis, int pos, box4 cb[2]) {
+static uint32_t partition_small(pref *r, uint32_t n, int axis, int pos, box4 cb[2]) {
   cb[0] = box_empty(), cb[1] = box_empty();
   uint32_t i = 0, j = n;
   for (;;) {
     rr_vf4 ci = {0}, cj = {0}; /* set by the scans before use */
-    while (i < j && !ref_right(&r[i], m, axis, pos, &ci)) box_grow(&cb[0], ci, ci), i++;
-    while (i < j && ref_right(&r[j - 1], m, axis, pos, &cj)) box_grow(&cb[1], cj, cj), j--;
+    while (i < j && !ref_right(&r[i], axis, pos, &ci)) box_grow(&cb[0], ci, ci), i++;
+    while (i < j && ref_right(&r[j - 1], axis, pos, &cj)) box_grow(&cb[1], cj, cj), j--;
     if (i == j) return i;
     /* r[i] goes right and r[j - 1] left (j - 1 > i: r[i] stopped the left scan) */
     pref tmp = r[i];
@@ -251,7 +254,7 @@ static void chunk_count(int c, int thread, void *arg) {
   uint32_t k = 0;
   for (uint32_t i = 0; i < n; i++) {
     rr_vf4 cen;
-    k += !ref_right(&r[i], j->m, j->axis, j->pos, &cen);
+    k += !ref_right(&r[i], j->axis, j->pos, &cen);
   }
   j->nleft[c] = k;
 }
@@ -267,7 +270,7 @@ static void chunk_scatter(int c, int thread, void *arg) {
   box4 cb[2] = {box_empty(), box_empty()};
   for (uint32_t i = 0; i < n; i++) {
     rr_vf4 cen;
-    int side = ref_right(&r[i], j->m, j->axis, j->pos, &cen);
+    int side = ref_right(&r[i], j->axis, j->pos, &cen);
     box_grow(&cb[side], cen, cen);
     out[side ? ri++ : li++] = r[i];
   }
@@ -362,7 +365,7 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
     free(job.nleft), free(job.offset), free(job.ccb);
   } else {
     box4 cb[2];
-    sp->mid = partition_small(bd->buf[t->buf] + t->start, t->count, &m, axis, pos, cb);
+    sp->mid = partition_small(bd->buf[t->buf] + t->start, t->count, axis, pos, cb);
     sp->l.cbox = cb[0], sp->r.cbox = cb[1];
   }
 children:
@@ -493,7 +496,7 @@ static void make_refs(int c, int thread, void *arg) {
     pref *r = &j->refs[i];
     if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE) rr_tri_box(s, i, r->lo, r->hi);
     else rr_ana_box(s, i, r->lo, r->hi);
-    r->id = i, r->pad = 0;
+    r->id = i, memset(r->bin, 0, sizeof r->bin);
     rr_vf4 lo, hi;
     ref_load(r, &lo, &hi);
     box_grow(&b, lo, hi);
@@ -564,7 +567,7 @@ static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
  * axis x of the j-th at v[(3k + x)·count + j] (the layout of rr_bvh.leaf_v). */
 static void copy_corners(const rr_scene *s, const uint32_t *prims, uint32_t first, uint32_t count, float *v) {
   const float *p[9]; /* in locals: the stores into v cannot change them */
-  for (int m = 0; m < 9; m++) p[m] = s->p[m / 3][m % 3];
+  memcpy(p, s->p, sizeof p);
   for (uint32_t j = 0; j < count; j++) {
     uint32_t t = prims[first + j];
     float *o = v + j;
