@@ -492,12 +492,22 @@ static void make_refs(int c, int thread, void *arg) {
   const rr_scene *s = j->s;
   uint32_t a = (uint32_t)c * BVH_CHUNK, e = s->ntris - a < BVH_CHUNK ? s->ntris : a + BVH_CHUNK;
   box4 b = box_empty(), cb = box_empty();
+  float *const *p = &s->p[0][0]; /* the nine coordinate arrays */
   for (uint32_t i = a; i < e; i++) {
     pref *r = &j->refs[i];
-    if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE) rr_tri_box(s, i, r->lo, r->hi);
-    else rr_ana_box(s, i, r->lo, r->hi);
-    r->id = i, memset(r->bin, 0, sizeof r->bin);
     rr_vf4 lo, hi;
+    if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE && !scene_inf(s, i)) {
+      /* rr_tri_box's fminf / fmaxf as lanes: the same bits for finite corners
+       * (the scene holds no others), an equal pair giving the second as both do */
+      rr_vf4 v0 = {p[0][i], p[1][i], p[2][i], 0}, v1 = {p[3][i], p[4][i], p[5][i], 0};
+      rr_vf4 v2 = {p[6][i], p[7][i], p[8][i], 0};
+      lo = rr_vf4_min(v0, rr_vf4_min(v1, v2)), hi = rr_vf4_max(v0, rr_vf4_max(v1, v2));
+      memcpy(r->lo, &lo, 12), memcpy(r->hi, &hi, 12);
+    } else {
+      if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE) rr_tri_box(s, i, r->lo, r->hi);
+      else rr_ana_box(s, i, r->lo, r->hi);
+    }
+    r->id = i, memset(r->bin, 0, sizeof r->bin);
     ref_load(r, &lo, &hi);
     box_grow(&b, lo, hi);
     rr_vf4 cen = centroid(lo, hi);
