@@ -127,7 +127,8 @@ static void bin_range(pref *r, uint32_t n, const binmap *m, bins *b) {
     rr_vf4 lo = rr_vf4_load(r[i].lo), hi = rr_vf4_load(r[i].hi);
     rr_vi4 idx = bin_of(m, centroid(lo, hi));
     int i0 = idx[0], i1 = idx[1], i2 = idx[2]; /* the three axes written out: no loop to run */
-    r[i].bin[0] = (uint8_t)i0, r[i].bin[1] = (uint8_t)i1, r[i].bin[2] = (uint8_t)i2;
+    uint8_t bin[4] = {(uint8_t)i0, (uint8_t)i1, (uint8_t)i2, 0};
+    memcpy(r[i].bin, bin, 4); /* one store */
     box_grow(&b->box[0][i0], lo, hi), b->n[0][i0]++;
     box_grow(&b->box[1][i1], lo, hi), b->n[1][i1]++;
     box_grow(&b->box[2][i2], lo, hi), b->n[2][i2]++;
@@ -167,23 +168,19 @@ static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, doub
   int nb = m->nb;
   for (int a = 0; a < 3; a++) {
     if (!m->ok[a]) continue;
+    /* Only splits at a nonempty bin i with triangles left of it are candidates,
+     * so the right costs are needed at nonempty bins only, and the left ones at
+     * candidates only; the first of equal candidates wins. */
     double rcost[BVH_MAX_BINS];
-    uint32_t rcnt[BVH_MAX_BINS];
     box4 acc = box_empty();
     uint32_t cnt = 0;
-    for (int i = nb - 1; i > 0; i--) {
+    for (int i = nb - 1; i > 0; i--)
       if (b->n[a][i]) box_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = half_area(acc) * cnt;
-      else rcost[i] = i + 1 < nb ? rcost[i + 1] : 0;
-      rcnt[i] = cnt;
-    }
     acc = box_empty(), cnt = 0;
-    double lcost = 0;
     for (int i = 1; i < nb; i++) {
-      if (b->n[a][i - 1]) box_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1], lcost = half_area(acc) * cnt;
-      /* Only splits at a bin boundary with triangles on both sides, and the first
-       * of equal candidates (a run of empty bins gives equal costs). */
-      if (!cnt || !rcnt[i] || !b->n[a][i]) continue;
-      double c = lcost + rcost[i];
+      box_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1]; /* an empty bin's box changes nothing */
+      if (!cnt || !b->n[a][i]) continue;
+      double c = half_area(acc) * cnt + rcost[i];
       if (!found || c < *cost) found = true, *cost = c, *axis = a, *pos = i;
     }
   }
