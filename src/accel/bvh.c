@@ -17,6 +17,7 @@
 
 #include "core/simd.h"
 
+#include <float.h>
 #include <string.h>
 
 enum {
@@ -70,7 +71,7 @@ static inline void box_merge(box4 *b, box4 o) { box_grow(b, o.lo, o.hi); }
 static inline double half_area(box4 b) {
   rr_vf4 e = b.hi - b.lo, p = e * rr_vf4_yzx(e);
   float a = p[0] + p[1] + p[2];
-  if (isfinite(a) && a >= 0) return a;
+  if (a >= 0 && a <= FLT_MAX) return a; /* finite (NaN fails both) */
   if (!(e[0] >= 0)) return 0; /* empty (or NaN) */
   double x = (double)b.hi[0] - b.lo[0], y = (double)b.hi[1] - b.lo[1], z = (double)b.hi[2] - b.lo[2];
   return x * y + y * z + z * x;
