@@ -434,6 +434,14 @@ static void build_subtree(int ti, int thread, void *arg) {
   (void)thread;
   sub_job *j = arg;
   node_vec *nv = &j->local[ti];
+  /* Room for the whole subtree at once (at most 2 count - 2 nodes below the root):
+   * no regrowing copies. */
+  nv->cap = 2 * j->tasks[ti].count;
+  nv->v = malloc((size_t)nv->cap * sizeof *nv->v);
+  if (!nv->v) {
+    nv->cap = 0, nv->oom = true;
+    return;
+  }
   task stack[2 * 128];
   int sp = 0;
   stack[sp++] = j->tasks[ti];
@@ -636,18 +644,21 @@ typedef struct {
   uint32_t next;           /* the next free node */
 } wide8_build;
 
-/* The prims under binary node k into j->first[k], j->count[k]; the count is left
- * 0 where they are not one range (never, for the builder's trees; checked). */
-static void subtree_range(wide8_build *j, uint32_t k) {
-  const bvh_node *n = &j->b->nodes[k];
-  if (n->count) {
-    j->first[k] = n->first, j->count[k] = n->count;
-    return;
+/* The prims under each binary node k into j->first[k], j->count[k]; the count is
+ * left 0 where they are not one range (never, for the builder's trees; checked).
+ * Children come after their parent in the builder's layout, so one backward pass
+ * sees them first. */
+static void subtree_ranges(wide8_build *j) {
+  for (uint32_t k = j->b->nnodes; k-- > 0;) {
+    const bvh_node *n = &j->b->nodes[k];
+    if (n->count) {
+      j->first[k] = n->first, j->count[k] = n->count;
+      continue;
+    }
+    uint32_t l = n->first, r = n->first + 1;
+    bool joined = j->count[l] && j->count[r] && j->first[l] + j->count[l] == j->first[r];
+    j->first[k] = j->first[l], j->count[k] = joined ? j->count[l] + j->count[r] : 0;
   }
-  uint32_t l = n->first, r = n->first + 1;
-  subtree_range(j, l), subtree_range(j, r);
-  bool joined = j->count[l] && j->count[r] && j->first[l] + j->count[l] == j->first[r];
-  j->first[k] = j->first[l], j->count[k] = joined ? j->count[l] + j->count[r] : 0;
 }
 
 /* Whether binary node c is a leaf of wide8: a leaf, or a subtree of at most four triangles. */
@@ -717,7 +728,7 @@ static bool collapse_wide8(rr_bvh *b, const rr_scene *s) {
   bool ok = j.first && j.count && b->leaf_v8;
   if (ok) {
     memset(b->leaf_v8 + nv, 0, BVH_LEAF_PAD * sizeof(float));
-    subtree_range(&j, 0);
+    subtree_ranges(&j);
     b->nwide8 = count_nodes8(&j, 0); /* counted first: no room to guess and trim */
     b->wide8 = alloc_lines((size_t)b->nwide8 * sizeof(bvh_wide8));
     ok = b->wide8 != NULL;
