@@ -127,7 +127,7 @@ static void bin_range(pref *r, uint32_t n, const binmap *m, bins *b) {
      * which nothing reads (half_area, store_box and the bins use lanes 0-2). */
     rr_vf4 lo = rr_vf4_load(r[i].lo), hi = rr_vf4_load(r[i].hi);
     rr_vi4 idx = bin_of(m, centroid(lo, hi));
-    int i0 = idx[0], i1 = idx[1], i2 = idx[2]; /* the three axes written out: no loop to run */
+    uint32_t i0 = (uint32_t)idx[0], i1 = (uint32_t)idx[1], i2 = (uint32_t)idx[2]; /* written out: no loop */
 #ifdef RR_SIMD_X86
     /* the four lanes packed to bytes (lane 3, garbage, saturates) and stored at once */
     __m128i pk = _mm_packs_epi32((__m128i)idx, (__m128i)idx);
