@@ -568,17 +568,18 @@ static uint32_t open_slots(const rr_bvh *b, uint32_t k, uint32_t width, uint32_t
 static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
   uint32_t slot[4], n = open_slots(b, k, 4, slot);
   bvh_wide *wn = &b->wide[w];
-  for (int i = 0; i < 4; i++) {
-    b->wide_node[4 * w + i] = i < (int)n ? slot[i] : UINT32_MAX;
-    for (int a = 0; a < 3; a++) {
-      wn->lo[a][i] = i < (int)n ? b->nodes[slot[i]].lo[a] : INFINITY;
-      wn->hi[a][i] = i < (int)n ? b->nodes[slot[i]].hi[a] : -INFINITY;
-    }
-    wn->ref[i] = i < (int)n ? 0 : UINT32_MAX, wn->count[i] = 0;
-    if (i >= (int)n) continue;
+  for (uint32_t i = n; i < 4; i++) { /* empty slots */
+    b->wide_node[4 * w + i] = UINT32_MAX;
+    for (int a = 0; a < 3; a++) wn->lo[a][i] = INFINITY, wn->hi[a][i] = -INFINITY;
+    wn->ref[i] = UINT32_MAX, wn->count[i] = 0;
+  }
+  for (uint32_t i = 0; i < n; i++) {
     const bvh_node *c = &b->nodes[slot[i]];
+    b->wide_node[4 * w + i] = slot[i];
+    for (int a = 0; a < 3; a++) wn->lo[a][i] = c->lo[a], wn->hi[a][i] = c->hi[a];
+    wn->count[i] = c->count;
     if (c->count) {
-      wn->ref[i] = c->first, wn->count[i] = c->count;
+      wn->ref[i] = c->first;
     } else {
       wn->ref[i] = (*next)++;
       collapse_node(b, wn->ref[i], slot[i], next);
