@@ -297,6 +297,37 @@ static void median_split(builder *bd, const task *t, split *sp) {
   range_bounds(r + sp->mid, t->count - sp->mid, &sp->r.box, &sp->r.cbox);
 }
 
+/* split_task for a range of two references, which is most of the bottom of the
+ * tree, without bins and with the same result. Their centroids span the centroid
+ * box, so on every axis with extent one is in bin 0 and the other in bin nb - 1:
+ * each such axis offers the one split (one reference each side) at the same cost,
+ * and the first such axis wins. */
+static void split_pair(builder *bd, const task *t, int nb, split *sp) {
+  pref *r = bd->buf[t->buf] + t->start;
+  binmap m = binmap_make(t->cbox, nb);
+  int axis = -1;
+  for (int a = 2; a >= 0; a--)
+    if (m.ok[a]) axis = a;
+  if (axis < 0) { /* no split found: a leaf, or split at the median */
+    if (t->count > (uint32_t)bd->leaf_size) median_split(bd, t, sp);
+    return;
+  }
+  box4 b[2];
+  ref_load(&r[0], &b[0].lo, &b[0].hi), ref_load(&r[1], &b[1].lo, &b[1].hi);
+  double cost = half_area(b[0]) * 1 + half_area(b[1]) * 1, area = half_area(t->box);
+  if (t->count <= (uint32_t)bd->leaf_size && BVH_COST_TRI * t->count * area <= BVH_COST_NODE * area + BVH_COST_TRI * cost)
+    return;
+  rr_vf4 c[2] = {centroid(b[0].lo, b[0].hi), centroid(b[1].lo, b[1].hi)};
+  int left = c[0][axis] < c[1][axis] ? 0 : 1; /* bin 0; they differ on an axis with extent */
+  if (left) {
+    pref tmp = r[0];
+    r[0] = r[1], r[1] = tmp;
+  }
+  sp->l.box = b[left], sp->r.box = b[!left];
+  sp->l.cbox = (box4){c[left], c[left]}, sp->r.cbox = (box4){c[!left], c[!left]};
+  sp->mid = 1;
+}
+
 /* Decides how to split t (or not) and partitions its references; `threads` only
  * says how many threads may help with a big range. Out of memory, t stays a leaf
  * and bd->oom is set. */
@@ -310,6 +341,10 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
     goto children;
   }
   int nb = bins_for(bd, t->count);
+  if (t->count == 2) {
+    split_pair(bd, t, nb, sp);
+    goto children;
+  }
   binmap m = binmap_make(t->cbox, nb);
   bins bins_local, *b = &bins_local;
   int nchunks = big ? (int)((t->count + BVH_CHUNK - 1) / BVH_CHUNK) : 1;
