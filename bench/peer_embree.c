@@ -12,6 +12,7 @@ struct peer_embree {
   uint32_t *sphere_ids; /* Embree's sphere primID k (geometry 1) is rastray's primitive sphere_ids[k] */
   atomic_llong bytes, peak; /* reported by Embree's memory monitor, from any of its threads */
   peer_embree_memory mem;
+  double build_cpu_ms; /* processor time of the process during rtcCommitScene */
 };
 
 /* Embree calls this before each allocation (bytes > 0) and after each release (< 0). */
@@ -91,15 +92,18 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
   }
   long long before = atomic_load(&e->bytes);
   atomic_store(&e->peak, before);
-  double t0 = rr_now_ms();
+  double t0 = rr_now_ms(), c0 = rr_cpu_ms();
   rtcCommitScene(e->scene);
   *build_ms = rr_now_ms() - t0;
+  e->build_cpu_ms = rr_cpu_ms() - c0;
   long long after = atomic_load(&e->bytes);
   e->mem = (peer_embree_memory){(double)after, (double)(after - before), (double)atomic_load(&e->peak)};
   return e;
 }
 
 peer_embree_memory peer_embree_bytes(const peer_embree *e) { return e->mem; }
+
+double peer_embree_build_cpu_ms(const peer_embree *e) { return e->build_cpu_ms; }
 
 void peer_embree_release(peer_embree *e) {
   if (!e) return;

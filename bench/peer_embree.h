@@ -19,6 +19,9 @@ typedef struct {
   double scene, bvh, build_peak;
 } peer_embree_memory;
 peer_embree_memory peer_embree_bytes(const peer_embree *e);
+/* Processor time of the whole process during the build (all threads; on a loaded
+ * machine steadier than the wall time, at one thread the same work). */
+double peer_embree_build_cpu_ms(const peer_embree *e);
 /* Casts one primary ray per pixel of camera c: width = 1 uses rtcIntersect1,
  * width = 8 rtcIntersect8 on 2x4-pixel packets; tiles dealt to `threads` threads.
  * Writes ids (RR_MISS on a miss) and t (+inf on a miss) in rastray's layout and

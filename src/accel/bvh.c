@@ -17,6 +17,7 @@
 
 #include "core/simd.h"
 
+#include <float.h>
 #include <string.h>
 
 enum {
@@ -31,12 +32,14 @@ enum {
 #define BVH_COST_NODE 1.0
 #define BVH_COST_TRI 1.0
 
-/* A triangle reference: its bounds; the id sits in a lane that is masked off. */
+/* A triangle reference: its bounds; the id and the bins sit in lanes that are
+ * masked off. bin: its bin on each axis, as the binning of the range it is in put
+ * it, so that the partition that follows need not bin it again. */
 typedef struct {
   float lo[3];
   uint32_t id;
   float hi[3];
-  uint32_t pad;
+  uint8_t bin[4];
 } pref;
 
 typedef struct {
@@ -68,7 +71,7 @@ static inline void box_merge(box4 *b, box4 o) { box_grow(b, o.lo, o.hi); }
 static inline double half_area(box4 b) {
   rr_vf4 e = b.hi - b.lo, p = e * rr_vf4_yzx(e);
   float a = p[0] + p[1] + p[2];
-  if (isfinite(a) && a >= 0) return a;
+  if (a >= 0 && a <= FLT_MAX) return a; /* finite (NaN fails both) */
   if (!(e[0] >= 0)) return 0; /* empty (or NaN) */
   double x = (double)b.hi[0] - b.lo[0], y = (double)b.hi[1] - b.lo[1], z = (double)b.hi[2] - b.lo[2];
   return x * y + y * z + z * x;
@@ -116,13 +119,23 @@ static void bins_clear(bins *b, int nb) {
     for (int i = 0; i < nb; i++) b->box[a][i] = box_empty(), b->n[a][i] = 0;
 }
 
-static void bin_range(const pref *r, uint32_t n, const binmap *m, bins *b) {
+/* Bins a range, noting each reference's bins in it (pref.bin). */
+static void bin_range(pref *r, uint32_t n, const binmap *m, bins *b) {
   bins_clear(b, m->nb);
   for (uint32_t i = 0; i < n; i++) {
-    rr_vf4 lo, hi;
-    ref_load(&r[i], &lo, &hi);
+    /* Lane 3 (id, bins) unmasked: it only reaches lanes 3 of the bin boxes,
+     * which nothing reads (half_area, store_box and the bins use lanes 0-2). */
+    rr_vf4 lo = rr_vf4_load(r[i].lo), hi = rr_vf4_load(r[i].hi);
     rr_vi4 idx = bin_of(m, centroid(lo, hi));
-    int i0 = idx[0], i1 = idx[1], i2 = idx[2]; /* the three axes written out: no loop to run */
+    uint32_t i0 = (uint32_t)idx[0], i1 = (uint32_t)idx[1], i2 = (uint32_t)idx[2]; /* written out: no loop */
+#ifdef RR_SIMD_X86
+    /* the four lanes packed to bytes (lane 3, garbage, saturates) and stored at once */
+    __m128i pk = _mm_packs_epi32((__m128i)idx, (__m128i)idx);
+    uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(pk, pk));
+    memcpy(r[i].bin, &packed, 4);
+#else
+    r[i].bin[0] = (uint8_t)i0, r[i].bin[1] = (uint8_t)i1, r[i].bin[2] = (uint8_t)i2;
+#endif
     box_grow(&b->box[0][i0], lo, hi), b->n[0][i0]++;
     box_grow(&b->box[1][i1], lo, hi), b->n[1][i1]++;
     box_grow(&b->box[2][i2], lo, hi), b->n[2][i2]++;
@@ -162,36 +175,31 @@ static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, doub
   int nb = m->nb;
   for (int a = 0; a < 3; a++) {
     if (!m->ok[a]) continue;
+    /* Only splits at a nonempty bin i with triangles left of it are candidates,
+     * so the right costs are needed at nonempty bins only, and the left ones at
+     * candidates only; the first of equal candidates wins. */
     double rcost[BVH_MAX_BINS];
-    uint32_t rcnt[BVH_MAX_BINS];
     box4 acc = box_empty();
     uint32_t cnt = 0;
-    for (int i = nb - 1; i > 0; i--) {
+    for (int i = nb - 1; i > 0; i--)
       if (b->n[a][i]) box_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = half_area(acc) * cnt;
-      else rcost[i] = i + 1 < nb ? rcost[i + 1] : 0;
-      rcnt[i] = cnt;
-    }
     acc = box_empty(), cnt = 0;
-    double lcost = 0;
     for (int i = 1; i < nb; i++) {
-      if (b->n[a][i - 1]) box_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1], lcost = half_area(acc) * cnt;
-      /* Only splits at a bin boundary with triangles on both sides, and the first
-       * of equal candidates (a run of empty bins gives equal costs). */
-      if (!cnt || !rcnt[i] || !b->n[a][i]) continue;
-      double c = lcost + rcost[i];
+      box_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1]; /* an empty bin's box changes nothing */
+      if (!cnt || !b->n[a][i]) continue;
+      double c = half_area(acc) * cnt + rcost[i];
       if (!found || c < *cost) found = true, *cost = c, *axis = a, *pos = i;
     }
   }
   return found;
 }
 
-/* Whether a reference goes right of the split (bin >= pos on `axis`); *c is its centroid. */
-static inline bool ref_right(const pref *r, const binmap *m, int axis, int pos, rr_vf4 *c) {
+/* Whether a binned reference goes right of the split (bin >= pos on `axis`); *c is its centroid. */
+static inline bool ref_right(const pref *r, int axis, int pos, rr_vf4 *c) {
   rr_vf4 lo, hi;
   ref_load(r, &lo, &hi);
   *c = centroid(lo, hi);
-  rr_vi4 idx = bin_of(m, *c);
-  return idx[axis] >= pos;
+  return r->bin[axis] >= pos;
 }
 
 /* Bounds and centroid bounds of a range. */
@@ -208,13 +216,13 @@ static void range_bounds(const pref *r, uint32_t n, box4 *box, box4 *cbox) {
 
 /* In-place partition of a small range (one thread): left = bin < pos. Two-sided:
  * each reference is looked at once, and only those on the wrong side move. */
-static uint32_t partition_small(pref *r, uint32_t n, const binmap *m, int axis, int pos, box4 cb[2]) {
+static uint32_t partition_small(pref *r, uint32_t n, int axis, int pos, box4 cb[2]) {
   cb[0] = box_empty(), cb[1] = box_empty();
   uint32_t i = 0, j = n;
   for (;;) {
     rr_vf4 ci = {0}, cj = {0}; /* set by the scans before use */
-    while (i < j && !ref_right(&r[i], m, axis, pos, &ci)) box_grow(&cb[0], ci, ci), i++;
-    while (i < j && ref_right(&r[j - 1], m, axis, pos, &cj)) box_grow(&cb[1], cj, cj), j--;
+    while (i < j && !ref_right(&r[i], axis, pos, &ci)) box_grow(&cb[0], ci, ci), i++;
+    while (i < j && ref_right(&r[j - 1], axis, pos, &cj)) box_grow(&cb[1], cj, cj), j--;
     if (i == j) return i;
     /* r[i] goes right and r[j - 1] left (j - 1 > i: r[i] stopped the left scan) */
     pref tmp = r[i];
@@ -251,7 +259,7 @@ static void chunk_count(int c, int thread, void *arg) {
   uint32_t k = 0;
   for (uint32_t i = 0; i < n; i++) {
     rr_vf4 cen;
-    k += !ref_right(&r[i], j->m, j->axis, j->pos, &cen);
+    k += !ref_right(&r[i], j->axis, j->pos, &cen);
   }
   j->nleft[c] = k;
 }
@@ -267,7 +275,7 @@ static void chunk_scatter(int c, int thread, void *arg) {
   box4 cb[2] = {box_empty(), box_empty()};
   for (uint32_t i = 0; i < n; i++) {
     rr_vf4 cen;
-    int side = ref_right(&r[i], j->m, j->axis, j->pos, &cen);
+    int side = ref_right(&r[i], j->axis, j->pos, &cen);
     box_grow(&cb[side], cen, cen);
     out[side ? ri++ : li++] = r[i];
   }
@@ -289,6 +297,37 @@ static void median_split(builder *bd, const task *t, split *sp) {
   range_bounds(r + sp->mid, t->count - sp->mid, &sp->r.box, &sp->r.cbox);
 }
 
+/* split_task for a range of two references, which is most of the bottom of the
+ * tree, without bins and with the same result. Their centroids span the centroid
+ * box, so on every axis with extent one is in bin 0 and the other in bin nb - 1:
+ * each such axis offers the one split (one reference each side) at the same cost,
+ * and the first such axis wins. */
+static void split_pair(builder *bd, const task *t, int nb, split *sp) {
+  pref *r = bd->buf[t->buf] + t->start;
+  binmap m = binmap_make(t->cbox, nb);
+  int axis = -1;
+  for (int a = 2; a >= 0; a--)
+    if (m.ok[a]) axis = a;
+  if (axis < 0) { /* no split found: a leaf, or split at the median */
+    if (t->count > (uint32_t)bd->leaf_size) median_split(bd, t, sp);
+    return;
+  }
+  box4 b[2];
+  ref_load(&r[0], &b[0].lo, &b[0].hi), ref_load(&r[1], &b[1].lo, &b[1].hi);
+  double cost = half_area(b[0]) * 1 + half_area(b[1]) * 1, area = half_area(t->box);
+  if (t->count <= (uint32_t)bd->leaf_size && BVH_COST_TRI * t->count * area <= BVH_COST_NODE * area + BVH_COST_TRI * cost)
+    return;
+  rr_vf4 c[2] = {centroid(b[0].lo, b[0].hi), centroid(b[1].lo, b[1].hi)};
+  int left = c[0][axis] < c[1][axis] ? 0 : 1; /* bin 0; they differ on an axis with extent */
+  if (left) {
+    pref tmp = r[0];
+    r[0] = r[1], r[1] = tmp;
+  }
+  sp->l.box = b[left], sp->r.box = b[!left];
+  sp->l.cbox = (box4){c[left], c[left]}, sp->r.cbox = (box4){c[!left], c[!left]};
+  sp->mid = 1;
+}
+
 /* Decides how to split t (or not) and partitions its references; `threads` only
  * says how many threads may help with a big range. Out of memory, t stays a leaf
  * and bd->oom is set. */
@@ -302,6 +341,10 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
     goto children;
   }
   int nb = bins_for(bd, t->count);
+  if (t->count == 2) {
+    split_pair(bd, t, nb, sp);
+    goto children;
+  }
   binmap m = binmap_make(t->cbox, nb);
   bins bins_local, *b = &bins_local;
   int nchunks = big ? (int)((t->count + BVH_CHUNK - 1) / BVH_CHUNK) : 1;
@@ -362,7 +405,7 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
     free(job.nleft), free(job.offset), free(job.ccb);
   } else {
     box4 cb[2];
-    sp->mid = partition_small(bd->buf[t->buf] + t->start, t->count, &m, axis, pos, cb);
+    sp->mid = partition_small(bd->buf[t->buf] + t->start, t->count, axis, pos, cb);
     sp->l.cbox = cb[0], sp->r.cbox = cb[1];
   }
 children:
@@ -432,6 +475,14 @@ static void build_subtree(int ti, int thread, void *arg) {
   (void)thread;
   sub_job *j = arg;
   node_vec *nv = &j->local[ti];
+  /* Room for the whole subtree at once (at most 2 count - 2 nodes below the root):
+   * no regrowing copies. */
+  nv->cap = 2 * j->tasks[ti].count;
+  nv->v = malloc((size_t)nv->cap * sizeof *nv->v);
+  if (!nv->v) {
+    nv->cap = 0, nv->oom = true;
+    return;
+  }
   task stack[2 * 128];
   int sp = 0;
   stack[sp++] = j->tasks[ti];
@@ -489,12 +540,22 @@ static void make_refs(int c, int thread, void *arg) {
   const rr_scene *s = j->s;
   uint32_t a = (uint32_t)c * BVH_CHUNK, e = s->ntris - a < BVH_CHUNK ? s->ntris : a + BVH_CHUNK;
   box4 b = box_empty(), cb = box_empty();
+  float *const *p = &s->p[0][0]; /* the nine coordinate arrays */
   for (uint32_t i = a; i < e; i++) {
     pref *r = &j->refs[i];
-    if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE) rr_tri_box(s, i, r->lo, r->hi);
-    else rr_ana_box(s, i, r->lo, r->hi);
-    r->id = i, r->pad = 0;
     rr_vf4 lo, hi;
+    if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE && !scene_inf(s, i)) {
+      /* rr_tri_box's fminf / fmaxf as lanes: the same bits for finite corners
+       * (the scene holds no others), an equal pair giving the second as both do */
+      rr_vf4 v0 = {p[0][i], p[1][i], p[2][i], 0}, v1 = {p[3][i], p[4][i], p[5][i], 0};
+      rr_vf4 v2 = {p[6][i], p[7][i], p[8][i], 0};
+      lo = rr_vf4_min(v0, rr_vf4_min(v1, v2)), hi = rr_vf4_max(v0, rr_vf4_max(v1, v2));
+      memcpy(r->lo, &lo, 12), memcpy(r->hi, &hi, 12);
+    } else {
+      if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE) rr_tri_box(s, i, r->lo, r->hi);
+      else rr_ana_box(s, i, r->lo, r->hi);
+    }
+    r->id = i, memset(r->bin, 0, sizeof r->bin);
     ref_load(r, &lo, &hi);
     box_grow(&b, lo, hi);
     rr_vf4 cen = centroid(lo, hi);
@@ -518,20 +579,22 @@ static double node_area(const bvh_node *n) {
  * used (or only leaves are left). Returns how many. */
 static uint32_t open_slots(const rr_bvh *b, uint32_t k, uint32_t width, uint32_t *slot) {
   uint32_t n = 0;
+  double area[8]; /* per slot: its area, or -1 for a leaf (never opened) */
   const bvh_node *nk = &b->nodes[k];
   if (nk->count) slot[n++] = k; /* a leaf root */
   else slot[n++] = nk->first, slot[n++] = nk->first + 1;
+  for (uint32_t i = 0; i < n; i++) area[i] = b->nodes[slot[i]].count ? -1 : node_area(&b->nodes[slot[i]]);
   while (n < width) {
     int open = -1;
     double best = -1;
-    for (uint32_t i = 0; i < n; i++) {
-      const bvh_node *c = &b->nodes[slot[i]];
-      if (!c->count && node_area(c) > best) best = node_area(c), open = (int)i;
-    }
+    for (uint32_t i = 0; i < n; i++)
+      if (area[i] > best) best = area[i], open = (int)i;
     if (open < 0) break;
     uint32_t first = b->nodes[slot[open]].first;
-    for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1];
+    for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1], area[i] = area[i - 1];
     slot[open] = first, slot[open + 1] = first + 1, n++;
+    for (uint32_t i = (uint32_t)open; i < (uint32_t)open + 2; i++)
+      area[i] = b->nodes[slot[i]].count ? -1 : node_area(&b->nodes[slot[i]]);
   }
   return n;
 }
@@ -540,21 +603,36 @@ static uint32_t open_slots(const rr_bvh *b, uint32_t k, uint32_t width, uint32_t
 static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
   uint32_t slot[4], n = open_slots(b, k, 4, slot);
   bvh_wide *wn = &b->wide[w];
-  for (int i = 0; i < 4; i++) {
-    b->wide_node[4 * w + i] = i < (int)n ? slot[i] : UINT32_MAX;
-    for (int a = 0; a < 3; a++) {
-      wn->lo[a][i] = i < (int)n ? b->nodes[slot[i]].lo[a] : INFINITY;
-      wn->hi[a][i] = i < (int)n ? b->nodes[slot[i]].hi[a] : -INFINITY;
-    }
-    wn->ref[i] = i < (int)n ? 0 : UINT32_MAX, wn->count[i] = 0;
-    if (i >= (int)n) continue;
+  for (uint32_t i = n; i < 4; i++) { /* empty slots */
+    b->wide_node[4 * w + i] = UINT32_MAX;
+    for (int a = 0; a < 3; a++) wn->lo[a][i] = INFINITY, wn->hi[a][i] = -INFINITY;
+    wn->ref[i] = UINT32_MAX, wn->count[i] = 0;
+  }
+  for (uint32_t i = 0; i < n; i++) {
     const bvh_node *c = &b->nodes[slot[i]];
+    b->wide_node[4 * w + i] = slot[i];
+    for (int a = 0; a < 3; a++) wn->lo[a][i] = c->lo[a], wn->hi[a][i] = c->hi[a];
+    wn->count[i] = c->count;
     if (c->count) {
-      wn->ref[i] = c->first, wn->count[i] = c->count;
+      wn->ref[i] = c->first;
     } else {
       wn->ref[i] = (*next)++;
       collapse_node(b, wn->ref[i], slot[i], next);
     }
+  }
+}
+
+/* The corners of the triangles prims[first .. first + count) into v: corner k's
+ * axis x of the j-th at v[(3k + x)·count + j] (the layout of rr_bvh.leaf_v). */
+static void copy_corners(const rr_scene *s, const uint32_t *prims, uint32_t first, uint32_t count, float *v) {
+  const float *p[9]; /* in locals: the stores into v cannot change them */
+  memcpy(p, s->p, sizeof p);
+  for (uint32_t j = 0; j < count; j++) {
+    uint32_t t = prims[first + j];
+    float *o = v + j;
+    o[0] = p[0][t], o[count] = p[1][t], o[2 * count] = p[2][t];
+    o[3 * count] = p[3][t], o[4 * count] = p[4][t], o[5 * count] = p[5][t];
+    o[6 * count] = p[6][t], o[7 * count] = p[7][t], o[8 * count] = p[8][t];
   }
 }
 
@@ -566,9 +644,7 @@ static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
   memset(b->leaf_v + n, 0, BVH_LEAF_PAD * sizeof(float));
   for (uint32_t i = 0; i < b->nnodes; i++) {
     const bvh_node *nd = &b->nodes[i];
-    float *v = b->leaf_v + (size_t)9 * nd->first;
-    for (uint32_t m = 0; nd->count && m < 9; m++)
-      for (uint32_t j = 0; j < nd->count; j++) v[m * nd->count + j] = s->p[m / 3][m % 3][b->prims[nd->first + j]];
+    if (nd->count) copy_corners(s, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
   }
   return true;
 }
@@ -610,18 +686,21 @@ typedef struct {
   uint32_t next;           /* the next free node */
 } wide8_build;
 
-/* The prims under binary node k into j->first[k], j->count[k]; the count is left
- * 0 where they are not one range (never, for the builder's trees; checked). */
-static void subtree_range(wide8_build *j, uint32_t k) {
-  const bvh_node *n = &j->b->nodes[k];
-  if (n->count) {
-    j->first[k] = n->first, j->count[k] = n->count;
-    return;
+/* The prims under each binary node k into j->first[k], j->count[k]; the count is
+ * left 0 where they are not one range (never, for the builder's trees; checked).
+ * Children come after their parent in the builder's layout, so one backward pass
+ * sees them first. */
+static void subtree_ranges(wide8_build *j) {
+  for (uint32_t k = j->b->nnodes; k-- > 0;) {
+    const bvh_node *n = &j->b->nodes[k];
+    if (n->count) {
+      j->first[k] = n->first, j->count[k] = n->count;
+      continue;
+    }
+    uint32_t l = n->first, r = n->first + 1;
+    bool joined = j->count[l] && j->count[r] && j->first[l] + j->count[l] == j->first[r];
+    j->first[k] = j->first[l], j->count[k] = joined ? j->count[l] + j->count[r] : 0;
   }
-  uint32_t l = n->first, r = n->first + 1;
-  subtree_range(j, l), subtree_range(j, r);
-  bool joined = j->count[l] && j->count[r] && j->first[l] + j->count[l] == j->first[r];
-  j->first[k] = j->first[l], j->count[k] = joined ? j->count[l] + j->count[r] : 0;
 }
 
 /* Whether binary node c is a leaf of wide8: a leaf, or a subtree of at most four triangles. */
@@ -633,17 +712,21 @@ static bool leaf8(const wide8_build *j, uint32_t c) {
 static uint32_t open_slots8(const wide8_build *j, uint32_t k, uint32_t *slot) {
   const bvh_node *nodes = j->b->nodes;
   uint32_t n = 0;
+  double area[8]; /* per slot: its area, or -1 for a leaf of wide8 (never opened) */
   if (leaf8(j, k)) slot[n++] = k; /* a leaf root */
   else slot[n++] = nodes[k].first, slot[n++] = nodes[k].first + 1;
+  for (uint32_t i = 0; i < n; i++) area[i] = leaf8(j, slot[i]) ? -1 : node_area(&nodes[slot[i]]);
   while (n < 8) {
     int open = -1;
     double best = -1;
     for (uint32_t i = 0; i < n; i++)
-      if (!leaf8(j, slot[i]) && node_area(&nodes[slot[i]]) > best) best = node_area(&nodes[slot[i]]), open = (int)i;
+      if (area[i] > best) best = area[i], open = (int)i;
     if (open < 0) break;
     uint32_t first = nodes[slot[open]].first;
-    for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1];
+    for (uint32_t i = n; i > (uint32_t)open + 1; i--) slot[i] = slot[i - 1], area[i] = area[i - 1];
     slot[open] = first, slot[open + 1] = first + 1, n++;
+    for (uint32_t i = (uint32_t)open; i < (uint32_t)open + 2; i++)
+      area[i] = leaf8(j, slot[i]) ? -1 : node_area(&nodes[slot[i]]);
   }
   return n;
 }
@@ -661,9 +744,7 @@ static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
     uint32_t c = slot[i];
     if (leaf8(j, c)) { /* a leaf: its corners as leaf_v's */
       uint32_t first = j->first[c], count = j->count[c];
-      float *v = b->leaf_v8 + (size_t)9 * first;
-      for (uint32_t m = 0; m < 9; m++)
-        for (uint32_t t = 0; t < count; t++) v[m * count + t] = j->s->p[m / 3][m % 3][b->prims[first + t]];
+      copy_corners(j->s, b->prims, first, count, b->leaf_v8 + (size_t)9 * first);
       wn->ref[i] = first, wn->count[i] = count;
     } else {
       wn->ref[i] = j->next++;
@@ -689,7 +770,7 @@ static bool collapse_wide8(rr_bvh *b, const rr_scene *s) {
   bool ok = j.first && j.count && b->leaf_v8;
   if (ok) {
     memset(b->leaf_v8 + nv, 0, BVH_LEAF_PAD * sizeof(float));
-    subtree_range(&j, 0);
+    subtree_ranges(&j);
     b->nwide8 = count_nodes8(&j, 0); /* counted first: no room to guess and trim */
     b->wide8 = alloc_lines((size_t)b->nwide8 * sizeof(bvh_wide8));
     ok = b->wide8 != NULL;
@@ -737,6 +818,22 @@ static double sah_cost(const struct rr_bvh *b) {
   double x = (double)r->hi[0] - r->lo[0], y = (double)r->hi[1] - r->lo[1], z = (double)r->hi[2] - r->lo[2];
   double ra = x * y + y * z + z * x;
   return ra > 0 ? sum / ra : 0;
+}
+
+/* The copies made from the finished binary tree, side by side: each reads the
+ * tree and writes its own arrays. */
+typedef struct {
+  rr_bvh *b;
+  const rr_scene *s;
+  bool ok[3];
+} finish_job;
+
+static void finish_part(int part, int thread, void *arg) {
+  (void)thread;
+  finish_job *j = arg;
+  if (part == 0) j->ok[0] = collapse_wide8(j->b, j->s); /* the biggest first */
+  else if (part == 1) j->ok[1] = collapse_wide(j->b);
+  else j->ok[2] = copy_leaf_corners(j->b, j->s), j->b->sah_cost = sah_cost(j->b);
 }
 
 rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out) {
@@ -880,9 +977,9 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   for (uint32_t i = 0; i < small.n; i++)
     if (small.v[i].buf)
       for (uint32_t k = small.v[i].start; k < small.v[i].start + small.v[i].count; k++) b->prims[k] = bd.buf[1][k].id;
-  if (!collapse_wide(b) || !collapse_wide8(b, s)) goto oom;
-  if (!copy_leaf_corners(b, s)) goto oom;
-  b->sah_cost = sah_cost(b);
+  finish_job fj = {b, s, {false, false, false}};
+  rr_parallel_for(3, bd.threads, finish_part, &fj);
+  if (!fj.ok[0] || !fj.ok[1] || !fj.ok[2]) goto oom;
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
              (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) +
              (uint64_t)b->nwide8 * sizeof(bvh_wide8) + 2 * ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
