@@ -52,37 +52,36 @@
 
 int rr_tri_setup(const rr_scene *s, uint32_t i, const camera *c, bool cull_backfaces, tri_setup *out) {
   int face;
-  setup_lanes1(s, &i, 1, c, 1, NULL, cull_backfaces, out, &face, NULL, 0);
+  setup_one1(s, &i, 1, c, cull_backfaces, out, &face, NULL);
   return face;
-}
-
-/* Eight lanes at a time where the processor has AVX2, else one; inlined into each
- * caller, so that one camera (rr_tri_setup_planes) compiles without the loop over cameras. */
-__attribute__((always_inline)) static inline void setup_run(const rr_scene *s, const uint32_t *ids, int n,
-                                                            const camera *cams, int ncams, const uint8_t *views,
-                                                            bool cull_backfaces, bool simd, tri_setup *out, int *face,
-                                                            tri_plane *pl) {
-  int k = 0;
-#ifdef RR_SIMD_X86
-  if (simd && __builtin_cpu_supports("avx2"))
-    for (; k < n; k += 8)
-      setup_lanes8(s, ids + k, n - k < 8 ? n - k : 8, cams, ncams, views ? views + k : NULL, cull_backfaces, out + k,
-                   face + k, pl ? pl + k : NULL, (size_t)n);
-#endif
-  (void)simd;
-  for (; k < n; k++)
-    setup_lanes1(s, ids + k, 1, cams, ncams, views ? views + k : NULL, cull_backfaces, out + k, face + k,
-                 pl ? pl + k : NULL, (size_t)n);
 }
 
 void rr_tri_setup_views(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
                         const uint8_t *views, bool cull_backfaces, bool simd, tri_setup *out, int *face, tri_plane *pl) {
-  setup_run(s, ids, n, cams, ncams, views, cull_backfaces, simd, out, face, pl);
+  int k = 0;
+#ifdef RR_SIMD_X86
+  if (simd && __builtin_cpu_supports("avx2"))
+    for (; k < n; k += 8)
+      setup_views8(s, ids + k, n - k < 8 ? n - k : 8, cams, ncams, views ? views + k : NULL, cull_backfaces, out + k,
+                   face + k, pl ? pl + k : NULL, (size_t)n);
+#endif
+  (void)simd;
+  for (; k < n; k++)
+    setup_views1(s, ids + k, 1, cams, ncams, views ? views + k : NULL, cull_backfaces, out + k, face + k,
+                 pl ? pl + k : NULL, (size_t)n);
 }
 
+/* One camera: the template without its loop over cameras (setup_one). */
 void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces,
                          bool simd, tri_setup *out, int *face, tri_plane *pl) {
-  setup_run(s, ids, n, c, 1, NULL, cull_backfaces, simd, out, face, pl);
+  int k = 0;
+#ifdef RR_SIMD_X86
+  if (simd && __builtin_cpu_supports("avx2"))
+    for (; k < n; k += 8)
+      setup_one8(s, ids + k, n - k < 8 ? n - k : 8, c, cull_backfaces, out + k, face + k, pl ? pl + k : NULL);
+#endif
+  (void)simd;
+  for (; k < n; k++) setup_one1(s, ids + k, 1, c, cull_backfaces, out + k, face + k, pl ? pl + k : NULL);
 }
 
 void rr_tri_setup_run(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces, bool simd,

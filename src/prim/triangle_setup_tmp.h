@@ -50,7 +50,7 @@ typedef struct {
  * lane l goes to out[k·stride + l], face[k·stride + l] (SETUP_CULLED when not
  * asked for), pl likewise. The same operations in the same order as for each
  * camera alone, so the same bits. */
-TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32_t *ids, int count, const camera *cams,
+TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32_t *ids, int count, const camera *cams,
                                                  int ncams, const uint8_t *views, bool cull, tri_setup *out, int *face,
                                                  tri_plane *pl, size_t stride) {
   int32_t lane_id[W], lane_inf[W] = {0};
@@ -222,6 +222,19 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
       o->cx = cx[l], o->cy = cy[l];
     }
   }
+}
+
+/* setup_lanes for several cameras (it is always inlined: a call of its own here). */
+TARGET static void RR_CAT(setup_views, W)(const rr_scene *s, const uint32_t *ids, int count, const camera *cams,
+                                          int ncams, const uint8_t *views, bool cull, tri_setup *out, int *face,
+                                          tri_plane *pl, size_t stride) {
+  RR_CAT(setup_lanes, W)(s, ids, count, cams, ncams, views, cull, out, face, pl, stride);
+}
+
+/* setup_lanes for one camera and every lane, compiled without the loop over cameras. */
+TARGET static void RR_CAT(setup_one, W)(const rr_scene *s, const uint32_t *ids, int count, const camera *c, bool cull,
+                                        tri_setup *out, int *face, tri_plane *pl) {
+  RR_CAT(setup_lanes, W)(s, ids, count, c, 1, NULL, cull, out, face, pl, 0);
 }
 
 /* tri_moved for W positions at once (planar cameras; c: any of them, whose sample
