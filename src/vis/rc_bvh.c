@@ -88,7 +88,9 @@ enum { SETUP_CHUNK = 1024, SEEN_CHUNK = 1024, BATCH = 2 * BVH_MAX_LEAF };
 enum { SETUP_ANALYTIC = -2 };
 /* reach_walk stops testing boxes below a slot over at most REACH_FEW samples whose
  * subtree holds at most REACH_CAP triangles. */
-enum { REACH_FEW = 4, REACH_CAP = 32 }; /* leaf_batch.setup of an analytic primitive */
+enum { REACH_FEW = 4, REACH_CAP = 8 };
+/* batch_finish tests a triangle whose corner rectangle holds at most PROBE samples at them. */
+enum { PROBE = 16 }; /* leaf_batch.setup of an analytic primitive */
 
 /* A batch of leaves (leaves[]: wide node · 4 + slot) and their triangles ids[k],
  * and of the ones set up (setup[k] >= 0: their index in ts/face) the pixel
@@ -144,6 +146,29 @@ static void seen_chunk(int job, int thread, void *arg) {
   for (uint32_t q = 0; q < nf; q++) fs->seen[found[q].id] = 1;
 }
 
+/* A triangle whose corner rectangle bb holds at most PROBE samples (most of a
+ * detailed mesh's) is tested at them here, with the sample test its rays make
+ * (the same w, sx, sy: the same bits): its floor is then the least t it gives
+ * there, exact, and its rectangle tr only the samples where it passes (none: it
+ * is dropped, +inf). Cheaper than a floor over the rectangle in double, and
+ * tighter for the rays. A NaN t, which never wins, still floors by 0. */
+static float probe_samples(const tri_setup *ts, const camera *c, const int bb[4], float tr[4]) {
+  float lo = INFINITY, r[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+  for (int y = bb[1]; y <= bb[3]; y++)
+    for (int x = bb[0]; x <= bb[2]; x++) {
+      float sx = (float)x + c->sx0, sy = (float)y + c->sy0, e[3], t, l1, l2;
+      vec3 w = v3(1.0f, sx, sy);
+      tri_edges_w(ts, w, e);
+      if (!sample_test_w(e, ts->w, ts->tie, tri_vol(ts, sx, sy), tri_num(ts, sx, sy), tri_den_w(ts, w), &t, &l1, &l2))
+        continue;
+      t = t == t ? t : 0;
+      lo = t < lo ? t : lo;
+      r[0] = minf(r[0], sx), r[1] = minf(r[1], sy), r[2] = maxf(r[2], sx), r[3] = maxf(r[3], sy);
+    }
+  memcpy(tr, r, sizeof r);
+  return lo;
+}
+
 /* Finishes the batch's leaves: each triangle's setup, id, rectangle and floor, each
  * leaf's least floor and rectangle into its wide node's slot. A planar camera's triangle is tested only at
  * the samples of its corner rectangle (as 3dr-bb tests it), so its floor holds over
@@ -180,7 +205,10 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
         /* the extreme samples, as the rays compute their coordinates */
         tr[0] = (float)lb->bb[k][0] + c->sx0, tr[1] = (float)lb->bb[k][1] + c->sy0;
         tr[2] = (float)lb->bb[k][2] + c->sx0, tr[3] = (float)lb->bb[k][3] + c->sy0;
-        if (lb->bb[k][0] > 0 || lb->bb[k][1] > 0 || lb->bb[k][2] < c->width - 1 || lb->bb[k][3] < c->height - 1) {
+        const int *bb = lb->bb[k];
+        if ((bb[2] - bb[0] + 1) * (bb[3] - bb[1] + 1) <= PROBE) {
+          t = probe_samples(&lt->ts, c, bb, tr);
+        } else if (bb[0] > 0 || bb[1] > 0 || bb[2] < c->width - 1 || bb[3] < c->height - 1) {
           t = rr_tri_rect_floor(&lt->ts, c, tr);
         } else {
           /* A corner rectangle of the whole image (mostly a triangle crossing the
