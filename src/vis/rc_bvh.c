@@ -326,7 +326,8 @@ static int box_reach(const camera *c, const bvh_wide *n, int *few) {
   rr_vf4 R;
   for (int i = 0; i < 4; i++) R[i] = sqrtf(r2[i]);
   R = R * rr_vf4_splat(1.01f); /* rounded up past this computation's own error */
-  rr_vf4 m = rr_vf4_splat(1.0f / 32) + rr_vf4_splat(2e-5f) * big + rr_vf4_splat(16 * u) * R * (one + R) * rr_vf4_splat(wh);
+  rr_vf4 m = rr_vf4_splat(1.0f / 32) + rr_vf4_splat(2e-5f) * big +
+             rr_vf4_splat(16 * u) * R * (one + R) * rr_vf4_splat(wh);
   /* The first and last pixel whose sample lies in the widened rectangle, clamped
    * to the image, as whole numbers: ceil and floor of values in [-1, width] (a
    * rectangle beyond the image stays empty), so truncation to int is exact. */
@@ -340,10 +341,11 @@ static int box_reach(const camera *c, const bvh_wide *n, int *few) {
     idx[k] = k < 2 ? t - (tf < v) : t + (tf > v); /* ceil for the first, floor for the last */
   }
   /* A slot is out only when everything is a number and the rectangle holds no sample. */
-  rr_vi4 sure = front & (m < rr_vf4_splat(INFINITY)) & (a[0] == a[0]) & (a[1] == a[1]) & (a[2] == a[2]) & (a[3] == a[3]);
+  rr_vi4 sure = front & (m < rr_vf4_splat(INFINITY));
+  for (int k = 0; k < 4; k++) sure &= a[k] == a[k];
   rr_vi4 nx = idx[2] - idx[0] + 1, ny = idx[3] - idx[1] + 1;
-  rr_vi4 live = (rr_vi4){n->ref[0] != UINT32_MAX, n->ref[1] != UINT32_MAX, n->ref[2] != UINT32_MAX, n->ref[3] != UINT32_MAX};
-  live = -live;
+  rr_vi4 live = -(rr_vi4){n->ref[0] != UINT32_MAX, n->ref[1] != UINT32_MAX, n->ref[2] != UINT32_MAX,
+                          n->ref[3] != UINT32_MAX};
   rr_vi4 out = sure & ((nx <= 0) | (ny <= 0));
   *few = rr_vi4_bits(live & sure & ~out & (nx * ny <= REACH_FEW));
   return rr_vi4_bits(live & ~out);
@@ -361,8 +363,8 @@ static bool subtree_small(const rr_bvh *b, uint32_t w, uint32_t *cap) {
 }
 
 /* Perspective frames: walks down from wide node w through the slots box_reach
- * keeps (all of them when `all`), adding the leaves met to the batch (set up and finished whenever it
- * fills) and giving every other slot no samples. Above `depth` 0 it walks on;
+ * keeps (all of them when `all`), adding the leaves met to the batch (set up and
+ * finished whenever it fills) and giving every other slot no samples. Above `depth` 0 it walks on;
  * at 0 it leaves the node to roots[] (walked in parallel) instead. */
 typedef struct {
   uint32_t w[64];
