@@ -3,6 +3,8 @@
 #include "vis/vis.h"
 #include "core/simd.h"
 
+#include <string.h>
+
 /* The sample loop, one lane at a time (any camera) and, with AVX2, eight. */
 #define RR_TEMPLATE "vis/raster3d_tmp.h"
 #include "core/simd_widths.h"
@@ -24,28 +26,51 @@ uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const 
   return samples;
 }
 
-uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int r[4],
+void rr_tri_moves_ready(const tri_setup *ts, tri_moves *mv, const camera *cams, int ns, bool simd) {
+  if (mv->ready) return;
+  const int lanes = (ns + 7) & ~7; /* what the kernels' lanes read */
+  for (int s = 0; s < lanes; s++) mv->r[0][s] = mv->r[1][s] = INT32_MAX, mv->r[2][s] = mv->r[3][s] = INT32_MIN;
+  if (mv->pl) {
+    rr_tri_moved_all(ts, mv->pl, &cams[0], lanes, mv->ox, mv->oy, simd, mv->pa, mv->num0, mv->cx, mv->cy);
+  } else {
+    for (int s = 0; s < lanes; s++) mv->pa[s] = ts->pa, mv->num0[s] = ts->num0, mv->cx[s] = ts->cx, mv->cy[s] = ts->cy;
+  }
+  mv->live = 0;
+  for (uint32_t todo = mv->pl ? ~(uint32_t)mv->pos.none & ((1u << ns) - 1) : (1u << ns) - 1; todo; todo &= todo - 1) {
+    const int s = __builtin_ctz(todo);
+    int q[4];
+    if (!mv->pl) memcpy(q, mv->bb, sizeof q);
+    else if (!tri_pos_rect(&mv->pos, mv->bb, s, q) || q[0] > mv->draw[2] || q[2] < mv->draw[0] ||
+             q[1] > mv->draw[3] || q[3] < mv->draw[1])
+      continue;
+    for (int k = 0; k < 4; k++) mv->r[k][s] = q[k];
+    mv->live |= 1u << s;
+  }
+  mv->ready = true;
+}
+
+uint64_t rr_raster_rect_samples(const tri_setup *ts, tri_moves *mv, uint32_t id, const int r[4],
                                 const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd) {
   const bool planar = cams[0].planar;
 #ifdef RR_SIMD_X86
   const bool avx2 = simd && __builtin_cpu_supports("avx2");
 #endif
   uint64_t got = 0, samples = 0;
-  (void)simd;
   if (planar && (r[2] - r[0] + 1) * (r[3] - r[1] + 1) <= 2 * ns) {
     /* a triangle of a few pixels (most of a detailed mesh): lanes over the positions
      * of each pixel rather than a scanline of a sample or two per position (up to
      * 2·ns pixels: by callgrind on the bunny and the teapot grid, fewer lanes to
      * fill want fewer pixels) */
 #ifdef RR_SIMD_X86
-    if (avx2) got = raster_pixels8(ts, mv, id, r, ns, vb, &samples);
+    if (avx2) got = raster_pixels8(ts, mv, id, r, &cams[0], ns, vb, &samples);
     else
 #endif
-      got = raster_pixels1(ts, mv, id, r, ns, vb, &samples);
+      got = raster_pixels1(ts, mv, id, r, &cams[0], ns, vb, &samples);
   } else {
     /* each position over its own part of r */
     uint8_t act[RR_MAX_SAMPLES];
     int rs[RR_MAX_SAMPLES][4], n = 0;
+    rr_tri_moves_ready(ts, mv, cams, ns, simd);
     for (uint32_t live = mv->live; live; live &= live - 1) {
       const int s = __builtin_ctz(live);
       int x0 = mv->r[0][s] > r[0] ? mv->r[0][s] : r[0], y0 = mv->r[1][s] > r[1] ? mv->r[1][s] : r[1];

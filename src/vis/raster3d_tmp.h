@@ -110,57 +110,75 @@ TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_mov
                 : RR_CAT(raster_loop, W)(ts, mv, act, rs, id, rs[0], cams, n, vb, false);
 }
 
-/* A rectangle r of a few pixels at several positions (planar cameras): for each
- * pixel, lanes over the positions whose own rectangle holds it (mv), W at a time.
- * The same operations in the same order as the loop above, lane by lane, so the
- * same bits; the lanes that pass take the depth test one at a time, each in its
- * own layer. Adds the samples tested to *tested. */
+#include "prim/triangle_moved_tmp.h"
+
+/* A rectangle r of a few pixels at several positions (planar cameras): the
+ * triangle set up once for all of them, lanes over (pixel, position) pairs. A
+ * step takes P positions (ns rounded up to a power of two, at most W) at W / P
+ * pixels of r in row order, so a triangle of a pixel or two at 16 positions costs
+ * two steps, at 4 positions one. Each position's own rectangle comes in the lanes
+ * from the bounds' bits (tri_pos_rect), its moved setup values (tri_moved) at the
+ * first hit, so a draw costs nothing per position beyond its lanes. The same
+ * operations in the same order as the loop above, lane by lane, so the same bits;
+ * the lanes that pass take the depth test one at a time, each in its own layer.
+ * Adds the samples tested to *tested. */
 TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
-                                                const int r[4], int ns, visbuf *vb, uint64_t *tested) {
+                                                const int r[4], const camera *c, int ns, visbuf *vb,
+                                                uint64_t *tested) {
   const RR_CAT(tri_lanes, W) L = RR_CAT(lanes_of, W)(ts);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
+  int lg = 0; /* P = 1 << lg */
+  while (1 << lg < ns && 1 << lg < W) lg++;
+  const int P = 1 << lg, G = W / P, w = r[2] - r[0] + 1;
+  const VI lane = VI_(lanes)(), last_x = VI_(splat)(r[2]), last_y = VI_(splat)(r[3]), wv = VI_(splat)(w);
+  const tri_pos_bits *b = &mv->pos;
   uint64_t covered = 0, evals = 0;
-  for (int p0 = 0; p0 < ns; p0 += W) {
-    if (!(mv->live >> p0 & ((1u << W) - 1))) continue; /* (W <= 16) */
-    const VI rx0 = VI_(load)(mv->r[0] + p0), ry0 = VI_(load)(mv->r[1] + p0);
-    const VI rx1 = VI_(load)(mv->r[2] + p0), ry1 = VI_(load)(mv->r[3] + p0);
-    const VF ox = VF_(load)(mv->ox + p0), oy = VF_(load)(mv->oy + p0);
-    for (int y = r[1]; y <= r[3]; y++) {
-      const VI yi = VI_(splat)(y), in_y = (yi >= ry0) & (yi <= ry1);
-      if (!VI_(bits)(in_y)) continue;
-      const VF sy = VF_(from_int)(yi) + oy;
-      for (int x = r[0]; x <= r[2]; x++) {
-        const VI xi = VI_(splat)(x);
-        VI in = in_y & (xi >= rx0) & (xi <= rx1);
-        const int tried = VI_(bits)(in);
-        if (!tried) continue;
-        evals += (uint64_t)__builtin_popcount((unsigned)tried);
-        const VF sx = VF_(from_int)(xi) + ox;
-        VF ev[3];
+  for (int p0 = 0; p0 < ns; p0 += P) {
+    const VI p = VI_(splat)(p0) + (lane & (P - 1)), bit = VI_(splat)(1) << p;
+    const VI live = ((VI_(splat)(b->none) & bit) == 0) & (p < ns);
+    if (!VI_(bits)(live)) continue;
+    /* tri_pos_rect in the lanes */
+    const VI rx0 = VI_(splat)(mv->bb[0]) - ((VI_(splat)(b->x0) & bit) != 0);
+    const VI ry0 = VI_(splat)(mv->bb[1]) - ((VI_(splat)(b->y0) & bit) != 0);
+    const VI rx1 = VI_(splat)(mv->bb[2]) + ((VI_(splat)(b->x1) & bit) != 0);
+    const VI ry1 = VI_(splat)(mv->bb[3]) + ((VI_(splat)(b->y1) & bit) != 0);
+    const VF ox = VF_(gather)(mv->ox, p), oy = VF_(gather)(mv->oy, p);
+    VF m[4];
+    bool moved = false;
+    /* the lanes' pixels: the q-th of the step's G, wrapped into r's rows */
+    VI x = VI_(splat)(r[0]) + (lane >> lg), y = VI_(splat)(r[1]);
+    for (int i = 0; VI_(bits)(y <= last_y); i += G) {
+      if (i) x += VI_(splat)(G);
+      for (VI wrap; VI_(bits)(wrap = x > last_x);) x -= wrap & wv, y -= wrap;
+      VI in = live & (y <= last_y) & (x >= rx0) & (x <= rx1) & (y >= ry0) & (y <= ry1);
+      const int tried = VI_(bits)(in);
+      if (!tried) continue;
+      evals += (uint64_t)__builtin_popcount((unsigned)tried);
+      const VF sx = VF_(from_int)(x) + ox, sy = VF_(from_int)(y) + oy;
+      VF ev[3];
 #pragma GCC unroll 3
-        for (int e = 0; e < 3; e++) {
-          ev[e] = (L.a[e] * one + L.b[e] * sx) + L.cc[e] * sy;
-          in &= TRI_EDGE_INSIDE(ev[e], L.tie[e], zero);
-        }
-        if (!VI_(bits)(in)) continue;
-        const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = (L.vol + sx * L.vol_x) + sy * L.vol_y;
-        in &= TRI_HIT_AHEAD(sum, v, zero);
-        int hit = VI_(bits)(in);
-        if (!hit) continue;
-        const VF pa = VF_(load)(mv->pa + p0), num0 = VF_(load)(mv->num0 + p0);
-        const VF cx = VF_(load)(mv->cx + p0), cy = VF_(load)(mv->cy + p0);
-        const VF den = (pa * one + L.pb * (sx - cx)) + L.pc * (sy - cy);
-        const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * L.num_x) + (sy - cy) * L.num_y, den, v, inv, zero,
-                                                VF_(select));
-        const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
-        for (; hit; hit &= hit - 1) {
-          const int l = __builtin_ctz((unsigned)hit);
-          const size_t k = (size_t)(p0 + l) * layer + (size_t)y * width + (size_t)x;
-          covered++;
-          if (t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
-            vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
-        }
+      for (int e = 0; e < 3; e++) {
+        ev[e] = (L.a[e] * one + L.b[e] * sx) + L.cc[e] * sy;
+        in &= TRI_EDGE_INSIDE(ev[e], L.tie[e], zero);
+      }
+      if (!VI_(bits)(in)) continue;
+      const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = (L.vol + sx * L.vol_x) + sy * L.vol_y;
+      in &= TRI_HIT_AHEAD(sum, v, zero);
+      int hit = VI_(bits)(in);
+      if (!hit) continue;
+      if (!moved) RR_CAT(tri_moved_lanes, W)(ts, mv->pl, c, ox, oy, m), moved = true;
+      const VF pa = m[0], num0 = m[1], cx = m[2], cy = m[3];
+      const VF den = (pa * one + L.pb * (sx - cx)) + L.pc * (sy - cy);
+      const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * L.num_x) + (sy - cy) * L.num_y, den, v, inv, zero,
+                                              VF_(select));
+      const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
+      for (; hit; hit &= hit - 1) {
+        const int l = __builtin_ctz((unsigned)hit);
+        const size_t k = (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
+        covered++;
+        if (t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
+          vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
       }
     }
   }
