@@ -112,13 +112,13 @@ TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_mov
 
 #include "prim/triangle_moved_tmp.h"
 
-/* A rectangle r of a few pixels at several positions (planar cameras): the
- * triangle set up once for all of them, lanes over (pixel, position) pairs. A
- * step takes P positions (ns rounded up to a power of two, at most W) at W / P
- * pixels of r in row order, so a triangle of a pixel or two at 16 positions costs
- * two steps, at 4 positions one. Each position's own rectangle comes in the lanes
+/* A triangle of a few pixels at several positions (planar cameras), within r: set
+ * up once for all of them, lanes over (position, pixel) pairs. A step takes P
+ * positions (ns rounded up to a power of two, at most W), each at the next W / P
+ * pixels of its own rectangle (within r) in row order, so a triangle of a pixel or
+ * two costs one step per P positions. Each position's rectangle comes in the lanes
  * from the bounds' bits (tri_pos_rect), its moved setup values (tri_moved) at the
- * first hit, so a draw costs nothing per position beyond its lanes. The same
+ * first hit: a draw costs nothing per position beyond its lanes. The same
  * operations in the same order as the loop above, lane by lane, so the same bits;
  * the lanes that pass take the depth test one at a time, each in its own layer.
  * Adds the samples tested to *tested. */
@@ -130,30 +130,33 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
   int lg = 0; /* P = 1 << lg */
   while (1 << lg < ns && 1 << lg < W) lg++;
-  const int P = 1 << lg, G = W / P, w = r[2] - r[0] + 1;
-  const VI lane = VI_(lanes)(), last_x = VI_(splat)(r[2]), last_y = VI_(splat)(r[3]), wv = VI_(splat)(w);
+  const int P = 1 << lg, G = W / P;
+  const VI lane = VI_(lanes)(), one_i = VI_(splat)(1);
   const tri_pos_bits *b = &mv->pos;
   uint64_t covered = 0, evals = 0;
   for (int p0 = 0; p0 < ns; p0 += P) {
-    const VI p = VI_(splat)(p0) + (lane & (P - 1)), bit = VI_(splat)(1) << p;
-    const VI live = ((VI_(splat)(b->none) & bit) == 0) & (p < ns);
+    const VI p = VI_(splat)(p0) + (lane & (P - 1)), bit = one_i << p;
+    /* tri_pos_rect in the lanes, clipped to r */
+    VI x0 = VI_(splat)(mv->bb[0]) - ((VI_(splat)(b->x0) & bit) != 0);
+    VI y0 = VI_(splat)(mv->bb[1]) - ((VI_(splat)(b->y0) & bit) != 0);
+    VI x1 = VI_(splat)(mv->bb[2]) + ((VI_(splat)(b->x1) & bit) != 0);
+    VI y1 = VI_(splat)(mv->bb[3]) + ((VI_(splat)(b->y1) & bit) != 0);
+    const VI r0 = VI_(splat)(r[0]), r1 = VI_(splat)(r[1]), r2 = VI_(splat)(r[2]), r3 = VI_(splat)(r[3]);
+    x0 = VI_(select)(x0 < r0, r0, x0), y0 = VI_(select)(y0 < r1, r1, y0);
+    x1 = VI_(select)(x1 > r2, r2, x1), y1 = VI_(select)(y1 > r3, r3, y1);
+    const VI live = ((VI_(splat)(b->none) & bit) == 0) & (p < ns) & (x0 <= x1) & (y0 <= y1);
     if (!VI_(bits)(live)) continue;
-    /* tri_pos_rect in the lanes */
-    const VI rx0 = VI_(splat)(mv->bb[0]) - ((VI_(splat)(b->x0) & bit) != 0);
-    const VI ry0 = VI_(splat)(mv->bb[1]) - ((VI_(splat)(b->y0) & bit) != 0);
-    const VI rx1 = VI_(splat)(mv->bb[2]) + ((VI_(splat)(b->x1) & bit) != 0);
-    const VI ry1 = VI_(splat)(mv->bb[3]) + ((VI_(splat)(b->y1) & bit) != 0);
+    y1 = VI_(select)(live, y1, y0 - one_i); /* a lane without samples never runs */
+    const VI wv = x1 - x0 + one_i;
     const VF ox = VF_(gather)(mv->ox, p), oy = VF_(gather)(mv->oy, p);
     VF m[4];
     bool moved = false;
-    /* the lanes' pixels: the q-th of the step's G, wrapped into r's rows */
-    VI x = VI_(splat)(r[0]) + (lane >> lg), y = VI_(splat)(r[1]);
-    for (int i = 0; VI_(bits)(y <= last_y); i += G) {
-      if (i) x += VI_(splat)(G);
-      for (VI wrap; VI_(bits)(wrap = x > last_x);) x -= wrap & wv, y -= wrap;
-      VI in = live & (y <= last_y) & (x >= rx0) & (x <= rx1) & (y >= ry0) & (y <= ry1);
-      const int tried = VI_(bits)(in);
-      if (!tried) continue;
+    /* each lane's pixels: the q-th of every G of its rectangle's, wrapped into its rows */
+    VI x = x0 + (lane >> lg), y = y0;
+    for (VI in;; x += VI_(splat)(G)) {
+      for (VI wrap; VI_(bits)(wrap = live & (x > x1));) x -= wrap & wv, y -= wrap;
+      const int tried = VI_(bits)(in = y <= y1);
+      if (!tried) break;
       evals += (uint64_t)__builtin_popcount((unsigned)tried);
       const VF sx = VF_(from_int)(x) + ox, sy = VF_(from_int)(y) + oy;
       VF ev[3];
