@@ -128,11 +128,10 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
   const RR_CAT(tri_lanes, W) L = RR_CAT(lanes_of, W)(ts);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
-  int lg = 0; /* P = 1 << lg */
-  while (1 << lg < ns && 1 << lg < W) lg++;
-  const int P = 1 << lg, G = W / P;
+  const int lg_w = __builtin_ctz(W), lg_ns = ns > 1 ? 32 - __builtin_clz((unsigned)ns - 1) : 0;
+  const int lg = lg_ns < lg_w ? lg_ns : lg_w, P = 1 << lg, G = W / P;
   const VI lane = VI_(lanes)(), one_i = VI_(splat)(1);
-  const tri_pos_bits *b = &mv->pos;
+  const tri_pos_bits *b = mv->pos;
   uint64_t covered = 0, evals = 0;
   for (int p0 = 0; p0 < ns; p0 += P) {
     const VI p = VI_(splat)(p0) + (lane & (P - 1)), bit = one_i << p;

@@ -375,10 +375,10 @@ static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
   tri_moves mv; /* (no initializer: the per-position arrays are filled when needed) */
   mv.ox = t->ox, mv.oy = t->oy, mv.pl = NULL, mv.ready = false;
   mv.draw[0] = r.x0, mv.draw[1] = r.y0, mv.draw[2] = r.x1 - 1, mv.draw[3] = r.y1 - 1;
-  memcpy(mv.bb, j->bb, sizeof mv.bb);
+  mv.bb = j->bb;
   if (t->c->planar) {
     if (!(~(uint32_t)j->pos.none & ((1u << t->ns) - 1))) return;
-    mv.pl = &j->pl, mv.pos = j->pos;
+    mv.pl = &j->pl, mv.pos = &j->pos;
   }
   draw_rect(t, j, &mv, r);
 }

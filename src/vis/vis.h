@@ -191,8 +191,9 @@ uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], con
 typedef struct tri_moves {
   const float *ox, *oy;
   const tri_plane *pl;
-  tri_pos_bits pos;
-  int bb[4], draw[4];
+  const tri_pos_bits *pos;
+  const int *bb;
+  int draw[4];
   bool ready;
   uint32_t live;
   float pa[RR_MAX_SAMPLES], num0[RR_MAX_SAMPLES], cx[RR_MAX_SAMPLES], cy[RR_MAX_SAMPLES];
