@@ -377,7 +377,11 @@ static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
   mv.draw[0] = r.x0, mv.draw[1] = r.y0, mv.draw[2] = r.x1 - 1, mv.draw[3] = r.y1 - 1;
   mv.bb = j->bb;
   if (t->c->planar) {
-    if (!(~(uint32_t)j->pos.none & ((1u << t->ns) - 1))) return;
+    /* drawn when some position's own rectangle meets r (usually the first tried) */
+    uint32_t todo = ~(uint32_t)j->pos.none & ((1u << t->ns) - 1);
+    for (int q[4]; todo; todo &= todo - 1)
+      if (tri_pos_rect(&j->pos, j->bb, __builtin_ctz(todo), q) && meets(q, r)) break;
+    if (!todo) return;
     mv.pl = &j->pl, mv.pos = &j->pos;
   }
   draw_rect(t, j, &mv, r);
