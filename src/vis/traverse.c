@@ -377,9 +377,10 @@ static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
   mv.draw[0] = r.x0, mv.draw[1] = r.y0, mv.draw[2] = r.x1 - 1, mv.draw[3] = r.y1 - 1;
   mv.bb = j->bb;
   if (t->c->planar) {
-    /* drawn when some position's own rectangle meets r (usually the first tried) */
+    /* drawn when some position's own rectangle meets r: any does when r holds bb */
     uint32_t todo = ~(uint32_t)j->pos.none & ((1u << t->ns) - 1);
-    for (int q[4]; todo; todo &= todo - 1)
+    const bool whole = r.x0 <= j->bb[0] && r.x1 > j->bb[2] && r.y0 <= j->bb[1] && r.y1 > j->bb[3];
+    for (int q[4]; todo && !whole; todo &= todo - 1)
       if (tri_pos_rect(&j->pos, j->bb, __builtin_ctz(todo), q) && meets(q, r)) break;
     if (!todo) return;
     mv.pl = &j->pl, mv.pos = &j->pos;
