@@ -59,27 +59,24 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
   const VI bounded = c->type == RR_CAMERA_ORTHOGRAPHIC ? projected & (inf == 0) : projected;
   const VF big = VF_(max)(VF_(max)(VF_(abs)(x0), VF_(abs)(x1)), VF_(max)(VF_(abs)(y0), VF_(abs)(y1)));
   const VF m = VF_(splat)(1.0f / 64) + VF_(splat)(1e-5f) * big;
-  /* the rectangle of pixels whose sample at position (ox, oy) may lie in the hull;
-   * with several positions, the union of those that hold one */
-#define POS_RECT(ox, oy)                                                                                    \
-  VF lx = VF_(max)(VF_(ceil)(x0 - ox - m), zero), hx = VF_(min)(VF_(floor)(x1 - ox + m), last_x);        \
-  VF ly = VF_(max)(VF_(ceil)(y0 - oy - m), zero), hy = VF_(min)(VF_(floor)(y1 - oy + m), last_y);
-  POS_RECT(VF_(splat)(pos[0][0]), VF_(splat)(pos[0][1]))
+  /* the rectangle of pixels whose sample at position p may lie in the hull, each
+   * position's once; with several positions, the union of those that hold one */
+  VF plx[RR_MAX_SAMPLES], phx[RR_MAX_SAMPLES], ply[RR_MAX_SAMPLES], phy[RR_MAX_SAMPLES];
+  for (int p = 0; p < npos; p++) {
+    const VF ox = VF_(splat)(pos[p][0]), oy = VF_(splat)(pos[p][1]);
+    plx[p] = VF_(max)(VF_(ceil)(x0 - ox - m), zero), phx[p] = VF_(min)(VF_(floor)(x1 - ox + m), last_x);
+    ply[p] = VF_(max)(VF_(ceil)(y0 - oy - m), zero), phy[p] = VF_(min)(VF_(floor)(y1 - oy + m), last_y);
+  }
+  VF lx = plx[0], hx = phx[0], ly = ply[0], hy = phy[0];
   VI empty = (lx > hx) | (ly > hy);
   for (int p = 1; p < npos; p++) {
-    VF ux = lx, uy = ly, vx = hx, vy = hy;
-    VI was = empty;
-    {
-      POS_RECT(VF_(splat)(pos[p][0]), VF_(splat)(pos[p][1]))
-      const VI none = (lx > hx) | (ly > hy);
-      /* empty so far: this position's rectangle; else the union with it unless it is empty */
-      ux = VF_(select)(was, lx, VF_(select)(none, ux, VF_(min)(ux, lx)));
-      uy = VF_(select)(was, ly, VF_(select)(none, uy, VF_(min)(uy, ly)));
-      vx = VF_(select)(was, hx, VF_(select)(none, vx, VF_(max)(vx, hx)));
-      vy = VF_(select)(was, hy, VF_(select)(none, vy, VF_(max)(vy, hy)));
-      empty = was & none;
-    }
-    lx = ux, ly = uy, hx = vx, hy = vy;
+    const VI was = empty, none = (plx[p] > phx[p]) | (ply[p] > phy[p]);
+    /* empty so far: this position's rectangle; else the union with it unless it is empty */
+    lx = VF_(select)(was, plx[p], VF_(select)(none, lx, VF_(min)(lx, plx[p])));
+    ly = VF_(select)(was, ply[p], VF_(select)(none, ly, VF_(min)(ly, ply[p])));
+    hx = VF_(select)(was, phx[p], VF_(select)(none, hx, VF_(max)(hx, phx[p])));
+    hy = VF_(select)(was, phy[p], VF_(select)(none, hy, VF_(max)(hy, phy[p])));
+    empty = was & none;
   }
   const int keep = VI_(bits)(ahead_any & ~(bounded & empty)) & ((1 << n) - 1);
   if (!keep) return 0;
@@ -90,15 +87,11 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
   /* each position's own rectangle within the union, a bit per position (tri_pos_bits) */
   VI none = VI_(splat)(0), in_x0 = none, in_y0 = none, in_x1 = none, in_y1 = none;
   for (int p = 0; p < npos && npos > 1; p++) {
-    VF ux = lx, uy = ly, vx = hx, vy = hy;
-    {
-      POS_RECT(VF_(splat)(pos[p][0]), VF_(splat)(pos[p][1]))
-      const VI bit = VI_(splat)(1 << p) & bounded;
-      none |= ((lx > hx) | (ly > hy)) & bit;
-      in_x0 |= (lx > ux) & bit, in_y0 |= (ly > uy) & bit, in_x1 |= (hx < vx) & bit, in_y1 |= (hy < vy) & bit;
-    }
+    const VI bit = VI_(splat)(1 << p) & bounded;
+    none |= ((plx[p] > phx[p]) | (ply[p] > phy[p])) & bit;
+    in_x0 |= (plx[p] > lx) & bit, in_y0 |= (ply[p] > ly) & bit, in_x1 |= (phx[p] < hx) & bit,
+        in_y1 |= (phy[p] < hy) & bit;
   }
-#undef POS_RECT
   uint32_t kept = 0;
   for (int l = 0; l < n; l++)
     if (keep >> l & 1)

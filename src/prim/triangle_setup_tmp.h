@@ -237,21 +237,15 @@ TARGET static void RR_CAT(setup_one, W)(const rr_scene *s, const uint32_t *ids, 
   RR_CAT(setup_lanes, W)(s, ids, count, c, 1, NULL, cull, out, face, pl, 0);
 }
 
-/* tri_moved for W positions at once (planar cameras; c: any of them, whose sample
- * offsets ox[0..W-1], oy[0..W-1] differ): ts's pa, num0, cx, cy at each, lane by
- * lane in tri_moved's operations (minps and maxps are its comparisons), so its bits. */
+#include "prim/triangle_moved_tmp.h"
+
+/* tri_moved_lanes stored: positions ox[0..W-1], oy[0..W-1] */
 TARGET static void RR_CAT(moved_lanes, W)(const tri_setup *ts, const tri_plane *pl, const camera *c, const float *ox,
                                           const float *oy, float *pa, float *num0, float *cx, float *cy) {
-  const VF lo_x = VF_(load)(ox), lo_y = VF_(load)(oy);
-  const VF hi_x = VF_(splat)((float)(c->width - 1)) + lo_x, hi_y = VF_(splat)((float)(c->height - 1)) + lo_y;
-  VF x = VF_(max)(VF_(min)(VF_(splat)(pl->px), hi_x), lo_x), y = VF_(max)(VF_(min)(VF_(splat)(pl->py), hi_y), lo_y);
-  x = VF_(floor)(x - lo_x) + lo_x, y = VF_(floor)(y - lo_y) + lo_y;
-  const VD base = pl->base - TO_D(VF_(splat)(0.0f)); /* (base - 0 keeps a -0) */
-  const VF p = TO_F(base + TO_D(x) * pl->u + TO_D(y) * pl->v);
-  const bool persp = c->type == RR_CAMERA_PERSPECTIVE;
-  const VF pav = persp ? p : VF_(splat)(ts->pa), n0v = persp ? VF_(splat)(ts->num0) : p;
-  memcpy(pa, &pav, W * sizeof(float)), memcpy(num0, &n0v, W * sizeof(float));
-  memcpy(cx, &x, W * sizeof(float)), memcpy(cy, &y, W * sizeof(float));
+  VF m[4];
+  RR_CAT(tri_moved_lanes, W)(ts, pl, c, VF_(load)(ox), VF_(load)(oy), m);
+  memcpy(pa, &m[0], W * sizeof(float)), memcpy(num0, &m[1], W * sizeof(float));
+  memcpy(cx, &m[2], W * sizeof(float)), memcpy(cy, &m[3], W * sizeof(float));
 }
 
 #undef SPLAT3

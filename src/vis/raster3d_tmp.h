@@ -110,57 +110,77 @@ TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_mov
                 : RR_CAT(raster_loop, W)(ts, mv, act, rs, id, rs[0], cams, n, vb, false);
 }
 
-/* A rectangle r of a few pixels at several positions (planar cameras): for each
- * pixel, lanes over the positions whose own rectangle holds it (mv), W at a time.
- * The same operations in the same order as the loop above, lane by lane, so the
- * same bits; the lanes that pass take the depth test one at a time, each in its
- * own layer. Adds the samples tested to *tested. */
+#include "prim/triangle_moved_tmp.h"
+
+/* A triangle of a few pixels at several positions (planar cameras), within r: set
+ * up once for all of them, lanes over (position, pixel) pairs. A step takes P
+ * positions (ns rounded up to a power of two, at most W), each at the next W / P
+ * pixels of its own rectangle (within r) in row order, so a triangle of a pixel or
+ * two costs one step per P positions. Each position's rectangle comes in the lanes
+ * from the bounds' bits (tri_pos_rect), its moved setup values (tri_moved) at the
+ * first hit: a draw costs nothing per position beyond its lanes. The same
+ * operations in the same order as the loop above, lane by lane, so the same bits;
+ * the lanes that pass take the depth test one at a time, each in its own layer.
+ * Adds the samples tested to *tested. */
 TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
-                                                const int r[4], int ns, visbuf *vb, uint64_t *tested) {
+                                                const int r[4], const camera *c, int ns, visbuf *vb,
+                                                uint64_t *tested) {
   const RR_CAT(tri_lanes, W) L = RR_CAT(lanes_of, W)(ts);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
+  const int lg_w = __builtin_ctz(W), lg_ns = ns > 1 ? 32 - __builtin_clz((unsigned)ns - 1) : 0;
+  const int lg = lg_ns < lg_w ? lg_ns : lg_w, P = 1 << lg, G = W / P;
+  const VI lane = VI_(lanes)(), one_i = VI_(splat)(1);
+  const tri_pos_bits *b = mv->pos;
   uint64_t covered = 0, evals = 0;
-  for (int p0 = 0; p0 < ns; p0 += W) {
-    if (!(mv->live >> p0 & ((1u << W) - 1))) continue; /* (W <= 16) */
-    const VI rx0 = VI_(load)(mv->r[0] + p0), ry0 = VI_(load)(mv->r[1] + p0);
-    const VI rx1 = VI_(load)(mv->r[2] + p0), ry1 = VI_(load)(mv->r[3] + p0);
-    const VF ox = VF_(load)(mv->ox + p0), oy = VF_(load)(mv->oy + p0);
-    for (int y = r[1]; y <= r[3]; y++) {
-      const VI yi = VI_(splat)(y), in_y = (yi >= ry0) & (yi <= ry1);
-      if (!VI_(bits)(in_y)) continue;
-      const VF sy = VF_(from_int)(yi) + oy;
-      for (int x = r[0]; x <= r[2]; x++) {
-        const VI xi = VI_(splat)(x);
-        VI in = in_y & (xi >= rx0) & (xi <= rx1);
-        const int tried = VI_(bits)(in);
-        if (!tried) continue;
-        evals += (uint64_t)__builtin_popcount((unsigned)tried);
-        const VF sx = VF_(from_int)(xi) + ox;
-        VF ev[3];
+  for (int p0 = 0; p0 < ns; p0 += P) {
+    const VI p = VI_(splat)(p0) + (lane & (P - 1)), bit = one_i << p;
+    /* tri_pos_rect in the lanes, clipped to r */
+    VI x0 = VI_(splat)(mv->bb[0]) - ((VI_(splat)(b->x0) & bit) != 0);
+    VI y0 = VI_(splat)(mv->bb[1]) - ((VI_(splat)(b->y0) & bit) != 0);
+    VI x1 = VI_(splat)(mv->bb[2]) + ((VI_(splat)(b->x1) & bit) != 0);
+    VI y1 = VI_(splat)(mv->bb[3]) + ((VI_(splat)(b->y1) & bit) != 0);
+    const VI r0 = VI_(splat)(r[0]), r1 = VI_(splat)(r[1]), r2 = VI_(splat)(r[2]), r3 = VI_(splat)(r[3]);
+    x0 = VI_(select)(x0 < r0, r0, x0), y0 = VI_(select)(y0 < r1, r1, y0);
+    x1 = VI_(select)(x1 > r2, r2, x1), y1 = VI_(select)(y1 > r3, r3, y1);
+    const VI live = ((VI_(splat)(b->none) & bit) == 0) & (p < ns) & (x0 <= x1) & (y0 <= y1);
+    if (!VI_(bits)(live)) continue;
+    y1 = VI_(select)(live, y1, y0 - one_i); /* a lane without samples never runs */
+    const VI wv = x1 - x0 + one_i;
+    const VF ox = VF_(gather)(mv->ox, p), oy = VF_(gather)(mv->oy, p);
+    VF m[4];
+    bool moved = false;
+    /* each lane's pixels: the q-th of every G of its rectangle's, wrapped into its rows */
+    VI x = x0 + (lane >> lg), y = y0;
+    for (VI in;; x += VI_(splat)(G)) {
+      for (VI wrap; VI_(bits)(wrap = live & (x > x1));) x -= wrap & wv, y -= wrap;
+      const int tried = VI_(bits)(in = y <= y1);
+      if (!tried) break;
+      evals += (uint64_t)__builtin_popcount((unsigned)tried);
+      const VF sx = VF_(from_int)(x) + ox, sy = VF_(from_int)(y) + oy;
+      VF ev[3];
 #pragma GCC unroll 3
-        for (int e = 0; e < 3; e++) {
-          ev[e] = (L.a[e] * one + L.b[e] * sx) + L.cc[e] * sy;
-          in &= TRI_EDGE_INSIDE(ev[e], L.tie[e], zero);
-        }
-        if (!VI_(bits)(in)) continue;
-        const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = (L.vol + sx * L.vol_x) + sy * L.vol_y;
-        in &= TRI_HIT_AHEAD(sum, v, zero);
-        int hit = VI_(bits)(in);
-        if (!hit) continue;
-        const VF pa = VF_(load)(mv->pa + p0), num0 = VF_(load)(mv->num0 + p0);
-        const VF cx = VF_(load)(mv->cx + p0), cy = VF_(load)(mv->cy + p0);
-        const VF den = (pa * one + L.pb * (sx - cx)) + L.pc * (sy - cy);
-        const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * L.num_x) + (sy - cy) * L.num_y, den, v, inv, zero,
-                                                VF_(select));
-        const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
-        for (; hit; hit &= hit - 1) {
-          const int l = __builtin_ctz((unsigned)hit);
-          const size_t k = (size_t)(p0 + l) * layer + (size_t)y * width + (size_t)x;
-          covered++;
-          if (t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
-            vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
-        }
+      for (int e = 0; e < 3; e++) {
+        ev[e] = (L.a[e] * one + L.b[e] * sx) + L.cc[e] * sy;
+        in &= TRI_EDGE_INSIDE(ev[e], L.tie[e], zero);
+      }
+      if (!VI_(bits)(in)) continue;
+      const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = (L.vol + sx * L.vol_x) + sy * L.vol_y;
+      in &= TRI_HIT_AHEAD(sum, v, zero);
+      int hit = VI_(bits)(in);
+      if (!hit) continue;
+      if (!moved) RR_CAT(tri_moved_lanes, W)(ts, mv->pl, c, ox, oy, m), moved = true;
+      const VF pa = m[0], num0 = m[1], cx = m[2], cy = m[3];
+      const VF den = (pa * one + L.pb * (sx - cx)) + L.pc * (sy - cy);
+      const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * L.num_x) + (sy - cy) * L.num_y, den, v, inv, zero,
+                                              VF_(select));
+      const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
+      for (; hit; hit &= hit - 1) {
+        const int l = __builtin_ctz((unsigned)hit);
+        const size_t k = (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
+        covered++;
+        if (t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
+          vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
       }
     }
   }

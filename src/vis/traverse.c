@@ -119,7 +119,7 @@ static uint64_t ana_raster(trav *t, uint32_t id, tile_rect r, uint64_t *covered)
   return (uint64_t)(r.x1 - r.x0) * (uint64_t)(r.y1 - r.y0) * (uint64_t)t->ns;
 }
 
-KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r) {
+KERNEL uint64_t raster_samples(trav *t, const tri_job *j, tri_moves *mv, tile_rect r) {
   int rect[4] = {r.x0, r.y0, r.x1 - 1, r.y1 - 1};
   uint64_t covered = 0;
   if (j->ana) { /* every position over the whole rectangle: no moved setup */
@@ -134,6 +134,7 @@ KERNEL uint64_t raster_samples(trav *t, const tri_job *j, const tri_moves *mv, t
   if (t->heat_e && !mv)
     heat_charge(t->heat_e, t->vb->width, r.x0, r.y0, r.x1, r.y1, (float)((r.x1 - r.x0) * (r.y1 - r.y0)));
   /* several positions: each over its own rectangle */
+  if (t->heat_e && mv) rr_tri_moves_ready(&j->ts, mv, t->cams, t->ns, t->simd);
   for (uint32_t live = t->heat_e && mv ? mv->live : 0; live; live &= live - 1) {
     const int p = __builtin_ctz(live), q[4] = {mv->r[0][p], mv->r[1][p], mv->r[2][p], mv->r[3][p]};
     int x0 = q[0] > r.x0 ? q[0] : r.x0, y0 = q[1] > r.y0 ? q[1] : r.y0;
@@ -218,7 +219,7 @@ static int bend_rejects(trav *t, const tri_job *j, tile_rect b) {
  * early-z shows it is hidden; otherwise it is refined by 4 in each direction down
  * to single pixels. Accepted samples still go through the sample test, which keeps
  * the result bit-identical. */
-static uint64_t bin_raster(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r, int size) {
+static uint64_t bin_raster(trav *t, const tri_job *j, tri_moves *mv, tile_rect r, int size) {
   uint64_t covered = 0;
   for (int by = r.y0 - r.y0 % size; by < r.y1; by += size)
     for (int bx = r.x0 - r.x0 % size; bx < r.x1; bx += size) {
@@ -491,7 +492,7 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
 
 /* Rasterizes a prepared triangle into the samples r, with its setup moved to
  * each position (mv; NULL for one position). */
-KERNEL void draw_rect(trav *t, const tri_job *j, const tri_moves *mv, tile_rect r) {
+KERNEL void draw_rect(trav *t, const tri_job *j, tri_moves *mv, tile_rect r) {
   /* Curved views start from bins of at most 16² samples: the bend bound grows with
    * the square of the bin, and a lat-long bin of 64² spans a quarter of the sphere. */
   if (t->o->binning)
@@ -499,33 +500,24 @@ KERNEL void draw_rect(trav *t, const tri_job *j, const tri_moves *mv, tile_rect 
   else raster_samples(t, j, mv, r);
 }
 
-/* Several positions: the setup moved to each once per draw, not per bin, with
- * each position's own rectangle (planar: the one-position frame's, tri_pos_rect;
- * curved: the union), which the kernel keeps to. A position whose rectangle misses
- * r is not moved. */
+/* Several positions: each over its own rectangle (planar: the one-position
+ * frame's, tri_pos_rect; curved: the union), which the kernel keeps to; what
+ * moves with the position is made by the kernel when it needs it, once a draw. */
 static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
-  tri_moves mv;
-  const bool planar = t->c->planar;
-  const int lanes = (t->ns + 7) & ~7; /* what the kernels' lanes read */
-  for (int s = 0; s < lanes; s++) mv.r[0][s] = mv.r[1][s] = INT32_MAX, mv.r[2][s] = mv.r[3][s] = INT32_MIN;
-  memcpy(mv.ox, t->ox, sizeof mv.ox), memcpy(mv.oy, t->oy, sizeof mv.oy);
-  if (planar) {
-    rr_tri_moved_all(&j->ts, &j->pl, t->c, lanes, mv.ox, mv.oy, t->simd, mv.pa, mv.num0, mv.cx, mv.cy);
-  } else {
-    for (int s = 0; s < lanes; s++)
-      mv.pa[s] = j->ts.pa, mv.num0[s] = j->ts.num0, mv.cx[s] = j->ts.cx, mv.cy[s] = j->ts.cy;
+  tri_moves mv; /* (no initializer: the per-position arrays are filled when needed) */
+  mv.ox = t->ox, mv.oy = t->oy, mv.pl = NULL, mv.ready = false;
+  mv.draw[0] = r.x0, mv.draw[1] = r.y0, mv.draw[2] = r.x1 - 1, mv.draw[3] = r.y1 - 1;
+  mv.bb = j->bb;
+  if (t->c->planar) {
+    /* drawn when some position's own rectangle meets r: any does when r holds bb */
+    uint32_t todo = ~(uint32_t)j->pos.none & ((1u << t->ns) - 1);
+    const bool whole = r.x0 <= j->bb[0] && r.x1 > j->bb[2] && r.y0 <= j->bb[1] && r.y1 > j->bb[3];
+    for (int q[4]; todo && !whole; todo &= todo - 1)
+      if (tri_pos_rect(&j->pos, j->bb, __builtin_ctz(todo), q) && meets(q, r)) break;
+    if (!todo) return;
+    mv.pl = &j->pl, mv.pos = &j->pos;
   }
-  mv.live = 0;
-  for (uint32_t todo = planar ? ~(uint32_t)j->pos.none & ((1u << t->ns) - 1) : (1u << t->ns) - 1; todo;
-       todo &= todo - 1) {
-    const int s = __builtin_ctz(todo);
-    int q[4];
-    if (!planar) memcpy(q, j->bb, sizeof q);
-    else if (!tri_pos_rect(&j->pos, j->bb, s, q) || !meets(q, r)) continue;
-    for (int k = 0; k < 4; k++) mv.r[k][s] = q[k];
-    mv.live |= 1u << s;
-  }
-  if (mv.live) draw_rect(t, j, &mv, r);
+  draw_rect(t, j, &mv, r);
 }
 
 /* Rasterizes a prepared triangle into the samples of f it may cover. */

@@ -183,22 +183,35 @@ bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx,
 uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb,
                         uint64_t *covered, bool simd);
 
-/* A triangle at several sample positions, by component for the lanes: for each
- * position s, its offset (ox, oy) (the camera's sx0, sy0), the setup values that
- * move with it (rr_tri_setup_at: pa, num0, cx, cy) and its own rectangle
- * (tri_pos_rect: x0 = r[0][s] .. x1 = r[2][s], y0 = r[1][s] .. y1 = r[3][s]); live
- * bit s: the rectangle may hold a sample. A position not live has an empty
- * rectangle and tests none. */
+/* A triangle at several sample positions. The caller says how it moves: the
+ * positions' offsets ox, oy (the cameras' sx0, sy0, padded to RR_MAX_SAMPLES with
+ * the first), the rectangle `draw` it is drawn into (inclusive) and, for a planar
+ * camera, pl (rr_tri_setup_at) with the bounds' union bb and bits pos
+ * (tri_pos_rect); pl NULL: a curved camera, every position as ts over bb. What
+ * follows from that, by component for the lanes, is made on demand (ready, by
+ * rr_tri_moves_ready): for each position s the setup values that move with it
+ * (pa, num0, cx, cy) and its own rectangle (x0 = r[0][s] .. x1 = r[2][s], y0 =
+ * r[1][s] .. y1 = r[3][s]); live bit s: that rectangle meets draw. A position
+ * not live has an empty rectangle and tests none. A triangle of a few pixels
+ * needs none of it: the kernel takes each position's rectangle from the bits and
+ * moves the setup in its lanes at the first hit. */
 typedef struct tri_moves {
+  const float *ox, *oy;
+  const tri_plane *pl;
+  const tri_pos_bits *pos;
+  const int *bb;
+  int draw[4];
+  bool ready;
   uint32_t live;
-  float ox[RR_MAX_SAMPLES], oy[RR_MAX_SAMPLES], pa[RR_MAX_SAMPLES], num0[RR_MAX_SAMPLES];
-  float cx[RR_MAX_SAMPLES], cy[RR_MAX_SAMPLES];
+  float pa[RR_MAX_SAMPLES], num0[RR_MAX_SAMPLES], cx[RR_MAX_SAMPLES], cy[RR_MAX_SAMPLES];
   int32_t r[4][RR_MAX_SAMPLES];
 } tri_moves;
-/* rr_raster_rect at ns sample positions at once: position s of mv->live over
- * rect ∩ its rectangle, with cams[s] and layer s of vb (of vb->width × vb->height
- * each). Returns the evaluations, one per sample of those rectangles. */
-uint64_t rr_raster_rect_samples(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int rect[4],
+/* Makes mv's per-position values for ts at the ns positions of cams (once). */
+void rr_tri_moves_ready(const tri_setup *ts, tri_moves *mv, const camera *cams, int ns, bool simd);
+/* rr_raster_rect at ns sample positions at once: each position over rect ∩ its
+ * rectangle, with cams[s] and layer s of vb (of vb->width × vb->height each).
+ * Returns the evaluations, one per sample of those rectangles. */
+uint64_t rr_raster_rect_samples(const tri_setup *ts, tri_moves *mv, uint32_t id, const int rect[4],
                                 const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd);
 
 /* Test and benchmark hook: the relative error of depths t (one per sample of the
