@@ -23,7 +23,8 @@ CAMERAS = [ffi.string(lib.rr_camera_name(c)).decode() for c in range(lib.RR_CAME
 AOVS = ("depth", "id", "normal", "bary", "evals", "nodes", "mesh", "material", "coverage", "sample-id",
         "sample-depth", "sample-mesh", "uv", "uv-deriv", "albedo", "direct", "reflection", "shadow", "emission",
         "z-depth", "shadow-lights")
-_HIT = np.dtype([("prim", "<u4"), ("t", "<f4"), ("l1", "<f4"), ("l2", "<f4"), ("geom", "<u4")])  # rr_hit
+_HIT = np.dtype([("prim", "<u4"), ("t", "<f4"), ("l1", "<f4"), ("l2", "<f4"), ("geom", "<u4"),
+                 ("inst", "<u4")])  # rr_hit
 assert _HIT.itemsize == ffi.sizeof("rr_hit")
 _DTYPES = {lib.RR_PIXEL_U8: np.uint8, lib.RR_PIXEL_F32: np.float32, lib.RR_PIXEL_U32: np.uint32}
 
@@ -361,7 +362,7 @@ class Scene:
     def intersect(self, rays, threads=0, normals=True):
         """Closest hits of rays (N, 6) float32 (origin, direction) through the ray
         streams, as Open3D's cast_rays: t_hit (+inf on a miss), primitive_ids and
-        geometry_ids (MISS on a miss), primitive_uvs (barycentrics λ1, λ2) and, with
+        geometry_ids (MISS on a miss), instance_ids (MISS where no instance), primitive_uvs (barycentrics λ1, λ2) and, with
         normals, primitive_normals (unit geometric normals, 0 on a miss). The first
         four are views into the library's array of hits (strided, not copied)."""
         s, keep = self._stream(rays)
@@ -371,9 +372,9 @@ class Scene:
             dev = _Device()
             dev.check(lib.rr_intersect_stream(dev.ptr, self._scene(), s, _threads(threads),
                                               ffi.from_buffer("rr_hit[]", hits)))
-        words = hits.view(np.float32).reshape(n, 5)
+        words = hits.view(np.float32).reshape(n, len(_HIT.names))
         out = {"t_hit": hits["t"], "primitive_ids": hits["prim"], "geometry_ids": hits["geom"],
-               "primitive_uvs": words[:, 2:4]}
+               "instance_ids": hits["inst"], "primitive_uvs": words[:, 2:4]}
         if normals:
             prim = np.ascontiguousarray(hits["prim"])
             out["primitive_normals"] = np.zeros((n, 3), dtype=np.float32)

@@ -568,7 +568,7 @@ static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
     const bvh_node *nd = &b->nodes[i];
     float *v = b->leaf_v + (size_t)9 * nd->first;
     for (uint32_t m = 0; nd->count && m < 9; m++)
-      for (uint32_t j = 0; j < nd->count; j++) v[m * nd->count + j] = s->p[m / 3][m % 3][b->prims[nd->first + j]];
+      for (uint32_t j = 0; j < nd->count; j++) v[m * nd->count + j] = scene_coord(s, (int)m / 3, (int)m % 3, b->prims[nd->first + j]);
   }
   return true;
 }
@@ -663,7 +663,7 @@ static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
       uint32_t first = j->first[c], count = j->count[c];
       float *v = b->leaf_v8 + (size_t)9 * first;
       for (uint32_t m = 0; m < 9; m++)
-        for (uint32_t t = 0; t < count; t++) v[m * count + t] = j->s->p[m / 3][m % 3][b->prims[first + t]];
+        for (uint32_t t = 0; t < count; t++) v[m * count + t] = scene_coord(j->s, (int)m / 3, (int)m % 3, b->prims[first + t]);
       wn->ref[i] = first, wn->count[i] = count;
     } else {
       wn->ref[i] = j->next++;

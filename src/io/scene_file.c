@@ -393,11 +393,12 @@ static bool is_identity(const xform *x) {
  * plane's point and normal (by the inverse transpose); a sphere's centre, and its
  * radius by the scale, which must be uniform (a sphere stays a sphere). */
 static rr_error xform_analytic(json_reader *r, rr_scene *s, const xform *x, const double nm[3][3], uint32_t i) {
-  float *a = s->ana + (size_t)ANA_FLOATS * i;
+  uint32_t j = scene_st(s, i);
+  float *a = s->ana + (size_t)ANA_FLOATS * j;
   vec3 c = xf_point(x, v3(a[0], a[1], a[2]), false);
   if (!(fabsf(c.x) <= 1e30f && fabsf(c.y) <= 1e30f && fabsf(c.z) <= 1e30f))
     return rr_json_fail(r, NULL, "the transform takes vertices beyond 1e30");
-  for (int k = 0; k < 3; k++) s->p[k][0][i] = c.x, s->p[k][1][i] = c.y, s->p[k][2][i] = c.z;
+  for (int k = 0; k < 3; k++) s->p[k][0][j] = c.x, s->p[k][1][j] = c.y, s->p[k][2][j] = c.z;
   a[0] = c.x, a[1] = c.y, a[2] = c.z;
   if (scene_kind(s, i) == RR_GEOMETRY_BOX) return rr_json_fail(r, NULL, "boxes are placed by 'boxes', not moved");
   if (scene_kind(s, i) == RR_GEOMETRY_PLANE) {
@@ -429,6 +430,8 @@ static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_
       nm[i][j] = (x->m[i1][j1] * x->m[i2][j2] - x->m[i1][j2] * x->m[i2][j1]) * (d < 0 ? -1 : 1);
     }
   for (uint32_t i = t0; i < s->ntris; i++) {
+    uint32_t in, j = scene_locate(s, i, &in);
+    if (in != RR_MISS) continue; /* an instance: its transform moves (below) */
     if (scene_kind(s, i) != RR_GEOMETRY_TRIANGLE) {
       rr_error e = xform_analytic(r, s, x, nm, i);
       if (e) return e;
@@ -440,22 +443,33 @@ static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_
       if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z) || fabsf(p.x) > 1e30f || fabsf(p.y) > 1e30f ||
           fabsf(p.z) > 1e30f)
         return rr_json_fail(r, NULL, "the transform takes vertices beyond 1e30");
-      s->p[k][0][i] = p.x, s->p[k][1][i] = p.y, s->p[k][2][i] = p.z;
+      s->p[k][0][j] = p.x, s->p[k][1][j] = p.y, s->p[k][2][j] = p.z;
       if (s->n[0][0]) {
-        vec3 n = xf_unit(nm, v3(s->n[k][0][i], s->n[k][1][i], s->n[k][2][i]));
-        s->n[k][0][i] = n.x, s->n[k][1][i] = n.y, s->n[k][2][i] = n.z;
+        vec3 n = xf_unit(nm, v3(s->n[k][0][j], s->n[k][1][j], s->n[k][2][j]));
+        s->n[k][0][j] = n.x, s->n[k][1][j] = n.y, s->n[k][2][j] = n.z;
       }
     }
     if (d < 0) {
       for (int c = 0; c < 3; c++) {
-        swapf(&s->p[1][c][i], &s->p[2][c][i]);
-        if (s->n[0][0]) swapf(&s->n[1][c][i], &s->n[2][c][i]);
-        if (s->col[0][0]) swapf(&s->col[1][c][i], &s->col[2][c][i]);
-        if (c < 2 && s->uv[0][0]) swapf(&s->uv[1][c][i], &s->uv[2][c][i]);
+        swapf(&s->p[1][c][j], &s->p[2][c][j]);
+        if (s->n[0][0]) swapf(&s->n[1][c][j], &s->n[2][c][j]);
+        if (s->col[0][0]) swapf(&s->col[1][c][j], &s->col[2][c][j]);
+        if (c < 2 && s->uv[0][0]) swapf(&s->uv[1][c][j], &s->uv[2][c][j]);
       }
-      if (s->inf) s->inf[i] = (uint8_t)((inf & 1u) | (inf >> 1 & 2u) | (inf << 1 & 4u));
+      if (s->inf) s->inf[j] = (uint8_t)((inf & 1u) | (inf >> 1 & 2u) | (inf << 1 & 4u));
     }
   }
+  if (s->inst && s->inst->base >= t0) /* instances loaded with the object: x after their transforms */
+    for (uint32_t k = 0; k < s->inst->n; k++) {
+      float *m = s->inst->xf[k], o[12];
+      for (int r0 = 0; r0 < 3; r0++)
+        for (int c = 0; c < 4; c++)
+          o[4 * r0 + c] = (float)(x->m[r0][0] * m[c] + x->m[r0][1] * m[4 + c] + x->m[r0][2] * m[8 + c] +
+                                  (c == 3 ? x->t[r0] : 0));
+      rr_error e = rr_instance_set(s, k, o);
+      if (e) return rr_json_fail(r, NULL, "%s", rr_device_message(s->dev));
+      if (k + 1 == s->inst->n) rr_scene_update_bounds(s);
+    }
   for (uint32_t c = c0; c < s->ncameras; c++) {
     file_camera *fc = &s->cameras[c];
     fc->eye = xf_point(x, fc->eye, false);

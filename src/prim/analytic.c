@@ -2,7 +2,7 @@
 #include "prim/analytic.h"
 #include "prim/triangle.h"
 
-static const float *ana_of(const rr_scene *s, uint32_t i) { return s->ana + (size_t)ANA_FLOATS * i; }
+static const float *ana_of(const rr_scene *s, uint32_t i) { return s->ana + (size_t)ANA_FLOATS * scene_st(s, i); }
 
 bool rr_ana_hit(const rr_scene *s, uint32_t i, const ana_ray *r, float *t, float *u, float *v) {
   switch (scene_kind(s, i)) {

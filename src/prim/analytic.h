@@ -34,7 +34,7 @@ enum { ANA_FLOATS = 12 };
 
 /* The kind of primitive i (triangles unless the scene holds analytic ones). */
 static inline prim_kind scene_kind(const rr_scene *s, uint32_t i) {
-  return s->kind ? (prim_kind)s->kind[i] : RR_GEOMETRY_TRIANGLE;
+  return s->kind ? (prim_kind)s->kind[scene_st(s, i)] : RR_GEOMETRY_TRIANGLE;
 }
 
 /* A ray in double: origin o and (unnormalised) direction d. */

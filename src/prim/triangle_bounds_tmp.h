@@ -16,7 +16,15 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
   for (int l = 0; l < W; l++)
     lane_id[l] = (int32_t)(ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1));
   if (s->inf)
-    for (int l = 0; l < W; l++) lane_inf[l] = s->inf[lane_id[l]];
+    for (int l = 0; l < W; l++) lane_inf[l] = (int32_t)scene_inf(s, (uint32_t)lane_id[l]);
+  /* instances: each lane's corners moved to world by scene_vertex (the gather's floats otherwise) */
+  float lane_p[3][3][W];
+  if (s->inst)
+    for (int l = 0; l < W; l++)
+      for (int k = 0; k < 3; k++) {
+        vec3 v = scene_vertex(s, k, (uint32_t)lane_id[l]);
+        lane_p[k][0][l] = v.x, lane_p[k][1][l] = v.y, lane_p[k][2][l] = v.z;
+      }
   const VI idx = VI_(load)(lane_id), inf = VI_(load)(lane_inf);
   const bool persp = c->type == RR_CAMERA_PERSPECTIVE, contiguous = !ids && n == W;
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f), half = VF_(splat)(0.5f);
@@ -34,7 +42,9 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
     VF q[3]; /* the corner relative to the eye, or its direction when at infinity */
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-      VF p = contiguous ? VF_(load)(s->p[k][a] + first) : VF_(gather)(s->p[k][a], idx);
+      VF p = s->inst     ? VF_(load)(lane_p[k][a])
+             : contiguous ? VF_(load)(s->p[k][a] + first)
+                          : VF_(gather)(s->p[k][a], idx);
       q[a] = p - eye[a];
       if (s->inf) q[a] = VF_(select)(-((inf >> k) & 1), p, q[a]);
     }

@@ -47,7 +47,15 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
   int32_t lane_id[W], lane_inf[W] = {0};
   for (int l = 0; l < W; l++) lane_id[l] = (int32_t)ids[l < count ? l : count - 1];
   if (s->inf)
-    for (int l = 0; l < W; l++) lane_inf[l] = s->inf[lane_id[l]];
+    for (int l = 0; l < W; l++) lane_inf[l] = (int32_t)scene_inf(s, (uint32_t)lane_id[l]);
+  /* instances: each lane's corners moved to world by scene_vertex (the gather's floats otherwise) */
+  float lane_p[3][3][W];
+  if (s->inst)
+    for (int l = 0; l < W; l++)
+      for (int k = 0; k < 3; k++) {
+        vec3 v = scene_vertex(s, k, (uint32_t)lane_id[l]);
+        lane_p[k][0][l] = v.x, lane_p[k][1][l] = v.y, lane_p[k][2][l] = v.z;
+      }
   const VI idx = VI_(load)(lane_id), inf = VI_(load)(lane_inf);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   const V3 zero3 = {zero, zero, zero};
@@ -56,7 +64,8 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
   VI at_inf[3] = {VI_(splat)(0), VI_(splat)(0), VI_(splat)(0)};
 #pragma GCC unroll 3
   for (int k = 0; k < 3; k++) {
-    p[k] = (V3){VF_(gather)(s->p[k][0], idx), VF_(gather)(s->p[k][1], idx), VF_(gather)(s->p[k][2], idx)};
+    p[k] = s->inst ? (V3){VF_(load)(lane_p[k][0]), VF_(load)(lane_p[k][1]), VF_(load)(lane_p[k][2])}
+                   : (V3){VF_(gather)(s->p[k][0], idx), VF_(gather)(s->p[k][1], idx), VF_(gather)(s->p[k][2], idx)};
     q[k] = SUB3(p[k], SPLAT3(c->eye));
     if (s->inf) {
       at_inf[k] = -((inf >> k) & 1);

@@ -54,7 +54,7 @@ static hit hit_make(const rr_scene *s, uint32_t id, float l1, float l2, float t,
     vec3 sn = v3(0, 0, 0);
     float w[3] = {h.l0, h.l1, h.l2};
     for (int v = 0; v < 3; v++)
-      sn = v3_add(sn, v3_scale(v3(s->n[v][0][id], s->n[v][1][id], s->n[v][2][id]), w[v]));
+      sn = v3_add(sn, v3_scale(scene_normal(s, v, id), w[v]));
     if (v3_dot(sn, sn) > 1e-12f) {
       sn = v3_norm(sn);
       /* keep interpolated normals on the geometric normal's side */
@@ -89,7 +89,7 @@ static tex_coord hit_texcoord(const rr_scene *s, const hit *h, bool derivs) {
 }
 
 static void base_color(const rr_scene *s, const hit *h, const tex_filter *tf, float rgb[3]) {
-  const rr_material *m = s->nmaterials ? &s->materials[s->material[h->id] % s->nmaterials] : NULL;
+  const rr_material *m = s->nmaterials ? &s->materials[scene_material(s, h->id) % s->nmaterials] : NULL;
   rgb[0] = rgb[1] = rgb[2] = SCENE_GREY;
   if (!m) return;
   memcpy(rgb, m->color, sizeof m->color);
@@ -101,9 +101,10 @@ static void base_color(const rr_scene *s, const hit *h, const tex_filter *tf, fl
     rr_texture_sample(&m->texture, &tc, tf, t);
     for (int c = 0; c < 3; c++) rgb[c] *= t[c];
   }
-  if (s->col[0][0]) /* vertex colours (linear) multiply in, like glTF's COLOR_0 */
-    for (int c = 0; c < 3; c++)
-      rgb[c] *= h->l0 * s->col[0][c][h->id] + h->l1 * s->col[1][c][h->id] + h->l2 * s->col[2][c][h->id];
+  if (s->col[0][0]) { /* vertex colours (linear) multiply in, like glTF's COLOR_0 */
+    uint32_t j = scene_st(s, h->id);
+    for (int c = 0; c < 3; c++) rgb[c] *= h->l0 * s->col[0][c][j] + h->l1 * s->col[1][c][j] + h->l2 * s->col[2][c][j];
+  }
 }
 
 static uint32_t hash32(uint32_t x) {
@@ -226,7 +227,7 @@ static void hit_surface(const rr_scene *s, const hit *h, const tex_filter *tf, s
     sf->p = v3_add(v3_add(v3_scale(scene_vertex(s, 0, i), h->l0), v3_scale(scene_vertex(s, 1, i), h->l1)),
                    v3_scale(scene_vertex(s, 2, i), h->l2));
   }
-  sf->m = s->nmaterials ? &s->materials[s->material[i] % s->nmaterials] : NULL;
+  sf->m = s->nmaterials ? &s->materials[scene_material(s, i) % s->nmaterials] : NULL;
   base_color(s, h, tf, sf->base);
 }
 
@@ -627,7 +628,7 @@ static rr_error frame_cameras(rr_device *dev, const rr_camera *cam, const rr_fra
 static uint32_t id_aov(const rr_scene *s, rr_aov aov, uint32_t id) {
   if (aov == RR_AOV_ID) return scene_face_id(s, id);
   if (id >= s->ntris) return RR_MISS;
-  return aov == RR_AOV_MESH ? rr_scene_geometry_of(s, id) : s->material[id];
+  return aov == RR_AOV_MESH ? rr_scene_geometry_of(s, id) : scene_material(s, id);
 }
 
 /* The sample nearest the pixel's centre (the lowest index on a tie): the same in

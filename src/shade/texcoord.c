@@ -6,7 +6,8 @@
 
 /* Corner k's UVs. */
 static void corner_uv(const rr_scene *s, int k, uint32_t i, float uv[2]) {
-  uv[0] = s->uv[k][0][i], uv[1] = s->uv[k][1][i];
+  uint32_t j = scene_st(s, i);
+  uv[0] = s->uv[k][0][j], uv[1] = s->uv[k][1][j];
 }
 
 tex_coord rr_texcoord(const rr_scene *s, uint32_t i, float l1, float l2, float t, vec3 o, vec3 d,
@@ -31,8 +32,9 @@ tex_coord rr_texcoord(const rr_scene *s, uint32_t i, float l1, float l2, float t
   vec3 gv = v3_add(v3_scale(ga, dua[1]), v3_scale(gb, dub[1]));
   if (!inf) { /* the perspective-correct barycentrics of the visibility buffer */
     float l0 = 1.0f - l1 - l2;
-    tc.u = l0 * s->uv[0][0][i] + l1 * s->uv[1][0][i] + l2 * s->uv[2][0][i];
-    tc.v = l0 * s->uv[0][1][i] + l1 * s->uv[1][1][i] + l2 * s->uv[2][1][i];
+    uint32_t j = scene_st(s, i);
+    tc.u = l0 * s->uv[0][0][j] + l1 * s->uv[1][0][j] + l2 * s->uv[2][0][j];
+    tc.v = l0 * s->uv[0][1][j] + l1 * s->uv[1][1][j] + l2 * s->uv[2][1][j];
   } else { /* from the hit point: no corner to weigh by 1 - l1 - l2 */
     vec3 q = v3_sub(v3_add(o, v3_scale(d, t)), pf);
     tc.u = uvf[0] + v3_dot(gu, q), tc.v = uvf[1] + v3_dot(gv, q);
