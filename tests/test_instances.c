@@ -245,6 +245,61 @@ static void check_errors(rr_device *dev, const float *pos, const uint32_t *idx) 
   rr_scene_release(s);
 }
 
+/* Scene files: "instances" places a mesh by a list of transforms; bad ones are refused
+ * with one line naming the transform. */
+static void check_scene_file(rr_device *dev) {
+  char dir[] = "/tmp/rr_inst_XXXXXX";
+  if (!mkdtemp(dir)) {
+    CHECK(0, "mkdtemp");
+    return;
+  }
+  const char *good = test_write_file(dir, "good.json",
+      "{\"instances\": {\"builtin\": \"box\", \"name\": \"crate\", \"transforms\": [{\"translate\": [3, 0, 0]},"
+      " {\"rotate\": [0, 45, 0], \"scale\": [1, 2, 1]}, {\"matrix\": [[1, 0, 0, 0], [0, 1, 0, -3], [0, 0, 1, 0], [0, 0, 0, 1]]}]},"
+      " \"spheres\": [{\"center\": [0, 5, 0], \"radius\": 1}]}");
+  rr_scene *s = NULL;
+  CHECK(rr_scene_load(dev, good, &s) == RR_OK, "good file: %s", rr_device_message(dev));
+  if (s) {
+    rr_scene_info in;
+    rr_scene_get_info(s, &in);
+    CHECK(in.instances == 3 && in.triangles == 3 * in.stored_triangles - 0 && in.spheres == 1, "%u instances, %llu triangles",
+          in.instances, (unsigned long long)in.triangles);
+    rr_camera cam = test_random_view(s, 1.5f, 2.0f, 0.1f, 60, 60);
+    rr_frame *a = test_render(dev, s, &cam, RR_METHOD_RC, 1, 32, 24, 0);
+    rr_frame *b = test_render(dev, s, &cam, RR_METHOD_3DR_FULL, 2, 32, 24, 0);
+    if (a && b) CHECK(test_frames_differ(a, b) == 0 && test_frame_hits(a) > 0, "scene file: 3dr-full equals rc");
+    rr_frame_release(a), rr_frame_release(b);
+    rr_scene_release(s);
+  }
+  static const struct {
+    const char *body, *want;
+  } bad[] = {
+      {"{\"instances\": {\"builtin\": \"box\", \"transforms\": [{}, {\"scale\": [1, 0, 1]}]}}",
+       "'instances.transforms[1]': the transform is singular"},
+      {"{\"instances\": {\"builtin\": \"box\", \"transforms\": [{\"scale\": [-1, 1, 1]}]}}",
+       "'instances.transforms[0]': a mirroring transform"},
+      {"{\"instances\": {\"builtin\": \"box\", \"transforms\": [{\"translate\": [1, \"x\", 0]}]}}",
+       "'instances.transforms[0].translate'"},
+      {"{\"instances\": {\"builtin\": \"box\", \"transforms\": [{\"translate\": [1e30, 0, 0], \"scale\": 1e30}]}}",
+       "'instances.transforms[0]'"},
+      {"{\"instances\": {\"builtin\": \"box\", \"translate\": [1, 0, 0], \"transforms\": [{}]}}",
+       "unknown key 'translate'"},
+      {"{\"instances\": {\"builtin\": \"box\"}}", "missing 'transforms'"},
+      {"{\"instances\": {\"builtin\": \"sphere\", \"transforms\": [{}]}}", "triangle meshes only"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    const char *path = test_write_file(dir, "bad.json", bad[k].body);
+    rr_scene *t = NULL;
+    rr_error e = rr_scene_load(dev, path, &t);
+    const char *msg = rr_device_message(dev);
+    CHECK(e != RR_OK && !t && strstr(msg, bad[k].want) && !strchr(msg, '\n'), "bad file %zu: %s", k, msg);
+    rr_scene_release(t);
+  }
+  char cmd[64];
+  snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+  CHECK(system(cmd) == 0, "rm");
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
   float *pos = malloc(sizeof(float) * 9 * NTRI);
@@ -262,6 +317,7 @@ int main(void) {
   rr_scene_release(inst), rr_scene_release(flat);
   check_grid(dev);
   check_errors(dev, pos, idx);
+  check_scene_file(dev);
   free(pos), free(idx);
   rr_device_release(dev);
   return test_done();

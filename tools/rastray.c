@@ -850,6 +850,9 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
   if (in.spheres || in.planes || in.boxes)
     printf("analytic     %llu spheres, %llu planes, %llu boxes\n", (unsigned long long)in.spheres,
            (unsigned long long)in.planes, (unsigned long long)in.boxes);
+  if (in.instances)
+    printf("instances    %u of one mesh (%llu triangles stored)\n", in.instances,
+           (unsigned long long)in.stored_triangles);
   printf("materials    %u\n", in.materials);
   printf("geometries   %u\n", in.geometries);
   enum { LISTED = 32 }; /* a scene of more lists none: the list would drown the rest */
@@ -914,6 +917,7 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
   printf("bvh sah cost %.3f\n", in.bvh_sah_cost);
   printf("bvh build    %.1f ms\n", in.bvh_build_ms);
   printf("bvh memory   %.2f MiB\n", in.bvh_bytes / 1048576.0);
+  printf("scene memory %.2f MiB (primitives%s)\n", in.scene_bytes / 1048576.0, in.instances ? " and instances" : "");
   return 0;
 }
 

@@ -356,7 +356,9 @@ static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
     rotate_by(deg, m);
     memcpy(x->m, m, sizeof m);
   }
-  double d = det3(x->m);
+  double m[3][3]; /* (a copy: GCC's inliner misjudges x->m's size otherwise) */
+  memcpy(m, x->m, sizeof m);
+  double d = det3(m);
   if (!(fabs(d) > 1e-300) || !isfinite(d)) return rr_json_fail(r, NULL, "the transform is singular (a zero scale?)");
   return RR_OK;
 }
@@ -541,12 +543,16 @@ static rr_error resolve_path(json_reader *r, const char *key, const char *base_d
   return RR_OK;
 }
 
-/* A mesh: "file" or "builtin", "name", a transform, "material". */
+static rr_error read_instances(json_reader *r, const cJSON *list, rr_scene *s, uint32_t t0, uint64_t faces, uint32_t g0);
+
+/* A mesh: "file" or "builtin", "name", a transform, "material"; or, instanced, the
+ * same with "transforms" (one per instance) in place of the transform. */
 static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const char *base_dir,
-                          const rr_load_options *opt) {
+                          const rr_load_options *opt, bool instanced) {
   static const char *const keys[] = {"file",   "builtin", "name",     "translate", "rotate",
                                      "scale",  "matrix",  "material", "smooth",    NULL};
-  rr_error e = rr_json_keys(r, obj, keys);
+  static const char *const inst_keys[] = {"file", "builtin", "name", "transforms", "material", "smooth", NULL};
+  rr_error e = rr_json_keys(r, obj, instanced ? inst_keys : keys);
   if (e) return e;
   const char *file = NULL, *builtin = NULL, *name = NULL;
   if ((e = rr_json_string(r, obj, "file", &file)) || (e = rr_json_string(r, obj, "builtin", &builtin)) ||
@@ -583,6 +589,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
   if (scene_faces(s) == faces) return rr_json_fail(r, builtin ? "builtin" : "file", "no triangles");
   for (uint32_t g = g0; name && g < s->ngeoms; g++)
     if ((e = rr_scene_name_geometry(s, g, name))) return e;
+  if (instanced && (e = read_instances(r, rr_json_get(obj, "transforms"), s, t0, faces, g0))) return e;
   if ((e = apply_xform(r, s, &x, t0, c0, l0))) return e;
   if (smooth && (e = rr_scene_smooth_normals(s, t0, s->ntris))) return e;
   if (material) {
@@ -590,6 +597,42 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
     e = read_material(r, material, s, m0);
     rr_json_leave(r, len);
   }
+  return e;
+}
+
+/* "transforms": one transform object per instance of the mesh stored from t0 on. */
+static rr_error read_instances(json_reader *r, const cJSON *list, rr_scene *s, uint32_t t0, uint64_t faces, uint32_t g0) {
+  static const char *const keys[] = {"translate", "rotate", "scale", "matrix", NULL};
+  if (!list) return rr_json_fail(r, NULL, "missing 'transforms'");
+  int n = cJSON_GetArraySize(list);
+  if (!cJSON_IsArray(list) || n < 1) return rr_json_fail(r, "transforms", "expected an array of transform objects");
+  if (s->inst) return rr_json_fail(r, NULL, "a scene holds one instanced mesh");
+  if (s->ntris == t0) return rr_json_fail(r, NULL, "no triangles kept");
+  vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+  for (uint32_t j = t0; j < s->ntris; j++)
+    for (int k = 0; k < 3; k++) lo = v3_min(lo, scene_stored_vertex(s, k, j)), hi = v3_max(hi, scene_stored_vertex(s, k, j));
+  float (*xf)[12] = malloc((size_t)n * sizeof *xf);
+  if (!xf) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for %d instances", n);
+  rr_error e = RR_OK;
+  int i = 0;
+  xform x;
+  for (const cJSON *item = list->child; item && !e; item = item->next, i++) {
+    size_t len = rr_json_enter(r, "transforms", 0);
+    rr_json_enter(r, NULL, i);
+    e = !cJSON_IsObject(item) ? rr_json_fail(r, NULL, "expected a transform object") : rr_json_keys(r, item, keys);
+    if (!e) e = read_xform(r, item, &x);
+    for (int row = 0; !e && row < 3; row++)
+      for (int c = 0; c < 4; c++) xf[i][4 * row + c] = (float)(c < 3 ? x.m[row][c] : x.t[row]);
+    const char *why = e ? NULL : rr_instance_problem(xf[i], lo, hi);
+    if (why) e = rr_json_fail(r, NULL, "%s", why);
+    rr_json_leave(r, len);
+  }
+  if (!e && rr_scene_instance(s, t0, scene_faces(s) - faces, g0, (uint32_t)n, (const float (*)[12])xf) != RR_OK) {
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", rr_device_message(s->dev));
+    e = rr_json_fail(r, NULL, "%s", msg);
+  }
+  free(xf);
   return e;
 }
 
@@ -742,7 +785,7 @@ typedef struct mesh_arg {
 
 static rr_error mesh_item(json_reader *r, const cJSON *item, void *arg) {
   const mesh_arg *a = arg;
-  return read_mesh(r, item, a->s, a->base_dir, a->opt);
+  return read_mesh(r, item, a->s, a->base_dir, a->opt, false);
 }
 
 static rr_error light_item(json_reader *r, const cJSON *item, void *arg) { return read_light(r, item, arg); }
@@ -794,7 +837,7 @@ static rr_error import_camera(json_reader *r, const cJSON *obj, const char *base
 /* Everything of the file but the commit. */
 static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const char *base_dir,
                            const rr_load_options *opt, rr_scene_settings *st) {
-  static const char *const keys[] = {"meshes", "spheres", "planes", "boxes", "lights", "camera", "render", "comment", NULL};
+  static const char *const keys[] = {"meshes", "instances", "spheres", "planes", "boxes", "lights", "camera", "render", "comment", NULL};
   rr_error e = rr_json_keys(r, root, keys);
   const char *comment;
   if (!e) e = rr_json_string(r, root, "comment", &comment);
@@ -814,8 +857,14 @@ static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const
   }
   mesh_arg ma = {s, base_dir, opt};
   /* meshes may be left out when spheres or planes are given */
-  bool analytic = rr_json_get(root, "spheres") || rr_json_get(root, "planes") || rr_json_get(root, "boxes");
+  bool analytic = rr_json_get(root, "spheres") || rr_json_get(root, "planes") || rr_json_get(root, "boxes") ||
+                  rr_json_get(root, "instances");
   if (!e) e = each(r, root, "meshes", !analytic, mesh_item, &ma);
+  if (!e && (item = rr_json_get(root, "instances"))) { /* one instanced mesh, after the meshes */
+    size_t len = rr_json_enter(r, "instances", 0);
+    e = cJSON_IsObject(item) ? read_mesh(r, item, s, base_dir, opt, true) : rr_json_fail(r, NULL, "expected an object");
+    rr_json_leave(r, len);
+  }
   if (!e) e = each(r, root, "spheres", false, sphere_item, s);
   if (!e) e = each(r, root, "planes", false, plane_item, s);
   if (!e) e = each(r, root, "boxes", false, box_item, s);
