@@ -739,8 +739,19 @@ static double sah_cost(const struct rr_bvh *b) {
   return ra > 0 ? sum / ra : 0;
 }
 
+bool rr_bvh_finish(rr_bvh *b, const rr_scene *s) {
+  uint32_t n = b->nprims;
+  if (!collapse_wide(b) || !collapse_wide8(b, s) || !copy_leaf_corners(b, s)) return false;
+  b->sah_cost = sah_cost(b);
+  b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
+             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) +
+             (uint64_t)b->nwide8 * sizeof(bvh_wide8) + 2 * ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
+  return true;
+}
+
 rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out) {
   *out = NULL;
+  if (s->inst) return rr_bvh_build_instanced(s, opt, out); /* accel/bvh_instance.c */
   double t0 = rr_now_ms();
   builder bd = {.bins = opt->bins ? opt->bins : BVH_DEFAULT_BINS,
                 .leaf_size = opt->leaf_size ? opt->leaf_size : BVH_DEFAULT_LEAF,
@@ -880,12 +891,7 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   for (uint32_t i = 0; i < small.n; i++)
     if (small.v[i].buf)
       for (uint32_t k = small.v[i].start; k < small.v[i].start + small.v[i].count; k++) b->prims[k] = bd.buf[1][k].id;
-  if (!collapse_wide(b) || !collapse_wide8(b, s)) goto oom;
-  if (!copy_leaf_corners(b, s)) goto oom;
-  b->sah_cost = sah_cost(b);
-  b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
-             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) +
-             (uint64_t)b->nwide8 * sizeof(bvh_wide8) + 2 * ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
+  if (!rr_bvh_finish(b, s)) goto oom;
   b->build_ms = rr_now_ms() - t0;
   rr_progress(&progress, 1);
   *out = b;
