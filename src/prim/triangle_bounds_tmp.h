@@ -17,9 +17,13 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
     lane_id[l] = (int32_t)(ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1));
   if (s->inf)
     for (int l = 0; l < W; l++) lane_inf[l] = (int32_t)scene_inf(s, (uint32_t)lane_id[l]);
-  /* instances: each lane's corners moved to world by scene_vertex (the gather's floats otherwise) */
-  float lane_p[3][3][W];
-  if (s->inst)
+  /* instances: translated lanes gather their stored corners and add the translation
+   * (inst_point's addition); other maps move each lane's corners with scene_vertex */
+  float lane_p[3][3][W], lane_tr[3 * W];
+  int32_t lane_st[W], lane_moved[W];
+  const bool moved = s->inst != NULL, shifted = moved && scene_lanes(s, lane_id, W, lane_st, lane_tr, lane_moved);
+  const VI st_idx = moved ? VI_(load)(lane_st) : VI_(splat)(0), moved_m = moved ? VI_(load)(lane_moved) : VI_(splat)(0);
+  if (moved && !shifted)
     for (int l = 0; l < W; l++)
       for (int k = 0; k < 3; k++) {
         vec3 v = scene_vertex(s, k, (uint32_t)lane_id[l]);
@@ -42,7 +46,9 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
     VF q[3]; /* the corner relative to the eye, or its direction when at infinity */
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-      VF p = s->inst     ? VF_(load)(lane_p[k][a])
+      VF p = shifted      ? VF_(select)(moved_m, VF_(gather)(s->p[k][a], st_idx) + VF_(load)(lane_tr + a * W),
+                                         VF_(gather)(s->p[k][a], st_idx))
+             : moved      ? VF_(load)(lane_p[k][a])
              : contiguous ? VF_(load)(s->p[k][a] + first)
                           : VF_(gather)(s->p[k][a], idx);
       q[a] = p - eye[a];

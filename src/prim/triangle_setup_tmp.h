@@ -48,9 +48,13 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
   for (int l = 0; l < W; l++) lane_id[l] = (int32_t)ids[l < count ? l : count - 1];
   if (s->inf)
     for (int l = 0; l < W; l++) lane_inf[l] = (int32_t)scene_inf(s, (uint32_t)lane_id[l]);
-  /* instances: each lane's corners moved to world by scene_vertex (the gather's floats otherwise) */
-  float lane_p[3][3][W];
-  if (s->inst)
+  /* instances: translated lanes gather their stored corners and add the translation
+   * (inst_point's addition); other maps move each lane's corners with scene_vertex */
+  float lane_p[3][3][W], lane_tr[3 * W];
+  int32_t lane_st[W], lane_moved[W];
+  const bool moved = s->inst != NULL, shifted = moved && scene_lanes(s, lane_id, W, lane_st, lane_tr, lane_moved);
+  const VI st_idx = moved ? VI_(load)(lane_st) : VI_(splat)(0), moved_m = moved ? VI_(load)(lane_moved) : VI_(splat)(0);
+  if (moved && !shifted)
     for (int l = 0; l < W; l++)
       for (int k = 0; k < 3; k++) {
         vec3 v = scene_vertex(s, k, (uint32_t)lane_id[l]);
@@ -64,8 +68,14 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
   VI at_inf[3] = {VI_(splat)(0), VI_(splat)(0), VI_(splat)(0)};
 #pragma GCC unroll 3
   for (int k = 0; k < 3; k++) {
-    p[k] = s->inst ? (V3){VF_(load)(lane_p[k][0]), VF_(load)(lane_p[k][1]), VF_(load)(lane_p[k][2])}
+    if (shifted) {
+      V3 g = {VF_(gather)(s->p[k][0], st_idx), VF_(gather)(s->p[k][1], st_idx), VF_(gather)(s->p[k][2], st_idx)};
+      V3 t = {VF_(load)(lane_tr), VF_(load)(lane_tr + W), VF_(load)(lane_tr + 2 * W)};
+      p[k] = SELECT3(moved_m, ADD3(g, t), g);
+    } else {
+      p[k] = moved ? (V3){VF_(load)(lane_p[k][0]), VF_(load)(lane_p[k][1]), VF_(load)(lane_p[k][2])}
                    : (V3){VF_(gather)(s->p[k][0], idx), VF_(gather)(s->p[k][1], idx), VF_(gather)(s->p[k][2], idx)};
+    }
     q[k] = SUB3(p[k], SPLAT3(c->eye));
     if (s->inf) {
       at_inf[k] = -((inf >> k) & 1);

@@ -152,6 +152,23 @@ static inline vec3 scene_stored_vertex(const rr_scene *s, int k, uint32_t j) {
   return v3(s->p[k][0][j], s->p[k][1][j], s->p[k][2][j]);
 }
 
+/* For kernels that load w lanes of corners (triangle i = ids[l] in lane l): where each
+ * is stored (st[l]), the translation of its instance (tr[a·w + l], axis a; 0 where
+ * none) and whether one moves it (mask[l] = -1, else 0); so that stored + tr is
+ * inst_point's corner, the same float addition. False when some lane's instance is
+ * more than a translation: then the caller moves its corners with scene_vertex. */
+static inline bool scene_lanes(const rr_scene *s, const int32_t *ids, int w, int32_t *st, float *tr, int32_t *mask) {
+  bool shift = true;
+  for (int l = 0; l < w; l++) {
+    uint32_t k;
+    st[l] = (int32_t)scene_locate(s, (uint32_t)ids[l], &k);
+    mask[l] = k == RR_MISS ? 0 : -1;
+    shift = shift && (k == RR_MISS || s->inst->shift[k]);
+    for (int a = 0; a < 3; a++) tr[a * w + l] = k == RR_MISS ? 0.0f : s->inst->xf[k][4 * a + 3];
+  }
+  return shift;
+}
+
 /* Corner k of triangle i in world space. */
 static inline vec3 scene_vertex(const rr_scene *s, int k, uint32_t i) {
   uint32_t in, j = scene_locate(s, i, &in);
