@@ -679,18 +679,19 @@ typedef enum rr_aov {
   RR_AOV_SHADOW_LIGHTS, /* L floats (L = the punctual lights, 1 .. RR_MAX_SHADOW_LIGHTS): channel i is 1 where
                            light i reaches the point (facing it, inside its cone, unblocked), else 0 (and on a
                            miss): from the same occlusion passes as shadow, which is their mean */
+  RR_AOV_INSTANCE,      /* 1 uint32: the instance a sample sees (rr_hit.inst), RR_MISS on a miss and off instances */
   RR_AOV_COUNT
 } rr_aov;
 #define RR_MAX_SHADOW_LIGHTS 16 /* most lights the shadow-lights AOV holds (a channel each) */
 /* With several samples per pixel the per-pixel AOVs follow one rule each: id, mesh,
- * material, normal, bary, uv and uv-deriv are those of the sample nearest the pixel's centre (the
+ * material, instance, normal, bary, uv and uv-deriv are those of the sample nearest the pixel's centre (the
  * lowest such s on a tie; the same s in every pixel), so they belong to one
  * surface; depth is the nearest depth among all the pixel's samples; evals and
  * nodes sum over the samples. The sample-* AOVs give every sample. */
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
  * "material", "coverage", "sample-id", "sample-depth", "sample-mesh", "uv", "uv-deriv",
- * "albedo", "direct", "reflection", "shadow", "emission", "z-depth", "shadow-lights"); -1 when unknown. */
+ * "albedo", "direct", "reflection", "shadow", "emission", "z-depth", "shadow-lights", "instance"); -1 when unknown. */
 RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;

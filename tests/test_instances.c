@@ -207,6 +207,20 @@ static void check_grid(rr_device *dev) {
         int d = test_frames_differ(fa, fb);
         CHECK(d == 0, "grid view %d, %s: instances differ from copies at %d samples", v, rr_method_name(ms[m]), d);
         CHECK(test_frame_hits(fa) > 20, "grid view %d: %d hits", v, test_frame_hits(fa));
+        rr_image ia = {0}, ma = {0};
+        if (rr_frame_aov(dev, si, &cam, fa, RR_AOV_INSTANCE, &ia) == RR_OK &&
+            rr_frame_aov(dev, si, &cam, fa, RR_AOV_MESH, &ma) == RR_OK) {
+          const uint32_t *inst = ia.data, *mesh = ma.data;
+          int wrong = 0, seen = 0;
+          for (int k = 0; k < 64 * 48; k++) { /* one geometry per instance: the mesh id is the instance */
+            wrong += fa->vb.id[k] == RR_MISS ? inst[k] != RR_MISS : inst[k] != mesh[k] || inst[k] >= (uint32_t)(n * n);
+            seen += inst[k] != RR_MISS && inst[k] != 0;
+          }
+          CHECK(wrong == 0 && (v == 1 || seen > 0), "grid view %d: instance AOV wrong at %d samples (%d seen)", v, wrong, seen);
+        } else {
+          CHECK(0, "instance AOV: %s", rr_device_message(dev));
+        }
+        rr_image_free(&ia), rr_image_free(&ma);
         for (int k = 0; k < 64 * 48; k++) { /* ids as the flattened grid's */
           if (fa->vb.id[k] == RR_MISS) continue;
           CHECK(scene_face_id(si, fa->vb.id[k]) == scene_face_id(sf, fb->vb.id[k]), "id at %d", k);

@@ -22,7 +22,7 @@ METHODS = [ffi.string(lib.rr_method_name(m)).decode() for m in range(lib.RR_METH
 CAMERAS = [ffi.string(lib.rr_camera_name(c)).decode() for c in range(lib.RR_CAMERA_COUNT)]
 AOVS = ("depth", "id", "normal", "bary", "evals", "nodes", "mesh", "material", "coverage", "sample-id",
         "sample-depth", "sample-mesh", "uv", "uv-deriv", "albedo", "direct", "reflection", "shadow", "emission",
-        "z-depth", "shadow-lights")
+        "z-depth", "shadow-lights", "instance")
 _HIT = np.dtype([("prim", "<u4"), ("t", "<f4"), ("l1", "<f4"), ("l2", "<f4"), ("geom", "<u4"),
                  ("inst", "<u4")])  # rr_hit
 assert _HIT.itemsize == ffi.sizeof("rr_hit")

@@ -624,10 +624,11 @@ static rr_error frame_cameras(rr_device *dev, const rr_camera *cam, const rr_fra
   return RR_OK;
 }
 
-/* The value of an integer AOV (id, mesh, material) at a sample that saw primitive id. */
+/* The value of an integer AOV (id, mesh, material, instance) at a sample that saw primitive id. */
 static uint32_t id_aov(const rr_scene *s, rr_aov aov, uint32_t id) {
   if (aov == RR_AOV_ID) return scene_face_id(s, id);
   if (id >= s->ntris) return RR_MISS;
+  if (aov == RR_AOV_INSTANCE) return scene_instance_of(s, id);
   return aov == RR_AOV_MESH ? rr_scene_geometry_of(s, id) : scene_material(s, id);
 }
 
@@ -664,7 +665,7 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
                                              [RR_AOV_BARY] = 2,  [RR_AOV_EVALS] = 1,    [RR_AOV_NODES] = 1,
                                              [RR_AOV_MESH] = 1,  [RR_AOV_MATERIAL] = 1, [RR_AOV_COVERAGE] = 1,
                                              [RR_AOV_UV] = 2,    [RR_AOV_UV_DERIV] = 4,
-                                             [RR_AOV_ZDEPTH] = 1}; /* the lit parts: lit_aov */
+                                             [RR_AOV_ZDEPTH] = 1,   [RR_AOV_INSTANCE] = 1}; /* the lit parts: lit_aov */
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
     if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
@@ -674,7 +675,8 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
     return rr_ok(dev);
   }
   rr_aov base = per_sample_base(aov);
-  bool per_sample = base != aov, ints = base == RR_AOV_ID || base == RR_AOV_MESH || base == RR_AOV_MATERIAL;
+  bool per_sample = base != aov, ints = base == RR_AOV_ID || base == RR_AOV_MESH || base == RR_AOV_MATERIAL ||
+                                  base == RR_AOV_INSTANCE;
   int ch = per_sample ? f->samples : channels[aov], centre = centre_sample(f);
   e = image_alloc(dev, out, vb->width, vb->height, ch, ints ? RR_PIXEL_U32 : RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov);
   if (e) return e;
