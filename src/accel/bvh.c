@@ -558,6 +558,13 @@ static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
   }
 }
 
+/* Triangle i's corners into a leaf's block: coordinate m (3·corner + axis) at v[m·stride]. */
+static void leaf_corners(const rr_scene *s, uint32_t i, float *v, uint32_t stride) {
+  vec3 c[3];
+  scene_corners(s, i, c);
+  for (int k = 0; k < 3; k++) v[(3 * k) * stride] = c[k].x, v[(3 * k + 1) * stride] = c[k].y, v[(3 * k + 2) * stride] = c[k].z;
+}
+
 /* The corners of the leaves' triangles, leaf by leaf (rr_bvh.leaf_v). */
 static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
   size_t n = (size_t)9 * b->nprims;
@@ -567,8 +574,7 @@ static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
   for (uint32_t i = 0; i < b->nnodes; i++) {
     const bvh_node *nd = &b->nodes[i];
     float *v = b->leaf_v + (size_t)9 * nd->first;
-    for (uint32_t m = 0; nd->count && m < 9; m++)
-      for (uint32_t j = 0; j < nd->count; j++) v[m * nd->count + j] = scene_coord(s, (int)m / 3, (int)m % 3, b->prims[nd->first + j]);
+    for (uint32_t j = 0; j < nd->count; j++) leaf_corners(s, b->prims[nd->first + j], v + j, nd->count);
   }
   return true;
 }
@@ -662,8 +668,7 @@ static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
     if (leaf8(j, c)) { /* a leaf: its corners as leaf_v's */
       uint32_t first = j->first[c], count = j->count[c];
       float *v = b->leaf_v8 + (size_t)9 * first;
-      for (uint32_t m = 0; m < 9; m++)
-        for (uint32_t t = 0; t < count; t++) v[m * count + t] = scene_coord(j->s, (int)m / 3, (int)m % 3, b->prims[first + t]);
+      for (uint32_t t = 0; t < count; t++) leaf_corners(j->s, b->prims[first + t], v + t, count);
       wn->ref[i] = first, wn->count[i] = count;
     } else {
       wn->ref[i] = j->next++;

@@ -334,7 +334,9 @@ static inline void tri_inf_box(unsigned inf, float v0, float v1, float v2, float
 static inline void rr_tri_box(const rr_scene *s, uint32_t i, float lo[3], float hi[3]) {
   unsigned inf = scene_inf(s, i);
   float c[3][3];
-  for (int k = 0; k < 3; k++) v3_store(c[k], scene_vertex(s, k, i));
+  vec3 v[3];
+  scene_corners(s, i, v);
+  for (int k = 0; k < 3; k++) v3_store(c[k], v[k]);
   for (int x = 0; x < 3; x++) {
     float v0 = c[0][x], v1 = c[1][x], v2 = c[2][x];
     if (inf) {

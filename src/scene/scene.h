@@ -159,14 +159,29 @@ static inline vec3 scene_stored_vertex(const rr_scene *s, int k, uint32_t j) {
  * more than a translation: then the caller moves its corners with scene_vertex. */
 static inline bool scene_lanes(const rr_scene *s, const int32_t *ids, int w, int32_t *st, float *tr, int32_t *mask) {
   bool shift = true;
+  uint32_t lo = 0, len = 0, kl = RR_MISS; /* the last lane's instance and its indices lo .. lo + len */
   for (int l = 0; l < w; l++) {
-    uint32_t k;
-    st[l] = (int32_t)scene_locate(s, (uint32_t)ids[l], &k);
+    uint32_t k, i = (uint32_t)ids[l];
+    if (i - lo < len) { /* the same instance as the last lane (neighbours mostly are): no division */
+      k = kl, st[l] = (int32_t)(s->inst->base + (i - lo));
+    } else {
+      st[l] = (int32_t)scene_locate(s, i, &k);
+      if (k != RR_MISS) kl = k, lo = i - (uint32_t)st[l] + s->inst->base, len = s->inst->T;
+    }
     mask[l] = k == RR_MISS ? 0 : -1;
     shift = shift && (k == RR_MISS || s->inst->shift[k]);
     for (int a = 0; a < 3; a++) tr[a * w + l] = k == RR_MISS ? 0.0f : s->inst->xf[k][4 * a + 3];
   }
   return shift;
+}
+
+/* The three corners of triangle i in world space (one look-up for the three). */
+static inline void scene_corners(const rr_scene *s, uint32_t i, vec3 c[3]) {
+  uint32_t in, j = scene_locate(s, i, &in);
+  for (int k = 0; k < 3; k++) {
+    c[k] = v3(s->p[k][0][j], s->p[k][1][j], s->p[k][2][j]);
+    if (in != RR_MISS) c[k] = inst_point(s->inst->xf[in], s->inst->shift[in], c[k]);
+  }
 }
 
 /* Corner k of triangle i in world space. */
