@@ -21,7 +21,12 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
    * (inst_point's addition); other maps move each lane's corners with scene_vertex */
   float lane_p[3][3][W], lane_tr[3 * W];
   int32_t lane_st[W], lane_moved[W];
-  const bool moved = s->inst != NULL, shifted = moved && scene_lanes(s, lane_id, W, lane_st, lane_tr, lane_moved);
+  /* a whole run of W inside one translated instance (the common case): loads at its
+   * stored index plus the translation, as a scene without instances loads */
+  uint32_t run_k = RR_MISS, run_st = !ids && n == W && s->inst ? scene_locate(s, first, &run_k) : 0;
+  const bool run = run_k != RR_MISS && s->inst->shift[run_k] && run_st - s->inst->base + W <= s->inst->T;
+  const bool moved = s->inst != NULL && !run,
+             shifted = moved && scene_lanes(s, lane_id, W, lane_st, lane_tr, lane_moved);
   const VI st_idx = moved ? VI_(load)(lane_st) : VI_(splat)(0), moved_m = moved ? VI_(load)(lane_moved) : VI_(splat)(0);
   if (moved && !shifted)
     for (int l = 0; l < W; l++)
@@ -46,7 +51,8 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
     VF q[3]; /* the corner relative to the eye, or its direction when at infinity */
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-      VF p = shifted      ? VF_(select)(moved_m, VF_(gather)(s->p[k][a], st_idx) + VF_(load)(lane_tr + a * W),
+      VF p = run          ? VF_(load)(s->p[k][a] + run_st) + VF_(splat)(s->inst->xf[run_k][4 * a + 3])
+             : shifted    ? VF_(select)(moved_m, VF_(gather)(s->p[k][a], st_idx) + VF_(load)(lane_tr + a * W),
                                          VF_(gather)(s->p[k][a], st_idx))
              : moved      ? VF_(load)(lane_p[k][a])
              : contiguous ? VF_(load)(s->p[k][a] + first)

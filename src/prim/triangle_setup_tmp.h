@@ -52,7 +52,14 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
    * (inst_point's addition); other maps move each lane's corners with scene_vertex */
   float lane_p[3][3][W], lane_tr[3 * W];
   int32_t lane_st[W], lane_moved[W];
-  const bool moved = s->inst != NULL, shifted = moved && scene_lanes(s, lane_id, W, lane_st, lane_tr, lane_moved);
+  /* W consecutive triangles inside one translated instance (the common case): the
+   * stored corners plus the translation, one look-up for the lanes */
+  bool consecutive = s->inst && count == W;
+  for (int l = 1; consecutive && l < W; l++) consecutive = ids[l] == ids[0] + (uint32_t)l;
+  uint32_t run_k = RR_MISS, run_st = consecutive ? scene_locate(s, ids[0], &run_k) : 0;
+  const bool run = run_k != RR_MISS && s->inst->shift[run_k] && run_st - s->inst->base + W <= s->inst->T;
+  const bool moved = s->inst != NULL && !run,
+             shifted = moved && scene_lanes(s, lane_id, W, lane_st, lane_tr, lane_moved);
   const VI st_idx = moved ? VI_(load)(lane_st) : VI_(splat)(0), moved_m = moved ? VI_(load)(lane_moved) : VI_(splat)(0);
   if (moved && !shifted)
     for (int l = 0; l < W; l++)
@@ -68,7 +75,11 @@ TARGET static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32
   VI at_inf[3] = {VI_(splat)(0), VI_(splat)(0), VI_(splat)(0)};
 #pragma GCC unroll 3
   for (int k = 0; k < 3; k++) {
-    if (shifted) {
+    if (run) {
+      const float *m = s->inst->xf[run_k];
+      p[k] = (V3){VF_(load)(s->p[k][0] + run_st) + VF_(splat)(m[3]), VF_(load)(s->p[k][1] + run_st) + VF_(splat)(m[7]),
+                  VF_(load)(s->p[k][2] + run_st) + VF_(splat)(m[11])};
+    } else if (shifted) {
       V3 g = {VF_(gather)(s->p[k][0], st_idx), VF_(gather)(s->p[k][1], st_idx), VF_(gather)(s->p[k][2], st_idx)};
       V3 t = {VF_(load)(lane_tr), VF_(load)(lane_tr + W), VF_(load)(lane_tr + 2 * W)};
       p[k] = SELECT3(moved_m, ADD3(g, t), g);
