@@ -175,7 +175,8 @@ static const char scenes_note[] =
     "scenes: a file assimp reads (.obj .ply .gltf .glb .dae .3ds ...), a scene file (.json:\n"
     "        meshes, transforms, materials, lights, camera and settings, which options\n"
     "        override; docs/scene-file.md), or demo, plane[:N], sphere[:N], box[:N], torus[:N],\n"
-    "        rooms[:N], grid:PATH:N (N×N copies of a mesh), ground (an infinite plane\n"
+    "        rooms[:N], grid:PATH:N (N×N instances of a mesh; grid-flat:PATH:N written\n"
+    "        out), ground (an infinite plane\n"
     "        through points at infinity, with a sphere and a box; 3D methods), checker (an\n"
     "        infinite checkerboard-textured plane seen at a grazing angle)\n";
 

@@ -569,12 +569,12 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, rr_scene *s, const c
   char path[MAX_PATH];
   if (builtin) {
     if (!opt->builtins) return rr_json_fail(r, "builtin", "built-in meshes are not allowed here");
-    if (opt->sandbox && strncmp(builtin, "grid:", 5) == 0)
+    if (opt->sandbox && (strncmp(builtin, "grid:", 5) == 0 || strncmp(builtin, "grid-flat:", 10) == 0))
       return rr_json_fail(r, "builtin", "grid: reads a file, which the sandbox does not allow (use 'file' and a transform)");
     e = rr_scene_load_builtin(s, builtin);
     if (e == RR_ERROR_UNSUPPORTED)
       return rr_json_fail(r, "builtin", "unknown built-in '%.64s' (expected demo, plane[:N], sphere[:N], box[:N], "
-                                     "torus[:N], rooms[:N], ground, ground:inf, checker or grid:PATH:N)", builtin);
+                                     "torus[:N], rooms[:N], ground, ground:inf, checker, grid:PATH:N or grid-flat:PATH:N)", builtin);
   } else {
     if (!file[0]) return rr_json_fail(r, "file", "empty path");
     if (strlen(file) >= MAX_PATH) return rr_json_fail(r, "file", "path too long");

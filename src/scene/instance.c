@@ -96,6 +96,10 @@ rr_error rr_scene_instance(rr_scene *s, uint32_t first, uint64_t F, uint32_t g0,
   if ((uint64_t)n * T > UINT32_MAX - 1 - first || first_face + (uint64_t)n * F > UINT32_MAX - 1)
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%u instances of %u triangles: too many ids (at most %u)", n, T,
                    UINT32_MAX - 1);
+  /* a scene file's budget counts every instance's triangles: the BVH holds them all */
+  if (s->max_tris && first + (uint64_t)n * T > s->max_tris)
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%u instances of %u triangles: over the limit of %llu triangles", n, T,
+                   (unsigned long long)s->max_tris);
   scene_instances *in = calloc(1, sizeof *in);
   if (in) {
     in->xf = malloc((size_t)n * sizeof *in->xf), in->nxf = malloc((size_t)n * sizeof *in->nxf);
