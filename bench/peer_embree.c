@@ -54,7 +54,7 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
   }
   for (uint32_t i = 0; i < s->ntris; i++)
     for (int k = 0; k < 3; k++) {
-      for (int c = 0; c < 3; c++) v[(3 * (size_t)i + k) * 3 + c] = s->p[k][c][i];
+      for (int c = 0; c < 3; c++) v[(3 * (size_t)i + k) * 3 + c] = scene_coord(s, k, c, i);
       ix[3 * (size_t)i + k] = 3 * i + k;
     }
   rtcCommitGeometry(g);
