@@ -756,7 +756,6 @@ bool rr_bvh_finish(rr_bvh *b, const rr_scene *s) {
 
 rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out) {
   *out = NULL;
-  if (s->inst) return rr_bvh_build_instanced(s, opt, out); /* accel/bvh_instance.c */
   double t0 = rr_now_ms();
   builder bd = {.bins = opt->bins ? opt->bins : BVH_DEFAULT_BINS,
                 .leaf_size = opt->leaf_size ? opt->leaf_size : BVH_DEFAULT_LEAF,

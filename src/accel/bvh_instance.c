@@ -40,6 +40,7 @@ static void world_box(const scene_instances *in, uint32_t k, const float lo[3], 
 
 typedef struct item {
   float lo[3], hi[3];
+  float key;      /* the centre along the axis being sorted on (twice it) */
   uint32_t ref;   /* an instance, or an index of the scene (a primitive of its own) */
   bool instance;
 } item;
@@ -50,7 +51,6 @@ typedef struct graft {
   rr_bvh *b;
   uint32_t next_node; /* the next free pair */
   uint32_t next_prim; /* the next free range of prims */
-  int axis;           /* of the sort in progress */
 } graft;
 
 /* Copies object node `o` of ob's tree as instance k's into slot `at`. */
@@ -71,11 +71,9 @@ static void copy_subtree(graft *g, uint32_t k, uint32_t o, uint32_t at, uint32_t
   copy_subtree(g, k, src->first + 1, p + 1, prim0, depth + 1);
 }
 
-static _Thread_local int sort_axis;
-static int by_centre(const void *a, const void *b) {
+static int by_key(const void *a, const void *b) {
   const item *x = a, *y = b;
-  float cx = x->lo[sort_axis] + x->hi[sort_axis], cy = y->lo[sort_axis] + y->hi[sort_axis];
-  return (cx > cy) - (cx < cy);
+  return (x->key > y->key) - (x->key < y->key);
 }
 
 /* The tree over items[0 .. n) into slot `at`. */
@@ -109,8 +107,8 @@ static void build_top(graft *g, item *items, uint32_t n, uint32_t at, uint32_t d
   int axis = 0;
   for (int a = 1; a < 3; a++)
     if (chi[a] - clo[a] > chi[axis] - clo[axis]) axis = a;
-  sort_axis = axis;
-  qsort(items, n, sizeof *items, by_centre);
+  for (uint32_t i = 0; i < n; i++) items[i].key = items[i].lo[axis] + items[i].hi[axis];
+  qsort(items, n, sizeof *items, by_key);
   memcpy(dst->lo, lo, sizeof lo), memcpy(dst->hi, hi, sizeof hi);
   uint32_t p = g->next_node;
   g->next_node += 2;

@@ -26,15 +26,6 @@ const char *rr_instance_problem(const float m[12], vec3 lo, vec3 hi) {
   return NULL;
 }
 
-void rr_instance_free(scene_instances *in) {
-  if (!in) return;
-  free(in->xf), free(in->nxf), free(in->shift);
-  free(in);
-}
-
-uint64_t rr_instance_bytes(const scene_instances *in) {
-  return in ? sizeof *in + (uint64_t)in->n * (sizeof *in->xf + sizeof *in->nxf + sizeof *in->shift) : 0;
-}
 
 /* The inverse transpose of m's 3×3 part (the cofactors over the determinant). */
 static void normal_matrix(const float m[12], float out[9]) {
@@ -125,3 +116,49 @@ rr_error rr_scene_instance(rr_scene *s, uint32_t first, uint64_t F, uint32_t g0,
   rr_scene_update_bounds(s);
   return RR_OK;
 }
+
+rr_error rr_scene_add_instances(rr_scene *s, const float *pos, size_t nvert, const uint32_t *idx, size_t ntri,
+                                const float rgb[3], const float *xf, size_t count) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  if (!xf && count) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_instances: NULL transforms");
+  if (count == 0 || count > UINT32_MAX) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_instances: %zu instances", count);
+  if (s->inst) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_instances: the scene holds instances already (one instanced mesh)");
+  /* the transforms are checked before anything is added (rr_scene_instance checks again, on the kept triangles) */
+  vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+  for (size_t t = 0; pos && idx && t < 3 * ntri; t++)
+    if (idx[t] < nvert) lo = v3_min(lo, v3_load(pos + 3 * (size_t)idx[t])), hi = v3_max(hi, v3_load(pos + 3 * (size_t)idx[t]));
+  for (size_t k = 0; k < count; k++) {
+    const char *why = rr_instance_problem(xf + 12 * k, lo, hi);
+    if (why) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_add_instances: instance %zu has %s", k, why);
+  }
+  uint32_t t0 = s->ntris, g0 = s->ngeoms, m0 = s->nmaterials;
+  uint64_t f0 = scene_faces(s);
+  rr_error e = rr_scene_add_mesh(s, pos, nvert, idx, ntri, rgb);
+  if (e) return e;
+  if (s->ntris == t0) return rr_ok(s->dev); /* every triangle skipped: nothing to draw */
+  e = rr_scene_instance(s, t0, scene_faces(s) - f0, g0, (uint32_t)count, (const float (*)[12])xf);
+  if (e) { /* (out of memory, or a mesh at infinity) take the mesh back out */
+    s->skipped -= scene_faces(s) - s->ntris - (f0 - t0), s->ntris = t0, s->ngeoms = g0;
+    s->nmaterials = m0; /* (add_mesh's material holds no texture) */
+    rr_scene_update_bounds(s);
+    return e;
+  }
+  return rr_ok(s->dev);
+}
+
+rr_error rr_scene_get_instance(const rr_scene *s, uint32_t prim, uint32_t *instance, uint32_t *local) {
+  if (!s) return RR_ERROR_ARGUMENT;
+  uint32_t k = RR_MISS, l = RR_MISS;
+  if (prim != RR_MISS && prim >= scene_faces(s))
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "rr_scene_get_instance: primitive %u out of range (%llu in the scene)",
+                   prim, (unsigned long long)scene_faces(s));
+  if (s->inst && prim != RR_MISS) {
+    /* by id (a skipped face's too): instance k's ids run from the first instance's by k·F */
+    uint32_t first = s->inst->face0, F = s->inst->F;
+    if (prim >= first && prim - first < (uint64_t)s->inst->n * F) k = (prim - first) / F, l = (prim - first) % F;
+  }
+  if (instance) *instance = k;
+  if (local) *local = l;
+  return rr_ok(s->dev);
+}
+

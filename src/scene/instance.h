@@ -61,8 +61,14 @@ rr_error rr_scene_instance(rr_scene *s, uint32_t first, uint64_t F, uint32_t g0,
 rr_error rr_instance_set(rr_scene *s, uint32_t k, const float m[12]);
 
 /* Bytes the instances take (their transforms). */
-uint64_t rr_instance_bytes(const scene_instances *in);
+static inline uint64_t rr_instance_bytes(const scene_instances *in) {
+  return in ? sizeof *in + (uint64_t)in->n * (sizeof *in->xf + sizeof *in->nxf + sizeof *in->shift) : 0;
+}
 
-void rr_instance_free(scene_instances *in);
+static inline void rr_instance_free(scene_instances *in) {
+  if (!in) return;
+  free(in->xf), free(in->nxf), free(in->shift);
+  free(in);
+}
 
 #endif
