@@ -60,7 +60,7 @@ typedef struct job {
 /* The textured material of triangle id, or NULL. */
 static const rr_material *textured(const rr_scene *s, uint32_t id) {
   if (id == RR_MISS || !s->nmaterials || !s->uv[0][0]) return NULL;
-  const rr_material *m = &s->materials[s->material[id] % s->nmaterials];
+  const rr_material *m = &s->materials[scene_material(s, id) % s->nmaterials];
   return m->texture.width > 0 ? m : NULL;
 }
 

@@ -56,7 +56,7 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
   }
   for (uint32_t i = 0; i < s->ntris; i++)
     for (int k = 0; k < 3; k++) {
-      for (int c = 0; c < 3; c++) v[(3 * (size_t)i + k) * 3 + c] = s->p[k][c][i];
+      for (int c = 0; c < 3; c++) v[(3 * (size_t)i + k) * 3 + c] = scene_coord(s, k, c, i);
       ix[3 * (size_t)i + k] = 3 * i + k;
     }
   rtcCommitGeometry(g);
@@ -83,7 +83,7 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
     }
     for (uint32_t i = 0, k = 0; i < s->ntris; i++)
       if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {
-        memcpy(sv + 4 * (size_t)k, s->ana + (size_t)ANA_FLOATS * i, 4 * sizeof(float));
+        memcpy(sv + 4 * (size_t)k, rr_ana_params(s, i), 4 * sizeof(float));
         e->sphere_ids[k++] = i;
       }
     rtcCommitGeometry(sg);

@@ -147,7 +147,7 @@ int osmesa_load(osmesa_peer *p, const rr_scene *s) {
     uint32_t c = i + 1;
     for (int k = 0; k < 3; k++) {
       size_t v = (size_t)i * 3 + k;
-      for (int a = 0; a < 3; a++) pos[v * 3 + a] = s->p[k][a][i];
+      for (int a = 0; a < 3; a++) pos[v * 3 + a] = scene_coord(s, k, a, i);
       col[v * 4 + 0] = (uint8_t)c, col[v * 4 + 1] = (uint8_t)(c >> 8), col[v * 4 + 2] = (uint8_t)(c >> 16);
       col[v * 4 + 3] = 255;
     }

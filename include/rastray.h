@@ -129,6 +129,23 @@ RR_API rr_error rr_scene_add_planes(rr_scene *scene, const float *planes, size_t
  * hit's l1 is face + u (face = 2·axis + 1 on the positive side, 0 .. 5), l2 is v,
  * (u, v) the hit's position on the face over [0, 1]². */
 RR_API rr_error rr_scene_add_boxes(rr_scene *scene, const float *boxes, size_t count, const float rgb[3]);
+/* Appends an indexed triangle mesh (as rr_scene_add_mesh) drawn `count` times,
+ * instance k moved by the affine transform transforms[12k .. 12k+11] (3×4 row-major:
+ * world = M·p + t, rows (m00 m01 m02 tx), (m10 ..), (m20 ..)), like Embree's instance
+ * geometry: the mesh is stored once. In ids and geometries the instances read as
+ * the mesh copied `count` times in a row: instance k's triangle t has id
+ * first + k·F + t (F: the mesh's triangles, skipped ones too) and its own copy of
+ * the geometry; rr_scene_get_instance tells them apart. A scene holds one instanced
+ * mesh. A transform that is not finite, singular or mirroring (negative
+ * determinant) refuses the call (RR_ERROR_ARGUMENT, the message naming the
+ * instance) and adds nothing. */
+RR_API rr_error rr_scene_add_instances(rr_scene *scene, const float *positions, size_t nvertices,
+                                       const uint32_t *indices, size_t ntriangles, const float rgb[3],
+                                       const float *transforms, size_t count);
+/* The instance holding primitive id `prim` (RR_MISS when it is no instance's, and
+ * for RR_MISS) and prim's id within the instanced mesh (*local: as if the mesh were
+ * alone in the scene from its first id). Either pointer may be NULL. */
+RR_API rr_error rr_scene_get_instance(const rr_scene *scene, uint32_t prim, uint32_t *instance, uint32_t *local);
 /* Builds what rendering needs (the BVH); called implicitly by rr_scene_load.
  * Uses the device's build options (rr_device_set_build_options). */
 RR_API rr_error rr_scene_commit(rr_scene *scene);
@@ -185,6 +202,9 @@ typedef struct rr_scene_info {
   float front[3]; /* the side the model faces, seen by rr_camera_frame: +Z for Y-up, -Y for Z-up files */
   uint64_t texture_bytes; /* the textures' texels as read and their MIP chains (16-bit linear RGBA) */
   uint64_t spheres, planes, boxes; /* analytic primitives (not counted in triangles) */
+  uint32_t instances;        /* instances of the instanced mesh (rr_scene_add_instances), 0 when none */
+  uint64_t stored_triangles; /* triangles stored: triangles less the instances' copies (each mesh once) */
+  uint64_t scene_bytes;      /* the primitives' arrays (positions, normals, UVs, ...) and the instances */
 } rr_scene_info;
 
 /* Fills what is known about a scene. */
@@ -246,6 +266,7 @@ typedef struct rr_hit {
   float t;       /* ray parameter of the hit (+inf on a miss) */
   float l1, l2;  /* barycentrics of the hit: weights of the triangle's vertices 1 and 2 */
   uint32_t geom; /* the geometry holding prim (rr_scene_get_geometry), RR_MISS on a miss */
+  uint32_t inst; /* the instance holding prim (rr_scene_get_instance), RR_MISS when none */
 } rr_hit;
 
 /* Threading: rr_intersect and rr_occluded only read the scene, so any number of
@@ -658,18 +679,19 @@ typedef enum rr_aov {
   RR_AOV_SHADOW_LIGHTS, /* L floats (L = the punctual lights, 1 .. RR_MAX_SHADOW_LIGHTS): channel i is 1 where
                            light i reaches the point (facing it, inside its cone, unblocked), else 0 (and on a
                            miss): from the same occlusion passes as shadow, which is their mean */
+  RR_AOV_INSTANCE,      /* 1 uint32: the instance a sample sees (rr_hit.inst), RR_MISS on a miss and off instances */
   RR_AOV_COUNT
 } rr_aov;
 #define RR_MAX_SHADOW_LIGHTS 16 /* most lights the shadow-lights AOV holds (a channel each) */
 /* With several samples per pixel the per-pixel AOVs follow one rule each: id, mesh,
- * material, normal, bary, uv and uv-deriv are those of the sample nearest the pixel's centre (the
+ * material, instance, normal, bary, uv and uv-deriv are those of the sample nearest the pixel's centre (the
  * lowest such s on a tie; the same s in every pixel), so they belong to one
  * surface; depth is the nearest depth among all the pixel's samples; evals and
  * nodes sum over the samples. The sample-* AOVs give every sample. */
 
 /* The AOV named `name` ("depth", "id", "normal", "bary", "evals", "nodes", "mesh",
  * "material", "coverage", "sample-id", "sample-depth", "sample-mesh", "uv", "uv-deriv",
- * "albedo", "direct", "reflection", "shadow", "emission", "z-depth", "shadow-lights"); -1 when unknown. */
+ * "albedo", "direct", "reflection", "shadow", "emission", "z-depth", "shadow-lights", "instance"); -1 when unknown. */
 RR_API int rr_aov_from_name(const char *name);
 
 typedef enum rr_pixel_type { RR_PIXEL_U8 = 0, RR_PIXEL_F32, RR_PIXEL_U32 } rr_pixel_type;

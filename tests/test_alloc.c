@@ -81,14 +81,14 @@ static uint64_t scene_print(const rr_scene *s) {
   rr_scene_info info;
   rr_scene_get_info(s, &info);
   uint64_t h = mix(mix(mix(mix(mix(0, info.triangles), info.skipped), info.materials), info.geometries), info.bvh_nodes);
-  for (uint32_t i = 0; i < s->ntris; i++)
+  for (uint32_t i = 0; i < scene_stored(s); i++) /* (the arrays as stored: an instanced mesh once) */
     for (int k = 0; k < 3; k++) {
       h = mix_bytes(h, &s->p[k][0][i], 4), h = mix_bytes(h, &s->p[k][1][i], 4), h = mix_bytes(h, &s->p[k][2][i], 4);
       if (s->n[0][0]) h = mix_bytes(h, &s->n[k][2][i], 4);
       if (s->uv[0][0]) h = mix_bytes(h, &s->uv[k][1][i], 4);
       if (s->col[0][0]) h = mix_bytes(h, &s->col[k][1][i], 4);
     }
-  return mix_bytes(h, s->material, (size_t)s->ntris * sizeof *s->material);
+  return mix_bytes(h, s->material, (size_t)scene_stored(s) * sizeof *s->material);
 }
 
 static rr_error load(const fixture *fx, uint64_t *print) {

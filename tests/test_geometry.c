@@ -43,7 +43,7 @@ static void check_table(const rr_scene *s, const char *what) {
     uint32_t id = scene_face_id(s, i), geom = RR_MISS;
     bad_order += id >= faces || (i > 0 && id <= scene_face_id(s, i - 1));
     rr_scene_get_geometry(s, id, &geom, NULL);
-    bad_material += geom == RR_MISS || s->material[i] != s->geoms[geom].material;
+    bad_material += geom == RR_MISS || scene_material(s, i) != s->geoms[geom].material;
   }
   CHECK(bad_range == 0 && next == faces, "%s: %u geometries out of order, they end at %u of %llu", what, bad_range,
         next, (unsigned long long)faces);

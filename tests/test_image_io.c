@@ -584,7 +584,8 @@ static void test_exr_layers(void) {
       [1 + RR_AOV_DIRECT] = {"direct.B", "direct.G", "direct.R"},
       [1 + RR_AOV_REFLECTION] = {"reflection.B", "reflection.G", "reflection.R"}, [1 + RR_AOV_SHADOW] = {"shadow"},
       [1 + RR_AOV_EMISSION] = {"emission.B", "emission.G", "emission.R"}, [1 + RR_AOV_ZDEPTH] = {"zdepth"},
-      [1 + RR_AOV_SHADOW_LIGHTS] = {"shadow.l00"}}; /* the default rig's one light */
+      [1 + RR_AOV_SHADOW_LIGHTS] = {"shadow.l00"}, /* the default rig's one light */
+      [1 + RR_AOV_INSTANCE] = {"instance"}};
   rr_scene *s = colour_scene(rgb);
   rr_image images[1 + RR_AOV_COUNT];
   memset(images, 0, sizeof images);

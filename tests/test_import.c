@@ -339,7 +339,7 @@ static void check_vertex_colors(rr_device *dev) {
           "OBJ vertex colours decoded to linear: %g", s->col[0][0] ? s->col[0][1][0] : -1);
     rr_scene_release(s);
   }
-  /* grid: copies carry their corner colours too */
+  /* grid: copies (instances, read through scene_st) carry their corner colours too */
   char grid[600];
   snprintf(grid, sizeof grid, "grid:%s:2", obj);
   CHECK(rr_scene_load(dev, grid, &s) == RR_OK, "%s", rr_device_message(dev));
@@ -347,7 +347,7 @@ static void check_vertex_colors(rr_device *dev) {
     bool same = s->ntris == 4 && s->col[0][0];
     for (uint32_t t = 1; same && t < s->ntris; t++)
       for (int k = 0; k < 3; k++)
-        for (int c = 0; c < 3; c++) same = same && s->col[k][c][t] == s->col[k][c][0];
+        for (int c = 0; c < 3; c++) same = same && s->col[k][c][scene_st(s, t)] == s->col[k][c][0];
     CHECK(same, "grid copies keep the vertex colours (%u triangles)", s->ntris);
     rr_scene_release(s);
   }

@@ -298,7 +298,10 @@ static void check_same(const char *name, const char *expect) {
         a->nmaterials, b->nmaterials, a->ncameras, b->ncameras, a->nlights, b->nlights);
   if (a->ntris == b->ntris && a->ngeoms == b->ngeoms && a->nmaterials == b->nmaterials && a->ncameras == b->ncameras &&
       a->nlights == b->nlights) {
-    uint32_t n = a->ntris;
+    uint32_t n = scene_stored(a); /* the arrays as stored (an instanced mesh once) */
+    CHECK(scene_stored(b) == n && (a->inst != NULL) == (b->inst != NULL) &&
+              (!a->inst || (a->inst->n == b->inst->n && !memcmp(a->inst->xf, b->inst->xf, a->inst->n * sizeof *a->inst->xf))),
+          "%s: instances differ", name);
     CHECK(same_floats(a->p, b->p, 3, n) && same_floats(a->n, b->n, 3, n) && same_floats(a->col, b->col, 3, n), "%s: positions, normals or colours differ", name);
     bool uv = true;
     for (int k = 0; k < 3; k++)

@@ -391,3 +391,26 @@ def test_analytic_primitives():
         assert {1, 2, 3} <= set(np.unique(ids[0]).tolist())
     with pytest.raises(rastray.Error, match="sphere 0 has radius"):
         rastray.Scene.from_arrays(v, f, spheres=np.array([[0, 0, 0, -1]], np.float32))
+
+
+def test_instances():
+    """A mesh drawn by transforms: counted once, hits name their instance (intersect's
+    instance_ids, the instance AOV), every method the same ids; a mirror is refused."""
+    v = np.array([[-1, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+    f = np.array([[0, 1, 2]], np.uint32)
+    xf = np.array([[[1, 0, 0, x], [0, 1, 0, 0], [0, 0, 1, 0]] for x in (-3, 0, 3)], np.float32)
+    with rastray.Scene.from_arrays(v, f, instances=xf) as s:
+        info = s.info
+        assert (info["triangles"], info["instances"], info["geometries"]) == (3, 3, 3)
+        hit = s.intersect(np.array([[3, 0.2, 5, 0, 0, -1], [9, 0.2, 5, 0, 0, -1]], np.float32))
+        assert hit["primitive_ids"][0] == 2 and hit["instance_ids"][0] == 2
+        assert hit["instance_ids"][1] == rastray.MISS
+        cam = rastray.Camera(eye=(0, 0.5, 9), target=(0, 0.5, 0), fov=50)
+        out = [s.render(cam, size=(48, 32), method=m, aovs=("id", "instance")) for m in ("rc", "rc-packet", "3dr-bb")]
+        assert all(np.array_equal(out[0]["id"], o["id"]) for o in out[1:])
+        hits = out[0]["id"] != rastray.MISS
+        assert hits.any() and np.array_equal(out[0]["instance"][hits], out[0]["id"][hits])
+    with pytest.raises(rastray.Error, match="instance 1 has a mirroring transform"):
+        bad = xf.copy()
+        bad[1, 0, 0] = -1
+        rastray.Scene.from_arrays(v, f, instances=bad)

@@ -376,6 +376,10 @@ static void options(void) {
   CHECK(rr_scene_load_file(dev, test_write_file(sub, "grid.json", text), &box, &s, NULL) != RR_OK && !s &&
             strstr(rr_device_message(dev), "sandbox"),
         "grid: under the sandbox: %s", rr_device_message(dev));
+  snprintf(text, sizeof text, "{\"instances\": {\"builtin\": \"grid-flat:%s:2\", \"transforms\": [{}]}}", path);
+  CHECK(rr_scene_load_file(dev, test_write_file(sub, "gridf.json", text), &box, &s, NULL) != RR_OK && !s &&
+            strstr(rr_device_message(dev), "sandbox"),
+        "grid-flat: under the sandbox: %s", rr_device_message(dev));
   /* base_dir: relative paths from elsewhere */
   rr_load_options base;
   rr_load_options_init(&base);

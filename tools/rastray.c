@@ -175,7 +175,8 @@ static const char scenes_note[] =
     "scenes: a file assimp reads (.obj .ply .gltf .glb .dae .3ds ...), a scene file (.json:\n"
     "        meshes, transforms, materials, lights, camera and settings, which options\n"
     "        override; docs/scene-file.md), or demo, plane[:N], sphere[:N], box[:N], torus[:N],\n"
-    "        rooms[:N], grid:PATH:N (N×N copies of a mesh), ground (an infinite plane\n"
+    "        rooms[:N], grid:PATH:N (N×N instances of a mesh; grid-flat:PATH:N written\n"
+    "        out), ground (an infinite plane\n"
     "        through points at infinity, with a sphere and a box; 3D methods), checker (an\n"
     "        infinite checkerboard-textured plane seen at a grazing angle)\n";
 
@@ -251,7 +252,8 @@ static const cli_option render_options[] = {
      "write AOVs as .npy, .pfm or .exr (stdout: - as NPY, or FMT:-); repeatable.\n"
      "LIST: one NAME, NAME,NAME,... or all, as the layers of one EXR. NAME: color\n"
      "(the shaded image), depth (EXR Z), normal (N.X N.Y N.Z), bary (bary.u bary.v),\n"
-     "id (triangle), mesh (geometry id), material (index) (ids: EXR UINT), evals,\n"
+     "id (triangle), mesh (geometry id), material (index), instance (ids: EXR UINT),\n"
+     "evals,\n"
      "nodes, coverage (fraction of samples hit), sample-id, sample-depth,\n"
      "sample-mesh (H×W×N, one per sample: EXR id.s00.., Z.s00.., mesh.s00..), uv\n"
      "(texture coordinates: uv.u uv.v), uv-deriv (their derivatives per pixel:\n"
@@ -581,7 +583,7 @@ static aov_out parse_aov(const char *arg) {
       die(EXIT_USAGE,
           "unknown AOV '%s' (expected color, depth, id, mesh, material, normal, bary, evals, nodes, coverage, "
           "sample-id, sample-depth, sample-mesh, uv, uv-deriv, albedo, direct, reflection, shadow, emission, "
-          "z-depth, shadow-lights or all)",
+          "z-depth, shadow-lights, instance or all)",
           name);
   }
   if (!a.images && !a.all) die(EXIT_USAGE, "bad --aov '%s' (expected LIST=PATH)", arg);
@@ -850,6 +852,9 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
   if (in.spheres || in.planes || in.boxes)
     printf("analytic     %llu spheres, %llu planes, %llu boxes\n", (unsigned long long)in.spheres,
            (unsigned long long)in.planes, (unsigned long long)in.boxes);
+  if (in.instances)
+    printf("instances    %u of one mesh (%llu triangles stored)\n", in.instances,
+           (unsigned long long)in.stored_triangles);
   printf("materials    %u\n", in.materials);
   printf("geometries   %u\n", in.geometries);
   enum { LISTED = 32 }; /* a scene of more lists none: the list would drown the rest */
@@ -914,6 +919,7 @@ static int cmd_info(rr_device *dev, const cli_command *cmd, int argc, char **arg
   printf("bvh sah cost %.3f\n", in.bvh_sah_cost);
   printf("bvh build    %.1f ms\n", in.bvh_build_ms);
   printf("bvh memory   %.2f MiB\n", in.bvh_bytes / 1048576.0);
+  printf("scene memory %.2f MiB (primitives%s)\n", in.scene_bytes / 1048576.0, in.instances ? " and instances" : "");
   return 0;
 }
 
@@ -1140,8 +1146,8 @@ static int cmd_render(rr_device *dev, const cli_command *cmd, int argc, char **a
                            1u << RR_AOV_SAMPLE_MESH | 1u << RR_AOV_UV | 1u << RR_AOV_UV_DERIV |
                            1u << RR_AOV_ALBEDO | 1u << RR_AOV_DIRECT | 1u << RR_AOV_REFLECTION |
                            1u << RR_AOV_SHADOW | 1u << RR_AOV_EMISSION | 1u << RR_AOV_ZDEPTH |
-                           1u << RR_AOV_SHADOW_LIGHTS; /* the AA and texture outputs and
-                                                                           the lit parts: asked for by name */
+                           1u << RR_AOV_SHADOW_LIGHTS | 1u << RR_AOV_INSTANCE; /* the AA and texture outputs,
+                                                              the lit parts and instances: asked for by name */
   for (int k = 0; k < naov; k++) /* all: every per-pixel AOV of the visibility the frame has */
     if (aovs[k].all) aovs[k].images = (COLOR_BIT | ((1u << RR_AOV_COUNT) - 1)) & ~by_name & ~(opt.heat ? 0 : heat_aovs);
   if (camera_file) { /* the file's values, where no flag gave one */

@@ -22,8 +22,9 @@ METHODS = [ffi.string(lib.rr_method_name(m)).decode() for m in range(lib.RR_METH
 CAMERAS = [ffi.string(lib.rr_camera_name(c)).decode() for c in range(lib.RR_CAMERA_COUNT)]
 AOVS = ("depth", "id", "normal", "bary", "evals", "nodes", "mesh", "material", "coverage", "sample-id",
         "sample-depth", "sample-mesh", "uv", "uv-deriv", "albedo", "direct", "reflection", "shadow", "emission",
-        "z-depth", "shadow-lights")
-_HIT = np.dtype([("prim", "<u4"), ("t", "<f4"), ("l1", "<f4"), ("l2", "<f4"), ("geom", "<u4")])  # rr_hit
+        "z-depth", "shadow-lights", "instance")
+_HIT = np.dtype([("prim", "<u4"), ("t", "<f4"), ("l1", "<f4"), ("l2", "<f4"), ("geom", "<u4"),
+                 ("inst", "<u4")])  # rr_hit
 assert _HIT.itemsize == ffi.sizeof("rr_hit")
 _DTYPES = {lib.RR_PIXEL_U8: np.uint8, lib.RR_PIXEL_F32: np.float32, lib.RR_PIXEL_U32: np.uint32}
 
@@ -213,12 +214,15 @@ class Scene:
         return cls(out[0], dev)
 
     @classmethod
-    def from_arrays(cls, vertices, faces, colors=None, threads=0, spheres=None, planes=None, boxes=None):
+    def from_arrays(cls, vertices, faces, colors=None, threads=0, spheres=None, planes=None, boxes=None,
+                    instances=None):
         """One mesh: vertices (N, 3) float32, faces (M, 3) uint32, colors (N, 3)
         linear RGB per vertex or None. Degenerate and non-finite triangles are
         skipped (they keep their ids). Analytic primitives after it, one geometry
         per kind: spheres (K, 4) centre and radius, planes (K, 6) point and normal,
-        boxes (K, 12) centre, half sizes, x and y axes (rr_scene_add_boxes)."""
+        boxes (K, 12) centre, half sizes, x and y axes (rr_scene_add_boxes).
+        instances (K, 3, 4) affine transforms: the mesh is drawn K times, stored once
+        (rr_scene_add_instances; no colors then)."""
         analytic = []
         for arr, name, cols, fn in ((spheres, "spheres", 4, "rr_scene_add_spheres"),
                                     (planes, "planes", 6, "rr_scene_add_planes"),
@@ -230,6 +234,10 @@ class Scene:
         if f.size and int(f.max()) >= len(v):
             raise ValueError("faces index vertex %d of %d" % (int(f.max()), len(v)))
         c = None if colors is None else _array(colors, "colors", np.float32, 3)
+        xf = None if instances is None else _array(np.asarray(instances, np.float32).reshape(-1, 12), "instances",
+                                                   np.float32, 12)
+        if xf is not None and c is not None:
+            raise ValueError("instances take no vertex colors")
         if c is not None and len(c) != len(v):
             raise ValueError("colors must have one row per vertex (%d), not %d" % (len(v), len(c)))
         dev = _Device.building(threads)
@@ -239,7 +247,11 @@ class Scene:
         try:
             vp, fp = ffi.from_buffer("float[]", v), ffi.from_buffer("uint32_t[]", f)
             cp = ffi.NULL if c is None else ffi.from_buffer("float[]", c)
-            dev.check(lib.rr_scene_add_mesh_colors(self._ptr, vp, len(v), fp, len(f), ffi.NULL, cp))
+            if xf is None:
+                dev.check(lib.rr_scene_add_mesh_colors(self._ptr, vp, len(v), fp, len(f), ffi.NULL, cp))
+            else:
+                dev.check(lib.rr_scene_add_instances(self._ptr, vp, len(v), fp, len(f), ffi.NULL,
+                                                     ffi.from_buffer("float[]", xf), len(xf)))
             for a, add in analytic:
                 dev.check(add(self._ptr, ffi.from_buffer("float[]", a), len(a), ffi.NULL))
             dev.check(lib.rr_scene_commit(self._ptr))
@@ -274,7 +286,7 @@ class Scene:
         i = ffi.new("rr_scene_info *")
         self._dev.check(lib.rr_scene_get_info(self._scene(), i))
         return {"triangles": i.triangles, "skipped": i.skipped, "geometries": i.geometries,
-                "spheres": i.spheres, "planes": i.planes, "boxes": i.boxes,
+                "spheres": i.spheres, "planes": i.planes, "boxes": i.boxes, "instances": i.instances,
                 "bounds": (np.array(list(i.bounds_min)), np.array(list(i.bounds_max)))}
 
     def frame_camera(self, size, fov=45.0):
@@ -361,7 +373,7 @@ class Scene:
     def intersect(self, rays, threads=0, normals=True):
         """Closest hits of rays (N, 6) float32 (origin, direction) through the ray
         streams, as Open3D's cast_rays: t_hit (+inf on a miss), primitive_ids and
-        geometry_ids (MISS on a miss), primitive_uvs (barycentrics λ1, λ2) and, with
+        geometry_ids (MISS on a miss), instance_ids (MISS where no instance), primitive_uvs (barycentrics λ1, λ2) and, with
         normals, primitive_normals (unit geometric normals, 0 on a miss). The first
         four are views into the library's array of hits (strided, not copied)."""
         s, keep = self._stream(rays)
@@ -371,9 +383,9 @@ class Scene:
             dev = _Device()
             dev.check(lib.rr_intersect_stream(dev.ptr, self._scene(), s, _threads(threads),
                                               ffi.from_buffer("rr_hit[]", hits)))
-        words = hits.view(np.float32).reshape(n, 5)
+        words = hits.view(np.float32).reshape(n, len(_HIT.names))
         out = {"t_hit": hits["t"], "primitive_ids": hits["prim"], "geometry_ids": hits["geom"],
-               "primitive_uvs": words[:, 2:4]}
+               "instance_ids": hits["inst"], "primitive_uvs": words[:, 2:4]}
         if normals:
             prim = np.ascontiguousarray(hits["prim"])
             out["primitive_normals"] = np.zeros((n, 3), dtype=np.float32)

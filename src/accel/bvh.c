@@ -623,8 +623,18 @@ static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
 }
 
 /* The corners of the triangles prims[first .. first + count) into v: corner k's
- * axis x of the j-th at v[(3k + x)·count + j] (the layout of rr_bvh.leaf_v). */
+ * axis x of the j-th at v[(3k + x)·count + j] (the layout of rr_bvh.leaf_v). An
+ * instance's corners are moved to world space (scene_corners), the rest copied. */
 static void copy_corners(const rr_scene *s, const uint32_t *prims, uint32_t first, uint32_t count, float *v) {
+  if (s->inst) {
+    for (uint32_t j = 0; j < count; j++) {
+      vec3 c[3];
+      scene_corners(s, prims[first + j], c);
+      for (int k = 0; k < 3; k++)
+        v[(3 * k) * count + j] = c[k].x, v[(3 * k + 1) * count + j] = c[k].y, v[(3 * k + 2) * count + j] = c[k].z;
+    }
+    return;
+  }
   const float *p[9]; /* in locals: the stores into v cannot change them */
   memcpy(p, s->p, sizeof p);
   for (uint32_t j = 0; j < count; j++) {
@@ -836,6 +846,17 @@ static void finish_part(int part, int thread, void *arg) {
   else j->ok[2] = copy_leaf_corners(j->b, j->s), j->b->sah_cost = sah_cost(j->b);
 }
 
+bool rr_bvh_finish(rr_bvh *b, const rr_scene *s, int threads) {
+  finish_job fj = {b, s, {false, false, false}};
+  rr_parallel_for(3, threads, finish_part, &fj);
+  if (!fj.ok[0] || !fj.ok[1] || !fj.ok[2]) return false;
+  uint32_t n = b->nprims;
+  b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
+             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) +
+             (uint64_t)b->nwide8 * sizeof(bvh_wide8) + 2 * ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
+  return true;
+}
+
 rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **out) {
   *out = NULL;
   double t0 = rr_now_ms();
@@ -977,12 +998,7 @@ rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, struct rr_bvh **
   for (uint32_t i = 0; i < small.n; i++)
     if (small.v[i].buf)
       for (uint32_t k = small.v[i].start; k < small.v[i].start + small.v[i].count; k++) b->prims[k] = bd.buf[1][k].id;
-  finish_job fj = {b, s, {false, false, false}};
-  rr_parallel_for(3, bd.threads, finish_part, &fj);
-  if (!fj.ok[0] || !fj.ok[1] || !fj.ok[2]) goto oom;
-  b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
-             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) +
-             (uint64_t)b->nwide8 * sizeof(bvh_wide8) + 2 * ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
+  if (!rr_bvh_finish(b, s, bd.threads)) goto oom;
   b->build_ms = rr_now_ms() - t0;
   rr_progress(&progress, 1);
   *out = b;

@@ -57,8 +57,18 @@ typedef struct bvh_wide8 {
 enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK = 128, BVH_LEAF_PAD = 8 };
 
 /* Builds a binned-SAH BVH over the scene's triangles (accel/bvh.c); the tree is the
- * same for any opt->threads. An empty scene gets NULL. */
+ * same for any opt->threads. An empty scene gets NULL. (A scene with instances takes
+ * rr_bvh_build_instanced, which rr_scene_commit calls: far quicker, the same hits.) */
 rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, rr_bvh **out);
+/* The BVH of a scene with instances (accel/bvh_instance.c): the mesh's tree built once
+ * in its own space and copied per instance with its boxes moved to world space (each
+ * holding its triangles' world corners), under a tree over the instances and the
+ * other primitives. The same kind of tree as rr_bvh_build's, for every traversal. */
+rr_error rr_bvh_build_instanced(rr_scene *s, const rr_build_options *opt, rr_bvh **out);
+/* Completes a binary tree (nodes, prims, nnodes, nprims set): the 4- and 8-wide
+ * forms, the leaves' corners (side by side on `threads`), the SAH cost and the
+ * bytes. False when out of memory. */
+bool rr_bvh_finish(rr_bvh *b, const rr_scene *s, int threads);
 /* The scene's BVH when it is current, else NULL with a message in dev (an empty
  * scene also gives NULL, with *empty set: every ray misses). */
 const rr_bvh *rr_bvh_of(rr_device *dev, const rr_scene *s, bool *empty);

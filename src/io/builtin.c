@@ -310,12 +310,12 @@ static rr_error gen_ground(rr_scene *s) {
 }
 
 static rr_error gen_box_on_ground(rr_scene *s) {
-  uint32_t t0 = s->ntris;
+  uint32_t t0 = scene_stored(s); /* (stored indices: after any instances) */
   rr_error e = gen_box(s, 1);
   if (e) return e;
   /* the unit box [-1,1]^3 to half size, standing 0.05 above the plane at (1.5, -0.5):
    * the same map for every corner keeps shared corners identical */
-  for (uint32_t i = t0; i < s->ntris; i++)
+  for (uint32_t i = t0; i < scene_stored(s); i++)
     for (int k = 0; k < 3; k++) {
       s->p[k][0][i] = s->p[k][0][i] * 0.5f + 1.5f;
       s->p[k][1][i] = s->p[k][1][i] * 0.5f + 0.55f;
@@ -370,15 +370,18 @@ static rr_error gen_checker(rr_scene *s) {
 
 /* ---- grid of copies ----------------------------------------------------------------- */
 
-/* grid:PATH:N — N×N copies of a mesh file on the XZ plane, copy k = j·N + i moved by
- * (i·1.25·sx, 0, j·1.25·sz). The copies are written straight into the arrays rather
- * than through rr_scene_push: a translated sliver could round to zero area and be
- * dropped, which would break the rule that copy k's triangle m has index k·T + m and
- * id k·F + (the file's id of m), F the file's faces, dropped ones included (ids as if
- * the file were loaded N² times). Each copy has its own geometries, like the file's,
- * named as in the file. */
-static rr_error load_grid(rr_scene *s, const char *name) {
-  const char *rest = name + strlen("grid:");
+/* grid:PATH:N — N×N instances of a mesh file on the XZ plane (scene/instance.h),
+ * instance k = j·N + i moved by (i·1.25·sx, 0, j·1.25·sz): the mesh is stored once.
+ * Instance k's triangle m has index k·T + m and id k·F + (the file's id of m), F the
+ * file's faces, dropped ones included (ids as if the file were loaded N² times), and
+ * its own geometries, like the file's, named as in the file.
+ *
+ * grid-flat:PATH:N — the same scene with the copies written out (N²·T triangles
+ * stored), every corner moved by inst_point as the instances' are: the reference the
+ * instanced grid renders bit for bit like. The copies go straight into the arrays
+ * rather than through rr_scene_push, which could drop a translated sliver. */
+static rr_error load_grid(rr_scene *s, const char *name, bool flat) {
+  const char *rest = name + strlen(flat ? "grid-flat:" : "grid:");
   const char *colon = strrchr(rest, ':'); /* PATH may itself contain ':' */
   if (!colon || colon == rest)
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "bad grid name '%s' (expected grid:PATH:N)", name);
@@ -386,6 +389,7 @@ static rr_error load_grid(rr_scene *s, const char *name) {
   if (!parse_count(colon + 1, 1, 1000, &n))
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "bad grid count '%s' in '%s' (expected 1..1000)",
                    colon + 1, name);
+  if (s->inst) return rr_fail(s->dev, RR_ERROR_ARGUMENT, "grid '%s': the scene holds instances already", name);
   size_t len = (size_t)(colon - rest);
   char *path = malloc(len + 1);
   if (!path) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory reading '%s'", name);
@@ -413,37 +417,49 @@ static rr_error load_grid(rr_scene *s, const char *name) {
   float sx = xhi - xlo, sz = zhi - zlo;
   if (!isfinite((float)(n - 1) * 1.25f * sx) || !isfinite((float)(n - 1) * 1.25f * sz))
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "grid '%s': the mesh is too large to replicate", name);
+  float (*xf)[12] = malloc(copies * sizeof *xf);
+  if (!xf) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for the grid's %llu instances", (unsigned long long)copies);
+  for (uint64_t copy = 0; copy < copies; copy++) {
+    float ox = (float)(copy % n) * 1.25f * sx, oz = (float)(copy / n) * 1.25f * sz;
+    const float m[12] = {1, 0, 0, ox, 0, 1, 0, 0, 0, 0, 1, oz};
+    memcpy(xf[copy], m, sizeof m);
+  }
+  if (!flat) {
+    e = rr_scene_instance(s, t0, F, g0, (uint32_t)copies, (const float (*)[12])xf);
+    free(xf);
+    return e;
+  }
 
   s->skipped += (s->skipped - skipped0) * (copies - 1); /* as loading the file N² times would */
   e = rr_scene_reserve(s, (uint32_t)(total - T), false, false);
   if (!e && F != T) e = rr_scene_reserve_ids(s); /* copies' ids differ from their indices */
-  if (e) return e;
   uint32_t g1 = s->ngeoms;
-  for (uint64_t copy = 1; copy < copies; copy++) {
-    float ox = (float)(copy % n) * 1.25f * sx, oz = (float)(copy / n) * 1.25f * sz;
-    size_t dst = t0 + copy * T;
-    for (uint32_t g = g0; g < g1; g++) {
+  for (uint64_t copy = 1; copy < copies && !e; copy++)
+    for (uint32_t g = g0; g < g1 && !e; g++)
       e = rr_scene_repeat_geometry(s, g, s->geoms[g].first + (uint32_t)(copy * T),
                                    s->geoms[g].face + (uint32_t)(copy * F));
-      if (e) return e;
-    }
+  /* backwards, so that copy 0 (written over the file's corners) comes last */
+  for (uint64_t copy = copies; !e && copy-- > 0;) {
+    size_t dst = t0 + copy * T;
     for (int k = 0; k < 3; k++) {
       for (uint32_t m = 0; m < T; m++) {
-        s->p[k][0][dst + m] = s->p[k][0][t0 + m] + ox;
-        s->p[k][1][dst + m] = s->p[k][1][t0 + m];
-        s->p[k][2][dst + m] = s->p[k][2][t0 + m] + oz;
+        vec3 p = inst_point(xf[copy], true, v3(s->p[k][0][t0 + m], s->p[k][1][t0 + m], s->p[k][2][t0 + m]));
+        s->p[k][0][dst + m] = p.x, s->p[k][1][dst + m] = p.y, s->p[k][2][dst + m] = p.z;
       }
-      for (int c = 0; c < 3; c++)
+      for (int c = 0; c < 3 && copy; c++)
         if (s->n[k][c]) memcpy(s->n[k][c] + dst, s->n[k][c] + t0, T * sizeof(float));
-      for (int c = 0; c < 2; c++)
+      for (int c = 0; c < 2 && copy; c++)
         if (s->uv[k][c]) memcpy(s->uv[k][c] + dst, s->uv[k][c] + t0, T * sizeof(float));
-      for (int c = 0; c < 3; c++)
+      for (int c = 0; c < 3 && copy; c++)
         if (s->col[k][c]) memcpy(s->col[k][c] + dst, s->col[k][c] + t0, T * sizeof(float));
     }
+    if (!copy) continue;
     if (s->inf) memcpy(s->inf + dst, s->inf + t0, T);
     memcpy(s->material + dst, s->material + t0, T * sizeof(uint32_t));
     for (uint32_t m = 0; s->file_id && m < T; m++) s->file_id[dst + m] = s->file_id[t0 + m] + (uint32_t)(copy * F);
   }
+  free(xf);
+  if (e) return e;
   s->ntris = (uint32_t)(t0 + total);
   rr_scene_update_bounds(s);
   return RR_OK;
@@ -556,6 +572,8 @@ static int corner_cmp(const void *pa, const void *pb) {
 }
 
 rr_error rr_scene_smooth_normals(rr_scene *s, uint32_t t0, uint32_t t1) {
+  /* on the stored triangles (an instanced mesh's once, in its own space) */
+  if (t1 > t0) t0 = scene_st(s, t0), t1 = scene_st(s, t1 - 1) + 1;
   size_t nt = t1 - t0, nc = 3 * nt;
   rr_error e = rr_scene_reserve(s, 0, true, false);
   if (e) return e;
@@ -567,10 +585,10 @@ rr_error rr_scene_smooth_normals(rr_scene *s, uint32_t t0, uint32_t t1) {
   }
   for (size_t t = 0; t < nt; t++) {
     uint32_t i = t0 + (uint32_t)t;
-    vec3 p0 = scene_vertex(s, 0, i), p1 = scene_vertex(s, 1, i), p2 = scene_vertex(s, 2, i);
+    vec3 p0 = scene_stored_vertex(s, 0, i), p1 = scene_stored_vertex(s, 1, i), p2 = scene_stored_vertex(s, 2, i);
     fn[t] = v3_cross(v3_sub(p1, p0), v3_sub(p2, p0));
     for (uint32_t k = 0; k < 3; k++) {
-      vec3 p = scene_vertex(s, (int)k, i);
+      vec3 p = scene_stored_vertex(s, (int)k, i);
       c[3 * t + k] = (corner_key){p.x, p.y, p.z, (uint32_t)t, k};
     }
   }
@@ -629,17 +647,18 @@ static rr_error place_file(rr_scene *s, const char *file, const char *name, floa
   if (e) return e;
   float cy = cosf(yaw * (float)(RR_PI / 180)), sy = sinf(yaw * (float)(RR_PI / 180));
   vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
-  for (uint32_t i = t0; i < s->ntris; i++)
+  uint32_t j0 = scene_stored(s) - (s->ntris - t0); /* stored indices: after any instances */
+  for (uint32_t i = j0; i < scene_stored(s); i++)
     for (int k = 0; k < 3; k++) {
-      vec3 p = scene_vertex(s, k, i);
+      vec3 p = scene_stored_vertex(s, k, i);
       lo = v3_min(lo, p), hi = v3_max(hi, p);
     }
   vec3 ext = v3_sub(hi, lo);
   float scale = size / fmaxf(ext.x, fmaxf(ext.y, ext.z));
   vec3 mid = v3(0.5f * (lo.x + hi.x), lo.y, 0.5f * (lo.z + hi.z));
-  for (uint32_t i = t0; i < s->ntris; i++)
+  for (uint32_t i = j0; i < scene_stored(s); i++)
     for (int k = 0; k < 3; k++) {
-      vec3 p = v3_scale(v3_sub(scene_vertex(s, k, i), mid), scale);
+      vec3 p = v3_scale(v3_sub(scene_stored_vertex(s, k, i), mid), scale);
       s->p[k][0][i] = cy * p.x + sy * p.z + x;
       s->p[k][1][i] = p.y;
       s->p[k][2][i] = -sy * p.x + cy * p.z + z;
@@ -721,7 +740,9 @@ rr_error rr_scene_load_builtin(rr_scene *s, const char *name) {
   } else if (strcmp(name, "checker") == 0) {
     e = gen_checker(s);
   } else if (strncmp(name, "grid:", 5) == 0) {
-    e = load_grid(s, name);
+    e = load_grid(s, name, false);
+  } else if (strncmp(name, "grid-flat:", 10) == 0) {
+    e = load_grid(s, name, true);
   } else {
     return RR_ERROR_UNSUPPORTED; /* not a built-in name: the caller reads it as a file */
   }

@@ -295,6 +295,7 @@ static const struct {
     [RR_AOV_ZDEPTH] = {1, {"zdepth"}},
     /* a light per channel, as the samples are */
     [RR_AOV_SHADOW_LIGHTS] = PER_SAMPLE("shadow.l"),
+    [RR_AOV_INSTANCE] = {1, {"instance"}},
 };
 _Static_assert(RR_MAX_SHADOW_LIGHTS == RR_MAX_SAMPLES, "PER_SAMPLE names the lights too");
 _Static_assert(RR_MAX_SAMPLES == 16, "PER_SAMPLE names 16 samples");

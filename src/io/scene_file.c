@@ -356,7 +356,9 @@ static rr_error read_xform(json_reader *r, const cJSON *obj, xform *x) {
     rotate_by(deg, m);
     memcpy(x->m, m, sizeof m);
   }
-  double d = det3(x->m);
+  double m[3][3]; /* (a copy: GCC's inliner misjudges x->m's size otherwise) */
+  memcpy(m, x->m, sizeof m);
+  double d = det3(m);
   if (!(fabs(d) > 1e-300) || !isfinite(d)) return rr_json_fail(r, NULL, "the transform is singular (a zero scale?)");
   return RR_OK;
 }
@@ -393,11 +395,12 @@ static bool is_identity(const xform *x) {
  * plane's point and normal (by the inverse transpose); a sphere's centre, and its
  * radius by the scale, which must be uniform (a sphere stays a sphere). */
 static rr_error xform_analytic(json_reader *r, rr_scene *s, const xform *x, const double nm[3][3], uint32_t i) {
-  float *a = s->ana + (size_t)ANA_FLOATS * i;
+  uint32_t j = scene_st(s, i);
+  float *a = s->ana + (size_t)ANA_FLOATS * j;
   vec3 c = xf_point(x, v3(a[0], a[1], a[2]), false);
   if (!(fabsf(c.x) <= 1e30f && fabsf(c.y) <= 1e30f && fabsf(c.z) <= 1e30f))
     return rr_json_fail(r, NULL, "the transform takes vertices beyond 1e30");
-  for (int k = 0; k < 3; k++) s->p[k][0][i] = c.x, s->p[k][1][i] = c.y, s->p[k][2][i] = c.z;
+  for (int k = 0; k < 3; k++) s->p[k][0][j] = c.x, s->p[k][1][j] = c.y, s->p[k][2][j] = c.z;
   a[0] = c.x, a[1] = c.y, a[2] = c.z;
   if (scene_kind(s, i) == RR_GEOMETRY_BOX) return rr_json_fail(r, NULL, "boxes are placed by 'boxes', not moved");
   if (scene_kind(s, i) == RR_GEOMETRY_PLANE) {
@@ -429,6 +432,8 @@ static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_
       nm[i][j] = (x->m[i1][j1] * x->m[i2][j2] - x->m[i1][j2] * x->m[i2][j1]) * (d < 0 ? -1 : 1);
     }
   for (uint32_t i = t0; i < s->ntris; i++) {
+    uint32_t in, j = scene_locate(s, i, &in);
+    if (in != RR_MISS) continue; /* an instance: its transform moves (below) */
     if (scene_kind(s, i) != RR_GEOMETRY_TRIANGLE) {
       rr_error e = xform_analytic(r, s, x, nm, i);
       if (e) return e;
@@ -440,22 +445,33 @@ static rr_error apply_xform(json_reader *r, rr_scene *s, const xform *x, uint32_
       if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z) || fabsf(p.x) > 1e30f || fabsf(p.y) > 1e30f ||
           fabsf(p.z) > 1e30f)
         return rr_json_fail(r, NULL, "the transform takes vertices beyond 1e30");
-      s->p[k][0][i] = p.x, s->p[k][1][i] = p.y, s->p[k][2][i] = p.z;
+      s->p[k][0][j] = p.x, s->p[k][1][j] = p.y, s->p[k][2][j] = p.z;
       if (s->n[0][0]) {
-        vec3 n = xf_unit(nm, v3(s->n[k][0][i], s->n[k][1][i], s->n[k][2][i]));
-        s->n[k][0][i] = n.x, s->n[k][1][i] = n.y, s->n[k][2][i] = n.z;
+        vec3 n = xf_unit(nm, v3(s->n[k][0][j], s->n[k][1][j], s->n[k][2][j]));
+        s->n[k][0][j] = n.x, s->n[k][1][j] = n.y, s->n[k][2][j] = n.z;
       }
     }
     if (d < 0) {
       for (int c = 0; c < 3; c++) {
-        swapf(&s->p[1][c][i], &s->p[2][c][i]);
-        if (s->n[0][0]) swapf(&s->n[1][c][i], &s->n[2][c][i]);
-        if (s->col[0][0]) swapf(&s->col[1][c][i], &s->col[2][c][i]);
-        if (c < 2 && s->uv[0][0]) swapf(&s->uv[1][c][i], &s->uv[2][c][i]);
+        swapf(&s->p[1][c][j], &s->p[2][c][j]);
+        if (s->n[0][0]) swapf(&s->n[1][c][j], &s->n[2][c][j]);
+        if (s->col[0][0]) swapf(&s->col[1][c][j], &s->col[2][c][j]);
+        if (c < 2 && s->uv[0][0]) swapf(&s->uv[1][c][j], &s->uv[2][c][j]);
       }
-      if (s->inf) s->inf[i] = (uint8_t)((inf & 1u) | (inf >> 1 & 2u) | (inf << 1 & 4u));
+      if (s->inf) s->inf[j] = (uint8_t)((inf & 1u) | (inf >> 1 & 2u) | (inf << 1 & 4u));
     }
   }
+  if (s->inst && s->inst->base >= t0) /* instances loaded with the object: x after their transforms */
+    for (uint32_t k = 0; k < s->inst->n; k++) {
+      float *m = s->inst->xf[k], o[12];
+      for (int r0 = 0; r0 < 3; r0++)
+        for (int c = 0; c < 4; c++)
+          o[4 * r0 + c] = (float)(x->m[r0][0] * m[c] + x->m[r0][1] * m[4 + c] + x->m[r0][2] * m[8 + c] +
+                                  (c == 3 ? x->t[r0] : 0));
+      rr_error e = rr_instance_set(s, k, o);
+      if (e) return rr_json_fail(r, NULL, "%s", rr_device_message(s->dev));
+      if (k + 1 == s->inst->n) rr_scene_update_bounds(s);
+    }
   for (uint32_t c = c0; c < s->ncameras; c++) {
     file_camera *fc = &s->cameras[c];
     fc->eye = xf_point(x, fc->eye, false);
@@ -546,14 +562,18 @@ static rr_error resolve_path(json_reader *r, const char *key, const char *base_d
   return RR_OK;
 }
 
-/* A mesh: "file" or "builtin", "name", a transform, "material". */
-static rr_error read_mesh(json_reader *r, const cJSON *obj, const mesh_arg *a) {
+static rr_error read_instances(json_reader *r, const cJSON *list, rr_scene *s, uint32_t t0, uint64_t faces, uint32_t g0);
+
+/* A mesh: "file" or "builtin", "name", a transform, "material"; or, instanced, the
+ * same with "transforms" (one per instance) in place of the transform. */
+static rr_error read_mesh(json_reader *r, const cJSON *obj, const mesh_arg *a, bool instanced) {
   rr_scene *s = a->s;
   const char *base_dir = a->base_dir;
   const rr_load_options *opt = a->opt;
   static const char *const keys[] = {"file",   "builtin", "name",     "translate", "rotate",
                                      "scale",  "matrix",  "material", "smooth",    NULL};
-  rr_error e = rr_json_keys(r, obj, keys);
+  static const char *const inst_keys[] = {"file", "builtin", "name", "transforms", "material", "smooth", NULL};
+  rr_error e = rr_json_keys(r, obj, instanced ? inst_keys : keys);
   if (e) return e;
   const char *file = NULL, *builtin = NULL, *name = NULL;
   if ((e = rr_json_string(r, obj, "file", &file)) || (e = rr_json_string(r, obj, "builtin", &builtin)) ||
@@ -570,12 +590,12 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, const mesh_arg *a) {
   char path[MAX_PATH];
   if (builtin) {
     if (!opt->builtins) return rr_json_fail(r, "builtin", "built-in meshes are not allowed here");
-    if (opt->sandbox && strncmp(builtin, "grid:", 5) == 0)
+    if (opt->sandbox && (strncmp(builtin, "grid:", 5) == 0 || strncmp(builtin, "grid-flat:", 10) == 0))
       return rr_json_fail(r, "builtin", "grid: reads a file, which the sandbox does not allow (use 'file' and a transform)");
     e = rr_scene_load_builtin(s, builtin);
     if (e == RR_ERROR_UNSUPPORTED)
       return rr_json_fail(r, "builtin", "unknown built-in '%.64s' (expected demo, plane[:N], sphere[:N], box[:N], "
-                                     "torus[:N], rooms[:N], spheres[:N], ground, ground:inf, checker or grid:PATH:N)", builtin);
+                                     "torus[:N], rooms[:N], spheres[:N], ground, ground:inf, checker, grid:PATH:N or grid-flat:PATH:N)", builtin);
   } else {
     if (!file[0]) return rr_json_fail(r, "file", "empty path");
     if (strlen(file) >= MAX_PATH) return rr_json_fail(r, "file", "path too long");
@@ -590,6 +610,7 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, const mesh_arg *a) {
   if (scene_faces(s) == faces) return rr_json_fail(r, builtin ? "builtin" : "file", "no triangles");
   for (uint32_t g = g0; name && g < s->ngeoms; g++)
     if ((e = rr_scene_name_geometry(s, g, name))) return e;
+  if (instanced && (e = read_instances(r, rr_json_get(obj, "transforms"), s, t0, faces, g0))) return e;
   if ((e = apply_xform(r, s, &x, t0, c0, l0))) return e;
   if (smooth && (e = rr_scene_smooth_normals(s, t0, s->ntris))) return e;
   if (material) {
@@ -597,6 +618,42 @@ static rr_error read_mesh(json_reader *r, const cJSON *obj, const mesh_arg *a) {
     e = read_material(r, material, a, m0);
     rr_json_leave(r, len);
   }
+  return e;
+}
+
+/* "transforms": one transform object per instance of the mesh stored from t0 on. */
+static rr_error read_instances(json_reader *r, const cJSON *list, rr_scene *s, uint32_t t0, uint64_t faces, uint32_t g0) {
+  static const char *const keys[] = {"translate", "rotate", "scale", "matrix", NULL};
+  if (!list) return rr_json_fail(r, NULL, "missing 'transforms'");
+  int n = cJSON_GetArraySize(list);
+  if (!cJSON_IsArray(list) || n < 1) return rr_json_fail(r, "transforms", "expected an array of transform objects");
+  if (s->inst) return rr_json_fail(r, NULL, "a scene holds one instanced mesh");
+  if (s->ntris == t0) return rr_json_fail(r, NULL, "no triangles kept");
+  vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+  for (uint32_t j = t0; j < s->ntris; j++)
+    for (int k = 0; k < 3; k++) lo = v3_min(lo, scene_stored_vertex(s, k, j)), hi = v3_max(hi, scene_stored_vertex(s, k, j));
+  float (*xf)[12] = malloc((size_t)n * sizeof *xf);
+  if (!xf) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for %d instances", n);
+  rr_error e = RR_OK;
+  int i = 0;
+  xform x;
+  for (const cJSON *item = list->child; item && !e; item = item->next, i++) {
+    size_t len = rr_json_enter(r, "transforms", 0);
+    rr_json_enter(r, NULL, i);
+    e = !cJSON_IsObject(item) ? rr_json_fail(r, NULL, "expected a transform object") : rr_json_keys(r, item, keys);
+    if (!e) e = read_xform(r, item, &x);
+    for (int row = 0; !e && row < 3; row++)
+      for (int c = 0; c < 4; c++) xf[i][4 * row + c] = (float)(c < 3 ? x.m[row][c] : x.t[row]);
+    const char *why = e ? NULL : rr_instance_problem(xf[i], lo, hi);
+    if (why) e = rr_json_fail(r, NULL, "%s", why);
+    rr_json_leave(r, len);
+  }
+  if (!e && rr_scene_instance(s, t0, scene_faces(s) - faces, g0, (uint32_t)n, (const float (*)[12])xf) != RR_OK) {
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", rr_device_message(s->dev));
+    e = rr_json_fail(r, NULL, "%s", msg);
+  }
+  free(xf);
   return e;
 }
 
@@ -743,7 +800,7 @@ static rr_error each(json_reader *r, const cJSON *root, const char *key, bool re
 }
 
 static rr_error mesh_item(json_reader *r, const cJSON *item, void *arg) {
-  return read_mesh(r, item, arg);
+  return read_mesh(r, item, arg, false);
 }
 
 static rr_error light_item(json_reader *r, const cJSON *item, void *arg) { return read_light(r, item, arg); }
@@ -795,7 +852,7 @@ static rr_error import_camera(json_reader *r, const cJSON *obj, const char *base
 /* Everything of the file but the commit. */
 static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const char *base_dir,
                            const rr_load_options *opt, rr_scene_settings *st) {
-  static const char *const keys[] = {"meshes", "spheres", "planes", "boxes", "lights", "camera", "render", "comment", NULL};
+  static const char *const keys[] = {"meshes", "instances", "spheres", "planes", "boxes", "lights", "camera", "render", "comment", NULL};
   rr_error e = rr_json_keys(r, root, keys);
   const char *comment;
   if (!e) e = rr_json_string(r, root, "comment", &comment);
@@ -815,8 +872,14 @@ static rr_error read_scene(json_reader *r, const cJSON *root, rr_scene *s, const
   }
   mesh_arg ma = {s, base_dir, opt};
   /* meshes may be left out when spheres or planes are given */
-  bool analytic = rr_json_get(root, "spheres") || rr_json_get(root, "planes") || rr_json_get(root, "boxes");
+  bool analytic = rr_json_get(root, "spheres") || rr_json_get(root, "planes") || rr_json_get(root, "boxes") ||
+                  rr_json_get(root, "instances");
   if (!e) e = each(r, root, "meshes", !analytic, mesh_item, &ma);
+  if (!e && (item = rr_json_get(root, "instances"))) { /* one instanced mesh, after the meshes */
+    size_t len = rr_json_enter(r, "instances", 0);
+    e = cJSON_IsObject(item) ? read_mesh(r, item, &ma, true) : rr_json_fail(r, NULL, "expected an object");
+    rr_json_leave(r, len);
+  }
   if (!e) e = each(r, root, "spheres", false, sphere_item, &ma);
   if (!e) e = each(r, root, "planes", false, plane_item, &ma);
   if (!e) e = each(r, root, "boxes", false, box_item, &ma);

@@ -2,13 +2,12 @@
 #include "prim/analytic.h"
 #include "prim/triangle.h"
 
-static const float *ana_of(const rr_scene *s, uint32_t i) { return s->ana + (size_t)ANA_FLOATS * i; }
 
 bool rr_ana_hit(const rr_scene *s, uint32_t i, const ana_ray *r, float *t, float *u, float *v) {
   switch (scene_kind(s, i)) {
-  case RR_GEOMETRY_SPHERE: return rr_ana_sphere_hit(ana_of(s, i), r, t, u, v);
-  case RR_GEOMETRY_PLANE: return rr_ana_plane_hit(ana_of(s, i), r, t, u, v);
-  case RR_GEOMETRY_BOX: return rr_ana_box_hit(ana_of(s, i), r, t, u, v);
+  case RR_GEOMETRY_SPHERE: return rr_ana_sphere_hit(rr_ana_params(s, i), r, t, u, v);
+  case RR_GEOMETRY_PLANE: return rr_ana_plane_hit(rr_ana_params(s, i), r, t, u, v);
+  case RR_GEOMETRY_BOX: return rr_ana_box_hit(rr_ana_params(s, i), r, t, u, v);
   default: return false;
   }
 }
@@ -20,7 +19,7 @@ static int box_face(float u) {
 }
 
 vec3 rr_ana_normal(const rr_scene *s, uint32_t i, float u, float v) {
-  const float *a = ana_of(s, i);
+  const float *a = rr_ana_params(s, i);
   if (scene_kind(s, i) == RR_GEOMETRY_PLANE) return v3(a[3], a[4], a[5]);
   if (scene_kind(s, i) == RR_GEOMETRY_BOX) {
     double R[3][3];
@@ -35,7 +34,7 @@ vec3 rr_ana_normal(const rr_scene *s, uint32_t i, float u, float v) {
 }
 
 vec3 rr_ana_point(const rr_scene *s, uint32_t i, float u, float v) {
-  const float *a = ana_of(s, i);
+  const float *a = rr_ana_params(s, i);
   if (scene_kind(s, i) == RR_GEOMETRY_PLANE) {
     double ua[3], va[3], p[3];
     rr_ana_plane_axes(a + 3, ua, va);
@@ -61,7 +60,7 @@ vec3 rr_ana_point(const rr_scene *s, uint32_t i, float u, float v) {
  * the stored axes are unit and orthogonal to float rounding only, so the box the
  * slab test sees is R⁻¹ of the cube, R⁻¹ = Rᵀ to within ~1e-7. */
 static void box_extent(const rr_scene *s, uint32_t i, double ext[3]) {
-  const float *a = ana_of(s, i);
+  const float *a = rr_ana_params(s, i);
   if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {
     ext[0] = ext[1] = ext[2] = a[3];
     return;
@@ -75,7 +74,7 @@ static void box_extent(const rr_scene *s, uint32_t i, double ext[3]) {
 /* The sphere around a box (centre, half diagonal widened by 1e-6) or a sphere itself:
  * what cones and floors bound a box by. */
 static void bounding_sphere(const rr_scene *s, uint32_t i, float out[4]) {
-  const float *a = ana_of(s, i);
+  const float *a = rr_ana_params(s, i);
   out[0] = a[0], out[1] = a[1], out[2] = a[2];
   out[3] = scene_kind(s, i) == RR_GEOMETRY_BOX
                ? nextafterf((float)((sqrt((double)a[3] * a[3] + (double)a[4] * a[4] + (double)a[5] * a[5]) + 1e-6 * ((double)a[3] + a[4] + a[5]))),
@@ -84,7 +83,7 @@ static void bounding_sphere(const rr_scene *s, uint32_t i, float out[4]) {
 }
 
 void rr_ana_box(const rr_scene *s, uint32_t i, float lo[3], float hi[3]) {
-  const float *a = ana_of(s, i);
+  const float *a = rr_ana_params(s, i);
   if (scene_kind(s, i) == RR_GEOMETRY_SPHERE || scene_kind(s, i) == RR_GEOMETRY_BOX) {
     double ext[3];
     box_extent(s, i, ext);
@@ -154,7 +153,7 @@ static void conic_rect(const float *a, const double base[3], double M[3][3], dou
 }
 
 static bool sphere_rect(const rr_scene *s, uint32_t i, const camera *c, int rect[4]) {
-  const float *a = ana_of(s, i);
+  const float *a = rr_ana_params(s, i);
   bool box = scene_kind(s, i) == RR_GEOMETRY_BOX;
   double ext[3];
   box_extent(s, i, ext);
@@ -209,7 +208,7 @@ bool rr_ana_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, int re
 bool rr_ana_cone_excludes(const rr_scene *s, uint32_t i, const camera *c, vec3 axis, float angle) {
   float bs[4];
   bounding_sphere(s, i, bs);
-  const float *a = scene_kind(s, i) == RR_GEOMETRY_PLANE ? ana_of(s, i) : bs;
+  const float *a = scene_kind(s, i) == RR_GEOMETRY_PLANE ? rr_ana_params(s, i) : bs;
   double e[3], ax[3];
   d3(c->eye, e), d3(axis, ax);
   double la = sqrt(dot3(ax, ax));
@@ -244,7 +243,7 @@ float rr_ana_t_floor(const rr_scene *s, uint32_t i, const camera *c) {
   float bs[4]; /* a box's hits lie in its bounding sphere: that sphere's floor holds */
   bounding_sphere(s, i, bs);
   bool sphere = scene_kind(s, i) != RR_GEOMETRY_PLANE;
-  const float *a = sphere ? bs : ana_of(s, i);
+  const float *a = sphere ? bs : rr_ana_params(s, i);
   double e[3], f[3];
   d3(c->eye, e), d3(c->fwd, f);
   if (!c->planar) {

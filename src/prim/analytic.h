@@ -34,7 +34,12 @@ enum { ANA_FLOATS = 12 };
 
 /* The kind of primitive i (triangles unless the scene holds analytic ones). */
 static inline prim_kind scene_kind(const rr_scene *s, uint32_t i) {
-  return s->kind ? (prim_kind)s->kind[i] : RR_GEOMETRY_TRIANGLE;
+  return s->kind ? (prim_kind)s->kind[scene_st(s, i)] : RR_GEOMETRY_TRIANGLE;
+}
+
+/* The ANA_FLOATS parameters of analytic primitive i (where it is stored). */
+static inline const float *rr_ana_params(const rr_scene *s, uint32_t i) {
+  return s->ana + (size_t)ANA_FLOATS * scene_st(s, i);
 }
 
 /* A ray in double: origin o and (unnormalised) direction d. */

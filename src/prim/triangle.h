@@ -342,8 +342,12 @@ static inline void tri_inf_box(unsigned inf, float v0, float v1, float v2, float
 /* The kind's bounds: triangle i's world box, lo[3] and hi[3] (the BVH's references). */
 static inline void rr_tri_box(const rr_scene *s, uint32_t i, float lo[3], float hi[3]) {
   unsigned inf = scene_inf(s, i);
+  float c[3][3];
+  vec3 v[3];
+  scene_corners(s, i, v);
+  for (int k = 0; k < 3; k++) v3_store(c[k], v[k]);
   for (int x = 0; x < 3; x++) {
-    float v0 = s->p[0][x][i], v1 = s->p[1][x][i], v2 = s->p[2][x][i];
+    float v0 = c[0][x], v1 = c[1][x], v2 = c[2][x];
     if (inf) {
       tri_inf_box(inf, v0, v1, v2, &lo[x], &hi[x]);
       continue;

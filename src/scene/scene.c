@@ -44,6 +44,7 @@ void rr_scene_release(rr_scene *s) {
   for (uint32_t l = 0; l < s->nlights; l++) free((char *)s->lights[l].name);
   free(s->lights);
   rr_bvh_release(s->bvh);
+  rr_instance_free(s->inst);
   free(s);
 }
 
@@ -57,7 +58,7 @@ static bool grow(float **arr, uint32_t cap) {
 }
 
 rr_error rr_scene_reserve(rr_scene *s, uint32_t more, bool with_normals, bool with_uvs) {
-  uint64_t need = (uint64_t)s->ntris + more;
+  uint64_t need = (uint64_t)scene_stored(s) + more;
   if (scene_faces(s) + more > UINT32_MAX - 1) /* every id, dropped faces' too, below RR_MISS */
     return rr_fail(s->dev, RR_ERROR_ARGUMENT, "scene too large: %llu triangles",
                    (unsigned long long)(scene_faces(s) + more));
@@ -88,7 +89,8 @@ rr_error rr_scene_reserve_ids(rr_scene *s) {
   if (s->file_id) return RR_OK;
   s->file_id = malloc((s->cap ? s->cap : 1) * sizeof *s->file_id);
   if (!s->file_id) return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for the ids of %u triangles", s->ntris);
-  for (uint32_t i = 0; i < s->ntris; i++) s->file_id[i] = i; /* nothing was dropped before them */
+  /* nothing was dropped before them: id = index, which scene_face_id gives for storage = id (instance.h) */
+  for (uint32_t i = 0; i < scene_stored(s); i++) s->file_id[i] = i;
   return RR_OK;
 }
 
@@ -102,13 +104,13 @@ rr_error rr_scene_reserve_colors(rr_scene *s) {
         for (int j = 0; j < 9; j++) free(s->col[j / 3][j % 3]), s->col[j / 3][j % 3] = NULL;
         return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory for vertex colours");
       }
-      for (uint32_t i = 0; i < s->ntris; i++) s->col[k][c][i] = 1.0f; /* white changes nothing */
+      for (uint32_t i = 0; i < scene_stored(s); i++) s->col[k][c][i] = 1.0f; /* white changes nothing */
     }
   return RR_OK;
 }
 
 void rr_scene_trim(rr_scene *s) {
-  if (s->ntris && s->ntris < s->cap) resize(s, s->ntris, false, false); /* on failure the arrays stay as they were */
+  if (scene_stored(s) && scene_stored(s) < s->cap) resize(s, scene_stored(s), false, false); /* on failure the arrays stay as they were */
 }
 
 /* Every per-triangle array to cap entries; add_n / add_uv start those arrays.
@@ -123,14 +125,14 @@ static bool resize(rr_scene *s, uint32_t cap, bool add_n, bool add_uv) {
       if (s->n[k][c] || add_n) {
         bool fresh = !s->n[k][c];
         ok = ok && grow(&s->n[k][c], cap);
-        if (ok && fresh) memset(s->n[k][c], 0, (size_t)s->ntris * sizeof(float));
+        if (ok && fresh) memset(s->n[k][c], 0, (size_t)scene_stored(s) * sizeof(float));
       }
     }
     for (int c = 0; c < 2; c++) {
       if (s->uv[k][c] || add_uv) {
         bool fresh = !s->uv[k][c];
         ok = ok && grow(&s->uv[k][c], cap);
-        if (ok && fresh) memset(s->uv[k][c], 0, (size_t)s->ntris * sizeof(float));
+        if (ok && fresh) memset(s->uv[k][c], 0, (size_t)scene_stored(s) * sizeof(float));
       }
     }
   }
@@ -168,6 +170,11 @@ static bool resize(rr_scene *s, uint32_t cap, bool add_n, bool add_uv) {
   return true;
 }
 
+/* The stored id of the next primitive (the one scene_face_id turns into the next id). */
+static uint32_t stored_id(const rr_scene *s) {
+  return (uint32_t)(scene_faces(s) - (s->inst ? (uint64_t)(s->inst->n - 1) * s->inst->F : 0));
+}
+
 static bool finite3(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
 /* The plane's normal from the edge vectors out of the first finite corner f: for a
@@ -200,15 +207,15 @@ bool rr_scene_push_inf(rr_scene *s, const vec3 p[3], unsigned inf, const vec3 *n
     s->skipped++;
     return false;
   }
-  if (s->ntris >= s->cap && rr_scene_reserve(s, 1, n != NULL, uv != NULL) != RR_OK) return false;
+  if (scene_stored(s) >= s->cap && rr_scene_reserve(s, 1, n != NULL, uv != NULL) != RR_OK) return false;
   if ((n && !s->n[0][0]) || (uv && !s->uv[0][0]))
     if (rr_scene_reserve(s, 0, n != NULL, uv != NULL) != RR_OK) return false;
   if (inf && rr_scene_reserve_inf(s) != RR_OK) return false;
   if (col && rr_scene_reserve_colors(s) != RR_OK) return false;
   if (s->skipped && rr_scene_reserve_ids(s) != RR_OK) return false;
   if (!s->ngeoms && rr_scene_open_geometry(s, RR_GEOMETRY_TRIANGLE, mat, NULL) != RR_OK) return false;
-  uint32_t i = s->ntris;
-  if (s->file_id) s->file_id[i] = (uint32_t)scene_faces(s); /* reserve keeps ids below RR_MISS */
+  uint32_t i = scene_stored(s);
+  if (s->file_id) s->file_id[i] = stored_id(s); /* reserve keeps ids below RR_MISS */
   s->ntris++;
   if (s->inf) s->inf[i] = (uint8_t)(inf & 7u);
   for (int k = 0; k < 3; k++) {
@@ -354,8 +361,9 @@ uint32_t rr_scene_geometry_of(const rr_scene *s, uint32_t prim) {
 }
 
 rr_hit rr_scene_hit(const rr_scene *s, uint32_t prim, float t, float l1, float l2) {
-  if (prim == RR_MISS) return (rr_hit){.prim = RR_MISS, .t = t, .l1 = l1, .l2 = l2, .geom = RR_MISS};
-  return (rr_hit){.prim = scene_face_id(s, prim), .t = t, .l1 = l1, .l2 = l2, .geom = rr_scene_geometry_of(s, prim)};
+  if (prim == RR_MISS) return (rr_hit){.prim = RR_MISS, .t = t, .l1 = l1, .l2 = l2, .geom = RR_MISS, .inst = RR_MISS};
+  return (rr_hit){.prim = scene_face_id(s, prim), .t = t, .l1 = l1, .l2 = l2, .geom = rr_scene_geometry_of(s, prim),
+                  .inst = scene_instance_of(s, prim)};
 }
 
 const char *rr_geometry_kind_name(int kind) { return prim_kind_name(kind); }
@@ -528,8 +536,8 @@ static rr_error add_analytic(rr_scene *s, const char *api, prim_kind kind, const
   if (e) return e;
   for (size_t k = 0; k < count; k++) {
     const float *a = v + per * k;
-    uint32_t i = s->ntris;
-    if (s->file_id) s->file_id[i] = (uint32_t)scene_faces(s);
+    uint32_t i = scene_stored(s);
+    if (s->file_id) s->file_id[i] = stored_id(s);
     s->ntris++;
     /* the triangle corners all at the centre (point): a triangle every triangle path drops */
     for (int c = 0; c < 3; c++)
@@ -600,6 +608,13 @@ rr_error rr_scene_get_info(const rr_scene *s, rr_scene_info *info) {
     for (int l = 0; l < t->nlevels; l++) info->texture_bytes += (uint64_t)t->levels[l].width * t->levels[l].height * 8;
   }
   v3_store(info->up, s->up), v3_store(info->front, s->front);
+  info->instances = s->inst ? s->inst->n : 0;
+  info->stored_triangles = scene_stored(s) - s->nspheres - s->nplanes - s->nboxes;
+  /* per stored primitive: positions, and what the scene has of normals, UVs, colours,
+   * material, id, corners at infinity, kinds and analytic parameters */
+  uint64_t per = 9 * 4 + 4 + (s->n[0][0] ? 36 : 0) + (s->uv[0][0] ? 24 : 0) + (s->col[0][0] ? 36 : 0) +
+                 (s->file_id ? 4 : 0) + (s->inf ? 1 : 0) + (s->kind ? 1 + 4 * ANA_FLOATS : 0);
+  info->scene_bytes = per * scene_stored(s) + rr_instance_bytes(s->inst);
   rr_bvh_fill_info(s->bvh, info);
   return RR_OK;
 }
@@ -638,10 +653,10 @@ uint32_t rr_scene_index_of(const rr_scene *s, uint32_t id) {
   uint32_t lo = 0, hi = s->ntris;
   while (lo < hi) {
     uint32_t mid = lo + (hi - lo) / 2;
-    if (s->file_id[mid] < id) lo = mid + 1;
+    if (scene_face_id(s, mid) < id) lo = mid + 1;
     else hi = mid;
   }
-  return lo < s->ntris && s->file_id[lo] == id ? lo : RR_MISS;
+  return lo < s->ntris && scene_face_id(s, lo) == id ? lo : RR_MISS;
 }
 
 /* Why a caller's material cannot be set, or NULL. */
@@ -730,7 +745,7 @@ rr_error rr_scene_commit(rr_scene *s) {
   if (s->dev) opt = s->dev->build;
   rr_scene_trim(s);
   struct rr_bvh *b;
-  rr_error e = rr_bvh_build(s, &opt, &b);
+  rr_error e = s->inst ? rr_bvh_build_instanced(s, &opt, &b) : rr_bvh_build(s, &opt, &b); /* accel/bvh_instance.c */
   if (e) return e;
   rr_bvh_release(s->bvh);
   s->bvh = b;

@@ -5,6 +5,7 @@
 
 #include "core/core.h"
 #include "prim/prim.h"
+#include "scene/instance.h"
 
 struct rr_bvh;
 
@@ -115,17 +116,97 @@ struct rr_scene {
   uint32_t ncameras;
   rr_light_info *lights; /* in world space; names are the scene's copies */
   uint32_t nlights;
+  scene_instances *inst; /* NULL, or the instanced mesh (scene/instance.h): then ntris counts
+                            indices (every instance's triangles), the arrays hold storage */
   struct rr_bvh *bvh; /* built by rr_scene_commit */
   uint64_t max_tris;  /* most triangles rr_scene_reserve grants (a scene file's budget); 0: no limit */
 };
 
+/* Where index i is stored (scene/instance.h), and in *inst its instance (RR_MISS when
+ * i is no instance's). Without instances: i itself. */
+static inline uint32_t scene_locate(const rr_scene *s, uint32_t i, uint32_t *inst) {
+  const scene_instances *in = s->inst;
+  *inst = RR_MISS;
+  if (!in || i < in->base) return i;
+  uint32_t r = i - in->base;
+  if (r < in->n * in->T) return *inst = r / in->T, in->base + r % in->T;
+  return i - (in->n - 1) * in->T;
+}
+static inline uint32_t scene_st(const rr_scene *s, uint32_t i) {
+  uint32_t k;
+  return scene_locate(s, i, &k);
+}
+/* The instance holding index i, RR_MISS when none does. */
+static inline uint32_t scene_instance_of(const rr_scene *s, uint32_t i) {
+  uint32_t k;
+  scene_locate(s, i, &k);
+  return i < s->ntris ? k : RR_MISS;
+}
+/* Triangles stored (index space minus the instances' copies): where the next goes. */
+static inline uint32_t scene_stored(const rr_scene *s) {
+  return s->inst ? s->ntris - (s->inst->n - 1) * s->inst->T : s->ntris;
+}
+
+/* Corner k of the triangle stored at j (an instance's: in its mesh's own space). */
+static inline vec3 scene_stored_vertex(const rr_scene *s, int k, uint32_t j) {
+  return v3(s->p[k][0][j], s->p[k][1][j], s->p[k][2][j]);
+}
+
+/* For kernels that load w lanes of corners (triangle i = ids[l] in lane l): where each
+ * is stored (st[l]), the translation of its instance (tr[a·w + l], axis a; 0 where
+ * none) and whether one moves it (mask[l] = -1, else 0); so that stored + tr is
+ * inst_point's corner, the same float addition. False when some lane's instance is
+ * more than a translation: then the caller moves its corners with scene_vertex. */
+static inline bool scene_lanes(const rr_scene *s, const int32_t *ids, int w, int32_t *st, float *tr, int32_t *mask) {
+  bool shift = true;
+  uint32_t lo = 0, len = 0, kl = RR_MISS; /* the last lane's instance and its indices lo .. lo + len */
+  for (int l = 0; l < w; l++) {
+    uint32_t k, i = (uint32_t)ids[l];
+    if (i - lo < len) { /* the same instance as the last lane (neighbours mostly are): no division */
+      k = kl, st[l] = (int32_t)(s->inst->base + (i - lo));
+    } else {
+      st[l] = (int32_t)scene_locate(s, i, &k);
+      if (k != RR_MISS) kl = k, lo = i - (uint32_t)st[l] + s->inst->base, len = s->inst->T;
+    }
+    mask[l] = k == RR_MISS ? 0 : -1;
+    shift = shift && (k == RR_MISS || s->inst->shift[k]);
+    for (int a = 0; a < 3; a++) tr[a * w + l] = k == RR_MISS ? 0.0f : s->inst->xf[k][4 * a + 3];
+  }
+  return shift;
+}
+
+/* The three corners of triangle i in world space (one look-up for the three). */
+static inline void scene_corners(const rr_scene *s, uint32_t i, vec3 c[3]) {
+  uint32_t in, j = scene_locate(s, i, &in);
+  for (int k = 0; k < 3; k++) {
+    c[k] = v3(s->p[k][0][j], s->p[k][1][j], s->p[k][2][j]);
+    if (in != RR_MISS) c[k] = inst_point(s->inst->xf[in], s->inst->shift[in], c[k]);
+  }
+}
+
+/* Corner k of triangle i in world space. */
 static inline vec3 scene_vertex(const rr_scene *s, int k, uint32_t i) {
-  return v3(s->p[k][0][i], s->p[k][1][i], s->p[k][2][i]);
+  uint32_t in, j = scene_locate(s, i, &in);
+  vec3 p = v3(s->p[k][0][j], s->p[k][1][j], s->p[k][2][j]);
+  return in == RR_MISS ? p : inst_point(s->inst->xf[in], s->inst->shift[in], p);
+}
+
+/* Axis x of corner k of triangle i in world space. */
+static inline float scene_coord(const rr_scene *s, int k, int x, uint32_t i) {
+  if (!s->inst) return s->p[k][x][i];
+  vec3 p = scene_vertex(s, k, i);
+  return x == 0 ? p.x : x == 1 ? p.y : p.z;
 }
 
 /* The id of triangle i (RR_MISS and other indices past the last stay as they are). */
 static inline uint32_t scene_face_id(const rr_scene *s, uint32_t i) {
-  return s->file_id && i < s->ntris ? s->file_id[i] : i;
+  if (i >= s->ntris) return i;
+  if (!s->inst) return s->file_id ? s->file_id[i] : i;
+  if (!s->file_id) return i;
+  uint32_t in, j = scene_locate(s, i, &in);
+  /* stored ids are those of the first instance; later ones (and what follows) move on by F each */
+  uint32_t k = in != RR_MISS ? in : i < s->inst->base ? 0 : s->inst->n - 1;
+  return s->file_id[j] + k * s->inst->F;
 }
 /* The index of the kept triangle whose id is `id` (file_id grows, so a binary
  * search); RR_MISS for RR_MISS and for ids no kept triangle has. */
@@ -134,12 +215,21 @@ uint32_t rr_scene_index_of(const rr_scene *s, uint32_t id);
 static inline uint64_t scene_faces(const rr_scene *s) { return s->ntris + s->skipped; }
 
 /* Which corners of triangle i lie at infinity (bit k: corner k); 0 for most. */
-static inline unsigned scene_inf(const rr_scene *s, uint32_t i) { return s->inf ? s->inf[i] : 0u; }
+static inline unsigned scene_inf(const rr_scene *s, uint32_t i) { return s->inf ? s->inf[scene_st(s, i)] : 0u; }
 /* Corner k of triangle i seen from `eye`: p - eye for a finite corner, the
  * direction itself for a point at infinity (where every ray from eye meets it). */
 static inline vec3 scene_q(const rr_scene *s, int k, uint32_t i, vec3 eye) {
   vec3 p = scene_vertex(s, k, i);
   return scene_inf(s, i) >> k & 1u ? p : v3_sub(p, eye);
+}
+/* The material of triangle i. */
+static inline uint32_t scene_material(const rr_scene *s, uint32_t i) { return s->material[scene_st(s, i)]; }
+/* Corner k's shading normal of triangle i in world space (unnormalised; zero when the
+ * scene has none: s->n NULL). */
+static inline vec3 scene_normal(const rr_scene *s, int k, uint32_t i) {
+  uint32_t in, j = scene_locate(s, i, &in);
+  vec3 n = v3(s->n[k][0][j], s->n[k][1][j], s->n[k][2][j]);
+  return in == RR_MISS || s->inst->shift[in] ? n : inst_dir(s->inst->nxf[in], n);
 }
 /* The (unnormalised) normal of triangle i's plane, for finite and infinite corners. */
 vec3 rr_scene_tri_normal(const rr_scene *s, uint32_t i);

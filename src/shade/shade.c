@@ -55,7 +55,7 @@ static hit hit_make(const rr_scene *s, uint32_t id, float l1, float l2, float t,
     vec3 sn = v3(0, 0, 0);
     float w[3] = {h.l0, h.l1, h.l2};
     for (int v = 0; v < 3; v++)
-      sn = v3_add(sn, v3_scale(v3(s->n[v][0][id], s->n[v][1][id], s->n[v][2][id]), w[v]));
+      sn = v3_add(sn, v3_scale(scene_normal(s, v, id), w[v]));
     if (v3_dot(sn, sn) > 1e-12f) {
       sn = v3_norm(sn);
       /* keep interpolated normals on the geometric normal's side */
@@ -125,7 +125,7 @@ static void mirror_diffs(const rr_scene *s, const hit *h, surface *sf) {
     float nn = v3_dot(n, n);
     ga = v3_scale(v3_cross(e2, n), 1.0f / nn), gb = v3_scale(v3_cross(n, e1), 1.0f / nn);
     vec3 c[3];
-    for (int v = 0; v < 3; v++) c[v] = v3(s->n[v][0][i], s->n[v][1][i], s->n[v][2][i]);
+    for (int v = 0; v < 3; v++) c[v] = scene_normal(s, v, i);
     e1n = v3_sub(c[1], c[0]), e2n = v3_sub(c[2], c[0]);
     big_n = v3_add(v3_add(v3_scale(c[0], h->l0), v3_scale(c[1], h->l1)), v3_scale(c[2], h->l2));
   }
@@ -136,7 +136,7 @@ static void mirror_diffs(const rr_scene *s, const hit *h, surface *sf) {
     sf->dv[k] = v3_neg(v3_sub(dd, v3_scale(h->dir, v3_dot(h->dir, dd))));
     sf->dn[k] = v3(0, 0, 0);
     if (scene_kind(s, i) == RR_GEOMETRY_SPHERE) {
-      const float *a = s->ana + (size_t)ANA_FLOATS * i;
+      const float *a = rr_ana_params(s, i);
       float side = v3_dot(sf->n, v3_sub(sf->p, v3(a[0], a[1], a[2]))) >= 0 ? 1.0f : -1.0f;
       sf->dn[k] = v3_scale(sf->dp[k], side / a[3]);
     } else if (smooth) {
@@ -150,7 +150,7 @@ static void mirror_diffs(const rr_scene *s, const hit *h, surface *sf) {
 }
 
 static void base_color(const rr_scene *s, const hit *h, const tex_filter *tf, float rgb[3]) {
-  const rr_material *m = s->nmaterials ? &s->materials[s->material[h->id] % s->nmaterials] : NULL;
+  const rr_material *m = s->nmaterials ? &s->materials[scene_material(s, h->id) % s->nmaterials] : NULL;
   rgb[0] = rgb[1] = rgb[2] = SCENE_GREY;
   if (!m) return;
   memcpy(rgb, m->color, sizeof m->color);
@@ -162,9 +162,10 @@ static void base_color(const rr_scene *s, const hit *h, const tex_filter *tf, fl
     rr_texture_sample(&m->texture, &tc, tf, t);
     for (int c = 0; c < 3; c++) rgb[c] *= t[c];
   }
-  if (s->col[0][0]) /* vertex colours (linear) multiply in, like glTF's COLOR_0 */
-    for (int c = 0; c < 3; c++)
-      rgb[c] *= h->l0 * s->col[0][c][h->id] + h->l1 * s->col[1][c][h->id] + h->l2 * s->col[2][c][h->id];
+  if (s->col[0][0]) { /* vertex colours (linear) multiply in, like glTF's COLOR_0 */
+    uint32_t j = scene_st(s, h->id);
+    for (int c = 0; c < 3; c++) rgb[c] *= h->l0 * s->col[0][c][j] + h->l1 * s->col[1][c][j] + h->l2 * s->col[2][c][j];
+  }
 }
 
 static uint32_t hash32(uint32_t x) {
@@ -287,7 +288,7 @@ static void hit_surface(const rr_scene *s, const hit *h, const tex_filter *tf, s
     sf->p = v3_add(v3_add(v3_scale(scene_vertex(s, 0, i), h->l0), v3_scale(scene_vertex(s, 1, i), h->l1)),
                    v3_scale(scene_vertex(s, 2, i), h->l2));
   }
-  sf->m = s->nmaterials ? &s->materials[s->material[i] % s->nmaterials] : NULL;
+  sf->m = s->nmaterials ? &s->materials[scene_material(s, i) % s->nmaterials] : NULL;
   base_color(s, h, tf, sf->base);
   mirror_diffs(s, h, sf);
 }
@@ -686,11 +687,12 @@ static rr_error frame_cameras(rr_device *dev, const rr_camera *cam, const rr_fra
   return RR_OK;
 }
 
-/* The value of an integer AOV (id, mesh, material) at a sample that saw primitive id. */
+/* The value of an integer AOV (id, mesh, material, instance) at a sample that saw primitive id. */
 static uint32_t id_aov(const rr_scene *s, rr_aov aov, uint32_t id) {
   if (aov == RR_AOV_ID) return scene_face_id(s, id);
   if (id >= s->ntris) return RR_MISS;
-  return aov == RR_AOV_MESH ? rr_scene_geometry_of(s, id) : s->material[id];
+  if (aov == RR_AOV_INSTANCE) return scene_instance_of(s, id);
+  return aov == RR_AOV_MESH ? rr_scene_geometry_of(s, id) : scene_material(s, id);
 }
 
 /* The sample nearest the pixel's centre (the lowest index on a tie): the same in
@@ -726,7 +728,7 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
                                              [RR_AOV_BARY] = 2,  [RR_AOV_EVALS] = 1,    [RR_AOV_NODES] = 1,
                                              [RR_AOV_MESH] = 1,  [RR_AOV_MATERIAL] = 1, [RR_AOV_COVERAGE] = 1,
                                              [RR_AOV_UV] = 2,    [RR_AOV_UV_DERIV] = 4,
-                                             [RR_AOV_ZDEPTH] = 1}; /* the lit parts: lit_aov */
+                                             [RR_AOV_ZDEPTH] = 1,   [RR_AOV_INSTANCE] = 1}; /* the lit parts: lit_aov */
   if (aov == RR_AOV_EVALS || aov == RR_AOV_NODES) {
     const float *counts = aov == RR_AOV_EVALS ? f->heat_e : f->heat_n;
     if (!counts) return rr_fail(dev, RR_ERROR_ARGUMENT, "AOVs evals and nodes need options.heat set when rendering");
@@ -736,7 +738,8 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
     return rr_ok(dev);
   }
   rr_aov base = per_sample_base(aov);
-  bool per_sample = base != aov, ints = base == RR_AOV_ID || base == RR_AOV_MESH || base == RR_AOV_MATERIAL;
+  bool per_sample = base != aov, ints = base == RR_AOV_ID || base == RR_AOV_MESH || base == RR_AOV_MATERIAL ||
+                                  base == RR_AOV_INSTANCE;
   int ch = per_sample ? f->samples : channels[aov], centre = centre_sample(f);
   e = image_alloc(dev, out, vb->width, vb->height, ch, ints ? RR_PIXEL_U32 : RR_PIXEL_F32, RR_IMAGE_AOV + (int)aov);
   if (e) return e;

@@ -44,7 +44,7 @@ static void footprint(tex_coord *tc, vec3 gu, vec3 gv, vec3 n, float t, vec3 d, 
  *   (a + 2) mod 3 of its frame over [0, 1]², ∇ = that axis / the face's size. */
 static tex_coord ana_texcoord(const rr_scene *s, uint32_t i, float u, float v, float t, vec3 d,
                               const vec3 do_dxy[2], const vec3 dd_dxy[2]) {
-  const float *a = s->ana + (size_t)ANA_FLOATS * i;
+  const float *a = rr_ana_params(s, i);
   vec3 n = rr_ana_normal(s, i, u, v), gu, gv;
   tex_coord tc = {0};
   prim_kind kind = scene_kind(s, i);
@@ -72,7 +72,8 @@ static tex_coord ana_texcoord(const rr_scene *s, uint32_t i, float u, float v, f
 
 /* Corner k's UVs. */
 static void corner_uv(const rr_scene *s, int k, uint32_t i, float uv[2]) {
-  uv[0] = s->uv[k][0][i], uv[1] = s->uv[k][1][i];
+  uint32_t j = scene_st(s, i);
+  uv[0] = s->uv[k][0][j], uv[1] = s->uv[k][1][j];
 }
 
 tex_coord rr_texcoord(const rr_scene *s, uint32_t i, float l1, float l2, float t, vec3 o, vec3 d,
@@ -98,8 +99,9 @@ tex_coord rr_texcoord(const rr_scene *s, uint32_t i, float l1, float l2, float t
   vec3 gv = v3_add(v3_scale(ga, dua[1]), v3_scale(gb, dub[1]));
   if (!inf) { /* the perspective-correct barycentrics of the visibility buffer */
     float l0 = 1.0f - l1 - l2;
-    tc.u = l0 * s->uv[0][0][i] + l1 * s->uv[1][0][i] + l2 * s->uv[2][0][i];
-    tc.v = l0 * s->uv[0][1][i] + l1 * s->uv[1][1][i] + l2 * s->uv[2][1][i];
+    uint32_t j = scene_st(s, i);
+    tc.u = l0 * s->uv[0][0][j] + l1 * s->uv[1][0][j] + l2 * s->uv[2][0][j];
+    tc.v = l0 * s->uv[0][1][j] + l1 * s->uv[1][1][j] + l2 * s->uv[2][1][j];
   } else { /* from the hit point: no corner to weigh by 1 - l1 - l2 */
     vec3 q = v3_sub(v3_add(o, v3_scale(d, t)), pf);
     tc.u = uvf[0] + v3_dot(gu, q), tc.v = uvf[1] + v3_dot(gv, q);

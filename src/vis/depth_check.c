@@ -19,7 +19,7 @@ static double plane_t(const rr_scene *s, uint32_t id, const double o[3], const d
   int f = !(inf & 1u) ? 0 : !(inf & 2u) ? 1 : 2;
   double p[3][3], r[2][3], n[3];
   for (int j = 0; j < 3; j++)
-    for (int a = 0; a < 3; a++) p[j][a] = s->p[j][a][id];
+    for (int a = 0; a < 3; a++) p[j][a] = scene_coord(s, j, a, id);
   for (int j = 0; j < 2; j++) {
     int k = (f + 1 + j) % 3;
     for (int a = 0; a < 3; a++) r[j][a] = inf >> k & 1u ? p[k][a] : p[k][a] - p[f][a];

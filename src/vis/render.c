@@ -117,7 +117,7 @@ int rr_aov_from_name(const char *name) {
   static const char *const names[RR_AOV_COUNT] = {"depth", "id",       "normal",    "bary",         "evals",      "nodes",
                                                   "mesh",  "material", "coverage", "sample-id", "sample-depth", "sample-mesh",
                                                   "uv",    "uv-deriv", "albedo", "direct", "reflection", "shadow",
-                                                  "emission", "z-depth", "shadow-lights"};
+                                                  "emission", "z-depth", "shadow-lights", "instance"};
   return name_index(names, RR_AOV_COUNT, name);
 }
 
