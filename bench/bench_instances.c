@@ -10,8 +10,13 @@
  * medians of --reps frames taken in turns, instanced and flat, so that load on the
  * machine hits both alike), with a check that both frames are the same bits.
  * --instructions: instead, callgrind's instructions of one build and one frame per
- * method and scene (repeatable on a loaded machine). */
+ * method and scene (repeatable on a loaded machine). With Embree found at build
+ * time, also Embree's memory, build and rtcIntersect8 frame on the same view, with
+ * its own instancing against the copies written out. */
 #include "benchutil.h"
+#ifdef RR_HAVE_EMBREE
+#include "peer_embree.h"
+#endif
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -122,6 +127,34 @@ int main(int argc, char **argv) {
          heap[1] / heap[0], build[1] / build[0], ms[1][0] / ms[0][0], ms[1][1] / ms[0][1]);
   for (int m = 0; m < NMETHODS; m++)
     printf("%s: instanced and flat frames %s\n", rr_method_name(methods[m]), same[m] ? "bit-identical" : "DIFFER");
+#ifdef RR_HAVE_EMBREE
+  /* Embree on the same view: its instancing (a scene of the mesh, one instance
+   * geometry per copy) against the copies written out, MEDIUM build, rtcIntersect8 */
+  if (!count) {
+    camera c;
+    if (rr_cam_setup(dev, &cam, w, h, &c) != RR_OK) return 1;
+    size_t ns = (size_t)w * h;
+    uint32_t *ids = malloc(ns * sizeof *ids);
+    float *tt = malloc(ns * sizeof *tt);
+    printf("| Embree | memory MiB | build ms | rtcIntersect8 ms |\n|---|---|---|---|\n");
+    for (int k = 0; ids && tt && k < 2; k++) {
+      double bt[REPS_MAX], ft[REPS_MAX], b = 0;
+      peer_embree *e = NULL;
+      for (int r = 0; r < reps; r++) {
+        peer_embree_release(e);
+        e = peer_embree_new(s[k], threads, 1, &bt[r]);
+        if (!e) return 1;
+      }
+      peer_embree_cast(e, &c, 8, threads, ids, tt); /* warm-up */
+      for (int r = 0; r < reps; r++) ft[r] = peer_embree_cast(e, &c, 8, threads, ids, tt);
+      b = bench_median(bt, reps);
+      printf("| %s | %.2f | %.1f | %.1f |\n", kind[k], peer_embree_bytes(e).scene / 1048576.0, b, bench_median(ft, reps));
+      peer_embree_release(e);
+    }
+    free(ids), free(tt);
+    rr_cam_release(&c);
+  }
+#endif
   rr_scene_release(s[0]), rr_scene_release(s[1]);
   rr_device_release(dev);
   return same[0] && same[1] ? 0 : 1;

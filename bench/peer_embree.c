@@ -10,6 +10,8 @@ struct peer_embree {
   RTCDevice dev;
   RTCScene scene;
   uint32_t *sphere_ids; /* Embree's sphere primID k (geometry 1) is rastray's primitive sphere_ids[k] */
+  uint32_t inst_T;      /* instanced: instance k's primID i is rastray's primitive k·inst_T + i */
+  RTCScene mesh;        /* instanced: the one mesh, instanced by the top scene */
   atomic_llong bytes, peak; /* reported by Embree's memory monitor, from any of its threads */
   peer_embree_memory mem;
   double build_cpu_ms; /* processor time of the process during rtcCommitScene */
@@ -30,6 +32,64 @@ static void embree_error(void *user, enum RTCError code, const char *msg) {
   fprintf(stderr, "embree: error %d: %s\n", (int)code, msg);
 }
 
+/* Commits e->scene, timing it (wall and processor) and taking Embree's account of
+ * the memory. */
+static void commit_measured(peer_embree *e, double *build_ms) {
+  long long before = atomic_load(&e->bytes);
+  atomic_store(&e->peak, before);
+  double t0 = rr_now_ms(), c0 = rr_cpu_ms();
+  rtcCommitScene(e->scene);
+  *build_ms = rr_now_ms() - t0;
+  e->build_cpu_ms = rr_cpu_ms() - c0;
+  long long after = atomic_load(&e->bytes);
+  e->mem = (peer_embree_memory){(double)after, (double)(after - before), (double)atomic_load(&e->peak)};
+}
+
+/* A scene that is one instanced mesh (a grid): Embree's own instancing, the mesh in
+ * a scene of its own (its stored corners) and one RTC_GEOMETRY_TYPE_INSTANCE per
+ * instance with its 3×4 transform; the build counts both commits, the memory the top's. */
+static peer_embree *new_instanced(peer_embree *e, const rr_scene *s, int quality, double *build_ms) {
+  const scene_instances *in = s->inst;
+  enum RTCBuildQuality q = quality >= 2 ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
+  e->inst_T = in->T;
+  e->mesh = rtcNewScene(e->dev);
+  rtcSetSceneBuildQuality(e->mesh, q);
+  RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+  float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                     (size_t)in->T * 3);
+  unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), in->T);
+  if (!v || !ix) {
+    rtcReleaseGeometry(g);
+    peer_embree_release(e);
+    return NULL;
+  }
+  for (uint32_t i = 0; i < in->T; i++)
+    for (int k = 0; k < 3; k++) {
+      vec3 p = scene_stored_vertex(s, k, i);
+      v[(3 * (size_t)i + k) * 3] = p.x, v[(3 * (size_t)i + k) * 3 + 1] = p.y, v[(3 * (size_t)i + k) * 3 + 2] = p.z;
+      ix[3 * (size_t)i + k] = 3 * i + k;
+    }
+  rtcCommitGeometry(g);
+  rtcAttachGeometry(e->mesh, g);
+  rtcReleaseGeometry(g);
+  e->scene = rtcNewScene(e->dev);
+  rtcSetSceneBuildQuality(e->scene, q);
+  double t0 = rr_now_ms(), c0 = rr_cpu_ms(), top_ms;
+  rtcCommitScene(e->mesh);
+  double mesh_ms = rr_now_ms() - t0, mesh_cpu = rr_cpu_ms() - c0;
+  for (uint32_t k = 0; k < in->n; k++) {
+    RTCGeometry ig = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(ig, e->mesh);
+    rtcSetGeometryTransform(ig, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, in->xf[k]);
+    rtcCommitGeometry(ig);
+    rtcAttachGeometryByID(e->scene, ig, k);
+    rtcReleaseGeometry(ig);
+  }
+  commit_measured(e, &top_ms);
+  *build_ms = mesh_ms + top_ms, e->build_cpu_ms += mesh_cpu;
+  return e;
+}
+
 peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double *build_ms) {
   char cfg[64];
   snprintf(cfg, sizeof cfg, "threads=%d", threads);
@@ -43,6 +103,7 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
   }
   rtcSetDeviceErrorFunction(e->dev, embree_error, NULL);
   rtcSetDeviceMemoryMonitorFunction(e->dev, embree_monitor, e);
+  if (s->inst && s->inst->base == 0 && s->ntris == s->inst->n * s->inst->T) return new_instanced(e, s, quality, build_ms);
   /* One vertex per triangle corner, so triangle i has Embree primID i. */
   RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
   float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
@@ -90,14 +151,7 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
     rtcAttachGeometryByID(e->scene, sg, 1);
     rtcReleaseGeometry(sg);
   }
-  long long before = atomic_load(&e->bytes);
-  atomic_store(&e->peak, before);
-  double t0 = rr_now_ms(), c0 = rr_cpu_ms();
-  rtcCommitScene(e->scene);
-  *build_ms = rr_now_ms() - t0;
-  e->build_cpu_ms = rr_cpu_ms() - c0;
-  long long after = atomic_load(&e->bytes);
-  e->mem = (peer_embree_memory){(double)after, (double)(after - before), (double)atomic_load(&e->peak)};
+  commit_measured(e, build_ms);
   return e;
 }
 
@@ -108,14 +162,17 @@ double peer_embree_build_cpu_ms(const peer_embree *e) { return e->build_cpu_ms; 
 void peer_embree_release(peer_embree *e) {
   if (!e) return;
   if (e->scene) rtcReleaseScene(e->scene);
+  if (e->mesh) rtcReleaseScene(e->mesh);
   if (e->dev) rtcReleaseDevice(e->dev);
   free(e->sphere_ids);
   free(e);
 }
 
 /* rastray's primitive index of Embree's hit (geometry 0: triangles by index, 1: spheres). */
-static uint32_t hit_id(const peer_embree *e, unsigned geom, unsigned prim) {
-  return geom == RTC_INVALID_GEOMETRY_ID ? RR_MISS : geom == 0 ? prim : e->sphere_ids[prim];
+static uint32_t hit_id(const peer_embree *e, unsigned geom, unsigned inst, unsigned prim) {
+  if (geom == RTC_INVALID_GEOMETRY_ID) return RR_MISS;
+  if (e->mesh) return inst * e->inst_T + prim; /* instanced: instance inst's triangle prim */
+  return geom == 0 ? prim : e->sphere_ids[prim];
 }
 
 enum { EMB_TILE = 32 };
@@ -144,10 +201,11 @@ static void cast1_tile(int job, int thread, void *arg) {
       rh.ray.tnear = 0, rh.ray.tfar = INFINITY, rh.ray.time = 0, rh.ray.mask = 0xFFFFFFFFu, rh.ray.id = 0,
       rh.ray.flags = 0;
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID, rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
       rtcIntersect1(j->e->scene, &ctx, &rh);
       size_t k = (size_t)y * c->width + x;
       bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-      j->ids[k] = hit_id(j->e, rh.hit.geomID, rh.hit.primID);
+      j->ids[k] = hit_id(j->e, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID);
       j->t[k] = hit ? rh.ray.tfar : INFINITY;
     }
 }
@@ -172,13 +230,14 @@ static void cast8_tile(int job, int thread, void *arg) {
         rh.ray.tnear[l] = 0, rh.ray.tfar[l] = INFINITY, rh.ray.time[l] = 0, rh.ray.mask[l] = 0xFFFFFFFFu;
         rh.ray.id[l] = 0, rh.ray.flags[l] = 0;
         rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID, rh.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
       }
       rtcIntersect8(valid, j->e->scene, &ctx, &rh);
       for (int l = 0; l < 8; l++) {
         if (!valid[l]) continue;
         size_t k = (size_t)(py + (l >> 2)) * c->width + px + (l & 3);
         bool hit = rh.hit.geomID[l] != RTC_INVALID_GEOMETRY_ID;
-        j->ids[k] = hit_id(j->e, rh.hit.geomID[l], rh.hit.primID[l]);
+        j->ids[k] = hit_id(j->e, rh.hit.geomID[l], rh.hit.instID[0][l], rh.hit.primID[l]);
         j->t[k] = hit ? rh.ray.tfar[l] : INFINITY;
       }
     }
@@ -213,7 +272,8 @@ static void rays1_chunk(int job, int thread, void *arg) {
     struct RTCRayHit rh = {.ray = {.org_x = r->org[0], .org_y = r->org[1], .org_z = r->org[2], .tnear = r->tmin,
                                    .dir_x = r->dir[0], .dir_y = r->dir[1], .dir_z = r->dir[2], .tfar = r->tmax,
                                    .mask = 0xFFFFFFFFu},
-                           .hit = {.geomID = RTC_INVALID_GEOMETRY_ID, .primID = RTC_INVALID_GEOMETRY_ID}};
+                           .hit = {.geomID = RTC_INVALID_GEOMETRY_ID, .primID = RTC_INVALID_GEOMETRY_ID,
+                                   .instID = {RTC_INVALID_GEOMETRY_ID}}};
     if (j->any) {
       rtcOccluded1(j->e->scene, &ctx, &rh.ray);
       j->ids[i] = rh.ray.tfar == -INFINITY ? 0 : RR_MISS; /* Embree marks an occluded ray so */
@@ -221,7 +281,7 @@ static void rays1_chunk(int job, int thread, void *arg) {
     }
     rtcIntersect1(j->e->scene, &ctx, &rh);
     bool hit = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-    j->ids[i] = hit_id(j->e, rh.hit.geomID, rh.hit.primID);
+    j->ids[i] = hit_id(j->e, rh.hit.geomID, rh.hit.instID[0], rh.hit.primID);
     j->t[i] = hit ? rh.ray.tfar : INFINITY;
   }
 }
@@ -243,6 +303,7 @@ static void rays8_chunk(int job, int thread, void *arg) {
       rh.ray.tnear[l] = r->tmin, rh.ray.tfar[l] = r->tmax, rh.ray.time[l] = 0, rh.ray.mask[l] = 0xFFFFFFFFu;
       rh.ray.id[l] = 0, rh.ray.flags[l] = 0;
       rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID, rh.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
     }
     if (j->any)
       rtcOccluded8(valid, j->e->scene, &ctx, &rh.ray);
@@ -250,7 +311,7 @@ static void rays8_chunk(int job, int thread, void *arg) {
       rtcIntersect8(valid, j->e->scene, &ctx, &rh);
     for (int l = 0; l < 8 && i0 + l < j->n; l++) {
       bool hit = j->any ? rh.ray.tfar[l] == -INFINITY : rh.hit.geomID[l] != RTC_INVALID_GEOMETRY_ID;
-      j->ids[i0 + l] = !hit ? RR_MISS : j->any ? 0 : hit_id(j->e, rh.hit.geomID[l], rh.hit.primID[l]);
+      j->ids[i0 + l] = !hit ? RR_MISS : j->any ? 0 : hit_id(j->e, rh.hit.geomID[l], rh.hit.instID[0][l], rh.hit.primID[l]);
       if (!j->any) j->t[i0 + l] = hit ? rh.ray.tfar[l] : INFINITY;
     }
   }
