@@ -9,6 +9,8 @@
  * lane, so every width gives the same rectangles. Writes the triangles whose
  * rectangle holds a sample to out, in order; returns how many. */
 
+#include "prim/triangle_corners_tmp.h"
+
 TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
                                                        const camera *c, int npos, const float (*pos)[2],
                                                        tri_bound *out) {
@@ -17,25 +19,10 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
     lane_id[l] = (int32_t)(ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1));
   if (s->inf)
     for (int l = 0; l < W; l++) lane_inf[l] = (int32_t)scene_inf(s, (uint32_t)lane_id[l]);
-  /* instances: translated lanes gather their stored corners and add the translation
-   * (inst_point's addition); other maps move each lane's corners with scene_vertex */
-  float lane_p[3][3][W], lane_tr[3 * W];
-  int32_t lane_st[W], lane_moved[W];
-  /* a whole run of W inside one translated instance (the common case): loads at its
-   * stored index plus the translation, as a scene without instances loads */
-  uint32_t run_k = RR_MISS, run_st = !ids && n == W && s->inst ? scene_locate(s, first, &run_k) : 0;
-  const bool run = run_k != RR_MISS && s->inst->shift[run_k] && run_st - s->inst->base + W <= s->inst->T;
-  const bool moved = s->inst != NULL && !run,
-             shifted = moved && scene_lanes(s, lane_id, W, lane_st, lane_tr, lane_moved);
-  const VI st_idx = moved ? VI_(load)(lane_st) : VI_(splat)(0), moved_m = moved ? VI_(load)(lane_moved) : VI_(splat)(0);
-  if (moved && !shifted)
-    for (int l = 0; l < W; l++)
-      for (int k = 0; k < 3; k++) {
-        vec3 v = scene_vertex(s, k, (uint32_t)lane_id[l]);
-        lane_p[k][0][l] = v.x, lane_p[k][1][l] = v.y, lane_p[k][2][l] = v.z;
-      }
-  const VI idx = VI_(load)(lane_id), inf = VI_(load)(lane_inf);
-  const bool persp = c->type == RR_CAMERA_PERSPECTIVE, contiguous = !ids && n == W;
+  const VI inf = VI_(load)(lane_inf);
+  const bool persp = c->type == RR_CAMERA_PERSPECTIVE;
+  VF corner[3][3];
+  RR_CAT(lane_corners, W)(s, lane_id, !ids && n == W, corner);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f), half = VF_(splat)(0.5f);
   const VF inf_f = VF_(splat)(INFINITY), width = VF_(splat)((float)c->width), height = VF_(splat)((float)c->height);
   const VF last_x = VF_(splat)((float)(c->width - 1)), last_y = VF_(splat)((float)(c->height - 1));
@@ -51,12 +38,7 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
     VF q[3]; /* the corner relative to the eye, or its direction when at infinity */
 #pragma GCC unroll 3
     for (int a = 0; a < 3; a++) {
-      VF p = run          ? VF_(load)(s->p[k][a] + run_st) + VF_(splat)(s->inst->xf[run_k][4 * a + 3])
-             : shifted    ? VF_(select)(moved_m, VF_(gather)(s->p[k][a], st_idx) + VF_(load)(lane_tr + a * W),
-                                         VF_(gather)(s->p[k][a], st_idx))
-             : moved      ? VF_(load)(lane_p[k][a])
-             : contiguous ? VF_(load)(s->p[k][a] + first)
-                          : VF_(gather)(s->p[k][a], idx);
+      VF p = corner[k][a];
       q[a] = p - eye[a];
       if (s->inf) q[a] = VF_(select)(-((inf >> k) & 1), p, q[a]);
     }

@@ -37,6 +37,8 @@ typedef struct {
 #define SELECT3(m, a, b) \
   ((V3){VF_(select)(m, (a).x, (b).x), VF_(select)(m, (a).y, (b).y), VF_(select)(m, (a).z, (b).z)})
 /* lex_less(a, b) and lex_positive(g1, g2, g3) as masks, with the scalar comparisons' NaN behaviour */
+#include "prim/triangle_corners_tmp.h"
+
 #define LEX_LESS3(a, b) \
   VI_(select)((a).x != (b).x, (a).x < (b).x, VI_(select)((a).y != (b).y, (a).y < (b).y, (a).z < (b).z))
 #define LEX_POSITIVE(g1, g2, g3) \
@@ -57,26 +59,11 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(
   for (int l = 0; l < W; l++) lane_id[l] = (int32_t)ids[l < count ? l : count - 1];
   if (s->inf)
     for (int l = 0; l < W; l++) lane_inf[l] = (int32_t)scene_inf(s, (uint32_t)lane_id[l]);
-  /* instances: translated lanes gather their stored corners and add the translation
-   * (inst_point's addition); other maps move each lane's corners with scene_vertex */
-  float lane_p[3][3][W], lane_tr[3 * W];
-  int32_t lane_st[W], lane_moved[W];
-  /* W consecutive triangles inside one translated instance (the common case): the
-   * stored corners plus the translation, one look-up for the lanes */
-  bool consecutive = s->inst && count == W;
+  bool consecutive = count == W;
   for (int l = 1; consecutive && l < W; l++) consecutive = ids[l] == ids[0] + (uint32_t)l;
-  uint32_t run_k = RR_MISS, run_st = consecutive ? scene_locate(s, ids[0], &run_k) : 0;
-  const bool run = run_k != RR_MISS && s->inst->shift[run_k] && run_st - s->inst->base + W <= s->inst->T;
-  const bool moved = s->inst != NULL && !run,
-             shifted = moved && scene_lanes(s, lane_id, W, lane_st, lane_tr, lane_moved);
-  const VI st_idx = moved ? VI_(load)(lane_st) : VI_(splat)(0), moved_m = moved ? VI_(load)(lane_moved) : VI_(splat)(0);
-  if (moved && !shifted)
-    for (int l = 0; l < W; l++)
-      for (int k = 0; k < 3; k++) {
-        vec3 v = scene_vertex(s, k, (uint32_t)lane_id[l]);
-        lane_p[k][0][l] = v.x, lane_p[k][1][l] = v.y, lane_p[k][2][l] = v.z;
-      }
-  const VI idx = VI_(load)(lane_id), inf = VI_(load)(lane_inf);
+  VF corner[3][3];
+  RR_CAT(lane_corners, W)(s, lane_id, consecutive, corner);
+  const VI inf = VI_(load)(lane_inf);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   const V3 zero3 = {zero, zero, zero};
   const vec3 eye = cams[0].eye;
@@ -85,18 +72,7 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(
   VI at_inf[3] = {VI_(splat)(0), VI_(splat)(0), VI_(splat)(0)};
 #pragma GCC unroll 3
   for (int k = 0; k < 3; k++) {
-    if (run) {
-      const float *m = s->inst->xf[run_k];
-      p[k] = (V3){VF_(load)(s->p[k][0] + run_st) + VF_(splat)(m[3]), VF_(load)(s->p[k][1] + run_st) + VF_(splat)(m[7]),
-                  VF_(load)(s->p[k][2] + run_st) + VF_(splat)(m[11])};
-    } else if (shifted) {
-      V3 g = {VF_(gather)(s->p[k][0], st_idx), VF_(gather)(s->p[k][1], st_idx), VF_(gather)(s->p[k][2], st_idx)};
-      V3 t = {VF_(load)(lane_tr), VF_(load)(lane_tr + W), VF_(load)(lane_tr + 2 * W)};
-      p[k] = SELECT3(moved_m, ADD3(g, t), g);
-    } else {
-      p[k] = moved ? (V3){VF_(load)(lane_p[k][0]), VF_(load)(lane_p[k][1]), VF_(load)(lane_p[k][2])}
-                   : (V3){VF_(gather)(s->p[k][0], idx), VF_(gather)(s->p[k][1], idx), VF_(gather)(s->p[k][2], idx)};
-    }
+    p[k] = (V3){corner[k][0], corner[k][1], corner[k][2]};
     q[k] = SUB3(p[k], SPLAT3(eye));
     if (s->inf) {
       at_inf[k] = -((inf >> k) & 1);
