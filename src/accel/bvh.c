@@ -848,7 +848,9 @@ static void finish_part(int part, int thread, void *arg) {
 
 bool rr_bvh_finish(rr_bvh *b, const rr_scene *s, int threads) {
   finish_job fj = {b, s, {false, false, false}};
-  rr_parallel_for(3, threads, finish_part, &fj);
+  /* small trees on the calling thread, as the build keeps them: no pool is started
+   * for them (a process with threads imports in process under the sanitizers) */
+  rr_parallel_for(3, b->nprims >= BVH_PAR_MIN ? threads : 1, finish_part, &fj);
   if (!fj.ok[0] || !fj.ok[1] || !fj.ok[2]) return false;
   uint32_t n = b->nprims;
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
