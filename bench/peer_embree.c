@@ -45,6 +45,28 @@ static void commit_measured(peer_embree *e, double *build_ms) {
   e->mem = (peer_embree_memory){(double)after, (double)(after - before), (double)atomic_load(&e->peak)};
 }
 
+/* Triangles 0 .. n-1 of s as one committed Embree geometry, one vertex per corner so
+ * that triangle i has primID i: their world corners, or (stored) their corners as
+ * stored (an instanced mesh's own space). NULL when Embree has no memory. */
+static RTCGeometry triangle_geometry(peer_embree *e, const rr_scene *s, uint32_t n, bool stored) {
+  RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+  float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), (size_t)n * 3);
+  unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), n);
+  if (!v || !ix) {
+    rtcReleaseGeometry(g);
+    return NULL;
+  }
+  for (uint32_t i = 0; i < n; i++)
+    for (int k = 0; k < 3; k++) {
+      vec3 p = stored ? scene_stored_vertex(s, k, i) : scene_vertex(s, k, i);
+      float *o = v + (3 * (size_t)i + k) * 3;
+      o[0] = p.x, o[1] = p.y, o[2] = p.z;
+      ix[3 * (size_t)i + k] = 3 * i + k;
+    }
+  rtcCommitGeometry(g);
+  return g;
+}
+
 /* A scene that is one instanced mesh (a grid): Embree's own instancing, the mesh in
  * a scene of its own (its stored corners) and one RTC_GEOMETRY_TYPE_INSTANCE per
  * instance with its 3×4 transform; the build counts both commits, the memory the top's. */
@@ -54,22 +76,11 @@ static peer_embree *new_instanced(peer_embree *e, const rr_scene *s, int quality
   e->inst_T = in->T;
   e->mesh = rtcNewScene(e->dev);
   rtcSetSceneBuildQuality(e->mesh, q);
-  RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-  float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                     (size_t)in->T * 3);
-  unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), in->T);
-  if (!v || !ix) {
-    rtcReleaseGeometry(g);
+  RTCGeometry g = triangle_geometry(e, s, in->T, true);
+  if (!g) {
     peer_embree_release(e);
     return NULL;
   }
-  for (uint32_t i = 0; i < in->T; i++)
-    for (int k = 0; k < 3; k++) {
-      vec3 p = scene_stored_vertex(s, k, i);
-      v[(3 * (size_t)i + k) * 3] = p.x, v[(3 * (size_t)i + k) * 3 + 1] = p.y, v[(3 * (size_t)i + k) * 3 + 2] = p.z;
-      ix[3 * (size_t)i + k] = 3 * i + k;
-    }
-  rtcCommitGeometry(g);
   rtcAttachGeometry(e->mesh, g);
   rtcReleaseGeometry(g);
   e->scene = rtcNewScene(e->dev);
@@ -104,23 +115,11 @@ peer_embree *peer_embree_new(const rr_scene *s, int threads, int quality, double
   rtcSetDeviceErrorFunction(e->dev, embree_error, NULL);
   rtcSetDeviceMemoryMonitorFunction(e->dev, embree_monitor, e);
   if (s->inst && s->inst->base == 0 && s->ntris == s->inst->n * s->inst->T) return new_instanced(e, s, quality, build_ms);
-  /* One vertex per triangle corner, so triangle i has Embree primID i. */
-  RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-  float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                     (size_t)s->ntris * 3);
-  unsigned *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-                                         s->ntris);
-  if (!v || !ix) {
-    rtcReleaseGeometry(g);
+  RTCGeometry g = triangle_geometry(e, s, s->ntris, false);
+  if (!g) {
     peer_embree_release(e);
     return NULL;
   }
-  for (uint32_t i = 0; i < s->ntris; i++)
-    for (int k = 0; k < 3; k++) {
-      for (int c = 0; c < 3; c++) v[(3 * (size_t)i + k) * 3 + c] = scene_coord(s, k, c, i);
-      ix[3 * (size_t)i + k] = 3 * i + k;
-    }
-  rtcCommitGeometry(g);
   e->scene = rtcNewScene(e->dev);
   rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_NONE);
   rtcSetSceneBuildQuality(e->scene, quality >= 2 ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);

@@ -126,43 +126,34 @@ static void check_methods(rr_device *dev, const rr_scene *inst, const rr_scene *
   CHECK(inst_hits > 100, "instances are seen (%d samples)", inst_hits);
 }
 
+/* A hit's instance ids: rr_scene_get_instance's, and for a triangle of an instance its
+ * local index (the first instance's first id is `first`). */
+typedef struct inst_check {
+  const rr_scene *s;
+  uint32_t first;
+  int on_inst;
+} inst_check;
+
+static void check_hit_instance(const rr_hit *a, void *arg) {
+  inst_check *ic = arg;
+  uint32_t k = 0, l = 0;
+  CHECK(rr_scene_get_instance(ic->s, a->prim, &k, &l) == RR_OK && k == a->inst, "instance of %u: %u, hit says %u",
+        a->prim, k, a->inst);
+  if (a->inst != RR_MISS) {
+    ic->on_inst++;
+    CHECK(a->inst < NINST && l == a->prim - ic->first - a->inst * NTRI, "hit %u: instance %u local %u", a->prim,
+          a->inst, l);
+  }
+}
+
 /* rr_intersect / rr_occluded against brute force, and the instance ids of hits. */
 static void check_rays(rr_device *dev, const rr_scene *s) {
-  int bad = 0, n = 0, on_inst = 0;
-  uint32_t first = RR_MISS;
-  for (uint32_t i = 0; i < s->ntris && first == RR_MISS; i++)
-    if (scene_instance_of(s, i) == 0) first = scene_face_id(s, i);
-  for (int v = 0; v < 6; v++) {
-    rr_camera cam = test_random_view(s, v % 2 ? 0.1f : 1.2f, v % 2 ? 0.6f : 2.5f, 0.3f, 70, 70);
-    camera c;
-    if (rr_cam_setup(dev, &cam, 24, 18, &c) != RR_OK) continue;
-    for (int y = 0; y < 18; y++)
-      for (int x = 0; x < 24; x++) {
-        vec3 o, d;
-        if (!rr_cam_ray(&c, x, y, &o, &d)) continue;
-        rr_ray ray = {{o.x, o.y, o.z}, {d.x, d.y, d.z}, 0, INFINITY};
-        if (v == 5) ray.tmin = test_randf(0, 5), ray.tmax = ray.tmin + test_randf(0, 10);
-        rr_hit a, b;
-        int any, occ = -1;
-        CHECK(rr_intersect(dev, s, &ray, &a) == RR_OK, "rr_intersect");
-        b = test_brute_ray(s, &ray, &any);
-        n++;
-        if (memcmp(&a, &b, sizeof a) != 0 && bad++ < 4)
-          CHECK(0, "view %d ray (%d, %d): rr_intersect %u t %a, brute force %u t %a", v, x, y, a.prim, a.t, b.prim, b.t);
-        CHECK(rr_occluded(dev, s, &ray, &occ) == RR_OK && occ == any, "rr_occluded %d, brute force %d", occ, any);
-        uint32_t k = 0, l = 0;
-        CHECK(rr_scene_get_instance(s, a.prim, &k, &l) == RR_OK && k == a.inst, "instance of %u: %u, hit says %u",
-              a.prim, k, a.inst);
-        if (a.inst != RR_MISS) {
-          on_inst++;
-          CHECK(a.inst < NINST && l == a.prim - first - a.inst * NTRI, "hit %u: instance %u local %u", a.prim, a.inst, l);
-        }
-      }
-    rr_cam_release(&c);
-  }
-  CHECK(bad == 0, "%d of %d rays differ from brute force", bad, n);
-  CHECK(on_inst > 50, "rays on instances: %d", on_inst);
-  printf("rays: %d, %d on instances, %d differ from brute force\n", n, on_inst, bad);
+  inst_check ic = {s, RR_MISS, 0};
+  for (uint32_t i = 0; i < s->ntris && ic.first == RR_MISS; i++)
+    if (scene_instance_of(s, i) == 0) ic.first = scene_face_id(s, i);
+  int hits, n = test_check_rays(dev, s, check_hit_instance, &ic, &hits);
+  CHECK(ic.on_inst > 50, "rays on instances: %d", ic.on_inst);
+  printf("rays: %d, %d on instances\n", n, ic.on_inst);
 }
 
 /* grid:PATH:N against grid-flat:PATH:N. */

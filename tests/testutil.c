@@ -263,3 +263,33 @@ rr_camera test_camera(rr_camera_type type, vec3 eye, vec3 target, float fov) {
   c.fov_deg = fov;
   return c;
 }
+
+int test_check_rays(rr_device *dev, const rr_scene *s, void (*each)(const rr_hit *h, void *arg), void *arg,
+                    int *hits) {
+  int bad = 0, n = 0;
+  *hits = 0;
+  for (int v = 0; v < 6; v++) {
+    rr_camera cam = test_random_view(s, v % 2 ? 0.1f : 1.2f, v % 2 ? 0.6f : 2.5f, 0.3f, 70, 70);
+    camera c;
+    if (rr_cam_setup(dev, &cam, 24, 18, &c) != RR_OK) continue;
+    for (int y = 0; y < 18; y++)
+      for (int x = 0; x < 24; x++) {
+        vec3 o, d;
+        if (!rr_cam_ray(&c, x, y, &o, &d)) continue;
+        rr_ray ray = {{o.x, o.y, o.z}, {d.x, d.y, d.z}, 0, INFINITY};
+        if (v == 5) ray.tmin = test_randf(0, 5), ray.tmax = ray.tmin + test_randf(0, 10);
+        rr_hit a, b;
+        int any, occ = -1;
+        CHECK(rr_intersect(dev, s, &ray, &a) == RR_OK, "rr_intersect");
+        b = test_brute_ray(s, &ray, &any);
+        n++, *hits += a.prim != RR_MISS;
+        if (memcmp(&a, &b, sizeof a) != 0 && bad++ < 4)
+          CHECK(0, "view %d ray (%d, %d): rr_intersect %u t %a, brute force %u t %a", v, x, y, a.prim, a.t, b.prim, b.t);
+        CHECK(rr_occluded(dev, s, &ray, &occ) == RR_OK && occ == any, "rr_occluded %d, brute force %d", occ, any);
+        if (each) each(&a, arg);
+      }
+    rr_cam_release(&c);
+  }
+  CHECK(bad == 0, "%d of %d rays differ from brute force", bad, n);
+  return n;
+}

@@ -94,6 +94,12 @@ int test_exr_find(const test_exr_file *x, const char *name);
  * sample test of rc (rr_tri_ray_hit), ties in t to the lower id; *any: whether
  * any triangle is hit in [tmin, tmax]. */
 rr_hit test_brute_ray(const rr_scene *s, const rr_ray *ray, int *any);
+/* rr_intersect and rr_occluded against test_brute_ray on the camera rays of six
+ * random views of s (24×18; every other one close up, the last with random tmin and
+ * tmax); fails on any difference. each (NULL: none) sees every rr_intersect result.
+ * Returns the rays; *hits: those that hit. */
+int test_check_rays(rr_device *dev, const rr_scene *s, void (*each)(const rr_hit *h, void *arg), void *arg,
+                    int *hits);
 /* A camera of `type` at eye looking at target, fov_deg fov, y up. */
 rr_camera test_camera(rr_camera_type type, vec3 eye, vec3 target, float fov);
 /* Deterministic random numbers for property tests. */
