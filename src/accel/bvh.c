@@ -654,7 +654,7 @@ static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
   memset(b->leaf_v + n, 0, BVH_LEAF_PAD * sizeof(float));
   for (uint32_t i = 0; i < b->nnodes; i++) {
     const bvh_node *nd = &b->nodes[i];
-    if (nd->count) copy_corners(s, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
+    if (nd->count && nd->count != BVH_INST) copy_corners(s, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
   }
   return true;
 }
@@ -708,7 +708,8 @@ static void subtree_ranges(wide8_build *j) {
       continue;
     }
     uint32_t l = n->first, r = n->first + 1;
-    bool joined = j->count[l] && j->count[r] && j->first[l] + j->count[l] == j->first[r];
+    bool joined = j->count[l] && j->count[r] && j->first[l] + j->count[l] == j->first[r] &&
+                  j->count[l] != BVH_INST && j->count[r] != BVH_INST;
     j->first[k] = j->first[l], j->count[k] = joined ? j->count[l] + j->count[r] : 0;
   }
 }
@@ -754,7 +755,7 @@ static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
     uint32_t c = slot[i];
     if (leaf8(j, c)) { /* a leaf: its corners as leaf_v's */
       uint32_t first = j->first[c], count = j->count[c];
-      copy_corners(j->s, b->prims, first, count, b->leaf_v8 + (size_t)9 * first);
+      if (count != BVH_INST) copy_corners(j->s, b->prims, first, count, b->leaf_v8 + (size_t)9 * first);
       wn->ref[i] = first, wn->count[i] = count;
     } else {
       wn->ref[i] = j->next++;
@@ -793,6 +794,7 @@ static bool collapse_wide8(rr_bvh *b, const rr_scene *s) {
 void rr_bvh_release(rr_bvh *b) {
   if (!b) return;
   free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node), free(b->wide8), free(b->leaf_v8), free(b->leaf_v);
+  rr_bvh_release(b->obj);
   free(b);
 }
 
@@ -822,7 +824,7 @@ static double sah_cost(const struct rr_bvh *b) {
     const bvh_node *n = &b->nodes[i];
     double x = (double)n->hi[0] - n->lo[0], y = (double)n->hi[1] - n->lo[1], z = (double)n->hi[2] - n->lo[2];
     double a = x * y + y * z + z * x;
-    sum += n->count ? BVH_COST_TRI * n->count * a : BVH_COST_NODE * a;
+    sum += n->count && n->count != BVH_INST ? BVH_COST_TRI * n->count * a : BVH_COST_NODE * a;
   }
   const bvh_node *r = &b->nodes[0];
   double x = (double)r->hi[0] - r->lo[0], y = (double)r->hi[1] - r->lo[1], z = (double)r->hi[2] - r->lo[2];
@@ -856,6 +858,7 @@ bool rr_bvh_finish(rr_bvh *b, const rr_scene *s, int threads) {
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
              (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) +
              (uint64_t)b->nwide8 * sizeof(bvh_wide8) + 2 * ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
+  b->ntop = b->vpos = n, b->vnodes = b->nnodes, b->vwide = b->nwide, b->vwide8 = b->nwide8;
   return true;
 }
 
@@ -1030,7 +1033,7 @@ const rr_bvh *rr_bvh_of(rr_device *dev, const rr_scene *s, bool *empty) {
 
 void rr_bvh_fill_info(const rr_bvh *b, rr_scene_info *info) {
   if (!b) return;
-  info->bvh_nodes = b->nnodes;
+  info->bvh_nodes = b->nnodes + (b->obj ? b->obj->nnodes : 0); /* stored ones */
   info->bvh_leaves = b->nleaves;
   info->bvh_depth = b->depth;
   info->bvh_sah_cost = b->sah_cost;

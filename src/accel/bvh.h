@@ -34,7 +34,22 @@ typedef struct rr_bvh {
    * that four lanes may be loaded from any triangle. */
   float *leaf_v;
   float *leaf_v8; /* the same for the leaves of wide8, which may join a few binary leaves */
+  /* Two levels (a scene with instances, accel/bvh_instance.c): the arrays above are a
+   * small top tree, and a reference past them names a node of `obj`, the instanced
+   * mesh's tree stored once in object space, as instance k's: binary node nnodes +
+   * k·obj->nnodes + j, wide node nwide + k·obj->nwide + j, wide8 node nwide8 +
+   * k·obj->nwide8 + j, leaf position ntop + k·obj->nprims + j (accel/bvh_levels.h reads
+   * them). The v* totals count every reference (the arrays' own counts for one
+   * level): what per-frame arrays indexed by node or position are sized by. */
+  struct rr_bvh *obj;
+  const struct scene_instances *inst;
+  uint32_t ntop; /* positions of the top's own prims (nprims for one level) */
+  uint32_t vnodes, vwide, vwide8, vpos;
 } rr_bvh;
+
+/* Marks a top leaf of a two-level tree while it is built: count BVH_INST, prims[first]
+ * the instance (rr_bvh_finish skips its corners; the build then makes it a reference). */
+#define BVH_INST 0x80000000u
 
 /* A 4-wide node: up to four of the binary tree's nodes side by side, bounds as
  * lanes per axis (an empty slot has an empty box). A slot with count > 0 is a leaf
@@ -61,9 +76,9 @@ enum { BVH_DEFAULT_BINS = 32, BVH_DEFAULT_LEAF = 4, BVH_MAX_LEAF = 64, BVH_STACK
  * rr_bvh_build_instanced, which rr_scene_commit calls: far quicker, the same hits.) */
 rr_error rr_bvh_build(rr_scene *s, const rr_build_options *opt, rr_bvh **out);
 /* The BVH of a scene with instances (accel/bvh_instance.c): the mesh's tree built once
- * in its own space and copied per instance with its boxes moved to world space (each
- * holding its triangles' world corners), under a tree over the instances and the
- * other primitives. The same kind of tree as rr_bvh_build's, for every traversal. */
+ * in its own space, under a small tree over the instances and the other primitives
+ * whose instance leaves refer to it (rr_bvh.obj); traversals read its nodes through
+ * accel/bvh_levels.h, which moves them to world space on the way. */
 rr_error rr_bvh_build_instanced(rr_scene *s, const rr_build_options *opt, rr_bvh **out);
 /* Completes a binary tree (nodes, prims, nnodes, nprims set): the 4- and 8-wide
  * forms, the leaves' corners (side by side on `threads`), the SAH cost and the

@@ -1,42 +1,26 @@
-/* The BVH of a scene with instances (accel/bvh.h, scene/instance.h).
+/* The BVH of a scene with instances (accel/bvh.h, scene/instance.h): two levels.
  *
  * The instanced mesh's tree is built once, by rr_bvh_build, over a view of its stored
- * triangles (object space). Each instance gets a copy of it whose boxes are moved to
- * world space and whose leaves name the instance's triangles (base + k·T + i); a tree
- * over the items (the instances' world boxes and the scene's other primitives, split
- * at the median of the widest axis of their centres) holds the copies. The result is
- * an ordinary binary tree (children in pairs, the root alone at 0, each subtree's
- * primitives one range of prims), finished by rr_bvh_finish like any other, so every
- * traversal reads it unchanged.
+ * triangles (object space), with every form the traversals read (binary, 4- and
+ * 8-wide nodes, the leaves' corners): rr_bvh.obj. Over it, a small top tree of the
+ * items (the instances' world boxes and the scene's other primitives, split at the
+ * median of the widest axis of their centres), finished by rr_bvh_finish like any
+ * other tree with each instance a leaf marked BVH_INST. Then each such leaf becomes a
+ * reference to instance k's copy of the object tree's root, in all three forms: a
+ * binary node takes the root's world node itself (its children then instance k's),
+ * a wide slot names instance k's root wide node. Nothing is copied per instance:
+ * traversals make instance k's nodes and leaves on the way (accel/bvh_levels.h, which
+ * also says why its world boxes hold what they must).
  *
- * A moved box holds the world corners of its triangles (inst_point's floats), which
- * is all the traversals assume of a box: for a translation, fl(lo + t) <= fl(p + t)
- * <= fl(hi + t) for lo <= p <= hi (rounding is monotonic); for other maps, interval
- * arithmetic in double widened by far more than inst_point's rounding (five roundings
- * of at most 2^-24 of the terms' magnitudes) and rounded outward. */
+ * Memory: the object tree once, the top's few nodes, and per instance nothing but its
+ * transform (in the scene). Per-frame state indexed by node or position (rc-bvh's
+ * bounds) is sized by the references (rr_bvh.vwide, vpos), as for the scene written
+ * out. */
 #include "accel/bvh.h"
+#include "accel/bvh_levels.h"
 #include "scene/scene.h"
 
 #include <string.h>
-
-/* World box of an object-space box lo..hi under instance k. */
-static void world_box(const scene_instances *in, uint32_t k, const float lo[3], const float hi[3], float wlo[3],
-                      float whi[3]) {
-  const float *m = in->xf[k];
-  for (int a = 0; a < 3; a++) {
-    if (in->shift[k]) {
-      wlo[a] = lo[a] + m[4 * a + 3], whi[a] = hi[a] + m[4 * a + 3];
-      continue;
-    }
-    double l = m[4 * a + 3], h = l, mag = fabs(l);
-    for (int j = 0; j < 3; j++) {
-      double x = (double)m[4 * a + j] * lo[j], y = (double)m[4 * a + j] * hi[j];
-      l += fmin(x, y), h += fmax(x, y), mag += fmax(fabs(x), fabs(y));
-    }
-    double pad = mag * 0x1p-20;
-    wlo[a] = nextafterf((float)(l - pad), -INFINITY), whi[a] = nextafterf((float)(h + pad), INFINITY);
-  }
-}
 
 typedef struct item {
   float lo[3], hi[3];
@@ -47,29 +31,10 @@ typedef struct item {
 
 typedef struct graft {
   const rr_scene *s;
-  const rr_bvh *ob; /* the mesh's tree, in object space */
   rr_bvh *b;
   uint32_t next_node; /* the next free pair */
   uint32_t next_prim; /* the next free range of prims */
 } graft;
-
-/* Copies object node `o` of ob's tree as instance k's into slot `at`. */
-static void copy_subtree(graft *g, uint32_t k, uint32_t o, uint32_t at, uint32_t prim0, uint32_t depth) {
-  const bvh_node *src = &g->ob->nodes[o];
-  bvh_node *dst = &g->b->nodes[at];
-  world_box(g->s->inst, k, src->lo, src->hi, dst->lo, dst->hi);
-  if (src->count) {
-    dst->first = prim0 + src->first, dst->count = src->count;
-    g->b->nleaves++;
-    g->b->depth = depth > g->b->depth ? depth : g->b->depth;
-    return;
-  }
-  uint32_t p = g->next_node;
-  g->next_node += 2;
-  dst->first = p, dst->count = 0;
-  copy_subtree(g, k, src->first, p, prim0, depth + 1);
-  copy_subtree(g, k, src->first + 1, p + 1, prim0, depth + 1);
-}
 
 static int by_key(const void *a, const void *b) {
   const item *x = a, *y = b;
@@ -81,19 +46,12 @@ static void build_top(graft *g, item *items, uint32_t n, uint32_t at, uint32_t d
   bvh_node *dst = &g->b->nodes[at];
   if (n == 1) {
     const item *it = items;
-    if (it->instance) { /* the instance's copy of the mesh's tree, its triangles the next T prims */
-      const scene_instances *in = g->s->inst;
-      uint32_t prim0 = g->next_prim;
-      for (uint32_t i = 0; i < in->T; i++) g->b->prims[prim0 + i] = in->base + it->ref * in->T + g->ob->prims[i];
-      g->next_prim += in->T;
-      copy_subtree(g, it->ref, 0, at, prim0, depth);
-    } else {
-      memcpy(dst->lo, it->lo, sizeof dst->lo), memcpy(dst->hi, it->hi, sizeof dst->hi);
-      g->b->prims[g->next_prim] = it->ref;
-      dst->first = g->next_prim++, dst->count = 1;
-      g->b->nleaves++;
-      g->b->depth = depth > g->b->depth ? depth : g->b->depth;
-    }
+    /* a leaf: one primitive, or an instance (BVH_INST, its number in prims) */
+    memcpy(dst->lo, it->lo, sizeof dst->lo), memcpy(dst->hi, it->hi, sizeof dst->hi);
+    g->b->prims[g->next_prim] = it->ref;
+    dst->first = g->next_prim++, dst->count = it->instance ? BVH_INST : 1;
+    g->b->nleaves++;
+    g->b->depth = depth > g->b->depth ? depth : g->b->depth;
     return;
   }
   float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -117,6 +75,26 @@ static void build_top(graft *g, item *items, uint32_t n, uint32_t at, uint32_t d
   build_top(g, items + n / 2, n - n / 2, p + 1, depth + 1);
 }
 
+/* Makes the finished top tree b two-level: ob (the object tree) becomes b->obj, and
+ * each instance leaf (BVH_INST) a reference to its instance's copy of ob's root. */
+static void link_instances(rr_bvh *b, rr_bvh *ob, const scene_instances *in) {
+  b->obj = ob, b->inst = in;
+  b->vnodes = b->nnodes + in->n * ob->nnodes, b->vwide = b->nwide + in->n * ob->nwide;
+  b->vwide8 = b->nwide8 + in->n * ob->nwide8, b->vpos = b->ntop + in->n * ob->nprims;
+  for (uint32_t i = 0; i < b->nnodes; i++) {
+    bvh_node *n = &b->nodes[i], root;
+    if (n->count == BVH_INST) *n = *bvh_node_at(b, b->nnodes + b->prims[n->first] * ob->nnodes, &root);
+  }
+  for (uint32_t w = 0; w < b->nwide; w++)
+    for (int i = 0; i < 4; i++)
+      if (b->wide[w].count[i] == BVH_INST)
+        b->wide[w].ref[i] = b->nwide + b->prims[b->wide[w].ref[i]] * ob->nwide, b->wide[w].count[i] = 0;
+  for (uint32_t w = 0; w < b->nwide8; w++)
+    for (int i = 0; i < 8; i++)
+      if (b->wide8[w].count[i] == BVH_INST)
+        b->wide8[w].ref[i] = b->nwide8 + b->prims[b->wide8[w].ref[i]] * ob->nwide8, b->wide8[w].count[i] = 0;
+}
+
 rr_error rr_bvh_build_instanced(rr_scene *s, const rr_build_options *opt, rr_bvh **out) {
   *out = NULL;
   double t0 = rr_now_ms();
@@ -131,24 +109,31 @@ rr_error rr_bvh_build_instanced(rr_scene *s, const rr_build_options *opt, rr_bvh
   rr_error e = rr_bvh_build(&view, opt, &ob);
   if (e) return e;
   uint32_t nown = s->ntris - in->n * in->T, nitems = in->n + nown;
-  uint64_t nnodes = 2 * (uint64_t)nitems - 1 - in->n + (uint64_t)in->n * ob->nnodes;
+  /* every reference a traversal may meet must fit in 32 bits */
+  uint64_t vnodes = 2 * (uint64_t)nitems + (uint64_t)in->n * ob->nnodes;
+  uint64_t vwide8 = 2 * (uint64_t)nitems + (uint64_t)in->n * ob->nwide8;
+  uint64_t vpos = nitems + (uint64_t)in->n * in->T;
+  if (vnodes >= UINT32_MAX / 2 || vwide8 >= UINT32_MAX / 2 || vpos >= UINT32_MAX / 2) {
+    rr_bvh_release(ob);
+    return rr_fail(s->dev, RR_ERROR_ARGUMENT, "%u instances of %u triangles are too many for one BVH", in->n, in->T);
+  }
   rr_bvh *b = calloc(1, sizeof *b);
   item *items = malloc((size_t)nitems * sizeof *items);
   if (b) {
-    b->nprims = s->ntris, b->bins = ob->bins, b->leaf_size = ob->leaf_size;
-    b->node_mem = nnodes < UINT32_MAX / 2 ? aligned_alloc(64, ((nnodes + 2) * sizeof(bvh_node) + 63) & ~(size_t)63) : NULL;
-    b->prims = malloc((size_t)s->ntris * sizeof *b->prims);
+    b->nprims = nitems, b->bins = ob->bins, b->leaf_size = ob->leaf_size;
+    b->node_mem = aligned_alloc(64, ((2 * (size_t)nitems + 2) * sizeof(bvh_node) + 63) & ~(size_t)63);
+    b->prims = malloc((size_t)nitems * sizeof *b->prims);
   }
   if (!b || !items || !b->node_mem || !b->prims) {
     free(items), rr_bvh_release(b), rr_bvh_release(ob);
     return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory building the BVH of %u instances", in->n);
   }
   b->nodes = (bvh_node *)b->node_mem + 1; /* pairs start at odd indices: each on one cache line */
-  b->nnodes = (uint32_t)nnodes;
+  b->nnodes = 2 * nitems - 1;
   uint32_t m = 0;
   for (uint32_t k = 0; k < in->n; k++, m++) {
     items[m] = (item){.ref = k, .instance = true};
-    world_box(in, k, ob->nodes[0].lo, ob->nodes[0].hi, items[m].lo, items[m].hi);
+    bvh_inst_box(in, k, ob->nodes[0].lo, ob->nodes[0].hi, items[m].lo, items[m].hi);
   }
   for (uint32_t i = 0; i < s->ntris; i++) {
     if (i == in->base) i += in->n * in->T;
@@ -158,14 +143,18 @@ rr_error rr_bvh_build_instanced(rr_scene *s, const rr_build_options *opt, rr_bvh
     else rr_ana_box(s, i, items[m].lo, items[m].hi);
     m++;
   }
-  graft g = {.s = s, .ob = ob, .b = b, .next_node = 1};
+  graft g = {.s = s, .b = b, .next_node = 1};
   build_top(&g, items, nitems, 0, 0);
   free(items);
-  rr_bvh_release(ob);
-  if (!rr_bvh_finish(b, s, opt->threads ? opt->threads : rr_cpu_count())) {
-    rr_bvh_release(b);
+  if (!rr_bvh_finish(b, s, 1)) { /* a few nodes: on this thread */
+    rr_bvh_release(b), rr_bvh_release(ob);
     return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory building the BVH of %u instances", in->n);
   }
+  link_instances(b, ob, in);
+  b->nprims = s->ntris;
+  b->bytes += ob->bytes;
+  b->nleaves += in->n * (ob->nleaves - 1);
+  b->depth += ob->depth;
   b->build_ms = rr_now_ms() - t0;
   *out = b;
   return RR_OK;

@@ -12,10 +12,13 @@
  * - best: the best t so far (a packet: its lanes' largest), above which a
  *   stacked slot is dropped on pop.
  * A policy only reads the tree and writes its own state: one traversal touches
- * nothing shared. */
+ * nothing shared. Nodes and leaves are references of accel/bvh_levels.h (with
+ * instances, an instance's node comes moved to world space; a leaf's positions
+ * go through bvh_leaf_at or bvh_prim_at). */
 #ifndef RR_BVH_TRACE_H
 #define RR_BVH_TRACE_H
 
+#include "accel/bvh_levels.h"
 #include "core/simd.h"
 #include "vis/vis.h"
 
@@ -100,7 +103,8 @@ KERNEL bool bvh_trace(const rr_bvh *b, void *q, uint64_t lanes, trace_node_fn no
     if (count) {
       if (leaf(q, ref, count, lanes)) return true;
     } else {
-      const bvh_wide *w = &b->wide[ref];
+      BVH_NODE_ALIGN bvh_wide buf; /* an instance's node, moved to world space (accel/bvh_levels.h) */
+      const bvh_wide *w = bvh_wide_at(b, ref, &buf);
       trace_slots s = {.lanes = {lanes, lanes, lanes, lanes}};
       int hits = node(q, w, ref, lanes, &s);
       if (hits) {

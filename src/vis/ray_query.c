@@ -59,15 +59,18 @@ typedef struct {
  * judge). The same triangles pass whatever the order, and depth_wins keeps the
  * nearest, lower id on a tie, so the hit does not depend on the order. */
 KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool any) {
-  const float *v = r->b->leaf_v8 + (size_t)9 * first;
+  float vbuf[9 * BVH_MAX_LEAF + BVH_LEAF_PAD]; /* an instance's leaf, in world space */
+  uint32_t ibuf[BVH_MAX_LEAF];
+  const uint32_t *ids;
+  const float *v = bvh_leaf_at(r->b, true, first, count, vbuf, ibuf, &ids);
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;
     rr_vf4 pre[4];
     int may = tri_ray_may_hit4(v + j, count, r->o, r->d, pre) & ((1 << n) - 1);
     if (r->s->inf)
-      for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, r->b->prims[first + j + k]) != 0) << k;
+      for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, ids[j + k]) != 0) << k;
     for (; may; may &= may - 1) {
-      uint32_t lane = (uint32_t)__builtin_ctz(may), id = r->b->prims[first + j + lane];
+      uint32_t lane = (uint32_t)__builtin_ctz(may), id = ids[j + lane];
       float t, l1, l2, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
       const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
       if (e[0] > 0 && e[1] > 0 && e[2] > 0 && !(r->s->inf && scene_inf(r->s, id)) &&
@@ -83,7 +86,7 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
     const float dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
     ana_ray ar = ana_ray_of(r->org, dir);
     for (uint32_t j = 0; j < count; j++) {
-      uint32_t id = r->b->prims[first + j];
+      uint32_t id = ids[j];
       float t, u, v;
       if (scene_kind(r->s, id) == RR_GEOMETRY_TRIANGLE || !rr_ana_hit(r->s, id, &ar, &t, &u, &v)) continue;
       if (!(t >= r->tmin && t <= r->t)) continue;

@@ -21,7 +21,6 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
   for (int a = 0; a < 3; a++)
     o[a] = RQ_(splat)(r->org[a]), inv_n[a] = RQ_(splat)(r->inv_n[a]), inv_f[a] = RQ_(splat)(r->inv_f[a]);
   const RQ_VF tlo = RQ_(splat)(r->tlo);
-  const bvh_wide8 *nodes = r->b->wide8;
   int sp = 0;
   uint32_t ref = 0, count = 0; /* node 0 */
   for (;;) {
@@ -29,7 +28,8 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
       if (query_leaf(r, ref, count, any)) return true;
     } else {
       /* The slab test (vis/ray_query.c: query_ray), slots in lanes. */
-      const bvh_wide8 *w = &nodes[ref];
+      BVH_NODE_ALIGN bvh_wide8 buf; /* an instance's node, moved to world space (accel/bvh_levels.h) */
+      const bvh_wide8 *w = bvh_wide8_at(r->b, ref, &buf);
       const char *base = (const char *)w;
       const RQ_VF best = RQ_(splat)(r->t);
       float entry[8] __attribute__((aligned(32)));

@@ -103,13 +103,20 @@ enum { REACH_FEW = 4, REACH_CAP = 8, PROBE = 4 };
  * and of the ones set up (setup[k] >= 0: their index in ts/face) the pixel
  * rectangle bb[k] (planar). */
 typedef struct {
-  uint32_t ids[BATCH], sid[BATCH], leaves[BATCH];
+  uint32_t ids[BATCH], sid[BATCH], leaves[BATCH], first[BATCH], count[BATCH]; /* per leaf: its positions */
   int n, nl, setup[BATCH];
   int bb[BATCH][4];
   tri_setup ts[BATCH];
   int face[BATCH];
   tri_bound found[BATCH];
 } leaf_batch;
+
+/* Adds leaf slot `leaf` (wide node · 4 + slot) holding positions [first, first + count). */
+static void leaf_add(leaf_batch *lb, const rr_bvh *b, uint32_t leaf, uint32_t first, uint32_t count) {
+  bvh_prims_at(b, first, count, lb->ids + lb->n);
+  lb->first[lb->nl] = first, lb->count[lb->nl] = count;
+  lb->n += (int)count, lb->leaves[lb->nl++] = leaf;
+}
 
 /* Sets up the batch's triangles that can be seen, eight lanes at a time where
  * there is AVX2 (lanes never mix: the same bits as one at a time). Planar cameras
@@ -181,7 +188,6 @@ static float probe_samples(const tri_setup *ts, const camera *c, const int bb[4]
  * the samples of its corner rectangle (as 3dr-bb tests it), so its floor holds over
  * that rectangle; a curved camera's over the whole image. */
 static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
-  const rr_bvh *b = fs->b;
   const camera *c = fs->cam;
   /* The batch's run: room for every triangle set up and seen (one whose floor
    * finds no sample stays an unused entry). Where the run lands depends on the
@@ -193,14 +199,14 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
   leaf_tri *out = fs->ts + base;
   nout = 0;
   for (int q = 0, k = 0; q < lb->nl; q++) {
-    uint32_t w = lb->leaves[q] / 4, s = lb->leaves[q] % 4, first = b->wide[w].ref[s];
+    uint32_t w = lb->leaves[q] / 4, s = lb->leaves[q] % 4, first = lb->first[q];
     float tlo = INFINITY, r[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
-    for (uint32_t i = first; i < first + b->wide[w].count[s]; i++, k++) {
+    for (uint32_t i = first; i < first + lb->count[q]; i++, k++) {
       int j = lb->setup[k];
       fs->slot[i] = UINT32_MAX;
       if (j != SETUP_ANALYTIC && (j < 0 || lb->face[j] == SETUP_CULLED)) continue;
       leaf_tri *lt = &out[nout];
-      lt->id = b->prims[i];
+      lt->id = lb->ids[k];
       float t, *tr = lt->rect;
       if (j == SETUP_ANALYTIC) {
         /* its samples (rr_ana_screen_bounds) and its floor over the image (rr_ana_t_floor) */
@@ -249,12 +255,13 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
 static void setup_leaves(int job, int thread, void *arg) {
   frame_setups *fs = arg;
   const rr_bvh *b = fs->b;
-  uint32_t w0 = (uint32_t)job * SETUP_CHUNK, w1 = w0 + SETUP_CHUNK < b->nwide ? w0 + SETUP_CHUNK : b->nwide;
+  uint32_t w0 = (uint32_t)job * SETUP_CHUNK, w1 = w0 + SETUP_CHUNK < b->vwide ? w0 + SETUP_CHUNK : b->vwide;
   leaf_batch lb;
   lb.n = lb.nl = 0;
-  for (uint32_t w = w0; w < w1; w++)
+  for (uint32_t w = w0; w < w1; w++) {
+    BVH_NODE_ALIGN bvh_wide buf;
+    const bvh_wide *n = bvh_wide_at(b, w, &buf);
     for (uint32_t i = 0; i < 4; i++) {
-      const bvh_wide *n = &b->wide[w];
       if (n->ref[i] == UINT32_MAX) {
         wide_bounds *wb = &fs->wb[w];
         wb->tlo[i] = wb->x0[i] = wb->y0[i] = INFINITY, wb->x1[i] = wb->y1[i] = -INFINITY;
@@ -264,9 +271,9 @@ static void setup_leaves(int job, int thread, void *arg) {
         batch_setup(fs, &lb, thread), batch_finish(fs, &lb);
         lb.n = lb.nl = 0;
       }
-      memcpy(lb.ids + lb.n, b->prims + n->ref[i], n->count[i] * sizeof *lb.ids);
-      lb.n += (int)n->count[i], lb.leaves[lb.nl++] = 4 * w + i;
+      leaf_add(&lb, b, 4 * w + i, n->ref[i], n->count[i]);
     }
+  }
   batch_setup(fs, &lb, thread), batch_finish(fs, &lb);
 }
 
@@ -353,7 +360,8 @@ static int box_reach(const camera *c, const bvh_wide *n, int *few) {
 
 /* Whether the subtree of wide node w holds at most `cap` triangles. */
 static bool subtree_small(const rr_bvh *b, uint32_t w, uint32_t *cap) {
-  const bvh_wide *n = &b->wide[w];
+  BVH_NODE_ALIGN bvh_wide buf;
+  const bvh_wide *n = bvh_wide_at(b, w, &buf);
   for (int i = 0; i < 4; i++) {
     if (n->ref[i] == UINT32_MAX) continue;
     if (n->count[i] ? n->count[i] > *cap : !subtree_small(b, n->ref[i], cap)) return false;
@@ -377,7 +385,8 @@ static void reach_walk(frame_setups *fs, uint32_t w, int depth, bool all, leaf_b
     roots->w[roots->n++] = w;
     return;
   }
-  const bvh_wide *n = &fs->b->wide[w];
+  BVH_NODE_ALIGN bvh_wide buf;
+  const bvh_wide *n = bvh_wide_at(fs->b, w, &buf);
   wide_bounds *wb = &fs->wb[w];
   int few = 0, reach = all ? 15 : box_reach(fs->cam, n, &few);
   fs->reached[w] = 1;
@@ -395,8 +404,7 @@ static void reach_walk(frame_setups *fs, uint32_t w, int depth, bool all, leaf_b
         batch_setup(fs, lb, thread), batch_finish(fs, lb);
         lb->n = lb->nl = 0;
       }
-      memcpy(lb->ids + lb->n, fs->b->prims + n->ref[i], n->count[i] * sizeof *lb->ids);
-      lb->n += (int)n->count[i], lb->leaves[lb->nl++] = 4 * w + (uint32_t)i;
+      leaf_add(lb, fs->b, 4 * w + (uint32_t)i, n->ref[i], n->count[i]);
     }
   }
 }
@@ -427,7 +435,8 @@ static void reach_frame(frame_setups *fs, int threads) {
 /* Fills the inner slots of wide node w from their children, bottom up, and returns
  * the union of its slots: the least bound and the rectangle x0, y0, x1, y1. */
 static void wide_union(frame_setups *fs, uint32_t w, float u[5]) {
-  const bvh_wide *n = &fs->b->wide[w];
+  BVH_NODE_ALIGN bvh_wide buf;
+  const bvh_wide *n = bvh_wide_at(fs->b, w, &buf);
   wide_bounds *wb = &fs->wb[w];
   for (int i = 0; i < 4; i++) {
     if (n->count[i] || n->ref[i] == UINT32_MAX || (fs->reached && !fs->reached[n->ref[i]])) continue;
@@ -449,7 +458,7 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
   *fs = (frame_setups){.s = ctx->scene, .b = b, .cam = ctx->cam, .cull = ctx->opt->cull_backfaces != 0,
                         .simd = !ctx->opt->scalar, .st = st};
   atomic_init(&fs->nts, 0);
-  size_t n = b->nprims;
+  size_t n = b->vpos;
   fs->ts = malloc(n * sizeof *fs->ts + 1);
   fs->slot = malloc(n * sizeof *fs->slot + 1);
   /* Perspective views of scenes with more triangles than samples walk down to the
@@ -460,9 +469,9 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
    * scenes with corners at infinity (boxes cut at PRIM_FAR) bound every triangle. */
   bool reach = fs->cam->type == RR_CAMERA_PERSPECTIVE && !ctx->scene->inf &&
                ctx->scene->ntris > (uint64_t)ctx->cam->width * (uint64_t)ctx->cam->height;
-  if (reach) fs->reached = calloc(b->nwide, 1);
+  if (reach) fs->reached = calloc(b->vwide, 1);
   else if (fs->cam->planar) fs->seen = malloc((size_t)ctx->scene->ntris + 1);
-  fs->wb = aligned_alloc(16, (size_t)b->nwide * sizeof *fs->wb);
+  fs->wb = aligned_alloc(16, (size_t)b->vwide * sizeof *fs->wb);
   if (!fs->ts || !fs->slot || !fs->wb || (reach ? !fs->reached : fs->cam->planar && !fs->seen)) {
     setups_free(fs);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %zu triangle setups", n);
@@ -472,7 +481,7 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
   } else {
     if (fs->cam->planar)
       rr_parallel_for((int)((ctx->scene->ntris + SEEN_CHUNK - 1) / SEEN_CHUNK), ctx->threads, seen_chunk, fs);
-    rr_parallel_for((int)((b->nwide + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, fs);
+    rr_parallel_for((int)((b->vwide + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, fs);
   }
   float root[5];
   wide_union(fs, 0, root);

@@ -126,7 +126,7 @@ KERNEL float sr_best(const void *q) {
 static bool sr_leaf_ana(sr_state *b, uint32_t first, uint32_t count, uint64_t lanes) {
   const rr_scene *s = b->s;
   for (uint32_t j = 0; j < count; j++) {
-    uint32_t id = b->b->prims[first + j];
+    uint32_t id = bvh_prim_at(b->b, first + j);
     if (scene_kind(s, id) == RR_GEOMETRY_TRIANGLE) continue;
     b->st.setups++;
     for (uint64_t live = b->live & lanes; live; live &= live - 1) {
@@ -149,12 +149,15 @@ KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes, con
   sr_state *b = q;
   const rr_scene *s = b->s;
   if (s->kind && sr_leaf_ana(b, first, count, lanes)) return true;
-  const float *v = b->b->leaf_v + (size_t)9 * first;
+  float vbuf[9 * BVH_MAX_LEAF + BVH_LEAF_PAD]; /* an instance's leaf, in world space */
+  uint32_t ibuf[BVH_MAX_LEAF];
+  const uint32_t *ids;
+  const float *v = bvh_leaf_at(b->b, false, first, count, vbuf, ibuf, &ids);
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;
     int inf = 0;
     if (s->inf)
-      for (uint32_t k = 0; k < n; k++) inf |= (scene_inf(s, b->b->prims[first + j + k]) != 0) << k;
+      for (uint32_t k = 0; k < n; k++) inf |= (scene_inf(s, ids[j + k]) != 0) << k;
     tri4_edges te;
     b->st.setups += n;
     if (parallel) { /* each ray its own pre-test: the edges depend on its origin */
@@ -168,7 +171,7 @@ KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes, con
           int lane = __builtin_ctz(may);
           float t, l1, l2;
           const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
-          if (!ray_tri_test(s, b->b->prims[first + j + lane], &b->rc[k], r->org, r->dir, e, r->tmin, r->tmax, &t,
+          if (!ray_tri_test(s, ids[j + lane], &b->rc[k], r->org, r->dir, e, r->tmin, r->tmax, &t,
                             &l1, &l2))
             continue;
           b->occluded[b->idx[k]] = 1;
@@ -208,7 +211,7 @@ KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes, con
         int lane = __builtin_ctz(may);
         float t, l1, l2;
         const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
-        if (!ray_tri_test(s, b->b->prims[first + j + lane], &b->rc[k], r->org, r->dir, e, r->tmin, r->tmax, &t, &l1,
+        if (!ray_tri_test(s, ids[j + lane], &b->rc[k], r->org, r->dir, e, r->tmin, r->tmax, &t, &l1,
                           &l2))
           continue;
         b->occluded[b->idx[k]] = 1;

@@ -12,6 +12,7 @@
  * Depth here is the ray parameter t along d(x, y) = d0 + x dx + y dy; for the
  * perspective camera d·fwd = 1, so t is also the distance along fwd. Culling
  * decisions keep a relative safety margin so they never remove a winning triangle. */
+#include "accel/bvh_levels.h"
 #include "core/simd.h"
 #include "vis/hiz.h"
 #include "vis/sortmiddle.h"
@@ -735,13 +736,16 @@ static void flush(trav *t) {
   t->npend = 0;
 }
 
+/* Nodes are references of accel/bvh_levels.h: with instances, a node past the top's
+ * is an instance's node moved to world space, so the oracles see world boxes. */
 static void generate(trav *t, const frustum *f, uint32_t node) {
   const rr_bvh *bvh = t->s->bvh;
-  const bvh_node *n = &bvh->nodes[node];
+  bvh_node buf;
+  const bvh_node *n = bvh_node_at(bvh, node, &buf);
   if (n->count) {
     const tile_rect r = f->r, p = t->pend_r;
     if (t->npend && (r.x0 != p.x0 || r.y0 != p.y0 || r.x1 != p.x1 || r.y1 != p.y1)) flush(t);
-    memcpy(t->pend + t->npend, bvh->prims + n->first, n->count * sizeof *t->pend);
+    for (uint32_t i = 0; i < n->count; i++) t->pend[t->npend + i] = bvh_prim_at(bvh, n->first + i);
     t->npend += n->count, t->pend_r = r;
     if (t->npend >= PEND_DRAW) flush(t);
     return;
@@ -753,7 +757,8 @@ static void generate(trav *t, const frustum *f, uint32_t node) {
 /* tmin: the node's box_tmin, which its parent knew already */
 static void traverse(trav *t, const frustum *f, uint32_t node, float tmin) {
   const rr_bvh *bvh = t->s->bvh;
-  const bvh_node *n = &bvh->nodes[node];
+  bvh_node buf, ba, bb;
+  const bvh_node *n = bvh_node_at(bvh, node, &buf);
   const oracles *o = t->o;
   t->st.nodes++;
   heat_charge(t->heat_n, t->vb->width, f->r.x0, f->r.y0, f->r.x1, f->r.y1, 1.0f);
@@ -772,7 +777,7 @@ static void traverse(trav *t, const frustum *f, uint32_t node, float tmin) {
   }
   /* Children front to back: nearer box first along the view direction. */
   uint32_t a = n->first, b = n->first + 1;
-  float za = box_tmin(&bvh->nodes[a], t->c), zb = box_tmin(&bvh->nodes[b], t->c);
+  float za = box_tmin(bvh_node_at(bvh, a, &ba), t->c), zb = box_tmin(bvh_node_at(bvh, b, &bb), t->c);
   if (zb < za) {
     traverse(t, f, b, zb);
     traverse(t, f, a, za);
