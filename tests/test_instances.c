@@ -48,41 +48,50 @@ static void random_xf(float (*xf)[12]) {
   }
 }
 
-/* The scene with instances (flat = false) or with the instances written out as
- * meshes through inst_point (flat = true); a mesh and spheres before and after. */
-static rr_scene *build(rr_device *dev, const float *pos, const uint32_t *idx, const float (*xf)[12], bool flat) {
+/* The scene with ninst instances of the first ntri triangles of the mesh (flat =
+ * false) or with the instances written out as meshes through inst_point (flat =
+ * true); with `others`, a mesh and spheres before and after. */
+static rr_scene *build_n(rr_device *dev, const float *pos, const uint32_t *idx, const float (*xf)[12], bool flat,
+                         int ntri, int ninst, bool others) {
   rr_scene *s = NULL;
   if (rr_scene_new(dev, &s) != RR_OK) return NULL;
   float before[9] = {-6, 0, -6, 6, 0, -6, 0, 0, 6}; /* a floor */
   uint32_t i3[3] = {0, 2, 1};
-  CHECK(rr_scene_add_mesh(s, before, 3, i3, 1, NULL) == RR_OK, "floor");
+  if (others) CHECK(rr_scene_add_mesh(s, before, 3, i3, 1, NULL) == RR_OK, "floor");
   if (!flat) {
-    CHECK(rr_scene_add_instances(s, pos, 3 * NTRI, idx, NTRI, NULL, &xf[0][0], NINST) == RR_OK, "instances: %s",
-          rr_device_message(dev));
+    CHECK(rr_scene_add_instances(s, pos, 3 * (uint32_t)ntri, idx, (uint32_t)ntri, NULL, &xf[0][0], (uint32_t)ninst) ==
+              RR_OK,
+          "instances: %s", rr_device_message(dev));
   } else {
     float *p = malloc(sizeof(float) * 9 * NTRI);
-    for (int k = 0; k < NINST; k++) {
-      for (int v = 0; v < 3 * NTRI; v++) {
+    for (int k = 0; k < ninst; k++) {
+      for (int v = 0; v < 3 * ntri; v++) {
         bool shift = xf[k][0] == 1 && xf[k][1] == 0 && xf[k][2] == 0 && xf[k][4] == 0 && xf[k][5] == 1 &&
                      xf[k][6] == 0 && xf[k][8] == 0 && xf[k][9] == 0 && xf[k][10] == 1;
         v3_store(p + 3 * v, inst_point(xf[k], shift, v3_load(pos + 3 * v)));
       }
-      CHECK(rr_scene_add_mesh(s, p, 3 * NTRI, idx, NTRI, NULL) == RR_OK, "copy %d", k);
+      CHECK(rr_scene_add_mesh(s, p, 3 * (uint32_t)ntri, idx, (uint32_t)ntri, NULL) == RR_OK, "copy %d", k);
     }
     free(p);
   }
-  const float sp[8] = {0, 1, 0, 0.7f, 3, 0.5f, 2, 0.5f};
-  CHECK(rr_scene_add_spheres(s, sp, 2, NULL) == RR_OK, "spheres");
-  CHECK(rr_scene_add_mesh(s, pos, 3 * NTRI, idx, NTRI, NULL) == RR_OK, "a mesh after");
-  CHECK(rr_scene_commit(s) == RR_OK, "commit");
+  if (others) {
+    const float sp[8] = {0, 1, 0, 0.7f, 3, 0.5f, 2, 0.5f};
+    CHECK(rr_scene_add_spheres(s, sp, 2, NULL) == RR_OK, "spheres");
+    CHECK(rr_scene_add_mesh(s, pos, 3 * NTRI, idx, NTRI, NULL) == RR_OK, "a mesh after");
+  }
+  CHECK(rr_scene_commit(s) == RR_OK, "commit: %s", rr_device_message(dev));
   return s;
+}
+
+static rr_scene *build(rr_device *dev, const float *pos, const uint32_t *idx, const float (*xf)[12], bool flat) {
+  return build_n(dev, pos, idx, xf, flat, NTRI, NINST, true);
 }
 
 static const rr_method all[] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_METHOD_2DR_BB, RR_METHOD_2DR_BIN,
                                 RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,  RR_METHOD_3DR_FC, RR_METHOD_3DR_FS,
                                 RR_METHOD_3DR_FULL};
 
-static void check_methods(rr_device *dev, const rr_scene *inst, const rr_scene *flat, int views) {
+static void check_methods(rr_device *dev, const rr_scene *inst, const rr_scene *flat, int views, int min_hits) {
   int inst_hits = 0, frames = 0;
   for (int v = 0; v < views; v++)
     for (int type = 0; type < RR_CAMERA_COUNT; type++) {
@@ -123,7 +132,7 @@ static void check_methods(rr_device *dev, const rr_scene *inst, const rr_scene *
       rr_frame_release(ref), rr_frame_release(fref);
     }
   printf("methods: %d frame pairs, %d samples on instances\n", frames, inst_hits);
-  CHECK(inst_hits > 100, "instances are seen (%d samples)", inst_hits);
+  CHECK(inst_hits > min_hits, "instances are seen (%d samples)", inst_hits);
 }
 
 /* A hit's instance ids: rr_scene_get_instance's, and for a triangle of an instance its
@@ -156,6 +165,36 @@ static void check_rays(rr_device *dev, const rr_scene *s) {
   printf("rays: %d, %d on instances\n", n, ic.on_inst);
 }
 
+/* Trees of odd shapes, every method against the flattened scene and the ray queries
+ * against brute force: instances alone (the top tree's root an instance: one
+ * instance, and many); a mesh of one triangle (the object tree one leaf); leaves of
+ * up to 16 triangles (an instance's leaves are made in the traversals' buffers). */
+static void check_shapes(rr_device *dev, const float *pos, const uint32_t *idx, const float (*xf)[12]) {
+  const struct {
+    int ntri, ninst, leaf;
+    bool others;
+  } c[] = {{NTRI, 1, 0, false}, {NTRI, NINST, 0, false}, {1, NINST, 0, false}, {1, 1, 0, true}, {NTRI, NINST, 16, true}};
+  for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+    rr_build_options opt;
+    rr_build_options_init(&opt);
+    if (c[i].leaf) opt.leaf_size = c[i].leaf;
+    CHECK(rr_device_set_build_options(dev, &opt) == RR_OK, "build options");
+    printf("shape %zu: %d triangles, %d instances%s, leaves of %d\n", i, c[i].ntri, c[i].ninst,
+           c[i].others ? " and more" : "", opt.leaf_size);
+    rr_scene *inst = build_n(dev, pos, idx, xf, false, c[i].ntri, c[i].ninst, c[i].others);
+    rr_scene *flat = build_n(dev, pos, idx, xf, true, c[i].ntri, c[i].ninst, c[i].others);
+    if (inst && flat) {
+      check_methods(dev, inst, flat, 2, c[i].ntri > 1 ? 20 : 0);
+      int hits;
+      test_check_rays(dev, inst, NULL, NULL, &hits);
+    }
+    rr_scene_release(inst), rr_scene_release(flat);
+  }
+  rr_build_options opt;
+  rr_build_options_init(&opt);
+  rr_device_set_build_options(dev, &opt);
+}
+
 /* grid:PATH:N against grid-flat:PATH:N. */
 static void check_grid(rr_device *dev) {
   const char *model = test_model("teapot.obj");
@@ -179,6 +218,10 @@ static void check_grid(rr_device *dev) {
   CHECK(ii.instances == (uint32_t)(n * n) && fi.instances == 0, "instances %u", ii.instances);
   CHECK(ii.stored_triangles * n * n == fi.stored_triangles, "stored %llu vs %llu",
         (unsigned long long)ii.stored_triangles, (unsigned long long)fi.stored_triangles);
+  /* two levels: the mesh's tree once, not one per instance */
+  CHECK(ii.bvh_bytes * (uint64_t)(n * n) < 2 * fi.bvh_bytes && ii.scene_bytes * (uint64_t)(n * n) < 2 * fi.scene_bytes,
+        "memory: BVH %llu against %llu flat, scene %llu against %llu", (unsigned long long)ii.bvh_bytes,
+        (unsigned long long)fi.bvh_bytes, (unsigned long long)ii.scene_bytes, (unsigned long long)fi.scene_bytes);
   CHECK(memcmp(ii.bounds_min, fi.bounds_min, 12) == 0 && memcmp(ii.bounds_max, fi.bounds_max, 12) == 0, "bounds");
   for (uint32_t g = 0; g < ii.geometries; g++) {
     rr_geometry_info gi, gf;
@@ -316,10 +359,11 @@ int main(void) {
   rr_scene *flat = build(dev, pos, idx, (const float (*)[12])xf, true);
   if (inst && flat) {
     CHECK(inst->ntris == flat->ntris && inst->inst && inst->inst->n == NINST, "index space");
-    check_methods(dev, inst, flat, test_quick() ? 2 : 4);
+    check_methods(dev, inst, flat, test_quick() ? 2 : 4, 100);
     check_rays(dev, inst);
   }
   rr_scene_release(inst), rr_scene_release(flat);
+  check_shapes(dev, pos, idx, (const float (*)[12])xf);
   check_grid(dev);
   check_errors(dev, pos, idx);
   check_scene_file(dev);

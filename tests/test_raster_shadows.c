@@ -7,7 +7,7 @@
  * --shadows rays, raster and auto; an empty scene. The same on a scene mixing
  * triangles with analytic spheres, boxes and infinite planes (prim/analytic.h),
  * lights inside spheres and boxes too, where some rays are occluded only by an
- * analytic primitive. */
+ * analytic primitive; and on that scene with a mesh drawn as instances. */
 #include "prim/analytic.h"
 #include "vis/shadow_raster.h"
 #include "testutil.h"
@@ -75,7 +75,7 @@ static size_t targets(const rr_scene *s, vec3 eye, vec3 light, vec3 *out, size_t
  * from the light to the points; a directional one: rays from every point along
  * `towards`, unbounded (parallel rays: an orthographic camera). Adds the occluded and
  * lit counts to seen[0..1], and to seen[2] the occluded rays whose nearest hit is an
- * analytic primitive. */
+ * analytic primitive; and on that scene with a mesh drawn as instances. */
 static void check_rays(const rr_scene *s, const vec3 *light, vec3 towards, const vec3 *pts, size_t n,
                        const char *what, size_t seen[3]) {
   rr_ray *rays = malloc(n * sizeof *rays);
@@ -169,7 +169,9 @@ static void check_scene(const char *name, int lights, size_t npts) {
 
 /* Random triangles, spheres (some crossing the ground), boxes (half of them turned),
  * a ground plane y = 0 and an oblique plane off to the side, ids interleaving kinds. */
-static rr_scene *mixed_scene(int ntri, int nsph) {
+/* Triangles, spheres, boxes and planes; with `instances`, the last mesh is drawn
+ * as four instances (translated, rotated and scaled, sheared: the two-level BVH). */
+static rr_scene *mixed_scene(int ntri, int nsph, bool instances) {
   rr_scene *s = NULL;
   CHECK(rr_scene_new(dev, &s) == RR_OK, "%s", rr_device_message(dev));
   float *pos = malloc(sizeof(float) * 9 * (size_t)ntri), *sp = malloc(sizeof(float) * 4 * (size_t)nsph);
@@ -201,7 +203,15 @@ static rr_scene *mixed_scene(int ntri, int nsph) {
   const float planes[12] = {0, 0, 0, 0, 1, 0, 0, 0, -9, 0.3f, 0.2f, 1};
   CHECK(rr_scene_add_planes(s, planes, 2, NULL) == RR_OK, "%s", rr_device_message(dev));
   for (int k = 0; k < 9 * ntri; k++) pos[k] *= 0.5f; /* more triangles after the analytic geometries */
-  CHECK(rr_scene_add_mesh(s, pos, (size_t)3 * ntri, idx, (size_t)ntri, NULL) == RR_OK, "%s", rr_device_message(dev));
+  const float xf[4][12] = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0},
+                           {0.6f, 0, 0.9f, 2.5f, 0, 1.1f, 0, 0.5f, -0.9f, 0, 0.6f, -1},
+                           {1, 0.25f, 0, -3, 0, 0.9f, -0.2f, 1, 0, 0, 1, 2},
+                           {1, 0, 0, 0.75f, 0, 1, 0, 0.125f, 0, 0, 1, -3.5f}};
+  if (instances)
+    CHECK(rr_scene_add_instances(s, pos, (size_t)3 * ntri, idx, (size_t)ntri, NULL, &xf[0][0], 4) == RR_OK, "%s",
+          rr_device_message(dev));
+  else
+    CHECK(rr_scene_add_mesh(s, pos, (size_t)3 * ntri, idx, (size_t)ntri, NULL) == RR_OK, "%s", rr_device_message(dev));
   free(pos), free(sp), free(idx);
   CHECK(rr_scene_commit(s) == RR_OK, "%s", rr_device_message(dev));
   return s;
@@ -371,12 +381,14 @@ int main(void) {
   }
   check_lit("demo", false);
   check_lit("sphere:24", true);
-  rr_scene *mixed = mixed_scene(quick ? 60 : 200, quick ? 16 : 40);
-  if (mixed) {
-    check_lights(mixed, "mixed", quick ? 4 : 16, npts);
+  for (int inst = 0; inst < 2; inst++) {
+    const char *name = inst ? "mixed with instances" : "mixed";
+    rr_scene *mixed = mixed_scene(quick ? 60 : 200, quick ? 16 : 40, inst);
+    if (!mixed) continue;
+    check_lights(mixed, name, quick ? 4 : 16, npts);
     check_inside_ana(mixed, npts / 2);
-    check_lit_scene(mixed, "mixed", false);
-    check_lit_scene(mixed, "mixed", true);
+    check_lit_scene(mixed, name, false);
+    check_lit_scene(mixed, name, true);
     rr_scene_release(mixed);
   }
   check_empty();

@@ -153,7 +153,7 @@ rr_error rr_bvh_build_instanced(rr_scene *s, const rr_build_options *opt, rr_bvh
   link_instances(b, ob, in);
   b->nprims = s->ntris;
   b->bytes += ob->bytes;
-  b->nleaves += in->n * (ob->nleaves - 1);
+  b->nleaves += ob->nleaves - in->n; /* stored ones, as the nodes */
   b->depth += ob->depth;
   b->build_ms = rr_now_ms() - t0;
   *out = b;

@@ -21,6 +21,7 @@
 #define RR_BVH_LEVELS_H
 
 #include "accel/bvh.h"
+#include "core/simd.h"
 #include "scene/instance.h"
 
 #include <math.h>
@@ -67,34 +68,50 @@ static inline const bvh_node *bvh_node_at(const rr_bvh *b, uint32_t r, bvh_node 
   return buf;
 }
 
-/* Wide node r of a W-wide form (TYPE, the arrays ARR and counts N of rr_bvh). An
- * empty slot (ref UINT32_MAX) keeps its empty box. */
+/* Instance k's copy of wide node src (W slots, W a multiple of 4) into buf: leaves
+ * move by `leaves`, inner slots by `inner`, empty slots (ref UINT32_MAX) keep their
+ * empty boxes. A translation in four-lane steps (the same additions). */
+static inline __attribute__((always_inline)) void bvh_wide_move(const scene_instances *in, uint32_t k, int W,
+                                                                const float *slo, const float *shi,
+                                                                const uint32_t *sref, const uint32_t *scount, float *lo,
+                                                                float *hi, uint32_t *ref, uint32_t *count,
+                                                                uint32_t leaves, uint32_t inner) {
+  const float *m = in->xf[k];
+  if (in->shift[k]) {
+    for (int a = 0; a < 3; a++)
+      for (int h = 0; h < W; h += 4) {
+        rr_vf4 t = rr_vf4_splat(m[4 * a + 3]);
+        rr_vf4_store(lo + a * W + h, rr_vf4_load(slo + a * W + h) + t);
+        rr_vf4_store(hi + a * W + h, rr_vf4_load(shi + a * W + h) + t);
+      }
+  } else {
+    for (int i = 0; i < W; i++) {
+      float l[3] = {slo[i], slo[W + i], slo[2 * W + i]}, u[3] = {shi[i], shi[W + i], shi[2 * W + i]}, wl[3], wu[3];
+      if (sref[i] != UINT32_MAX) bvh_inst_box(in, k, l, u, wl, wu);
+      else memcpy(wl, l, sizeof l), memcpy(wu, u, sizeof u);
+      for (int a = 0; a < 3; a++) lo[a * W + i] = wl[a], hi[a * W + i] = wu[a];
+    }
+  }
+  const rr_vi4 vl = {(int32_t)leaves, (int32_t)leaves, (int32_t)leaves, (int32_t)leaves};
+  const rr_vi4 vi = {(int32_t)inner, (int32_t)inner, (int32_t)inner, (int32_t)inner};
+  for (int h = 0; h < W; h += 4) {
+    rr_vi4 r, c;
+    memcpy(&r, sref + h, sizeof r), memcpy(&c, scount + h, sizeof c);
+    rr_vi4 leaf = c != 0, empty = r == -1;
+    r += ((leaf & vl) | (~leaf & vi)) & ~empty;
+    memcpy(ref + h, &r, sizeof r), memcpy(count + h, &c, sizeof c);
+  }
+}
+
+/* Wide node r of a W-wide form (TYPE, the arrays ARR and counts N of rr_bvh). */
 #define BVH_WIDE_AT(NAME, TYPE, W, ARR, N)                                                                     \
-  static inline const TYPE *NAME(const rr_bvh *b, uint32_t r, TYPE *buf) {                                    \
+  static inline __attribute__((always_inline)) const TYPE *NAME(const rr_bvh *b, uint32_t r, TYPE *buf) {     \
     if (__builtin_expect(r < b->N, 1)) return &b->ARR[r];                                                     \
     const rr_bvh *o = b->obj;                                                                                 \
-    const scene_instances *in = b->inst;                                                                      \
     uint32_t j, k = bvh_inst_of(r, b->N, o->N, &j);                                                           \
     const TYPE *src = &o->ARR[j];                                                                             \
-    const float *m = in->xf[k];                                                                               \
-    if (in->shift[k]) {                                                                                       \
-      for (int a = 0; a < 3; a++)                                                                             \
-        for (int i = 0; i < W; i++)                                                                           \
-          buf->lo[a][i] = src->lo[a][i] + m[4 * a + 3], buf->hi[a][i] = src->hi[a][i] + m[4 * a + 3];         \
-    } else {                                                                                                  \
-      for (int i = 0; i < W; i++) {                                                                           \
-        float lo[3] = {src->lo[0][i], src->lo[1][i], src->lo[2][i]};                                          \
-        float hi[3] = {src->hi[0][i], src->hi[1][i], src->hi[2][i]}, wlo[3], whi[3];                          \
-        if (src->ref[i] != UINT32_MAX) bvh_inst_box(in, k, lo, hi, wlo, whi);                                 \
-        else memcpy(wlo, lo, sizeof lo), memcpy(whi, hi, sizeof hi);                                          \
-        for (int a = 0; a < 3; a++) buf->lo[a][i] = wlo[a], buf->hi[a][i] = whi[a];                           \
-      }                                                                                                       \
-    }                                                                                                         \
-    uint32_t leaves = b->ntop + k * o->nprims, inner = b->N + k * o->N;                                       \
-    for (int i = 0; i < W; i++) {                                                                             \
-      buf->count[i] = src->count[i];                                                                          \
-      buf->ref[i] = src->ref[i] == UINT32_MAX ? UINT32_MAX : src->ref[i] + (src->count[i] ? leaves : inner);  \
-    }                                                                                                         \
+    bvh_wide_move(b->inst, k, W, &src->lo[0][0], &src->hi[0][0], src->ref, src->count, &buf->lo[0][0],        \
+                  &buf->hi[0][0], buf->ref, buf->count, b->ntop + k * o->nprims, b->N + k * o->N);            \
     return buf;                                                                                               \
   }
 BVH_WIDE_AT(bvh_wide_at, bvh_wide, 4, wide, nwide)
