@@ -1,4 +1,7 @@
-/* Acceleration: the binned-SAH BVH over a scene's triangles and its 4-wide form. */
+/* Acceleration: the binned-SAH BVH over a scene's triangles, its 4- and 8-wide forms
+ * and leaf corner copies. A scene with instances has two levels (rr_bvh.obj: the
+ * instanced mesh's tree once, in object space, under a small top tree); traversals
+ * read either kind through accel/bvh_levels.h. */
 #ifndef RR_BVH_H
 #define RR_BVH_H
 

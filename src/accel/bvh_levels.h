@@ -68,6 +68,22 @@ static inline const bvh_node *bvh_node_at(const rr_bvh *b, uint32_t r, bvh_node 
   return buf;
 }
 
+/* A wide node's references (W slots, a multiple of 4) moved: leaves by `leaves`,
+ * inner slots by `inner`, empty ones (UINT32_MAX) kept. */
+static inline __attribute__((always_inline)) void bvh_move_refs(int W, const uint32_t *sref, const uint32_t *scount,
+                                                                uint32_t *ref, uint32_t *count, uint32_t leaves,
+                                                                uint32_t inner) {
+  const rr_vi4 vl = {(int32_t)leaves, (int32_t)leaves, (int32_t)leaves, (int32_t)leaves};
+  const rr_vi4 vi = {(int32_t)inner, (int32_t)inner, (int32_t)inner, (int32_t)inner};
+  for (int h = 0; h < W; h += 4) {
+    rr_vi4 r, c;
+    memcpy(&r, sref + h, sizeof r), memcpy(&c, scount + h, sizeof c);
+    rr_vi4 leaf = c != 0, empty = r == -1;
+    r += ((leaf & vl) | (~leaf & vi)) & ~empty;
+    memcpy(ref + h, &r, sizeof r), memcpy(count + h, &c, sizeof c);
+  }
+}
+
 /* Instance k's copy of wide node src (W slots, W a multiple of 4) into buf: leaves
  * move by `leaves`, inner slots by `inner`, empty slots (ref UINT32_MAX) keep their
  * empty boxes. A translation in four-lane steps (the same additions). */
@@ -92,15 +108,7 @@ static inline __attribute__((always_inline)) void bvh_wide_move(const scene_inst
       for (int a = 0; a < 3; a++) lo[a * W + i] = wl[a], hi[a * W + i] = wu[a];
     }
   }
-  const rr_vi4 vl = {(int32_t)leaves, (int32_t)leaves, (int32_t)leaves, (int32_t)leaves};
-  const rr_vi4 vi = {(int32_t)inner, (int32_t)inner, (int32_t)inner, (int32_t)inner};
-  for (int h = 0; h < W; h += 4) {
-    rr_vi4 r, c;
-    memcpy(&r, sref + h, sizeof r), memcpy(&c, scount + h, sizeof c);
-    rr_vi4 leaf = c != 0, empty = r == -1;
-    r += ((leaf & vl) | (~leaf & vi)) & ~empty;
-    memcpy(ref + h, &r, sizeof r), memcpy(count + h, &c, sizeof c);
-  }
+  bvh_move_refs(W, sref, scount, ref, count, leaves, inner);
 }
 
 /* Wide node r of a W-wide form (TYPE, the arrays ARR and counts N of rr_bvh). */
@@ -117,6 +125,19 @@ static inline __attribute__((always_inline)) void bvh_wide_move(const scene_inst
 BVH_WIDE_AT(bvh_wide_at, bvh_wide, 4, wide, nwide)
 BVH_WIDE_AT(bvh_wide8_at, bvh_wide8, 8, wide8, nwide8)
 #undef BVH_WIDE_AT
+
+/* The references alone of 4-wide node r (ref, count as bvh_wide's): for walks that
+ * read no box. */
+static inline __attribute__((always_inline)) void bvh_wide_refs(const rr_bvh *b, uint32_t r, uint32_t ref[4],
+                                                                uint32_t count[4]) {
+  if (r < b->nwide) {
+    memcpy(ref, b->wide[r].ref, sizeof b->wide[r].ref), memcpy(count, b->wide[r].count, sizeof b->wide[r].count);
+    return;
+  }
+  const rr_bvh *o = b->obj;
+  uint32_t j, k = bvh_inst_of(r, b->nwide, o->nwide, &j);
+  bvh_move_refs(4, o->wide[j].ref, o->wide[j].count, ref, count, b->ntop + k * o->nprims, b->nwide + k * o->nwide);
+}
 
 /* The id at leaf position p. */
 static inline uint32_t bvh_prim_at(const rr_bvh *b, uint32_t p) {

@@ -360,12 +360,12 @@ static int box_reach(const camera *c, const bvh_wide *n, int *few) {
 
 /* Whether the subtree of wide node w holds at most `cap` triangles. */
 static bool subtree_small(const rr_bvh *b, uint32_t w, uint32_t *cap) {
-  BVH_NODE_ALIGN bvh_wide buf;
-  const bvh_wide *n = bvh_wide_at(b, w, &buf);
+  uint32_t ref[4], count[4];
+  bvh_wide_refs(b, w, ref, count);
   for (int i = 0; i < 4; i++) {
-    if (n->ref[i] == UINT32_MAX) continue;
-    if (n->count[i] ? n->count[i] > *cap : !subtree_small(b, n->ref[i], cap)) return false;
-    *cap -= n->count[i];
+    if (ref[i] == UINT32_MAX) continue;
+    if (count[i] ? count[i] > *cap : !subtree_small(b, ref[i], cap)) return false;
+    *cap -= count[i];
   }
   return true;
 }
@@ -435,13 +435,13 @@ static void reach_frame(frame_setups *fs, int threads) {
 /* Fills the inner slots of wide node w from their children, bottom up, and returns
  * the union of its slots: the least bound and the rectangle x0, y0, x1, y1. */
 static void wide_union(frame_setups *fs, uint32_t w, float u[5]) {
-  BVH_NODE_ALIGN bvh_wide buf;
-  const bvh_wide *n = bvh_wide_at(fs->b, w, &buf);
+  uint32_t ref[4], count[4];
+  bvh_wide_refs(fs->b, w, ref, count);
   wide_bounds *wb = &fs->wb[w];
   for (int i = 0; i < 4; i++) {
-    if (n->count[i] || n->ref[i] == UINT32_MAX || (fs->reached && !fs->reached[n->ref[i]])) continue;
+    if (count[i] || ref[i] == UINT32_MAX || (fs->reached && !fs->reached[ref[i]])) continue;
     float c[5];
-    wide_union(fs, n->ref[i], c);
+    wide_union(fs, ref[i], c);
     wb->tlo[i] = c[0], wb->x0[i] = c[1], wb->y0[i] = c[2], wb->x1[i] = c[3], wb->y1[i] = c[4];
   }
   u[0] = u[1] = u[2] = INFINITY, u[3] = u[4] = -INFINITY;
