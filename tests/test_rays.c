@@ -3,7 +3,8 @@
  * triangle with the setup and sample test of rc (rr_tri_ray_hit) — on random rays
  * (some with tmin/tmax cutting hits), rays through the shared edges and vertices
  * of plane:8, rays from the bunny's surface, rays through leaves of up to
- * 13 triangles and through a ground with corners at infinity, in both layouts, on 1, 2 and 8
+ * 13 triangles (also as instances: the two-level BVH) and through a ground with
+ * corners at infinity, in both layouts, on 1, 2 and 8
  * threads; and bad input: NaN/inf components (a miss and an error naming the
  * ray), count 0, bad strides, thread counts and NULL arrays; the queries' bound on t
  * before the full test (ray_t_outside) against the full test. */
@@ -316,19 +317,28 @@ int main(void) {
     memcpy(&fan[9 * i], v, sizeof v);
     for (int k = 0; k < 3; k++) idx[3 * i + k] = (uint32_t)(3 * i + k);
   }
-  for (int k = 0; k < 2; k++) {
-    rr_error e = k ? rr_scene_load(dev, "ground:inf", &s) : rr_scene_new(dev, &s);
-    if (!k && !e) e = rr_scene_add_mesh(s, fan, 3 * FAN, idx, FAN, NULL);
-    if (!k && !e) e = rr_scene_commit(s);
+  /* and the fan as instances (translated, rotated and scaled, sheared): the two-level
+   * tree's leaves made in the traversal's buffers */
+  const float xf[3][12] = {{1, 0, 0, 0.5f, 0, 1, 0, 0.25f, 0, 0, 1, -2},
+                           {0.6f, 0, 0.9f, 2.5f, 0, 1.1f, 0, 0.5f, -0.9f, 0, 0.6f, -1},
+                           {1, 0.25f, 0, -3, 0, 0.9f, -0.2f, 1, 0, 0, 1, 2}};
+  const char *names[3] = {"fan, leaves of up to 13", "ground (corners at infinity)", "fan as instances"};
+  for (int k = 0; k < 3; k++) {
+    rr_error e = k == 1 ? rr_scene_load(dev, "ground:inf", &s) : rr_scene_new(dev, &s);
+    if (k == 0 && !e) e = rr_scene_add_mesh(s, fan, 3 * FAN, idx, FAN, NULL);
+    if (k == 2 && !e) e = rr_scene_add_instances(s, fan, 3 * FAN, idx, FAN, NULL, &xf[0][0], 3);
+    if (k != 1 && !e) e = rr_scene_commit(s);
     if (e) {
-      CHECK(0, "%s: %s", k ? "ground:inf" : "fan", rr_device_message(dev));
+      CHECK(0, "%s: %s", names[k], rr_device_message(dev));
       continue;
     }
+    const rr_bvh *b = s->bvh->obj ? s->bvh->obj : s->bvh; /* (the instanced mesh's own tree) */
     uint32_t widest = 0;
-    for (uint32_t i = 0; i < s->bvh->nnodes; i++) widest = s->bvh->nodes[i].count > widest ? s->bvh->nodes[i].count : widest;
-    CHECK(k || widest > 4, "fan: no leaf beyond four triangles (at most %u)", widest);
+    for (uint32_t i = 0; i < b->nnodes; i++) widest = b->nodes[i].count > widest ? b->nodes[i].count : widest;
+    CHECK(k == 1 || widest > 4, "%s: no leaf beyond four triangles (at most %u)", names[k], widest);
+    CHECK(k != 2 || s->bvh->obj, "%s: two levels", names[k]);
     rr_ray *rays = random_rays(s, 500);
-    check_rays(dev, s, rays, 500, 1, k ? "ground (corners at infinity)" : "fan, leaves of up to 13");
+    check_rays(dev, s, rays, 500, 1, names[k]);
     free(rays);
     rr_scene_release(s);
   }
