@@ -75,6 +75,25 @@ static void build_top(graft *g, item *items, uint32_t n, uint32_t at, uint32_t d
   build_top(g, items + n / 2, n - n / 2, p + 1, depth + 1);
 }
 
+static double half_area(const float lo[3], const float hi[3]) {
+  double x = (double)hi[0] - lo[0], y = (double)hi[1] - lo[1], z = (double)hi[2] - lo[2];
+  return x * y + y * z + z * x;
+}
+
+/* The SAH cost of the tree the traversals see: the top's, and per instance the
+ * object tree's with its areas scaled as its root's (exact for translations). */
+static double two_level_sah(const rr_bvh *b, const rr_bvh *ob, const scene_instances *in) {
+  double top = half_area(b->nodes[0].lo, b->nodes[0].hi), root = half_area(ob->nodes[0].lo, ob->nodes[0].hi);
+  if (!(top > 0) || !(root > 0)) return b->sah_cost;
+  double sum = b->sah_cost * top, per = ob->sah_cost; /* the object tree's sum over its root's area */
+  for (uint32_t k = 0; k < in->n; k++) {
+    float lo[3], hi[3];
+    bvh_inst_box(in, k, ob->nodes[0].lo, ob->nodes[0].hi, lo, hi);
+    sum += per * half_area(lo, hi);
+  }
+  return sum / top;
+}
+
 /* Makes the finished top tree b two-level: ob (the object tree) becomes b->obj, and
  * each instance leaf (BVH_INST) a reference to its instance's copy of ob's root. */
 static void link_instances(rr_bvh *b, rr_bvh *ob, const scene_instances *in) {
@@ -150,6 +169,7 @@ rr_error rr_bvh_build_instanced(rr_scene *s, const rr_build_options *opt, rr_bvh
     rr_bvh_release(b), rr_bvh_release(ob);
     return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory building the BVH of %u instances", in->n);
   }
+  b->sah_cost = two_level_sah(b, ob, in);
   link_instances(b, ob, in);
   b->nprims = s->ntris;
   b->bytes += ob->bytes;
