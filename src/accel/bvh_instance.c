@@ -12,6 +12,9 @@
  * traversals make instance k's nodes and leaves on the way (accel/bvh_levels.h, which
  * also says why its world boxes hold what they must).
  *
+ * Depth: the top's median split is at most 32 deep and the object tree's at most
+ * BVH_SAH_DEPTH (48, accel/bvh.c) + 32, so a traversal's path stays within BVH_STACK levels.
+ *
  * Memory: the object tree once, the top's few nodes, and per instance nothing but its
  * transform (in the scene). Per-frame state indexed by node or position (rc-bvh's
  * bounds) is sized by the references (rr_bvh.vwide, vpos), as for the scene written
@@ -29,12 +32,12 @@ typedef struct item {
   bool instance;
 } item;
 
-typedef struct graft {
+typedef struct top_build {
   const rr_scene *s;
   rr_bvh *b;
   uint32_t next_node; /* the next free pair */
   uint32_t next_prim; /* the next free range of prims */
-} graft;
+} top_build;
 
 static int by_key(const void *a, const void *b) {
   const item *x = a, *y = b;
@@ -42,7 +45,7 @@ static int by_key(const void *a, const void *b) {
 }
 
 /* The tree over items[0 .. n) into slot `at`. */
-static void build_top(graft *g, item *items, uint32_t n, uint32_t at, uint32_t depth) {
+static void build_top(top_build *g, item *items, uint32_t n, uint32_t at, uint32_t depth) {
   bvh_node *dst = &g->b->nodes[at];
   if (n == 1) {
     const item *it = items;
@@ -162,10 +165,10 @@ rr_error rr_bvh_build_instanced(rr_scene *s, const rr_build_options *opt, rr_bvh
     else rr_ana_box(s, i, items[m].lo, items[m].hi);
     m++;
   }
-  graft g = {.s = s, .b = b, .next_node = 1};
+  top_build g = {.s = s, .b = b, .next_node = 1};
   build_top(&g, items, nitems, 0, 0);
   free(items);
-  if (!rr_bvh_finish(b, s, 1)) { /* a few nodes: on this thread */
+  if (!rr_bvh_finish(b, s, opt->threads ? opt->threads : rr_cpu_count())) {
     rr_bvh_release(b), rr_bvh_release(ob);
     return rr_fail(s->dev, RR_ERROR_MEMORY, "out of memory building the BVH of %u instances", in->n);
   }
