@@ -5,10 +5,14 @@
  *   gives rc's bits on it;
  * - grid:PATH:N (instances) equals grid-flat:PATH:N (copies written out) bit for bit,
  *   ids and geometries included, and stores the mesh once;
+ * - the two-level BVH as its readers see it (accel/bvh_levels.h): in each form
+ *   (binary, 4- and 8-wide) every triangle in exactly one leaf, whose corners are its
+ *   world corners and lie in the leaf's world box;
  * - instance ids: rr_hit.inst, rr_scene_get_instance;
  * - rr_intersect / rr_occluded agree with brute force (test_brute_ray);
  * - bad transforms (NaN, singular, mirroring) refused naming the instance, in the
  *   API and in scene files. */
+#include "accel/bvh_levels.h"
 #include "vis/vis.h"
 #include "io/io.h"
 #include "testutil.h"
@@ -165,6 +169,92 @@ static void check_rays(rr_device *dev, const rr_scene *s) {
   printf("rays: %d, %d on instances\n", n, ic.on_inst);
 }
 
+/* ---- the two-level BVH through its readers' accessors ---------------------------- */
+
+typedef struct tree_walk {
+  const rr_scene *s;
+  uint32_t *cover; /* per triangle: the leaves holding it */
+  uint32_t bad;
+} tree_walk;
+
+/* A leaf's ids and corners (leaf_v's layout, v8: leaf_v8's) against the scene's
+ * world corners and the leaf's box lo..hi. */
+static void walk_leaf(tree_walk *w, bool v8, uint32_t first, uint32_t count, const float lo[3], const float hi[3]) {
+  float vbuf[9 * BVH_MAX_LEAF + BVH_LEAF_PAD];
+  uint32_t ibuf[BVH_MAX_LEAF];
+  const uint32_t *ids;
+  if (count > BVH_MAX_LEAF) {
+    w->bad++;
+    return;
+  }
+  const float *v = bvh_leaf_at(w->s->bvh, v8, first, count, vbuf, ibuf, &ids);
+  for (uint32_t t = 0; t < count; t++) {
+    uint32_t id = ids[t];
+    w->bad += id != bvh_prim_at(w->s->bvh, first + t);
+    if (id >= w->s->ntris) {
+      w->bad++;
+      continue;
+    }
+    w->cover[id]++;
+    if (scene_kind(w->s, id) != RR_GEOMETRY_TRIANGLE) continue;
+    vec3 c[3];
+    scene_corners(w->s, id, c);
+    for (int m = 0; m < 9; m++) {
+      float want = m % 3 == 0 ? c[m / 3].x : m % 3 == 1 ? c[m / 3].y : c[m / 3].z, got = v[m * count + t];
+      w->bad += got != want || !(lo[m % 3] <= got && got <= hi[m % 3]);
+    }
+  }
+}
+
+static void walk_node(tree_walk *w, uint32_t r, int depth) {
+  bvh_node buf;
+  const bvh_node *n = bvh_node_at(w->s->bvh, r, &buf);
+  if (depth > BVH_STACK) w->bad++;
+  else if (n->count) walk_leaf(w, false, n->first, n->count, n->lo, n->hi);
+  else walk_node(w, n->first, depth + 1), walk_node(w, n->first + 1, depth + 1);
+}
+
+/* The 4-wide (W 4) or 8-wide form from node r. */
+static void walk_wide(tree_walk *w, int W, uint32_t r, int depth) {
+  BVH_NODE_ALIGN bvh_wide b4;
+  BVH_NODE_ALIGN bvh_wide8 b8;
+  const bvh_wide *n4 = W == 4 ? bvh_wide_at(w->s->bvh, r, &b4) : NULL;
+  const bvh_wide8 *n8 = W == 8 ? bvh_wide8_at(w->s->bvh, r, &b8) : NULL;
+  if (n4) { /* the references alone, as rc-bvh's walks read them */
+    uint32_t ref[4], count[4];
+    bvh_wide_refs(w->s->bvh, r, ref, count);
+    w->bad += memcmp(ref, n4->ref, sizeof ref) != 0 || memcmp(count, n4->count, sizeof count) != 0;
+  }
+  for (int i = 0; i < W && depth <= BVH_STACK; i++) {
+    uint32_t ref = n4 ? n4->ref[i] : n8->ref[i], count = n4 ? n4->count[i] : n8->count[i];
+    float lo[3], hi[3];
+    for (int a = 0; a < 3; a++)
+      lo[a] = n4 ? n4->lo[a][i] : n8->lo[a][i], hi[a] = n4 ? n4->hi[a][i] : n8->hi[a][i];
+    if (ref == UINT32_MAX) w->bad += lo[0] <= hi[0] || count;
+    else if (count) walk_leaf(w, W == 8, ref, count, lo, hi);
+    else walk_wide(w, W, ref, depth + 1);
+  }
+  w->bad += depth > BVH_STACK;
+}
+
+static void check_levels(const rr_scene *s, const char *name) {
+  const rr_bvh *b = s->bvh;
+  CHECK(b && b->obj && b->inst == s->inst && b->nprims == s->ntris, "%s: two levels", name);
+  if (!b || !b->obj) return;
+  CHECK(b->vpos == b->ntop + s->inst->n * s->inst->T && b->vwide == b->nwide + s->inst->n * b->obj->nwide,
+        "%s: references", name);
+  for (int form = 0; form < 3; form++) {
+    tree_walk w = {s, calloc(s->ntris, sizeof(uint32_t)), 0};
+    if (form == 0) walk_node(&w, 0, 0);
+    else walk_wide(&w, form == 1 ? 4 : 8, 0, 0);
+    uint32_t missing = 0;
+    for (uint32_t i = 0; i < s->ntris; i++) missing += w.cover[i] != 1;
+    CHECK(w.bad == 0 && missing == 0, "%s: the %s form has %u faults, %u triangles not in exactly one leaf", name,
+          form == 0 ? "binary" : form == 1 ? "4-wide" : "8-wide", w.bad, missing);
+    free(w.cover);
+  }
+}
+
 /* Trees of odd shapes, every method against the flattened scene and the ray queries
  * against brute force: instances alone (the top tree's root an instance: one
  * instance, and many); a mesh of one triangle (the object tree one leaf); leaves of
@@ -184,6 +274,7 @@ static void check_shapes(rr_device *dev, const float *pos, const uint32_t *idx, 
     rr_scene *inst = build_n(dev, pos, idx, xf, false, c[i].ntri, c[i].ninst, c[i].others);
     rr_scene *flat = build_n(dev, pos, idx, xf, true, c[i].ntri, c[i].ninst, c[i].others);
     if (inst && flat) {
+      check_levels(inst, "shape");
       check_methods(dev, inst, flat, 2, c[i].ntri > 1 ? 20 : 0);
       int hits;
       test_check_rays(dev, inst, NULL, NULL, &hits);
@@ -218,6 +309,7 @@ static void check_grid(rr_device *dev) {
   CHECK(ii.instances == (uint32_t)(n * n) && fi.instances == 0, "instances %u", ii.instances);
   CHECK(ii.stored_triangles * n * n == fi.stored_triangles, "stored %llu vs %llu",
         (unsigned long long)ii.stored_triangles, (unsigned long long)fi.stored_triangles);
+  check_levels(si, a);
   /* two levels: the mesh's tree once, not one per instance */
   CHECK(ii.bvh_bytes * (uint64_t)(n * n) < 2 * fi.bvh_bytes && ii.scene_bytes * (uint64_t)(n * n) < 2 * fi.scene_bytes,
         "memory: BVH %llu against %llu flat, scene %llu against %llu", (unsigned long long)ii.bvh_bytes,
@@ -359,6 +451,7 @@ int main(void) {
   rr_scene *flat = build(dev, pos, idx, (const float (*)[12])xf, true);
   if (inst && flat) {
     CHECK(inst->ntris == flat->ntris && inst->inst && inst->inst->n == NINST, "index space");
+    check_levels(inst, "instances");
     check_methods(dev, inst, flat, test_quick() ? 2 : 4, 100);
     check_rays(dev, inst);
   }
