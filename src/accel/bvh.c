@@ -654,7 +654,8 @@ static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
   memset(b->leaf_v + n, 0, BVH_LEAF_PAD * sizeof(float));
   for (uint32_t i = 0; i < b->nnodes; i++) {
     const bvh_node *nd = &b->nodes[i];
-    if (nd->count && nd->count != BVH_INST) copy_corners(s, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
+    if (nd->count && nd->count != BVH_INST) /* (an instance's leaf has no corners of its own) */
+      copy_corners(s, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
   }
   return true;
 }
