@@ -86,15 +86,13 @@ typedef struct {
 
 static binmap binmap_make(box4 cbox, int nb) {
   binmap m;
-  float sc[4] = {0, 0, 0, 0};
-  for (int a = 0; a < 3; a++) {
-    float ext = cbox.hi[a] - cbox.lo[a];
-    float s = (float)nb / ext;
-    m.ok[a] = ext > 0 && isfinite(ext) && isfinite(s);
-    sc[a] = m.ok[a] ? s : 0;
-  }
+  /* per axis: ok when 0 < ext <= FLT_MAX and nb / ext is finite (NaN fails all) */
+  rr_vf4 ext = cbox.hi - cbox.lo, s = rr_vf4_splat((float)nb) / ext;
+  rr_vi4 ok = (ext > 0) & (ext <= FLT_MAX) & (rr_vf4_abs(s) <= FLT_MAX) & xyz_mask();
+  int bits = rr_vi4_bits(ok);
+  for (int a = 0; a < 3; a++) m.ok[a] = bits >> a & 1;
   m.cmin = (rr_vf4)((rr_vi4)cbox.lo & xyz_mask());
-  m.scale = rr_vf4_load(sc);
+  m.scale = (rr_vf4)((rr_vi4)s & ok);
   m.top = rr_vf4_splat((float)(nb - 1));
   m.nb = nb;
   return m;
@@ -693,8 +691,26 @@ typedef struct {
   rr_bvh *b;
   const rr_scene *s;
   uint32_t *first, *count; /* per binary node: its subtree's prims (count 0: not consecutive) */
-  uint32_t next;           /* the next free node */
+  uint32_t next, cap;      /* the next free node; room in b->wide8 */
+  bool oom;
 } wide8_build;
+
+/* A new wide8 node's index, the array grown by doubling when full (UINT32_MAX
+ * when out of memory). Growing as it goes costs less than counting first. */
+static uint32_t wide8_new(wide8_build *j) {
+  if (j->next == j->cap) {
+    uint32_t cap = j->cap * 2;
+    bvh_wide8 *p = cap > j->cap ? alloc_lines((size_t)cap * sizeof *p) : NULL;
+    if (!p) {
+      j->oom = true;
+      return UINT32_MAX;
+    }
+    memcpy(p, j->b->wide8, (size_t)j->next * sizeof *p);
+    free(j->b->wide8);
+    j->b->wide8 = p, j->cap = cap;
+  }
+  return j->next++;
+}
 
 /* The prims under each binary node k into j->first[k], j->count[k]; the count is
  * left 0 where they are not one range (never, for the builder's trees; checked).
@@ -744,7 +760,7 @@ static uint32_t open_slots8(const wide8_build *j, uint32_t k, uint32_t *slot) {
 static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
   rr_bvh *b = j->b;
   uint32_t slot[8], n = open_slots8(j, k, slot);
-  bvh_wide8 *wn = &b->wide8[w];
+  bvh_wide8 *wn = &b->wide8[w]; /* moves when a child grows the array */
   for (uint32_t i = 0; i < 8; i++) {
     const bvh_node *c = i < n ? &b->nodes[slot[i]] : NULL;
     for (int a = 0; a < 3; a++) wn->lo[a][i] = c ? c->lo[a] : INFINITY, wn->hi[a][i] = c ? c->hi[a] : -INFINITY;
@@ -757,23 +773,18 @@ static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
       copy_corners(j->s, b->prims, first, count, b->leaf_v8 + (size_t)9 * first);
       wn->ref[i] = first, wn->count[i] = count;
     } else {
-      wn->ref[i] = j->next++;
-      collapse_node8(j, wn->ref[i], c);
+      uint32_t r = wide8_new(j);
+      if (r == UINT32_MAX) return;
+      collapse_node8(j, r, c);
+      b->wide8[w].ref[i] = r;
+      wn = &b->wide8[w];
     }
   }
 }
 
-/* The wide8 nodes collapse_node8 makes from binary node k. */
-static uint32_t count_nodes8(const wide8_build *j, uint32_t k) {
-  uint32_t slot[8], n = open_slots8(j, k, slot), total = 1;
-  for (uint32_t i = 0; i < n; i++)
-    if (!leaf8(j, slot[i])) total += count_nodes8(j, slot[i]);
-  return total;
-}
-
 static bool collapse_wide8(rr_bvh *b, const rr_scene *s) {
   size_t nv = (size_t)9 * b->nprims;
-  wide8_build j = {.b = b, .s = s, .next = 1};
+  wide8_build j = {.b = b, .s = s, .next = 1, .cap = 64};
   j.first = malloc((size_t)b->nnodes * sizeof(uint32_t));
   j.count = malloc((size_t)b->nnodes * sizeof(uint32_t));
   b->leaf_v8 = alloc_lines((nv + BVH_LEAF_PAD) * sizeof(float));
@@ -781,11 +792,11 @@ static bool collapse_wide8(rr_bvh *b, const rr_scene *s) {
   if (ok) {
     memset(b->leaf_v8 + nv, 0, BVH_LEAF_PAD * sizeof(float));
     subtree_ranges(&j);
-    b->nwide8 = count_nodes8(&j, 0); /* counted first: no room to guess and trim */
-    b->wide8 = alloc_lines((size_t)b->nwide8 * sizeof(bvh_wide8));
+    b->wide8 = alloc_lines((size_t)j.cap * sizeof(bvh_wide8));
     ok = b->wide8 != NULL;
   }
-  if (ok) collapse_node8(&j, 0, 0);
+  if (ok) collapse_node8(&j, 0, 0), ok = !j.oom;
+  b->nwide8 = j.next;
   free(j.first), free(j.count);
   return ok;
 }
