@@ -117,8 +117,41 @@ static void bins_clear(bins *b, int nb) {
     for (int i = 0; i < nb; i++) b->box[a][i] = box_empty(), b->n[a][i] = 0;
 }
 
+#ifdef RR_SIMD_X86
+/* bin_range with a reference's box and a bin's as one eight-lane vector each
+ * (lower corner, then upper): the bin grows by a min and a max blended, the
+ * same bounds in fewer instructions. */
+RR_TARGET_AVX2 static inline void bin_grow8(bins *b, int a, uint32_t k, __m256 v) {
+  float *bx = (float *)&b->box[a][k];
+  __m256 old = _mm256_loadu_ps(bx);
+  _mm256_storeu_ps(bx, _mm256_blend_ps(_mm256_min_ps(old, v), _mm256_max_ps(old, v), 0xF0));
+  b->n[a][k]++;
+}
+
+RR_TARGET_AVX2 static void bin_range_avx2(pref *r, uint32_t n, const binmap *m, bins *b) {
+  bins_clear(b, m->nb);
+  for (uint32_t i = 0; i < n; i++) {
+    __m256 v = _mm256_loadu_ps(r[i].lo); /* lanes 3 and 7 (id, bins): as in bin_range */
+    __m128 lo = _mm256_castps256_ps128(v), hi = _mm256_extractf128_ps(v, 1);
+    __m128i idx = (__m128i)bin_of(m, centroid((rr_vf4)lo, (rr_vf4)hi));
+    __m128i pk = _mm_packs_epi32(idx, idx);
+    uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(pk, pk));
+    memcpy(r[i].bin, &packed, 4);
+    bin_grow8(b, 0, (uint32_t)_mm_cvtsi128_si32(idx), v);
+    bin_grow8(b, 1, (uint32_t)_mm_extract_epi32(idx, 1), v);
+    bin_grow8(b, 2, (uint32_t)_mm_extract_epi32(idx, 2), v);
+  }
+}
+#endif
+
 /* Bins a range, noting each reference's bins in it (pref.bin). */
 static void bin_range(pref *r, uint32_t n, const binmap *m, bins *b) {
+#ifdef RR_SIMD_X86
+  if (__builtin_cpu_supports("avx2")) {
+    bin_range_avx2(r, n, m, b);
+    return;
+  }
+#endif
   bins_clear(b, m->nb);
   for (uint32_t i = 0; i < n; i++) {
     /* Lane 3 (id, bins) unmasked: it only reaches lanes 3 of the bin boxes,
