@@ -71,7 +71,10 @@ static inline void box_merge(box4 *b, box4 o) { box_grow(b, o.lo, o.hi); }
 static inline double half_area(box4 b) {
   rr_vf4 e = b.hi - b.lo, p = e * rr_vf4_yzx(e);
   float a = p[0] + p[1] + p[2];
-  if (a >= 0 && a <= FLT_MAX) return a; /* finite (NaN fails both) */
+  uint32_t bits;
+  memcpy(&bits, &a, sizeof bits);
+  if (bits <= 0x7F7FFFFFu) return a; /* +0 to FLT_MAX: one test for the common case */
+  if (a >= 0 && a <= FLT_MAX) return a; /* -0 (NaN fails both) */
   if (!(e[0] >= 0)) return 0; /* empty (or NaN) */
   double x = (double)b.hi[0] - b.lo[0], y = (double)b.hi[1] - b.lo[1], z = (double)b.hi[2] - b.lo[2];
   return x * y + y * z + z * x;
@@ -129,7 +132,12 @@ RR_TARGET_AVX2 static inline void bin_grow8(bins *b, int a, uint32_t k, __m256 v
 }
 
 RR_TARGET_AVX2 static void bin_range_avx2(pref *r, uint32_t n, const binmap *m, bins *b) {
-  bins_clear(b, m->nb);
+  /* bins_clear with a bin's box as one vector, the counts eight at a time */
+  __m256 empty = _mm256_setr_ps(INFINITY, INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY, -INFINITY);
+  for (int a = 0; a < 3; a++) {
+    for (int i = 0; i < m->nb; i++) _mm256_storeu_ps((float *)&b->box[a][i], empty);
+    for (int i = 0; i < m->nb; i += 8) _mm256_storeu_si256((__m256i *)&b->n[a][i], _mm256_setzero_si256());
+  }
   for (uint32_t i = 0; i < n; i++) {
     __m256 v = _mm256_loadu_ps(r[i].lo); /* lanes 3 and 7 (id, bins): as in bin_range */
     __m128 lo = _mm256_castps256_ps128(v), hi = _mm256_extractf128_ps(v, 1);
@@ -317,7 +325,8 @@ static void chunk_scatter(int c, int thread, void *arg) {
 
 static int bins_for(const builder *bd, uint32_t count) {
   /* Few references gain nothing from many bins but pay for the sweep. */
-  int nb = count < (uint32_t)bd->bins ? (int)count : bd->bins;
+  uint32_t want = count / 2;
+  int nb = want < (uint32_t)bd->bins ? (int)want : bd->bins;
   return nb < 4 ? (bd->bins < 4 ? bd->bins : 4) : nb;
 }
 
