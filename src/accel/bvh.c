@@ -110,30 +110,53 @@ static inline rr_vi4 bin_of(const binmap *m, rr_vf4 c) {
   return rr_vi4_trunc(f);
 }
 
+/* A bin's box is kept as its lower corner and its upper corner negated, so that
+ * both grow by a min (one eight-lane min under AVX2). -min(-a, -b) is max(a, b)
+ * to the bit, NaN and signed zeros included (both give b when they tie). */
 typedef struct {
-  box4 box[3][BVH_MAX_BINS];
+  rr_vf4 lo, nhi;
+} nbox;
+
+static inline rr_vf4 neg(rr_vf4 v) { return (rr_vf4)((rr_vi4)v ^ (rr_vi4)rr_vf4_splat(-0.0f)); }
+
+static inline nbox nbox_empty(void) {
+  nbox b = {rr_vf4_splat(INFINITY), rr_vf4_splat(INFINITY)};
+  return b;
+}
+
+static inline void nbox_merge(nbox *b, nbox o) {
+  b->lo = rr_vf4_min(b->lo, o.lo);
+  b->nhi = rr_vf4_min(b->nhi, o.nhi);
+}
+
+static inline box4 nbox_box(nbox b) {
+  box4 r = {b.lo, neg(b.nhi)};
+  return r;
+}
+
+typedef struct {
+  nbox box[3][BVH_MAX_BINS];
   uint32_t n[3][BVH_MAX_BINS];
 } bins;
 
 static void bins_clear(bins *b, int nb) {
   for (int a = 0; a < 3; a++)
-    for (int i = 0; i < nb; i++) b->box[a][i] = box_empty(), b->n[a][i] = 0;
+    for (int i = 0; i < nb; i++) b->box[a][i] = nbox_empty(), b->n[a][i] = 0;
 }
 
 #ifdef RR_SIMD_X86
-/* bin_range with a reference's box and a bin's as one eight-lane vector each
- * (lower corner, then upper): the bin grows by a min and a max blended, the
- * same bounds in fewer instructions. */
+/* bin_range with a reference's box (upper corner negated) and a bin's as one
+ * eight-lane vector each: a bin grows by one min. */
 RR_TARGET_AVX2 static inline void bin_grow8(bins *b, int a, uint32_t k, __m256 v) {
   float *bx = (float *)&b->box[a][k];
-  __m256 old = _mm256_loadu_ps(bx);
-  _mm256_storeu_ps(bx, _mm256_blend_ps(_mm256_min_ps(old, v), _mm256_max_ps(old, v), 0xF0));
+  _mm256_storeu_ps(bx, _mm256_min_ps(_mm256_loadu_ps(bx), v));
   b->n[a][k]++;
 }
 
 RR_TARGET_AVX2 static void bin_range_avx2(pref *r, uint32_t n, const binmap *m, bins *b) {
   /* bins_clear with a bin's box as one vector, the counts eight at a time */
-  __m256 empty = _mm256_setr_ps(INFINITY, INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY, -INFINITY);
+  __m256 empty = _mm256_set1_ps(INFINITY);
+  __m256 neg_hi = _mm256_setr_ps(0, 0, 0, 0, -0.0f, -0.0f, -0.0f, -0.0f);
   for (int a = 0; a < 3; a++) {
     for (int i = 0; i < m->nb; i++) _mm256_storeu_ps((float *)&b->box[a][i], empty);
     for (int i = 0; i < m->nb; i += 8) _mm256_storeu_si256((__m256i *)&b->n[a][i], _mm256_setzero_si256());
@@ -141,6 +164,7 @@ RR_TARGET_AVX2 static void bin_range_avx2(pref *r, uint32_t n, const binmap *m, 
   for (uint32_t i = 0; i < n; i++) {
     __m256 v = _mm256_loadu_ps(r[i].lo); /* lanes 3 and 7 (id, bins): as in bin_range */
     __m128 lo = _mm256_castps256_ps128(v), hi = _mm256_extractf128_ps(v, 1);
+    v = _mm256_xor_ps(v, neg_hi);
     __m128i idx = (__m128i)bin_of(m, centroid((rr_vf4)lo, (rr_vf4)hi));
     __m128i pk = _mm_packs_epi32(idx, idx);
     uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(pk, pk));
@@ -175,15 +199,16 @@ static void bin_range(pref *r, uint32_t n, const binmap *m, bins *b) {
 #else
     r[i].bin[0] = (uint8_t)i0, r[i].bin[1] = (uint8_t)i1, r[i].bin[2] = (uint8_t)i2;
 #endif
-    box_grow(&b->box[0][i0], lo, hi), b->n[0][i0]++;
-    box_grow(&b->box[1][i1], lo, hi), b->n[1][i1]++;
-    box_grow(&b->box[2][i2], lo, hi), b->n[2][i2]++;
+    nbox rb = {lo, neg(hi)};
+    nbox_merge(&b->box[0][i0], rb), b->n[0][i0]++;
+    nbox_merge(&b->box[1][i1], rb), b->n[1][i1]++;
+    nbox_merge(&b->box[2][i2], rb), b->n[2][i2]++;
   }
 }
 
 static void bins_merge(bins *into, const bins *b, int nb) {
   for (int a = 0; a < 3; a++)
-    for (int i = 0; i < nb; i++) box_merge(&into->box[a][i], b->box[a][i]), into->n[a][i] += b->n[a][i];
+    for (int i = 0; i < nb; i++) nbox_merge(&into->box[a][i], b->box[a][i]), into->n[a][i] += b->n[a][i];
 }
 
 /* A range of references waiting to become a subtree rooted at `node`; they lie
@@ -218,26 +243,26 @@ static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, doub
      * so the right costs are needed at nonempty bins only, and the left ones at
      * candidates only; the first of equal candidates wins. */
     double rcost[BVH_MAX_BINS];
-    box4 acc = box_empty();
+    nbox acc = nbox_empty();
     uint32_t cnt = 0;
     for (int i = nb - 1; i > 0; i--)
-      if (b->n[a][i]) box_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = half_area(acc) * cnt;
-    acc = box_empty(), cnt = 0;
+      if (b->n[a][i]) nbox_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = half_area(nbox_box(acc)) * cnt;
+    acc = nbox_empty(), cnt = 0;
     for (int i = 1; i < nb; i++) {
-      box_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1]; /* an empty bin's box changes nothing */
+      nbox_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1]; /* an empty bin's box changes nothing */
       if (!cnt || !b->n[a][i]) continue;
-      double c = half_area(acc) * cnt + rcost[i];
+      double c = half_area(nbox_box(acc)) * cnt + rcost[i];
       if (!found || c < *cost) found = true, *cost = c, *axis = a, *pos = i;
     }
   }
   return found;
 }
 
-/* Whether a binned reference goes right of the split (bin >= pos on `axis`); *c is its centroid. */
+/* Whether a binned reference goes right of the split (bin >= pos on `axis`); *c is
+ * its centroid, lane 3 unmasked: it only reaches the lanes 3 of centroid bounds,
+ * which binmap_make masks off. */
 static inline bool ref_right(const pref *r, int axis, int pos, rr_vf4 *c) {
-  rr_vf4 lo, hi;
-  ref_load(r, &lo, &hi);
-  *c = centroid(lo, hi);
+  *c = centroid(rr_vf4_load(r->lo), rr_vf4_load(r->hi));
   return r->bin[axis] >= pos;
 }
 
@@ -415,9 +440,10 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
     median_split(bd, t, sp);
     goto children;
   }
-  sp->l.box = box_empty(), sp->r.box = box_empty();
+  nbox lr[2] = {nbox_empty(), nbox_empty()};
   for (int i = 0; i < nb; i++)
-    if (b->n[axis][i]) box_merge(i < pos ? &sp->l.box : &sp->r.box, b->box[axis][i]);
+    if (b->n[axis][i]) nbox_merge(&lr[i >= pos], b->box[axis][i]);
+  sp->l.box = nbox_box(lr[0]), sp->r.box = nbox_box(lr[1]);
   if (big) {
     job.axis = axis, job.pos = pos;
     job.nleft = malloc(sizeof(uint32_t) * nchunks);
