@@ -134,6 +134,19 @@ static inline box4 nbox_box(nbox b) {
   return r;
 }
 
+/* half_area of an nbox without negating: lo + nhi is lo - hi, which is
+ * -(hi - lo) to the bit but where hi == lo (+0 both), so the products are
+ * half_area's but for the sign of a zero one, and the sum differs at most in
+ * the sign of a zero area, which no cost comparison or sum can see. */
+static inline double nbox_area(nbox b) {
+  rr_vf4 s = b.lo + b.nhi, p = s * rr_vf4_yzx(s);
+  float a = p[0] + p[1] + p[2];
+  uint32_t bits;
+  memcpy(&bits, &a, sizeof bits);
+  if (bits <= 0x7F7FFFFFu) return a;
+  return half_area(nbox_box(b));
+}
+
 typedef struct {
   nbox box[3][BVH_MAX_BINS];
   uint32_t n[3][BVH_MAX_BINS];
@@ -246,12 +259,12 @@ static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, doub
     nbox acc = nbox_empty();
     uint32_t cnt = 0;
     for (int i = nb - 1; i > 0; i--)
-      if (b->n[a][i]) nbox_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = half_area(nbox_box(acc)) * cnt;
+      if (b->n[a][i]) nbox_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = nbox_area(acc) * cnt;
     acc = nbox_empty(), cnt = 0;
     for (int i = 1; i < nb; i++) {
       nbox_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1]; /* an empty bin's box changes nothing */
       if (!cnt || !b->n[a][i]) continue;
-      double c = half_area(nbox_box(acc)) * cnt + rcost[i];
+      double c = nbox_area(acc) * cnt + rcost[i];
       if (!found || c < *cost) found = true, *cost = c, *axis = a, *pos = i;
     }
   }
