@@ -28,6 +28,9 @@ enum {
   BVH_SAH_DEPTH = 48,   /* below this depth split at the median: bounds the depth */
 };
 
+/* Inlined into its callers, the subtree builder's AVX2 copy among them. */
+#define BVH_INLINE static inline __attribute__((always_inline))
+
 /* SAH costs of a traversal step and a triangle test (relative). */
 #define BVH_COST_NODE 1.0
 #define BVH_COST_TRI 1.0
@@ -87,7 +90,7 @@ typedef struct {
   bool ok[3]; /* axis has extent */
 } binmap;
 
-static binmap binmap_make(box4 cbox, int nb) {
+BVH_INLINE binmap binmap_make(box4 cbox, int nb) {
   binmap m;
   /* per axis: ok when 0 < ext <= FLT_MAX and nb / ext is finite (NaN fails all) */
   rr_vf4 ext = cbox.hi - cbox.lo, s = rr_vf4_splat((float)nb) / ext;
@@ -247,7 +250,7 @@ typedef struct {
 
 /* Chooses the cheapest binned SAH split; returns false when every centroid falls
  * into one bin on every axis. *cost is the SAH cost of the split (unnormalised). */
-static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, double *cost) {
+BVH_INLINE bool best_split(const bins *b, const binmap *m, int *axis, int *pos, double *cost) {
   bool found = false;
   int nb = m->nb;
   for (int a = 0; a < 3; a++) {
@@ -293,7 +296,7 @@ static void range_bounds(const pref *r, uint32_t n, box4 *box, box4 *cbox) {
 
 /* In-place partition of a small range (one thread): left = bin < pos. Two-sided:
  * each reference is looked at once, and only those on the wrong side move. */
-static uint32_t partition_small(pref *r, uint32_t n, int axis, int pos, box4 cb[2]) {
+BVH_INLINE uint32_t partition_small(pref *r, uint32_t n, int axis, int pos, box4 cb[2]) {
   cb[0] = box_empty(), cb[1] = box_empty();
   uint32_t i = 0, j = n;
   for (;;) {
@@ -380,7 +383,7 @@ static void median_split(builder *bd, const task *t, split *sp) {
  * box, so on every axis with extent one is in bin 0 and the other in bin nb - 1:
  * each such axis offers the one split (one reference each side) at the same cost,
  * and the first such axis wins. */
-static void split_pair(builder *bd, const task *t, int nb, split *sp) {
+BVH_INLINE void split_pair(builder *bd, const task *t, int nb, split *sp) {
   pref *r = bd->buf[t->buf] + t->start;
   binmap m = binmap_make(t->cbox, nb);
   int axis = -1;
@@ -409,7 +412,7 @@ static void split_pair(builder *bd, const task *t, int nb, split *sp) {
 /* Decides how to split t (or not) and partitions its references; `threads` only
  * says how many threads may help with a big range. Out of memory, t stays a leaf
  * and bd->oom is set. */
-static void split_task(builder *bd, const task *t, int threads, split *sp) {
+BVH_INLINE void split_task_inl(builder *bd, const task *t, int threads, split *sp) {
   sp->mid = 0;
   uint16_t buf = t->buf;
   if (t->count <= 1) return;
@@ -495,6 +498,24 @@ children:
   sp->l.buf = sp->r.buf = buf;
 }
 
+#ifdef RR_SIMD_X86
+/* split_task_inl compiled for AVX2 (three-operand forms: fewer register copies);
+ * the same operations, so the same tree. */
+RR_TARGET_AVX2 static void split_task_avx2(builder *bd, const task *t, int threads, split *sp) {
+  split_task_inl(bd, t, threads, sp);
+}
+#endif
+
+static void split_task(builder *bd, const task *t, int threads, split *sp) {
+#ifdef RR_SIMD_X86
+  if (__builtin_cpu_supports("avx2")) {
+    split_task_avx2(bd, t, threads, sp);
+    return;
+  }
+#endif
+  split_task_inl(bd, t, threads, sp);
+}
+
 static void store_box(bvh_node *n, box4 b) {
   memcpy(n->lo, &b.lo, 12), memcpy(n->hi, &b.hi, 12);
 }
@@ -550,9 +571,7 @@ typedef struct {
   uint32_t *leaves, *depth;
 } sub_job;
 
-static void build_subtree(int ti, int thread, void *arg) {
-  (void)thread;
-  sub_job *j = arg;
+BVH_INLINE void build_subtree_inl(int ti, sub_job *j) {
   node_vec *nv = &j->local[ti];
   /* Room for the whole subtree at once (at most 2 count - 2 nodes below the root):
    * no regrowing copies. */
@@ -572,7 +591,7 @@ static void build_subtree(int ti, int thread, void *arg) {
     task t = stack[--sp];
     bvh_node *n = (t.node & 0x80000000u) ? &nv->v[t.node & 0x7FFFFFFFu] : &j->top[t.node];
     split s;
-    split_task(j->bd, &t, 1, &s);
+    split_task_inl(j->bd, &t, 1, &s);
     store_box(n, t.box);
     if (!s.mid) {
       n->first = t.start, n->count = t.count;
@@ -589,6 +608,22 @@ static void build_subtree(int ti, int thread, void *arg) {
     stack[sp++] = s.l;
   }
   j->leaves[ti] = leaves, j->depth[ti] = depth;
+}
+
+#ifdef RR_SIMD_X86
+/* The subtree loop with split_task_inl in it, compiled for AVX2 as split_task_avx2. */
+RR_TARGET_AVX2 static void build_subtree_avx2(int ti, sub_job *j) { build_subtree_inl(ti, j); }
+#endif
+
+static void build_subtree(int ti, int thread, void *arg) {
+  (void)thread;
+#ifdef RR_SIMD_X86
+  if (__builtin_cpu_supports("avx2")) {
+    build_subtree_avx2(ti, arg);
+    return;
+  }
+#endif
+  build_subtree_inl(ti, arg);
 }
 
 /* ---- the top of the tree: big ranges, split one level at a time ------------ */
