@@ -174,7 +174,8 @@ RR_TARGET_AVX2 static void bin_range_avx2(pref *r, uint32_t n, const binmap *m, 
   __m256 empty = _mm256_set1_ps(INFINITY);
   __m256 neg_hi = _mm256_setr_ps(0, 0, 0, 0, -0.0f, -0.0f, -0.0f, -0.0f);
   for (int a = 0; a < 3; a++) {
-    for (int i = 0; i < m->nb; i++) _mm256_storeu_ps((float *)&b->box[a][i], empty);
+    for (int i = 0; i < m->nb; i += 2) /* two at a time: BVH_MAX_BINS is even */
+      _mm256_storeu_ps((float *)&b->box[a][i], empty), _mm256_storeu_ps((float *)&b->box[a][i + 1], empty);
     for (int i = 0; i < m->nb; i += 8) _mm256_storeu_si256((__m256i *)&b->n[a][i], _mm256_setzero_si256());
   }
   for (uint32_t i = 0; i < n; i++) {
@@ -739,6 +740,9 @@ static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
 /* The corners of the triangles prims[first .. first + count) into v: corner k's
  * axis x of the j-th at v[(3k + x)·count + j] (the layout of rr_bvh.leaf_v). An
  * instance's corners are moved to world space (scene_corners), the rest copied. */
+static inline void copy_corners_p(const float *const *sp, const uint32_t *prims, uint32_t first, uint32_t count,
+                                  float *v);
+
 static void copy_corners(const rr_scene *s, const uint32_t *prims, uint32_t first, uint32_t count, float *v) {
   if (s->inst) {
     for (uint32_t j = 0; j < count; j++) {
@@ -749,8 +753,15 @@ static void copy_corners(const rr_scene *s, const uint32_t *prims, uint32_t firs
     }
     return;
   }
+  copy_corners_p((const float *const *)&s->p[0][0], prims, first, count, v);
+}
+
+/* copy_corners of a scene without instances, given its nine coordinate arrays
+ * (hoisted out of the leaf loops). */
+static inline void copy_corners_p(const float *const *sp, const uint32_t *prims, uint32_t first, uint32_t count,
+                                  float *v) {
   const float *p[9]; /* in locals: the stores into v cannot change them */
-  memcpy(p, s->p, sizeof p);
+  memcpy(p, sp, sizeof p);
   for (uint32_t j = 0; j < count; j++) {
     uint32_t t = prims[first + j];
     float *o = v + j;
@@ -766,9 +777,12 @@ static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
   b->leaf_v = alloc_lines((n + BVH_LEAF_PAD) * sizeof(float));
   if (!b->leaf_v) return false;
   memset(b->leaf_v + n, 0, BVH_LEAF_PAD * sizeof(float));
+  const float *const *p = (const float *const *)&s->p[0][0];
   for (uint32_t i = 0; i < b->nnodes; i++) {
     const bvh_node *nd = &b->nodes[i];
-    if (nd->count) copy_corners(s, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
+    if (!nd->count) continue;
+    if (s->inst) copy_corners(s, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
+    else copy_corners_p(p, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
   }
   return true;
 }
@@ -886,7 +900,9 @@ static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
     uint32_t c = slot[i];
     if (leaf8(j, c)) { /* a leaf: its corners as leaf_v's */
       uint32_t first = j->first[c], count = j->count[c];
-      copy_corners(j->s, b->prims, first, count, b->leaf_v8 + (size_t)9 * first);
+      float *v = b->leaf_v8 + (size_t)9 * first;
+      if (j->s->inst) copy_corners(j->s, b->prims, first, count, v);
+      else copy_corners_p((const float *const *)&j->s->p[0][0], b->prims, first, count, v);
       wn->ref[i] = first, wn->count[i] = count;
     } else {
       uint32_t r = wide8_new(j);
