@@ -152,7 +152,7 @@ static inline double nbox_area(nbox b) {
 
 typedef struct {
   nbox box[3][BVH_MAX_BINS];
-  uint32_t n[3][BVH_MAX_BINS];
+  uint32_t n[3][BVH_MAX_BINS + 8]; /* room to read eight from any bin */
 } bins;
 
 static void bins_clear(bins *b, int nb) {
@@ -249,31 +249,118 @@ typedef struct {
   bool oom; /* an allocation failed (only the building thread splits big ranges, which allocate) */
 } builder;
 
+/* best_split on axis a: the candidates there, after those of the axes before. */
+BVH_INLINE void best_split_axis(const bins *b, int a, int nb, bool *found, int *axis, int *pos, double *cost) {
+  /* Only splits at a nonempty bin i with triangles left of it are candidates,
+   * so the right costs are needed at nonempty bins only, and the left ones at
+   * candidates only; the first of equal candidates wins. */
+  double rcost[BVH_MAX_BINS];
+  nbox acc = nbox_empty();
+  uint32_t cnt = 0;
+  for (int i = nb - 1; i > 0; i--)
+    if (b->n[a][i]) nbox_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = nbox_area(acc) * cnt;
+  acc = nbox_empty(), cnt = 0;
+  for (int i = 1; i < nb; i++) {
+    nbox_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1]; /* an empty bin's box changes nothing */
+    if (!cnt || !b->n[a][i]) continue;
+    double c = nbox_area(acc) * cnt + rcost[i];
+    if (!*found || c < *cost) *found = true, *cost = c, *axis = a, *pos = i;
+  }
+}
+
 /* Chooses the cheapest binned SAH split; returns false when every centroid falls
  * into one bin on every axis. *cost is the SAH cost of the split (unnormalised). */
 BVH_INLINE bool best_split(const bins *b, const binmap *m, int *axis, int *pos, double *cost) {
   bool found = false;
+  for (int a = 0; a < 3; a++)
+    if (m->ok[a]) best_split_axis(b, a, m->nb, &found, axis, pos, cost);
+  return found;
+}
+
+#ifdef RR_SIMD_X86
+/* The areas of eight boxes given as lo + nhi (nbox_area's s) at p[0..7]: their
+ * lanes transposed, then (x·y + y·z) + z·x as nbox_area sums them. *bad: lanes
+ * whose area is not in [+0, FLT_MAX], where nbox_area would take half_area. */
+RR_TARGET_AVX2 static inline __m256 areas8(float (*p)[4], int *bad) {
+  __m256 r0 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p[0])), _mm_load_ps(p[4]), 1);
+  __m256 r1 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p[1])), _mm_load_ps(p[5]), 1);
+  __m256 r2 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p[2])), _mm_load_ps(p[6]), 1);
+  __m256 r3 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p[3])), _mm_load_ps(p[7]), 1);
+  __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpacklo_ps(r2, r3);
+  __m256 t2 = _mm256_unpackhi_ps(r0, r1), t3 = _mm256_unpackhi_ps(r2, r3);
+  __m256 x = _mm256_shuffle_ps(t0, t1, 0x44), y = _mm256_shuffle_ps(t0, t1, 0xEE), z = _mm256_shuffle_ps(t2, t3, 0x44);
+  __m256 a = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, y), _mm256_mul_ps(y, z)), _mm256_mul_ps(z, x));
+  __m256i bits = _mm256_castps_si256(a);
+  __m256i out = _mm256_or_si256(_mm256_cmpgt_epi32(bits, _mm256_set1_epi32(0x7F7FFFFF)),
+                                _mm256_cmpgt_epi32(_mm256_setzero_si256(), bits));
+  *bad = _mm256_movemask_ps(_mm256_castsi256_ps(out));
+  return a;
+}
+
+/* area · count per lane in double, as best_split multiplies them. */
+RR_TARGET_AVX2 static inline void costs8(__m256 a, const int32_t *n, __m256d c[2]) {
+  c[0] = _mm256_mul_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(a)), _mm256_cvtepi32_pd(_mm_loadu_si128((const __m128i *)n)));
+  c[1] = _mm256_mul_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(a, 1)),
+                       _mm256_cvtepi32_pd(_mm_loadu_si128((const __m128i *)(n + 4))));
+}
+
+/* best_split with the costs of eight candidates at a time: one pass each way
+ * makes every bin's left box (bins < i) and right box (bins >= i) as lo + nhi
+ * with their counts, then areas and costs as lanes, then a scan of the
+ * candidates in best_split's order. The same operations on the same values, so
+ * the same costs to the bit; an axis where a candidate's area is not a finite
+ * float (or is -0) takes best_split's loop instead. */
+RR_TARGET_AVX2 static bool best_split_avx2(const bins *b, const binmap *m, int *axis, int *pos, double *cost) {
+  enum { N = BVH_MAX_BINS + 8 }; /* bins 1 .. nb - 1 in groups of eight */
+  bool found = false;
   int nb = m->nb;
   for (int a = 0; a < 3; a++) {
     if (!m->ok[a]) continue;
-    /* Only splits at a nonempty bin i with triangles left of it are candidates,
-     * so the right costs are needed at nonempty bins only, and the left ones at
-     * candidates only; the first of equal candidates wins. */
-    double rcost[BVH_MAX_BINS];
+    float ls[N][4] __attribute__((aligned(16))), rs[N][4] __attribute__((aligned(16)));
+    int32_t lc[N], rc[N];
+    double c[N];
     nbox acc = nbox_empty();
     uint32_t cnt = 0;
-    for (int i = nb - 1; i > 0; i--)
-      if (b->n[a][i]) nbox_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = nbox_area(acc) * cnt;
+    for (int i = nb - 1; i > 0; i--) {
+      nbox_merge(&acc, b->box[a][i]), cnt += b->n[a][i];
+      rr_vf4_store(rs[i], acc.lo + acc.nhi), rc[i] = (int32_t)cnt;
+    }
     acc = nbox_empty(), cnt = 0;
     for (int i = 1; i < nb; i++) {
-      nbox_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1]; /* an empty bin's box changes nothing */
-      if (!cnt || !b->n[a][i]) continue;
-      double c = nbox_area(acc) * cnt + rcost[i];
-      if (!found || c < *cost) found = true, *cost = c, *axis = a, *pos = i;
+      nbox_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1];
+      rr_vf4_store(ls[i], acc.lo + acc.nhi), lc[i] = (int32_t)cnt;
+    }
+    for (int i = nb; i < nb + 8; i++) /* the last group's lanes past the bins: defined, never candidates */
+      rr_vf4_store(ls[i], rr_vf4_splat(0)), rr_vf4_store(rs[i], rr_vf4_splat(0)), lc[i] = rc[i] = 0;
+    uint64_t cand = 0;
+    int bad = 0;
+    for (int i = 1; i < nb; i += 8) {
+      /* candidates: lanes i + k < nb with a nonempty bin and references left of it */
+      __m256i lane = _mm256_add_epi32(_mm256_set1_epi32(i), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+      __m256i in = _mm256_cmpgt_epi32(_mm256_set1_epi32(nb), lane);
+      __m256i zero = _mm256_setzero_si256();
+      __m256i nz = _mm256_andnot_si256(_mm256_cmpeq_epi32(_mm256_loadu_si256((const __m256i *)&b->n[a][i]), zero),
+                                       _mm256_andnot_si256(_mm256_cmpeq_epi32(_mm256_loadu_si256((const __m256i *)&lc[i]), zero), in));
+      int ok = _mm256_movemask_ps(_mm256_castsi256_ps(nz)), bl, br;
+      __m256 al = areas8(&ls[i], &bl), ar = areas8(&rs[i], &br);
+      bad |= (bl | br) & ok;
+      __m256d cl[2], cr[2];
+      costs8(al, &lc[i], cl), costs8(ar, &rc[i], cr);
+      _mm256_storeu_pd(&c[i], _mm256_add_pd(cl[0], cr[0])), _mm256_storeu_pd(&c[i + 4], _mm256_add_pd(cl[1], cr[1]));
+      cand |= (uint64_t)ok << i;
+    }
+    if (bad) {
+      best_split_axis(b, a, nb, &found, axis, pos, cost);
+      continue;
+    }
+    for (; cand; cand &= cand - 1) {
+      int i = __builtin_ctzll(cand);
+      if (!found || c[i] < *cost) found = true, *cost = c[i], *axis = a, *pos = i;
     }
   }
   return found;
 }
+#endif
 
 /* Whether a binned reference goes right of the split (bin >= pos on `axis`); *c is
  * its centroid, lane 3 unmasked: it only reaches the lanes 3 of centroid bounds,
@@ -413,7 +500,7 @@ BVH_INLINE void split_pair(builder *bd, const task *t, int nb, split *sp) {
 /* Decides how to split t (or not) and partitions its references; `threads` only
  * says how many threads may help with a big range. Out of memory, t stays a leaf
  * and bd->oom is set. */
-BVH_INLINE void split_task_inl(builder *bd, const task *t, int threads, split *sp) {
+BVH_INLINE void split_task_inl(builder *bd, const task *t, int threads, split *sp, bool avx2) {
   sp->mid = 0;
   uint16_t buf = t->buf;
   if (t->count <= 1) return;
@@ -446,7 +533,12 @@ BVH_INLINE void split_task_inl(builder *bd, const task *t, int threads, split *s
   }
   int axis = 0, pos = 0;
   double cost = 0;
+#ifdef RR_SIMD_X86
+  bool found = avx2 && nb >= 12 ? best_split_avx2(b, &m, &axis, &pos, &cost) : best_split(b, &m, &axis, &pos, &cost);
+#else
+  (void)avx2;
   bool found = best_split(b, &m, &axis, &pos, &cost);
+#endif
   double area = half_area(t->box);
   /* Leaf when small enough and no split is cheaper (costs scaled by the area). */
   if (t->count <= (uint32_t)bd->leaf_size &&
@@ -503,7 +595,7 @@ children:
 /* split_task_inl compiled for AVX2 (three-operand forms: fewer register copies);
  * the same operations, so the same tree. */
 RR_TARGET_AVX2 static void split_task_avx2(builder *bd, const task *t, int threads, split *sp) {
-  split_task_inl(bd, t, threads, sp);
+  split_task_inl(bd, t, threads, sp, true);
 }
 #endif
 
@@ -514,7 +606,7 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
     return;
   }
 #endif
-  split_task_inl(bd, t, threads, sp);
+  split_task_inl(bd, t, threads, sp, false);
 }
 
 static void store_box(bvh_node *n, box4 b) {
@@ -572,7 +664,7 @@ typedef struct {
   uint32_t *leaves, *depth;
 } sub_job;
 
-BVH_INLINE void build_subtree_inl(int ti, sub_job *j) {
+BVH_INLINE void build_subtree_inl(int ti, sub_job *j, bool avx2) {
   node_vec *nv = &j->local[ti];
   /* Room for the whole subtree at once (at most 2 count - 2 nodes below the root):
    * no regrowing copies. */
@@ -592,7 +684,7 @@ BVH_INLINE void build_subtree_inl(int ti, sub_job *j) {
     task t = stack[--sp];
     bvh_node *n = (t.node & 0x80000000u) ? &nv->v[t.node & 0x7FFFFFFFu] : &j->top[t.node];
     split s;
-    split_task_inl(j->bd, &t, 1, &s);
+    split_task_inl(j->bd, &t, 1, &s, avx2);
     store_box(n, t.box);
     if (!s.mid) {
       n->first = t.start, n->count = t.count;
@@ -613,7 +705,7 @@ BVH_INLINE void build_subtree_inl(int ti, sub_job *j) {
 
 #ifdef RR_SIMD_X86
 /* The subtree loop with split_task_inl in it, compiled for AVX2 as split_task_avx2. */
-RR_TARGET_AVX2 static void build_subtree_avx2(int ti, sub_job *j) { build_subtree_inl(ti, j); }
+RR_TARGET_AVX2 static void build_subtree_avx2(int ti, sub_job *j) { build_subtree_inl(ti, j, true); }
 #endif
 
 static void build_subtree(int ti, int thread, void *arg) {
@@ -624,7 +716,7 @@ static void build_subtree(int ti, int thread, void *arg) {
     return;
   }
 #endif
-  build_subtree_inl(ti, arg);
+  build_subtree_inl(ti, arg, false);
 }
 
 /* ---- the top of the tree: big ranges, split one level at a time ------------ */
