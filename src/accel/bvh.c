@@ -850,16 +850,28 @@ static void copy_corners(const rr_scene *s, const uint32_t *prims, uint32_t firs
 
 /* copy_corners of a scene without instances, given its nine coordinate arrays
  * (hoisted out of the leaf loops). */
-static inline void copy_corners_p(const float *const *sp, const uint32_t *prims, uint32_t first, uint32_t count,
-                                  float *v) {
-  const float *p[9]; /* in locals: the stores into v cannot change them */
-  memcpy(p, sp, sizeof p);
+/* copy_corners_p's loop; inlined with a constant count for the common leaves. */
+BVH_INLINE void copy_corners_n(const float *const *p, const uint32_t *prims, uint32_t count, float *v) {
   for (uint32_t j = 0; j < count; j++) {
-    uint32_t t = prims[first + j];
+    uint32_t t = prims[j];
     float *o = v + j;
     o[0] = p[0][t], o[count] = p[1][t], o[2 * count] = p[2][t];
     o[3 * count] = p[3][t], o[4 * count] = p[4][t], o[5 * count] = p[5][t];
     o[6 * count] = p[6][t], o[7 * count] = p[7][t], o[8 * count] = p[8][t];
+  }
+}
+
+static inline void copy_corners_p(const float *const *sp, const uint32_t *prims, uint32_t first, uint32_t count,
+                                  float *v) {
+  const float *p[9]; /* in locals: the stores into v cannot change them */
+  memcpy(p, sp, sizeof p);
+  prims += first;
+  switch (count) { /* the offsets folded for leaves of one to four */
+  case 1: copy_corners_n(p, prims, 1, v); break;
+  case 2: copy_corners_n(p, prims, 2, v); break;
+  case 3: copy_corners_n(p, prims, 3, v); break;
+  case 4: copy_corners_n(p, prims, 4, v); break;
+  default: copy_corners_n(p, prims, count, v);
   }
 }
 
