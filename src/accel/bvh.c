@@ -384,14 +384,25 @@ static void range_bounds(const pref *r, uint32_t n, box4 *box, box4 *cbox) {
 
 /* In-place partition of a small range (one thread): left = bin < pos. Two-sided:
  * each reference is looked at once, and only those on the wrong side move. */
+/* ref_right with *c twice the centroid, lo + hi: halving is monotonic and keeps
+ * signs, so bounds over lo + hi halved are the centroids' bounds but for the sign
+ * of a zero that underflowed, which no bin map can tell from the other zero. */
+static inline bool ref_right2(const pref *r, int axis, int pos, rr_vf4 *c) {
+  *c = rr_vf4_load(r->lo) + rr_vf4_load(r->hi);
+  return r->bin[axis] >= pos;
+}
+
 BVH_INLINE uint32_t partition_small(pref *r, uint32_t n, int axis, int pos, box4 cb[2]) {
   cb[0] = box_empty(), cb[1] = box_empty();
   uint32_t i = 0, j = n;
   for (;;) {
     rr_vf4 ci = {0}, cj = {0}; /* set by the scans before use */
-    while (i < j && !ref_right(&r[i], axis, pos, &ci)) box_grow(&cb[0], ci, ci), i++;
-    while (i < j && ref_right(&r[j - 1], axis, pos, &cj)) box_grow(&cb[1], cj, cj), j--;
-    if (i == j) return i;
+    while (i < j && !ref_right2(&r[i], axis, pos, &ci)) box_grow(&cb[0], ci, ci), i++;
+    while (i < j && ref_right2(&r[j - 1], axis, pos, &cj)) box_grow(&cb[1], cj, cj), j--;
+    if (i == j) {
+      for (int k = 0; k < 2; k++) cb[k].lo *= 0.5f, cb[k].hi *= 0.5f;
+      return i;
+    }
     /* r[i] goes right and r[j - 1] left (j - 1 > i: r[i] stopped the left scan) */
     pref tmp = r[i];
     r[i++] = r[--j], r[j] = tmp;
@@ -748,7 +759,33 @@ static void make_refs(int c, int thread, void *arg) {
   uint32_t a = (uint32_t)c * BVH_CHUNK, e = s->ntris - a < BVH_CHUNK ? s->ntris : a + BVH_CHUNK;
   box4 b = box_empty(), cb = box_empty();
   float *const *p = &s->p[0][0]; /* the nine coordinate arrays */
-  for (uint32_t i = a; i < e; i++) {
+  uint32_t i = a;
+#ifdef RR_SIMD_X86
+  if (!s->kind && !s->inf && !s->inst) /* plain triangles: four at a time */
+    for (; i + 4 <= e; i += 4) {
+      /* per axis, the four triangles' bounds as lanes (the same min and max as
+       * below), then turned into four references */
+      __m128 lo[4], hi[4];
+      for (int x = 0; x < 3; x++) {
+        __m128 v0 = _mm_loadu_ps(p[x] + i), v1 = _mm_loadu_ps(p[3 + x] + i), v2 = _mm_loadu_ps(p[6 + x] + i);
+        lo[x] = _mm_min_ps(v0, _mm_min_ps(v1, v2)), hi[x] = _mm_max_ps(v0, _mm_max_ps(v1, v2));
+      }
+      lo[3] = _mm_castsi128_ps(_mm_add_epi32(_mm_set1_epi32((int32_t)i), _mm_setr_epi32(0, 1, 2, 3))); /* ids */
+      hi[3] = _mm_setzero_ps();                                                                      /* bins */
+      _MM_TRANSPOSE4_PS(lo[0], lo[1], lo[2], lo[3]);
+      _MM_TRANSPOSE4_PS(hi[0], hi[1], hi[2], hi[3]);
+      for (int k = 0; k < 4; k++) {
+        pref *r = &j->refs[i + k];
+        _mm_storeu_ps(r->lo, lo[k]), _mm_storeu_ps(r->hi, hi[k]);
+        rr_vf4 l, h;
+        ref_load(r, &l, &h);
+        box_grow(&b, l, h);
+        rr_vf4 cen = centroid(l, h);
+        box_grow(&cb, cen, cen);
+      }
+    }
+#endif
+  for (; i < e; i++) {
     pref *r = &j->refs[i];
     rr_vf4 lo, hi;
     if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE && !scene_inf(s, i)) {
