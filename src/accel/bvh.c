@@ -777,8 +777,7 @@ static void make_refs(int c, int thread, void *arg) {
       for (int k = 0; k < 4; k++) {
         pref *r = &j->refs[i + k];
         _mm_storeu_ps(r->lo, lo[k]), _mm_storeu_ps(r->hi, hi[k]);
-        rr_vf4 l, h;
-        ref_load(r, &l, &h);
+        rr_vf4 l = (rr_vf4)((rr_vi4)lo[k] & xyz_mask()), h = (rr_vf4)hi[k]; /* ref_load's (bins are 0) */
         box_grow(&b, l, h);
         rr_vf4 cen = centroid(l, h);
         box_grow(&cb, cen, cen);
