@@ -464,7 +464,10 @@ static void chunk_scatter(int c, int thread, void *arg) {
 /* ---- splitting one range ---------------------------------------------------- */
 
 static int bins_for(const builder *bd, uint32_t count) {
-  /* Few references gain nothing from many bins but pay for the sweep. */
+  /* Half as many bins as references (at least 4, at most bd->bins): one per
+   * reference costs a sweep step per reference and axis for nearly the same
+   * splits (SAH cost within 0.03% on the bunny, nefertiti and a teapot grid; a
+   * third or a quarter as many bins cost 0.1-0.2%). */
   uint32_t want = count / 2;
   int nb = want < (uint32_t)bd->bins ? (int)want : bd->bins;
   return nb < 4 ? (bd->bins < 4 ? bd->bins : 4) : nb;
