@@ -382,8 +382,6 @@ static void range_bounds(const pref *r, uint32_t n, box4 *box, box4 *cbox) {
   }
 }
 
-/* In-place partition of a small range (one thread): left = bin < pos. Two-sided:
- * each reference is looked at once, and only those on the wrong side move. */
 /* ref_right with *c twice the centroid, lo + hi: halving is monotonic and keeps
  * signs, so bounds over lo + hi halved are the centroids' bounds but for the sign
  * of a zero that underflowed, which no bin map can tell from the other zero. */
@@ -391,6 +389,9 @@ static inline bool ref_right2(const pref *r, int axis, int pos, rr_vf4 *c) {
   *c = rr_vf4_load(r->lo) + rr_vf4_load(r->hi);
   return r->bin[axis] >= pos;
 }
+
+/* In-place partition of a small range (one thread): left = bin < pos. Two-sided:
+ * each reference is looked at once, and only those on the wrong side move. */
 
 BVH_INLINE uint32_t partition_small(pref *r, uint32_t n, int axis, int pos, box4 cb[2]) {
   cb[0] = box_empty(), cb[1] = box_empty();
@@ -548,7 +549,9 @@ BVH_INLINE void split_task_inl(builder *bd, const task *t, int threads, split *s
   int axis = 0, pos = 0;
   double cost = 0;
 #ifdef RR_SIMD_X86
-  bool found = avx2 && nb >= 12 ? best_split_avx2(b, &m, &axis, &pos, &cost) : best_split(b, &m, &axis, &pos, &cost);
+  /* eight candidates at a time pay from 12 bins on; its counts are int32 lanes */
+  bool wide = avx2 && nb >= 12 && t->count <= INT32_MAX;
+  bool found = wide ? best_split_avx2(b, &m, &axis, &pos, &cost) : best_split(b, &m, &axis, &pos, &cost);
 #else
   (void)avx2;
   bool found = best_split(b, &m, &axis, &pos, &cost);
