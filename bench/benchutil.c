@@ -37,12 +37,13 @@ double bench_median(double *v, int n) {
 const char *bench_scene_path(const char *name) {
   static char buf[4096];
   if (access(name, R_OK) == 0 || strchr(name, '/')) return name;
-  if (strncmp(name, "grid:", 5) == 0) {
+  size_t pre = strncmp(name, "grid:", 5) == 0 ? 5 : strncmp(name, "grid-flat:", 10) == 0 ? 10 : 0;
+  if (pre) { /* grid:MESH:N, grid-flat:MESH:N: MESH from the models when not a file here */
     const char *last = strrchr(name, ':');
     char mesh[1024];
-    snprintf(mesh, sizeof mesh, "%.*s", (int)(last - name - 5), name + 5);
+    snprintf(mesh, sizeof mesh, "%.*s", (int)(last - name - pre), name + pre);
     if (access(mesh, R_OK) != 0) {
-      snprintf(buf, sizeof buf, "grid:%s/%s%s", RR_MODELS_DIR, mesh, last);
+      snprintf(buf, sizeof buf, "%.*s%s/%s%s", (int)pre, name, RR_MODELS_DIR, mesh, last);
       return buf;
     }
     return name;

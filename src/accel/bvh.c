@@ -28,6 +28,9 @@ enum {
   BVH_SAH_DEPTH = 48,   /* below this depth split at the median: bounds the depth */
 };
 
+/* Inlined into its callers, the subtree builder's AVX2 copy among them. */
+#define BVH_INLINE static inline __attribute__((always_inline))
+
 /* SAH costs of a traversal step and a triangle test (relative). */
 #define BVH_COST_NODE 1.0
 #define BVH_COST_TRI 1.0
@@ -71,7 +74,10 @@ static inline void box_merge(box4 *b, box4 o) { box_grow(b, o.lo, o.hi); }
 static inline double half_area(box4 b) {
   rr_vf4 e = b.hi - b.lo, p = e * rr_vf4_yzx(e);
   float a = p[0] + p[1] + p[2];
-  if (a >= 0 && a <= FLT_MAX) return a; /* finite (NaN fails both) */
+  uint32_t bits;
+  memcpy(&bits, &a, sizeof bits);
+  if (bits <= 0x7F7FFFFFu) return a; /* +0 to FLT_MAX: one test for the common case */
+  if (a >= 0 && a <= FLT_MAX) return a; /* -0 (NaN fails both) */
   if (!(e[0] >= 0)) return 0; /* empty (or NaN) */
   double x = (double)b.hi[0] - b.lo[0], y = (double)b.hi[1] - b.lo[1], z = (double)b.hi[2] - b.lo[2];
   return x * y + y * z + z * x;
@@ -84,17 +90,15 @@ typedef struct {
   bool ok[3]; /* axis has extent */
 } binmap;
 
-static binmap binmap_make(box4 cbox, int nb) {
+BVH_INLINE binmap binmap_make(box4 cbox, int nb) {
   binmap m;
-  float sc[4] = {0, 0, 0, 0};
-  for (int a = 0; a < 3; a++) {
-    float ext = cbox.hi[a] - cbox.lo[a];
-    float s = (float)nb / ext;
-    m.ok[a] = ext > 0 && isfinite(ext) && isfinite(s);
-    sc[a] = m.ok[a] ? s : 0;
-  }
+  /* per axis: ok when 0 < ext <= FLT_MAX and nb / ext is finite (NaN fails all) */
+  rr_vf4 ext = cbox.hi - cbox.lo, s = rr_vf4_splat((float)nb) / ext;
+  rr_vi4 ok = (ext > 0) & (ext <= FLT_MAX) & (rr_vf4_abs(s) <= FLT_MAX) & xyz_mask();
+  int bits = rr_vi4_bits(ok);
+  for (int a = 0; a < 3; a++) m.ok[a] = bits >> a & 1;
   m.cmin = (rr_vf4)((rr_vi4)cbox.lo & xyz_mask());
-  m.scale = rr_vf4_load(sc);
+  m.scale = (rr_vf4)((rr_vi4)s & ok);
   m.top = rr_vf4_splat((float)(nb - 1));
   m.nb = nb;
   return m;
@@ -109,18 +113,94 @@ static inline rr_vi4 bin_of(const binmap *m, rr_vf4 c) {
   return rr_vi4_trunc(f);
 }
 
+/* A bin's box is kept as its lower corner and its upper corner negated, so that
+ * both grow by a min (one eight-lane min under AVX2). -min(-a, -b) is max(a, b)
+ * to the bit, NaN and signed zeros included (both give b when they tie). */
 typedef struct {
-  box4 box[3][BVH_MAX_BINS];
-  uint32_t n[3][BVH_MAX_BINS];
+  rr_vf4 lo, nhi;
+} nbox;
+
+static inline rr_vf4 neg(rr_vf4 v) { return (rr_vf4)((rr_vi4)v ^ (rr_vi4)rr_vf4_splat(-0.0f)); }
+
+static inline nbox nbox_empty(void) {
+  nbox b = {rr_vf4_splat(INFINITY), rr_vf4_splat(INFINITY)};
+  return b;
+}
+
+static inline void nbox_merge(nbox *b, nbox o) {
+  b->lo = rr_vf4_min(b->lo, o.lo);
+  b->nhi = rr_vf4_min(b->nhi, o.nhi);
+}
+
+static inline box4 nbox_box(nbox b) {
+  box4 r = {b.lo, neg(b.nhi)};
+  return r;
+}
+
+/* half_area of an nbox without negating: lo + nhi is lo - hi, which is
+ * -(hi - lo) to the bit but where hi == lo (+0 both), so the products are
+ * half_area's but for the sign of a zero one, and the sum differs at most in
+ * the sign of a zero area, which no cost comparison or sum can see. */
+static inline double nbox_area(nbox b) {
+  rr_vf4 s = b.lo + b.nhi, p = s * rr_vf4_yzx(s);
+  float a = p[0] + p[1] + p[2];
+  uint32_t bits;
+  memcpy(&bits, &a, sizeof bits);
+  if (bits <= 0x7F7FFFFFu) return a;
+  return half_area(nbox_box(b));
+}
+
+typedef struct {
+  nbox box[3][BVH_MAX_BINS];
+  uint32_t n[3][BVH_MAX_BINS + 8]; /* room to read eight from any bin */
 } bins;
 
 static void bins_clear(bins *b, int nb) {
   for (int a = 0; a < 3; a++)
-    for (int i = 0; i < nb; i++) b->box[a][i] = box_empty(), b->n[a][i] = 0;
+    for (int i = 0; i < nb; i++) b->box[a][i] = nbox_empty(), b->n[a][i] = 0;
 }
+
+#ifdef RR_SIMD_X86
+/* bin_range with a reference's box (upper corner negated) and a bin's as one
+ * eight-lane vector each: a bin grows by one min. */
+RR_TARGET_AVX2 static inline void bin_grow8(bins *b, int a, uint32_t k, __m256 v) {
+  float *bx = (float *)&b->box[a][k];
+  _mm256_storeu_ps(bx, _mm256_min_ps(_mm256_loadu_ps(bx), v));
+  b->n[a][k]++;
+}
+
+RR_TARGET_AVX2 static void bin_range_avx2(pref *r, uint32_t n, const binmap *m, bins *b) {
+  /* bins_clear with a bin's box as one vector, the counts eight at a time */
+  __m256 empty = _mm256_set1_ps(INFINITY);
+  __m256 neg_hi = _mm256_setr_ps(0, 0, 0, 0, -0.0f, -0.0f, -0.0f, -0.0f);
+  for (int a = 0; a < 3; a++) {
+    for (int i = 0; i < m->nb; i += 2) /* two at a time: BVH_MAX_BINS is even */
+      _mm256_storeu_ps((float *)&b->box[a][i], empty), _mm256_storeu_ps((float *)&b->box[a][i + 1], empty);
+    for (int i = 0; i < m->nb; i += 8) _mm256_storeu_si256((__m256i *)&b->n[a][i], _mm256_setzero_si256());
+  }
+  for (uint32_t i = 0; i < n; i++) {
+    __m256 v = _mm256_loadu_ps(r[i].lo); /* lanes 3 and 7 (id, bins): as in bin_range */
+    __m128 lo = _mm256_castps256_ps128(v), hi = _mm256_extractf128_ps(v, 1);
+    v = _mm256_xor_ps(v, neg_hi);
+    __m128i idx = (__m128i)bin_of(m, centroid((rr_vf4)lo, (rr_vf4)hi));
+    __m128i pk = _mm_packs_epi32(idx, idx);
+    uint32_t packed = (uint32_t)_mm_cvtsi128_si32(_mm_packus_epi16(pk, pk));
+    memcpy(r[i].bin, &packed, 4);
+    bin_grow8(b, 0, (uint32_t)_mm_cvtsi128_si32(idx), v);
+    bin_grow8(b, 1, (uint32_t)_mm_extract_epi32(idx, 1), v);
+    bin_grow8(b, 2, (uint32_t)_mm_extract_epi32(idx, 2), v);
+  }
+}
+#endif
 
 /* Bins a range, noting each reference's bins in it (pref.bin). */
 static void bin_range(pref *r, uint32_t n, const binmap *m, bins *b) {
+#ifdef RR_SIMD_X86
+  if (__builtin_cpu_supports("avx2")) {
+    bin_range_avx2(r, n, m, b);
+    return;
+  }
+#endif
   bins_clear(b, m->nb);
   for (uint32_t i = 0; i < n; i++) {
     /* Lane 3 (id, bins) unmasked: it only reaches lanes 3 of the bin boxes,
@@ -136,15 +216,16 @@ static void bin_range(pref *r, uint32_t n, const binmap *m, bins *b) {
 #else
     r[i].bin[0] = (uint8_t)i0, r[i].bin[1] = (uint8_t)i1, r[i].bin[2] = (uint8_t)i2;
 #endif
-    box_grow(&b->box[0][i0], lo, hi), b->n[0][i0]++;
-    box_grow(&b->box[1][i1], lo, hi), b->n[1][i1]++;
-    box_grow(&b->box[2][i2], lo, hi), b->n[2][i2]++;
+    nbox rb = {lo, neg(hi)};
+    nbox_merge(&b->box[0][i0], rb), b->n[0][i0]++;
+    nbox_merge(&b->box[1][i1], rb), b->n[1][i1]++;
+    nbox_merge(&b->box[2][i2], rb), b->n[2][i2]++;
   }
 }
 
 static void bins_merge(bins *into, const bins *b, int nb) {
   for (int a = 0; a < 3; a++)
-    for (int i = 0; i < nb; i++) box_merge(&into->box[a][i], b->box[a][i]), into->n[a][i] += b->n[a][i];
+    for (int i = 0; i < nb; i++) nbox_merge(&into->box[a][i], b->box[a][i]), into->n[a][i] += b->n[a][i];
 }
 
 /* A range of references waiting to become a subtree rooted at `node`; they lie
@@ -168,37 +249,124 @@ typedef struct {
   bool oom; /* an allocation failed (only the building thread splits big ranges, which allocate) */
 } builder;
 
+/* best_split on axis a: the candidates there, after those of the axes before. */
+BVH_INLINE void best_split_axis(const bins *b, int a, int nb, bool *found, int *axis, int *pos, double *cost) {
+  /* Only splits at a nonempty bin i with triangles left of it are candidates,
+   * so the right costs are needed at nonempty bins only, and the left ones at
+   * candidates only; the first of equal candidates wins. */
+  double rcost[BVH_MAX_BINS];
+  nbox acc = nbox_empty();
+  uint32_t cnt = 0;
+  for (int i = nb - 1; i > 0; i--)
+    if (b->n[a][i]) nbox_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = nbox_area(acc) * cnt;
+  acc = nbox_empty(), cnt = 0;
+  for (int i = 1; i < nb; i++) {
+    nbox_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1]; /* an empty bin's box changes nothing */
+    if (!cnt || !b->n[a][i]) continue;
+    double c = nbox_area(acc) * cnt + rcost[i];
+    if (!*found || c < *cost) *found = true, *cost = c, *axis = a, *pos = i;
+  }
+}
+
 /* Chooses the cheapest binned SAH split; returns false when every centroid falls
  * into one bin on every axis. *cost is the SAH cost of the split (unnormalised). */
-static bool best_split(const bins *b, const binmap *m, int *axis, int *pos, double *cost) {
+BVH_INLINE bool best_split(const bins *b, const binmap *m, int *axis, int *pos, double *cost) {
+  bool found = false;
+  for (int a = 0; a < 3; a++)
+    if (m->ok[a]) best_split_axis(b, a, m->nb, &found, axis, pos, cost);
+  return found;
+}
+
+#ifdef RR_SIMD_X86
+/* The areas of eight boxes given as lo + nhi (nbox_area's s) at p[0..7]: their
+ * lanes transposed, then (x·y + y·z) + z·x as nbox_area sums them. *bad: lanes
+ * whose area is not in [+0, FLT_MAX], where nbox_area would take half_area. */
+RR_TARGET_AVX2 static inline __m256 areas8(float (*p)[4], int *bad) {
+  __m256 r0 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p[0])), _mm_load_ps(p[4]), 1);
+  __m256 r1 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p[1])), _mm_load_ps(p[5]), 1);
+  __m256 r2 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p[2])), _mm_load_ps(p[6]), 1);
+  __m256 r3 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_load_ps(p[3])), _mm_load_ps(p[7]), 1);
+  __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpacklo_ps(r2, r3);
+  __m256 t2 = _mm256_unpackhi_ps(r0, r1), t3 = _mm256_unpackhi_ps(r2, r3);
+  __m256 x = _mm256_shuffle_ps(t0, t1, 0x44), y = _mm256_shuffle_ps(t0, t1, 0xEE), z = _mm256_shuffle_ps(t2, t3, 0x44);
+  __m256 a = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, y), _mm256_mul_ps(y, z)), _mm256_mul_ps(z, x));
+  __m256i bits = _mm256_castps_si256(a);
+  __m256i out = _mm256_or_si256(_mm256_cmpgt_epi32(bits, _mm256_set1_epi32(0x7F7FFFFF)),
+                                _mm256_cmpgt_epi32(_mm256_setzero_si256(), bits));
+  *bad = _mm256_movemask_ps(_mm256_castsi256_ps(out));
+  return a;
+}
+
+/* area · count per lane in double, as best_split multiplies them. */
+RR_TARGET_AVX2 static inline void costs8(__m256 a, const int32_t *n, __m256d c[2]) {
+  c[0] = _mm256_mul_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(a)), _mm256_cvtepi32_pd(_mm_loadu_si128((const __m128i *)n)));
+  c[1] = _mm256_mul_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(a, 1)),
+                       _mm256_cvtepi32_pd(_mm_loadu_si128((const __m128i *)(n + 4))));
+}
+
+/* best_split with the costs of eight candidates at a time: one pass each way
+ * makes every bin's left box (bins < i) and right box (bins >= i) as lo + nhi
+ * with their counts, then areas and costs as lanes, then a scan of the
+ * candidates in best_split's order. The same operations on the same values, so
+ * the same costs to the bit; an axis where a candidate's area is not a finite
+ * float (or is -0) takes best_split's loop instead. */
+RR_TARGET_AVX2 static bool best_split_avx2(const bins *b, const binmap *m, int *axis, int *pos, double *cost) {
+  enum { N = BVH_MAX_BINS + 8 }; /* bins 1 .. nb - 1 in groups of eight */
   bool found = false;
   int nb = m->nb;
   for (int a = 0; a < 3; a++) {
     if (!m->ok[a]) continue;
-    /* Only splits at a nonempty bin i with triangles left of it are candidates,
-     * so the right costs are needed at nonempty bins only, and the left ones at
-     * candidates only; the first of equal candidates wins. */
-    double rcost[BVH_MAX_BINS];
-    box4 acc = box_empty();
+    float ls[N][4] __attribute__((aligned(16))), rs[N][4] __attribute__((aligned(16)));
+    int32_t lc[N], rc[N];
+    double c[N];
+    nbox acc = nbox_empty();
     uint32_t cnt = 0;
-    for (int i = nb - 1; i > 0; i--)
-      if (b->n[a][i]) box_merge(&acc, b->box[a][i]), cnt += b->n[a][i], rcost[i] = half_area(acc) * cnt;
-    acc = box_empty(), cnt = 0;
+    for (int i = nb - 1; i > 0; i--) {
+      nbox_merge(&acc, b->box[a][i]), cnt += b->n[a][i];
+      rr_vf4_store(rs[i], acc.lo + acc.nhi), rc[i] = (int32_t)cnt;
+    }
+    acc = nbox_empty(), cnt = 0;
     for (int i = 1; i < nb; i++) {
-      box_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1]; /* an empty bin's box changes nothing */
-      if (!cnt || !b->n[a][i]) continue;
-      double c = half_area(acc) * cnt + rcost[i];
-      if (!found || c < *cost) found = true, *cost = c, *axis = a, *pos = i;
+      nbox_merge(&acc, b->box[a][i - 1]), cnt += b->n[a][i - 1];
+      rr_vf4_store(ls[i], acc.lo + acc.nhi), lc[i] = (int32_t)cnt;
+    }
+    for (int i = nb; i < nb + 8; i++) /* the last group's lanes past the bins: defined, never candidates */
+      rr_vf4_store(ls[i], rr_vf4_splat(0)), rr_vf4_store(rs[i], rr_vf4_splat(0)), lc[i] = rc[i] = 0;
+    uint64_t cand = 0;
+    int bad = 0;
+    for (int i = 1; i < nb; i += 8) {
+      /* candidates: lanes i + k < nb with a nonempty bin and references left of it */
+      __m256i lane = _mm256_add_epi32(_mm256_set1_epi32(i), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+      __m256i in = _mm256_cmpgt_epi32(_mm256_set1_epi32(nb), lane);
+      __m256i zero = _mm256_setzero_si256();
+      __m256i nz = _mm256_andnot_si256(_mm256_cmpeq_epi32(_mm256_loadu_si256((const __m256i *)&b->n[a][i]), zero),
+                                       _mm256_andnot_si256(_mm256_cmpeq_epi32(_mm256_loadu_si256((const __m256i *)&lc[i]), zero), in));
+      int ok = _mm256_movemask_ps(_mm256_castsi256_ps(nz)), bl, br;
+      __m256 al = areas8(&ls[i], &bl), ar = areas8(&rs[i], &br);
+      bad |= (bl | br) & ok;
+      __m256d cl[2], cr[2];
+      costs8(al, &lc[i], cl), costs8(ar, &rc[i], cr);
+      _mm256_storeu_pd(&c[i], _mm256_add_pd(cl[0], cr[0])), _mm256_storeu_pd(&c[i + 4], _mm256_add_pd(cl[1], cr[1]));
+      cand |= (uint64_t)ok << i;
+    }
+    if (bad) {
+      best_split_axis(b, a, nb, &found, axis, pos, cost);
+      continue;
+    }
+    for (; cand; cand &= cand - 1) {
+      int i = __builtin_ctzll(cand);
+      if (!found || c[i] < *cost) found = true, *cost = c[i], *axis = a, *pos = i;
     }
   }
   return found;
 }
+#endif
 
-/* Whether a binned reference goes right of the split (bin >= pos on `axis`); *c is its centroid. */
+/* Whether a binned reference goes right of the split (bin >= pos on `axis`); *c is
+ * its centroid, lane 3 unmasked: it only reaches the lanes 3 of centroid bounds,
+ * which binmap_make masks off. */
 static inline bool ref_right(const pref *r, int axis, int pos, rr_vf4 *c) {
-  rr_vf4 lo, hi;
-  ref_load(r, &lo, &hi);
-  *c = centroid(lo, hi);
+  *c = centroid(rr_vf4_load(r->lo), rr_vf4_load(r->hi));
   return r->bin[axis] >= pos;
 }
 
@@ -214,16 +382,28 @@ static void range_bounds(const pref *r, uint32_t n, box4 *box, box4 *cbox) {
   }
 }
 
+/* ref_right with *c twice the centroid, lo + hi: halving is monotonic and keeps
+ * signs, so bounds over lo + hi halved are the centroids' bounds but for the sign
+ * of a zero that underflowed, which no bin map can tell from the other zero. */
+static inline bool ref_right2(const pref *r, int axis, int pos, rr_vf4 *c) {
+  *c = rr_vf4_load(r->lo) + rr_vf4_load(r->hi);
+  return r->bin[axis] >= pos;
+}
+
 /* In-place partition of a small range (one thread): left = bin < pos. Two-sided:
  * each reference is looked at once, and only those on the wrong side move. */
-static uint32_t partition_small(pref *r, uint32_t n, int axis, int pos, box4 cb[2]) {
+
+BVH_INLINE uint32_t partition_small(pref *r, uint32_t n, int axis, int pos, box4 cb[2]) {
   cb[0] = box_empty(), cb[1] = box_empty();
   uint32_t i = 0, j = n;
   for (;;) {
     rr_vf4 ci = {0}, cj = {0}; /* set by the scans before use */
-    while (i < j && !ref_right(&r[i], axis, pos, &ci)) box_grow(&cb[0], ci, ci), i++;
-    while (i < j && ref_right(&r[j - 1], axis, pos, &cj)) box_grow(&cb[1], cj, cj), j--;
-    if (i == j) return i;
+    while (i < j && !ref_right2(&r[i], axis, pos, &ci)) box_grow(&cb[0], ci, ci), i++;
+    while (i < j && ref_right2(&r[j - 1], axis, pos, &cj)) box_grow(&cb[1], cj, cj), j--;
+    if (i == j) {
+      for (int k = 0; k < 2; k++) cb[k].lo *= 0.5f, cb[k].hi *= 0.5f;
+      return i;
+    }
     /* r[i] goes right and r[j - 1] left (j - 1 > i: r[i] stopped the left scan) */
     pref tmp = r[i];
     r[i++] = r[--j], r[j] = tmp;
@@ -285,8 +465,12 @@ static void chunk_scatter(int c, int thread, void *arg) {
 /* ---- splitting one range ---------------------------------------------------- */
 
 static int bins_for(const builder *bd, uint32_t count) {
-  /* Few references gain nothing from many bins but pay for the sweep. */
-  int nb = count < (uint32_t)bd->bins ? (int)count : bd->bins;
+  /* Half as many bins as references (at least 4, at most bd->bins): one per
+   * reference costs a sweep step per reference and axis for nearly the same
+   * splits (SAH cost within 0.03% on the bunny, nefertiti and a teapot grid; a
+   * third or a quarter as many bins cost 0.1-0.2%). */
+  uint32_t want = count / 2;
+  int nb = want < (uint32_t)bd->bins ? (int)want : bd->bins;
   return nb < 4 ? (bd->bins < 4 ? bd->bins : 4) : nb;
 }
 
@@ -302,7 +486,7 @@ static void median_split(builder *bd, const task *t, split *sp) {
  * box, so on every axis with extent one is in bin 0 and the other in bin nb - 1:
  * each such axis offers the one split (one reference each side) at the same cost,
  * and the first such axis wins. */
-static void split_pair(builder *bd, const task *t, int nb, split *sp) {
+BVH_INLINE void split_pair(builder *bd, const task *t, int nb, split *sp) {
   pref *r = bd->buf[t->buf] + t->start;
   binmap m = binmap_make(t->cbox, nb);
   int axis = -1;
@@ -331,7 +515,7 @@ static void split_pair(builder *bd, const task *t, int nb, split *sp) {
 /* Decides how to split t (or not) and partitions its references; `threads` only
  * says how many threads may help with a big range. Out of memory, t stays a leaf
  * and bd->oom is set. */
-static void split_task(builder *bd, const task *t, int threads, split *sp) {
+BVH_INLINE void split_task_inl(builder *bd, const task *t, int threads, split *sp, bool avx2) {
   sp->mid = 0;
   uint16_t buf = t->buf;
   if (t->count <= 1) return;
@@ -364,7 +548,14 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
   }
   int axis = 0, pos = 0;
   double cost = 0;
+#ifdef RR_SIMD_X86
+  /* eight candidates at a time pay from 12 bins on; its counts are int32 lanes */
+  bool wide = avx2 && nb >= 12 && t->count <= INT32_MAX;
+  bool found = wide ? best_split_avx2(b, &m, &axis, &pos, &cost) : best_split(b, &m, &axis, &pos, &cost);
+#else
+  (void)avx2;
   bool found = best_split(b, &m, &axis, &pos, &cost);
+#endif
   double area = half_area(t->box);
   /* Leaf when small enough and no split is cheaper (costs scaled by the area). */
   if (t->count <= (uint32_t)bd->leaf_size &&
@@ -375,9 +566,10 @@ static void split_task(builder *bd, const task *t, int threads, split *sp) {
     median_split(bd, t, sp);
     goto children;
   }
-  sp->l.box = box_empty(), sp->r.box = box_empty();
+  nbox lr[2] = {nbox_empty(), nbox_empty()};
   for (int i = 0; i < nb; i++)
-    if (b->n[axis][i]) box_merge(i < pos ? &sp->l.box : &sp->r.box, b->box[axis][i]);
+    if (b->n[axis][i]) nbox_merge(&lr[i >= pos], b->box[axis][i]);
+  sp->l.box = nbox_box(lr[0]), sp->r.box = nbox_box(lr[1]);
   if (big) {
     job.axis = axis, job.pos = pos;
     job.nleft = malloc(sizeof(uint32_t) * nchunks);
@@ -414,6 +606,24 @@ children:
   sp->r.start = t->start + sp->mid, sp->r.count = t->count - sp->mid;
   sp->l.depth = sp->r.depth = t->depth + 1;
   sp->l.buf = sp->r.buf = buf;
+}
+
+#ifdef RR_SIMD_X86
+/* split_task_inl compiled for AVX2 (three-operand forms: fewer register copies);
+ * the same operations, so the same tree. */
+RR_TARGET_AVX2 static void split_task_avx2(builder *bd, const task *t, int threads, split *sp) {
+  split_task_inl(bd, t, threads, sp, true);
+}
+#endif
+
+static void split_task(builder *bd, const task *t, int threads, split *sp) {
+#ifdef RR_SIMD_X86
+  if (__builtin_cpu_supports("avx2")) {
+    split_task_avx2(bd, t, threads, sp);
+    return;
+  }
+#endif
+  split_task_inl(bd, t, threads, sp, false);
 }
 
 static void store_box(bvh_node *n, box4 b) {
@@ -471,9 +681,7 @@ typedef struct {
   uint32_t *leaves, *depth;
 } sub_job;
 
-static void build_subtree(int ti, int thread, void *arg) {
-  (void)thread;
-  sub_job *j = arg;
+BVH_INLINE void build_subtree_inl(int ti, sub_job *j, bool avx2) {
   node_vec *nv = &j->local[ti];
   /* Room for the whole subtree at once (at most 2 count - 2 nodes below the root):
    * no regrowing copies. */
@@ -493,7 +701,7 @@ static void build_subtree(int ti, int thread, void *arg) {
     task t = stack[--sp];
     bvh_node *n = (t.node & 0x80000000u) ? &nv->v[t.node & 0x7FFFFFFFu] : &j->top[t.node];
     split s;
-    split_task(j->bd, &t, 1, &s);
+    split_task_inl(j->bd, &t, 1, &s, avx2);
     store_box(n, t.box);
     if (!s.mid) {
       n->first = t.start, n->count = t.count;
@@ -510,6 +718,22 @@ static void build_subtree(int ti, int thread, void *arg) {
     stack[sp++] = s.l;
   }
   j->leaves[ti] = leaves, j->depth[ti] = depth;
+}
+
+#ifdef RR_SIMD_X86
+/* The subtree loop with split_task_inl in it, compiled for AVX2 as split_task_avx2. */
+RR_TARGET_AVX2 static void build_subtree_avx2(int ti, sub_job *j) { build_subtree_inl(ti, j, true); }
+#endif
+
+static void build_subtree(int ti, int thread, void *arg) {
+  (void)thread;
+#ifdef RR_SIMD_X86
+  if (__builtin_cpu_supports("avx2")) {
+    build_subtree_avx2(ti, arg);
+    return;
+  }
+#endif
+  build_subtree_inl(ti, arg, false);
 }
 
 /* ---- the top of the tree: big ranges, split one level at a time ------------ */
@@ -541,7 +765,32 @@ static void make_refs(int c, int thread, void *arg) {
   uint32_t a = (uint32_t)c * BVH_CHUNK, e = s->ntris - a < BVH_CHUNK ? s->ntris : a + BVH_CHUNK;
   box4 b = box_empty(), cb = box_empty();
   float *const *p = &s->p[0][0]; /* the nine coordinate arrays */
-  for (uint32_t i = a; i < e; i++) {
+  uint32_t i = a;
+#ifdef RR_SIMD_X86
+  if (!s->kind && !s->inf && !s->inst) /* plain triangles: four at a time */
+    for (; i + 4 <= e; i += 4) {
+      /* per axis, the four triangles' bounds as lanes (the same min and max as
+       * below), then turned into four references */
+      __m128 lo[4], hi[4];
+      for (int x = 0; x < 3; x++) {
+        __m128 v0 = _mm_loadu_ps(p[x] + i), v1 = _mm_loadu_ps(p[3 + x] + i), v2 = _mm_loadu_ps(p[6 + x] + i);
+        lo[x] = _mm_min_ps(v0, _mm_min_ps(v1, v2)), hi[x] = _mm_max_ps(v0, _mm_max_ps(v1, v2));
+      }
+      lo[3] = _mm_castsi128_ps(_mm_add_epi32(_mm_set1_epi32((int32_t)i), _mm_setr_epi32(0, 1, 2, 3))); /* ids */
+      hi[3] = _mm_setzero_ps();                                                                      /* bins */
+      _MM_TRANSPOSE4_PS(lo[0], lo[1], lo[2], lo[3]);
+      _MM_TRANSPOSE4_PS(hi[0], hi[1], hi[2], hi[3]);
+      for (int k = 0; k < 4; k++) {
+        pref *r = &j->refs[i + k];
+        _mm_storeu_ps(r->lo, lo[k]), _mm_storeu_ps(r->hi, hi[k]);
+        rr_vf4 l = (rr_vf4)((rr_vi4)lo[k] & xyz_mask()), h = (rr_vf4)hi[k]; /* ref_load's (bins are 0) */
+        box_grow(&b, l, h);
+        rr_vf4 cen = centroid(l, h);
+        box_grow(&cb, cen, cen);
+      }
+    }
+#endif
+  for (; i < e; i++) {
     pref *r = &j->refs[i];
     rr_vf4 lo, hi;
     if (scene_kind(s, i) == RR_GEOMETRY_TRIANGLE && !scene_inf(s, i)) {
@@ -625,6 +874,9 @@ static void collapse_node(rr_bvh *b, uint32_t w, uint32_t k, uint32_t *next) {
 /* The corners of the triangles prims[first .. first + count) into v: corner k's
  * axis x of the j-th at v[(3k + x)·count + j] (the layout of rr_bvh.leaf_v). An
  * instance's corners are moved to world space (scene_corners), the rest copied. */
+static inline void copy_corners_p(const float *const *sp, const uint32_t *prims, uint32_t first, uint32_t count,
+                                  float *v);
+
 static void copy_corners(const rr_scene *s, const uint32_t *prims, uint32_t first, uint32_t count, float *v) {
   if (s->inst) {
     for (uint32_t j = 0; j < count; j++) {
@@ -635,14 +887,33 @@ static void copy_corners(const rr_scene *s, const uint32_t *prims, uint32_t firs
     }
     return;
   }
-  const float *p[9]; /* in locals: the stores into v cannot change them */
-  memcpy(p, s->p, sizeof p);
+  copy_corners_p((const float *const *)&s->p[0][0], prims, first, count, v);
+}
+
+/* copy_corners of a scene without instances, given its nine coordinate arrays
+ * (hoisted out of the leaf loops). */
+/* copy_corners_p's loop; inlined with a constant count for the common leaves. */
+BVH_INLINE void copy_corners_n(const float *const *p, const uint32_t *prims, uint32_t count, float *v) {
   for (uint32_t j = 0; j < count; j++) {
-    uint32_t t = prims[first + j];
+    uint32_t t = prims[j];
     float *o = v + j;
     o[0] = p[0][t], o[count] = p[1][t], o[2 * count] = p[2][t];
     o[3 * count] = p[3][t], o[4 * count] = p[4][t], o[5 * count] = p[5][t];
     o[6 * count] = p[6][t], o[7 * count] = p[7][t], o[8 * count] = p[8][t];
+  }
+}
+
+static inline void copy_corners_p(const float *const *sp, const uint32_t *prims, uint32_t first, uint32_t count,
+                                  float *v) {
+  const float *p[9]; /* in locals: the stores into v cannot change them */
+  memcpy(p, sp, sizeof p);
+  prims += first;
+  switch (count) { /* the offsets folded for leaves of one to four */
+  case 1: copy_corners_n(p, prims, 1, v); break;
+  case 2: copy_corners_n(p, prims, 2, v); break;
+  case 3: copy_corners_n(p, prims, 3, v); break;
+  case 4: copy_corners_n(p, prims, 4, v); break;
+  default: copy_corners_n(p, prims, count, v);
   }
 }
 
@@ -652,10 +923,12 @@ static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
   b->leaf_v = alloc_lines((n + BVH_LEAF_PAD) * sizeof(float));
   if (!b->leaf_v) return false;
   memset(b->leaf_v + n, 0, BVH_LEAF_PAD * sizeof(float));
+  const float *const *p = (const float *const *)&s->p[0][0];
   for (uint32_t i = 0; i < b->nnodes; i++) {
     const bvh_node *nd = &b->nodes[i];
-    if (nd->count && nd->count != BVH_INST) /* (an instance's leaf has no corners of its own) */
-      copy_corners(s, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
+    if (!nd->count || nd->count == BVH_INST) continue; /* (an instance's leaf has no corners of its own) */
+    if (s->inst) copy_corners(s, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
+    else copy_corners_p(p, b->prims, nd->first, nd->count, b->leaf_v + (size_t)9 * nd->first);
   }
   return true;
 }
@@ -694,8 +967,26 @@ typedef struct {
   rr_bvh *b;
   const rr_scene *s;
   uint32_t *first, *count; /* per binary node: its subtree's prims (count 0: not consecutive) */
-  uint32_t next;           /* the next free node */
+  uint32_t next, cap;      /* the next free node; room in b->wide8 */
+  bool oom;
 } wide8_build;
+
+/* A new wide8 node's index, the array grown by doubling when full (UINT32_MAX
+ * when out of memory). Growing as it goes costs less than counting first. */
+static uint32_t wide8_new(wide8_build *j) {
+  if (j->next == j->cap) {
+    uint32_t cap = j->cap * 2;
+    bvh_wide8 *p = cap > j->cap ? alloc_lines((size_t)cap * sizeof *p) : NULL;
+    if (!p) {
+      j->oom = true;
+      return UINT32_MAX;
+    }
+    memcpy(p, j->b->wide8, (size_t)j->next * sizeof *p);
+    free(j->b->wide8);
+    j->b->wide8 = p, j->cap = cap;
+  }
+  return j->next++;
+}
 
 /* The prims under each binary node k into j->first[k], j->count[k]; the count is
  * left 0 where they are not one range (never, for the builder's trees; checked).
@@ -746,7 +1037,7 @@ static uint32_t open_slots8(const wide8_build *j, uint32_t k, uint32_t *slot) {
 static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
   rr_bvh *b = j->b;
   uint32_t slot[8], n = open_slots8(j, k, slot);
-  bvh_wide8 *wn = &b->wide8[w];
+  bvh_wide8 *wn = &b->wide8[w]; /* moves when a child grows the array */
   for (uint32_t i = 0; i < 8; i++) {
     const bvh_node *c = i < n ? &b->nodes[slot[i]] : NULL;
     for (int a = 0; a < 3; a++) wn->lo[a][i] = c ? c->lo[a] : INFINITY, wn->hi[a][i] = c ? c->hi[a] : -INFINITY;
@@ -756,26 +1047,25 @@ static void collapse_node8(wide8_build *j, uint32_t w, uint32_t k) {
     uint32_t c = slot[i];
     if (leaf8(j, c)) { /* a leaf: its corners as leaf_v's */
       uint32_t first = j->first[c], count = j->count[c];
-      if (count != BVH_INST) copy_corners(j->s, b->prims, first, count, b->leaf_v8 + (size_t)9 * first);
+      float *v = b->leaf_v8 + (size_t)9 * first;
+      if (count == BVH_INST) /* an instance's leaf has no corners of its own */
+        ;
+      else if (j->s->inst) copy_corners(j->s, b->prims, first, count, v);
+      else copy_corners_p((const float *const *)&j->s->p[0][0], b->prims, first, count, v);
       wn->ref[i] = first, wn->count[i] = count;
     } else {
-      wn->ref[i] = j->next++;
-      collapse_node8(j, wn->ref[i], c);
+      uint32_t r = wide8_new(j);
+      if (r == UINT32_MAX) return;
+      collapse_node8(j, r, c);
+      b->wide8[w].ref[i] = r;
+      wn = &b->wide8[w];
     }
   }
 }
 
-/* The wide8 nodes collapse_node8 makes from binary node k. */
-static uint32_t count_nodes8(const wide8_build *j, uint32_t k) {
-  uint32_t slot[8], n = open_slots8(j, k, slot), total = 1;
-  for (uint32_t i = 0; i < n; i++)
-    if (!leaf8(j, slot[i])) total += count_nodes8(j, slot[i]);
-  return total;
-}
-
 static bool collapse_wide8(rr_bvh *b, const rr_scene *s) {
   size_t nv = (size_t)9 * b->nprims;
-  wide8_build j = {.b = b, .s = s, .next = 1};
+  wide8_build j = {.b = b, .s = s, .next = 1, .cap = 64};
   j.first = malloc((size_t)b->nnodes * sizeof(uint32_t));
   j.count = malloc((size_t)b->nnodes * sizeof(uint32_t));
   b->leaf_v8 = alloc_lines((nv + BVH_LEAF_PAD) * sizeof(float));
@@ -783,11 +1073,11 @@ static bool collapse_wide8(rr_bvh *b, const rr_scene *s) {
   if (ok) {
     memset(b->leaf_v8 + nv, 0, BVH_LEAF_PAD * sizeof(float));
     subtree_ranges(&j);
-    b->nwide8 = count_nodes8(&j, 0); /* counted first: no room to guess and trim */
-    b->wide8 = alloc_lines((size_t)b->nwide8 * sizeof(bvh_wide8));
+    b->wide8 = alloc_lines((size_t)j.cap * sizeof(bvh_wide8));
     ok = b->wide8 != NULL;
   }
-  if (ok) collapse_node8(&j, 0, 0);
+  if (ok) collapse_node8(&j, 0, 0), ok = !j.oom;
+  b->nwide8 = j.next;
   free(j.first), free(j.count);
   return ok;
 }
