@@ -75,7 +75,7 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   CHECK(rr_scene_add_mesh(s, p, (size_t)ntri * 3, idx, (size_t)ntri, NULL) == RR_OK, "mesh: %s",
         rr_device_message(dev));
   CHECK(rr_scene_commit(s) == RR_OK, "commit");
-  long missed = 0, passing = 0, area = 0, tight = 0, seen = 0;
+  long missed = 0, passing = 0, area = 0, tight = 0, seen = 0, caps = 0, cap_missed = 0, half_missed = 0;
   /* a cube's samples are those of its six perspective faces (camera/camera.h) */
   const bool cube = rc->type == RR_CAMERA_CUBE;
   for (int f = 0; f < (cube ? 6 : 1); f++) {
@@ -85,8 +85,11 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
     for (uint32_t i = 0; i < s->ntris; i++) {
       tri_setup ts;
       if (rr_tri_setup(s, i, cc, false, &ts) == SETUP_CULLED) continue;
-      int r[4], rt[4];
+      int r[4], rt[4], rc[4], rh[4];
       bool has = rr_tri_screen_bounds(s, i, cc, &ts, r);
+      /* the cap bound alone, at its radius and at half of it */
+      int cap = cube ? -1 : rr_tri_curved_cap(cc, &ts, 1, rc), half = cube ? -1 : rr_tri_curved_cap(cc, &ts, 0.5, rh);
+      caps += cap > 0;
       tight += cube || rr_tri_curved_rect(cc, &ts, rt) >= 0;
       seen++;
       long in = 0;
@@ -98,6 +101,11 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
           tri_edges_w(&ts, d, e);
           if (!sample_test_w(e, ts.w, ts.tie, tri_vol(&ts, d.y, d.z), 0, tri_den_w(&ts, d), &t, &l1, &l2)) continue;
           in++;
+          if (cap == 0 || (cap > 0 && (x < rc[0] || x > rc[2] || y < rc[1] || y > rc[3]))) {
+            if (cap_missed++ < 5)
+              fprintf(stderr, "%s: triangle %u passes at (%d, %d) outside its cap rectangle\n", what, i, x, y);
+          }
+          half_missed += half == 0 || (half > 0 && (x < rh[0] || x > rh[2] || y < rh[1] || y > rh[3]));
           if (!has || x < r[0] || x > r[2] || y < r[1] || y > r[3]) {
             if (missed++ < 5)
               fprintf(stderr, "%s: triangle %u passes at (%d, %d) of face %d outside [%d,%d]x[%d,%d]%s\n", what, i, x,
@@ -110,10 +118,14 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   }
   CHECK(missed == 0, "%s: %ld passing samples outside their triangle's rectangle", what, missed);
   CHECK(passing > 0, "%s: no triangle passes anywhere (the test would prove nothing)", what);
+  CHECK(cap_missed == 0, "%s: %ld passing samples outside their triangle's cap rectangle", what, cap_missed);
   bool polar_map = rc->type == RR_CAMERA_LATLONG || rc->type == RR_CAMERA_PARABOLIC || rc->type == RR_CAMERA_FISHEYE;
   CHECK(!polar_map || tight * 10 >= seen * 9, "%s: tight bounds for only %ld of %ld triangles", what, tight, seen);
-  printf("%s: %ld triangles (%ld tight), %ld passing samples in rectangles of %ld samples (%.1f%%)\n", what, seen,
-         tight, passing, area, area ? 100.0 * passing / area : 0.0);
+  /* the cap's radius is not loose by half: halved, it misses samples */
+  CHECK(!polar_map || half_missed > 0, "%s: a cap of half the radius misses no sample", what);
+  printf("%s: %ld triangles (%ld tight, %ld capped), %ld passing samples in rectangles of %ld samples (%.1f%%); "
+         "half caps miss %ld\n",
+         what, seen, tight, caps, passing, area, area ? 100.0 * passing / area : 0.0, half_missed);
   rr_scene_release(s);
   free(p), free(idx);
   rr_cam_release(&c);

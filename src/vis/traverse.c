@@ -478,14 +478,19 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
   }
   uint32_t kept = 0;
   t->st.setups += n;
-  for (uint32_t k = 0; k < n; k++) {
-    uint32_t id = ids ? ids[k] : first + k;
-    tri_job *j = out + kept;
-    if (rr_tri_setup(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED || !curved_bounds(t, id, &j->ts, j->bb) ||
-        (r && !meets(j->bb, *r)))
-      continue;
-    finish_setup(t, id, j);
-    kept++;
+  for (uint32_t q = 0; q < n; q += 8) { /* eight lanes at a time, the bits of one */
+    int m = n - q < 8 ? (int)(n - q) : 8, face[8];
+    uint32_t lid[8];
+    tri_setup ts[8];
+    for (int l = 0; l < m; l++) lid[l] = ids ? ids[q + l] : first + q + (uint32_t)l;
+    rr_tri_setup_run(t->s, lid, m, t->c, t->cull_back, t->simd, ts, face);
+    for (int l = 0; l < m; l++) {
+      tri_job *j = out + kept;
+      if (face[l] == SETUP_CULLED || !curved_bounds(t, lid[l], &ts[l], j->bb) || (r && !meets(j->bb, *r))) continue;
+      j->ts = ts[l];
+      finish_setup(t, lid[l], j);
+      kept++;
+    }
   }
   return kept;
 }
