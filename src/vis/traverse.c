@@ -670,6 +670,35 @@ static bool outside_cone(int has_cone, vec3 axis, float angle, const bvh_node *b
   return phi > angle + beta + 1e-4f;
 }
 
+/* May a sample of r (of the image when r is NULL) at one of the ns positions of
+ * a curved view polar about an axis look into box n? A box lies in the ball about its centre b of its
+ * half-diagonal r, which from the eye e (|b − e| > r) is the cap about b − e of
+ * radius asin(r / |b − e|) <= s / √(1 − s²), s = r / |b − e| (asin x <= tan asin x);
+ * a triangle's corners, in the box, look into that cap, and so do its spherical
+ * triangle (the cap is convex under 90°) and, within the slack of the frustum
+ * traversal's cone test (1e-4 rad; rays and edge values round to about 1e-6), the
+ * samples that pass its edge test. rr_cam_cap_rect bounds the cap's image. (The
+ * rounded planes of a sliver or of an edge seen end-on can pass samples farther
+ * out; rc-bvh's box test drops those too, and rc-bvh is what every method equals.)
+ * A box that holds the eye, or a cap it cannot bound, may. */
+static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
+  double b[3], d2 = 0, r2 = 0;
+  for (int a = 0; a < 3; a++) {
+    const double e = a == 0 ? cams->eye.x : a == 1 ? cams->eye.y : cams->eye.z;
+    b[a] = 0.5 * ((double)n->lo[a] + n->hi[a]) - e, d2 += b[a] * b[a];
+    r2 += 0.25 * ((double)n->hi[a] - n->lo[a]) * ((double)n->hi[a] - n->lo[a]);
+  }
+  double s2 = r2 * (1 + 1e-9) / d2;
+  if (!(s2 < 0.98)) return true;
+  const double dist = sqrt(d2), axis[3] = {b[0] / dist, b[1] / dist, b[2] / dist};
+  const double rho = sqrt(s2 / (1 - s2)) + 1e-4;
+  for (int p = 0; p < ns; p++) {
+    int q[4], k = rr_cam_cap_rect(&cams[p], axis, rho, q);
+    if (k < 0 || (k > 0 && (!r || meets(q, *r)))) return true;
+  }
+  return false;
+}
+
 /* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
  * the image plane, or outside the cone of directions (of every one of the ns
  * positions of cams; the side planes run along pixel edges, which hold any). */
@@ -679,6 +708,7 @@ static bool is_outside(const frustum *f, const bvh_node *b, const camera *cams, 
   if (f->one_ray) return !centre_hits(f, b);
   /* (a box whose box_tmin is positive lies in front of the eye) */
   if (f->nplanes) return (!(tmin > 0) && box_behind(b, c)) || box_outside_sides(f, b);
+  if (c->bend_x > 0 && !box_cap_meets(cams, ns, b, &f->r)) return true; /* the polar maps */
   if (!outside_cone(f->has_cone, f->axis, f->angle, b, c)) return false;
   for (int s = 1; s < ns; s++) {
     vec3 axis = v3(0, 0, 0);
@@ -851,52 +881,18 @@ static void root_band(int b, int thread, void *arg) {
 }
 
 /* A curved view polar about an axis, drawn from the root: the triangles of the
- * BVH leaves whose box may show a sample, marked in seen (1) before any setup, so
- * that most of a detailed mesh's triangles (behind a hemisphere, or between the
- * samples) cost no setup. A node's box lies in the ball about its centre b of its
- * half-diagonal r, which from the eye e (|b − e| > r) is the cap about b − e of
- * radius asin(r / |b − e|) <= s / √(1 − s²), s = r / |b − e| (asin x <= tan asin x);
- * a triangle's corners, in the box, look into that cap, and so do its spherical
- * triangle (the cap is convex under 90°) and, within the slack of the frustum
- * traversal's cone test (1e-4 rad; rays and edge values round to about 1e-6), the
- * samples that pass its edge test. rr_cam_cap_rect bounds the cap's image. (The
- * rounded planes of a sliver or of an edge seen end-on can pass samples farther
- * out; rc-bvh's box test drops those too, and rc-bvh is what every method equals.)
- * Boxes that hold the eye, or caps it cannot bound, are opened. */
+ * BVH leaves whose box may show a sample (box_cap_meets), marked in seen (1)
+ * before any setup, so that most of a detailed mesh's triangles (behind a
+ * hemisphere, or between the samples) cost no setup. */
 static void mark_seen(const trav *t, uint8_t *seen) {
   const rr_bvh *bvh = t->s->bvh;
   uint32_t stack[128], sp = 0;
   stack[sp++] = 0;
-  const double e[3] = {t->c->eye.x, t->c->eye.y, t->c->eye.z};
   while (sp) {
     const bvh_node *n = &bvh->nodes[stack[--sp]];
-    double b[3], d2 = 0, r2 = 0;
-    for (int a = 0; a < 3; a++) {
-      b[a] = 0.5 * ((double)n->lo[a] + n->hi[a]) - e[a], d2 += b[a] * b[a];
-      r2 += 0.25 * ((double)n->hi[a] - n->lo[a]) * ((double)n->hi[a] - n->lo[a]);
-    }
-    double s2 = r2 * (1 + 1e-9) / d2;
-    bool shown = true; /* some position's sample may look into the box */
-    if (s2 < 0.98) {
-      const double dist = sqrt(d2), axis[3] = {b[0] / dist, b[1] / dist, b[2] / dist};
-      const double rho = sqrt(s2 / (1 - s2)) + 1e-4;
-      shown = false;
-      for (int p = 0; p < t->ns && !shown; p++) {
-        int r[4];
-        shown = rr_cam_cap_rect(&t->cams[p], axis, rho, r) != 0;
-      }
-    }
-    if (!shown) continue;
-    if (n->count) { /* each triangle's own cap, the same argument for the box of its corners */
-      for (uint32_t k = 0; k < n->count; k++) {
-        const uint32_t id = bvh->prims[n->first + k];
-        bool tri_shown = scene_kind(t->s, id) != RR_GEOMETRY_TRIANGLE;
-        for (int p = 0; p < t->ns && !tri_shown; p++) {
-          int r[4];
-          tri_shown = rr_tri_corner_cap(t->s, id, &t->cams[p], 1e-4, r) != 0;
-        }
-        seen[id] = tri_shown;
-      }
+    if (!box_cap_meets(t->cams, t->ns, n, NULL)) continue;
+    if (n->count) {
+      for (uint32_t k = 0; k < n->count; k++) seen[bvh->prims[n->first + k]] = 1;
     } else if (sp + 2 <= sizeof stack / sizeof *stack) {
       stack[sp++] = n->first + 1, stack[sp++] = n->first;
     } else { /* (deeper than any tree built) the whole subtree */
