@@ -112,17 +112,21 @@ static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, i
  * and the widening E of the comment at the top; sin(θ_min / 2) in *smin. False
  * when the setup is degenerate or a sliver too thin to bound (E unknown). */
 static bool spherical_tri(const tri_setup *ts, dv3 n[3], dv3 v[3], double *smin, double *E) {
-  for (int i = 0; i < 3; i++) n[i] = dv(ts->a[i], ts->b[i], ts->c[i]);
-  /* T's vertices: vertex i lies on edges i+1 and i+2, inside edge i. Its interior
-   * angle θ_i is the angle between the inward normals' planes: cos θ_i = −n̂_j·n̂_k. */
-  double cmin_half = 1; /* the least 1 − cos θ_i: 2 sin²(θ_i / 2) */
+  double inv[3];
   for (int i = 0; i < 3; i++) {
-    double l = dlen(n[i]);
-    if (!(l > 0)) return false;
-    n[i] = dscale(n[i], 1 / l);
+    n[i] = dv(ts->a[i], ts->b[i], ts->c[i]);
+    double l2 = ddot(n[i], n[i]);
+    if (!(l2 > 0)) return false;
+    inv[i] = 1 / sqrt(l2);
   }
+  for (int i = 0; i < 3; i++) n[i] = dscale(n[i], inv[i]);
+  /* T's vertices: vertex i lies on edges i+1 and i+2, inside edge i. Its interior
+   * angle θ_i is the angle between the inward normals' planes: cos θ_i = −n̂_j·n̂_k,
+   * so 1 − cos θ_i = 2 sin²(θ_i / 2) = 1 + n̂_j·n̂_k. */
+  static const int nx[3] = {1, 2, 0}, nn[3] = {2, 0, 1};
+  double cmin_half = 1;
   for (int i = 0; i < 3; i++) {
-    dv3 nj = n[(i + 1) % 3], nk = n[(i + 2) % 3], x = dcross(nj, nk);
+    const dv3 nj = n[nx[i]], nk = n[nn[i]], x = dcross(nj, nk);
     double lx = dlen(x), s = ddot(x, n[i]);
     if (!(lx > 0) || !(fabs(s) > 1e-9 * lx)) return false;
     v[i] = dscale(x, (s > 0 ? 1 : -1) / lx);

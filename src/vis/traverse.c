@@ -678,8 +678,10 @@ static bool outside_cone(int has_cone, vec3 axis, float angle, const bvh_node *b
  * triangle (the cap is convex under 90°) and, within the slack of the frustum
  * traversal's cone test (1e-4 rad; rays and edge values round to about 1e-6), the
  * samples that pass its edge test. rr_cam_cap_rect bounds the cap's image. (The
- * rounded planes of a sliver or of an edge seen end-on can pass samples farther
- * out; rc-bvh's box test drops those too, and rc-bvh is what every method equals.)
+ * rounded planes of a near-degenerate sliver, or of an edge seen end-on, can pass
+ * samples farther out, as far as its setup's spherical triangle reaches; every
+ * box test of the BVH methods, the frustum cone here and rc-bvh's widened slabs,
+ * drops such samples alike: they are not hits of the triangle in its box.)
  * A box that holds the eye, or a cap it cannot bound, may. */
 static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
   double b[3], d2 = 0, r2 = 0;
