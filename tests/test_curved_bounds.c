@@ -75,7 +75,7 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   CHECK(rr_scene_add_mesh(s, p, (size_t)ntri * 3, idx, (size_t)ntri, NULL) == RR_OK, "mesh: %s",
         rr_device_message(dev));
   CHECK(rr_scene_commit(s) == RR_OK, "commit");
-  long missed = 0, passing = 0, area = 0, tight = 0, seen = 0;
+  long missed = 0, passing = 0, area = 0, tight = 0, seen = 0, caps = 0, cap_missed = 0, half_missed = 0, corner_missed = 0;
   /* a cube's samples are those of its six perspective faces (camera/camera.h) */
   const bool cube = rc->type == RR_CAMERA_CUBE;
   for (int f = 0; f < (cube ? 6 : 1); f++) {
@@ -85,8 +85,13 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
     for (uint32_t i = 0; i < s->ntris; i++) {
       tri_setup ts;
       if (rr_tri_setup(s, i, cc, false, &ts) == SETUP_CULLED) continue;
-      int r[4], rt[4];
+      int r[4], rt[4], rc[4], rh[4];
       bool has = rr_tri_screen_bounds(s, i, cc, &ts, r);
+      /* the cap bound alone, at its radius and at half of it */
+      int cap = cube ? -1 : rr_tri_curved_cap(cc, &ts, 1, rc), half = cube ? -1 : rr_tri_curved_cap(cc, &ts, 0.5, rh);
+      caps += cap > 0;
+      /* before the setup: the corner cap with the root pass's slack (vis/traverse.c, mark_seen) */
+      int rk[4], corner = cube ? -1 : rr_tri_corner_cap(s, i, cc, 1e-4, rk);
       tight += cube || rr_tri_curved_rect(cc, &ts, rt) >= 0;
       seen++;
       long in = 0;
@@ -98,6 +103,15 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
           tri_edges_w(&ts, d, e);
           if (!sample_test_w(e, ts.w, ts.tie, tri_vol(&ts, d.y, d.z), 0, tri_den_w(&ts, d), &t, &l1, &l2)) continue;
           in++;
+          if (cap == 0 || (cap > 0 && (x < rc[0] || x > rc[2] || y < rc[1] || y > rc[3]))) {
+            if (cap_missed++ < 5)
+              fprintf(stderr, "%s: triangle %u passes at (%d, %d) outside its cap rectangle\n", what, i, x, y);
+          }
+          if (corner == 0 || (corner > 0 && (x < rk[0] || x > rk[2] || y < rk[1] || y > rk[3]))) {
+            if (corner_missed++ < 5)
+              fprintf(stderr, "%s: triangle %u passes at (%d, %d) outside its corner cap\n", what, i, x, y);
+          }
+          half_missed += half == 0 || (half > 0 && (x < rh[0] || x > rh[2] || y < rh[1] || y > rh[3]));
           if (!has || x < r[0] || x > r[2] || y < r[1] || y > r[3]) {
             if (missed++ < 5)
               fprintf(stderr, "%s: triangle %u passes at (%d, %d) of face %d outside [%d,%d]x[%d,%d]%s\n", what, i, x,
@@ -110,10 +124,15 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   }
   CHECK(missed == 0, "%s: %ld passing samples outside their triangle's rectangle", what, missed);
   CHECK(passing > 0, "%s: no triangle passes anywhere (the test would prove nothing)", what);
+  CHECK(cap_missed == 0, "%s: %ld passing samples outside their triangle's cap rectangle", what, cap_missed);
+  CHECK(corner_missed == 0, "%s: %ld passing samples outside their triangle's corner cap", what, corner_missed);
   bool polar_map = rc->type == RR_CAMERA_LATLONG || rc->type == RR_CAMERA_PARABOLIC || rc->type == RR_CAMERA_FISHEYE;
   CHECK(!polar_map || tight * 10 >= seen * 9, "%s: tight bounds for only %ld of %ld triangles", what, tight, seen);
-  printf("%s: %ld triangles (%ld tight), %ld passing samples in rectangles of %ld samples (%.1f%%)\n", what, seen,
-         tight, passing, area, area ? 100.0 * passing / area : 0.0);
+  /* the cap's radius is not loose by half: halved, it misses samples */
+  CHECK(!polar_map || half_missed > 0, "%s: a cap of half the radius misses no sample", what);
+  printf("%s: %ld triangles (%ld tight, %ld capped), %ld passing samples in rectangles of %ld samples (%.1f%%); "
+         "half caps miss %ld\n",
+         what, seen, tight, caps, passing, area, area ? 100.0 * passing / area : 0.0, half_missed);
   rr_scene_release(s);
   free(p), free(idx);
   rr_cam_release(&c);
@@ -163,9 +182,50 @@ static void check_bend(rr_device *dev, rr_camera_type type, float fov, int w, in
   rr_cam_release(&c);
 }
 
+/* rr_cam_cap_rect: every sample whose ray lies within the cap (short of the rays'
+ * rounding) lies in the cap's rectangle; random caps of 1e-3 to 1.4 rad about
+ * the maps' hard directions. */
+static void check_caps(rr_device *dev, rr_camera_type type, float fov, int w, int h) {
+  rr_camera rc;
+  rr_camera_init(&rc);
+  rc.type = type, rc.fov_deg = fov;
+  camera c;
+  const float pos[2] = {(float)rnd(), (float)rnd()};
+  CHECK(rr_cam_setup_at(dev, &rc, w, h, pos, &c) == RR_OK, "camera");
+  long bad = 0, inside = 0, bounded = 0;
+  for (int k = 0; k < 600; k++) {
+    vec3 a = v3_norm(hard_dir(&rc, c.fwd, c.right, c.up));
+    double rho = exp(log(1e-3) + rnd() * (log(1.4) - log(1e-3))), axis[3] = {a.x, a.y, a.z};
+    int r[4], got = rr_cam_cap_rect(&c, axis, rho, r);
+    bounded += got >= 0;
+    if (got < 0) continue;
+    for (int y = 0; y < h; y++)
+      for (int x = 0; x < w; x++) {
+        vec3 d = c.dirs[(size_t)y * w + x];
+        double l = sqrt((double)d.x * d.x + (double)d.y * d.y + (double)d.z * d.z);
+        if (!(l > 0)) continue;
+        double cosang = (axis[0] * d.x + axis[1] * d.y + axis[2] * d.z) / l;
+        if (cosang < cos(rho - 2e-6)) continue;
+        inside++;
+        bad += got == 0 || x < r[0] || x > r[2] || y < r[1] || y > r[3];
+      }
+  }
+  CHECK(bad == 0 && inside > 0, "%s: %ld of %ld samples in a cap outside its rectangle", rr_camera_name(type), bad,
+        inside);
+  CHECK(bounded > 300, "%s: only %ld of 600 caps bounded", rr_camera_name(type), bounded);
+  printf("%s %g: cap rectangles hold the %ld samples of %ld caps\n", rr_camera_name(type), (double)fov, inside,
+         bounded);
+  rr_cam_release(&c);
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
   int ntri = test_quick() ? 150 : 1500;
+  check_caps(dev, RR_CAMERA_PARABOLIC, 90, 96, 80);
+  check_caps(dev, RR_CAMERA_LATLONG, 90, 128, 64);
+  check_caps(dev, RR_CAMERA_FISHEYE, 180, 96, 96);
+  check_caps(dev, RR_CAMERA_FISHEYE, 100, 80, 96);
+  check_caps(dev, RR_CAMERA_FISHEYE, 360, 80, 64);
   check_bend(dev, RR_CAMERA_PARABOLIC, 90, 96, 80);
   check_bend(dev, RR_CAMERA_LATLONG, 90, 128, 64);
   check_bend(dev, RR_CAMERA_FISHEYE, 180, 96, 96);

@@ -264,6 +264,20 @@ bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
  * sliver: the cells may bound it better), 0 when no sample can pass, -1 when it
  * knows no bound (another camera, a degenerate setup). */
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
+/* The cheaper cap bound rr_tri_curved_rect starts from (prim/triangle_curved.c):
+ * the image of a cap holding the spherical triangle, widened by the map's largest
+ * stretch over it; scale multiplies the cap's radius (1; the tests halve it to see
+ * samples missed). 1 with rect, 0 when no sample can pass, -1 when it knows no bound. */
+int rr_tri_curved_cap(const camera *c, const tri_setup *ts, double scale, int rect[4]);
+/* The image rectangle of the directions within angle rho of the unit axis for the
+ * curved cameras polar about an axis (lat-long, parabolic, fisheye): 1 with rect,
+ * 0 when no sample looks there, -1 when it knows no bound (another camera, rho of
+ * 1.5 rad or more, a cap over a pole of the map). */
+int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int rect[4]);
+/* Before any setup: the image rectangle of the cap about triangle i's corner
+ * directions from c's eye, widened by slack radians (what the caller allows for
+ * the rounding of the setup); as rr_cam_cap_rect, -1 also for corners at infinity. */
+int rr_tri_corner_cap(const rr_scene *s, uint32_t i, const camera *c, double slack, int rect[4]);
 /* Planar cameras bound a triangle from its corners alone, before its setup: most
  * triangles of a detailed mesh fall between samples. rr_tri_corner_bounds bounds triangles
  * ids[0..n-1] (first..first+n-1 when ids is NULL), 8 at a time with AVX2 when

@@ -38,8 +38,14 @@ void rr_tri_cone_setup(const rr_scene *s, uint32_t i, const camera *c, const tri
   tc->cap_angle = -1;
   if (v3_len(m) > 1e-3f) {
     tc->cap_axis = v3_norm(m);
-    float r = 0;
-    for (int k = 0; k < 3; k++) r = fmaxf(r, acosf(fminf(1.0f, v3_dot(u[k], tc->cap_axis))));
+    /* the angle from the chord h: 2 asin(h/2) <= h / √(1 − h²/4) (asin x <= tan asin x),
+     * without acos and its loss of accuracy near 1 */
+    float h2 = 0;
+    for (int k = 0; k < 3; k++) {
+      vec3 d = v3_sub(u[k], tc->cap_axis);
+      h2 = fmaxf(h2, v3_dot(d, d));
+    }
+    float r = h2 < 3.5f ? sqrtf(h2 / (1 - h2 / 4)) : CAMERA_NO_CONE;
     if (r < CAMERA_NO_CONE) tc->cap_angle = r * 1.0001f + 1e-5f;
   }
 }

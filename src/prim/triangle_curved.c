@@ -23,6 +23,11 @@
 #include "prim/triangle.h"
 
 #include <math.h>
+#include <string.h>
+
+/* A cap rectangle of at most this many samples is kept without the arcs'
+ * (they cost about ten times as much, and the few samples more cost less). */
+#define CAP_ENOUGH 64
 
 typedef struct dv3 { double x, y, z; } dv3;
 static dv3 dv(double x, double y, double z) { return (dv3){x, y, z}; }
@@ -35,6 +40,22 @@ static double dlen(dv3 a) { return sqrt(ddot(a, a)); }
 
 static double maxd(double a, double b) { return a > b ? a : b; } /* fmax is a call without -ffast-math */
 static double mind(double a, double b) { return a < b ? a : b; }
+/* atan2 within ATAN_ERR: Abramowitz & Stegun 4.4.49 (arctan x / x on [0, 1] by a
+ * polynomial in x², |error| <= 2e-8; 1.4e-8 over a grid of 2e6 points), then the
+ * octant's exact reflections. Five times cheaper than libm's, for the cap bounds,
+ * which widen their ranges by ATAN_ERR. */
+#define ATAN_ERR 1e-7
+static double fast_atan2(double y, double x) {
+  double ax = fabs(x), ay = fabs(y), hi = ax > ay ? ax : ay, lo = ax > ay ? ay : ax;
+  if (!(hi > 0)) return 0;
+  double a = lo / hi, q = a * a;
+  double r = a * (1 + q * (-0.3333314528 + q * (0.1999355085 + q * (-0.1420889944 + q * (0.1065626393 +
+                  q * (-0.0752896400 + q * (0.0429096138 + q * (-0.0161657367 + q * 0.0028662257))))))));
+  if (ay > ax) r = RR_PI / 2 - r;
+  if (x < 0) r = RR_PI - r;
+  return y < 0 ? -r : r;
+}
+
 static double wrap_pi(double a) { return a > RR_PI ? a - 2 * RR_PI : a < -RR_PI ? a + 2 * RR_PI : a; }
 
 /* The spherical triangle's angles about unit axis P, with polar angle
@@ -85,28 +106,160 @@ static void polar_range(const dv3 nu[3], const dv3 v[3], double E, dv3 P, dv3 e1
   *plo = mn - m, *phi = mx + m;
 }
 
-int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
-  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
-  dv3 n[3], v[3];
-  for (int i = 0; i < 3; i++) n[i] = dv(ts->a[i], ts->b[i], ts->c[i]);
-  /* T's vertices: vertex i lies on edges i+1 and i+2, inside edge i. Its interior
-   * angle θ_i is the angle between the inward normals' planes: cos θ_i = −n̂_j·n̂_k. */
-  double cmin_half = 1; /* the least 1 − cos θ_i: 2 sin²(θ_i / 2) */
+static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, int r[4]);
+
+/* The spherical triangle T of a setup's edge planes: unit normals n, vertices v,
+ * and the widening E of the comment at the top; sin(θ_min / 2) in *smin. False
+ * when the setup is degenerate or a sliver too thin to bound (E unknown). */
+static bool spherical_tri(const tri_setup *ts, dv3 n[3], dv3 v[3], double *smin, double *E) {
+  double inv[3];
   for (int i = 0; i < 3; i++) {
-    double l = dlen(n[i]);
-    if (!(l > 0)) return -1;
-    n[i] = dscale(n[i], 1 / l);
+    n[i] = dv(ts->a[i], ts->b[i], ts->c[i]);
+    double l2 = ddot(n[i], n[i]);
+    if (!(l2 > 0)) return false;
+    inv[i] = 1 / sqrt(l2);
   }
+  for (int i = 0; i < 3; i++) n[i] = dscale(n[i], inv[i]);
+  /* T's vertices: vertex i lies on edges i+1 and i+2, inside edge i. Its interior
+   * angle θ_i is the angle between the inward normals' planes: cos θ_i = −n̂_j·n̂_k,
+   * so 1 − cos θ_i = 2 sin²(θ_i / 2) = 1 + n̂_j·n̂_k. */
+  static const int nx[3] = {1, 2, 0}, nn[3] = {2, 0, 1};
+  double cmin_half = 1;
   for (int i = 0; i < 3; i++) {
-    dv3 nj = n[(i + 1) % 3], nk = n[(i + 2) % 3], x = dcross(nj, nk);
+    const dv3 nj = n[nx[i]], nk = n[nn[i]], x = dcross(nj, nk);
     double lx = dlen(x), s = ddot(x, n[i]);
-    if (!(lx > 0) || !(fabs(s) > 1e-9 * lx)) return -1;
+    if (!(lx > 0) || !(fabs(s) > 1e-9 * lx)) return false;
     v[i] = dscale(x, (s > 0 ? 1 : -1) / lx);
     cmin_half = mind(cmin_half, 1 + ddot(nj, nk));
   }
-  double smin = sqrt(maxd(0.0, 0.5 * cmin_half)); /* sin(θ_min / 2) */
-  if (!(smin > 1e-6)) return -1; /* E below 0.02 rad until 1e-3, then growing: a sliver */
-  const double eps = 1e-5, E = 2 * eps / smin + eps;
+  *smin = sqrt(maxd(0.0, 0.5 * cmin_half)); /* sin(θ_min / 2) */
+  if (!(*smin > 1e-6)) return false; /* E below 0.02 rad until 1e-3, then growing: a sliver */
+  const double eps = 1e-5;
+  *E = 2 * eps / *smin + eps;
+  return true;
+}
+
+/* The inclusive pixel rectangle of the samples whose sample coordinates lie in
+ * [x0, x1] × [y0, y1], with a hundredth of a pixel against the double rounding:
+ * 1, or 0 when it holds none. */
+static int ceil_in(double x, int n) { /* ceil(x) within [0, n], NaN as 0 */
+  if (!(x > 0)) return 0;
+  if (x >= n) return n;
+  int i = (int)x;
+  return i + (i < x);
+}
+static int floor_in(double x, int n) { /* floor(x) within [-1, n - 1], NaN as n - 1 */
+  if (!(x < n)) return n - 1;
+  if (x < 0) return -1;
+  return (int)x;
+}
+static int sample_rect(const camera *c, double x0, double x1, double y0, double y1, int r[4]) {
+  int lx = ceil_in(x0 - c->sx0 - 1e-2, c->width), hx = floor_in(x1 - c->sx0 + 1e-2, c->width);
+  int ly = ceil_in(y0 - c->sy0 - 1e-2, c->height), hy = floor_in(y1 - c->sy0 + 1e-2, c->height);
+  if (lx > hx || ly > hy) return 0;
+  r[0] = lx, r[1] = ly, r[2] = hx, r[3] = hy;
+  return 1;
+}
+
+/* The cap bound (cheap: no arcs, at most two atan2). T lies in the cap of its
+ * vertices about their mean direction m, of radius r (a cap under 90° is
+ * spherically convex and holds the vertices, so it holds their hull T), and every
+ * passing sample's exact direction w within E of T, so within ρ = r + E of m.
+ * With cos r = min m·v_i and the chord h = √(2 − 2 cos r), r = 2 asin(h/2) <=
+ * h / √(1 − h²/4) (asin x <= tan asin x). The geodesic from m to w stays in that
+ * cap, so the image of w lies within ρ·L of the image of m, L bounding the map's
+ * differential over the cap (its largest stretch, image units per radian):
+ *  - parabolic, the stereographic u + iv = tan(α/2) e^{iψ}: conformal, stretch
+ *    (tan(α/2))' = 1 / (1 + cos α), greatest at the cap's largest α <= α_m + ρ,
+ *    where cos(α_m + ρ) = cos α_m cos ρ − sin α_m sin ρ >= cos α_m·(1 − ρ²/2 when
+ *    cos α_m >= 0, else 1) − sin α_m·ρ (that bound is <= −1 once α_m + ρ >= π:
+ *    cos β + β sin β >= 1 on [0, π/2] for β = π − α_m; then no bound);
+ *  - fisheye, u + iv = (α/k) e^{iψ}: radial stretch 1/k, tangential α / (k sin α),
+ *    the larger, growing with α: at most (α_m + ρ) / (k·s) with s <= sin(α_m + ρ)
+ *    = sin α_m cos ρ + cos α_m sin ρ >= sin α_m (1 − ρ²/2) + min(cos α_m, 0)·ρ;
+ *  - lat-long, per axis: θ moves by at most the angle (|dθ| <= ds), φ by ds / sin θ,
+ *    and over the cap sin θ >= sin(a − ρ) >= sin a (1 − ρ²/2) − cos a·ρ, a the
+ *    angle from m to the nearer pole (sin a = sin θ_m, cos a = |cos θ_m|); with a
+ *    pole in the cap, or φ's range across the seam, the whole width.
+ * (1 − ρ²/2 <= cos ρ and sin ρ <= ρ for ρ >= 0.) The caps behind a hemisphere's
+ * disk hold no ray: α >= α_m − ρ, so cos α <= cos α_m·(1 or 1 − ρ²/2) + sin α_m·ρ.
+ * `scale` multiplies ρ (1; the tests see that a halved ρ misses samples).
+ * 1 with r, 0 when no sample can pass, -1 when the cap bounds nothing. */
+int rr_tri_curved_cap(const camera *c, const tri_setup *ts, double scale, int r[4]) {
+  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
+  dv3 n[3], v[3];
+  double smin, E;
+  if (!spherical_tri(ts, n, v, &smin, &E)) return -1;
+  return curved_cap(c, v, E, scale, r);
+}
+
+static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, int r[4]) {
+  dv3 m = dv(v[0].x + v[1].x + v[2].x, v[0].y + v[1].y + v[2].y, v[0].z + v[1].z + v[2].z);
+  double lm = dlen(m);
+  if (!(lm > 1e-3)) return -1;
+  m = dscale(m, 1 / lm);
+  double cr = mind(ddot(m, v[0]), mind(ddot(m, v[1]), ddot(m, v[2])));
+  if (!(cr > 0.1)) return -1; /* a cap beyond 84°: the arcs bound it better */
+  double h2 = maxd(0.0, 2 - 2 * cr), rho = (sqrt(h2 / (1 - h2 / 4)) + E + 1e-9) * scale;
+  const double md[3] = {m.x, m.y, m.z};
+  return rr_cam_cap_rect(c, md, rho, r);
+}
+
+int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int r[4]) {
+  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
+  if (!(rho < 1.5)) return -1;
+  const dv3 m = dv(axis[0], axis[1], axis[2]);
+  dv3 R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
+  const double W = c->width, H = c->height;
+  double mr = ddot(m, R), mu = ddot(m, U), mf = ddot(m, F);
+  if (c->type == RR_CAMERA_LATLONG) {
+    double ct = mu, st = sqrt(maxd(0.0, 1 - ct * ct)), theta = fast_atan2(st, ct);
+    double y0 = (theta - rho - ATAN_ERR) * H / RR_PI, y1 = (theta + rho + ATAN_ERR) * H / RR_PI;
+    double slo = st * (1 - rho * rho / 2) - fabs(ct) * rho; /* least sin θ over the cap */
+    double x0 = 0, x1 = W;
+    if (slo > 1e-6 && rho / slo < RR_PI) {
+      double phi = fast_atan2(mr, mf), dphi = rho / slo + ATAN_ERR;
+      if (phi - dphi >= -RR_PI && phi + dphi <= RR_PI)
+        x0 = (phi - dphi + RR_PI) * W / (2 * RR_PI), x1 = (phi + dphi + RR_PI) * W / (2 * RR_PI);
+    }
+    return sample_rect(c, x0, x1, y0, y1, r);
+  }
+  double ca = mf, sa = sqrt(maxd(0.0, 1 - ca * ca));
+  /* beyond the disk's rim (α = π/2, or the fisheye's k) by 1e-3 rad: no rays */
+  double cmax = ca * (ca >= 0 ? 1 : 1 - rho * rho / 2) + sa * rho; /* >= cos α over the cap */
+  double u, vv, rad;
+  if (c->type == RR_CAMERA_PARABOLIC) {
+    if (cmax < -1e-3) return 0;
+    double cmin = ca * (ca >= 0 ? 1 - rho * rho / 2 : 1) - sa * rho; /* <= cos α over the cap */
+    if (!(1 + cmin > 1e-3)) return -1;
+    u = mr / (1 + ca), vv = mu / (1 + ca), rad = rho / (1 + cmin);
+  } else {
+    double k = c->fov_deg * RR_PI / 360, am = fast_atan2(sa, ca);
+    if (am - ATAN_ERR - rho > k + 1e-3) return 0;
+    double s = sa * (1 - rho * rho / 2) + mind(ca, 0.0) * rho; /* <= sin(α_m + ρ) */
+    if (!(s > 1e-3)) return -1;
+    double f = sa > 1e-12 ? am / sa : 1; /* → 1 on the axis, where (mr, mu) → 0 */
+    /* am within ATAN_ERR of α_m: the centre's image within ATAN_ERR / k of (u, v) */
+    u = f * mr / k, vv = f * mu / k, rad = (am + ATAN_ERR + rho) / (k * s) * rho + ATAN_ERR / k;
+  }
+  /* u = 2 sx / W − 1, v = 1 − 2 sy / H */
+  return sample_rect(c, (u - rad + 1) * W / 2, (u + rad + 1) * W / 2, (1 - vv - rad) * H / 2, (1 - vv + rad) * H / 2, r);
+}
+
+int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
+  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
+  dv3 n[3], v[3];
+  double smin, E;
+  if (!spherical_tri(ts, n, v, &smin, &E)) return -1;
+  const int kind = smin > 1e-3 ? 1 : 2;
+  /* the cap first: enough for the small triangles of detailed meshes, and when
+   * it is not, the arcs' rectangle within it */
+  int cap[4], has_cap = curved_cap(c, v, E, 1, cap);
+  if (has_cap == 0) return 0;
+  if (has_cap > 0 && (cap[2] - cap[0] + 1) * (cap[3] - cap[1] + 1) <= CAP_ENOUGH) {
+    memcpy(r, cap, sizeof cap);
+    return kind;
+  }
   dv3 R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
   double alo, ahi, plo, phi, W = c->width, H = c->height;
   double x0, x1, y0, y1; /* sample coordinates */
@@ -143,11 +296,26 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
     /* u = 2 sx / W − 1, v = 1 − 2 sy / H */
     x0 = (u0 + 1) * W / 2, x1 = (u1 + 1) * W / 2, y0 = (1 - v1) * H / 2, y1 = (1 - v0) * H / 2;
   }
-  /* sample x + sx0 in [x0, x1], with a hundredth of a pixel against the double rounding */
-  double lx = ceil(x0 - c->sx0 - 1e-2), hx = floor(x1 - c->sx0 + 1e-2);
-  double ly = ceil(y0 - c->sy0 - 1e-2), hy = floor(y1 - c->sy0 + 1e-2);
-  lx = maxd(lx, 0), ly = maxd(ly, 0), hx = mind(hx, W - 1), hy = mind(hy, H - 1);
-  if (!(lx <= hx && ly <= hy)) return 0;
-  r[0] = (int)lx, r[1] = (int)ly, r[2] = (int)hx, r[3] = (int)hy;
-  return smin > 1e-3 ? 1 : 2;
+  if (!sample_rect(c, x0, x1, y0, y1, r)) return 0;
+  if (has_cap > 0) { /* both hold every passing sample */
+    r[0] = r[0] > cap[0] ? r[0] : cap[0], r[1] = r[1] > cap[1] ? r[1] : cap[1];
+    r[2] = r[2] < cap[2] ? r[2] : cap[2], r[3] = r[3] < cap[3] ? r[3] : cap[3];
+    if (r[0] > r[2] || r[1] > r[3]) return 0;
+  }
+  return kind;
 }
+
+int rr_tri_corner_cap(const rr_scene *s, uint32_t i, const camera *c, double slack, int r[4]) {
+  if (scene_inf(s, i)) return -1;
+  vec3 p[3];
+  scene_corners(s, i, p);
+  dv3 v[3], e = dvf(c->eye);
+  for (int k = 0; k < 3; k++) {
+    v[k] = dsub(dvf(p[k]), e);
+    double l = dlen(v[k]);
+    if (!(l > 0) || !(l < INFINITY)) return -1;
+    v[k] = dscale(v[k], 1 / l);
+  }
+  return curved_cap(c, v, slack, 1, r);
+}
+

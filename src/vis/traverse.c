@@ -69,6 +69,7 @@ typedef struct trav {
   hiz *face_hz;
   float *face_heat_e, *face_heat_n;
   int face_rows; /* rows of the stack of faces the root pass sorts into bands, per face */
+  const uint8_t *seen; /* a curved view's root pass: 0 for triangles no sample can see (mark_seen) */
 } trav;
 
 /* Points t at face f of a cube camera drawn in one pass (nothing otherwise). */
@@ -375,6 +376,16 @@ static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, int b
   return any;
 }
 
+/* Before its setup: may the triangle's corner cap (rr_tri_corner_cap, with the
+ * slack of mark_seen) show a sample of r at some position? */
+static bool corner_cap_meets(const trav *t, uint32_t id, tile_rect r) {
+  for (int p = 0; p < t->ns; p++) {
+    int b[4], k = rr_tri_corner_cap(t->s, id, &t->cams[p], 1e-4, b);
+    if (k < 0 || (k > 0 && meets(b, r))) return true;
+  }
+  return false;
+}
+
 /* Triangle setup: triangles ids[0..n-1] (first..first+n-1 when ids is NULL) into
  * out, keeping those that may cover a sample of *r (of the image when r is NULL);
  * returns how many. Planar cameras bound the triangles from their corners first
@@ -478,15 +489,25 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
     return setup_bounded(t, scratch, nb, out);
   }
   uint32_t kept = 0;
-  t->st.setups += n;
-  for (uint32_t k = 0; k < n; k++) {
-    uint32_t id = ids ? ids[k] : first + k;
-    tri_job *j = out + kept;
-    if (rr_tri_setup(t->s, id, t->c, t->cull_back, &j->ts) == SETUP_CULLED || !curved_bounds(t, id, &j->ts, j->bb) ||
-        (r && !meets(j->bb, *r)))
-      continue;
-    finish_setup(t, id, j);
-    kept++;
+  for (uint32_t q = 0; q < n;) { /* eight lanes at a time, the bits of one */
+    int m = 0, face[8];
+    uint32_t lid[8];
+    tri_setup ts[8];
+    for (; q < n && m < 8; q++) {
+      uint32_t id = ids ? ids[q] : first + q;
+      if (t->seen && !t->seen[id]) continue;
+      if (r && !t->seen && !corner_cap_meets(t, id, *r)) continue;
+      lid[m++] = id;
+    }
+    t->st.setups += (uint64_t)m;
+    rr_tri_setup_run(t->s, lid, m, t->c, t->cull_back, t->simd, ts, face);
+    for (int l = 0; l < m; l++) {
+      tri_job *j = out + kept;
+      if (face[l] == SETUP_CULLED || !curved_bounds(t, lid[l], &ts[l], j->bb) || (r && !meets(j->bb, *r))) continue;
+      j->ts = ts[l];
+      finish_setup(t, lid[l], j);
+      kept++;
+    }
   }
   return kept;
 }
@@ -650,6 +671,37 @@ static bool outside_cone(int has_cone, vec3 axis, float angle, const bvh_node *b
   return phi > angle + beta + 1e-4f;
 }
 
+/* May a sample of r (of the image when r is NULL) at one of the ns positions of
+ * a curved view polar about an axis look into box n? A box lies in the ball about its centre b of its
+ * half-diagonal r, which from the eye e (|b − e| > r) is the cap about b − e of
+ * radius asin(r / |b − e|) <= s / √(1 − s²), s = r / |b − e| (asin x <= tan asin x);
+ * a triangle's corners, in the box, look into that cap, and so do its spherical
+ * triangle (the cap is convex under 90°) and, within the slack of the frustum
+ * traversal's cone test (1e-4 rad; rays and edge values round to about 1e-6), the
+ * samples that pass its edge test. rr_cam_cap_rect bounds the cap's image. (The
+ * rounded planes of a near-degenerate sliver, or of an edge seen end-on, can pass
+ * samples farther out, as far as its setup's spherical triangle reaches; every
+ * box test of the BVH methods, the frustum cone here and rc-bvh's widened slabs,
+ * drops such samples alike: they are not hits of the triangle in its box.)
+ * A box that holds the eye, or a cap it cannot bound, may. */
+static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
+  double b[3], d2 = 0, r2 = 0;
+  for (int a = 0; a < 3; a++) {
+    const double e = a == 0 ? cams->eye.x : a == 1 ? cams->eye.y : cams->eye.z;
+    b[a] = 0.5 * ((double)n->lo[a] + n->hi[a]) - e, d2 += b[a] * b[a];
+    r2 += 0.25 * ((double)n->hi[a] - n->lo[a]) * ((double)n->hi[a] - n->lo[a]);
+  }
+  double s2 = r2 * (1 + 1e-9) / d2;
+  if (!(s2 < 0.98)) return true;
+  const double dist = sqrt(d2), axis[3] = {b[0] / dist, b[1] / dist, b[2] / dist};
+  const double rho = sqrt(s2 / (1 - s2)) + 1e-4;
+  for (int p = 0; p < ns; p++) {
+    int q[4], k = rr_cam_cap_rect(&cams[p], axis, rho, q);
+    if (k < 0 || (k > 0 && (!r || meets(q, *r)))) return true;
+  }
+  return false;
+}
+
 /* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
  * the image plane, or outside the cone of directions (of every one of the ns
  * positions of cams; the side planes run along pixel edges, which hold any). */
@@ -659,6 +711,7 @@ static bool is_outside(const frustum *f, const bvh_node *b, const camera *cams, 
   if (f->one_ray) return !centre_hits(f, b);
   /* (a box whose box_tmin is positive lies in front of the eye) */
   if (f->nplanes) return (!(tmin > 0) && box_behind(b, c)) || box_outside_sides(f, b);
+  if (c->bend_x > 0 && !box_cap_meets(cams, ns, b, &f->r)) return true; /* the polar maps */
   if (!outside_cone(f->has_cone, f->axis, f->angle, b, c)) return false;
   for (int s = 1; s < ns; s++) {
     vec3 axis = v3(0, 0, 0);
@@ -834,10 +887,44 @@ static void root_band(int b, int thread, void *arg) {
   add_stats(&rp->st[thread], &t.st);
 }
 
+/* A curved view polar about an axis, drawn from the root: the triangles of the
+ * BVH leaves whose box may show a sample (box_cap_meets), marked in seen (1)
+ * before any setup, so that most of a detailed mesh's triangles (behind a
+ * hemisphere, or between the samples) cost no setup. */
+static void mark_seen(const trav *t, uint8_t *seen) {
+  const rr_bvh *bvh = t->s->bvh;
+  uint32_t stack[128], sp = 0;
+  stack[sp++] = 0;
+  while (sp) {
+    const bvh_node *n = &bvh->nodes[stack[--sp]];
+    if (!box_cap_meets(t->cams, t->ns, n, NULL)) continue;
+    if (n->count) {
+      for (uint32_t k = 0; k < n->count; k++) seen[bvh->prims[n->first + k]] = 1;
+    } else if (sp + 2 <= sizeof stack / sizeof *stack) {
+      stack[sp++] = n->first + 1, stack[sp++] = n->first;
+    } else { /* (deeper than any tree built) the whole subtree */
+      for (uint32_t k = 0; k < bvh->nprims; k++) seen[bvh->prims[k]] = 1;
+      return;
+    }
+  }
+}
+
 static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *proto) {
   root_pass *rp = calloc(1, sizeof *rp);
   if (!rp) return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for triangle setups");
   rp->proto = *proto;
+  uint8_t *seen = NULL;
+  const rr_camera_type type = proto->c->type;
+  if (!proto->faces && ctx->scene->bvh && ctx->scene->bvh->nprims == ctx->scene->ntris &&
+      (type == RR_CAMERA_PARABOLIC || type == RR_CAMERA_LATLONG || type == RR_CAMERA_FISHEYE)) {
+    seen = calloc(ctx->scene->ntris, 1);
+    if (!seen) {
+      free(rp);
+      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for triangle setups");
+    }
+    mark_seen(&rp->proto, seen);
+    rp->proto.seen = seen;
+  }
   sortmiddle sm = {.arg = rp,
                    .size = sizeof(tri_job),
                    .batch = proto->faces ? ROOT_BATCH / 4 : ROOT_BATCH,
@@ -856,7 +943,7 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
   if (proto->faces) rp->proto.face_rows = (height + align - 1) / align * align, height = 6 * rp->proto.face_rows;
   bool ok = rr_sortmiddle(&sm, ctx->scene->ntris, height, align, ctx->threads);
   for (int i = 0; i < RR_MAX_THREADS; i++) add_stats(ctx->stats, &rp->st[i]);
-  free(rp);
+  free(rp), free(seen);
   return ok ? RR_OK : rr_fail(dev, RR_ERROR_MEMORY, "out of memory for triangle setups");
 }
 
