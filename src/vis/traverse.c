@@ -896,14 +896,15 @@ static void mark_seen(const trav *t, uint8_t *seen) {
   uint32_t stack[128], sp = 0;
   stack[sp++] = 0;
   while (sp) {
-    const bvh_node *n = &bvh->nodes[stack[--sp]];
+    bvh_node buf;
+    const bvh_node *n = bvh_node_at(bvh, stack[--sp], &buf);
     if (!box_cap_meets(t->cams, t->ns, n, NULL)) continue;
     if (n->count) {
-      for (uint32_t k = 0; k < n->count; k++) seen[bvh->prims[n->first + k]] = 1;
+      for (uint32_t k = 0; k < n->count; k++) seen[bvh_prim_at(bvh, n->first + k)] = 1;
     } else if (sp + 2 <= sizeof stack / sizeof *stack) {
       stack[sp++] = n->first + 1, stack[sp++] = n->first;
-    } else { /* (deeper than any tree built) the whole subtree */
-      for (uint32_t k = 0; k < bvh->nprims; k++) seen[bvh->prims[k]] = 1;
+    } else { /* (deeper than any tree built) everything */
+      memset(seen, 1, t->s->ntris);
       return;
     }
   }
