@@ -7,13 +7,15 @@
  * there) for the npos sample positions pos (the union of their rectangles): the
  * same operations in the same order (no FMA, true divisions), lane by
  * lane, so every width gives the same rectangles. Writes the triangles whose
- * rectangle holds a sample to out, in order; returns how many. */
+ * rectangle holds a sample to out, in order; returns how many. flat and npos are
+ * constants where it is inlined (corner_bounds_any): a scene without instances
+ * (lane_corners), and one position, whose rectangles stay in registers. */
 
 #include "prim/triangle_corners_tmp.h"
 
-TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
-                                                       const camera *c, int npos, const float (*pos)[2],
-                                                       tri_bound *out) {
+TARGET __attribute__((always_inline)) static inline uint32_t RR_CAT(corner_bounds, W)(
+    const rr_scene *s, uint32_t first, const uint32_t *ids, int n, const camera *c, int npos, const float (*pos)[2],
+    tri_bound *out, bool flat) {
   int32_t lane_id[W], lane_inf[W] = {0};
   for (int l = 0; l < W; l++)
     lane_id[l] = (int32_t)(ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1));
@@ -22,7 +24,7 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
   const VI inf = VI_(load)(lane_inf);
   const bool persp = c->type == RR_CAMERA_PERSPECTIVE;
   VF corner[3][3];
-  RR_CAT(lane_corners, W)(s, lane_id, !ids && n == W, corner);
+  RR_CAT(lane_corners, W)(s, lane_id, !ids && n == W, corner, flat);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f), half = VF_(splat)(0.5f);
   const VF inf_f = VF_(splat)(INFINITY), width = VF_(splat)((float)c->width), height = VF_(splat)((float)c->height);
   const VF last_x = VF_(splat)((float)(c->width - 1)), last_y = VF_(splat)((float)(c->height - 1));
@@ -66,6 +68,7 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
   /* the rectangle of pixels whose sample at position p may lie in the hull, each
    * position's once; with several positions, the union of those that hold one */
   VF plx[RR_MAX_SAMPLES], phx[RR_MAX_SAMPLES], ply[RR_MAX_SAMPLES], phy[RR_MAX_SAMPLES];
+  npos = npos > 1 ? npos : 1; /* what callers pass; it tells the compiler plx[0] is set */
   for (int p = 0; p < npos; p++) {
     const VF ox = VF_(splat)(pos[p][0]), oy = VF_(splat)(pos[p][1]);
     plx[p] = VF_(max)(VF_(ceil)(x0 - ox - m), zero), phx[p] = VF_(min)(VF_(floor)(x1 - ox + m), last_x);
@@ -104,4 +107,15 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
                                 {(uint16_t)none[l], (uint16_t)in_x0[l], (uint16_t)in_y0[l], (uint16_t)in_x1[l],
                                  (uint16_t)in_y1[l]}};
   return kept;
+}
+
+/* corner_bounds compiled apart for one position and for scenes without instances */
+TARGET static uint32_t RR_CAT(corner_bounds_any, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
+                                                    const camera *c, int npos, const float (*pos)[2],
+                                                    tri_bound *out) {
+  if (npos == 1)
+    return s->inst ? RR_CAT(corner_bounds, W)(s, first, ids, n, c, 1, pos, out, false)
+                   : RR_CAT(corner_bounds, W)(s, first, ids, n, c, 1, pos, out, true);
+  return s->inst ? RR_CAT(corner_bounds, W)(s, first, ids, n, c, npos, pos, out, false)
+                 : RR_CAT(corner_bounds, W)(s, first, ids, n, c, npos, pos, out, true);
 }
