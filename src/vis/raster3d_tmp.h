@@ -119,9 +119,12 @@ TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_mov
  * two costs one step per P positions. Each position's rectangle comes in the lanes
  * from the bounds' bits (tri_pos_rect), its moved setup values (tri_moved) at the
  * first hit: a draw costs nothing per position beyond its lanes. The same
- * operations in the same order as the loop above, lane by lane, so the same bits;
- * the lanes that pass take the depth test one at a time, each in its own layer.
- * Adds the samples tested to *tested. */
+ * operations in the same order as the loop above, lane by lane, so the same bits.
+ * The lanes that pass take the depth test together (their samples are distinct:
+ * a lane's position or pixel differs), reading each one's layer by a gather of
+ * 32-bit indices (frames of fewer than 2^31 samples; larger ones test one lane at
+ * a time), and the winners are written one at a time. Adds the samples tested to
+ * *tested. */
 TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
                                                 const int r[4], const camera *c, int ns, visbuf *vb,
                                                 uint64_t *tested) {
@@ -132,6 +135,9 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
   const int lg = lg_ns < lg_w ? lg_ns : lg_w, P = 1 << lg, G = W / P;
   const VI lane = VI_(lanes)(), one_i = VI_(splat)(1);
   const tri_pos_bits *b = mv->pos;
+  const bool gathered = (uint64_t)ns * layer <= INT32_MAX;
+  /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
+  const VI bias = VI_(splat)(INT32_MIN), id_biased = VI_(splat)((int32_t)id) ^ bias;
   uint64_t covered = 0, evals = 0;
   for (int p0 = 0; p0 < ns; p0 += P) {
     const VI p = VI_(splat)(p0) + (lane & (P - 1)), bit = one_i << p;
@@ -175,11 +181,18 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
       const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * L.num_x) + (sy - cy) * L.num_y, den, v, inv, zero,
                                               VF_(select));
       const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
+      covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
+      VI kv = VI_(splat)(0);
+      if (gathered) {
+        kv = p * VI_(splat)((int32_t)layer) + y * VI_(splat)((int32_t)width) + x;
+        const VF bt = VF_(gather_masked)(vb->t, kv, in);
+        const VI bid = VI_(gather_masked)((const int32_t *)vb->id, kv, in);
+        hit = VI_(bits)(in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased))));
+      }
       for (; hit; hit &= hit - 1) {
         const int l = __builtin_ctz((unsigned)hit);
-        const size_t k = (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
-        covered++;
-        if (t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
+        const size_t k = gathered ? (size_t)kv[l] : (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
+        if (gathered || t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
           vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
       }
     }
