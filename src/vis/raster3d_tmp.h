@@ -133,7 +133,8 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
   const int lg_w = __builtin_ctz(W), lg_ns = ns > 1 ? 32 - __builtin_clz((unsigned)ns - 1) : 0;
   const int lg = lg_ns < lg_w ? lg_ns : lg_w, P = 1 << lg, G = W / P;
-  const VI lane = VI_(lanes)(), one_i = VI_(splat)(1);
+  const VI lane = VI_(lanes)(), one_i = VI_(splat)(1), zero_i = VI_(splat)(0);
+  const VF half = VF_(splat)(0.5f);
   const tri_pos_bits *b = mv->pos;
   const bool gathered = (uint64_t)ns * layer <= INT32_MAX;
   /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
@@ -151,18 +152,21 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
     x1 = VI_(select)(x1 > r2, r2, x1), y1 = VI_(select)(y1 > r3, r3, y1);
     const VI live = ((VI_(splat)(b->none) & bit) == 0) & (p < ns) & (x0 <= x1) & (y0 <= y1);
     if (!VI_(bits)(live)) continue;
-    y1 = VI_(select)(live, y1, y0 - one_i); /* a lane without samples never runs */
-    const VI wv = x1 - x0 + one_i;
+    /* a lane without samples has none to run */
+    const VI wv = VI_(select)(live, x1 - x0 + one_i, one_i), n = VI_(select)(live, wv * (y1 - y0 + one_i), zero_i);
+    const VF inv_w = one / VF_(from_int)(wv);
     const VF ox = VF_(gather)(mv->ox, p), oy = VF_(gather)(mv->oy, p);
     VF m[4];
     bool moved = false;
-    /* each lane's pixels: the q-th of every G of its rectangle's, wrapped into its rows */
-    VI x = x0 + (lane >> lg), y = y0;
-    for (VI in;; x += VI_(splat)(G)) {
-      for (VI wrap; VI_(bits)(wrap = live & (x > x1));) x -= wrap & wv, y -= wrap;
-      const int tried = VI_(bits)(in = y <= y1);
+    /* each lane's pixels: the q-th of every G of its rectangle's in row order; pixel
+     * i is in row (i + 1/2) / wv, rounded down (exact while i < 2^22: the quotient
+     * lies 1/(2·wv) or more from an integer, far above two roundings) */
+    for (VI i = lane >> lg, in;; i += VI_(splat)(G)) {
+      const int tried = VI_(bits)(in = i < n);
       if (!tried) break;
       evals += (uint64_t)__builtin_popcount((unsigned)tried);
+      const VI row = VI_(trunc)((VF_(from_int)(i) + half) * inv_w);
+      const VI x = x0 + (i - row * wv), y = y0 + row;
       const VF sx = VF_(from_int)(x) + ox, sy = VF_(from_int)(y) + oy;
       VF ev[3];
 #pragma GCC unroll 3
