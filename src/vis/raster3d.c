@@ -88,7 +88,7 @@ uint64_t rr_raster_rect_samples(const tri_setup *ts, tri_moves *mv, uint32_t id,
    * 780 M and 3708 M; at 4 positions (two pixels a step) the bunny took 277 M and
    * 260 M, the grid 2285 M either way. */
   const int w = r[2] - r[0] + 1, area = w * (r[3] - r[1] + 1);
-  if (!(cams[0].planar && (area <= 2 * ns || (ns <= 4 && w <= 8))))
+  if (!(cams[0].planar && (area <= 4 * ns || (ns <= 4 && w <= 8))))
     return raster_scanlines(ts, mv, id, r, cams, ns, vb, covered, simd);
   uint64_t samples = 0, got;
 #ifdef RR_SIMD_X86
