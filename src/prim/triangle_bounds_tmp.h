@@ -73,15 +73,9 @@ TARGET __attribute__((always_inline)) static inline uint32_t RR_CAT(corner_bound
    * 2D functions e_k = ex·(Y − cy_k) − ey·(X − cx_k), outside where e_k·area < 0
    * and e_k² > (2m)²·|edge|², on coordinates below 2^20 (no overflow) and a
    * triangle whose projection turns (area not 0). */
-  VF ex[3], ey[3], len2[3];
-#pragma GCC unroll 3
-  for (int k = 0; k < 3; k++) {
-    const int j = k == 2 ? 0 : k + 1;
-    ex[k] = cx[j] - cx[k], ey[k] = cy[j] - cy[k];
-    len2[k] = (ex[k] * ex[k] + ey[k] * ey[k]) * (VF_(splat)(4.0f) * m * m);
-  }
-  const VF area = ey[0] * ex[2] - ex[0] * ey[2]; /* (c1 − c0) × (c2 − c0): the sign of the turn */
-  const VI testable = bounded & (big < VF_(splat)(0x1p20f)) & (area != zero);
+  VF ex[3], ey[3], len2[3], area = zero; /* made when first needed */
+  const VI testable = bounded & (big < VF_(splat)(0x1p20f));
+  bool edges = false;
   /* the rectangle of pixels whose sample at position p may lie in the hull, each
    * position's once; with several positions, the union of those that hold one */
   VF plx[RR_MAX_SAMPLES], phx[RR_MAX_SAMPLES], ply[RR_MAX_SAMPLES], phy[RR_MAX_SAMPLES];
@@ -92,6 +86,16 @@ TARGET __attribute__((always_inline)) static inline uint32_t RR_CAT(corner_bound
     ply[p] = VF_(max)(VF_(ceil)(y0 - oy - m), zero), phy[p] = VF_(min)(VF_(floor)(y1 - oy + m), last_y);
     const VI one_px = testable & (plx[p] == phx[p]) & (ply[p] == phy[p]);
     if (!VI_(bits)(one_px)) continue;
+    if (!edges) {
+#pragma GCC unroll 3
+      for (int k = 0; k < 3; k++) {
+        const int j = k == 2 ? 0 : k + 1;
+        ex[k] = cx[j] - cx[k], ey[k] = cy[j] - cy[k];
+        len2[k] = (ex[k] * ex[k] + ey[k] * ey[k]) * (VF_(splat)(4.0f) * m * m);
+      }
+      area = ey[0] * ex[2] - ex[0] * ey[2]; /* (c1 − c0) × (c2 − c0): the sign of the turn (0: none) */
+      edges = true;
+    }
     const VF X = plx[p] + ox, Y = ply[p] + oy;
     VI outside = VI_(splat)(0);
 #pragma GCC unroll 3
