@@ -109,6 +109,9 @@ static inline rr_vf1 rr_vf1_load(const float *p) { return (rr_vf1){p[0]}; }
 static inline rr_vi1 rr_vi1_load(const int32_t *p) { return (rr_vi1){p[0]}; }
 /* Lane k is p[i[k]]. */
 static inline rr_vf1 rr_vf1_gather(const float *p, rr_vi1 i) { return (rr_vf1){p[i[0]]}; }
+/* Lane k is p[i[k]] where m is set, else 0 (reading no memory). */
+static inline rr_vf1 rr_vf1_gather_masked(const float *p, rr_vi1 i, rr_vi1 m) { return (rr_vf1){m[0] ? p[i[0]] : 0.0f}; }
+static inline rr_vi1 rr_vi1_gather_masked(const int32_t *p, rr_vi1 i, rr_vi1 m) { return (rr_vi1){m[0] ? p[i[0]] : 0}; }
 /* Loads and stores only the lanes set in m (the others load as 0 and touch no memory). */
 static inline rr_vf1 rr_vf1_load_masked(const float *p, rr_vi1 m) { return (rr_vf1){m[0] ? p[0] : 0.0f}; }
 static inline rr_vi1 rr_vi1_load_masked(const int32_t *p, rr_vi1 m) { return (rr_vi1){m[0] ? p[0] : 0}; }
@@ -156,6 +159,12 @@ RR_TARGET_AVX2 static inline rr_vi8 rr_vi8_load(const int32_t *p) {
 }
 RR_TARGET_AVX2 static inline rr_vf8 rr_vf8_gather(const float *p, rr_vi8 i) {
   return _mm256_i32gather_ps(p, (__m256i)i, 4);
+}
+RR_TARGET_AVX2 static inline rr_vf8 rr_vf8_gather_masked(const float *p, rr_vi8 i, rr_vi8 m) {
+  return _mm256_mask_i32gather_ps(_mm256_setzero_ps(), p, (__m256i)i, (__m256)m, 4);
+}
+RR_TARGET_AVX2 static inline rr_vi8 rr_vi8_gather_masked(const int32_t *p, rr_vi8 i, rr_vi8 m) {
+  return (rr_vi8)_mm256_mask_i32gather_epi32(_mm256_setzero_si256(), (const int *)p, (__m256i)i, (__m256i)m, 4);
 }
 RR_TARGET_AVX2 static inline rr_vf8 rr_vf8_load_masked(const float *p, rr_vi8 m) {
   return _mm256_maskload_ps(p, (__m256i)m);

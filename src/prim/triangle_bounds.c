@@ -86,7 +86,7 @@ bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
   if (c->planar) {
     tri_bound b;
     const float pos[1][2] = {{c->sx0, c->sy0}};
-    if (!corner_bounds1(s, i, NULL, 1, c, 1, pos, &b)) return false;
+    if (!corner_bounds_any1(s, i, NULL, 1, c, 1, pos, &b)) return false;
     memcpy(r, b.bb, sizeof b.bb);
     return true;
   }
@@ -112,10 +112,10 @@ uint32_t rr_tri_corner_bounds_at(const rr_scene *s, uint32_t first, const uint32
 #ifdef RR_SIMD_X86
   if (simd && __builtin_cpu_supports("avx2"))
     for (; k < n; k += 8)
-      kept += corner_bounds8(s, first + k, ids ? ids + k : NULL, n - k < 8 ? (int)(n - k) : 8, c, npos, pos, out + kept);
+      kept += corner_bounds_any8(s, first + k, ids ? ids + k : NULL, n - k < 8 ? (int)(n - k) : 8, c, npos, pos, out + kept);
 #endif
   (void)simd;
-  for (; k < n; k++) kept += corner_bounds1(s, first + k, ids ? ids + k : NULL, 1, c, npos, pos, out + kept);
+  for (; k < n; k++) kept += corner_bounds_any1(s, first + k, ids ? ids + k : NULL, 1, c, npos, pos, out + kept);
   return kept;
 }
 

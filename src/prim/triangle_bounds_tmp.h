@@ -7,13 +7,15 @@
  * there) for the npos sample positions pos (the union of their rectangles): the
  * same operations in the same order (no FMA, true divisions), lane by
  * lane, so every width gives the same rectangles. Writes the triangles whose
- * rectangle holds a sample to out, in order; returns how many. */
+ * rectangle holds a sample to out, in order; returns how many. flat and npos are
+ * constants where it is inlined (corner_bounds_any): a scene without instances
+ * (lane_corners), and one position, whose rectangles stay in registers. */
 
 #include "prim/triangle_corners_tmp.h"
 
-TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
-                                                       const camera *c, int npos, const float (*pos)[2],
-                                                       tri_bound *out) {
+TARGET __attribute__((always_inline)) static inline uint32_t RR_CAT(corner_bounds, W)(
+    const rr_scene *s, uint32_t first, const uint32_t *ids, int n, const camera *c, int npos, const float (*pos)[2],
+    tri_bound *out, bool flat) {
   int32_t lane_id[W], lane_inf[W] = {0};
   for (int l = 0; l < W; l++)
     lane_id[l] = (int32_t)(ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1));
@@ -22,7 +24,7 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
   const VI inf = VI_(load)(lane_inf);
   const bool persp = c->type == RR_CAMERA_PERSPECTIVE;
   VF corner[3][3];
-  RR_CAT(lane_corners, W)(s, lane_id, !ids && n == W, corner);
+  RR_CAT(lane_corners, W)(s, lane_id, !ids && n == W, corner, flat);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f), half = VF_(splat)(0.5f);
   const VF inf_f = VF_(splat)(INFINITY), width = VF_(splat)((float)c->width), height = VF_(splat)((float)c->height);
   const VF last_x = VF_(splat)((float)(c->width - 1)), last_y = VF_(splat)((float)(c->height - 1));
@@ -30,7 +32,7 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
   const VF fwd[3] = {VF_(splat)(c->fwd.x), VF_(splat)(c->fwd.y), VF_(splat)(c->fwd.z)};
   const VF right[3] = {VF_(splat)(c->right.x), VF_(splat)(c->right.y), VF_(splat)(c->right.z)};
   const VF up[3] = {VF_(splat)(c->up.x), VF_(splat)(c->up.y), VF_(splat)(c->up.z)};
-  VF x0 = inf_f, y0 = inf_f, x1 = -inf_f, y1 = -inf_f;
+  VF x0 = inf_f, y0 = inf_f, x1 = -inf_f, y1 = -inf_f, cx[3], cy[3];
   /* some corner ahead of the eye; every corner projects to a finite point */
   VI ahead_any = VI_(splat)(0), projected = VI_(splat)(-1);
 #pragma GCC unroll 3
@@ -58,18 +60,50 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
     ahead_any |= ahead;
     projected &= ahead & (VF_(abs)(sx) < inf_f) & (VF_(abs)(sy) < inf_f);
     x0 = VF_(min)(x0, sx), x1 = VF_(max)(x1, sx), y0 = VF_(min)(y0, sy), y1 = VF_(max)(y1, sy);
+    cx[k] = sx, cy[k] = sy;
   }
   /* an orthographic view sees a triangle with a corner at infinity unbounded */
   const VI bounded = c->type == RR_CAMERA_ORTHOGRAPHIC ? projected & (inf == 0) : projected;
   const VF big = VF_(max)(VF_(max)(VF_(abs)(x0), VF_(abs)(x1)), VF_(max)(VF_(abs)(y0), VF_(abs)(y1)));
   const VF m = VF_(splat)(1.0f / 64) + VF_(splat)(1e-5f) * big;
+  /* A position whose rectangle is one pixel (most of a sub-pixel triangle's) holds
+   * no sample of the triangle when the sample lies outside an edge of the projected
+   * corners by more than 2m: each true corner lies within m of its projection (the
+   * margin above), so the triangle lies within m of the projected one. The edges'
+   * 2D functions e_k = ex·(Y − cy_k) − ey·(X − cx_k), outside where e_k·area < 0
+   * and e_k² > (2m)²·|edge|², on coordinates below 2^20 (no overflow) and a
+   * triangle whose projection turns (area not 0). */
+  VF ex[3], ey[3], len2[3], area = zero; /* made when first needed */
+  const VI testable = bounded & (big < VF_(splat)(0x1p20f));
+  bool edges = false;
   /* the rectangle of pixels whose sample at position p may lie in the hull, each
    * position's once; with several positions, the union of those that hold one */
   VF plx[RR_MAX_SAMPLES], phx[RR_MAX_SAMPLES], ply[RR_MAX_SAMPLES], phy[RR_MAX_SAMPLES];
+  npos = npos > 1 ? npos : 1; /* what callers pass; it tells the compiler plx[0] is set */
   for (int p = 0; p < npos; p++) {
     const VF ox = VF_(splat)(pos[p][0]), oy = VF_(splat)(pos[p][1]);
     plx[p] = VF_(max)(VF_(ceil)(x0 - ox - m), zero), phx[p] = VF_(min)(VF_(floor)(x1 - ox + m), last_x);
     ply[p] = VF_(max)(VF_(ceil)(y0 - oy - m), zero), phy[p] = VF_(min)(VF_(floor)(y1 - oy + m), last_y);
+    const VI one_px = testable & (plx[p] == phx[p]) & (ply[p] == phy[p]);
+    if (!VI_(bits)(one_px)) continue;
+    if (!edges) {
+#pragma GCC unroll 3
+      for (int k = 0; k < 3; k++) {
+        const int j = k == 2 ? 0 : k + 1;
+        ex[k] = cx[j] - cx[k], ey[k] = cy[j] - cy[k];
+        len2[k] = (ex[k] * ex[k] + ey[k] * ey[k]) * (VF_(splat)(4.0f) * m * m);
+      }
+      area = ey[0] * ex[2] - ex[0] * ey[2]; /* (c1 − c0) × (c2 − c0): the sign of the turn (0: none) */
+      edges = true;
+    }
+    const VF X = plx[p] + ox, Y = ply[p] + oy;
+    VI outside = VI_(splat)(0);
+#pragma GCC unroll 3
+    for (int k = 0; k < 3; k++) {
+      const VF e = ex[k] * (Y - cy[k]) - ey[k] * (X - cx[k]);
+      outside |= (e * area < zero) & (e * e > len2[k]);
+    }
+    plx[p] = VF_(select)(one_px & outside, phx[p] + one, plx[p]); /* no sample: an empty rectangle */
   }
   VF lx = plx[0], hx = phx[0], ly = ply[0], hy = phy[0];
   VI empty = (lx > hx) | (ly > hy);
@@ -104,4 +138,15 @@ TARGET static inline uint32_t RR_CAT(corner_bounds, W)(const rr_scene *s, uint32
                                 {(uint16_t)none[l], (uint16_t)in_x0[l], (uint16_t)in_y0[l], (uint16_t)in_x1[l],
                                  (uint16_t)in_y1[l]}};
   return kept;
+}
+
+/* corner_bounds compiled apart for one position and for scenes without instances */
+TARGET static uint32_t RR_CAT(corner_bounds_any, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
+                                                    const camera *c, int npos, const float (*pos)[2],
+                                                    tri_bound *out) {
+  if (npos == 1)
+    return s->inst ? RR_CAT(corner_bounds, W)(s, first, ids, n, c, 1, pos, out, false)
+                   : RR_CAT(corner_bounds, W)(s, first, ids, n, c, 1, pos, out, true);
+  return s->inst ? RR_CAT(corner_bounds, W)(s, first, ids, n, c, npos, pos, out, false)
+                 : RR_CAT(corner_bounds, W)(s, first, ids, n, c, npos, pos, out, true);
 }

@@ -6,15 +6,25 @@
  * inside one translated instance (the common case) loads its stored corners and
  * adds the translation, translated lanes gather theirs and add it, and other maps
  * move each lane's corners with scene_vertex: inst_point's operations, so the
- * flattened scene's bits. */
+ * flattened scene's bits. flat (a constant where it is inlined) says the scene has
+ * no instances: that copy is only the first case, whose corners stay in registers. */
 TARGET static inline __attribute__((always_inline)) void RR_CAT(lane_corners, W)(const rr_scene *s,
                                                                                const int32_t lane_id[W],
-                                                                               bool consecutive, VF p[3][3]) {
-  if (!s->inst) {
+                                                                               bool consecutive, VF p[3][3],
+                                                                               bool flat) {
+  if (flat || !s->inst) {
     const VI idx = VI_(load)(lane_id);
-    for (int k = 0; k < 3; k++)
-      for (int a = 0; a < 3; a++)
-        p[k][a] = consecutive ? VF_(load)(s->p[k][a] + lane_id[0]) : VF_(gather)(s->p[k][a], idx);
+    if (consecutive) {
+#pragma GCC unroll 3
+      for (int k = 0; k < 3; k++)
+#pragma GCC unroll 3
+        for (int a = 0; a < 3; a++) p[k][a] = VF_(load)(s->p[k][a] + lane_id[0]);
+    } else {
+#pragma GCC unroll 3
+      for (int k = 0; k < 3; k++)
+#pragma GCC unroll 3
+        for (int a = 0; a < 3; a++) p[k][a] = VF_(gather)(s->p[k][a], idx);
+    }
     return;
   }
   uint32_t run_k = RR_MISS, run_st = consecutive ? scene_locate(s, (uint32_t)lane_id[0], &run_k) : 0;

@@ -51,18 +51,19 @@ typedef struct {
  * views[l] asks for camera k (every lane when views is NULL). Camera k's setup of
  * lane l goes to out[k·stride + l], face[k·stride + l] (SETUP_CULLED when not
  * asked for), pl likewise. The same operations in the same order as for each
- * camera alone, so the same bits. */
-TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32_t *ids, int count, const camera *cams,
-                                                 int ncams, const uint8_t *views, bool cull, tri_setup *out, int *face,
-                                                 tri_plane *pl, size_t stride) {
+ * camera alone, so the same bits. flat: a constant, true when the scene has no
+ * instances (lane_corners). */
+TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(
+    const rr_scene *s, const uint32_t *ids, int count, const camera *cams, int ncams, const uint8_t *views, bool cull,
+    tri_setup *out, int *face, tri_plane *pl, size_t stride, bool flat) {
   int32_t lane_id[W], lane_inf[W] = {0};
   for (int l = 0; l < W; l++) lane_id[l] = (int32_t)ids[l < count ? l : count - 1];
   if (s->inf)
     for (int l = 0; l < W; l++) lane_inf[l] = (int32_t)scene_inf(s, (uint32_t)lane_id[l]);
-  bool consecutive = count == W;
-  for (int l = 1; consecutive && l < W; l++) consecutive = ids[l] == ids[0] + (uint32_t)l;
+  const bool consecutive =
+      count == W && VI_(bits)(VI_(load)(lane_id) == VI_(splat)(lane_id[0]) + VI_(lanes)()) == (1 << W) - 1;
   VF corner[3][3];
-  RR_CAT(lane_corners, W)(s, lane_id, consecutive, corner);
+  RR_CAT(lane_corners, W)(s, lane_id, consecutive, corner, flat);
   const VI inf = VI_(load)(lane_inf);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   const V3 zero3 = {zero, zero, zero};
@@ -104,10 +105,10 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(
     inf1 = VI_(select)(f1, at_inf[2], VI_(select)(f2, at_inf[0], at_inf[1]));
     inf2 = VI_(select)(f1, at_inf[0], VI_(select)(f2, at_inf[1], at_inf[2]));
   }
-  const V3 base1 = SELECT3(inf1, zero3, pf), base2 = SELECT3(inf2, zero3, pf); /* w_k·p_f */
-  const D3 r1 = SUB3_T(D3, TO_D3(p1), TO_D3(base1)), r2 = SUB3_T(D3, TO_D3(p2), TO_D3(base2));
-  const D3 nrm_eye = CROSS3_T(D3, r2, r1);
-  const D3 qf = SUB3_T(D3, TO_D3(pf), DSPLAT3(eye));
+  /* computed at the first camera that keeps a lane, after its edges: live across
+   * them, its doubles would take registers the edges need */
+  D3 nrm_eye, qf;
+  bool have_plane = false;
   VF w[3];
   for (int k = 0; k < 3; k++) w[k] = VF_(select)(at_inf[k], zero, one);
   const int lanes = (1 << count) - 1;
@@ -138,9 +139,10 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(
     const VI seen = (orient != zero) & (VF_(abs)(vol) < VF_(splat)(INFINITY)), front = orient > zero;
     const int front_m = VI_(bits)(front) & lanes,
               kept = VI_(bits)(seen & (cull ? front : VI_(splat)(-1))) & asked;
-    for (int l = 0; l < count; l++)
-      vface[l] = !(kept >> l & 1) ? SETUP_CULLED : front_m >> l & 1 ? SETUP_FRONT : SETUP_BACK;
-    if (!kept) continue;
+    if (!kept) {
+      for (int l = 0; l < count; l++) vface[l] = SETUP_CULLED;
+      continue;
+    }
     const VF sign = VF_(select)(front, one, VF_(splat)(-1.0f));
     const V3 d0 = SPLAT3(c->d0), dx = SPLAT3(c->dx), dy = SPLAT3(c->dy);
     VF ea[3], eb[3], ec[3];
@@ -171,6 +173,12 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(
       tie |= LEX_POSITIVE(g1, g2, DOT3(ne, fwd)) & (1 << e);
     }
     vol = vol * sign, vol_x = vol_x * sign, vol_y = vol_y * sign;
+    if (!have_plane) {
+      const V3 base1 = SELECT3(inf1, zero3, pf), base2 = SELECT3(inf2, zero3, pf); /* w_k·p_f */
+      const D3 r1 = SUB3_T(D3, TO_D3(p1), TO_D3(base1)), r2 = SUB3_T(D3, TO_D3(p2), TO_D3(base2));
+      nrm_eye = CROSS3_T(D3, r2, r1), qf = SUB3_T(D3, TO_D3(pf), DSPLAT3(eye));
+      have_plane = true;
+    }
     const D3 nrm = SCALE3_T(D3, nrm_eye, TO_D(sign));
     /* (cx, cy): the sample nearest to where p_f projects, within the image; the
      * coordinates of q_f in the basis of the camera's (d0, dx, dy) or, orthographic,
@@ -217,7 +225,8 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(
     }
     const VF fpa = TO_F(pa), fpb = TO_F(pb), fpc = TO_F(pc), fn0 = TO_F(num0), fnx = TO_F(num_x), fny = TO_F(num_y);
     for (int l = 0; l < count; l++) {
-      if (!(kept >> l & 1)) continue;
+      vface[l] = !(kept >> l & 1) ? SETUP_CULLED : front_m >> l & 1 ? SETUP_FRONT : SETUP_BACK;
+      if (vface[l] == SETUP_CULLED) continue;
       tri_setup *o = &vout[l];
       for (int e = 0; e < 3; e++) o->a[e] = ea[e][l], o->b[e] = eb[e][l], o->c[e] = ec[e][l];
       o->vol = vol[l], o->vol_x = vol_x[l], o->vol_y = vol_y[l];
@@ -230,17 +239,25 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(
   }
 }
 
-/* setup_lanes for several cameras (it is always inlined: a call of its own here). */
+/* setup_lanes for several cameras (it is always inlined: a call of its own here),
+ * compiled apart for scenes with and without instances. */
 TARGET static void RR_CAT(setup_views, W)(const rr_scene *s, const uint32_t *ids, int count, const camera *cams,
                                           int ncams, const uint8_t *views, bool cull, tri_setup *out, int *face,
                                           tri_plane *pl, size_t stride) {
-  RR_CAT(setup_lanes, W)(s, ids, count, cams, ncams, views, cull, out, face, pl, stride);
+  if (s->inst)
+    RR_CAT(setup_lanes, W)(s, ids, count, cams, ncams, views, cull, out, face, pl, stride, false);
+  else
+    RR_CAT(setup_lanes, W)(s, ids, count, cams, ncams, views, cull, out, face, pl, stride, true);
 }
 
-/* setup_lanes for one camera and every lane, compiled without the loop over cameras. */
+/* setup_lanes for one camera and every lane, compiled without the loop over
+ * cameras, and apart for scenes with and without instances. */
 TARGET static void RR_CAT(setup_one, W)(const rr_scene *s, const uint32_t *ids, int count, const camera *c, bool cull,
                                         tri_setup *out, int *face, tri_plane *pl) {
-  RR_CAT(setup_lanes, W)(s, ids, count, c, 1, NULL, cull, out, face, pl, 0);
+  if (s->inst)
+    RR_CAT(setup_lanes, W)(s, ids, count, c, 1, NULL, cull, out, face, pl, 0, false);
+  else
+    RR_CAT(setup_lanes, W)(s, ids, count, c, 1, NULL, cull, out, face, pl, 0, true);
 }
 
 #include "prim/triangle_moved_tmp.h"

@@ -119,9 +119,12 @@ TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_mov
  * two costs one step per P positions. Each position's rectangle comes in the lanes
  * from the bounds' bits (tri_pos_rect), its moved setup values (tri_moved) at the
  * first hit: a draw costs nothing per position beyond its lanes. The same
- * operations in the same order as the loop above, lane by lane, so the same bits;
- * the lanes that pass take the depth test one at a time, each in its own layer.
- * Adds the samples tested to *tested. */
+ * operations in the same order as the loop above, lane by lane, so the same bits.
+ * The lanes that pass take the depth test together (their samples are distinct:
+ * a lane's position or pixel differs), reading each one's layer by a gather of
+ * 32-bit indices (frames of fewer than 2^31 samples; larger ones test one lane at
+ * a time), and the winners are written one at a time. Adds the samples tested to
+ * *tested. */
 TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
                                                 const int r[4], const camera *c, int ns, visbuf *vb,
                                                 uint64_t *tested) {
@@ -130,8 +133,12 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
   const int lg_w = __builtin_ctz(W), lg_ns = ns > 1 ? 32 - __builtin_clz((unsigned)ns - 1) : 0;
   const int lg = lg_ns < lg_w ? lg_ns : lg_w, P = 1 << lg, G = W / P;
-  const VI lane = VI_(lanes)(), one_i = VI_(splat)(1);
+  const VI lane = VI_(lanes)(), one_i = VI_(splat)(1), zero_i = VI_(splat)(0);
+  const VF half = VF_(splat)(0.5f);
   const tri_pos_bits *b = mv->pos;
+  const bool gathered = (uint64_t)ns * layer <= INT32_MAX;
+  /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
+  const VI bias = VI_(splat)(INT32_MIN), id_biased = VI_(splat)((int32_t)id) ^ bias;
   uint64_t covered = 0, evals = 0;
   for (int p0 = 0; p0 < ns; p0 += P) {
     const VI p = VI_(splat)(p0) + (lane & (P - 1)), bit = one_i << p;
@@ -145,18 +152,21 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
     x1 = VI_(select)(x1 > r2, r2, x1), y1 = VI_(select)(y1 > r3, r3, y1);
     const VI live = ((VI_(splat)(b->none) & bit) == 0) & (p < ns) & (x0 <= x1) & (y0 <= y1);
     if (!VI_(bits)(live)) continue;
-    y1 = VI_(select)(live, y1, y0 - one_i); /* a lane without samples never runs */
-    const VI wv = x1 - x0 + one_i;
+    /* a lane without samples has none to run */
+    const VI wv = VI_(select)(live, x1 - x0 + one_i, one_i), n = VI_(select)(live, wv * (y1 - y0 + one_i), zero_i);
+    const VF inv_w = one / VF_(from_int)(wv);
     const VF ox = VF_(gather)(mv->ox, p), oy = VF_(gather)(mv->oy, p);
     VF m[4];
     bool moved = false;
-    /* each lane's pixels: the q-th of every G of its rectangle's, wrapped into its rows */
-    VI x = x0 + (lane >> lg), y = y0;
-    for (VI in;; x += VI_(splat)(G)) {
-      for (VI wrap; VI_(bits)(wrap = live & (x > x1));) x -= wrap & wv, y -= wrap;
-      const int tried = VI_(bits)(in = y <= y1);
+    /* each lane's pixels: the q-th of every G of its rectangle's in row order; pixel
+     * i is in row (i + 1/2) / wv, rounded down (exact while i < 2^22: the quotient
+     * lies 1/(2·wv) or more from an integer, far above two roundings) */
+    for (VI i = lane >> lg, in;; i += VI_(splat)(G)) {
+      const int tried = VI_(bits)(in = i < n);
       if (!tried) break;
       evals += (uint64_t)__builtin_popcount((unsigned)tried);
+      const VI row = VI_(trunc)((VF_(from_int)(i) + half) * inv_w);
+      const VI x = x0 + (i - row * wv), y = y0 + row;
       const VF sx = VF_(from_int)(x) + ox, sy = VF_(from_int)(y) + oy;
       VF ev[3];
 #pragma GCC unroll 3
@@ -175,11 +185,18 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
       const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * L.num_x) + (sy - cy) * L.num_y, den, v, inv, zero,
                                               VF_(select));
       const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
+      covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
+      VI kv = VI_(splat)(0);
+      if (gathered) {
+        kv = p * VI_(splat)((int32_t)layer) + y * VI_(splat)((int32_t)width) + x;
+        const VF bt = VF_(gather_masked)(vb->t, kv, in);
+        const VI bid = VI_(gather_masked)((const int32_t *)vb->id, kv, in);
+        hit = VI_(bits)(in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased))));
+      }
       for (; hit; hit &= hit - 1) {
         const int l = __builtin_ctz((unsigned)hit);
-        const size_t k = (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
-        covered++;
-        if (t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
+        const size_t k = gathered ? (size_t)kv[l] : (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
+        if (gathered || t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
           vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
       }
     }
