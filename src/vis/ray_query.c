@@ -100,7 +100,11 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
   float vbuf[9 * BVH_MAX_LEAF + BVH_LEAF_PAD]; /* an instance's leaf, in world space */
   uint32_t ibuf[BVH_MAX_LEAF];
   const uint32_t *ids;
-  const float *v = bvh_leaf_at(r->b, true, first, count, vbuf, ibuf, &ids);
+  const float *v;
+  if (first < r->b->ntop) /* the top's own leaf, bvh_leaf_at's first case without its call */
+    ids = r->b->prims + first, v = r->b->leaf_v8 + (size_t)9 * first;
+  else
+    v = bvh_leaf_at(r->b, true, first, count, vbuf, ibuf, &ids);
   if (query_tris(r, v, ids, 0, false, NULL, count, any)) return true;
   if (r->s->kind) { /* analytic primitives, which the pre-test rejects as edge-on: their own test */
     const float dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
@@ -192,8 +196,11 @@ static rr_error query_begin(rr_device *dev, const char *fn, const rr_scene *s, c
   return RR_OK;
 }
 
+/* rr_scene_hit's miss, without its call. */
+static const rr_hit query_miss = {.prim = RR_MISS, .t = INFINITY, .geom = RR_MISS, .inst = RR_MISS};
+
 rr_error rr_intersect(rr_device *dev, const rr_scene *scene, const rr_ray *ray, rr_hit *hit) {
-  if (hit) *hit = rr_scene_hit(scene, RR_MISS, INFINITY, 0, 0);
+  if (hit) *hit = query_miss;
   query_ray r;
   rr_error e = query_begin(dev, "rr_intersect", scene, ray, hit, &r);
   if (e) return e;
@@ -271,7 +278,7 @@ static void stream_chunk(int job, int thread, void *arg) {
     if (j->occluded)
       j->occluded[i] = hit;
     else
-      j->hits[i] = hit ? rr_scene_hit(j->s, r.id, r.t, r.l1, r.l2) : rr_scene_hit(j->s, RR_MISS, INFINITY, 0, 0);
+      j->hits[i] = hit ? rr_scene_hit(j->s, r.id, r.t, r.l1, r.l2) : query_miss;
   }
 }
 
