@@ -53,28 +53,37 @@ typedef struct {
  * way. A NaN slab (0·inf: the origin on a plane the ray runs in) is ignored: min
  * and max keep their second operand. Empty slots (lo = inf, hi = −inf) never pass. */
 
-/* Tests a leaf's triangles, keeping the nearest hit; `any`: stops at the first.
+/* Tests a leaf's count triangles, keeping the nearest hit; `any`: stops at the
+ * first. Their corners are at leaf in rr_bvh.leaf_v8's layout, their ids are
+ * ids[i] + idbase; `moved`: a translated instance's leaf read in place, whose
+ * corners are leaf's plus shift (x, y, z at shift[0], [4], [8]: a transform's
+ * last column), the additions bvh_leaf_at's copy makes, so the same bits.
  * Four at a time through the edge pre-test, then the full test for the lanes
  * that pass it (and for triangles with corners at infinity, which it cannot
  * judge). The same triangles pass whatever the order, and depth_wins keeps the
  * nearest, lower id on a tie, so the hit does not depend on the order. */
-KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool any) {
-  float vbuf[9 * BVH_MAX_LEAF + BVH_LEAF_PAD]; /* an instance's leaf, in world space */
-  uint32_t ibuf[BVH_MAX_LEAF];
-  const uint32_t *ids;
-  const float *v = bvh_leaf_at(r->b, true, first, count, vbuf, ibuf, &ids);
+KERNEL bool query_tris(query_ray *r, const float *leaf, const uint32_t *ids, uint32_t idbase, const bool moved,
+                       const float *shift, uint32_t count, const bool any) {
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;
+    const float *v = leaf + j;
+    size_t stride = count;
+    float mv[9 * 4]; /* the group's corners moved */
+    if (moved) {
+      for (int c = 0; c < 9; c++)
+        rr_vf4_store(mv + 4 * c, rr_vf4_load(v + c * count) + rr_vf4_splat(shift[4 * (c % 3)]));
+      v = mv, stride = 4;
+    }
     rr_vf4 pre[4];
-    int may = tri_ray_may_hit4(v + j, count, r->o, r->d, pre) & ((1 << n) - 1);
+    int may = tri_ray_may_hit4(v, stride, r->o, r->d, pre) & ((1 << n) - 1);
     if (r->s->inf)
-      for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, ids[j + k]) != 0) << k;
+      for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, ids[j + k] + idbase) != 0) << k;
     for (; may; may &= may - 1) {
-      uint32_t lane = (uint32_t)__builtin_ctz(may), id = ids[j + lane];
+      uint32_t lane = (uint32_t)__builtin_ctz(may), id = ids[j + lane] + idbase;
       float t, l1, l2, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
       const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
       if (e[0] > 0 && e[1] > 0 && e[2] > 0 && !(r->s->inf && scene_inf(r->s, id)) &&
-          ray_t_outside(ray_corner_extent(v + j + lane, count, r->org), r->dmax, e, r->tmin, r->t))
+          ray_t_outside(ray_corner_extent(v + lane, stride, r->org), r->dmax, e, r->tmin, r->t))
         continue;
       bool hit = ray_tri_test(r->s, id, &r->rc, r->org, dir, e, r->tmin, r->t, &t, &l1, &l2);
       if (!hit) continue;
@@ -82,6 +91,21 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
       if (depth_wins(t, id, r->t, r->id)) r->t = t, r->id = id, r->l1 = l1, r->l2 = l2;
     }
   }
+  return false;
+}
+
+/* Tests the leaf at positions [first, first + count) of the scene's tree (an
+ * instance's, other than a translation, through bvh_leaf_at's copy). */
+KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool any) {
+  float vbuf[9 * BVH_MAX_LEAF + BVH_LEAF_PAD]; /* an instance's leaf, in world space */
+  uint32_t ibuf[BVH_MAX_LEAF];
+  const uint32_t *ids;
+  const float *v;
+  if (first < r->b->ntop) /* the top's own leaf, bvh_leaf_at's first case without its call */
+    ids = r->b->prims + first, v = r->b->leaf_v8 + (size_t)9 * first;
+  else
+    v = bvh_leaf_at(r->b, true, first, count, vbuf, ibuf, &ids);
+  if (query_tris(r, v, ids, 0, false, NULL, count, any)) return true;
   if (r->s->kind) { /* analytic primitives, which the pre-test rejects as edge-on: their own test */
     const float dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
     ana_ray ar = ana_ray_of(r->org, dir);
@@ -172,8 +196,11 @@ static rr_error query_begin(rr_device *dev, const char *fn, const rr_scene *s, c
   return RR_OK;
 }
 
+/* rr_scene_hit's miss, without its call. */
+static const rr_hit query_miss = {.prim = RR_MISS, .t = INFINITY, .geom = RR_MISS, .inst = RR_MISS};
+
 rr_error rr_intersect(rr_device *dev, const rr_scene *scene, const rr_ray *ray, rr_hit *hit) {
-  if (hit) *hit = rr_scene_hit(scene, RR_MISS, INFINITY, 0, 0);
+  if (hit) *hit = query_miss;
   query_ray r;
   rr_error e = query_begin(dev, "rr_intersect", scene, ray, hit, &r);
   if (e) return e;
@@ -251,7 +278,7 @@ static void stream_chunk(int job, int thread, void *arg) {
     if (j->occluded)
       j->occluded[i] = hit;
     else
-      j->hits[i] = hit ? rr_scene_hit(j->s, r.id, r.t, r.l1, r.l2) : rr_scene_hit(j->s, RR_MISS, INFINITY, 0, 0);
+      j->hits[i] = hit ? rr_scene_hit(j->s, r.id, r.t, r.l1, r.l2) : query_miss;
   }
 }
 

@@ -10,26 +10,52 @@
  * (closest hit; an any-hit query takes them in slot order, as any hit ends it),
  * the others stacked with their entry, and a stacked slot is dropped on pop when
  * the best hit is already nearer (strictly: an equal t with a lower id still
- * wins). Leaves go to query_leaf, the one place a leaf's primitives are tested. */
+ * wins). Leaves go to query_tris, the one place a leaf's triangles are tested
+ * (through query_leaf, which adds the analytic primitives, for the scene's tree). */
 
-RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _body)(query_ray *r, const bool any) {
+RQ_TARGET static bool RR_CAT(RQ_NAME, _inst_any)(query_ray *r, uint32_t root, uint32_t k);
+RQ_TARGET static bool RR_CAT(RQ_NAME, _inst_closest)(query_ray *r, uint32_t root, uint32_t k);
+
+/* The traversal from wide8 node `root` of the scene's tree or, `inst`, of the
+ * object tree (rr_bvh.obj) as translated instance k's: its nodes and leaves read
+ * in place, the translation added as their planes and corners are loaded (the
+ * additions of bvh_levels.h's copies, so the same bits), its references left in
+ * the object tree's numbering. The scene's traversal hands each translated
+ * instance it enters to an instance traversal (as Embree does with an instance's
+ * tree) and walks the others through bvh_levels.h's copies. */
+RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _body)(query_ray *r, const bool any,
+                                                                                     const bool inst, uint32_t root,
+                                                                                     uint32_t k) {
   struct {
     uint32_t ref, count;
     float key;
   } stack[7 * BVH_STACK]; /* a level pushes at most seven; the tree is less than BVH_STACK deep */
-  RQ_VF o[3], inv_n[3], inv_f[3];
+  RQ_VF org[3], inv_n[3], inv_f[3];
   for (int a = 0; a < 3; a++)
-    o[a] = RQ_(splat)(r->org[a]), inv_n[a] = RQ_(splat)(r->inv_n[a]), inv_f[a] = RQ_(splat)(r->inv_f[a]);
+    org[a] = RQ_(splat)(r->org[a]), inv_n[a] = RQ_(splat)(r->inv_n[a]), inv_f[a] = RQ_(splat)(r->inv_f[a]);
   const RQ_VF tlo = RQ_(splat)(r->tlo);
+  const rr_bvh *b = r->b, *o = b->obj;
+  const float *shift = NULL; /* inst: the translation, x, y, z at [0], [4], [8] */
+  RQ_VF sh[3];
+  uint32_t idbase = 0;
+  if (inst) {
+    shift = b->inst->xf[k] + 3, idbase = b->inst->base + k * b->inst->T;
+    for (int a = 0; a < 3; a++) sh[a] = RQ_(splat)(shift[4 * a]);
+  }
   int sp = 0;
-  uint32_t ref = 0, count = 0; /* node 0 */
+  uint32_t ref = root, count = 0;
   for (;;) {
     if (count) {
-      if (query_leaf(r, ref, count, any)) return true;
+      if (inst ? query_tris(r, o->leaf_v8 + (size_t)9 * ref, o->prims + ref, idbase, true, shift, count, any)
+               : query_leaf(r, ref, count, any))
+        return true;
+    } else if (!inst && ref >= b->nwide8 && b->inst->shift[k = bvh_inst_of(ref, b->nwide8, o->nwide8, &root)]) {
+      /* a translated instance's root: its own traversal */
+      if (any ? RR_CAT(RQ_NAME, _inst_any)(r, root, k) : RR_CAT(RQ_NAME, _inst_closest)(r, root, k)) return true;
     } else {
       /* The slab test (vis/ray_query.c: query_ray), slots in lanes. */
-      BVH_NODE_ALIGN bvh_wide8 buf; /* an instance's node, moved to world space (accel/bvh_levels.h) */
-      const bvh_wide8 *w = bvh_wide8_at(r->b, ref, &buf);
+      BVH_NODE_ALIGN bvh_wide8 buf; /* another instance's node, moved to world space (accel/bvh_levels.h) */
+      const bvh_wide8 *w = inst ? &o->wide8[ref] : bvh_wide8_at(b, ref, &buf);
       const char *base = (const char *)w;
       const RQ_VF best = RQ_(splat)(r->t);
       float entry[8] __attribute__((aligned(32)));
@@ -39,8 +65,11 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
         RQ_VF t0 = tlo, t1 = best;
 #pragma GCC unroll 3
         for (int a = 0; a < 3; a++) {
-          t0 = RQ_(max)((RQ_(load_aligned)((const float *)(base + r->wn[a]) + h) - o[a]) * inv_n[a], t0);
-          t1 = RQ_(min)((RQ_(load_aligned)((const float *)(base + r->wf[a]) + h) - o[a]) * inv_f[a], t1);
+          RQ_VF pn = RQ_(load_aligned)((const float *)(base + r->wn[a]) + h);
+          RQ_VF pf = RQ_(load_aligned)((const float *)(base + r->wf[a]) + h);
+          if (inst) pn = pn + sh[a], pf = pf + sh[a];
+          t0 = RQ_(max)((pn - org[a]) * inv_n[a], t0);
+          t1 = RQ_(min)((pf - org[a]) * inv_f[a], t1);
         }
         memcpy(entry + h, &t0, sizeof t0);
         hits |= (unsigned)RQ_(bits)(t0 <= t1) << h;
@@ -84,9 +113,16 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
   }
 }
 
-/* Specialised for the two queries. */
-RQ_TARGET static bool RR_CAT(RQ_NAME, _closest)(query_ray *r) { return RR_CAT(RQ_NAME, _body)(r, false); }
-RQ_TARGET static bool RR_CAT(RQ_NAME, _any)(query_ray *r) { return RR_CAT(RQ_NAME, _body)(r, true); }
+/* Specialised for the two queries, the scene's tree and a translated instance's. */
+RQ_TARGET static bool RR_CAT(RQ_NAME, _closest)(query_ray *r) { return RR_CAT(RQ_NAME, _body)(r, false, false, 0, 0); }
+RQ_TARGET static bool RR_CAT(RQ_NAME, _any)(query_ray *r) { return RR_CAT(RQ_NAME, _body)(r, true, false, 0, 0); }
+RQ_TARGET static __attribute__((noinline)) bool RR_CAT(RQ_NAME, _inst_closest)(query_ray *r, uint32_t root,
+                                                                                 uint32_t k) {
+  return RR_CAT(RQ_NAME, _body)(r, false, true, root, k);
+}
+RQ_TARGET static __attribute__((noinline)) bool RR_CAT(RQ_NAME, _inst_any)(query_ray *r, uint32_t root, uint32_t k) {
+  return RR_CAT(RQ_NAME, _body)(r, true, true, root, k);
+}
 
 #undef RQ_LANES
 #undef RQ_VF

@@ -23,11 +23,14 @@ static inline bool ray_small(const rr_scene *s, const float org[3], const camera
 
 /* Why a ray cannot be traced, or NULL. */
 static inline const char *ray_problem(const float org[3], const float dir[3], float tmin, float tmax) {
-  for (int a = 0; a < 3; a++)
-    if (!isfinite(org[a]) || !isfinite(dir[a])) return "a non-finite origin or direction";
+  /* x − x is 0 for a finite x and NaN otherwise; NaN survives the sums */
+  float z = (org[0] - org[0]) + (org[1] - org[1]) + (org[2] - org[2]) + (dir[0] - dir[0]) + (dir[1] - dir[1]) +
+            (dir[2] - dir[2]);
+  if (__builtin_expect(z == 0 && (dir[0] != 0 || dir[1] != 0 || dir[2] != 0) && tmin == tmin && tmax == tmax, 1))
+    return NULL;
+  if (z != 0) return "a non-finite origin or direction";
   if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0) return "a zero direction";
-  if (isnan(tmin) || isnan(tmax)) return "a NaN range";
-  return NULL;
+  return "a NaN range";
 }
 
 /* Whether the full test (ray_tri_test) of a triangle whose pre-test values pre
