@@ -269,17 +269,17 @@ bool rr_tri_screen_bounds_sph(const rr_scene *s, uint32_t i, const camera *c, co
  * knows no bound (another camera, a degenerate setup). */
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
 /* What the curved bounds take from a setup, whatever the camera's position: its
- * spherical triangle (unit edge normals n, unit vertices v, sin of half the least
- * interior angle smin, the widening E; ok false when degenerate or a sliver) and
- * the cap that holds it (unit axis, radius rho; cap false when it bounds nothing).
- * rr_tri_spheres fills out[0..n-1], eight lanes at a time (AVX2 when simd). */
+ * spherical triangle (sin of half the least interior angle smin, the widening E;
+ * ok false when degenerate or a sliver) and the cap that holds it (unit axis,
+ * radius rho; cap false when it bounds nothing). rr_tri_spheres fills
+ * out[0..n-1], four lanes at a time (AVX2 when simd). */
 struct tri_sphere {
-  double n[3][3], v[3][3], smin, E, axis[3], rho;
+  double smin, E, axis[3], rho;
   bool ok, cap;
 };
 void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out);
-/* rr_tri_curved_rect from the setup's rr_tri_spheres. */
-int rr_tri_curved_rect_sph(const camera *c, const tri_sphere *sp, int rect[4]);
+/* rr_tri_curved_rect from the setup ts and its rr_tri_spheres. */
+int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_sphere *sp, int rect[4]);
 /* The cheaper cap bound rr_tri_curved_rect starts from (prim/triangle_curved.c):
  * the image of a cap holding the spherical triangle, widened by the map's largest
  * stretch over it; scale multiplies the cap's radius (1; the tests halve it to see

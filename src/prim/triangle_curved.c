@@ -120,15 +120,15 @@ static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, i
  * eight lanes at a time, in double: the vertices come from cross products of
  * normals that may be nearly parallel (slivers, with the 1e-9 tests), where float
  * would lose the digits the margins above do not cover. */
-typedef double vd8 __attribute__((vector_size(64)));
-typedef int64_t vl8 __attribute__((vector_size(64)));
-/* macros, not functions: 64-byte vector arguments would change the ABI without AVX-512 */
-#define vd_splat(x) ((vd8){0} + (x))
-#define vl_splat(x) ((vl8){0} + (x))
-#define vsel(m, a, b) ((vd8)(((m) & (vl8)(a)) | (~(m) & (vl8)(b))))
+typedef double vd4 __attribute__((vector_size(32)));
+typedef int64_t vl4 __attribute__((vector_size(32)));
+/* macros, not functions: 32-byte vector arguments would change the ABI without AVX */
+#define vd_splat(x) ((vd4){0} + (x))
+#define vl_splat(x) ((vl4){0} + (x))
+#define vsel(m, a, b) ((vd4)(((m) & (vl4)(a)) | (~(m) & (vl4)(b))))
 #define vmin(a, b) vsel((a) < (b), a, b) /* as mind, maxd: NaN gives b */
 #define vmax(a, b) vsel((a) > (b), a, b)
-#define vabs(a) ((vd8)((vl8)(a) & 0x7FFFFFFFFFFFFFFFLL))
+#define vabs(a) ((vd4)((vl4)(a) & 0x7FFFFFFFFFFFFFFFLL))
 #define vdot(a, b) ((a)[0] * (b)[0] + (a)[1] * (b)[1] + (a)[2] * (b)[2])
 #define vcross(a, b, o)                                                                                           \
   ((o)[0] = (a)[1] * (b)[2] - (a)[2] * (b)[1], (o)[1] = (a)[2] * (b)[0] - (a)[0] * (b)[2],                        \
@@ -138,8 +138,8 @@ typedef int64_t vl8 __attribute__((vector_size(64)));
 #define SPH_TARGET
 #define SPH_SQRT(x)                                                                                               \
   ({                                                                                                              \
-    vd8 x_ = (x), r_;                                                                                             \
-    for (int l_ = 0; l_ < 8; l_++) r_[l_] = sqrt(x_[l_]);                                                         \
+    vd4 x_ = (x), r_;                                                                                             \
+    for (int l_ = 0; l_ < 4; l_++) r_[l_] = sqrt(x_[l_]);                                                         \
     r_;                                                                                                           \
   })
 #include "prim/triangle_sphere_tmp.h"
@@ -149,34 +149,27 @@ typedef int64_t vl8 __attribute__((vector_size(64)));
 #ifdef RR_SIMD_X86
 #define SPH_NAME spheres_avx2
 #define SPH_TARGET RR_TARGET_AVX2
-#define SPH_SQRT(x)                                                                                               \
-  ({                                                                                                              \
-    vd8 x_ = (x);                                                                                                 \
-    __m256d h_[2];                                                                                                \
-    memcpy(h_, &x_, sizeof x_);                                                                                   \
-    h_[0] = _mm256_sqrt_pd(h_[0]), h_[1] = _mm256_sqrt_pd(h_[1]);                                                 \
-    memcpy(&x_, h_, sizeof x_);                                                                                   \
-    x_;                                                                                                           \
-  })
+#define SPH_SQRT(x) ((vd4)_mm256_sqrt_pd((__m256d)(x)))
 #include "prim/triangle_sphere_tmp.h"
 #undef SPH_NAME
 #undef SPH_TARGET
 #undef SPH_SQRT
 #endif
 
-void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out) {
-  for (int k = 0; k < n; k += 8) {
-    int m = n - k < 8 ? n - k : 8;
+static void spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out, double (*nv)[2][3][3]) {
+  for (int k = 0; k < n; k += 4) {
+    int m = n - k < 4 ? n - k : 4;
 #ifdef RR_SIMD_X86
     if (simd && __builtin_cpu_supports("avx2")) {
-      spheres_avx2(ts + k, m, out + k);
+      spheres_avx2(ts + k, m, out + k, nv ? nv + k : NULL);
       continue;
     }
 #endif
     (void)simd;
-    spheres_plain(ts + k, m, out + k);
+    spheres_plain(ts + k, m, out + k, nv ? nv + k : NULL);
   }
 }
+void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out) { spheres(ts, n, simd, out, NULL); }
 
 /* The inclusive pixel rectangle of the samples whose sample coordinates lie in
  * [x0, x1] × [y0, y1], with a hundredth of a pixel against the double rounding:
@@ -290,15 +283,12 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
   if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
   tri_sphere sp;
   rr_tri_spheres(ts, 1, true, &sp);
-  return rr_tri_curved_rect_sph(c, &sp, r);
+  return rr_tri_curved_rect_sph(c, ts, &sp, r);
 }
 
-int rr_tri_curved_rect_sph(const camera *c, const tri_sphere *sp, int r[4]) {
+int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_sphere *sp, int r[4]) {
   if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
   if (!sp->ok) return -1;
-  dv3 n[3], v[3];
-  for (int i = 0; i < 3; i++)
-    n[i] = dv(sp->n[i][0], sp->n[i][1], sp->n[i][2]), v[i] = dv(sp->v[i][0], sp->v[i][1], sp->v[i][2]);
   const double E = sp->E;
   const int kind = sp->smin > 1e-3 ? 1 : 2;
   /* the cap first: enough for the small triangles of detailed meshes, and when
@@ -309,6 +299,13 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_sphere *sp, int r[4]) {
     memcpy(r, cap, sizeof cap);
     return kind;
   }
+  /* the arcs need T's normals and vertices: this lane again, with them */
+  tri_sphere again;
+  double nv[1][2][3][3];
+  spheres(ts, 1, true, &again, nv);
+  dv3 n[3], v[3];
+  for (int i = 0; i < 3; i++)
+    n[i] = dv(nv[0][0][i][0], nv[0][0][i][1], nv[0][0][i][2]), v[i] = dv(nv[0][1][i][0], nv[0][1][i][1], nv[0][1][i][2]);
   dv3 R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
   double alo, ahi, plo, phi, W = c->width, H = c->height;
   double x0, x1, y0, y1; /* sample coordinates */
