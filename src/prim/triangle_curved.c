@@ -117,7 +117,7 @@ static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, i
  * degenerate or a sliver too thin to bound (smin <= 1e-6: E below 0.02 rad until
  * smin = 1e-3, then growing). And curved_cap's cap about the vertices' mean
  * direction, its radius with E (cap false where curved_cap gives -1). Computed
- * eight lanes at a time, in double: the vertices come from cross products of
+ * four lanes a pass, in double: the vertices come from cross products of
  * normals that may be nearly parallel (slivers, with the 1e-9 tests), where float
  * would lose the digits the margins above do not cover. */
 typedef double vd4 __attribute__((vector_size(32)));
