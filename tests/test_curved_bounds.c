@@ -122,6 +122,33 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
       if (has) area += (long)(r[2] - r[0] + 1) * (r[3] - r[1] + 1);
     }
   }
+  /* rr_tri_spheres: every lane the bits of a one-lane call, AVX2 or not, in groups
+   * of eight and a partial last one (the bounds above took the one-lane calls) */
+  tri_setup *all = malloc(s->ntris * sizeof *all);
+  uint32_t nset = 0;
+  for (uint32_t i = 0; i < s->ntris; i++)
+    if (rr_tri_setup(s, i, &c, false, &all[nset]) != SETUP_CULLED) nset++;
+  long lane_diff = 0, lane_ok = 0;
+  for (uint32_t q = 0; q < nset; q += 8) {
+    int m = nset - q < 8 ? (int)(nset - q) : 8;
+    tri_sphere wide[8], plain[8], one; /* two passes of four lanes */
+    rr_tri_spheres(all + q, m, true, wide);
+    rr_tri_spheres(all + q, m, false, plain);
+    for (int l = 0; l < m; l++) {
+      rr_tri_spheres(all + q + l, 1, true, &one);
+      const tri_sphere *x[2] = {&wide[l], &plain[l]};
+      for (int k = 0; k < 2; k++)
+        lane_diff += x[k]->ok != one.ok || x[k]->cap != one.cap ||
+                     (one.ok && (memcmp(&x[k]->smin, &one.smin, sizeof one.smin) ||
+                                 memcmp(&x[k]->E, &one.E, sizeof one.E))) ||
+                     (one.cap && (memcmp(x[k]->axis, one.axis, sizeof one.axis) ||
+                                  memcmp(&x[k]->rho, &one.rho, sizeof one.rho)));
+      lane_ok += one.ok;
+    }
+  }
+  free(all);
+  CHECK(lane_diff == 0, "%s: %ld lanes of rr_tri_spheres differ from one-lane calls", what, lane_diff);
+  CHECK(cube || lane_ok > 0, "%s: no spherical triangle to compare lanes on", what);
   CHECK(missed == 0, "%s: %ld passing samples outside their triangle's rectangle", what, missed);
   CHECK(passing > 0, "%s: no triangle passes anywhere (the test would prove nothing)", what);
   CHECK(cap_missed == 0, "%s: %ld passing samples outside their triangle's cap rectangle", what, cap_missed);

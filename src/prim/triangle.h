@@ -258,12 +258,28 @@ KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], 
  * none. For curved cameras it is rr_tri_curved_rect's where it knows one, else the
  * bounding box of the cells whose cone of directions no edge plane excludes. */
 bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int rect[4]);
+/* The same with the setup's rr_tri_spheres for curved cameras (sp may be NULL). */
+typedef struct tri_sphere tri_sphere;
+bool rr_tri_screen_bounds_sph(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts,
+                              const tri_sphere *sp, int rect[4]);
 /* The tight rectangle of the curved views polar about an axis (lat-long, parabolic,
  * fisheye), from the spherical triangle of the setup's edge planes
  * (prim/triangle_curved.c): 1 with rect, 2 with a rect whose margin is wide (a
  * sliver: the cells may bound it better), 0 when no sample can pass, -1 when it
  * knows no bound (another camera, a degenerate setup). */
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
+/* What the curved bounds take from a setup, whatever the camera's position: its
+ * spherical triangle (sin of half the least interior angle smin, the widening E;
+ * ok false when degenerate or a sliver) and the cap that holds it (unit axis,
+ * radius rho; cap false when it bounds nothing). rr_tri_spheres fills
+ * out[0..n-1], four lanes at a time (AVX2 when simd). */
+struct tri_sphere {
+  double smin, E, axis[3], rho;
+  bool ok, cap;
+};
+void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out);
+/* rr_tri_curved_rect from the setup ts and its rr_tri_spheres. */
+int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_sphere *sp, int rect[4]);
 /* The cheaper cap bound rr_tri_curved_rect starts from (prim/triangle_curved.c):
  * the image of a cap holding the spherical triangle, widened by the map's largest
  * stretch over it; scale multiplies the cap's radius (1; the tests halve it to see

@@ -83,6 +83,11 @@ static bool curved_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
 #include "core/simd_widths.h"
 
 bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts, int r[4]) {
+  return rr_tri_screen_bounds_sph(s, i, c, ts, NULL, r);
+}
+
+bool rr_tri_screen_bounds_sph(const rr_scene *s, uint32_t i, const camera *c, const tri_setup *ts,
+                              const tri_sphere *sp, int r[4]) {
   if (c->planar) {
     tri_bound b;
     const float pos[1][2] = {{c->sx0, c->sy0}};
@@ -92,7 +97,7 @@ bool rr_tri_screen_bounds(const rr_scene *s, uint32_t i, const camera *c, const 
   }
   /* Curved views have no straight-edged projection: the tight rectangle where it
    * is known, else the cells' cones; hemispheres see nothing wholly behind the eye plane. */
-  int tight = rr_tri_curved_rect(c, ts, r);
+  int tight = sp ? rr_tri_curved_rect_sph(c, ts, sp, r) : rr_tri_curved_rect(c, ts, r);
   if (tight == 0 || tight == 1) return tight > 0;
   int behind = 0;
   for (int k = 0; k < 3; k++) behind += !(v3_dot(scene_q(s, k, i, c->eye), c->fwd) > 0);

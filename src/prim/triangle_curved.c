@@ -21,6 +21,7 @@
  * image in the bounding box of that annular sector (or of the whole disk, or the
  * whole width for the lat-long, near the axis or across the seam). */
 #include "prim/triangle.h"
+#include "core/simd.h"
 
 #include <math.h>
 #include <string.h>
@@ -108,36 +109,67 @@ static void polar_range(const dv3 nu[3], const dv3 v[3], double E, dv3 P, dv3 e1
 
 static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, int r[4]);
 
-/* The spherical triangle T of a setup's edge planes: unit normals n, vertices v,
- * and the widening E of the comment at the top; sin(θ_min / 2) in *smin. False
- * when the setup is degenerate or a sliver too thin to bound (E unknown). */
-static bool spherical_tri(const tri_setup *ts, dv3 n[3], dv3 v[3], double *smin, double *E) {
-  double inv[3];
-  for (int i = 0; i < 3; i++) {
-    n[i] = dv(ts->a[i], ts->b[i], ts->c[i]);
-    double l2 = ddot(n[i], n[i]);
-    if (!(l2 > 0)) return false;
-    inv[i] = 1 / sqrt(l2);
+/* The spherical triangle T of a setup's edge planes (rr_tri_spheres): unit
+ * normals n, vertices v (vertex i lies on edges i+1 and i+2, inside edge i; its
+ * interior angle θ_i is the angle between the inward normals' planes, cos θ_i =
+ * −n̂_j·n̂_k, so 1 − cos θ_i = 2 sin²(θ_i / 2) = 1 + n̂_j·n̂_k), smin = sin(θ_min / 2)
+ * and the widening E of the comment at the top; not ok when the setup is
+ * degenerate or a sliver too thin to bound (smin <= 1e-6: E below 0.02 rad until
+ * smin = 1e-3, then growing). And curved_cap's cap about the vertices' mean
+ * direction, its radius with E (cap false where curved_cap gives -1). Computed
+ * four lanes a pass, in double: the vertices come from cross products of
+ * normals that may be nearly parallel (slivers, with the 1e-9 tests), where float
+ * would lose the digits the margins above do not cover. */
+typedef double vd4 __attribute__((vector_size(32)));
+typedef int64_t vl4 __attribute__((vector_size(32)));
+/* macros, not functions: 32-byte vector arguments would change the ABI without AVX */
+#define vd_splat(x) ((vd4){0} + (x))
+#define vl_splat(x) ((vl4){0} + (x))
+#define vsel(m, a, b) ((vd4)(((m) & (vl4)(a)) | (~(m) & (vl4)(b))))
+#define vmin(a, b) vsel((a) < (b), a, b) /* as mind, maxd: NaN gives b */
+#define vmax(a, b) vsel((a) > (b), a, b)
+#define vabs(a) ((vd4)((vl4)(a) & 0x7FFFFFFFFFFFFFFFLL))
+#define vdot(a, b) ((a)[0] * (b)[0] + (a)[1] * (b)[1] + (a)[2] * (b)[2])
+#define vcross(a, b, o)                                                                                           \
+  ((o)[0] = (a)[1] * (b)[2] - (a)[2] * (b)[1], (o)[1] = (a)[2] * (b)[0] - (a)[0] * (b)[2],                        \
+   (o)[2] = (a)[0] * (b)[1] - (a)[1] * (b)[0])
+
+#define SPH_NAME spheres_plain
+#define SPH_TARGET
+#define SPH_SQRT(x)                                                                                               \
+  ({                                                                                                              \
+    vd4 x_ = (x), r_;                                                                                             \
+    for (int l_ = 0; l_ < 4; l_++) r_[l_] = sqrt(x_[l_]);                                                         \
+    r_;                                                                                                           \
+  })
+#include "prim/triangle_sphere_tmp.h"
+#undef SPH_NAME
+#undef SPH_TARGET
+#undef SPH_SQRT
+#ifdef RR_SIMD_X86
+#define SPH_NAME spheres_avx2
+#define SPH_TARGET RR_TARGET_AVX2
+#define SPH_SQRT(x) ((vd4)_mm256_sqrt_pd((__m256d)(x)))
+#include "prim/triangle_sphere_tmp.h"
+#undef SPH_NAME
+#undef SPH_TARGET
+#undef SPH_SQRT
+#endif
+
+static void spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out, double (*nv)[2][3][3]) {
+  for (int k = 0; k < n; k += 4) {
+    int m = n - k < 4 ? n - k : 4;
+#ifdef RR_SIMD_X86
+    if (simd && __builtin_cpu_supports("avx2")) {
+      spheres_avx2(ts + k, m, out + k, nv ? nv + k : NULL);
+      continue;
+    }
+#endif
+    (void)simd;
+    spheres_plain(ts + k, m, out + k, nv ? nv + k : NULL);
   }
-  for (int i = 0; i < 3; i++) n[i] = dscale(n[i], inv[i]);
-  /* T's vertices: vertex i lies on edges i+1 and i+2, inside edge i. Its interior
-   * angle θ_i is the angle between the inward normals' planes: cos θ_i = −n̂_j·n̂_k,
-   * so 1 − cos θ_i = 2 sin²(θ_i / 2) = 1 + n̂_j·n̂_k. */
-  static const int nx[3] = {1, 2, 0}, nn[3] = {2, 0, 1};
-  double cmin_half = 1;
-  for (int i = 0; i < 3; i++) {
-    const dv3 nj = n[nx[i]], nk = n[nn[i]], x = dcross(nj, nk);
-    double lx = dlen(x), s = ddot(x, n[i]);
-    if (!(lx > 0) || !(fabs(s) > 1e-9 * lx)) return false;
-    v[i] = dscale(x, (s > 0 ? 1 : -1) / lx);
-    cmin_half = mind(cmin_half, 1 + ddot(nj, nk));
-  }
-  *smin = sqrt(maxd(0.0, 0.5 * cmin_half)); /* sin(θ_min / 2) */
-  if (!(*smin > 1e-6)) return false; /* E below 0.02 rad until 1e-3, then growing: a sliver */
-  const double eps = 1e-5;
-  *E = 2 * eps / *smin + eps;
-  return true;
 }
+void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out) { spheres(ts, n, simd, out, NULL); }
 
 /* The inclusive pixel rectangle of the samples whose sample coordinates lie in
  * [x0, x1] × [y0, y1], with a hundredth of a pixel against the double rounding:
@@ -187,12 +219,13 @@ static int sample_rect(const camera *c, double x0, double x1, double y0, double 
  * 1 with r, 0 when no sample can pass, -1 when the cap bounds nothing. */
 int rr_tri_curved_cap(const camera *c, const tri_setup *ts, double scale, int r[4]) {
   if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
-  dv3 n[3], v[3];
-  double smin, E;
-  if (!spherical_tri(ts, n, v, &smin, &E)) return -1;
-  return curved_cap(c, v, E, scale, r);
+  tri_sphere sp;
+  rr_tri_spheres(ts, 1, true, &sp);
+  return sp.cap ? rr_cam_cap_rect(c, sp.axis, sp.rho * scale, r) : -1;
 }
 
+/* curved_cap's cap for the corners of rr_tri_corner_cap (the lanes of
+ * rr_tri_spheres compute the same for set-up triangles). */
 static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, int r[4]) {
   dv3 m = dv(v[0].x + v[1].x + v[2].x, v[0].y + v[1].y + v[2].y, v[0].z + v[1].z + v[2].z);
   double lm = dlen(m);
@@ -248,18 +281,31 @@ int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int r[4])
 
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
   if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
-  dv3 n[3], v[3];
-  double smin, E;
-  if (!spherical_tri(ts, n, v, &smin, &E)) return -1;
-  const int kind = smin > 1e-3 ? 1 : 2;
+  tri_sphere sp;
+  rr_tri_spheres(ts, 1, true, &sp);
+  return rr_tri_curved_rect_sph(c, ts, &sp, r);
+}
+
+int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_sphere *sp, int r[4]) {
+  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
+  if (!sp->ok) return -1;
+  const double E = sp->E;
+  const int kind = sp->smin > 1e-3 ? 1 : 2;
   /* the cap first: enough for the small triangles of detailed meshes, and when
    * it is not, the arcs' rectangle within it */
-  int cap[4], has_cap = curved_cap(c, v, E, 1, cap);
+  int cap[4], has_cap = sp->cap ? rr_cam_cap_rect(c, sp->axis, sp->rho, cap) : -1;
   if (has_cap == 0) return 0;
   if (has_cap > 0 && (cap[2] - cap[0] + 1) * (cap[3] - cap[1] + 1) <= CAP_ENOUGH) {
     memcpy(r, cap, sizeof cap);
     return kind;
   }
+  /* the arcs need T's normals and vertices: this lane again, with them */
+  tri_sphere again;
+  double nv[1][2][3][3];
+  spheres(ts, 1, true, &again, nv);
+  dv3 n[3], v[3];
+  for (int i = 0; i < 3; i++)
+    n[i] = dv(nv[0][0][i][0], nv[0][0][i][1], nv[0][0][i][2]), v[i] = dv(nv[0][1][i][0], nv[0][1][i][1], nv[0][1][i][2]);
   dv3 R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
   double alo, ahi, plo, phi, W = c->width, H = c->height;
   double x0, x1, y0, y1; /* sample coordinates */

@@ -361,13 +361,13 @@ static bool meets(const int bb[4], tile_rect r) {
   return bb[0] < r.x1 && bb[2] >= r.x0 && bb[1] < r.y1 && bb[3] >= r.y0;
 }
 
-/* A curved camera's screen bounds of a set-up triangle, over every position's
- * rays (their cones differ); false when none may see it. */
-static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, int bb[4]) {
+/* A curved camera's screen bounds of a set-up triangle (its rr_tri_spheres), over
+ * every position's rays (their cones differ); false when none may see it. */
+static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, const tri_sphere *sp, int bb[4]) {
   bool any = false;
   for (int s = 0; s < t->ns; s++) {
     int r[4];
-    if (!rr_tri_screen_bounds(t->s, id, &t->cams[s], ts, r)) continue;
+    if (!rr_tri_screen_bounds_sph(t->s, id, &t->cams[s], ts, sp, r)) continue;
     if (!any) memcpy(bb, r, sizeof r);
     bb[0] = r[0] < bb[0] ? r[0] : bb[0], bb[1] = r[1] < bb[1] ? r[1] : bb[1];
     bb[2] = r[2] > bb[2] ? r[2] : bb[2], bb[3] = r[3] > bb[3] ? r[3] : bb[3];
@@ -501,9 +501,12 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
     }
     t->st.setups += (uint64_t)m;
     rr_tri_setup_run(t->s, lid, m, t->c, t->cull_back, t->simd, ts, face);
+    tri_sphere sp[8]; /* culled lanes too: a pass of four lanes costs the same */
+    rr_tri_spheres(ts, m, t->simd, sp);
     for (int l = 0; l < m; l++) {
       tri_job *j = out + kept;
-      if (face[l] == SETUP_CULLED || !curved_bounds(t, lid[l], &ts[l], j->bb) || (r && !meets(j->bb, *r))) continue;
+      if (face[l] == SETUP_CULLED || !curved_bounds(t, lid[l], &ts[l], &sp[l], j->bb) || (r && !meets(j->bb, *r)))
+        continue;
       j->ts = ts[l];
       finish_setup(t, lid[l], j);
       kept++;
