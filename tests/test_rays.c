@@ -6,8 +6,8 @@
  * 13 triangles (also as instances: the two-level BVH) and through a ground with
  * corners at infinity, in both layouts, on 1, 2 and 8
  * threads; and bad input: NaN/inf components (a miss and an error naming the
- * ray), count 0, bad strides, thread counts and NULL arrays; the queries' bound on t
- * before the full test (ray_t_outside) against the full test. */
+ * ray), count 0, bad strides, thread counts and NULL arrays; the queries' bounds on t
+ * before the full test (ray_t_outside, ray_t_inside) against the full test. */
 #include "vis/vis.h"
 #include "io/io.h"
 #include "vis/ray_test.h"
@@ -41,13 +41,16 @@ static void check_tri_paths(const rr_scene *s, const rr_ray *rays, size_t n, con
   CHECK(bad == 0 && hits > 0, "%s: %zu of the triangle tests differ (%zu hits)", what, bad, hits);
 }
 
-/* ray_t_outside, the queries' bound on t before the full test, against the full
- * test (rr_tri_ray_hit) on every finite triangle of s for every ray whose edge
- * pre-test passes with all values positive: where it says t lies outside the
- * ray's range, the full test finds no hit in it, and it never says so of the
- * range [t, t] around a hit's own t. Returns how often it cut a test. */
-static size_t check_t_bound(const rr_scene *s, const rr_ray *rays, size_t n, const char *what) {
-  size_t bad = 0, cut = 0, hits = 0;
+/* ray_t_outside and ray_t_inside, the queries' bounds on t before the full test,
+ * against the full test (rr_tri_ray_hit) on every finite triangle of s for every
+ * ray whose edge pre-test passes with all values positive: where ray_t_outside
+ * says t lies outside the ray's range, the full test finds no hit in it, and it
+ * never says so of the range [t, t] around a hit's own t; where ray_t_inside says
+ * t lies inside, the full test hits in the range, and it never says so of a range
+ * that starts just above or ends just below a hit's t. Returns how often
+ * ray_t_outside cut a test, and in *proved how often ray_t_inside proved a hit. */
+static size_t check_t_bound(const rr_scene *s, const rr_ray *rays, size_t n, const char *what, size_t *proved) {
+  size_t bad = 0, cut = 0, hits = 0, sure = 0;
   for (size_t r = 0; r < n; r++) {
     camera rc;
     rr_cam_for_ray(rays[r].org, rays[r].dir, &rc);
@@ -71,13 +74,20 @@ static size_t check_t_bound(const rr_scene *s, const rr_ray *rays, size_t n, con
       bool in = hit && t >= rays[r].tmin && t <= rays[r].tmax;
       float S = ray_corner_extent(v, 4, rays[r].org);
       bool out = ray_t_outside(S, dmax, e, rays[r].tmin, rays[r].tmax);
-      hits += hit, cut += out;
+      bool inside = ray_t_inside(S, dmax, e, rays[r].tmin, rays[r].tmax);
+      hits += hit, cut += out, sure += inside;
       if (((out && in) || (hit && ray_t_outside(S, dmax, e, t, t))) && bad++ < 4)
         CHECK(0, "%s: ray %zu, triangle %u: t %a in [%a, %a]: the bound cuts it", what, r, i, t, rays[r].tmin,
               rays[r].tmax);
+      if (((inside && !in) || (hit && (ray_t_inside(S, dmax, e, nextafterf(t, INFINITY), INFINITY) ||
+                                       ray_t_inside(S, dmax, e, -INFINITY, nextafterf(t, -INFINITY))))) &&
+          bad++ < 4)
+        CHECK(0, "%s: ray %zu, triangle %u: hit %d t %a, [%a, %a]: the bound proves a hit wrongly", what, r, i, hit,
+              t, rays[r].tmin, rays[r].tmax);
     }
   }
-  CHECK(bad == 0 && hits > 0, "%s: the t bound cut %zu hits (%zu hits)", what, bad, hits);
+  CHECK(bad == 0 && hits > 0, "%s: the t bounds failed %zu times (%zu hits)", what, bad, hits);
+  if (proved) *proved = sure;
   return cut;
 }
 
@@ -281,8 +291,9 @@ static void bunny_rays(rr_device *dev) {
   check_rays(dev, s, rays, n, test_quick() ? 30 : 100, "bunny surface");
   check_tri_paths(s, rays, test_quick() ? 4 : 16, "bunny surface"); /* every triangle: a few rays */
   /* rays from a surface point: the bound drops the start triangle (t about 0 < tmin) */
-  size_t cut = check_t_bound(s, rays, test_quick() ? 12 : 48, "bunny surface");
+  size_t proved, cut = check_t_bound(s, rays, test_quick() ? 12 : 48, "bunny surface", &proved);
   CHECK(cut > 0, "bunny surface: the t bound never cut a test");
+  CHECK(proved > 0, "bunny surface: the t bound never proved a hit");
   free(rays);
   rr_scene_release(s);
 }
@@ -295,7 +306,7 @@ int main(void) {
     rr_ray *rays = random_rays(s, n);
     check_rays(dev, s, rays, n, 1, "random rays");
     check_tri_paths(s, rays, n, "random rays");
-    check_t_bound(s, rays, n, "random rays");
+    check_t_bound(s, rays, n, "random rays", NULL);
     free(rays);
     rr_scene_release(s);
   } else {

@@ -54,8 +54,8 @@ typedef struct {
  * and max keep their second operand. Empty slots (lo = inf, hi = −inf) never pass. */
 
 /* Tests a leaf's count triangles, keeping the nearest hit; `any`: stops at the
- * first. Their corners are at leaf in rr_bvh.leaf_v8's layout, their ids are
- * ids[i] + idbase; `moved`: a translated instance's leaf read in place, whose
+ * first, which needs no full test where ray_t_inside proves it. Their corners
+ * are at leaf in rr_bvh.leaf_v8's layout, their ids are ids[i] + idbase; `moved`: a translated instance's leaf read in place, whose
  * corners are leaf's plus shift (x, y, z at shift[0], [4], [8]: a transform's
  * last column), the additions bvh_leaf_at's copy makes, so the same bits.
  * Four at a time through the edge pre-test, then the full test for the lanes
@@ -82,9 +82,11 @@ KERNEL bool query_tris(query_ray *r, const float *leaf, const uint32_t *ids, uin
       uint32_t lane = (uint32_t)__builtin_ctz(may), id = ids[j + lane] + idbase;
       float t, l1, l2, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
       const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
-      if (e[0] > 0 && e[1] > 0 && e[2] > 0 && !(r->s->inf && scene_inf(r->s, id)) &&
-          ray_t_outside(ray_corner_extent(v + lane, stride, r->org), r->dmax, e, r->tmin, r->t))
-        continue;
+      if (e[0] > 0 && e[1] > 0 && e[2] > 0 && !(r->s->inf && scene_inf(r->s, id))) {
+        const float S = ray_corner_extent(v + lane, stride, r->org);
+        if (ray_t_outside(S, r->dmax, e, r->tmin, r->t)) continue;
+        if (any && ray_t_inside(S, r->dmax, e, r->tmin, r->t)) return true; /* a proven hit: the answer */
+      }
       bool hit = ray_tri_test(r->s, id, &r->rc, r->org, dir, e, r->tmin, r->t, &t, &l1, &l2);
       if (!hit) continue;
       if (any) return true;

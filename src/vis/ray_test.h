@@ -61,6 +61,31 @@ static inline bool ray_t_outside(float S, float dmax, const float pre[4], float 
   return vol - err_v > 0 && (vol - err_v) / den_hi * (1 - 32 * u) > tmax;
 }
 
+/* The other side of ray_t_outside's bound, for any-hit queries: whether the full
+ * test (ray_tri_test) of a triangle whose pre-test values pre are all inside,
+ * e_i > 0, surely hits with t in [tmin, tmax], from those values alone, so that
+ * rr_occluded stops there without the ray's pseudo-camera or the plane in double.
+ * Where every e_i > 0 the full test's sample test reads only e, the volume and
+ * the plane's num, den (both of its paths: rr_tri_ray_finish with e, or
+ * rr_tri_ray_hit1, whose e_i = a_i + b_i·0 + c_i·0 are the same positive values
+ * when b_i, c_i are finite, the tie bits then unread): e inside, Σe > 0 and the
+ * volume |pre[3]| > 0 pass, and t is num / den or vol / Σe, both within
+ * ray_t_outside's bounds [(vol − err_v) / den_hi·(1 − 32u), (vol + err_v) /
+ * den_lo·(1 + 32u)]. b_i, c_i are finite: n_i·dx, n_i·dy with |n_i| ≤ 4.01·S² <
+ * 2⁶³ per axis (S ≤ 2³⁰), |dx| ≤ D and |dy| ≤ 2·D² ≤ 2³⁹ (rr_cam_for_ray: dx
+ * takes d's components, dy = d × dx) for D ≤ 2¹⁹, so each is below 3·2¹⁰²,
+ * also in double and once rounded to float. Hence the extra D ≤ 2¹⁹. tests/test_rays
+ * checks it against the full test. */
+static inline bool ray_t_inside(float S, float dmax, const float pre[4], float tmin, float tmax) {
+  if (!(S >= 0x1p-30f && S <= 0x1p30f && dmax >= 0x1p-30f && dmax <= 0x1p19f)) return false;
+  const float u = 0x1p-24f, vol = fabsf(pre[3]), sum = pre[0] + pre[1] + pre[2];
+  const float err_v = S * S * S * (128 * u), err_s = S * S * dmax * (512 * u);
+  const float den_lo = sum * (1 - 8 * u) - err_s, den_hi = sum * (1 + 8 * u) + err_s;
+  if (!(den_lo >= 0.5f * sum)) return false;
+  return vol - err_v > 0 && (vol - err_v) / den_hi * (1 - 32 * u) >= tmin &&
+         (vol + err_v) / den_lo * (1 + 32 * u) <= tmax;
+}
+
 /* S of ray_t_outside for a triangle laid out as tri_ray_may_hit4 reads its lanes
  * (corner k's axis x at v[(3k + x)·stride]): max |q_k| over the corners and axes,
  * q_k = p_k − o rounded as the pre-test rounds it. No NaN (finite corners), so a
