@@ -204,25 +204,27 @@ typedef struct {
 static inline tri_v4 tri_v4_sub(tri_v4 a, tri_v4 b) { return (tri_v4){a.x - b.x, a.y - b.y, a.z - b.z}; }
 static inline rr_vf4 tri_v4_dot(tri_v4 a, tri_v4 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 static inline rr_vi4 tri_vi4_select(rr_vi4 m, rr_vi4 a, rr_vi4 b) { return (m & a) | (~m & b); }
-/* tri_edge_normal lane by lane, as h × (l − h) and, in *neg, the sign bits that
- * turn it into the normal (set where the edge runs from h to l). */
-KERNEL tri_v4 tri_v4_edge_cross(tri_v4 a, tri_v4 b, rr_vi4 *neg) {
+/* tri_edge_normal lane by lane, in fewer operations: h × (a − b), h the edge's
+ * higher endpoint in the canonical order. Where a comes first, h = b and this is
+ * tri_edge_normal's h × (l − h) itself; where b does, h = a and tri_edge_normal
+ * returns −(h × (b − a)), which is h × (a − b) exactly: a − b = −(b − a), and
+ * negation is exact and rounding symmetric, so each product and difference of
+ * the cross product only changes sign — up to the sign of a zero, which no test
+ * below tells apart. */
+KERNEL tri_v4 tri_v4_edge_normal(tri_v4 a, tri_v4 b) {
   rr_vi4 swap = tri_vi4_select(b.x != a.x, b.x < a.x, tri_vi4_select(b.y != a.y, b.y < a.y, b.z < a.z));
-  tri_v4 l = {rr_vf4_select(swap, b.x, a.x), rr_vf4_select(swap, b.y, a.y), rr_vf4_select(swap, b.z, a.z)};
   tri_v4 h = {rr_vf4_select(swap, a.x, b.x), rr_vf4_select(swap, a.y, b.y), rr_vf4_select(swap, a.z, b.z)};
-  tri_v4 e = tri_v4_sub(l, h);
-  *neg = swap & (rr_vi4)rr_vf4_splat(-0.0f);
+  tri_v4 e = tri_v4_sub(a, b);
   return (tri_v4){h.y * e.z - h.z * e.y, h.z * e.x - h.x * e.z, h.x * e.y - h.y * e.x};
 }
-/* Negation is exact and rounding symmetric, so x·(−m) is −(x·m) up to the sign of
- * a zero, which no test below tells apart: the signs (the edge's and σ) are
- * applied to the dot products as sign bits. The part that depends on the eye
- * alone (the edge normals, their signs, the volume) is set up once for rays
- * sharing an origin (tri4_edges_setup: a leaf's triangles seen from a light);
- * tri4_edges_test is the part each direction pays. */
+/* σ (the sign that turns the inside positive) is applied to the dot products as
+ * a sign bit, exactly as a negation (again up to the sign of a zero). The part
+ * that depends on the eye alone (the edge normals, σ, the volume) is set up once
+ * for rays sharing an origin (tri4_edges_setup: a leaf's triangles seen from a
+ * light); tri4_edges_test is the part each direction pays. */
 typedef struct {
-  tri_v4 m[3];    /* h × (l − h) of each edge */
-  rr_vi4 sgn[3];  /* the sign bits that turn m·d into the edge value: the edge's and σ */
+  tri_v4 m[3];    /* the edge normals */
+  rr_vi4 sgn;     /* σ's sign bits, which turn m·d into the edge value */
   rr_vf4 vol;     /* q0·n0 */
   rr_vi4 ok;      /* the volume is not 0 and finite: the triangle is not edge-on */
 } tri4_edges;
@@ -231,20 +233,19 @@ KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 eye[3],
   for (int k = 0; k < 3; k++)
     q[k] = (tri_v4){rr_vf4_load(v + (3 * k) * stride) - eye[0], rr_vf4_load(v + (3 * k + 1) * stride) - eye[1],
                     rr_vf4_load(v + (3 * k + 2) * stride) - eye[2]};
-  rr_vi4 neg[3];
-  te->m[0] = tri_v4_edge_cross(q[1], q[2], &neg[0]), te->m[1] = tri_v4_edge_cross(q[2], q[0], &neg[1]),
-  te->m[2] = tri_v4_edge_cross(q[0], q[1], &neg[2]);
-  rr_vf4 vol = (rr_vf4)((rr_vi4)tri_v4_dot(q[0], te->m[0]) ^ neg[0]);
+  te->m[0] = tri_v4_edge_normal(q[1], q[2]), te->m[1] = tri_v4_edge_normal(q[2], q[0]),
+  te->m[2] = tri_v4_edge_normal(q[0], q[1]);
+  rr_vf4 vol = tri_v4_dot(q[0], te->m[0]);
   rr_vi4 sigma = (rr_vi4)vol & (rr_vi4)rr_vf4_splat(-0.0f); /* σ = −1 where the volume is negative */
-  for (int e = 0; e < 3; e++) te->sgn[e] = neg[e] ^ sigma;
+  te->sgn = sigma;
   te->vol = vol;
   te->ok = (vol != 0) & (rr_vf4_abs(vol) < INFINITY);
 }
 KERNEL int tri4_edges_test(const tri4_edges *te, const rr_vf4 d[3], rr_vf4 out[4]) {
   tri_v4 dv = {d[0], d[1], d[2]};
-  rr_vf4 a0 = (rr_vf4)((rr_vi4)tri_v4_dot(te->m[0], dv) ^ te->sgn[0]),
-         a1 = (rr_vf4)((rr_vi4)tri_v4_dot(te->m[1], dv) ^ te->sgn[1]),
-         a2 = (rr_vf4)((rr_vi4)tri_v4_dot(te->m[2], dv) ^ te->sgn[2]);
+  rr_vf4 a0 = (rr_vf4)((rr_vi4)tri_v4_dot(te->m[0], dv) ^ te->sgn),
+         a1 = (rr_vf4)((rr_vi4)tri_v4_dot(te->m[1], dv) ^ te->sgn),
+         a2 = (rr_vf4)((rr_vi4)tri_v4_dot(te->m[2], dv) ^ te->sgn);
   out[0] = a0, out[1] = a1, out[2] = a2, out[3] = te->vol;
   return rr_vi4_bits(te->ok & (a0 >= 0) & (a1 >= 0) & (a2 >= 0));
 }
