@@ -88,16 +88,23 @@ uint64_t rr_raster_rect_samples(const tri_setup *ts, tri_moves *mv, uint32_t id,
    * 780 M and 3708 M; at 4 positions (two pixels a step) the bunny took 277 M and
    * 260 M, the grid 2285 M either way. With the depth test in lanes (stop 30), up
    * to 4·ns pixels: the bunny at 16 positions 613 M against 646 M at 2·ns. */
-  const int w = r[2] - r[0] + 1, area = w * (r[3] - r[1] + 1);
-  if (!(cams[0].planar && (area <= 4 * ns || (ns <= 4 && w <= 8))))
+  if (!(cams[0].planar && rr_raster_few_pixels(r, ns)))
     return raster_scanlines(ts, mv, id, r, cams, ns, vb, covered, simd);
+#ifdef RR_SIMD_X86
+  simd = simd && __builtin_cpu_supports("avx2");
+#endif
+  return rr_raster_pixels(ts, mv, id, r, &cams[0], ns, vb, covered, simd);
+}
+
+uint64_t rr_raster_pixels(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int r[4], const camera *c,
+                          int ns, visbuf *vb, uint64_t *covered, bool avx2) {
   uint64_t samples = 0, got;
 #ifdef RR_SIMD_X86
-  if (simd && __builtin_cpu_supports("avx2")) got = raster_pixels8(ts, mv, id, r, &cams[0], ns, vb, &samples);
+  if (avx2) got = raster_pixels8(ts, mv, id, r, c, ns, vb, &samples);
   else
 #endif
-    got = raster_pixels1(ts, mv, id, r, &cams[0], ns, vb, &samples);
-  (void)simd;
+    got = raster_pixels1(ts, mv, id, r, c, ns, vb, &samples);
+  (void)avx2;
   if (covered) *covered += got;
   return samples;
 }

@@ -48,6 +48,9 @@ typedef struct trav {
   const oracles *o;
   visbuf *vb;
   bool cull_back, simd;
+  bool avx2;         /* simd and the CPU runs AVX2 (asked once a frame) */
+  bool direct;       /* several positions, nothing kept but the visibility buffer:
+                      * planar small draws go straight to rr_raster_pixels */
   bool hiz_used;     /* occlusion culling or early-z read the z tiles: keep them current */
   hiz *hz;           /* one level of HIZ×HIZ tiles */
   float *heat_e, *heat_n; /* optional per-pixel E and N charges */
@@ -541,6 +544,11 @@ static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
       if (tri_pos_rect(&j->pos, j->bb, __builtin_ctz(todo), q) && meets(q, r)) break;
     if (!todo) return;
     mv.pl = &j->pl, mv.pos = &j->pos;
+    /* most draws of a detailed mesh: no call chain, no per-draw checks of options */
+    if (t->direct && rr_raster_few_pixels(mv.draw, t->ns)) {
+      t->st.edge_evals += rr_raster_pixels(&j->ts, &mv, j->id, mv.draw, t->c, t->ns, t->vb, NULL, t->avx2);
+      return;
+    }
   }
   draw_rect(t, j, &mv, r);
 }
@@ -1005,6 +1013,8 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
                 .cull_back = ctx->opt->cull_backfaces != 0,
                 .simd = !ctx->opt->scalar,
                 .hiz_used = o->cull_occluded || (o->binning && o->early_z),
+                .direct = ctx->samples > 1 && !o->binning && !ctx->heat_e && !ctx->face_heat_e &&
+                          !(o->cull_occluded || (o->binning && o->early_z)),
                 .hz = &hz[0],
                 .heat_e = ctx->heat_e,
                 .heat_n = ctx->heat_n,
@@ -1018,6 +1028,9 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
   if (ctx->faces) /* face 0 to start with */
     proto.c = proto.cams = ctx->face_cams, proto.vb = &ctx->face_vb[0],
     proto.heat_e = ctx->face_heat_e, proto.heat_n = ctx->face_heat_n;
+#ifdef RR_SIMD_X86
+  proto.avx2 = proto.simd && __builtin_cpu_supports("avx2");
+#endif
   proto.span[0] = proto.span[2] = ctx->cams[0].sx0, proto.span[1] = proto.span[3] = ctx->cams[0].sy0;
   for (int s = 0; s < ctx->samples; s++) proto.pos[s][0] = ctx->cams[s].sx0, proto.pos[s][1] = ctx->cams[s].sy0;
   for (int s = 0; s < RR_MAX_SAMPLES; s++)

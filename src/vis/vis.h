@@ -214,6 +214,19 @@ void rr_tri_moves_ready(const tri_setup *ts, tri_moves *mv, const camera *cams, 
 uint64_t rr_raster_rect_samples(const tri_setup *ts, tri_moves *mv, uint32_t id, const int rect[4],
                                 const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd);
 
+/* Is the draw r (inclusive) at ns positions small enough for the lanes over
+ * (position, pixel) pairs (planar cameras)? rr_raster_rect_samples' choice. */
+static inline bool rr_raster_few_pixels(const int r[4], int ns) {
+  const int w = r[2] - r[0] + 1, area = w * (r[3] - r[1] + 1);
+  return area <= 4 * ns || (ns <= 4 && w <= 8);
+}
+/* rr_raster_rect_samples for such a draw, called straight from the traversal
+ * (planar camera c = cams[0]; mv needs only ox, oy, pl, pos and bb; avx2: the
+ * eight-lane kernel, which the caller has checked the CPU runs). Returns the
+ * evaluations; adds the covered samples to *covered. */
+uint64_t rr_raster_pixels(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int rect[4],
+                          const camera *c, int ns, visbuf *vb, uint64_t *covered, bool avx2);
+
 /* Test and benchmark hook: the relative error of depths t (one per sample of the
  * planar camera c's image; ids: the hit triangle, RR_MISS for none) against the
  * exact hit of each sample's ray (from c's own d0, dx, dy or o0, ox, oy, in double)
