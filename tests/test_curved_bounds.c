@@ -146,7 +146,7 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
           const camera *cp = p2 ? &moved : &c;
           int ra[4] = {0}, rb[4] = {0}, ka = rr_tri_sphere_cap_rect(cp, x[k], ra), kb = rr_cam_cap_rect(cp, one.axis, one.rho, rb);
           lane_diff += ka != kb || (kb > 0 && memcmp(ra, rb, sizeof ra));
-          lane_img += polar_map && x[k]->img_k != TRI_CAP_UNSET;
+          lane_img += rc->type == RR_CAMERA_PARABOLIC && x[k]->img_k != TRI_CAP_UNSET;
         }
         lane_diff += x[k]->ok != one.ok || x[k]->cap != one.cap ||
                      (one.ok && (memcmp(&x[k]->smin, &one.smin, sizeof one.smin) ||
@@ -160,7 +160,7 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   free(all);
   CHECK(lane_diff == 0, "%s: %ld lanes of rr_tri_spheres differ from one-lane calls", what, lane_diff);
   CHECK(cube || lane_ok > 0, "%s: no spherical triangle to compare lanes on", what);
-  CHECK(!polar_map || lane_img > 0, "%s: no cap image computed in the lanes", what);
+  CHECK(rc->type != RR_CAMERA_PARABOLIC || lane_img > 0, "%s: no cap image computed in the lanes", what);
   CHECK(missed == 0, "%s: %ld passing samples outside their triangle's rectangle", what, missed);
   CHECK(passing > 0, "%s: no triangle passes anywhere (the test would prove nothing)", what);
   CHECK(cap_missed == 0, "%s: %ld passing samples outside their triangle's cap rectangle", what, cap_missed);

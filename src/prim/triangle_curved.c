@@ -108,7 +108,6 @@ static void polar_range(const dv3 nu[3], const dv3 v[3], double E, dv3 P, dv3 e1
 }
 
 static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, int r[4]);
-static int cap_extent(const camera *c, const double axis[3], double rho, double e[4]);
 
 /* The spherical triangle T of a setup's edge planes (rr_tri_spheres): unit
  * normals n, vertices v (vertex i lies on edges i+1 and i+2, inside edge i; its
@@ -158,11 +157,11 @@ typedef int64_t vl4 __attribute__((vector_size(32)));
 #undef SPH_SQRT
 #endif
 
-/* c (may be NULL): the camera whose cap images to compute, the parabolic's in
- * the lanes, the lat-long's and fisheye's (atan2) by cap_extent per lane. */
+/* c (may be NULL): the camera whose cap images to compute, the parabolic's in the
+ * lanes; the lat-long's and fisheye's (atan2, not yet in lanes) are left unset:
+ * rr_tri_sphere_cap_rect computes them at need, for the lanes that pass the setup. */
 static void spheres(const tri_setup *ts, int n, const camera *c, bool simd, tri_sphere *out, double (*nv)[2][3][3]) {
-  const bool polar = c && (c->type == RR_CAMERA_LATLONG || c->type == RR_CAMERA_PARABOLIC || c->type == RR_CAMERA_FISHEYE);
-  const camera *pc = polar && c->type == RR_CAMERA_PARABOLIC ? c : NULL;
+  const camera *pc = c && c->type == RR_CAMERA_PARABOLIC ? c : NULL;
   for (int k = 0; k < n; k += 4) {
     int m = n - k < 4 ? n - k : 4;
 #ifdef RR_SIMD_X86
@@ -174,8 +173,6 @@ static void spheres(const tri_setup *ts, int n, const camera *c, bool simd, tri_
     (void)simd;
     spheres_plain(ts + k, m, pc, out + k, nv ? nv + k : NULL);
   }
-  if (polar && !pc)
-    for (int l = 0; l < n; l++) out[l].img_k = out[l].cap ? (int8_t)cap_extent(c, out[l].axis, out[l].rho, out[l].img) : -1;
 }
 void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out) { spheres(ts, n, NULL, simd, out, NULL); }
 void rr_tri_spheres_cam(const tri_setup *ts, int n, const camera *c, bool simd, tri_sphere *out) {

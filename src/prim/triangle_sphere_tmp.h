@@ -69,7 +69,7 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
   for (int l = 0; l < n; l++) {
     tri_sphere *o = &out[l];
     o->img_k = (int8_t)img[l];
-    for (int k = 0; k < 4; k++) o->img[k] = ext[k][l];
+    for (int k = 0; k < 4 && pc; k++) o->img[k] = ext[k][l];
     for (int i = 0; i < 3 && nv; i++)
       for (int k = 0; k < 3; k++) nv[l][0][i][k] = nrm[i][k][l], nv[l][1][i][k] = v[i][k][l];
     for (int k = 0; k < 3; k++) o->axis[k] = m[k][l];
