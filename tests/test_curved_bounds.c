@@ -128,32 +128,43 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   uint32_t nset = 0;
   for (uint32_t i = 0; i < s->ntris; i++)
     if (rr_tri_setup(s, i, &c, false, &all[nset]) != SETUP_CULLED) nset++;
-  long lane_diff = 0, lane_ok = 0;
+  const bool polar_map = rc->type == RR_CAMERA_LATLONG || rc->type == RR_CAMERA_PARABOLIC || rc->type == RR_CAMERA_FISHEYE;
+  long lane_diff = 0, lane_ok = 0, lane_img = 0;
   for (uint32_t q = 0; q < nset; q += 8) {
     int m = nset - q < 8 ? (int)(nset - q) : 8;
     tri_sphere wide[8], plain[8], one; /* two passes of four lanes */
-    rr_tri_spheres(all + q, m, true, wide);
-    rr_tri_spheres(all + q, m, false, plain);
+    rr_tri_spheres_cam(all + q, m, &c, true, wide);
+    rr_tri_spheres_cam(all + q, m, &c, false, plain);
     for (int l = 0; l < m; l++) {
       rr_tri_spheres(all + q + l, 1, true, &one);
       const tri_sphere *x[2] = {&wide[l], &plain[l]};
-      for (int k = 0; k < 2; k++)
+      for (int k = 0; k < 2; k++) {
+        /* the lanes' cap image against rr_cam_cap_rect, here and at another position */
+        camera moved = c;
+        moved.sx0 = (float)rnd(), moved.sy0 = (float)rnd();
+        for (int p2 = 0; p2 < 2 && one.cap; p2++) {
+          const camera *cp = p2 ? &moved : &c;
+          int ra[4] = {0}, rb[4] = {0}, ka = rr_tri_sphere_cap_rect(cp, x[k], ra), kb = rr_cam_cap_rect(cp, one.axis, one.rho, rb);
+          lane_diff += ka != kb || (kb > 0 && memcmp(ra, rb, sizeof ra));
+          lane_img += rc->type == RR_CAMERA_PARABOLIC && x[k]->img_k != TRI_CAP_UNSET;
+        }
         lane_diff += x[k]->ok != one.ok || x[k]->cap != one.cap ||
                      (one.ok && (memcmp(&x[k]->smin, &one.smin, sizeof one.smin) ||
                                  memcmp(&x[k]->E, &one.E, sizeof one.E))) ||
                      (one.cap && (memcmp(x[k]->axis, one.axis, sizeof one.axis) ||
                                   memcmp(&x[k]->rho, &one.rho, sizeof one.rho)));
+      }
       lane_ok += one.ok;
     }
   }
   free(all);
   CHECK(lane_diff == 0, "%s: %ld lanes of rr_tri_spheres differ from one-lane calls", what, lane_diff);
   CHECK(cube || lane_ok > 0, "%s: no spherical triangle to compare lanes on", what);
+  CHECK(rc->type != RR_CAMERA_PARABOLIC || lane_img > 0, "%s: no cap image computed in the lanes", what);
   CHECK(missed == 0, "%s: %ld passing samples outside their triangle's rectangle", what, missed);
   CHECK(passing > 0, "%s: no triangle passes anywhere (the test would prove nothing)", what);
   CHECK(cap_missed == 0, "%s: %ld passing samples outside their triangle's cap rectangle", what, cap_missed);
   CHECK(corner_missed == 0, "%s: %ld passing samples outside their triangle's corner cap", what, corner_missed);
-  bool polar_map = rc->type == RR_CAMERA_LATLONG || rc->type == RR_CAMERA_PARABOLIC || rc->type == RR_CAMERA_FISHEYE;
   CHECK(!polar_map || tight * 10 >= seen * 9, "%s: tight bounds for only %ld of %ld triangles", what, tight, seen);
   /* the cap's radius is not loose by half: halved, it misses samples */
   CHECK(!polar_map || half_missed > 0, "%s: a cap of half the radius misses no sample", what);

@@ -277,8 +277,18 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
 struct tri_sphere {
   double smin, E, axis[3], rho;
   bool ok, cap;
+  int8_t img_k;  /* the cap's image for rr_tri_spheres_cam's camera (parabolic): TRI_CAP_UNSET, */
+  double img[4]; /* or rr_cam_cap_rect's 1 with its extents x0, x1, y0, y1 (sample coordinates), 0, -1 */
 };
+#define TRI_CAP_UNSET 2
 void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out);
+/* The same with the cap's image for camera c (NULL: none; so far the parabolic's,
+ * computed in the lanes), whatever the sample position: rr_tri_sphere_cap_rect then serves every camera that differs from c
+ * only in sx0, sy0 (the positions of one frame). */
+void rr_tri_spheres_cam(const tri_setup *ts, int n, const camera *c, bool simd, tri_sphere *out);
+/* rr_cam_cap_rect of sp's cap for c (from sp's image when it has one): -1 when
+ * sp has no cap. */
+int rr_tri_sphere_cap_rect(const camera *c, const tri_sphere *sp, int rect[4]);
 /* rr_tri_curved_rect from the setup ts and its rr_tri_spheres. */
 int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_sphere *sp, int rect[4]);
 /* The cheaper cap bound rr_tri_curved_rect starts from (prim/triangle_curved.c):

@@ -126,6 +126,7 @@ typedef int64_t vl4 __attribute__((vector_size(32)));
 #define vd_splat(x) ((vd4){0} + (x))
 #define vl_splat(x) ((vl4){0} + (x))
 #define vsel(m, a, b) ((vd4)(((m) & (vl4)(a)) | (~(m) & (vl4)(b))))
+#define vsel_l(m, a, b) (((m) & (a)) | (~(m) & (b)))
 #define vmin(a, b) vsel((a) < (b), a, b) /* as mind, maxd: NaN gives b */
 #define vmax(a, b) vsel((a) > (b), a, b)
 #define vabs(a) ((vd4)((vl4)(a) & 0x7FFFFFFFFFFFFFFFLL))
@@ -156,20 +157,27 @@ typedef int64_t vl4 __attribute__((vector_size(32)));
 #undef SPH_SQRT
 #endif
 
-static void spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out, double (*nv)[2][3][3]) {
+/* c (may be NULL): the camera whose cap images to compute, the parabolic's in the
+ * lanes; the lat-long's and fisheye's (atan2, not yet in lanes) are left unset:
+ * rr_tri_sphere_cap_rect computes them at need, for the lanes that pass the setup. */
+static void spheres(const tri_setup *ts, int n, const camera *c, bool simd, tri_sphere *out, double (*nv)[2][3][3]) {
+  const camera *pc = c && c->type == RR_CAMERA_PARABOLIC ? c : NULL;
   for (int k = 0; k < n; k += 4) {
     int m = n - k < 4 ? n - k : 4;
 #ifdef RR_SIMD_X86
     if (simd && __builtin_cpu_supports("avx2")) {
-      spheres_avx2(ts + k, m, out + k, nv ? nv + k : NULL);
+      spheres_avx2(ts + k, m, pc, out + k, nv ? nv + k : NULL);
       continue;
     }
 #endif
     (void)simd;
-    spheres_plain(ts + k, m, out + k, nv ? nv + k : NULL);
+    spheres_plain(ts + k, m, pc, out + k, nv ? nv + k : NULL);
   }
 }
-void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out) { spheres(ts, n, simd, out, NULL); }
+void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out) { spheres(ts, n, NULL, simd, out, NULL); }
+void rr_tri_spheres_cam(const tri_setup *ts, int n, const camera *c, bool simd, tri_sphere *out) {
+  spheres(ts, n, c, simd, out, NULL);
+}
 
 /* The inclusive pixel rectangle of the samples whose sample coordinates lie in
  * [x0, x1] × [y0, y1], with a hundredth of a pixel against the double rounding:
@@ -238,8 +246,10 @@ static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, i
   return rr_cam_cap_rect(c, md, rho, r);
 }
 
-int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int r[4]) {
-  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
+/* rr_cam_cap_rect's sample-coordinate extents e = x0, x1, y0, y1 of the cap's
+ * image, before sample_rect: what does not depend on the sample position (the
+ * lanes of spheres compute the parabolic's alike). 1 with e, 0 or -1 as rr_cam_cap_rect. */
+static int cap_extent(const camera *c, const double axis[3], double rho, double e[4]) {
   if (!(rho < 1.5)) return -1;
   const dv3 m = dv(axis[0], axis[1], axis[2]);
   dv3 R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
@@ -255,7 +265,8 @@ int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int r[4])
       if (phi - dphi >= -RR_PI && phi + dphi <= RR_PI)
         x0 = (phi - dphi + RR_PI) * W / (2 * RR_PI), x1 = (phi + dphi + RR_PI) * W / (2 * RR_PI);
     }
-    return sample_rect(c, x0, x1, y0, y1, r);
+    e[0] = x0, e[1] = x1, e[2] = y0, e[3] = y1;
+    return 1;
   }
   double ca = mf, sa = sqrt(maxd(0.0, 1 - ca * ca));
   /* beyond the disk's rim (α = π/2, or the fisheye's k) by 1e-3 rad: no rays */
@@ -276,13 +287,28 @@ int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int r[4])
     u = f * mr / k, vv = f * mu / k, rad = (am + ATAN_ERR + rho) / (k * s) * rho + ATAN_ERR / k;
   }
   /* u = 2 sx / W − 1, v = 1 − 2 sy / H */
-  return sample_rect(c, (u - rad + 1) * W / 2, (u + rad + 1) * W / 2, (1 - vv - rad) * H / 2, (1 - vv + rad) * H / 2, r);
+  e[0] = (u - rad + 1) * W / 2, e[1] = (u + rad + 1) * W / 2, e[2] = (1 - vv - rad) * H / 2, e[3] = (1 - vv + rad) * H / 2;
+  return 1;
 }
+
+int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int r[4]) {
+  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
+  double e[4];
+  int k = cap_extent(c, axis, rho, e);
+  return k > 0 ? sample_rect(c, e[0], e[1], e[2], e[3], r) : k;
+}
+
+int rr_tri_sphere_cap_rect(const camera *c, const tri_sphere *sp, int r[4]) {
+  if (!sp->cap) return -1;
+  if (sp->img_k == TRI_CAP_UNSET) return rr_cam_cap_rect(c, sp->axis, sp->rho, r);
+  return sp->img_k > 0 ? sample_rect(c, sp->img[0], sp->img[1], sp->img[2], sp->img[3], r) : sp->img_k;
+}
+
 
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
   if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
   tri_sphere sp;
-  rr_tri_spheres(ts, 1, true, &sp);
+  rr_tri_spheres_cam(ts, 1, c, true, &sp);
   return rr_tri_curved_rect_sph(c, ts, &sp, r);
 }
 
@@ -293,7 +319,7 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_spher
   const int kind = sp->smin > 1e-3 ? 1 : 2;
   /* the cap first: enough for the small triangles of detailed meshes, and when
    * it is not, the arcs' rectangle within it */
-  int cap[4], has_cap = sp->cap ? rr_cam_cap_rect(c, sp->axis, sp->rho, cap) : -1;
+  int cap[4], has_cap = rr_tri_sphere_cap_rect(c, sp, cap);
   if (has_cap == 0) return 0;
   if (has_cap > 0 && (cap[2] - cap[0] + 1) * (cap[3] - cap[1] + 1) <= CAP_ENOUGH) {
     memcpy(r, cap, sizeof cap);
@@ -302,7 +328,7 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_spher
   /* the arcs need T's normals and vertices: this lane again, with them */
   tri_sphere again;
   double nv[1][2][3][3];
-  spheres(ts, 1, true, &again, nv);
+  spheres(ts, 1, NULL, true, &again, nv);
   dv3 n[3], v[3];
   for (int i = 0; i < 3; i++)
     n[i] = dv(nv[0][0][i][0], nv[0][0][i][1], nv[0][0][i][2]), v[i] = dv(nv[0][1][i][0], nv[0][1][i][1], nv[0][1][i][2]);

@@ -6,8 +6,9 @@
  * a scalar evaluation would: the proofs there carry over unchanged. A lane that
  * fails a test only clears its ok or cap; its NaNs go nowhere. Four lanes, not
  * eight: a leaf's setups keep about three. nv (may be NULL): the normals and
- * vertices, for the arcs. */
-SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, tri_sphere *out, double (*nv)[2][3][3]) {
+ * vertices, for the arcs. pc (may be NULL): a parabolic camera, whose cap images
+ * (cap_extent) the lanes compute too, in its order. */
+SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tri_sphere *out, double (*nv)[2][3][3]) {
   vd4 nrm[3][3], v[3][3]; /* [edge or vertex][axis] */
   vl4 ok = vl_splat(-1);
   for (int i = 0; i < 3; i++) {
@@ -46,8 +47,29 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, tri_sphere *out, dou
   const vd4 cr = vmin(vdot(m, v[0]), vmin(vdot(m, v[1]), vdot(m, v[2])));
   cap &= cr > 0.1;
   const vd4 h2 = vmax(vd_splat(0), 2 - 2 * cr), rho = SPH_SQRT(h2 / (1 - h2 / 4)) + E + 1e-9;
+  /* cap_extent's parabolic image of the cap: the centre's stereographic image,
+   * the radius ρ / (1 + cmin), and 0 for a cap behind the disk's rim */
+  vd4 ext[4] = {0};
+  vl4 img = vl_splat(TRI_CAP_UNSET);
+  if (pc) {
+    const double W = pc->width, H = pc->height;
+    vd4 mr = m[0] * (double)pc->right.x + m[1] * (double)pc->right.y + m[2] * (double)pc->right.z;
+    vd4 mu = m[0] * (double)pc->up.x + m[1] * (double)pc->up.y + m[2] * (double)pc->up.z;
+    vd4 ca = m[0] * (double)pc->fwd.x + m[1] * (double)pc->fwd.y + m[2] * (double)pc->fwd.z;
+    vd4 sa = SPH_SQRT(vmax(vd_splat(0), 1 - ca * ca)), q = 1 - rho * rho / 2;
+    vl4 front = ca >= 0;
+    vd4 cmax = ca * vsel(front, vd_splat(1), q) + sa * rho, cmin = ca * vsel(front, q, vd_splat(1)) - sa * rho;
+    vd4 u = mr / (1 + ca), vv = mu / (1 + ca), rad = rho / (1 + cmin);
+    ext[0] = (u - rad + 1) * W / 2, ext[1] = (u + rad + 1) * W / 2;
+    ext[2] = (1 - vv - rad) * H / 2, ext[3] = (1 - vv + rad) * H / 2;
+    img = vsel_l(1 + cmin > 1e-3, vl_splat(1), vl_splat(-1));
+    img = vsel_l(cmax < -1e-3, vl_splat(0), img);
+    img = vsel_l(rho < 1.5, img, vl_splat(-1));
+  }
   for (int l = 0; l < n; l++) {
     tri_sphere *o = &out[l];
+    o->img_k = (int8_t)img[l];
+    for (int k = 0; k < 4 && pc; k++) o->img[k] = ext[k][l];
     for (int i = 0; i < 3 && nv; i++)
       for (int k = 0; k < 3; k++) nv[l][0][i][k] = nrm[i][k][l], nv[l][1][i][k] = v[i][k][l];
     for (int k = 0; k < 3; k++) o->axis[k] = m[k][l];

@@ -505,7 +505,7 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
     t->st.setups += (uint64_t)m;
     rr_tri_setup_run(t->s, lid, m, t->c, t->cull_back, t->simd, ts, face);
     tri_sphere sp[8]; /* culled lanes too: a pass of four lanes costs the same */
-    rr_tri_spheres(ts, m, t->simd, sp);
+    rr_tri_spheres_cam(ts, m, t->c, t->simd, sp); /* with the caps' images, for every position */
     for (int l = 0; l < m; l++) {
       tri_job *j = out + kept;
       if (face[l] == SETUP_CULLED || !curved_bounds(t, lid[l], &ts[l], &sp[l], j->bb) || (r && !meets(j->bb, *r)))
