@@ -176,6 +176,14 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   rr_cam_release(&c);
 }
 
+/* Camera `type` of fov degrees at w×h, set up at a random sample position. */
+static void setup_at_random(rr_device *dev, rr_camera_type type, float fov, int w, int h, rr_camera *rc, camera *c) {
+  rr_camera_init(rc);
+  rc->type = type, rc->fov_deg = fov;
+  const float pos[2] = {(float)rnd(), (float)rnd()};
+  CHECK(rr_cam_setup_at(dev, rc, w, h, pos, c) == RR_OK, "camera");
+}
+
 /* The bend bound of curved binning (vis/traverse.c): over a rectangle of samples
  * spanning hx × hy, n·d stays within |n| (bend_x·hx² + bend_y·hy²) / 8 of the
  * bilinear interpolation of its corner values, so below the greatest of them plus
@@ -183,11 +191,8 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
  * rectangles and normals, every sample with a ray. */
 static void check_bend(rr_device *dev, rr_camera_type type, float fov, int w, int h) {
   rr_camera rc;
-  rr_camera_init(&rc);
-  rc.type = type, rc.fov_deg = fov;
   camera c;
-  const float pos[2] = {(float)rnd(), (float)rnd()};
-  CHECK(rr_cam_setup_at(dev, &rc, w, h, pos, &c) == RR_OK, "camera");
+  setup_at_random(dev, type, fov, w, h, &rc, &c);
   CHECK(c.bend_x > 0 && c.bend_y > 0, "%s: no bend bound", rr_camera_name(type));
   long bad = 0, tested = 0;
   double worst = 0; /* the largest excess over the interpolation, as a share of the bound */
@@ -225,11 +230,8 @@ static void check_bend(rr_device *dev, rr_camera_type type, float fov, int w, in
  * the maps' hard directions. */
 static void check_caps(rr_device *dev, rr_camera_type type, float fov, int w, int h) {
   rr_camera rc;
-  rr_camera_init(&rc);
-  rc.type = type, rc.fov_deg = fov;
   camera c;
-  const float pos[2] = {(float)rnd(), (float)rnd()};
-  CHECK(rr_cam_setup_at(dev, &rc, w, h, pos, &c) == RR_OK, "camera");
+  setup_at_random(dev, type, fov, w, h, &rc, &c);
   long bad = 0, inside = 0, bounded = 0;
   for (int k = 0; k < 600; k++) {
     vec3 a = v3_norm(hard_dir(&rc, c.fwd, c.right, c.up));
