@@ -51,14 +51,26 @@ static inline const char *ray_problem(const float org[3], const float dir[3], fl
  * their own roundings and hold only where nothing under- or overflows (S, D in
  * [2⁻³⁰, 2³⁰]) and the denominator keeps at least half of Σe. tests/test_rays
  * checks it against the full test. */
+typedef struct {
+  float vol, err_v, den_lo, den_hi; /* t lies in [(vol − err_v) / den_hi·(1 − 32u), (vol + err_v) / den_lo·(1 + 32u)] */
+} ray_t_terms;
+
+/* The terms of the bound above, false where it does not hold (dlim: the largest
+ * D its caller's proof allows). */
+static inline bool ray_t_terms_of(float S, float dmax, float dlim, const float pre[4], ray_t_terms *r) {
+  if (!(S >= 0x1p-30f && S <= 0x1p30f && dmax >= 0x1p-30f && dmax <= dlim)) return false;
+  const float u = 0x1p-24f, sum = pre[0] + pre[1] + pre[2], err_s = S * S * dmax * (512 * u);
+  r->vol = fabsf(pre[3]), r->err_v = S * S * S * (128 * u);
+  r->den_lo = sum * (1 - 8 * u) - err_s, r->den_hi = sum * (1 + 8 * u) + err_s;
+  return r->den_lo >= 0.5f * sum;
+}
+
 static inline bool ray_t_outside(float S, float dmax, const float pre[4], float tmin, float tmax) {
-  if (!(S >= 0x1p-30f && S <= 0x1p30f && dmax >= 0x1p-30f && dmax <= 0x1p30f)) return false;
-  const float u = 0x1p-24f, vol = fabsf(pre[3]), sum = pre[0] + pre[1] + pre[2];
-  const float err_v = S * S * S * (128 * u), err_s = S * S * dmax * (512 * u);
-  const float den_lo = sum * (1 - 8 * u) - err_s, den_hi = sum * (1 + 8 * u) + err_s;
-  if (!(den_lo >= 0.5f * sum)) return false;
-  if ((vol + err_v) / den_lo * (1 + 32 * u) < tmin) return true;
-  return vol - err_v > 0 && (vol - err_v) / den_hi * (1 - 32 * u) > tmax;
+  const float u = 0x1p-24f;
+  ray_t_terms r;
+  if (!ray_t_terms_of(S, dmax, 0x1p30f, pre, &r)) return false;
+  if ((r.vol + r.err_v) / r.den_lo * (1 + 32 * u) < tmin) return true;
+  return r.vol - r.err_v > 0 && (r.vol - r.err_v) / r.den_hi * (1 - 32 * u) > tmax;
 }
 
 /* The other side of ray_t_outside's bound, for any-hit queries: whether the full
@@ -77,13 +89,11 @@ static inline bool ray_t_outside(float S, float dmax, const float pre[4], float 
  * also in double and once rounded to float. Hence the extra D ≤ 2¹⁹. tests/test_rays
  * checks it against the full test. */
 static inline bool ray_t_inside(float S, float dmax, const float pre[4], float tmin, float tmax) {
-  if (!(S >= 0x1p-30f && S <= 0x1p30f && dmax >= 0x1p-30f && dmax <= 0x1p19f)) return false;
-  const float u = 0x1p-24f, vol = fabsf(pre[3]), sum = pre[0] + pre[1] + pre[2];
-  const float err_v = S * S * S * (128 * u), err_s = S * S * dmax * (512 * u);
-  const float den_lo = sum * (1 - 8 * u) - err_s, den_hi = sum * (1 + 8 * u) + err_s;
-  if (!(den_lo >= 0.5f * sum)) return false;
-  return vol - err_v > 0 && (vol - err_v) / den_hi * (1 - 32 * u) >= tmin &&
-         (vol + err_v) / den_lo * (1 + 32 * u) <= tmax;
+  const float u = 0x1p-24f;
+  ray_t_terms r;
+  if (!ray_t_terms_of(S, dmax, 0x1p19f, pre, &r)) return false;
+  return r.vol - r.err_v > 0 && (r.vol - r.err_v) / r.den_hi * (1 - 32 * u) >= tmin &&
+         (r.vol + r.err_v) / r.den_lo * (1 + 32 * u) <= tmax;
 }
 
 /* S of ray_t_outside for a triangle laid out as tri_ray_may_hit4 reads its lanes
