@@ -54,7 +54,8 @@ static void random_xf(float (*xf)[12]) {
 
 /* The scene with ninst instances of the first ntri triangles of the mesh (flat =
  * false) or with the instances written out as meshes through inst_point (flat =
- * true); with `others`, a mesh and spheres before and after. */
+ * true); with `others`, a mesh before, and spheres, a tilted plane, an oriented box and
+ * a mesh after. */
 static rr_scene *build_n(rr_device *dev, const float *pos, const uint32_t *idx, const float (*xf)[12], bool flat,
                          int ntri, int ninst, bool others) {
   rr_scene *s = NULL;
@@ -81,6 +82,9 @@ static rr_scene *build_n(rr_device *dev, const float *pos, const uint32_t *idx, 
   if (others) {
     const float sp[8] = {0, 1, 0, 0.7f, 3, 0.5f, 2, 0.5f};
     CHECK(rr_scene_add_spheres(s, sp, 2, NULL) == RR_OK, "spheres");
+    const float pl[6] = {0, -4, 0, 0.1f, 1, 0.05f}, bx[12] = {-2, 0.5f, 1, 0.4f, 0.3f, 0.6f, 1, 0.2f, 0, 0, 1, 0.3f};
+    CHECK(rr_scene_add_planes(s, pl, 1, NULL) == RR_OK, "plane");
+    CHECK(rr_scene_add_boxes(s, bx, 1, NULL) == RR_OK, "box");
     CHECK(rr_scene_add_mesh(s, pos, 3 * NTRI, idx, NTRI, NULL) == RR_OK, "a mesh after");
   }
   CHECK(rr_scene_commit(s) == RR_OK, "commit: %s", rr_device_message(dev));
