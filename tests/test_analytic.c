@@ -76,11 +76,7 @@ static void check_methods(rr_device *dev, const rr_scene *s, int views) {
   int hits[4] = {0, 0, 0, 0};
   for (int v = 0; v < views; v++) {
     for (int type = 0; type < RR_CAMERA_COUNT; type++) {
-      float fov = type == RR_CAMERA_FISHEYE ? 200 : 70;
-      bool inside = v % 2;
-      rr_camera cam = test_random_view(s, inside ? 0.05f : 1.2f, inside ? 0.5f : 2.5f, 0.3f, fov, fov);
-      cam.type = (rr_camera_type)type;
-      cam.ortho_height = 8;
+      rr_camera cam = test_random_camera(s, (rr_camera_type)type, v % 2);
       int w = type == RR_CAMERA_CUBE ? 64 : 56, h = 48;
       int cull = type % 2; /* back faces culled (triangles only: analytic primitives show what the ray meets) */
       rr_frame *ref = test_render(dev, s, &cam, RR_METHOD_RC, 2, w, h, cull);
@@ -89,7 +85,7 @@ static void check_methods(rr_device *dev, const rr_scene *s, int views) {
       kind_hits(s, ref, kh);
       for (int k = 0; k < 4; k++) hits[k] += kh[k];
       char what[256];
-      snprintf(what, sizeof what, "view %d (%s), %s camera", v, inside ? "inside" : "outside", rr_camera_name(type));
+      snprintf(what, sizeof what, "view %d (%s), %s camera", v, v % 2 ? "inside" : "outside", rr_camera_name(type));
       for (size_t m = 0; m < sizeof methods3d / sizeof methods3d[0]; m++) {
         int threads = 1 + (int)((v + type + m) % 2);
         rr_frame *f = test_render(dev, s, &cam, methods3d[m], threads, w, h, cull);

@@ -103,11 +103,7 @@ static void check_methods(rr_device *dev, const rr_scene *inst, const rr_scene *
   int inst_hits = 0, frames = 0;
   for (int v = 0; v < views; v++)
     for (int type = 0; type < RR_CAMERA_COUNT; type++) {
-      float fov = type == RR_CAMERA_FISHEYE ? 200 : 70;
-      bool inside = v % 2;
-      rr_camera cam = test_random_view(inst, inside ? 0.05f : 1.2f, inside ? 0.5f : 2.5f, 0.3f, fov, fov);
-      cam.type = (rr_camera_type)type;
-      cam.ortho_height = 8;
+      rr_camera cam = test_random_camera(inst, (rr_camera_type)type, v % 2);
       int w = type == RR_CAMERA_CUBE ? 64 : 40, h = type == RR_CAMERA_CUBE ? 48 : 32, cull = (v + type) % 2;
       rr_frame *ref = test_render(dev, inst, &cam, RR_METHOD_RC, 2, w, h, cull);
       rr_frame *fref = test_render(dev, flat, &cam, RR_METHOD_RC, 1, w, h, cull);

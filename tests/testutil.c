@@ -185,6 +185,14 @@ rr_camera test_random_view(const rr_scene *s, float dist_lo, float dist_hi, floa
   return cam;
 }
 
+rr_camera test_random_camera(const rr_scene *s, rr_camera_type type, bool inside) {
+  float fov = type == RR_CAMERA_FISHEYE ? 200 : 70;
+  rr_camera cam = test_random_view(s, inside ? 0.05f : 1.2f, inside ? 0.5f : 2.5f, 0.3f, fov, fov);
+  cam.type = type;
+  cam.ortho_height = 8;
+  return cam;
+}
+
 const char *test_write_file(const char *dir, const char *name, const char *text) {
   static char path[8][512];
   static int slot;

@@ -67,6 +67,10 @@ rr_frame *test_render_threads(rr_device *dev, const rr_scene *s, const rr_camera
  * view of fov_lo..fov_hi degrees; the rest as rr_camera_init (perspective, y up).
  * A range of one value (lo == hi) draws no random number. */
 rr_camera test_random_view(const rr_scene *s, float dist_lo, float dist_hi, float aim, float fov_lo, float fov_hi);
+/* A random view of camera `type` from outside the scene, or from inside it (close
+ * to its centre), with the fields every camera type needs (fisheye 200°, others 70°,
+ * orthographic height 8). */
+rr_camera test_random_camera(const rr_scene *s, rr_camera_type type, bool inside);
 /* rr_depth_errors (vis/vis.h) of a frame's depth for camera cam; false when the
  * camera cannot be set up or is not planar. */
 typedef rr_depth_stats test_depth_stats;
