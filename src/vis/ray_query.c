@@ -55,9 +55,10 @@ typedef struct {
 
 /* Tests a leaf's count triangles, keeping the nearest hit; `any`: stops at the
  * first, which needs no full test where ray_t_inside proves it. Their corners
- * are at leaf in rr_bvh.leaf_v8's layout, their ids are ids[i] + idbase; `moved`: a translated instance's leaf read in place, whose
- * corners are leaf's plus shift (x, y, z at shift[0], [4], [8]: a transform's
- * last column), the additions bvh_leaf_at's copy makes, so the same bits.
+ * are at leaf in rr_bvh.leaf_v8's layout, their ids are ids[i] + idbase;
+ * `moved`: a translated instance's leaf read in place, whose corners are leaf's
+ * plus shift (x, y, z at shift[0], [4], [8]: a transform's last column), the
+ * additions bvh_leaf_at's copy makes, so the same bits.
  * Four at a time through the edge pre-test, then the full test for the lanes
  * that pass it (and for triangles with corners at infinity, which it cannot
  * judge). The same triangles pass whatever the order, and depth_wins keeps the

@@ -135,7 +135,6 @@ static void visbuf_free(visbuf *vb) {
   memset(vb, 0, sizeof *vb);
 }
 
-/* A buffer of `samples` layers of w × h (vb->width and height are those of one layer). */
 /* Clears n samples, sixteen a copy (16 samples at 1024² are 256 MB; glibc's memset
  * of that size is a rep stosb, which callgrind counts a byte at a time): with
  * AVX2, two stores an array. */
@@ -157,6 +156,7 @@ static inline __attribute__((always_inline)) void visbuf_clear(visbuf *vb, size_
 RR_TARGET_AVX2 static void visbuf_clear_avx2(visbuf *vb, size_t n) { visbuf_clear(vb, n); }
 #endif
 
+/* A buffer of `samples` layers of w × h (vb->width and height are those of one layer). */
 static bool visbuf_alloc(visbuf *vb, int w, int h, int samples) {
   size_t n = (size_t)w * h * samples;
   vb->width = w, vb->height = h;
