@@ -933,6 +933,19 @@ static bool copy_leaf_corners(rr_bvh *b, const rr_scene *s) {
   return true;
 }
 
+void rr_bvh_count_wide(rr_bvh *b) {
+  for (uint32_t w = b->nwide; w-- > 0;) {
+    const bvh_wide *n = &b->wide[w];
+    uint32_t sum = 0;
+    for (int i = 0; i < 4; i++) {
+      uint32_t r = n->ref[i], c = n->count[i];
+      if (r == UINT32_MAX || c == BVH_INST) continue; /* empty, or an instance not yet linked */
+      sum += c ? c : r < b->nwide ? b->wide_tris[r] : b->obj->wide_tris[(r - b->nwide) % b->obj->nwide];
+    }
+    b->wide_tris[w] = sum;
+  }
+}
+
 static bool collapse_wide(rr_bvh *b) {
   /* At most one wide node per inner binary node (plus a leaf root). */
   uint32_t cap = (b->nnodes - 1) / 2 + 1;
@@ -953,6 +966,9 @@ static bool collapse_wide(rr_bvh *b) {
   } else {
     free(exact), free(exact_node);
   }
+  b->wide_tris = malloc((size_t)next * sizeof *b->wide_tris);
+  if (!b->wide_tris) return false;
+  rr_bvh_count_wide(b);
   return true;
 }
 
@@ -1084,7 +1100,7 @@ static bool collapse_wide8(rr_bvh *b, const rr_scene *s) {
 
 void rr_bvh_release(rr_bvh *b) {
   if (!b) return;
-  free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node), free(b->wide8), free(b->leaf_v8), free(b->leaf_v);
+  free(b->node_mem), free(b->prims), free(b->wide), free(b->wide_node), free(b->wide_tris), free(b->wide8), free(b->leaf_v8), free(b->leaf_v);
   rr_bvh_release(b->obj);
   free(b);
 }
@@ -1147,7 +1163,7 @@ bool rr_bvh_finish(rr_bvh *b, const rr_scene *s, int threads) {
   if (!fj.ok[0] || !fj.ok[1] || !fj.ok[2]) return false;
   uint32_t n = b->nprims;
   b->bytes = sizeof *b + (uint64_t)b->nnodes * sizeof(bvh_node) + (uint64_t)n * sizeof *b->prims +
-             (uint64_t)b->nwide * (sizeof(bvh_wide) + 4 * sizeof(uint32_t)) +
+             (uint64_t)b->nwide * (sizeof(bvh_wide) + 5 * sizeof(uint32_t)) +
              (uint64_t)b->nwide8 * sizeof(bvh_wide8) + 2 * ((uint64_t)9 * n + BVH_LEAF_PAD) * sizeof(float);
   b->ntop = b->vpos = n, b->vnodes = b->nnodes, b->vwide = b->nwide, b->vwide8 = b->nwide8;
   return true;

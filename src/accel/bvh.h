@@ -27,6 +27,7 @@ typedef struct rr_bvh {
   int bins, leaf_size;
   struct bvh_wide *wide; /* the same tree collapsed to 4 children per node, for single rays */
   uint32_t *wide_node;   /* per wide node, per slot: the node of `nodes` it is (UINT32_MAX: empty) */
+  uint32_t *wide_tris;   /* per wide node: the triangles of its subtree (rr_bvh_count_wide) */
   uint32_t nwide;
   struct bvh_wide8 *wide8; /* the tree collapsed to 8 children per node for the ray queries,
                              subtrees of at most four triangles joined into one leaf */
@@ -87,6 +88,10 @@ rr_error rr_bvh_build_instanced(rr_scene *s, const rr_build_options *opt, rr_bvh
  * forms, the leaves' corners (side by side on `threads`), the SAH cost and the
  * bytes. False when out of memory. */
 bool rr_bvh_finish(rr_bvh *b, const rr_scene *s, int threads);
+/* Fills rr_bvh.wide_tris from the wide nodes' slots, the children first (an inner
+ * slot's node always comes after its parent); a slot past the top's own nodes
+ * counts the object tree's node (whose own counts must be filled). */
+void rr_bvh_count_wide(rr_bvh *b);
 /* The scene's BVH when it is current, else NULL with a message in dev (an empty
  * scene also gives NULL, with *empty set: every ray misses). */
 const rr_bvh *rr_bvh_of(rr_device *dev, const rr_scene *s, bool *empty);

@@ -115,6 +115,7 @@ static void link_instances(rr_bvh *b, rr_bvh *ob, const scene_instances *in) {
     for (int i = 0; i < 8; i++)
       if (b->wide8[w].count[i] == BVH_INST)
         b->wide8[w].ref[i] = b->nwide8 + b->prims[b->wide8[w].ref[i]] * ob->nwide8, b->wide8[w].count[i] = 0;
+  rr_bvh_count_wide(b); /* again, with the instances' subtrees */
 }
 
 rr_error rr_bvh_build_instanced(rr_scene *s, const rr_build_options *opt, rr_bvh **out) {

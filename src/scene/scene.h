@@ -159,18 +159,28 @@ static inline vec3 scene_stored_vertex(const rr_scene *s, int k, uint32_t j) {
  * more than a translation: then the caller moves its corners with scene_vertex. */
 static inline bool scene_lanes(const rr_scene *s, const int32_t *ids, int w, int32_t *st, float *tr, int32_t *mask) {
   bool shift = true;
-  uint32_t lo = 0, len = 0, kl = RR_MISS; /* the last lane's instance and its indices lo .. lo + len */
+  /* The last lane's instance: its indices lo .. lo + len, whether it is a translation
+   * and by what (read once: the stores to tr could otherwise alias the transforms). */
+  uint32_t lo = 0, len = 0;
+  int32_t m = 0;
+  float t[3] = {0, 0, 0};
   for (int l = 0; l < w; l++) {
     uint32_t k, i = (uint32_t)ids[l];
     if (i - lo < len) { /* the same instance as the last lane (neighbours mostly are): no division */
-      k = kl, st[l] = (int32_t)(s->inst->base + (i - lo));
+      st[l] = (int32_t)(s->inst->base + (i - lo));
     } else {
       st[l] = (int32_t)scene_locate(s, i, &k);
-      if (k != RR_MISS) kl = k, lo = i - (uint32_t)st[l] + s->inst->base, len = s->inst->T;
+      m = k == RR_MISS ? 0 : -1;
+      if (k != RR_MISS) {
+        lo = i - (uint32_t)st[l] + s->inst->base, len = s->inst->T;
+        shift = shift && s->inst->shift[k];
+        for (int a = 0; a < 3; a++) t[a] = s->inst->xf[k][4 * a + 3];
+      } else {
+        len = 0, t[0] = t[1] = t[2] = 0;
+      }
     }
-    mask[l] = k == RR_MISS ? 0 : -1;
-    shift = shift && (k == RR_MISS || s->inst->shift[k]);
-    for (int a = 0; a < 3; a++) tr[a * w + l] = k == RR_MISS ? 0.0f : s->inst->xf[k][4 * a + 3];
+    mask[l] = m;
+    for (int a = 0; a < 3; a++) tr[a * w + l] = t[a];
   }
   return shift;
 }

@@ -316,18 +316,26 @@ static int box_reach(const camera *c, const bvh_wide *n, int *few) {
       pz[a][h] = q * rr_vf4_splat(fwd[a]), pr[a][h] = q * rr_vf4_splat(right[a]), pu[a][h] = q * rr_vf4_splat(up[a]);
       pl[a][h] = q * q;
     }
-  rr_vf4 x0 = rr_vf4_splat(INFINITY), y0 = x0, x1 = -x0, y1 = -x0;
+  /* A corner projects to sx = (qr / (z·tw) + 1)·½·W, sy = (1 − qu / (z·th))·½·H;
+   * each step after the quotient is monotonic in it under rounding (adding 1,
+   * subtracting from 1, multiplying by positive constants), so the extreme corners'
+   * samples are the extreme quotients' carried through once: the same bits as
+   * each corner's own. (Starting a sum at +0, as 0 + a + b + c, changes no value
+   * but the sign of a zero, which nothing below tells apart.) */
+  rr_vf4 rx0 = rr_vf4_splat(INFINITY), ry0 = rx0, rx1 = -rx0, ry1 = -rx0;
   rr_vi4 front = (rr_vi4){-1, -1, -1, -1};
   rr_vf4 r2 = zero; /* the largest (|q| / z)² */
   for (int k = 0; k < 8; k++) {
     int h0 = k & 1, h1 = k >> 1 & 1, h2 = k >> 2 & 1;
-    rr_vf4 z = zero + pz[0][h0] + pz[1][h1] + pz[2][h2], qr = zero + pr[0][h0] + pr[1][h1] + pr[2][h2];
-    rr_vf4 qu = zero + pu[0][h0] + pu[1][h1] + pu[2][h2], len2 = zero + pl[0][h0] + pl[1][h1] + pl[2][h2];
+    rr_vf4 z = pz[0][h0] + pz[1][h1] + pz[2][h2], qr = pr[0][h0] + pr[1][h1] + pr[2][h2];
+    rr_vf4 qu = pu[0][h0] + pu[1][h1] + pu[2][h2], len2 = pl[0][h0] + pl[1][h1] + pl[2][h2];
     front &= z > zero;
     r2 = rr_vf4_max(r2, len2 / (z * z));
-    rr_vf4 sx = (qr / (z * tw) + one) * half * W, sy = (one - qu / (z * th)) * half * H;
-    x0 = rr_vf4_min(x0, sx), x1 = rr_vf4_max(x1, sx), y0 = rr_vf4_min(y0, sy), y1 = rr_vf4_max(y1, sy);
+    rr_vf4 rx = qr / (z * tw), ry = qu / (z * th);
+    rx0 = rr_vf4_min(rx0, rx), rx1 = rr_vf4_max(rx1, rx), ry0 = rr_vf4_min(ry0, ry), ry1 = rr_vf4_max(ry1, ry);
   }
+  rr_vf4 x0 = (rx0 + one) * half * W, x1 = (rx1 + one) * half * W;
+  rr_vf4 y0 = (one - ry1) * half * H, y1 = (one - ry0) * half * H;
   const float u = 0x1p-24f, wh = (float)c->width / c->tan_half_w + (float)c->height / c->tan_half_h;
   rr_vf4 big = rr_vf4_max(rr_vf4_max(rr_vf4_abs(x0), rr_vf4_abs(x1)), rr_vf4_max(rr_vf4_abs(y0), rr_vf4_abs(y1)));
   rr_vf4 R;
@@ -359,15 +367,8 @@ static int box_reach(const camera *c, const bvh_wide *n, int *few) {
 }
 
 /* Whether the subtree of wide node w holds at most `cap` triangles. */
-static bool subtree_small(const rr_bvh *b, uint32_t w, uint32_t *cap) {
-  uint32_t ref[4], count[4];
-  bvh_wide_refs(b, w, ref, count);
-  for (int i = 0; i < 4; i++) {
-    if (ref[i] == UINT32_MAX) continue;
-    if (count[i] ? count[i] > *cap : !subtree_small(b, ref[i], cap)) return false;
-    *cap -= count[i];
-  }
-  return true;
+static bool subtree_small(const rr_bvh *b, uint32_t w, uint32_t cap) {
+  return (w < b->nwide ? b->wide_tris[w] : b->obj->wide_tris[(w - b->nwide) % b->obj->nwide]) <= cap;
 }
 
 /* Perspective frames: walks down from wide node w through the slots box_reach
@@ -396,8 +397,7 @@ static void reach_walk(frame_setups *fs, uint32_t w, int depth, bool all, leaf_b
     } else if (!n->count[i]) {
       /* A box over a few samples with a few triangles below: their corner bounds
        * (in batch_setup) cost less than the boxes' tests and drop the same ones. */
-      uint32_t cap = REACH_CAP;
-      bool below = all || (few >> i & 1 && subtree_small(fs->b, n->ref[i], &cap));
+      bool below = all || (few >> i & 1 && subtree_small(fs->b, n->ref[i], REACH_CAP));
       reach_walk(fs, n->ref[i], depth - 1, below, lb, thread, roots);
     } else {
       if (lb->n + (int)n->count[i] > BATCH) {
