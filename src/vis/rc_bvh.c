@@ -508,9 +508,11 @@ typedef struct {
   float t, l1, l2; /* best hit so far */
   uint32_t id;
   float sx, sy;
+  rr_vf4 sx4, sy4; /* the sample broadcast, for the rectangle tests */
   vec3 w;
   ray_q q;
   const frame_setups *fs;
+  const wide_bounds *wb; /* fs->wb, one load nearer */
   uint64_t evals, nodes;
 } primary_ray;
 
@@ -519,8 +521,8 @@ typedef struct {
 KERNEL int ray_node_planar(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s) {
   (void)lanes;
   primary_ray *r = q;
-  const wide_bounds *wb = &r->fs->wb[ref];
-  rr_vf4 x = rr_vf4_splat(r->sx), y = rr_vf4_splat(r->sy);
+  const wide_bounds *wb = &r->wb[ref];
+  rr_vf4 x = r->sx4, y = r->sy4;
   rr_vi4 in = (wb->x0 <= x) & (x <= wb->x1) & (wb->y0 <= y) & (y <= wb->y1);
   r->nodes += wide_slots(w);
   s->order = s->key = wb->tlo;
@@ -533,7 +535,7 @@ KERNEL int ray_node_curved(void *q, const bvh_wide *w, uint32_t ref, uint64_t la
   (void)lanes;
   primary_ray *r = q;
   r->nodes += wide_slots(w);
-  s->key = r->fs->wb[ref].tlo;
+  s->key = r->wb[ref].tlo;
   return wide_test(w, &r->q, 0, s->key, r->t, &s->order);
 }
 
@@ -543,9 +545,11 @@ KERNEL bool ray_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
   (void)lanes;
   primary_ray *r = q;
   visbuf one = {1, 1, &r->id, &r->t, &r->l1, &r->l2};
+  const uint32_t *slot = r->fs->slot; /* in locals: the hit's stores cannot change them */
+  const leaf_tri *ts = r->fs->ts;
   for (uint32_t i = first; i < first + count; i++) {
-    if (r->fs->slot[i] == UINT32_MAX) continue;
-    const leaf_tri *lt = &r->fs->ts[r->fs->slot[i]];
+    if (slot[i] == UINT32_MAX) continue;
+    const leaf_tri *lt = &ts[slot[i]];
     const float *tr = lt->rect;
     if (!(tr[0] <= r->sx && r->sx <= tr[2] && tr[1] <= r->sy && r->sy <= tr[3])) continue;
     r->evals++;
@@ -565,7 +569,11 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
   visbuf *vb = j->ctx->vb;
   int x0 = job % j->tiles_x * TILE, y0 = job / j->tiles_x * TILE;
   int x1 = x0 + TILE < vb->width ? x0 + TILE : vb->width, y1 = y0 + TILE < vb->height ? y0 + TILE : vb->height;
-  primary_ray r = {.fs = &j->fs};
+  primary_ray r = {.fs = &j->fs, .wb = j->fs.wb};
+  /* in locals: the stores into the buffers cannot change them */
+  uint32_t *vid = vb->id;
+  float *vt = vb->t, *vl1 = vb->l1, *vl2 = vb->l2, *heat_e = j->ctx->heat_e, *heat_n = j->ctx->heat_n;
+  const size_t stride = (size_t)vb->width;
   /* 4x4 blocks in the tile: neighbouring rays run one after the other and find
    * the nodes and setups their neighbour just loaded still in cache. */
   for (int by = y0; by < y1; by += 4)
@@ -574,6 +582,7 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
         int x = bx + (k & 3), y = by + (k >> 2);
         if (x >= x1 || y >= y1) continue;
         r.sx = (float)x + c->sx0, r.sy = (float)y + c->sy0;
+        r.sx4 = rr_vf4_splat(r.sx), r.sy4 = rr_vf4_splat(r.sy);
         r.t = INFINITY, r.id = RR_MISS, r.l1 = r.l2 = 0;
         r.w = camera_w(c, x, y);
         vec3 o, d;
@@ -583,9 +592,9 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
           ray_q_init(&r.q, o, d);
           bvh_trace(j->b, &r, 1, ray_node_curved, ray_leaf, ray_best);
         }
-        size_t i = (size_t)y * vb->width + x;
-        if (j->ctx->heat_e) j->ctx->heat_e[i] += (float)(r.evals - e0), j->ctx->heat_n[i] += (float)(r.nodes - n0);
-        vb->id[i] = r.id, vb->t[i] = r.t, vb->l1[i] = r.l1, vb->l2[i] = r.l2;
+        size_t i = (size_t)y * stride + x;
+        if (heat_e) heat_e[i] += (float)(r.evals - e0), heat_n[i] += (float)(r.nodes - n0);
+        vid[i] = r.id, vt[i] = r.t, vl1[i] = r.l1, vl2[i] = r.l2;
       }
   thread_stats *st = &j->st[thread];
   st->evals += r.evals, st->nodes += r.nodes;
