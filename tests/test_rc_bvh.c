@@ -6,6 +6,9 @@
 #include "io/io.h"
 #include "testutil.h"
 
+#include <stdlib.h>
+#include <string.h>
+
 /* Renders a view with the reference and with rc-bvh / rc-packet on 1, 2 and 8
  * threads: the same bits as the reference, and the same S, E and N on each. */
 static void check_view(rr_device *dev, const rr_scene *s, const char *name, int v, const rr_camera *cam,
@@ -141,10 +144,73 @@ static void small_part(rr_device *dev) {
   CHECK(S[1] <= S[0] + S[0] / 10, "S grows with the scene (%llu -> %llu) for the same view", S[0], S[1]);
 }
 
+/* Adds an n×n grid of cells (two triangles each) over the parallelogram o + u·a + v·b,
+ * u, v in [0, 1]. */
+static void add_sheet(rr_scene *s, int n, const float o[3], const float a[3], const float b[3]) {
+  size_t nv = (size_t)(n + 1) * (n + 1);
+  float *p = malloc(nv * 3 * sizeof *p);
+  uint32_t *idx = malloc((size_t)n * n * 6 * sizeof *idx);
+  if (!p || !idx) {
+    CHECK(0, "out of memory");
+    free(p), free(idx);
+    return;
+  }
+  for (int j = 0; j <= n; j++)
+    for (int i = 0; i <= n; i++)
+      for (int k = 0; k < 3; k++) p[3 * (j * (n + 1) + i) + k] = o[k] + a[k] * (float)i / (float)n + b[k] * (float)j / (float)n;
+  size_t t = 0;
+  for (int j = 0; j < n; j++)
+    for (int i = 0; i < n; i++) {
+      uint32_t v = (uint32_t)(j * (n + 1) + i), r = (uint32_t)(n + 1);
+      uint32_t q[6] = {v, v + 1, v + r, v + 1, v + r + 1, v + r};
+      memcpy(idx + 6 * t++, q, sizeof q);
+    }
+  CHECK(rr_scene_add_mesh(s, p, nv, idx, t, NULL) == RR_OK, "add a sheet");
+  free(p), free(idx);
+}
+
+/* Pruning at grazing angles: a wall of many small cells (more triangles than
+ * samples, so perspective frames walk down to the boxes that may hold a sample)
+ * with sheets just in front of and behind it, tilted by a few thousandths, seen
+ * nearly edge-on so that many hits lie within rounding of each other in depth:
+ * a box pruned or a floor set too high anywhere shows as a sample that differs
+ * from rc's. */
+static void grazing_sheets(rr_device *dev) {
+  rr_scene *s = NULL;
+  if (rr_scene_new(dev, &s) != RR_OK) {
+    CHECK(0, "rr_scene_new: %s", rr_device_message(dev));
+    return;
+  }
+  const float o[3] = {-1, 0, 0}, a[3] = {2, 0, 0}, b[3] = {0, 1, 0};
+  add_sheet(s, 48, o, a, b); /* the wall, z = 0 */
+  const float o1[3] = {-1, 0, 1e-4f}, b1[3] = {0, 1, -3e-3f}; /* crossing it, in front then behind */
+  add_sheet(s, 40, o1, a, b1);
+  const float o2[3] = {-1, 0.01f, -2e-5f}, a2[3] = {2, 0, 4e-5f}; /* just behind, tilted along x */
+  add_sheet(s, 32, o2, a2, b);
+  if (rr_scene_commit(s) != RR_OK) {
+    CHECK(0, "commit: %s", rr_device_message(dev));
+    rr_scene_release(s);
+    return;
+  }
+  for (int v = 0; v < 8; v++) {
+    rr_camera cam;
+    rr_camera_init(&cam);
+    /* eyes just beyond the wall's edge, a little in front of or behind its plane,
+     * looking along it at a point of it */
+    float h = v < 2 ? 0.01f : test_randf(0.02f, 0.3f), side = v % 2 ? 1.0f : -1.0f;
+    cam.eye[0] = side * test_randf(1.05f, 1.5f), cam.eye[1] = test_randf(0.2f, 0.8f), cam.eye[2] = v % 3 ? h : -h;
+    cam.target[0] = side * test_randf(-0.5f, 0.5f), cam.target[1] = test_randf(0.3f, 0.7f), cam.target[2] = 0;
+    cam.fov_deg = test_randf(15, 60);
+    check_view(dev, s, "grazing sheets", v, &cam, RR_METHOD_RC, 64, 48, v % 2);
+  }
+  rr_scene_release(s);
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
   bound_views(dev);
   small_part(dev);
+  grazing_sheets(dev);
   int q = test_quick(); /* the sanitizer run: fewer views and meshes, the same paths */
   check_scene(dev, "demo", "demo", 3, 3);
   check_scene(dev, "sphere:24", "sphere:24", 3, 3);
