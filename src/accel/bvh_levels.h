@@ -139,6 +139,18 @@ static inline __attribute__((always_inline)) void bvh_wide_refs(const rr_bvh *b,
   bvh_move_refs(4, o->wide[j].ref, o->wide[j].count, ref, count, b->ntop + k * o->nprims, b->nwide + k * o->nwide);
 }
 
+/* Wide node r for a walk that reads its references alone: the node itself, or
+ * instance k's copy with its references moved and its boxes left unset in buf. */
+static inline __attribute__((always_inline)) const bvh_wide *bvh_wide_refs_at(const rr_bvh *b, uint32_t r,
+                                                                             bvh_wide *buf) {
+  if (__builtin_expect(r < b->nwide, 1)) return &b->wide[r];
+  const rr_bvh *o = b->obj;
+  uint32_t j, k = bvh_inst_of(r, b->nwide, o->nwide, &j);
+  bvh_move_refs(4, o->wide[j].ref, o->wide[j].count, buf->ref, buf->count, b->ntop + k * o->nprims,
+                b->nwide + k * o->nwide);
+  return buf;
+}
+
 /* The id at leaf position p. */
 static inline uint32_t bvh_prim_at(const rr_bvh *b, uint32_t p) {
   if (p < b->ntop) return b->prims[p];

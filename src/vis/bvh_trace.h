@@ -92,9 +92,11 @@ KERNEL uint64_t wide_slots(const bvh_wide *w) {
 /* Front-to-back traversal of the 4-wide tree from its root with `lanes`: the
  * slots the node test enters, in order, the nearest visited and the others
  * stacked, each dropped on pop when best() is already nearer than its key
- * (strictly: an equal t with a lower id still wins). True when leaf() ended it. */
-KERNEL bool bvh_trace(const rr_bvh *b, void *q, uint64_t lanes, trace_node_fn node, trace_leaf_fn leaf,
-                      trace_best_fn best) {
+ * (strictly: an equal t with a lower id still wins). True when leaf() ended it.
+ * `boxes` false: node() reads no box, only the references (an instance's node
+ * then comes without its boxes moved). */
+KERNEL bool bvh_trace_nodes(const rr_bvh *b, void *q, uint64_t lanes, trace_node_fn node, trace_leaf_fn leaf,
+                            trace_best_fn best, const bool boxes) {
   struct {
     uint32_t ref, count;
     float key;
@@ -107,7 +109,7 @@ KERNEL bool bvh_trace(const rr_bvh *b, void *q, uint64_t lanes, trace_node_fn no
       if (leaf(q, ref, count, lanes)) return true;
     } else {
       BVH_NODE_ALIGN bvh_wide buf; /* an instance's node, moved to world space (accel/bvh_levels.h) */
-      const bvh_wide *w = bvh_wide_at(b, ref, &buf);
+      const bvh_wide *w = boxes ? bvh_wide_at(b, ref, &buf) : bvh_wide_refs_at(b, ref, &buf);
       trace_slots s = {.lanes = {lanes, lanes, lanes, lanes}};
       int hits = node(q, w, ref, lanes, &s);
       if (hits) {
@@ -142,6 +144,12 @@ KERNEL bool bvh_trace(const rr_bvh *b, void *q, uint64_t lanes, trace_node_fn no
     }
     ref = stack[sp].ref, count = stack[sp].count, lanes = stack_lanes[sp];
   }
+}
+
+/* bvh_trace_nodes for a node test that reads the boxes. */
+KERNEL bool bvh_trace(const rr_bvh *b, void *q, uint64_t lanes, trace_node_fn node, trace_leaf_fn leaf,
+                      trace_best_fn best) {
+  return bvh_trace_nodes(b, q, lanes, node, leaf, best, true);
 }
 
 #endif

@@ -387,7 +387,7 @@ static void reach_walk(frame_setups *fs, uint32_t w, int depth, bool all, leaf_b
     return;
   }
   BVH_NODE_ALIGN bvh_wide buf;
-  const bvh_wide *n = bvh_wide_at(fs->b, w, &buf);
+  const bvh_wide *n = all ? bvh_wide_refs_at(fs->b, w, &buf) : bvh_wide_at(fs->b, w, &buf);
   wide_bounds *wb = &fs->wb[w];
   int few = 0, reach = all ? 15 : box_reach(fs->cam, n, &few);
   fs->reached[w] = 1;
@@ -587,7 +587,7 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
         r.w = camera_w(c, x, y);
         vec3 o, d;
         uint64_t e0 = r.evals, n0 = r.nodes;
-        if (c->planar) bvh_trace(j->b, &r, 1, ray_node_planar, ray_leaf, ray_best);
+        if (c->planar) bvh_trace_nodes(j->b, &r, 1, ray_node_planar, ray_leaf, ray_best, false);
         else if (rr_cam_ray(c, x, y, &o, &d)) { /* else a pixel without a ray: a miss */
           ray_q_init(&r.q, o, d);
           bvh_trace(j->b, &r, 1, ray_node_curved, ray_leaf, ray_best);
@@ -693,7 +693,7 @@ static void rc_packet_tile(int job, int thread, void *arg) {
         p->t[k] = INFINITY, p->id[k] = RR_MISS, p->l1[k] = p->l2[k] = 0, p->heat_e[k] = p->heat_n[k] = 0;
         if (px + (k & 7) < vb->width && py + (k >> 3) < vb->height) p->valid |= 1ull << k;
       }
-      bvh_trace(j->b, p, p->valid, packet_node, packet_leaf, packet_best);
+      bvh_trace_nodes(j->b, p, p->valid, packet_node, packet_leaf, packet_best, false); /* rectangles only */
       for (int k = 0; k < PN; k++) {
         if (!((p->valid >> k) & 1)) continue;
         size_t i = (size_t)(py + (k >> 3)) * vb->width + px + (k & 7);
