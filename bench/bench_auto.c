@@ -20,11 +20,16 @@
  * at 256² and 512²; a least-squares fit on relative error, costs kept ≥ 0 (3dr-fc
  * and 3dr-full on curved views: 3dr-bin's costs times their median ratio to it). With
  * --threads N (N > 1) it also times every view on N threads against one (wall
- * clock: run it on a quiet machine) for the gain of a further thread. It prints the
- * fit's error per method and writes the header to --out FILE (stdout by default).
+ * clock: run it on a quiet machine) for the gain of a further thread; --keep-gains
+ * writes the gains in use instead (for a calibration on a loaded machine). It prints
+ * the fit's error per method and writes the header to --out FILE (stdout by default).
+ * --times FILE keeps the measured times: views found in FILE are not timed again,
+ * the others are timed and added to it, so that a change of the figures (not of a
+ * method's speed) is re-fitted in seconds.
  *
  *   bench_auto [--threads N[,N]] [--reps N] [--size N] [--cull] [--cpu] [--cpu-all] [--load]
- *              [--frames N] [--planar] [--calibrate [--out FILE]] [SCENE...] */
+ *              [--frames N] [--planar] [--calibrate [--out FILE] [--keep-gains] [--times FILE]]
+ *              [SCENE...] */
 #define _GNU_SOURCE /* getopt_long */
 #include "benchutil.h"
 #include "vis/vis.h"
@@ -313,10 +318,49 @@ static void print_costs(FILE *out, const char *name, double cost[][AUTO_NFIG], b
   fprintf(out, "};\n");
 }
 
+/* --times: one line a view, "scene camera width height cull", then the CPU ms and the
+ * gains of cands (nan where none). */
+typedef struct {
+  char key[128];
+  double ms[NCAND], gain[NCAND];
+} timed_view;
+
+static int read_times(const char *path, timed_view *t, int max) {
+  FILE *f = path ? fopen(path, "r") : NULL;
+  if (!f) return 0;
+  int n = 0;
+  char line[1024];
+  while (n < max && fgets(line, sizeof line, f)) {
+    char name[96];
+    int type, w, h, cull, used;
+    if (sscanf(line, "%95s %d %d %d %d%n", name, &type, &w, &h, &cull, &used) != 5) continue;
+    const char *p = line + used;
+    bool ok = true;
+    for (int c = 0; c < 2 * NCAND && ok; c++) {
+      double x;
+      int k;
+      ok = sscanf(p, "%lf%n", &x, &k) == 1;
+      p += ok ? k : 0;
+      (c < NCAND ? t[n].ms : t[n].gain)[c % NCAND] = x;
+    }
+    if (!ok) continue;
+    snprintf(t[n].key, sizeof t[n].key, "%s %d %d %d %d", name, type, w, h, cull);
+    n++;
+  }
+  fclose(f);
+  return n;
+}
+
 static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int threads, int reps,
-                     const char *out_path) {
+                     const char *out_path, bool keep_gains, const char *times_path) {
   static sample_view v[MAX_VIEWS];
-  int nv = 0;
+  static timed_view known[MAX_VIEWS];
+  int nv = 0, nknown = read_times(times_path, known, MAX_VIEWS);
+  FILE *times = times_path ? fopen(times_path, "a") : NULL;
+  if (times_path && !times) {
+    fprintf(stderr, "bench_auto: cannot write %s\n", times_path);
+    return 1;
+  }
   static const int sizes[] = {256, 512, 1024};
   fprintf(stderr, "bench_auto: calibrating on %d scene(s), %d thread(s)...\n", nscenes, threads);
   for (int sc = 0; sc < nscenes; sc++) {
@@ -342,22 +386,37 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
           memcpy(x->fig, p.fig, sizeof x->fig);
           x->planar = planar;
           for (int c = 0; c < NCAND; c++) x->pred[c] = predicted(&p, c);
-          time_candidates(dev, s, &cam, opt, reps, true, x->ms);
-          for (int c = 0; c < NCAND; c++) x->gain[c] = NAN;
-          if (threads > 1) {
-            double one[NCAND], many[NCAND];
-            time_candidates(dev, s, &cam, opt, reps, false, one);
-            opt.threads = threads;
-            time_candidates(dev, s, &cam, opt, reps, false, many);
-            for (int c = 0; c < NCAND; c++) x->gain[c] = one[c] / many[c];
+          char key[128];
+          snprintf(key, sizeof key, "%s %d %d %d %d", scenes[sc], type, w, h, cull);
+          int k = 0;
+          while (k < nknown && strcmp(known[k].key, key)) k++;
+          if (k < nknown) {
+            memcpy(x->ms, known[k].ms, sizeof x->ms), memcpy(x->gain, known[k].gain, sizeof x->gain);
+          } else {
+            time_candidates(dev, s, &cam, opt, reps, true, x->ms);
+            for (int c = 0; c < NCAND; c++) x->gain[c] = NAN;
+            if (threads > 1 && !keep_gains) {
+              double one[NCAND], many[NCAND];
+              time_candidates(dev, s, &cam, opt, reps, false, one);
+              opt.threads = threads;
+              time_candidates(dev, s, &cam, opt, reps, false, many);
+              for (int c = 0; c < NCAND; c++) x->gain[c] = one[c] / many[c];
+            }
+            if (times) {
+              fprintf(times, "%s", key);
+              for (int c = 0; c < 2 * NCAND; c++) fprintf(times, " %.6g", c < NCAND ? x->ms[c] : x->gain[c - NCAND]);
+              fprintf(times, "\n"), fflush(times);
+            }
           }
-          fprintf(stderr, "  %s %s %dx%d%s\n", scenes[sc], rr_camera_name(type), w, h, cull ? " culled" : "");
+          fprintf(stderr, "  %s %s %dx%d%s: D=%.3g%s\n", scenes[sc], rr_camera_name(type), w, h, cull ? " culled" : "",
+                  p.depth, k < nknown ? " (times from the file)" : "");
         }
     rr_scene_release(s);
   }
+  if (times) fclose(times);
   double planar_cost[NCAND][AUTO_NFIG], curved_cost[NCAND][AUTO_NFIG], gain[NCAND];
   printf("fit to %d views (CPU ms, one thread, median of %d): |predicted / measured − 1| of the fit and of\n"
-         "the model in use (its 3dr-fc and 3dr-full carry the 1.5× for occlusion)\n\n", nv, reps);
+         "the model in use\n\n", nv, reps);
   printf("| method | planar: median, max | curved: median, max | in use: planar | in use: curved | gain of a "
          "further thread |\n|---|---|---|---|---|---|\n");
   for (int c = 0; c < NCAND; c++) {
@@ -381,7 +440,7 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
     for (int i = 0; i < nv; i++)
       if (!isnan(v[i].gain[c])) g[n++] = v[i].gain[c];
     /* (t1 / tN − 1) / (N − 1): what each further thread adds */
-    gain[c] = n ? (bench_median(g, n) - 1) / (threads - 1) : 0.75;
+    gain[c] = keep_gains ? rr_auto_thread_gain(cands[c]) : n ? (bench_median(g, n) - 1) / (threads - 1) : 0.75;
     double e[4][2]; /* fit planar, fit curved, in use planar, in use curved: median, max */
     for (int k = 0; k < 4; k++) fit_error(v, nv, k % 2 == 0, c, k < 2 ? (k ? curved_cost : planar_cost)[c] : NULL,
                                           &e[k][0], &e[k][1]);
@@ -389,7 +448,7 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
     for (int k = 0; k < 4; k++)
       if (isnan(e[k][0])) printf(" – |"); /* not timed, or no candidate there */
       else printf(" %.0f%%, %.0f%% |", 100 * e[k][0], 100 * e[k][1]);
-    printf(" %.2f%s |\n", gain[c], n ? "" : " (not measured: --threads 2)");
+    printf(" %.2f%s |\n", gain[c], keep_gains ? " (kept)" : n ? "" : " (not measured: --threads 2)");
   }
   FILE *out = out_path ? fopen(out_path, "w") : stdout;
   if (!out) {
@@ -397,8 +456,9 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
     return 1;
   }
   fprintf(out, "\n/* auto's costs: written by `bench_auto --calibrate%s` (%d views, median of %d);\n"
-               " * see vis/auto.c and docs/auto.md. Figures: ",
-          threads > 1 ? " --threads 2" : "", nv, reps);
+               " * see vis/auto.c and docs/auto.md.%s Figures: ",
+          keep_gains ? " --keep-gains" : threads > 1 ? " --threads 2" : "", nv, reps,
+          keep_gains ? " The thread gains are those of the calibration before." : "");
   for (int f = 0; f < AUTO_NFIG; f++) fprintf(out, "%s%s", f ? ", " : "", rr_auto_fig_names[f]);
   fprintf(out, ". */\n");
   print_costs(out, "cost_planar", planar_cost, true);
@@ -414,21 +474,23 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
 
 static int usage(void) {
   fprintf(stderr, "usage: bench_auto [--threads N[,N]] [--reps N] [--size N] [--cull] [--cpu] [--cpu-all] [--load]\n"
-                  "                  [--frames N] [--planar] [--calibrate [--out FILE]] [SCENE...]\n");
+                  "                  [--frames N] [--planar] [--calibrate [--out FILE] [--keep-gains] [--times FILE]]\n"
+                  "                  [SCENE...]\n");
   return 2;
 }
 
 int main(int argc, char **argv) {
   bench_cfg cfg = {.reps = 5, .size = 512, .frames = 1};
-  int threads[2] = {1, 0}, nthreads = 1, load = 0, cal = 0;
-  const char *out_path = NULL;
+  int threads[2] = {1, 0}, nthreads = 1, load = 0, cal = 0, keep_gains = 0;
+  const char *out_path = NULL, *times_path = NULL;
   static const struct option longs[] = {
       {"threads", required_argument, 0, 't'}, {"reps", required_argument, 0, 'r'},
       {"size", required_argument, 0, 's'},    {"cull", no_argument, 0, 'c'},
       {"cpu", no_argument, 0, 'C'},           {"load", no_argument, 0, 'l'},
       {"frames", required_argument, 0, 'f'},  {"planar", no_argument, 0, 'p'},
       {"calibrate", no_argument, 0, 'k'},     {"out", required_argument, 0, 'o'},
-      {"cpu-all", no_argument, 0, 'A'},
+      {"cpu-all", no_argument, 0, 'A'},       {"keep-gains", no_argument, 0, 'g'},
+      {"times", required_argument, 0, 'T'},
       {0, 0, 0, 0}};
   for (int o; (o = getopt_long(argc, argv, "", longs, NULL)) != -1;) {
     switch (o) {
@@ -443,6 +505,8 @@ int main(int argc, char **argv) {
     case 'p': cfg.planar_only = 1; break;
     case 'k': cal = 1; break;
     case 'o': out_path = optarg; break;
+    case 'g': keep_gains = 1; break;
+    case 'T': times_path = optarg; break;
     default: return usage();
     }
   }
@@ -467,7 +531,7 @@ int main(int argc, char **argv) {
   if (load) start_load();
   rr_device *dev = rr_device_new();
   int code = 0;
-  if (cal) code = calibrate(dev, scenes, nscenes, threads[nthreads - 1], cfg.reps, out_path);
+  if (cal) code = calibrate(dev, scenes, nscenes, threads[nthreads - 1], cfg.reps, out_path, keep_gains, times_path);
   else {
     int misses = 0, views = 0;
     double worst = 0;
