@@ -17,8 +17,8 @@
  *
  * --calibrate re-derives the model's costs (src/vis/auto_costs.h) from CPU times on
  * one thread: planar views at 256², 512² and 1024², culling off and on, curved ones
- * at 256² and 512²; a least-squares fit on relative error, costs kept ≥ 0 (3dr-fc
- * and 3dr-full on curved views: 3dr-bin's costs times their median ratio to it). With
+ * at 256² and 512²; a least-squares fit on relative error, costs kept ≥ 0, one for
+ * the planar views and one for each curved camera type. With
  * --threads N (N > 1) it also times every view on N threads against one (wall
  * clock: run it on a quiet machine) for the gain of a further thread; --keep-gains
  * writes the gains in use instead (for a calibration on a loaded machine). It prints
@@ -218,9 +218,18 @@ static double table(rr_device *dev, const char *const *scenes, int nscenes, int 
 
 /* ---- --calibrate: the costs from measurements ----------------------------------- */
 
+/* The cost tables: planar views share one (its kind is RR_CAMERA_PERSPECTIVE's),
+ * each curved camera type has its own (how its rays map to 3dr's cells differs). */
+static int kind_of(int type) { return is_planar(type) ? RR_CAMERA_PERSPECTIVE : type; }
+static const char *const camera_enums[RR_CAMERA_COUNT] = {
+    "RR_CAMERA_PERSPECTIVE", "RR_CAMERA_ORTHOGRAPHIC", "RR_CAMERA_PARABOLIC", "RR_CAMERA_LATLONG",
+    "RR_CAMERA_FISHEYE",     "RR_CAMERA_CUBE",         "RR_CAMERA_OPENCV",    "RR_CAMERA_OPENCV_FISHEYE"};
+_Static_assert(RR_CAMERA_COUNT == 8, "camera_enums names every camera type");
+
 typedef struct {
   double fig[AUTO_NFIG];
   bool planar;
+  int kind;              /* kind_of(camera type) */
   double ms[NCAND];      /* CPU ms on one thread */
   double pred[NCAND];    /* what the model in use predicted, or NAN */
   double gain[NCAND];    /* wall ms on one thread / on N threads, or NAN */
@@ -257,17 +266,17 @@ static bool solve(double *a, double *b, double *x, int n) {
 /* Costs (ns per unit of each figure in `uses`) minimising the squared relative
  * error of predicted against measured ns over the views of one kind where c was
  * timed; a cost that comes out negative is dropped and the rest fitted again. */
-static void fit(const sample_view *v, int nv, bool planar, int c, unsigned uses, double cost[AUTO_NFIG]) {
+static void fit(const sample_view *v, int nv, int kind, int c, unsigned uses, double cost[AUTO_NFIG]) {
   for (;;) {
     int col[AUTO_NFIG], n = 0;
     for (int f = 0; f < AUTO_NFIG; f++)
       if (uses >> f & 1) col[n++] = f;
     double a[AUTO_NFIG * AUTO_NFIG] = {0}, b[AUTO_NFIG] = {0}, x[AUTO_NFIG], scale[AUTO_NFIG] = {0};
     for (int i = 0; i < nv; i++) /* columns scaled to unit size: figures differ by 10⁶ */
-      if (v[i].planar == planar && !isnan(v[i].ms[c]))
+      if (v[i].kind == kind && !isnan(v[i].ms[c]))
         for (int k = 0; k < n; k++) scale[k] = fmax(scale[k], v[i].fig[col[k]] / (v[i].ms[c] * 1e6));
     for (int i = 0; i < nv; i++) {
-      if (v[i].planar != planar || isnan(v[i].ms[c])) continue;
+      if (v[i].kind != kind || isnan(v[i].ms[c])) continue;
       double row[AUTO_NFIG];
       for (int k = 0; k < n; k++) row[k] = scale[k] > 0 ? v[i].fig[col[k]] / (v[i].ms[c] * 1e6) / scale[k] : 0;
       for (int k = 0; k < n; k++) {
@@ -290,14 +299,15 @@ static void fit(const sample_view *v, int nv, bool planar, int c, unsigned uses,
   }
 }
 
-/* Median and largest |predicted / measured − 1| on the views of one kind, of costs,
- * or (costs NULL) of the model in use. */
-static void fit_error(const sample_view *v, int nv, bool planar, int c, const double *cost, double *med,
-                      double *max) {
+/* Median and largest |predicted / measured − 1| of c on the planar or the curved
+ * views, of costs (by kind), or (costs NULL) of the model in use. */
+static void fit_error(const sample_view *v, int nv, bool planar, int c, double (*costs)[NCAND][AUTO_NFIG],
+                      double *med, double *max) {
   double e[MAX_VIEWS];
   int n = 0;
   for (int i = 0; i < nv; i++) {
-    if (v[i].planar != planar || isnan(v[i].ms[c]) || (!cost && isnan(v[i].pred[c]))) continue;
+    if (v[i].planar != planar || isnan(v[i].ms[c]) || (!costs && isnan(v[i].pred[c]))) continue;
+    const double *cost = costs ? costs[v[i].kind][c] : NULL;
     double ns = cost ? 0 : v[i].pred[c] * 1e6;
     for (int f = 0; cost && f < AUTO_NFIG; f++) ns += cost[f] * v[i].fig[f];
     e[n++] = fabs(ns / (v[i].ms[c] * 1e6) - 1);
@@ -307,15 +317,13 @@ static void fit_error(const sample_view *v, int nv, bool planar, int c, const do
   *med = n ? bench_median(e, n) : NAN;
 }
 
-static void print_costs(FILE *out, const char *name, double cost[][AUTO_NFIG], bool planar) {
-  fprintf(out, "static const double %s[RR_METHOD_COUNT][AUTO_NFIG] = {\n", name);
+static void print_costs(FILE *out, const char *indent, double cost[][AUTO_NFIG], bool planar) {
   for (int c = 0; c < NCAND; c++) {
     if (!planar && cands[c] == RR_METHOD_3DR_BB) continue; /* not a candidate */
-    fprintf(out, "    [%s] = {", cand_enums[c]);
+    fprintf(out, "%s[%s] = {", indent, cand_enums[c]);
     for (int f = 0; f < AUTO_NFIG; f++) fprintf(out, "%s%.4g", f ? ", " : "", cost[c][f]);
     fprintf(out, "},\n");
   }
-  fprintf(out, "};\n");
 }
 
 /* --times: one line a view, "scene camera width height cull", then the CPU ms and the
@@ -384,7 +392,7 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
           predict_or_exit(dev, s, &cam, opt, &p);
           sample_view *x = &v[nv++];
           memcpy(x->fig, p.fig, sizeof x->fig);
-          x->planar = planar;
+          x->planar = planar, x->kind = kind_of(type);
           for (int c = 0; c < NCAND; c++) x->pred[c] = predicted(&p, c);
           char key[128];
           snprintf(key, sizeof key, "%s %d %d %d %d", scenes[sc], type, w, h, cull);
@@ -408,33 +416,24 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
               fprintf(times, "\n"), fflush(times);
             }
           }
-          fprintf(stderr, "  %s %s %dx%d%s: D=%.3g%s\n", scenes[sc], rr_camera_name(type), w, h, cull ? " culled" : "",
-                  p.depth, k < nknown ? " (times from the file)" : "");
+          fprintf(stderr, "  %s %s %dx%d%s: %s; ms%s", scenes[sc], rr_camera_name(type), w, h, cull ? " culled" : "",
+                  p.figures, k < nknown ? " (from --times)" : "");
+          for (int c = 0; c < NCAND; c++) fprintf(stderr, " %.3g", x->ms[c]);
+          fprintf(stderr, "\n");
         }
     rr_scene_release(s);
   }
   if (times) fclose(times);
-  double planar_cost[NCAND][AUTO_NFIG], curved_cost[NCAND][AUTO_NFIG], gain[NCAND];
+  static double cost[RR_CAMERA_COUNT][NCAND][AUTO_NFIG];
+  double gain[NCAND];
   printf("fit to %d views (CPU ms, one thread, median of %d): |predicted / measured − 1| of the fit and of\n"
          "the model in use\n\n", nv, reps);
   printf("| method | planar: median, max | curved: median, max | in use: planar | in use: curved | gain of a "
          "further thread |\n|---|---|---|---|---|---|\n");
+  for (int k = 0; k < RR_CAMERA_COUNT; k++)
+    for (int c = 0; c < NCAND; c++)
+      if (kind_of(k) == k) fit(v, nv, k, c, rr_auto_uses(cands[c], is_planar(k)), cost[k][c]);
   for (int c = 0; c < NCAND; c++) {
-    fit(v, nv, true, c, rr_auto_uses(cands[c], true), planar_cost[c]);
-    fit(v, nv, false, c, rr_auto_uses(cands[c], false), curved_cost[c]);
-  }
-  for (int c = 0; c < NCAND; c++) {
-    /* Curved views: what 3dr-fc and 3dr-full save (cells, occlusion) follows
-     * neither T nor P, so a fit of their own misses by 3× (rooms against meshes);
-     * their costs are 3dr-bin's scaled by the median of their times over its. */
-    if (cands[c] == RR_METHOD_3DR_FC || cands[c] == RR_METHOD_3DR_FULL) {
-      double r[MAX_VIEWS], k;
-      int n = 0;
-      for (int i = 0; i < nv; i++)
-        if (!v[i].planar && !isnan(v[i].ms[c]) && !isnan(v[i].ms[BIN])) r[n++] = v[i].ms[c] / v[i].ms[BIN];
-      k = n ? bench_median(r, n) : 1;
-      for (int f = 0; f < AUTO_NFIG; f++) curved_cost[c][f] = k * curved_cost[BIN][f];
-    }
     double g[MAX_VIEWS];
     int n = 0;
     for (int i = 0; i < nv; i++)
@@ -442,8 +441,7 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
     /* (t1 / tN − 1) / (N − 1): what each further thread adds */
     gain[c] = keep_gains ? rr_auto_thread_gain(cands[c]) : n ? (bench_median(g, n) - 1) / (threads - 1) : 0.75;
     double e[4][2]; /* fit planar, fit curved, in use planar, in use curved: median, max */
-    for (int k = 0; k < 4; k++) fit_error(v, nv, k % 2 == 0, c, k < 2 ? (k ? curved_cost : planar_cost)[c] : NULL,
-                                          &e[k][0], &e[k][1]);
+    for (int k = 0; k < 4; k++) fit_error(v, nv, k % 2 == 0, c, k < 2 ? cost : NULL, &e[k][0], &e[k][1]);
     printf("| %s |", rr_method_name(cands[c]));
     for (int k = 0; k < 4; k++)
       if (isnan(e[k][0])) printf(" – |"); /* not timed, or no candidate there */
@@ -461,8 +459,19 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
           keep_gains ? " The thread gains are those of the calibration before." : "");
   for (int f = 0; f < AUTO_NFIG; f++) fprintf(out, "%s%s", f ? ", " : "", rr_auto_fig_names[f]);
   fprintf(out, ". */\n");
-  print_costs(out, "cost_planar", planar_cost, true);
-  print_costs(out, "cost_curved", curved_cost, false);
+  fprintf(out, "static const double cost_planar[RR_METHOD_COUNT][AUTO_NFIG] = {\n");
+  print_costs(out, "    ", cost[RR_CAMERA_PERSPECTIVE], true);
+  fprintf(out, "};\nstatic const double cost_curved[RR_CAMERA_COUNT][RR_METHOD_COUNT][AUTO_NFIG] = {\n");
+  for (int k = 0; k < RR_CAMERA_COUNT; k++) {
+    bool fitted = false; /* a type no view was timed on stays all 0 */
+    for (int c = 0; c < NCAND; c++)
+      for (int f = 0; f < AUTO_NFIG; f++) fitted |= cost[k][c][f] != 0;
+    if (is_planar(k) || !fitted) continue;
+    fprintf(out, "    [%s] = {\n", camera_enums[k]);
+    print_costs(out, "        ", cost[k], false);
+    fprintf(out, "    },\n");
+  }
+  fprintf(out, "};\n");
   fprintf(out, "static const double thread_gain[RR_METHOD_COUNT] = {");
   for (int c = 0; c < NCAND; c++) fprintf(out, "\n    [%s] = %.3g,", cand_enums[c], gain[c]);
   fprintf(out, "\n};\n");

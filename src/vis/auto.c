@@ -21,6 +21,7 @@ typedef struct view_figures {
   double samples; /* P: samples per pass (pixels) */
   int passes;     /* samples per pixel: every method runs once per sample position */
   int threads;    /* threads that run at once (no more than the cores) */
+  rr_camera_type type;
   bool planar;
 } view_figures;
 
@@ -77,6 +78,7 @@ static rr_error measure_view(rr_device *dev, const rr_scene *s, const rr_camera 
   int cores = rr_cpu_count();
   *v = (view_figures){.tris = s->ntris, .depth = 1, .samples = (double)opt->width * opt->height,
                       .passes = opt->samples, .threads = opt->threads && opt->threads < cores ? opt->threads : cores,
+                      .type = cam->type,
                       .planar = cam->type == RR_CAMERA_PERSPECTIVE || cam->type == RR_CAMERA_ORTHOGRAPHIC};
   if (!v->planar || !s->ntris) return RR_OK; /* curved views: T and P say enough (see predict) */
   camera c;
@@ -108,10 +110,11 @@ static rr_error measure_view(rr_device *dev, const rr_scene *s, const rr_camera 
 
 const char *const rr_auto_fig_names[AUTO_NFIG] = {"T", "S", "A", "R", "UP", "P", "PlogT", "S/D", "1"};
 
-/* The costs: ns per unit of each figure on one thread, for planar and curved
- * cameras, and what each further thread adds to one thread's speed. Written by
- * `bench_auto --calibrate --threads 2 --out src/vis/auto_costs.h` (docs/auto.md):
- * re-derive them when a method's speed changes. */
+/* The costs: ns per unit of each figure on one thread, for planar cameras and for
+ * each curved camera type (how its rays map to 3dr's cells differs: a cube's faces
+ * are planes, OpenCV's distortions are not), and what each further thread adds to
+ * one thread's speed. Written by `bench_auto --calibrate --threads 2 --out
+ * src/vis/auto_costs.h` (docs/auto.md): re-derive them when a method's speed changes. */
 #include "vis/auto_costs.h"
 
 double rr_auto_thread_gain(rr_method m) { return m >= 0 && m < RR_METHOD_COUNT ? thread_gain[m] : 0; }
@@ -121,22 +124,25 @@ double rr_auto_thread_gain(rr_method m) { return m >= 0 && m < RR_METHOD_COUNT ?
 #define FIG(f) (1u << AUTO_##f)
 unsigned rr_auto_uses(rr_method m, bool planar) {
   bool rays = m == RR_METHOD_RC_PACKET || m == RR_METHOD_RC_BVH;
-  /* rays: a setup of every triangle (T) or of what traversal reaches (P·log T) */
-  if (rays) return FIG(T) | FIG(P) | FIG(PLOGT) | FIG(ONE);
+  /* rays: a pass over every triangle (T), the setups of what traversal reaches
+   * (those on screen, S, known on planar views only) and a descent per sample (P·log T) */
+  if (rays) return FIG(T) | FIG(P) | FIG(PLOGT) | FIG(ONE) | (planar ? FIG(S) : 0);
   if (!planar) return FIG(T) | FIG(P) | FIG(ONE);
   switch (m) {
   case RR_METHOD_3DR_BB: return FIG(T) | FIG(S) | FIG(A) | FIG(UP) | FIG(P) | FIG(ONE);
   case RR_METHOD_3DR_BIN: return FIG(T) | FIG(S) | FIG(A) | FIG(R) | FIG(P) | FIG(ONE);
-  case RR_METHOD_3DR_FC: return FIG(T) | FIG(S) | FIG(A) | FIG(P) | FIG(ONE);
-  /* 3dr-full culls what is hidden: its setups and edges split into those of every
-   * rectangle (S, R: the frusta still reach them) and those of the front layer (S/D) */
+  /* The frustum methods skip part of what is hidden (3dr-full culls occluded
+   * boxes; 3dr-fc's fit gains from S/D as well): their setups split into those of
+   * every rectangle (S: the frusta still reach them) and those of the front layer
+   * (S/D). 3dr-bin's and 3dr-bb's fits gain little from it (1 point of median error). */
+  case RR_METHOD_3DR_FC: return FIG(T) | FIG(S) | FIG(SD) | FIG(A) | FIG(P) | FIG(ONE);
   default: return FIG(T) | FIG(S) | FIG(SD) | FIG(R) | FIG(P) | FIG(ONE);
   }
 }
 
 /* Predicted milliseconds of a method for a view. */
 static double predict(rr_method m, const view_figures *v, const double fig[AUTO_NFIG]) {
-  const double *c = (v->planar ? cost_planar : cost_curved)[m];
+  const double *c = v->planar ? cost_planar[m] : cost_curved[v->type][m];
   double ns = 0;
   for (int f = 0; f < AUTO_NFIG; f++) ns += c[f] * fig[f];
   return ns * 1e-6 * v->passes / (1 + thread_gain[m] * (v->threads - 1));
