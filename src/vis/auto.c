@@ -124,9 +124,11 @@ double rr_auto_thread_gain(rr_method m) { return m >= 0 && m < RR_METHOD_COUNT ?
 #define FIG(f) (1u << AUTO_##f)
 unsigned rr_auto_uses(rr_method m, bool planar) {
   bool rays = m == RR_METHOD_RC_PACKET || m == RR_METHOD_RC_BVH;
-  /* rays: a pass over every triangle (T), the setups of what traversal reaches
-   * (those on screen, S, known on planar views only) and a descent per sample (P·log T) */
-  if (rays) return FIG(T) | FIG(P) | FIG(PLOGT) | FIG(ONE) | (planar ? FIG(S) : 0);
+  /* rays: a pass over every triangle (T), a descent per sample (P·log T), and on
+   * planar views the setups of what traversal reaches (those on screen, S) and the
+   * tests of the triangles whose boxes a ray passes (about their rectangles, A: big
+   * overlapping triangles, as in rooms, cost rays dearly) */
+  if (rays) return FIG(T) | FIG(P) | FIG(PLOGT) | FIG(ONE) | (planar ? FIG(S) | FIG(A) : 0);
   if (!planar) return FIG(T) | FIG(P) | FIG(ONE);
   switch (m) {
   case RR_METHOD_3DR_BB: return FIG(T) | FIG(S) | FIG(A) | FIG(UP) | FIG(P) | FIG(ONE);
@@ -136,7 +138,7 @@ unsigned rr_auto_uses(rr_method m, bool planar) {
    * every rectangle (S: the frusta still reach them) and those of the front layer
    * (S/D). 3dr-bin's and 3dr-bb's fits gain little from it (1 point of median error). */
   case RR_METHOD_3DR_FC: return FIG(T) | FIG(S) | FIG(SD) | FIG(A) | FIG(P) | FIG(ONE);
-  default: return FIG(T) | FIG(S) | FIG(SD) | FIG(R) | FIG(P) | FIG(ONE);
+  default: return FIG(T) | FIG(S) | FIG(SD) | FIG(A) | FIG(R) | FIG(P) | FIG(ONE);
   }
 }
 

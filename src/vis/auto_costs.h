@@ -5,9 +5,9 @@ static const double cost_planar[RR_METHOD_COUNT][AUTO_NFIG] = {
     [RR_METHOD_3DR_BB] = {5.944, 137.2, 2.447, 0, 0.3017, 0.1548, 0, 0, 0},
     [RR_METHOD_3DR_BIN] = {6.193, 104, 1.174, 23.04, 0, 0.4186, 0, 0, 0},
     [RR_METHOD_3DR_FC] = {30.22, 101.4, 2.595, 0, 0, 2.171, 0, 757.8, 0},
-    [RR_METHOD_3DR_FULL] = {22.63, 0, 0, 14.11, 0, 5.42, 0, 907.6, 2.131e+05},
-    [RR_METHOD_RC_PACKET] = {38.8, 270.8, 0, 0, 0, 0, 1.077, 0, 0},
-    [RR_METHOD_RC_BVH] = {38.06, 340.9, 0, 0, 0, 0, 1.293, 0, 0},
+    [RR_METHOD_3DR_FULL] = {23.19, 0, 1.944, 3.771, 0, 4.894, 0, 1017, 3.12e+05},
+    [RR_METHOD_RC_PACKET] = {38.78, 275.3, 2.754, 0, 0, 0, 0.8117, 0, 0},
+    [RR_METHOD_RC_BVH] = {39.03, 329.3, 13.86, 0, 0, 0, 0.481, 0, 0},
 };
 static const double cost_curved[RR_CAMERA_COUNT][RR_METHOD_COUNT][AUTO_NFIG] = {
     [RR_CAMERA_PARABOLIC] = {
