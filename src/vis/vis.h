@@ -137,17 +137,17 @@ bool rr_oracle_occluded(const camera *c, const bvh_node *box, float farthest);
 /* The model itself, for bench_auto: the candidate methods for a view (exact, able to
  * draw its camera), each one's predicted milliseconds, and the figures behind them
  * (per sample position; predicted ns = sum of figure × cost, see auto.c): T, S, A,
- * R, U·P, P, P·log₂T, S/D (the setups of the front layer, D the depth complexity)
- * and 1 (a frame's fixed cost). */
+ * R, U·P, P, P·log₂T, S/D (the setups of the front layer, D the depth complexity),
+ * F (the setups a front-to-back pass leaves) and 1 (a frame's fixed cost). */
 enum { AUTO_NCAND = 5 };
-enum { AUTO_T, AUTO_S, AUTO_A, AUTO_R, AUTO_UP, AUTO_P, AUTO_PLOGT, AUTO_SD, AUTO_ONE, AUTO_NFIG };
+enum { AUTO_T, AUTO_S, AUTO_A, AUTO_R, AUTO_UP, AUTO_P, AUTO_PLOGT, AUTO_SD, AUTO_F, AUTO_ONE, AUTO_NFIG };
 typedef struct auto_prediction {
   rr_method method[AUTO_NCAND];
   double ms[AUTO_NCAND];
   double fig[AUTO_NFIG];
   double depth; /* D: how many rectangles cover a covered sample, on average (1 on curved views) */
   bool planar;
-  char figures[112]; /* "T=... S=... A=... R=... U=... D=..." */
+  char figures[128]; /* "T=... S=... A=... R=... U=... D=... F=..." */
 } auto_prediction;
 rr_error rr_auto_predict(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
                          auto_prediction *out);
