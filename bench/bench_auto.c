@@ -233,6 +233,7 @@ typedef struct {
   double ms[NCAND];      /* CPU ms on one thread */
   double pred[NCAND];    /* what the model in use predicted, or NAN */
   double gain[NCAND];    /* wall ms on one thread / on N threads, or NAN */
+  double look_ms;        /* the model's look at the view (rr_auto_predict), the least of 5 */
 } sample_view;
 
 /* Solves the n×n system a·x = b (row-major, destroyed) by elimination with partial
@@ -391,6 +392,12 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
           auto_prediction p;
           predict_or_exit(dev, s, &cam, opt, &p);
           sample_view *x = &v[nv++];
+          x->look_ms = INFINITY;
+          for (int r = 0; r < 5; r++) {
+            double t0 = bench_now_ms();
+            predict_or_exit(dev, s, &cam, opt, &p);
+            x->look_ms = fmin(x->look_ms, bench_now_ms() - t0);
+          }
           memcpy(x->fig, p.fig, sizeof x->fig);
           x->planar = planar, x->kind = kind_of(type);
           for (int c = 0; c < NCAND; c++) x->pred[c] = predicted(&p, c);
@@ -448,6 +455,10 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
       else printf(" %.0f%%, %.0f%% |", 100 * e[k][0], 100 * e[k][1]);
     printf(" %.2f%s |\n", gain[c], keep_gains ? " (kept)" : n ? "" : " (not measured: --threads 2)");
   }
+  double look[MAX_VIEWS], look_max = 0;
+  for (int i = 0; i < nv; i++) look[i] = v[i].look_ms, look_max = fmax(look_max, look[i]);
+  printf("\nthe model's look at a view (rr_auto_predict, wall, least of 5): median %.3f ms, largest %.3f ms\n",
+         nv ? bench_median(look, nv) : NAN, look_max);
   FILE *out = out_path ? fopen(out_path, "w") : stdout;
   if (!out) {
     fprintf(stderr, "bench_auto: cannot write %s\n", out_path);
