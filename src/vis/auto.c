@@ -10,7 +10,7 @@
 #include <string.h>
 
 /* What the model knows of a view before rendering anything: T, and for planar
- * cameras S, A, R, U and D estimated from an even sample of the triangles (corner
+ * cameras S, A, R, U, D and F estimated from an even sample of the triangles (corner
  * bounds and setup, what 3dr-bb does first), scaled up to the whole scene. */
 typedef struct view_figures {
   double tris;    /* T: triangles in the scene */
@@ -19,7 +19,7 @@ typedef struct view_figures {
   double edges;   /* R: their widths plus heights, summed (binning's work follows the edges) */
   double whole;   /* U: of those, triangles not bounded on screen (crossing the eye's plane): whole-image rectangles */
   double depth;   /* D: the depth complexity, rectangles over a covered sample (≥ 1; see depth_complexity) */
-  double front;   /* F: setups not hidden behind nearer rectangles (see front_setups) */
+  double front;   /* F: setups not hidden behind nearer rectangles (see hidden_rects) */
   double samples; /* P: samples per pass (pixels) */
   int passes;     /* samples per pixel: every method runs once per sample position */
   int threads;    /* threads that run at once (no more than the cores) */
@@ -32,7 +32,7 @@ enum { MODEL_SAMPLE = 4096 };
 
 /* ---- depth complexity -------------------------------------------------------- */
 
-/* What occlusion culling (3dr-full) saves: with depth complexity D, about one
+/* What hiding saves the frustum methods: with depth complexity D, about one
  * triangle in D is in front, and a front-to-back traversal that skips what is hidden
  * sets up about S / D. D is the average, over the covered samples, of how many
  * rectangles cover a sample, counted on a coarse grid of cells: each looked-at
