@@ -17,14 +17,19 @@
  *
  * --calibrate re-derives the model's costs (src/vis/auto_costs.h) from CPU times on
  * one thread: planar views at 256², 512² and 1024², culling off and on, curved ones
- * at 256² and 512²; a least-squares fit on relative error, costs kept ≥ 0 (3dr-fc
- * and 3dr-full on curved views: 3dr-bin's costs times their median ratio to it). With
+ * at 256² and 512²; a least-squares fit on relative error, costs kept ≥ 0, one for
+ * the planar views and one for each curved camera type. With
  * --threads N (N > 1) it also times every view on N threads against one (wall
- * clock: run it on a quiet machine) for the gain of a further thread. It prints the
- * fit's error per method and writes the header to --out FILE (stdout by default).
+ * clock: run it on a quiet machine) for the gain of a further thread; --keep-gains
+ * writes the gains in use instead (for a calibration on a loaded machine). It prints
+ * the fit's error per method and writes the header to --out FILE (stdout by default).
+ * --times FILE keeps the measured times: views found in FILE are not timed again,
+ * the others are timed and added to it, so that a change of the figures (not of a
+ * method's speed) is re-fitted in seconds.
  *
  *   bench_auto [--threads N[,N]] [--reps N] [--size N] [--cull] [--cpu] [--cpu-all] [--load]
- *              [--frames N] [--planar] [--calibrate [--out FILE]] [SCENE...] */
+ *              [--frames N] [--planar] [--calibrate [--out FILE] [--keep-gains] [--times FILE]]
+ *              [SCENE...] */
 #define _GNU_SOURCE /* getopt_long */
 #include "benchutil.h"
 #include "vis/vis.h"
@@ -213,12 +218,22 @@ static double table(rr_device *dev, const char *const *scenes, int nscenes, int 
 
 /* ---- --calibrate: the costs from measurements ----------------------------------- */
 
+/* The cost tables: planar views share one (its kind is RR_CAMERA_PERSPECTIVE's),
+ * each curved camera type has its own (how its rays map to 3dr's cells differs). */
+static int kind_of(int type) { return is_planar(type) ? RR_CAMERA_PERSPECTIVE : type; }
+static const char *const camera_enums[RR_CAMERA_COUNT] = {
+    "RR_CAMERA_PERSPECTIVE", "RR_CAMERA_ORTHOGRAPHIC", "RR_CAMERA_PARABOLIC", "RR_CAMERA_LATLONG",
+    "RR_CAMERA_FISHEYE",     "RR_CAMERA_CUBE",         "RR_CAMERA_OPENCV",    "RR_CAMERA_OPENCV_FISHEYE"};
+_Static_assert(RR_CAMERA_COUNT == 8, "camera_enums names every camera type");
+
 typedef struct {
   double fig[AUTO_NFIG];
   bool planar;
+  int kind;              /* kind_of(camera type) */
   double ms[NCAND];      /* CPU ms on one thread */
   double pred[NCAND];    /* what the model in use predicted, or NAN */
   double gain[NCAND];    /* wall ms on one thread / on N threads, or NAN */
+  double look_ms;        /* the model's look at the view (rr_auto_predict), the least of 5 */
 } sample_view;
 
 /* Solves the n×n system a·x = b (row-major, destroyed) by elimination with partial
@@ -252,17 +267,17 @@ static bool solve(double *a, double *b, double *x, int n) {
 /* Costs (ns per unit of each figure in `uses`) minimising the squared relative
  * error of predicted against measured ns over the views of one kind where c was
  * timed; a cost that comes out negative is dropped and the rest fitted again. */
-static void fit(const sample_view *v, int nv, bool planar, int c, unsigned uses, double cost[AUTO_NFIG]) {
+static void fit(const sample_view *v, int nv, int kind, int c, unsigned uses, double cost[AUTO_NFIG]) {
   for (;;) {
     int col[AUTO_NFIG], n = 0;
     for (int f = 0; f < AUTO_NFIG; f++)
       if (uses >> f & 1) col[n++] = f;
     double a[AUTO_NFIG * AUTO_NFIG] = {0}, b[AUTO_NFIG] = {0}, x[AUTO_NFIG], scale[AUTO_NFIG] = {0};
     for (int i = 0; i < nv; i++) /* columns scaled to unit size: figures differ by 10⁶ */
-      if (v[i].planar == planar && !isnan(v[i].ms[c]))
+      if (v[i].kind == kind && !isnan(v[i].ms[c]))
         for (int k = 0; k < n; k++) scale[k] = fmax(scale[k], v[i].fig[col[k]] / (v[i].ms[c] * 1e6));
     for (int i = 0; i < nv; i++) {
-      if (v[i].planar != planar || isnan(v[i].ms[c])) continue;
+      if (v[i].kind != kind || isnan(v[i].ms[c])) continue;
       double row[AUTO_NFIG];
       for (int k = 0; k < n; k++) row[k] = scale[k] > 0 ? v[i].fig[col[k]] / (v[i].ms[c] * 1e6) / scale[k] : 0;
       for (int k = 0; k < n; k++) {
@@ -285,14 +300,15 @@ static void fit(const sample_view *v, int nv, bool planar, int c, unsigned uses,
   }
 }
 
-/* Median and largest |predicted / measured − 1| on the views of one kind, of costs,
- * or (costs NULL) of the model in use. */
-static void fit_error(const sample_view *v, int nv, bool planar, int c, const double *cost, double *med,
-                      double *max) {
+/* Median and largest |predicted / measured − 1| of c on the planar or the curved
+ * views, of costs (by kind), or (costs NULL) of the model in use. */
+static void fit_error(const sample_view *v, int nv, bool planar, int c, double (*costs)[NCAND][AUTO_NFIG],
+                      double *med, double *max) {
   double e[MAX_VIEWS];
   int n = 0;
   for (int i = 0; i < nv; i++) {
-    if (v[i].planar != planar || isnan(v[i].ms[c]) || (!cost && isnan(v[i].pred[c]))) continue;
+    if (v[i].planar != planar || isnan(v[i].ms[c]) || (!costs && isnan(v[i].pred[c]))) continue;
+    const double *cost = costs ? costs[v[i].kind][c] : NULL;
     double ns = cost ? 0 : v[i].pred[c] * 1e6;
     for (int f = 0; cost && f < AUTO_NFIG; f++) ns += cost[f] * v[i].fig[f];
     e[n++] = fabs(ns / (v[i].ms[c] * 1e6) - 1);
@@ -302,21 +318,58 @@ static void fit_error(const sample_view *v, int nv, bool planar, int c, const do
   *med = n ? bench_median(e, n) : NAN;
 }
 
-static void print_costs(FILE *out, const char *name, double cost[][AUTO_NFIG], bool planar) {
-  fprintf(out, "static const double %s[RR_METHOD_COUNT][AUTO_NFIG] = {\n", name);
+static void print_costs(FILE *out, const char *indent, double cost[][AUTO_NFIG], bool planar) {
   for (int c = 0; c < NCAND; c++) {
     if (!planar && cands[c] == RR_METHOD_3DR_BB) continue; /* not a candidate */
-    fprintf(out, "    [%s] = {", cand_enums[c]);
+    fprintf(out, "%s[%s] = {", indent, cand_enums[c]);
     for (int f = 0; f < AUTO_NFIG; f++) fprintf(out, "%s%.4g", f ? ", " : "", cost[c][f]);
     fprintf(out, "},\n");
   }
-  fprintf(out, "};\n");
+}
+
+/* --times: one line a view, "scene camera width height cull", then the CPU ms and the
+ * gains of cands (nan where none). */
+typedef struct {
+  char key[128];
+  double ms[NCAND], gain[NCAND];
+} timed_view;
+
+static int read_times(const char *path, timed_view *t, int max) {
+  FILE *f = path ? fopen(path, "r") : NULL;
+  if (!f) return 0;
+  int n = 0;
+  char line[1024];
+  while (n < max && fgets(line, sizeof line, f)) {
+    char name[96];
+    int type, w, h, cull, used;
+    if (sscanf(line, "%95s %d %d %d %d%n", name, &type, &w, &h, &cull, &used) != 5) continue;
+    const char *p = line + used;
+    bool ok = true;
+    for (int c = 0; c < 2 * NCAND && ok; c++) {
+      double x;
+      int k;
+      ok = sscanf(p, "%lf%n", &x, &k) == 1;
+      p += ok ? k : 0;
+      (c < NCAND ? t[n].ms : t[n].gain)[c % NCAND] = x;
+    }
+    if (!ok) continue;
+    snprintf(t[n].key, sizeof t[n].key, "%s %d %d %d %d", name, type, w, h, cull);
+    n++;
+  }
+  fclose(f);
+  return n;
 }
 
 static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int threads, int reps,
-                     const char *out_path) {
+                     const char *out_path, bool keep_gains, const char *times_path) {
   static sample_view v[MAX_VIEWS];
-  int nv = 0;
+  static timed_view known[MAX_VIEWS];
+  int nv = 0, nknown = read_times(times_path, known, MAX_VIEWS);
+  FILE *times = times_path ? fopen(times_path, "a") : NULL;
+  if (times_path && !times) {
+    fprintf(stderr, "bench_auto: cannot write %s\n", times_path);
+    return 1;
+  }
   static const int sizes[] = {256, 512, 1024};
   fprintf(stderr, "bench_auto: calibrating on %d scene(s), %d thread(s)...\n", nscenes, threads);
   for (int sc = 0; sc < nscenes; sc++) {
@@ -339,70 +392,97 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
           auto_prediction p;
           predict_or_exit(dev, s, &cam, opt, &p);
           sample_view *x = &v[nv++];
-          memcpy(x->fig, p.fig, sizeof x->fig);
-          x->planar = planar;
-          for (int c = 0; c < NCAND; c++) x->pred[c] = predicted(&p, c);
-          time_candidates(dev, s, &cam, opt, reps, true, x->ms);
-          for (int c = 0; c < NCAND; c++) x->gain[c] = NAN;
-          if (threads > 1) {
-            double one[NCAND], many[NCAND];
-            time_candidates(dev, s, &cam, opt, reps, false, one);
-            opt.threads = threads;
-            time_candidates(dev, s, &cam, opt, reps, false, many);
-            for (int c = 0; c < NCAND; c++) x->gain[c] = one[c] / many[c];
+          x->look_ms = INFINITY;
+          for (int r = 0; r < 5; r++) {
+            double t0 = bench_now_ms();
+            predict_or_exit(dev, s, &cam, opt, &p);
+            x->look_ms = fmin(x->look_ms, bench_now_ms() - t0);
           }
-          fprintf(stderr, "  %s %s %dx%d%s\n", scenes[sc], rr_camera_name(type), w, h, cull ? " culled" : "");
+          memcpy(x->fig, p.fig, sizeof x->fig);
+          x->planar = planar, x->kind = kind_of(type);
+          for (int c = 0; c < NCAND; c++) x->pred[c] = predicted(&p, c);
+          char key[128];
+          snprintf(key, sizeof key, "%s %d %d %d %d", scenes[sc], type, w, h, cull);
+          int k = 0;
+          while (k < nknown && strcmp(known[k].key, key)) k++;
+          if (k < nknown) {
+            memcpy(x->ms, known[k].ms, sizeof x->ms), memcpy(x->gain, known[k].gain, sizeof x->gain);
+          } else {
+            time_candidates(dev, s, &cam, opt, reps, true, x->ms);
+            for (int c = 0; c < NCAND; c++) x->gain[c] = NAN;
+            if (threads > 1 && !keep_gains) {
+              double one[NCAND], many[NCAND];
+              time_candidates(dev, s, &cam, opt, reps, false, one);
+              opt.threads = threads;
+              time_candidates(dev, s, &cam, opt, reps, false, many);
+              for (int c = 0; c < NCAND; c++) x->gain[c] = one[c] / many[c];
+            }
+            if (times) {
+              fprintf(times, "%s", key);
+              for (int c = 0; c < 2 * NCAND; c++) fprintf(times, " %.6g", c < NCAND ? x->ms[c] : x->gain[c - NCAND]);
+              fprintf(times, "\n"), fflush(times);
+            }
+          }
+          fprintf(stderr, "  %s %s %dx%d%s: %s; ms%s", scenes[sc], rr_camera_name(type), w, h, cull ? " culled" : "",
+                  p.figures, k < nknown ? " (from --times)" : "");
+          for (int c = 0; c < NCAND; c++) fprintf(stderr, " %.3g", x->ms[c]);
+          fprintf(stderr, "\n");
         }
     rr_scene_release(s);
   }
-  double planar_cost[NCAND][AUTO_NFIG], curved_cost[NCAND][AUTO_NFIG], gain[NCAND];
+  if (times) fclose(times);
+  static double cost[RR_CAMERA_COUNT][NCAND][AUTO_NFIG];
+  double gain[NCAND];
   printf("fit to %d views (CPU ms, one thread, median of %d): |predicted / measured − 1| of the fit and of\n"
-         "the model in use (its 3dr-fc and 3dr-full carry the 1.5× for occlusion)\n\n", nv, reps);
+         "the model in use\n\n", nv, reps);
   printf("| method | planar: median, max | curved: median, max | in use: planar | in use: curved | gain of a "
          "further thread |\n|---|---|---|---|---|---|\n");
+  for (int k = 0; k < RR_CAMERA_COUNT; k++)
+    for (int c = 0; c < NCAND; c++)
+      if (kind_of(k) == k) fit(v, nv, k, c, rr_auto_uses(cands[c], is_planar(k)), cost[k][c]);
   for (int c = 0; c < NCAND; c++) {
-    fit(v, nv, true, c, rr_auto_uses(cands[c], true), planar_cost[c]);
-    fit(v, nv, false, c, rr_auto_uses(cands[c], false), curved_cost[c]);
-  }
-  for (int c = 0; c < NCAND; c++) {
-    /* Curved views: what 3dr-fc and 3dr-full save (cells, occlusion) follows
-     * neither T nor P, so a fit of their own misses by 3× (rooms against meshes);
-     * their costs are 3dr-bin's scaled by the median of their times over its. */
-    if (cands[c] == RR_METHOD_3DR_FC || cands[c] == RR_METHOD_3DR_FULL) {
-      double r[MAX_VIEWS], k;
-      int n = 0;
-      for (int i = 0; i < nv; i++)
-        if (!v[i].planar && !isnan(v[i].ms[c]) && !isnan(v[i].ms[BIN])) r[n++] = v[i].ms[c] / v[i].ms[BIN];
-      k = n ? bench_median(r, n) : 1;
-      for (int f = 0; f < AUTO_NFIG; f++) curved_cost[c][f] = k * curved_cost[BIN][f];
-    }
     double g[MAX_VIEWS];
     int n = 0;
     for (int i = 0; i < nv; i++)
       if (!isnan(v[i].gain[c])) g[n++] = v[i].gain[c];
     /* (t1 / tN − 1) / (N − 1): what each further thread adds */
-    gain[c] = n ? (bench_median(g, n) - 1) / (threads - 1) : 0.75;
+    gain[c] = keep_gains ? rr_auto_thread_gain(cands[c]) : n ? (bench_median(g, n) - 1) / (threads - 1) : 0.75;
     double e[4][2]; /* fit planar, fit curved, in use planar, in use curved: median, max */
-    for (int k = 0; k < 4; k++) fit_error(v, nv, k % 2 == 0, c, k < 2 ? (k ? curved_cost : planar_cost)[c] : NULL,
-                                          &e[k][0], &e[k][1]);
+    for (int k = 0; k < 4; k++) fit_error(v, nv, k % 2 == 0, c, k < 2 ? cost : NULL, &e[k][0], &e[k][1]);
     printf("| %s |", rr_method_name(cands[c]));
     for (int k = 0; k < 4; k++)
       if (isnan(e[k][0])) printf(" – |"); /* not timed, or no candidate there */
       else printf(" %.0f%%, %.0f%% |", 100 * e[k][0], 100 * e[k][1]);
-    printf(" %.2f%s |\n", gain[c], n ? "" : " (not measured: --threads 2)");
+    printf(" %.2f%s |\n", gain[c], keep_gains ? " (kept)" : n ? "" : " (not measured: --threads 2)");
   }
+  double look[MAX_VIEWS], look_max = 0;
+  for (int i = 0; i < nv; i++) look[i] = v[i].look_ms, look_max = fmax(look_max, look[i]);
+  printf("\nthe model's look at a view (rr_auto_predict, wall, least of 5): median %.3f ms, largest %.3f ms\n",
+         nv ? bench_median(look, nv) : NAN, look_max);
   FILE *out = out_path ? fopen(out_path, "w") : stdout;
   if (!out) {
     fprintf(stderr, "bench_auto: cannot write %s\n", out_path);
     return 1;
   }
   fprintf(out, "\n/* auto's costs: written by `bench_auto --calibrate%s` (%d views, median of %d);\n"
-               " * see vis/auto.c and docs/auto.md. Figures: ",
-          threads > 1 ? " --threads 2" : "", nv, reps);
+               " * see vis/auto.c and docs/auto.md.%s Figures: ",
+          keep_gains ? " --keep-gains" : threads > 1 ? " --threads 2" : "", nv, reps,
+          keep_gains ? " The thread gains are those of the calibration before." : "");
   for (int f = 0; f < AUTO_NFIG; f++) fprintf(out, "%s%s", f ? ", " : "", rr_auto_fig_names[f]);
   fprintf(out, ". */\n");
-  print_costs(out, "cost_planar", planar_cost, true);
-  print_costs(out, "cost_curved", curved_cost, false);
+  fprintf(out, "static const double cost_planar[RR_METHOD_COUNT][AUTO_NFIG] = {\n");
+  print_costs(out, "    ", cost[RR_CAMERA_PERSPECTIVE], true);
+  fprintf(out, "};\nstatic const double cost_curved[RR_CAMERA_COUNT][RR_METHOD_COUNT][AUTO_NFIG] = {\n");
+  for (int k = 0; k < RR_CAMERA_COUNT; k++) {
+    bool fitted = false; /* a type no view was timed on stays all 0 */
+    for (int c = 0; c < NCAND; c++)
+      for (int f = 0; f < AUTO_NFIG; f++) fitted |= cost[k][c][f] != 0;
+    if (is_planar(k) || !fitted) continue;
+    fprintf(out, "    [%s] = {\n", camera_enums[k]);
+    print_costs(out, "        ", cost[k], false);
+    fprintf(out, "    },\n");
+  }
+  fprintf(out, "};\n");
   fprintf(out, "static const double thread_gain[RR_METHOD_COUNT] = {");
   for (int c = 0; c < NCAND; c++) fprintf(out, "\n    [%s] = %.3g,", cand_enums[c], gain[c]);
   fprintf(out, "\n};\n");
@@ -414,21 +494,23 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
 
 static int usage(void) {
   fprintf(stderr, "usage: bench_auto [--threads N[,N]] [--reps N] [--size N] [--cull] [--cpu] [--cpu-all] [--load]\n"
-                  "                  [--frames N] [--planar] [--calibrate [--out FILE]] [SCENE...]\n");
+                  "                  [--frames N] [--planar] [--calibrate [--out FILE] [--keep-gains] [--times FILE]]\n"
+                  "                  [SCENE...]\n");
   return 2;
 }
 
 int main(int argc, char **argv) {
   bench_cfg cfg = {.reps = 5, .size = 512, .frames = 1};
-  int threads[2] = {1, 0}, nthreads = 1, load = 0, cal = 0;
-  const char *out_path = NULL;
+  int threads[2] = {1, 0}, nthreads = 1, load = 0, cal = 0, keep_gains = 0;
+  const char *out_path = NULL, *times_path = NULL;
   static const struct option longs[] = {
       {"threads", required_argument, 0, 't'}, {"reps", required_argument, 0, 'r'},
       {"size", required_argument, 0, 's'},    {"cull", no_argument, 0, 'c'},
       {"cpu", no_argument, 0, 'C'},           {"load", no_argument, 0, 'l'},
       {"frames", required_argument, 0, 'f'},  {"planar", no_argument, 0, 'p'},
       {"calibrate", no_argument, 0, 'k'},     {"out", required_argument, 0, 'o'},
-      {"cpu-all", no_argument, 0, 'A'},
+      {"cpu-all", no_argument, 0, 'A'},       {"keep-gains", no_argument, 0, 'g'},
+      {"times", required_argument, 0, 'T'},
       {0, 0, 0, 0}};
   for (int o; (o = getopt_long(argc, argv, "", longs, NULL)) != -1;) {
     switch (o) {
@@ -443,6 +525,8 @@ int main(int argc, char **argv) {
     case 'p': cfg.planar_only = 1; break;
     case 'k': cal = 1; break;
     case 'o': out_path = optarg; break;
+    case 'g': keep_gains = 1; break;
+    case 'T': times_path = optarg; break;
     default: return usage();
     }
   }
@@ -467,7 +551,7 @@ int main(int argc, char **argv) {
   if (load) start_load();
   rr_device *dev = rr_device_new();
   int code = 0;
-  if (cal) code = calibrate(dev, scenes, nscenes, threads[nthreads - 1], cfg.reps, out_path);
+  if (cal) code = calibrate(dev, scenes, nscenes, threads[nthreads - 1], cfg.reps, out_path, keep_gains, times_path);
   else {
     int misses = 0, views = 0;
     double worst = 0;

@@ -136,15 +136,18 @@ bool rr_oracle_occluded(const camera *c, const bvh_node *box, float farthest);
 
 /* The model itself, for bench_auto: the candidate methods for a view (exact, able to
  * draw its camera), each one's predicted milliseconds, and the figures behind them
- * (per sample position; predicted ns = sum of figure × cost, see auto.c). */
+ * (per sample position; predicted ns = sum of figure × cost, see auto.c): T, S, A,
+ * R, U·P, P, P·log₂T, S/D (the setups of the front layer, D the depth complexity),
+ * F (the setups a front-to-back pass leaves) and 1 (a frame's fixed cost). */
 enum { AUTO_NCAND = 5 };
-enum { AUTO_T, AUTO_S, AUTO_A, AUTO_R, AUTO_UP, AUTO_P, AUTO_PLOGT, AUTO_NFIG };
+enum { AUTO_T, AUTO_S, AUTO_A, AUTO_R, AUTO_UP, AUTO_P, AUTO_PLOGT, AUTO_SD, AUTO_F, AUTO_ONE, AUTO_NFIG };
 typedef struct auto_prediction {
   rr_method method[AUTO_NCAND];
   double ms[AUTO_NCAND];
   double fig[AUTO_NFIG];
+  double depth; /* D: how many rectangles cover a covered sample, on average (1 on curved views) */
   bool planar;
-  char figures[96]; /* "T=... S=... A=... R=... U=..." */
+  char figures[128]; /* "T=... S=... A=... R=... U=... D=... F=..." */
 } auto_prediction;
 rr_error rr_auto_predict(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
                          auto_prediction *out);
@@ -159,6 +162,8 @@ rr_error rr_auto_choose(rr_device *dev, const rr_scene *scene, const rr_camera *
                         auto_prediction *pred, rr_method near[AUTO_NCAND], int *close, bool *repays);
 rr_render_options rr_auto_trial_options(const rr_camera *cam, const rr_render_options *opt);
 extern const char *const rr_auto_fig_names[AUTO_NFIG];
+/* The gain of a further thread in use for method m (bench_auto --keep-gains). */
+double rr_auto_thread_gain(rr_method m);
 
 typedef rr_error (*vis_method_fn)(rr_device *dev, render_ctx *ctx);
 
