@@ -137,6 +137,9 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
   const VF half = VF_(splat)(0.5f);
   const tri_pos_bits *b = mv->pos;
   const bool gathered = (uint64_t)ns * layer <= INT32_MAX;
+  /* the buffer's arrays in locals: the compiler cannot tell that the writes leave vb alone */
+  float *const buf_t = vb->t, *const buf_l1 = vb->l1, *const buf_l2 = vb->l2;
+  uint32_t *const buf_id = vb->id;
   /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
   const VI bias = VI_(splat)(INT32_MIN), id_biased = VI_(splat)((int32_t)id) ^ bias;
   uint64_t covered = 0, evals = 0;
@@ -186,19 +189,23 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
                                               VF_(select));
       const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
       covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
-      VI kv = VI_(splat)(0);
       if (gathered) {
-        kv = p * VI_(splat)((int32_t)layer) + y * VI_(splat)((int32_t)width) + x;
-        const VF bt = VF_(gather_masked)(vb->t, kv, in);
-        const VI bid = VI_(gather_masked)((const int32_t *)vb->id, kv, in);
-        hit = VI_(bits)(in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased))));
-      }
-      for (; hit; hit &= hit - 1) {
-        const int l = __builtin_ctz((unsigned)hit);
-        const size_t k = gathered ? (size_t)kv[l] : (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
-        if (gathered || t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
-          vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
-      }
+        const VI kv = p * VI_(splat)((int32_t)layer) + y * VI_(splat)((int32_t)width) + x;
+        const VF bt = VF_(gather_masked)(buf_t, kv, in);
+        const VI bid = VI_(gather_masked)((const int32_t *)buf_id, kv, in);
+        /* the winners' writes, one lane at a time (no scatter in AVX2) */
+        for (hit = VI_(bits)(in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased)))); hit; hit &= hit - 1) {
+          const int l = __builtin_ctz((unsigned)hit);
+          const size_t k = (uint32_t)kv[l];
+          buf_t[k] = t[l], buf_id[k] = id, buf_l1[k] = l1[l], buf_l2[k] = l2[l];
+        }
+      } else
+        for (; hit; hit &= hit - 1) {
+          const int l = __builtin_ctz((unsigned)hit);
+          const size_t k = (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
+          if (t[l] < buf_t[k] || (t[l] == buf_t[k] && buf_id[k] > id))
+            buf_t[k] = t[l], buf_id[k] = id, buf_l1[k] = l1[l], buf_l2[k] = l2[l];
+        }
     }
   }
   *tested += evals;
