@@ -1,7 +1,7 @@
 /* A setup's values in lanes, as both loops below read them. */
 typedef struct {
   VF a[3], b[3], cc[3];
-  VI tie[3];
+  VI tie[3], tie2[3]; /* -1 and -2 where edge e's tie bit is set, else 0 */
   VF w0, w1, w2, vol, vol_x, vol_y, pb, pc, num_x, num_y;
 } RR_CAT(tri_lanes, W);
 
@@ -10,13 +10,24 @@ TARGET static inline __attribute__((always_inline)) RR_CAT(tri_lanes, W) RR_CAT(
 #pragma GCC unroll 3
   for (int e = 0; e < 3; e++) {
     L.a[e] = VF_(splat)(ts->a[e]), L.b[e] = VF_(splat)(ts->b[e]), L.cc[e] = VF_(splat)(ts->c[e]);
-    L.tie[e] = VI_(splat)(ts->tie >> e & 1u ? -1 : 0);
+    L.tie[e] = VI_(splat)(ts->tie >> e & 1u ? -1 : 0), L.tie2[e] = L.tie[e] + L.tie[e];
   }
   L.w0 = VF_(splat)(ts->w[0]), L.w1 = VF_(splat)(ts->w[1]), L.w2 = VF_(splat)(ts->w[2]);
   L.vol = VF_(splat)(ts->vol), L.vol_x = VF_(splat)(ts->vol_x), L.vol_y = VF_(splat)(ts->vol_y);
   L.pb = VF_(splat)(ts->pb), L.pc = VF_(splat)(ts->pc);
   L.num_x = VF_(splat)(ts->num_x), L.num_y = VF_(splat)(ts->num_y);
   return L;
+}
+
+typedef uint32_t RR_CAT(vu, W) __attribute__((vector_size(sizeof(VI))));
+
+/* TRI_EDGE_INSIDE(e, tie, 0) in two integer operations on e's bits, where it takes
+ * four: e > 0 is bits > 0 (-0 is INT32_MIN); with the tie, e >= 0 is bits - 1 > -2
+ * (wrapping: -0 becomes INT32_MAX, +0 -1, every negative float below -2). A NaN may
+ * land either side, but then the weighted sum is NaN too and TRI_HIT_AHEAD rejects
+ * the lane, so the hits are TRI_EDGE_INSIDE's. */
+TARGET static inline __attribute__((always_inline)) VI RR_CAT(edge_inside, W)(VF e, VI tie, VI tie2) {
+  return (VI)((RR_CAT(vu, W))e + (RR_CAT(vu, W))tie) > tie2;
 }
 
 /* The 3D rasterizer's sample loop for W lanes: a kernel template (core/simd.h)
@@ -72,7 +83,7 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_mov
 #pragma GCC unroll 3
       for (int e = 0; e < 3; e++) {
         ev[e] = planar ? ax[e] + L.cc[e] * sy : L.a[e] * wx + L.b[e] * wy + L.cc[e] * wz;
-        in &= TRI_EDGE_INSIDE(ev[e], L.tie[e], zero);
+        in &= RR_CAT(edge_inside, W)(ev[e], L.tie[e], L.tie2[e]);
       }
       if (!VI_(bits)(in)) continue;
       const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = vx + sy * L.vol_y;
@@ -175,7 +186,7 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
 #pragma GCC unroll 3
       for (int e = 0; e < 3; e++) {
         ev[e] = (L.a[e] * one + L.b[e] * sx) + L.cc[e] * sy;
-        in &= TRI_EDGE_INSIDE(ev[e], L.tie[e], zero);
+        in &= RR_CAT(edge_inside, W)(ev[e], L.tie[e], L.tie2[e]);
       }
       if (!VI_(bits)(in)) continue;
       const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = (L.vol + sx * L.vol_x) + sy * L.vol_y;
