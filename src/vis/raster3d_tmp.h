@@ -136,14 +136,16 @@ TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_mov
  * 32-bit indices (frames of fewer than 2^31 samples; larger ones test one lane at
  * a time), and the winners are written one at a time. Adds the samples tested to
  * *tested. */
-TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
-                                                const int r[4], const camera *c, int ns, visbuf *vb,
-                                                uint64_t *tested) {
+TARGET static inline __attribute__((always_inline)) uint64_t RR_CAT(pixels_at, W)(
+    const tri_setup *ts, const tri_moves *mv, uint32_t id, const int r[4], const camera *c, int ns, visbuf *vb,
+    uint64_t *tested, const int lg) {
   const RR_CAT(tri_lanes, W) L = RR_CAT(lanes_of, W)(ts);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
-  const int lg_w = __builtin_ctz(W), lg_ns = ns > 1 ? 32 - __builtin_clz((unsigned)ns - 1) : 0;
-  const int lg = lg_ns < lg_w ? lg_ns : lg_w, P = 1 << lg, G = W / P;
+  const int P = 1 << lg, G = W / P;
+  /* one pixel a lane (P = W): the next pixel is the one to the right, or the row's
+   * first on the next row, without the division by the width */
+  const bool stepwise = G == 1;
   const VI lane = VI_(lanes)(), one_i = VI_(splat)(1), zero_i = VI_(splat)(0);
   const VF half = VF_(splat)(0.5f);
   const tri_pos_bits *b = mv->pos;
@@ -175,12 +177,22 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
     /* each lane's pixels: the q-th of every G of its rectangle's in row order; pixel
      * i is in row (i + 1/2) / wv, rounded down (exact while i < 2^22: the quotient
      * lies 1/(2·wv) or more from an integer, far above two roundings) */
-    for (VI i = lane >> lg, in;; i += VI_(splat)(G)) {
-      const int tried = VI_(bits)(in = i < n);
-      if (!tried) break;
-      evals += (uint64_t)__builtin_popcount((unsigned)tried);
-      const VI row = VI_(trunc)((VF_(from_int)(i) + half) * inv_w);
-      const VI x = x0 + (i - row * wv), y = y0 + row;
+    int most = 0; /* stepwise: the steps left, from the lanes' largest pixel count */
+    if (stepwise)
+      for (int l = 0; l < W; l++) most = n[l] > most ? n[l] : most, evals += (uint64_t)n[l];
+    VI x = x0, y = y0, wrap;
+    for (VI i = lane >> lg, in; !stepwise || most > 0; most--, i += VI_(splat)(G), /* to the next pixel */
+         stepwise ? (x += one_i, wrap = x > x1, x = VI_(select)(wrap, x0, x), y -= wrap) : x) {
+      in = i < n;
+      if (!stepwise) {
+        const int tried = VI_(bits)(in);
+        if (!tried) break;
+        evals += (uint64_t)__builtin_popcount((unsigned)tried);
+      }
+      if (!stepwise) {
+        const VI row = VI_(trunc)((VF_(from_int)(i) + half) * inv_w);
+        x = x0 + (i - row * wv), y = y0 + row;
+      }
       const VF sx = VF_(from_int)(x) + ox, sy = VF_(from_int)(y) + oy;
       VF ev[3];
 #pragma GCC unroll 3
@@ -221,4 +233,11 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
   }
   *tested += evals;
   return covered;
+}
+TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
+                                                const int r[4], const camera *c, int ns, visbuf *vb,
+                                                uint64_t *tested) {
+  const int lg_w = __builtin_ctz(W), lg_ns = ns > 1 ? 32 - __builtin_clz((unsigned)ns - 1) : 0;
+  return lg_ns >= lg_w ? RR_CAT(pixels_at, W)(ts, mv, id, r, c, ns, vb, tested, lg_w)
+                       : RR_CAT(pixels_at, W)(ts, mv, id, r, c, ns, vb, tested, lg_ns);
 }
