@@ -49,8 +49,9 @@ typedef struct trav {
   visbuf *vb;
   bool cull_back, simd;
   bool avx2;         /* simd and the CPU runs AVX2 (asked once a frame) */
+  rr_pixels_kernel pixels; /* rr_raster_pixels' kernel for avx2 */
   bool direct;       /* several positions, nothing kept but the visibility buffer:
-                      * planar small draws go straight to rr_raster_pixels */
+                      * planar small draws go straight to the kernel (pixels) */
   bool hiz_used;     /* occlusion culling or early-z read the z tiles: keep them current */
   hiz *hz;           /* one level of HIZ×HIZ tiles */
   float *heat_e, *heat_n; /* optional per-pixel E and N charges */
@@ -546,7 +547,7 @@ static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
     mv.pl = &j->pl, mv.pos = &j->pos;
     /* most draws of a detailed mesh: no call chain, no per-draw checks of options */
     if (t->direct && rr_raster_few_pixels(mv.draw, t->ns)) {
-      t->st.edge_evals += rr_raster_pixels(&j->ts, &mv, j->id, mv.draw, t->c, t->ns, t->vb, NULL, t->avx2);
+      t->pixels(&j->ts, &mv, j->id, mv.draw, t->c, t->ns, t->vb, &t->st.edge_evals);
       return;
     }
   }
@@ -1030,6 +1031,7 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
     proto.heat_e = ctx->face_heat_e, proto.heat_n = ctx->face_heat_n;
 #ifdef RR_SIMD_X86
   proto.avx2 = proto.simd && __builtin_cpu_supports("avx2");
+  proto.pixels = rr_raster_pixels_kernel(proto.avx2);
 #endif
   proto.span[0] = proto.span[2] = ctx->cams[0].sx0, proto.span[1] = proto.span[3] = ctx->cams[0].sy0;
   for (int s = 0; s < ctx->samples; s++) proto.pos[s][0] = ctx->cams[s].sx0, proto.pos[s][1] = ctx->cams[s].sy0;
