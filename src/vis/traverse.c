@@ -532,7 +532,9 @@ KERNEL void draw_rect(trav *t, const tri_job *j, tri_moves *mv, tile_rect r) {
 /* Several positions: each over its own rectangle (planar: the one-position
  * frame's, tri_pos_rect; curved: the union), which the kernel keeps to; what
  * moves with the position is made by the kernel when it needs it, once a draw. */
-static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
+static void draw_moved(trav *t, const tri_job *j, int x0, int y0, int x1, int y1) {
+  /* (by corners: a tile_rect by value went through vector registers, ~10 instructions) */
+  const tile_rect r = {x0, y0, x1, y1};
   tri_moves mv; /* (no initializer: the per-position arrays are filled when needed) */
   mv.ox = t->ox, mv.oy = t->oy, mv.pl = NULL, mv.ready = false;
   mv.draw[0] = r.x0, mv.draw[1] = r.y0, mv.draw[2] = r.x1 - 1, mv.draw[3] = r.y1 - 1;
@@ -559,7 +561,7 @@ KERNEL void draw(trav *t, const tri_job *j, tile_rect f) {
   tile_rect r = {j->bb[0] > f.x0 ? j->bb[0] : f.x0, j->bb[1] > f.y0 ? j->bb[1] : f.y0,
                  j->bb[2] + 1 < f.x1 ? j->bb[2] + 1 : f.x1, j->bb[3] + 1 < f.y1 ? j->bb[3] + 1 : f.y1};
   if (r.x0 >= r.x1 || r.y0 >= r.y1) return;
-  if (t->ns > 1 && !j->ana) draw_moved(t, j, r);
+  if (t->ns > 1 && !j->ana) draw_moved(t, j, r.x0, r.y0, r.x1, r.y1);
   else draw_rect(t, j, NULL, r);
 }
 
