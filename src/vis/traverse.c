@@ -1033,8 +1033,8 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
     proto.heat_e = ctx->face_heat_e, proto.heat_n = ctx->face_heat_n;
 #ifdef RR_SIMD_X86
   proto.avx2 = proto.simd && __builtin_cpu_supports("avx2");
-  proto.pixels = rr_raster_pixels_kernel(proto.avx2);
 #endif
+  proto.pixels = rr_raster_pixels_kernel(proto.avx2);
   proto.span[0] = proto.span[2] = ctx->cams[0].sx0, proto.span[1] = proto.span[3] = ctx->cams[0].sy0;
   for (int s = 0; s < ctx->samples; s++) proto.pos[s][0] = ctx->cams[s].sx0, proto.pos[s][1] = ctx->cams[s].sy0;
   for (int s = 0; s < RR_MAX_SAMPLES; s++)
