@@ -108,3 +108,11 @@ uint64_t rr_raster_pixels(const tri_setup *ts, const tri_moves *mv, uint32_t id,
   if (covered) *covered += got;
   return samples;
 }
+
+rr_pixels_kernel rr_raster_pixels_kernel(bool avx2) {
+#ifdef RR_SIMD_X86
+  if (avx2) return raster_pixels8;
+#endif
+  (void)avx2;
+  return raster_pixels1;
+}

@@ -1,7 +1,7 @@
 /* A setup's values in lanes, as both loops below read them. */
 typedef struct {
   VF a[3], b[3], cc[3];
-  VI tie[3];
+  VI tie[3], tie2[3]; /* -1 and -2 where edge e's tie bit is set, else 0 */
   VF w0, w1, w2, vol, vol_x, vol_y, pb, pc, num_x, num_y;
 } RR_CAT(tri_lanes, W);
 
@@ -10,13 +10,24 @@ TARGET static inline __attribute__((always_inline)) RR_CAT(tri_lanes, W) RR_CAT(
 #pragma GCC unroll 3
   for (int e = 0; e < 3; e++) {
     L.a[e] = VF_(splat)(ts->a[e]), L.b[e] = VF_(splat)(ts->b[e]), L.cc[e] = VF_(splat)(ts->c[e]);
-    L.tie[e] = VI_(splat)(ts->tie >> e & 1u ? -1 : 0);
+    L.tie[e] = VI_(splat)(ts->tie >> e & 1u ? -1 : 0), L.tie2[e] = L.tie[e] + L.tie[e];
   }
   L.w0 = VF_(splat)(ts->w[0]), L.w1 = VF_(splat)(ts->w[1]), L.w2 = VF_(splat)(ts->w[2]);
   L.vol = VF_(splat)(ts->vol), L.vol_x = VF_(splat)(ts->vol_x), L.vol_y = VF_(splat)(ts->vol_y);
   L.pb = VF_(splat)(ts->pb), L.pc = VF_(splat)(ts->pc);
   L.num_x = VF_(splat)(ts->num_x), L.num_y = VF_(splat)(ts->num_y);
   return L;
+}
+
+typedef uint32_t RR_CAT(vu, W) __attribute__((vector_size(sizeof(VI))));
+
+/* TRI_EDGE_INSIDE(e, tie, 0) in two integer operations on e's bits, where it takes
+ * four: e > 0 is bits > 0 (-0 is INT32_MIN); with the tie, e >= 0 is bits - 1 > -2
+ * (wrapping: -0 becomes INT32_MAX, +0 -1, every negative float below -2). A NaN may
+ * land either side, but then the weighted sum is NaN too and TRI_HIT_AHEAD rejects
+ * the lane, so the hits are TRI_EDGE_INSIDE's. */
+TARGET static inline __attribute__((always_inline)) VI RR_CAT(edge_inside, W)(VF e, VI tie, VI tie2) {
+  return (VI)((RR_CAT(vu, W))e + (RR_CAT(vu, W))tie) > tie2;
 }
 
 /* The 3D rasterizer's sample loop for W lanes: a kernel template (core/simd.h)
@@ -72,7 +83,7 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_mov
 #pragma GCC unroll 3
       for (int e = 0; e < 3; e++) {
         ev[e] = planar ? ax[e] + L.cc[e] * sy : L.a[e] * wx + L.b[e] * wy + L.cc[e] * wz;
-        in &= TRI_EDGE_INSIDE(ev[e], L.tie[e], zero);
+        in &= RR_CAT(edge_inside, W)(ev[e], L.tie[e], L.tie2[e]);
       }
       if (!VI_(bits)(in)) continue;
       const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = vx + sy * L.vol_y;
@@ -125,18 +136,23 @@ TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_mov
  * 32-bit indices (frames of fewer than 2^31 samples; larger ones test one lane at
  * a time), and the winners are written one at a time. Adds the samples tested to
  * *tested. */
-TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
-                                                const int r[4], const camera *c, int ns, visbuf *vb,
-                                                uint64_t *tested) {
+TARGET static inline __attribute__((always_inline)) uint64_t RR_CAT(pixels_at, W)(
+    const tri_setup *ts, const tri_moves *mv, uint32_t id, const int r[4], const camera *c, int ns, visbuf *vb,
+    uint64_t *tested, const int lg) {
   const RR_CAT(tri_lanes, W) L = RR_CAT(lanes_of, W)(ts);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
-  const int lg_w = __builtin_ctz(W), lg_ns = ns > 1 ? 32 - __builtin_clz((unsigned)ns - 1) : 0;
-  const int lg = lg_ns < lg_w ? lg_ns : lg_w, P = 1 << lg, G = W / P;
+  const int P = 1 << lg, G = W / P;
+  /* one pixel a lane (P = W): the next pixel is the one to the right, or the row's
+   * first on the next row, without the division by the width */
+  const bool stepwise = G == 1;
   const VI lane = VI_(lanes)(), one_i = VI_(splat)(1), zero_i = VI_(splat)(0);
   const VF half = VF_(splat)(0.5f);
   const tri_pos_bits *b = mv->pos;
   const bool gathered = (uint64_t)ns * layer <= INT32_MAX;
+  /* the buffer's arrays in locals: the compiler cannot tell that the writes leave vb alone */
+  float *const buf_t = vb->t, *const buf_l1 = vb->l1, *const buf_l2 = vb->l2;
+  uint32_t *const buf_id = vb->id;
   /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
   const VI bias = VI_(splat)(INT32_MIN), id_biased = VI_(splat)((int32_t)id) ^ bias;
   uint64_t covered = 0, evals = 0;
@@ -161,18 +177,28 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
     /* each lane's pixels: the q-th of every G of its rectangle's in row order; pixel
      * i is in row (i + 1/2) / wv, rounded down (exact while i < 2^22: the quotient
      * lies 1/(2·wv) or more from an integer, far above two roundings) */
-    for (VI i = lane >> lg, in;; i += VI_(splat)(G)) {
-      const int tried = VI_(bits)(in = i < n);
-      if (!tried) break;
-      evals += (uint64_t)__builtin_popcount((unsigned)tried);
-      const VI row = VI_(trunc)((VF_(from_int)(i) + half) * inv_w);
-      const VI x = x0 + (i - row * wv), y = y0 + row;
+    int most = 0; /* stepwise: the steps left, from the lanes' largest pixel count */
+    if (stepwise)
+      for (int l = 0; l < W; l++) most = n[l] > most ? n[l] : most, evals += (uint64_t)n[l];
+    VI x = x0, y = y0, wrap;
+    for (VI i = lane >> lg, in; !stepwise || most > 0; most--, i += VI_(splat)(G), /* to the next pixel */
+         stepwise ? (x += one_i, wrap = x > x1, x = VI_(select)(wrap, x0, x), y -= wrap) : x) {
+      in = i < n;
+      if (!stepwise) {
+        const int tried = VI_(bits)(in);
+        if (!tried) break;
+        evals += (uint64_t)__builtin_popcount((unsigned)tried);
+      }
+      if (!stepwise) {
+        const VI row = VI_(trunc)((VF_(from_int)(i) + half) * inv_w);
+        x = x0 + (i - row * wv), y = y0 + row;
+      }
       const VF sx = VF_(from_int)(x) + ox, sy = VF_(from_int)(y) + oy;
       VF ev[3];
 #pragma GCC unroll 3
       for (int e = 0; e < 3; e++) {
         ev[e] = (L.a[e] * one + L.b[e] * sx) + L.cc[e] * sy;
-        in &= TRI_EDGE_INSIDE(ev[e], L.tie[e], zero);
+        in &= RR_CAT(edge_inside, W)(ev[e], L.tie[e], L.tie2[e]);
       }
       if (!VI_(bits)(in)) continue;
       const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = (L.vol + sx * L.vol_x) + sy * L.vol_y;
@@ -186,21 +212,32 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
                                               VF_(select));
       const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
       covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
-      VI kv = VI_(splat)(0);
       if (gathered) {
-        kv = p * VI_(splat)((int32_t)layer) + y * VI_(splat)((int32_t)width) + x;
-        const VF bt = VF_(gather_masked)(vb->t, kv, in);
-        const VI bid = VI_(gather_masked)((const int32_t *)vb->id, kv, in);
-        hit = VI_(bits)(in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased))));
-      }
-      for (; hit; hit &= hit - 1) {
-        const int l = __builtin_ctz((unsigned)hit);
-        const size_t k = gathered ? (size_t)kv[l] : (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
-        if (gathered || t[l] < vb->t[k] || (t[l] == vb->t[k] && vb->id[k] > id))
-          vb->t[k] = t[l], vb->id[k] = id, vb->l1[k] = l1[l], vb->l2[k] = l2[l];
-      }
+        const VI kv = p * VI_(splat)((int32_t)layer) + y * VI_(splat)((int32_t)width) + x;
+        const VF bt = VF_(gather_masked)(buf_t, kv, in);
+        const VI bid = VI_(gather_masked)((const int32_t *)buf_id, kv, in);
+        /* the winners' writes, one lane at a time (no scatter in AVX2) */
+        for (hit = VI_(bits)(in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased)))); hit; hit &= hit - 1) {
+          const int l = __builtin_ctz((unsigned)hit);
+          const size_t k = (uint32_t)kv[l];
+          buf_t[k] = t[l], buf_id[k] = id, buf_l1[k] = l1[l], buf_l2[k] = l2[l];
+        }
+      } else
+        for (; hit; hit &= hit - 1) {
+          const int l = __builtin_ctz((unsigned)hit);
+          const size_t k = (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
+          if (t[l] < buf_t[k] || (t[l] == buf_t[k] && buf_id[k] > id))
+            buf_t[k] = t[l], buf_id[k] = id, buf_l1[k] = l1[l], buf_l2[k] = l2[l];
+        }
     }
   }
   *tested += evals;
   return covered;
+}
+TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
+                                                const int r[4], const camera *c, int ns, visbuf *vb,
+                                                uint64_t *tested) {
+  const int lg_w = __builtin_ctz(W), lg_ns = ns > 1 ? 32 - __builtin_clz((unsigned)ns - 1) : 0;
+  return lg_ns >= lg_w ? RR_CAT(pixels_at, W)(ts, mv, id, r, c, ns, vb, tested, lg_w)
+                       : RR_CAT(pixels_at, W)(ts, mv, id, r, c, ns, vb, tested, lg_ns);
 }

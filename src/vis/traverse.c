@@ -49,8 +49,9 @@ typedef struct trav {
   visbuf *vb;
   bool cull_back, simd;
   bool avx2;         /* simd and the CPU runs AVX2 (asked once a frame) */
+  rr_pixels_kernel pixels; /* rr_raster_pixels' kernel for avx2 */
   bool direct;       /* several positions, nothing kept but the visibility buffer:
-                      * planar small draws go straight to rr_raster_pixels */
+                      * planar small draws go straight to the kernel (pixels) */
   bool hiz_used;     /* occlusion culling or early-z read the z tiles: keep them current */
   hiz *hz;           /* one level of HIZ×HIZ tiles */
   float *heat_e, *heat_n; /* optional per-pixel E and N charges */
@@ -531,7 +532,9 @@ KERNEL void draw_rect(trav *t, const tri_job *j, tri_moves *mv, tile_rect r) {
 /* Several positions: each over its own rectangle (planar: the one-position
  * frame's, tri_pos_rect; curved: the union), which the kernel keeps to; what
  * moves with the position is made by the kernel when it needs it, once a draw. */
-static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
+static void draw_moved(trav *t, const tri_job *j, int x0, int y0, int x1, int y1) {
+  /* (by corners: a tile_rect by value went through vector registers, ~10 instructions) */
+  const tile_rect r = {x0, y0, x1, y1};
   tri_moves mv; /* (no initializer: the per-position arrays are filled when needed) */
   mv.ox = t->ox, mv.oy = t->oy, mv.pl = NULL, mv.ready = false;
   mv.draw[0] = r.x0, mv.draw[1] = r.y0, mv.draw[2] = r.x1 - 1, mv.draw[3] = r.y1 - 1;
@@ -546,7 +549,7 @@ static void draw_moved(trav *t, const tri_job *j, tile_rect r) {
     mv.pl = &j->pl, mv.pos = &j->pos;
     /* most draws of a detailed mesh: no call chain, no per-draw checks of options */
     if (t->direct && rr_raster_few_pixels(mv.draw, t->ns)) {
-      t->st.edge_evals += rr_raster_pixels(&j->ts, &mv, j->id, mv.draw, t->c, t->ns, t->vb, NULL, t->avx2);
+      t->pixels(&j->ts, &mv, j->id, mv.draw, t->c, t->ns, t->vb, &t->st.edge_evals);
       return;
     }
   }
@@ -558,7 +561,7 @@ KERNEL void draw(trav *t, const tri_job *j, tile_rect f) {
   tile_rect r = {j->bb[0] > f.x0 ? j->bb[0] : f.x0, j->bb[1] > f.y0 ? j->bb[1] : f.y0,
                  j->bb[2] + 1 < f.x1 ? j->bb[2] + 1 : f.x1, j->bb[3] + 1 < f.y1 ? j->bb[3] + 1 : f.y1};
   if (r.x0 >= r.x1 || r.y0 >= r.y1) return;
-  if (t->ns > 1 && !j->ana) draw_moved(t, j, r);
+  if (t->ns > 1 && !j->ana) draw_moved(t, j, r.x0, r.y0, r.x1, r.y1);
   else draw_rect(t, j, NULL, r);
 }
 
@@ -1031,6 +1034,7 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
 #ifdef RR_SIMD_X86
   proto.avx2 = proto.simd && __builtin_cpu_supports("avx2");
 #endif
+  proto.pixels = rr_raster_pixels_kernel(proto.avx2);
   proto.span[0] = proto.span[2] = ctx->cams[0].sx0, proto.span[1] = proto.span[3] = ctx->cams[0].sy0;
   for (int s = 0; s < ctx->samples; s++) proto.pos[s][0] = ctx->cams[s].sx0, proto.pos[s][1] = ctx->cams[s].sy0;
   for (int s = 0; s < RR_MAX_SAMPLES; s++)

@@ -231,6 +231,11 @@ static inline bool rr_raster_few_pixels(const int r[4], int ns) {
  * evaluations; adds the covered samples to *covered. */
 uint64_t rr_raster_pixels(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int rect[4],
                           const camera *c, int ns, visbuf *vb, uint64_t *covered, bool avx2);
+/* Its kernel, picked once a frame so that a draw calls it without the wrapper:
+ * adds the evaluations to *tested and returns the covered samples. */
+typedef uint64_t (*rr_pixels_kernel)(const tri_setup *ts, const tri_moves *mv, uint32_t id, const int rect[4],
+                                     const camera *c, int ns, visbuf *vb, uint64_t *tested);
+rr_pixels_kernel rr_raster_pixels_kernel(bool avx2);
 
 /* Test and benchmark hook: the relative error of depths t (one per sample of the
  * planar camera c's image; ids: the hit triangle, RR_MISS for none) against the
