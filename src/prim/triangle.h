@@ -279,6 +279,10 @@ struct tri_sphere {
   bool ok, cap;
   int8_t img_k;  /* the cap's image for rr_tri_spheres_cam's camera (parabolic): TRI_CAP_UNSET, */
   double img[4]; /* or rr_cam_cap_rect's 1 with its extents x0, x1, y0, y1 (sample coordinates), 0, -1 */
+  /* with the cap: the triangle in the gnomonic chart about the axis m that holds
+   * every passing sample (prim/triangle_curved.c, chart_extent) and the largest
+   * length of its vertices (infinite when unknown) */
+  double gx[3][3], gt;
 };
 #define TRI_CAP_UNSET 2
 void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out);
@@ -296,6 +300,12 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_spher
  * stretch over it; scale multiplies the cap's radius (1; the tests halve it to see
  * samples missed). 1 with rect, 0 when no sample can pass, -1 when it knows no bound. */
 int rr_tri_curved_cap(const camera *c, const tri_setup *ts, double scale, int rect[4]);
+/* The chart bound rr_tri_curved_rect cuts the cap's with (lat-long and fisheye,
+ * prim/triangle_curved.c): the image of the spherical triangle's linearisation in
+ * the gnomonic chart about the cap's axis, widened by the map's second-order
+ * remainder times rem_scale (1; the tests see that 0 misses samples) and the
+ * setup's widening. 1 with rect, 0 when no sample can pass, -1 when it knows no bound. */
+int rr_tri_curved_chart(const camera *c, const tri_setup *ts, double rem_scale, int rect[4]);
 /* The image rectangle of the directions within angle rho of the unit axis for the
  * curved cameras polar about an axis (lat-long, parabolic, fisheye): 1 with rect,
  * 0 when no sample looks there, -1 when it knows no bound (another camera, rho of

@@ -29,6 +29,8 @@
 /* A cap rectangle of at most this many samples is kept without the arcs'
  * (they cost about ten times as much, and the few samples more cost less). */
 #define CAP_ENOUGH 64
+/* A cap rectangle of more samples than this is cut by the chart's too. */
+#define CHART_FROM 16
 
 typedef struct dv3 { double x, y, z; } dv3;
 static dv3 dv(double x, double y, double z) { return (dv3){x, y, z}; }
@@ -291,11 +293,110 @@ static int cap_extent(const camera *c, const double axis[3], double rho, double 
   return 1;
 }
 
+/* The chart bound of the lat-long and fisheye (tighter than the cap's but for
+ * round triangles: a thin one's cap is far wider than it). In the gnomonic chart
+ * about the cap's axis m, x ↦ p = (m + x) / |m + x| (x ⊥ m), great circles are
+ * straight lines: the spherical triangle T is the plane triangle of its
+ * vertices' images x_i = v_i / (v_i·m) − m. A passing sample's exact direction w
+ * has n̂_i·w >= −ε (the comment at the top) and lies in the cap (w·m >= cos ρ >=
+ * 1 − ρ²/2), so its chart point x = w / (w·m) − m has n̂_i·(m + x) >= −ε / cos ρ:
+ * T's edges shifted out by that, which meet at y_i = x_i + δ_i, δ_i ⊥ m with
+ * n̂_j·δ_i = n̂_k·δ_i = −ε / cos ρ, δ_i = −(ε / cos ρ) m × (n̂_j − n̂_k) /
+ * (m·(n̂_j × n̂_k)) (Cramer): x lies in the triangle Y of the y_i (tri_sphere.gx,
+ * in the lanes), |x| <= t = max |y_i|. (A sliver's sharp corner moves far, along
+ * the sliver only: the margin E of the cap widens it every way.) The map's image
+ * coordinates g along the ray s·x̂ from 0 (the geodesic from m, arc length
+ * σ = atan s, dσ/ds = 1 / (1 + s²) <= 1, |d²σ/ds²| <= 2s) have
+ * g(x) = g(0) + Dg·x + R, |R| <= (M2 + 2t·M1)·t²/2 per coordinate, M1 and M2
+ * bounding the first and second derivatives of g along unit-speed geodesics over
+ * the cap. Dg·x over Y spans the box of its values at the y_i (linear), so the
+ * samples' images lie in g(m) + box(Dg·y_i) ± R. M1, M2:
+ *  - lat-long, θ from up and φ = atan2(d·right, d·fwd) on the sphere's metric
+ *    dθ² + sin²θ dφ², geodesics θ'' = sin θ cos θ φ'², φ'' = −2 cot θ θ'φ' with
+ *    θ'² + sin²θ φ'² = 1: |θ'| <= 1, |φ'| <= 1 / sin θ, |θ''| <= |cos θ| / sin θ,
+ *    |φ''| <= |cos θ| / sin²θ (2|θ'||φ' sin θ| <= 1); over the cap sin θ >= slo
+ *    (cap_extent's), and Dθ·x = −x·up / sin θ_m, Dφ·x = x·(m_f right − m_r fwd) /
+ *    (m_r² + m_f²); the cap's conditions (no pole in it, φ off the seam) hold;
+ *  - fisheye, the polar plane coordinates (α / k, ψ) of the direction's angle α
+ *    from fwd: the image's acceleration along a geodesic (α'' = sin α cos α ψ'²,
+ *    ψ'' = −2 cot α α'ψ') has radial part ψ'²(α − sin α cos α) <= 2α³ / (3 sin²α)
+ *    (2α − sin 2α <= (2α)³ / 6) and tangential 2α'ψ'(1 − α cot α) <=
+ *    (sin α − α cos α) / sin²α <= α³ / (3 sin²α) (the difference grows from 0 with
+ *    derivative α(α − sin α)), so |g''| <= α³ / (k sin²α) and |g'| <= α / (k sin α),
+ *    both growing with α: at most A³ / (k s²) and A / (k s) with A >= α_m + ρ and
+ *    s <= sin(α_m + ρ) (cap_extent's). g = q(α) (d·right, d·up) / k, q = α / sin α,
+ *    so Dg·x = (q (x·right, x·up) − c₂ (x·fwd) (m_r, m_u)) / k with
+ *    c₂ = q'(α_m) / sin α_m = (sin α_m − α_m cos α_m) / sin³α_m; with α_m within
+ *    ATAN_ERR, q and c₂ are within ATAN_ERR / sin α_m and (ATAN_ERR + 1e-15) /
+ *    sin³α_m, which the margin carries (off the axis only: sin α_m > 1e-2).
+ * Rounding: the chart's vertices carry a few ulps of t, far below the 1e-9 rad added.
+ * rem_scale multiplies R (1; the tests see that 0 misses samples). 1 with the
+ * sample-coordinate extents e, -1 when it knows no bound. */
+static int chart_extent(const camera *c, const tri_sphere *sp, double rem_scale, double e[4]) {
+  const double rho = sp->rho, t = sp->gt, W = c->width, H = c->height;
+  if (!(rho < 1.5) || !(t < 1)) return -1;
+  const dv3 m = dv(sp->axis[0], sp->axis[1], sp->axis[2]), R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
+  const double mr = ddot(m, R), mu = ddot(m, U), mf = ddot(m, F);
+  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}; /* Dg·x_i: x, y image coordinates */
+  if (c->type == RR_CAMERA_LATLONG) {
+    const double ct = mu, st = sqrt(maxd(0.0, 1 - ct * ct)), slo = st * (1 - rho * rho / 2) - fabs(ct) * rho;
+    const double g2 = mr * mr + mf * mf;
+    if (!(slo > 1e-6) || !(rho / slo < RR_PI) || !(g2 > 1e-12)) return -1;
+    const double phi = fast_atan2(mr, mf), dphi = rho / slo + ATAN_ERR;
+    if (phi - dphi < -RR_PI || phi + dphi > RR_PI) return -1; /* across the seam */
+    const double theta = fast_atan2(st, ct);
+    const dv3 G = dsub(dscale(R, mf), dscale(F, mr));
+    for (int i = 0; i < 3; i++) {
+      const dv3 x = dv(sp->gx[i][0], sp->gx[i][1], sp->gx[i][2]);
+      const double dp = ddot(x, G) / g2, dt = -ddot(x, U) / st;
+      lo[0] = mind(lo[0], dp), hi[0] = maxd(hi[0], dp), lo[1] = mind(lo[1], dt), hi[1] = maxd(hi[1], dt);
+    }
+    const double h = t * t / 2 * rem_scale;
+    const double mp = (1 / (slo * slo) + 2 * t / slo) * h + 1e-9 / slo + ATAN_ERR;
+    const double mt = (1 / slo + 2 * t) * h + 1e-9 + ATAN_ERR;
+    /* φ = 2π sx / W − π, θ = π sy / H */
+    e[0] = (phi + lo[0] - mp + RR_PI) * W / (2 * RR_PI), e[1] = (phi + hi[0] + mp + RR_PI) * W / (2 * RR_PI);
+    e[2] = (theta + lo[1] - mt) * H / RR_PI, e[3] = (theta + hi[1] + mt) * H / RR_PI;
+    return 1;
+  }
+  if (c->type != RR_CAMERA_FISHEYE) return -1;
+  const double ca = mf, sa = sqrt(maxd(0.0, 1 - ca * ca)), k = c->fov_deg * RR_PI / 360;
+  const double s = sa * (1 - rho * rho / 2) + mind(ca, 0.0) * rho; /* <= sin(α_m + ρ) */
+  if (!(sa > 1e-2) || !(s > 1e-3)) return -1;
+  const double am = fast_atan2(sa, ca), A = am + ATAN_ERR + rho, M1 = A / (k * s), M2 = A * A * A / (k * s * s);
+  const double q = am / sa, c2 = (sa - am * ca) / (sa * sa * sa);
+  for (int i = 0; i < 3; i++) {
+    const dv3 x = dv(sp->gx[i][0], sp->gx[i][1], sp->gx[i][2]);
+    const double xf = ddot(x, F), du = (q * ddot(x, R) - c2 * xf * mr) / k, dv_ = (q * ddot(x, U) - c2 * xf * mu) / k;
+    lo[0] = mind(lo[0], du), hi[0] = maxd(hi[0], du), lo[1] = mind(lo[1], dv_), hi[1] = maxd(hi[1], dv_);
+  }
+  const double u = q * mr / k, vv = q * mu / k;
+  const double mg = (M2 + 2 * t * M1) * t * t / 2 * rem_scale + 1e-9 * M1 +
+                    (ATAN_ERR * (1 + t / sa + 2 * t / (sa * sa)) + 1e-12) / k;
+  /* u = 2 sx / W − 1, v = 1 − 2 sy / H */
+  e[0] = (u + lo[0] - mg + 1) * W / 2, e[1] = (u + hi[0] + mg + 1) * W / 2;
+  e[2] = (1 - vv - hi[1] - mg) * H / 2, e[3] = (1 - vv - lo[1] + mg) * H / 2;
+  return 1;
+}
+
 int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int r[4]) {
   if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
   double e[4];
   int k = cap_extent(c, axis, rho, e);
   return k > 0 ? sample_rect(c, e[0], e[1], e[2], e[3], r) : k;
+}
+
+/* chart_extent's rectangle: 1 with r, 0 when it holds no sample, -1 when unknown. */
+static int chart_rect(const camera *c, const tri_sphere *sp, double rem_scale, int r[4]) {
+  double e[4];
+  if (!sp->cap || chart_extent(c, sp, rem_scale, e) < 0) return -1;
+  return sample_rect(c, e[0], e[1], e[2], e[3], r);
+}
+
+int rr_tri_curved_chart(const camera *c, const tri_setup *ts, double rem_scale, int r[4]) {
+  tri_sphere sp;
+  rr_tri_spheres(ts, 1, true, &sp);
+  return sp.ok ? chart_rect(c, &sp, rem_scale, r) : -1;
 }
 
 int rr_tri_sphere_cap_rect(const camera *c, const tri_sphere *sp, int r[4]) {
@@ -321,6 +422,15 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_spher
    * it is not, the arcs' rectangle within it */
   int cap[4], has_cap = rr_tri_sphere_cap_rect(c, sp, cap);
   if (has_cap == 0) return 0;
+  if (has_cap > 0 && (cap[2] - cap[0] + 1) * (cap[3] - cap[1] + 1) > CHART_FROM) { /* and the chart's */
+    int g[4], kg = chart_rect(c, sp, 1, g);
+    if (kg == 0) return 0;
+    if (kg > 0) {
+      cap[0] = cap[0] > g[0] ? cap[0] : g[0], cap[1] = cap[1] > g[1] ? cap[1] : g[1];
+      cap[2] = cap[2] < g[2] ? cap[2] : g[2], cap[3] = cap[3] < g[3] ? cap[3] : g[3];
+      if (cap[0] > cap[2] || cap[1] > cap[3]) return 0;
+    }
+  }
   if (has_cap > 0 && (cap[2] - cap[0] + 1) * (cap[3] - cap[1] + 1) <= CAP_ENOUGH) {
     memcpy(r, cap, sizeof cap);
     return kind;

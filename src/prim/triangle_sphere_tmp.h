@@ -47,6 +47,22 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
   const vd4 cr = vmin(vdot(m, v[0]), vmin(vdot(m, v[1]), vdot(m, v[2])));
   cap &= cr > 0.1;
   const vd4 h2 = vmax(vd_splat(0), 2 - 2 * cr), rho = SPH_SQRT(h2 / (1 - h2 / 4)) + E + 1e-9;
+  /* chart_extent's triangle: the vertices in the gnomonic chart about m
+   * (v·m >= cr > 0.1 with the cap), each moved to where the edges through it,
+   * shifted out by ε / cos ρ, meet (chart_extent's comment) */
+  vd4 gx[3][3], gt2 = vd_splat(0);
+  const vd4 ec = eps / (1 - rho * rho / 2);
+  for (int i = 0; i < 3; i++) {
+    const vd4 *nj = nrm[(i + 1) % 3], *nk = nrm[(i + 2) % 3];
+    vd4 jk[3], mx[3], dn[3];
+    vcross(nj, nk, jk);
+    for (int k = 0; k < 3; k++) dn[k] = nj[k] - nk[k];
+    vcross(m, dn, mx);
+    const vd4 iv = 1 / vdot(v[i], m), sh = -ec / vdot(m, jk);
+    for (int k = 0; k < 3; k++) gx[i][k] = (v[i][k] * iv - m[k]) + mx[k] * sh;
+    gt2 = vmax(gt2, vdot(gx[i], gx[i]));
+  }
+  const vd4 gt = vsel(rho < 1.3, SPH_SQRT(gt2), vd_splat(INFINITY));
   /* cap_extent's parabolic image of the cap: the centre's stereographic image,
    * the radius ρ / (1 + cmin), and 0 for a cap behind the disk's rim */
   vd4 ext[4] = {0};
@@ -72,7 +88,8 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
     for (int k = 0; k < 4 && pc; k++) o->img[k] = ext[k][l];
     for (int i = 0; i < 3 && nv; i++)
       for (int k = 0; k < 3; k++) nv[l][0][i][k] = nrm[i][k][l], nv[l][1][i][k] = v[i][k][l];
-    for (int k = 0; k < 3; k++) o->axis[k] = m[k][l];
+    for (int k = 0; k < 3; k++) o->axis[k] = m[k][l], o->gx[0][k] = gx[0][k][l], o->gx[1][k] = gx[1][k][l], o->gx[2][k] = gx[2][k][l];
+    o->gt = gt[l];
     o->smin = smin[l], o->E = E[l], o->rho = rho[l];
     o->ok = ok[l] != 0, o->cap = ok[l] && cap[l];
   }
