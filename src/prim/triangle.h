@@ -279,9 +279,10 @@ struct tri_sphere {
   bool ok, cap;
   int8_t img_k;  /* the cap's image for rr_tri_spheres_cam's camera (parabolic): TRI_CAP_UNSET, */
   double img[4]; /* or rr_cam_cap_rect's 1 with its extents x0, x1, y0, y1 (sample coordinates), 0, -1 */
-  /* with the cap: the triangle in the gnomonic chart about the axis m that holds
-   * every passing sample (prim/triangle_curved.c, chart_extent) and the largest
-   * length of its vertices (infinite when unknown) */
+  /* with the cap, computed only where prim/triangle_curved.c needs them: the
+   * triangle in the gnomonic chart about the axis m that holds every passing
+   * sample (chart_extent) and the largest length of its vertices (infinite when
+   * not computed) */
   double gx[3][3], gt;
 };
 #define TRI_CAP_UNSET 2

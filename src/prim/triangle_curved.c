@@ -395,7 +395,8 @@ static int chart_rect(const camera *c, const tri_sphere *sp, double rem_scale, i
 
 int rr_tri_curved_chart(const camera *c, const tri_setup *ts, double rem_scale, int r[4]) {
   tri_sphere sp;
-  rr_tri_spheres(ts, 1, true, &sp);
+  double nv[1][2][3][3];
+  spheres(ts, 1, NULL, true, &sp, nv);
   return sp.ok ? chart_rect(c, &sp, rem_scale, r) : -1;
 }
 
@@ -422,8 +423,14 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_spher
    * it is not, the arcs' rectangle within it */
   int cap[4], has_cap = rr_tri_sphere_cap_rect(c, sp, cap);
   if (has_cap == 0) return 0;
-  if (has_cap > 0 && (cap[2] - cap[0] + 1) * (cap[3] - cap[1] + 1) > CHART_FROM) { /* and the chart's */
-    int g[4], kg = chart_rect(c, sp, 1, g);
+  /* the chart and the arcs need T's normals and vertices: this lane again, with them */
+  tri_sphere again;
+  double nv[1][2][3][3];
+  bool full = false;
+  if (has_cap > 0 && (cap[2] - cap[0] + 1) * (cap[3] - cap[1] + 1) > CHART_FROM &&
+      (c->type == RR_CAMERA_LATLONG || c->type == RR_CAMERA_FISHEYE)) { /* and the chart's */
+    spheres(ts, 1, NULL, true, &again, nv), full = true;
+    int g[4], kg = chart_rect(c, &again, 1, g);
     if (kg == 0) return 0;
     if (kg > 0) {
       cap[0] = cap[0] > g[0] ? cap[0] : g[0], cap[1] = cap[1] > g[1] ? cap[1] : g[1];
@@ -435,10 +442,7 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_spher
     memcpy(r, cap, sizeof cap);
     return kind;
   }
-  /* the arcs need T's normals and vertices: this lane again, with them */
-  tri_sphere again;
-  double nv[1][2][3][3];
-  spheres(ts, 1, NULL, true, &again, nv);
+  if (!full) spheres(ts, 1, NULL, true, &again, nv);
   dv3 n[3], v[3];
   for (int i = 0; i < 3; i++)
     n[i] = dv(nv[0][0][i][0], nv[0][0][i][1], nv[0][0][i][2]), v[i] = dv(nv[0][1][i][0], nv[0][1][i][1], nv[0][1][i][2]);

@@ -6,7 +6,7 @@
  * a scalar evaluation would: the proofs there carry over unchanged. A lane that
  * fails a test only clears its ok or cap; its NaNs go nowhere. Four lanes, not
  * eight: a leaf's setups keep about three. nv (may be NULL): the normals and
- * vertices, for the arcs. pc (may be NULL): a parabolic camera, whose cap images
+ * vertices, for the arcs, and the chart's triangle (gx, gt; else gt infinite). pc (may be NULL): a parabolic camera, whose cap images
  * (cap_extent) the lanes compute too, in its order. */
 SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tri_sphere *out, double (*nv)[2][3][3]) {
   vd4 nrm[3][3], v[3][3]; /* [edge or vertex][axis] */
@@ -51,8 +51,9 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
    * (v·m >= cr > 0.1 with the cap), each moved to where the edges through it,
    * shifted out by ε / cos ρ, meet (chart_extent's comment) */
   vd4 gx[3][3], gt2 = vd_splat(0);
+  memset(gx, 0, sizeof gx);
   const vd4 ec = eps / (1 - rho * rho / 2);
-  for (int i = 0; i < 3; i++) {
+  for (int i = 0; i < 3 && nv; i++) { /* (rarely needed: with the arcs' normals and vertices only) */
     const vd4 *nj = nrm[(i + 1) % 3], *nk = nrm[(i + 2) % 3];
     vd4 jk[3], mx[3], dn[3];
     vcross(nj, nk, jk);
@@ -88,8 +89,10 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
     for (int k = 0; k < 4 && pc; k++) o->img[k] = ext[k][l];
     for (int i = 0; i < 3 && nv; i++)
       for (int k = 0; k < 3; k++) nv[l][0][i][k] = nrm[i][k][l], nv[l][1][i][k] = v[i][k][l];
-    for (int k = 0; k < 3; k++) o->axis[k] = m[k][l], o->gx[0][k] = gx[0][k][l], o->gx[1][k] = gx[1][k][l], o->gx[2][k] = gx[2][k][l];
-    o->gt = gt[l];
+    for (int k = 0; k < 3; k++) o->axis[k] = m[k][l];
+    for (int i = 0; i < 3 && nv; i++)
+      for (int k = 0; k < 3; k++) o->gx[i][k] = gx[i][k][l];
+    o->gt = nv ? gt[l] : INFINITY;
     o->smin = smin[l], o->E = E[l], o->rho = rho[l];
     o->ok = ok[l] != 0, o->cap = ok[l] && cap[l];
   }

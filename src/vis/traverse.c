@@ -682,6 +682,31 @@ static bool outside_cone(int has_cone, vec3 axis, float angle, const bvh_node *b
   return phi > angle + beta + 1e-4f;
 }
 
+/* A shortcut of mark_seen's walk, where most boxes show a sample: a cap of
+ * radius rho_min or more (1.5 samples over the map's least stretch, in samples a
+ * radian) wholly inside the image (the parabolic's and fisheye's disk:
+ * cos α_m >= cos_min + rho·sin_min, above cos(α_rim − ρ)) is taken as showing
+ * one, without its rectangle (two atan2 for the lat-long and fisheye). Taking a
+ * box is always safe: this only gives up dropping the odd such box whose image
+ * falls between samples. */
+typedef struct cap_shortcut {
+  double rho_min, cos_min, sin_min; /* rho_min infinite: none */
+} cap_shortcut;
+
+static cap_shortcut cap_shortcut_of(const camera *c) {
+  cap_shortcut q = {INFINITY, 1, 0};
+  const double W = c->width, H = c->height;
+  if (c->type == RR_CAMERA_LATLONG) { /* every direction; stretch H / π along θ, >= W / 2π along φ */
+    q.rho_min = 1.5 / fmin(H / RR_PI, W / (2 * RR_PI)), q.cos_min = -2;
+  } else if (c->type == RR_CAMERA_PARABOLIC) { /* stretch 1 / (1 + cos α) >= 1/2 image half-widths */
+    q.rho_min = 1.5 / (fmin(W, H) / 4), q.cos_min = 0, q.sin_min = 1;
+  } else if (c->type == RR_CAMERA_FISHEYE) { /* radial stretch 1 / k, the least */
+    const double k = c->fov_deg * RR_PI / 360;
+    q.rho_min = 1.5 / (fmin(W, H) / (2 * k)), q.cos_min = cos(k), q.sin_min = sin(k);
+  }
+  return q;
+}
+
 /* May a sample of r (of the image when r is NULL) at one of the ns positions of
  * a curved view polar about an axis look into box n? A box lies in the ball about its centre b of its
  * half-diagonal r, which from the eye e (|b − e| > r) is the cap about b − e of
@@ -695,7 +720,8 @@ static bool outside_cone(int has_cone, vec3 axis, float angle, const bvh_node *b
  * box test of the BVH methods, the frustum cone here and rc-bvh's widened slabs,
  * drops such samples alike: they are not hits of the triangle in its box.)
  * A box that holds the eye, or a cap it cannot bound, may. */
-static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
+static bool box_cap_meets_or(const camera *cams, int ns, const bvh_node *n, const tile_rect *r,
+                             const cap_shortcut *sc) {
   double b[3], d2 = 0, r2 = 0;
   for (int a = 0; a < 3; a++) {
     const double e = a == 0 ? cams->eye.x : a == 1 ? cams->eye.y : cams->eye.z;
@@ -706,11 +732,20 @@ static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const t
   if (!(s2 < 0.98)) return true;
   const double dist = sqrt(d2), axis[3] = {b[0] / dist, b[1] / dist, b[2] / dist};
   const double rho = sqrt(s2 / (1 - s2)) + 1e-4;
+  if (sc && rho >= sc->rho_min) {
+    const double F[3] = {cams->fwd.x, cams->fwd.y, cams->fwd.z};
+    if (axis[0] * F[0] + axis[1] * F[1] + axis[2] * F[2] >= sc->cos_min + rho * sc->sin_min) return true;
+  }
   for (int p = 0; p < ns; p++) {
     int q[4], k = rr_cam_cap_rect(&cams[p], axis, rho, q);
     if (k < 0 || (k > 0 && (!r || meets(q, *r)))) return true;
   }
   return false;
+}
+
+/* box_cap_meets_or without the shortcut (a frustum's rectangle needs the cap's). */
+static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
+  return box_cap_meets_or(cams, ns, n, r, NULL);
 }
 
 /* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
@@ -905,11 +940,12 @@ static void root_band(int b, int thread, void *arg) {
 static void mark_seen(const trav *t, uint8_t *seen) {
   const rr_bvh *bvh = t->s->bvh;
   uint32_t stack[128], sp = 0;
+  const cap_shortcut sc = cap_shortcut_of(t->c);
   stack[sp++] = 0;
   while (sp) {
     bvh_node buf;
     const bvh_node *n = bvh_node_at(bvh, stack[--sp], &buf);
-    if (!box_cap_meets(t->cams, t->ns, n, NULL)) continue;
+    if (!box_cap_meets_or(t->cams, t->ns, n, NULL, &sc)) continue;
     if (n->count) {
       for (uint32_t k = 0; k < n->count; k++) seen[bvh_prim_at(bvh, n->first + k)] = 1;
     } else if (sp + 2 <= sizeof stack / sizeof *stack) {
