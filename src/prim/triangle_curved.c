@@ -48,12 +48,15 @@ static double mind(double a, double b) { return a < b ? a : b; }
  * octant's exact reflections. Five times cheaper than libm's, for the cap bounds,
  * which widen their ranges by ATAN_ERR. */
 #define ATAN_ERR 1e-7
+/* arctan a for a in [0, 1] (a and q = a², double or lanes of doubles) */
+#define ATAN01(a, q)                                                                                              \
+  ((a) * (1 + (q) * (-0.3333314528 + (q) * (0.1999355085 + (q) * (-0.1420889944 + (q) * (0.1065626393 +         \
+          (q) * (-0.0752896400 + (q) * (0.0429096138 + (q) * (-0.0161657367 + (q) * 0.0028662257)))))))))
 static double fast_atan2(double y, double x) {
   double ax = fabs(x), ay = fabs(y), hi = ax > ay ? ax : ay, lo = ax > ay ? ay : ax;
   if (!(hi > 0)) return 0;
   double a = lo / hi, q = a * a;
-  double r = a * (1 + q * (-0.3333314528 + q * (0.1999355085 + q * (-0.1420889944 + q * (0.1065626393 +
-                  q * (-0.0752896400 + q * (0.0429096138 + q * (-0.0161657367 + q * 0.0028662257))))))));
+  double r = ATAN01(a, q);
   if (ay > ax) r = RR_PI / 2 - r;
   if (x < 0) r = RR_PI - r;
   return y < 0 ? -r : r;
@@ -138,6 +141,7 @@ typedef int64_t vl4 __attribute__((vector_size(32)));
    (o)[2] = (a)[0] * (b)[1] - (a)[1] * (b)[0])
 
 #define SPH_NAME spheres_plain
+#define SPH_CAT(x) x##_plain
 #define SPH_TARGET
 #define SPH_SQRT(x)                                                                                               \
   ({                                                                                                              \
@@ -147,23 +151,25 @@ typedef int64_t vl4 __attribute__((vector_size(32)));
   })
 #include "prim/triangle_sphere_tmp.h"
 #undef SPH_NAME
+#undef SPH_CAT
 #undef SPH_TARGET
 #undef SPH_SQRT
 #ifdef RR_SIMD_X86
 #define SPH_NAME spheres_avx2
+#define SPH_CAT(x) x##_avx2
 #define SPH_TARGET RR_TARGET_AVX2
 #define SPH_SQRT(x) ((vd4)_mm256_sqrt_pd((__m256d)(x)))
 #include "prim/triangle_sphere_tmp.h"
 #undef SPH_NAME
+#undef SPH_CAT
 #undef SPH_TARGET
 #undef SPH_SQRT
 #endif
 
-/* c (may be NULL): the camera whose cap images to compute, the parabolic's in the
- * lanes; the lat-long's and fisheye's (atan2, not yet in lanes) are left unset:
- * rr_tri_sphere_cap_rect computes them at need, for the lanes that pass the setup. */
+/* c (may be NULL): the camera whose cap images to compute in the lanes. */
 static void spheres(const tri_setup *ts, int n, const camera *c, bool simd, tri_sphere *out, double (*nv)[2][3][3]) {
-  const camera *pc = c && c->type == RR_CAMERA_PARABOLIC ? c : NULL;
+  const camera *pc =
+      c && (c->type == RR_CAMERA_PARABOLIC || c->type == RR_CAMERA_LATLONG || c->type == RR_CAMERA_FISHEYE) ? c : NULL;
   for (int k = 0; k < n; k += 4) {
     int m = n - k < 4 ? n - k : 4;
 #ifdef RR_SIMD_X86
@@ -248,49 +254,34 @@ static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, i
   return rr_cam_cap_rect(c, md, rho, r);
 }
 
-/* rr_cam_cap_rect's sample-coordinate extents e = x0, x1, y0, y1 of the cap's
- * image, before sample_rect: what does not depend on the sample position (the
- * lanes of spheres compute the parabolic's alike). 1 with e, 0 or -1 as rr_cam_cap_rect. */
-static int cap_extent(const camera *c, const double axis[3], double rho, double e[4]) {
-  if (!(rho < 1.5)) return -1;
-  const dv3 m = dv(axis[0], axis[1], axis[2]);
-  dv3 R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
-  const double W = c->width, H = c->height;
-  double mr = ddot(m, R), mu = ddot(m, U), mf = ddot(m, F);
-  if (c->type == RR_CAMERA_LATLONG) {
-    double ct = mu, st = sqrt(maxd(0.0, 1 - ct * ct)), theta = fast_atan2(st, ct);
-    double y0 = (theta - rho - ATAN_ERR) * H / RR_PI, y1 = (theta + rho + ATAN_ERR) * H / RR_PI;
-    double slo = st * (1 - rho * rho / 2) - fabs(ct) * rho; /* least sin θ over the cap */
-    double x0 = 0, x1 = W;
-    if (slo > 1e-6 && rho / slo < RR_PI) {
-      double phi = fast_atan2(mr, mf), dphi = rho / slo + ATAN_ERR;
-      if (phi - dphi >= -RR_PI && phi + dphi <= RR_PI)
-        x0 = (phi - dphi + RR_PI) * W / (2 * RR_PI), x1 = (phi + dphi + RR_PI) * W / (2 * RR_PI);
+/* Four lanes a pass (triangle_sphere_tmp.h, cap_lanes: the argument of
+ * rr_tri_curved_cap's comment). */
+void rr_cam_cap_extents(const camera *c, const double (*axis)[3], const double *rho, int n, bool simd, double (*e)[4],
+                        int *k) {
+  for (int q = 0; q < n; q += 4) {
+    const int m = n - q < 4 ? n - q : 4;
+    vd4 a[3], r, ext[4];
+    for (int l = 0; l < 4; l++) { /* padding lanes repeat the last */
+      const int i = q + (l < m ? l : m - 1);
+      a[0][l] = axis[i][0], a[1][l] = axis[i][1], a[2][l] = axis[i][2], r[l] = rho[i];
     }
-    e[0] = x0, e[1] = x1, e[2] = y0, e[3] = y1;
-    return 1;
+    vl4 img;
+#ifdef RR_SIMD_X86
+    if (simd && __builtin_cpu_supports("avx2")) cap_lanes_avx2(c, a, &r, ext, &img);
+    else
+#endif
+      cap_lanes_plain(c, a, &r, ext, &img);
+    (void)simd;
+    for (int l = 0; l < m; l++) {
+      k[q + l] = (int)img[l];
+      for (int j = 0; j < 4; j++) e[q + l][j] = ext[j][l];
+    }
   }
-  double ca = mf, sa = sqrt(maxd(0.0, 1 - ca * ca));
-  /* beyond the disk's rim (α = π/2, or the fisheye's k) by 1e-3 rad: no rays */
-  double cmax = ca * (ca >= 0 ? 1 : 1 - rho * rho / 2) + sa * rho; /* >= cos α over the cap */
-  double u, vv, rad;
-  if (c->type == RR_CAMERA_PARABOLIC) {
-    if (cmax < -1e-3) return 0;
-    double cmin = ca * (ca >= 0 ? 1 - rho * rho / 2 : 1) - sa * rho; /* <= cos α over the cap */
-    if (!(1 + cmin > 1e-3)) return -1;
-    u = mr / (1 + ca), vv = mu / (1 + ca), rad = rho / (1 + cmin);
-  } else {
-    double k = c->fov_deg * RR_PI / 360, am = fast_atan2(sa, ca);
-    if (am - ATAN_ERR - rho > k + 1e-3) return 0;
-    double s = sa * (1 - rho * rho / 2) + mind(ca, 0.0) * rho; /* <= sin(α_m + ρ) */
-    if (!(s > 1e-3)) return -1;
-    double f = sa > 1e-12 ? am / sa : 1; /* → 1 on the axis, where (mr, mu) → 0 */
-    /* am within ATAN_ERR of α_m: the centre's image within ATAN_ERR / k of (u, v) */
-    u = f * mr / k, vv = f * mu / k, rad = (am + ATAN_ERR + rho) / (k * s) * rho + ATAN_ERR / k;
-  }
-  /* u = 2 sx / W − 1, v = 1 − 2 sy / H */
-  e[0] = (u - rad + 1) * W / 2, e[1] = (u + rad + 1) * W / 2, e[2] = (1 - vv - rad) * H / 2, e[3] = (1 - vv + rad) * H / 2;
-  return 1;
+}
+static int cap_extent(const camera *c, const double axis[3], double rho, double e[4]) {
+  int k;
+  rr_cam_cap_extents(c, (const double(*)[3])axis, &rho, 1, true, (double(*)[4])e, &k);
+  return k;
 }
 
 /* The chart bound of the lat-long and fisheye (tighter than the cap's but for
@@ -377,6 +368,10 @@ static int chart_extent(const camera *c, const tri_sphere *sp, double rem_scale,
   e[0] = (u + lo[0] - mg + 1) * W / 2, e[1] = (u + hi[0] + mg + 1) * W / 2;
   e[2] = (1 - vv - hi[1] - mg) * H / 2, e[3] = (1 - vv - lo[1] + mg) * H / 2;
   return 1;
+}
+
+int rr_cam_extent_rect(const camera *c, const double e[4], int k, int r[4]) {
+  return k > 0 ? sample_rect(c, e[0], e[1], e[2], e[3], r) : k;
 }
 
 int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int r[4]) {

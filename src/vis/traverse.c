@@ -719,9 +719,9 @@ static cap_shortcut cap_shortcut_of(const camera *c) {
  * samples farther out, as far as its setup's spherical triangle reaches; every
  * box test of the BVH methods, the frustum cone here and rc-bvh's widened slabs,
  * drops such samples alike: they are not hits of the triangle in its box.)
- * A box that holds the eye, or a cap it cannot bound, may. */
-static bool box_cap_meets_or(const camera *cams, int ns, const bvh_node *n, const tile_rect *r,
-                             const cap_shortcut *sc) {
+ * A box that holds the eye, or a cap it cannot bound, may. box_cap: false when the
+ * box may (or, with sc, is taken as showing one), else its cap's axis and rho. */
+static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *sc, double axis[3], double *rho) {
   double b[3], d2 = 0, r2 = 0;
   for (int a = 0; a < 3; a++) {
     const double e = a == 0 ? cams->eye.x : a == 1 ? cams->eye.y : cams->eye.z;
@@ -729,23 +729,32 @@ static bool box_cap_meets_or(const camera *cams, int ns, const bvh_node *n, cons
     r2 += 0.25 * ((double)n->hi[a] - n->lo[a]) * ((double)n->hi[a] - n->lo[a]);
   }
   double s2 = r2 * (1 + 1e-9) / d2;
-  if (!(s2 < 0.98)) return true;
-  const double dist = sqrt(d2), axis[3] = {b[0] / dist, b[1] / dist, b[2] / dist};
-  const double rho = sqrt(s2 / (1 - s2)) + 1e-4;
-  if (sc && rho >= sc->rho_min) {
+  if (!(s2 < 0.98)) return false;
+  const double dist = sqrt(d2);
+  axis[0] = b[0] / dist, axis[1] = b[1] / dist, axis[2] = b[2] / dist;
+  *rho = sqrt(s2 / (1 - s2)) + 1e-4;
+  if (sc && *rho >= sc->rho_min) {
     const double F[3] = {cams->fwd.x, cams->fwd.y, cams->fwd.z};
-    if (axis[0] * F[0] + axis[1] * F[1] + axis[2] * F[2] >= sc->cos_min + rho * sc->sin_min) return true;
+    if (axis[0] * F[0] + axis[1] * F[1] + axis[2] * F[2] >= sc->cos_min + *rho * sc->sin_min) return false;
   }
+  return true;
+}
+
+/* Does the cap's image (rr_cam_cap_extents' e, k) show a sample of r (of the image when NULL) at a position? */
+static bool extent_meets(const camera *cams, int ns, const double e[4], int k, const tile_rect *r) {
   for (int p = 0; p < ns; p++) {
-    int q[4], k = rr_cam_cap_rect(&cams[p], axis, rho, q);
-    if (k < 0 || (k > 0 && (!r || meets(q, *r)))) return true;
+    int q[4], kp = rr_cam_extent_rect(&cams[p], e, k, q);
+    if (kp < 0 || (kp > 0 && (!r || meets(q, *r)))) return true;
   }
   return false;
 }
 
-/* box_cap_meets_or without the shortcut (a frustum's rectangle needs the cap's). */
 static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
-  return box_cap_meets_or(cams, ns, n, r, NULL);
+  double axis[3], rho, e[4];
+  int k;
+  if (!box_cap(cams, n, NULL, axis, &rho)) return true;
+  rr_cam_cap_extents(cams, (const double(*)[3])axis, &rho, 1, true, (double(*)[4])e, &k);
+  return extent_meets(cams, ns, e, k, r);
 }
 
 /* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
@@ -939,20 +948,29 @@ static void root_band(int b, int thread, void *arg) {
  * hemisphere, or between the samples) cost no setup. */
 static void mark_seen(const trav *t, uint8_t *seen) {
   const rr_bvh *bvh = t->s->bvh;
-  uint32_t stack[128], sp = 0;
+  uint32_t stack[512], sp = 0;
   const cap_shortcut sc = cap_shortcut_of(t->c);
   stack[sp++] = 0;
-  while (sp) {
-    bvh_node buf;
-    const bvh_node *n = bvh_node_at(bvh, stack[--sp], &buf);
-    if (!box_cap_meets_or(t->cams, t->ns, n, NULL, &sc)) continue;
-    if (n->count) {
-      for (uint32_t k = 0; k < n->count; k++) seen[bvh_prim_at(bvh, n->first + k)] = 1;
-    } else if (sp + 2 <= sizeof stack / sizeof *stack) {
-      stack[sp++] = n->first + 1, stack[sp++] = n->first;
-    } else { /* (deeper than any tree built) everything */
-      memset(seen, 1, t->s->ntris);
-      return;
+  while (sp) { /* four nodes a step, their caps' images in lanes */
+    bvh_node buf[4];
+    const bvh_node *n[4];
+    double axis[4][3], rho[4], e[4][4];
+    int m = 0, test = 0, k[4], slot[4];
+    for (; sp && m < 4; m++) {
+      n[m] = bvh_node_at(bvh, stack[--sp], &buf[m]);
+      slot[m] = box_cap(t->cams, n[m], &sc, axis[test], &rho[test]) ? test++ : -1;
+    }
+    if (test) rr_cam_cap_extents(t->c, (const double(*)[3])axis, rho, test, t->simd, e, k);
+    for (int i = 0; i < m; i++) {
+      if (slot[i] >= 0 && !extent_meets(t->cams, t->ns, e[slot[i]], k[slot[i]], NULL)) continue;
+      if (n[i]->count) {
+        for (uint32_t q = 0; q < n[i]->count; q++) seen[bvh_prim_at(bvh, n[i]->first + q)] = 1;
+      } else if (sp + 2 <= sizeof stack / sizeof *stack) {
+        stack[sp++] = n[i]->first + 1, stack[sp++] = n[i]->first;
+      } else { /* (deeper than any tree built) everything */
+        memset(seen, 1, t->s->ntris);
+        return;
+      }
     }
   }
 }
