@@ -722,16 +722,17 @@ static cap_shortcut cap_shortcut_of(const camera *c) {
  * A box that holds the eye, or a cap it cannot bound, may. box_cap: false when the
  * box may (or, with sc, is taken as showing one), else its cap's axis and rho. */
 static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *sc, double axis[3], double *rho) {
+  const double eye[3] = {cams->eye.x, cams->eye.y, cams->eye.z};
   double b[3], d2 = 0, r2 = 0;
   for (int a = 0; a < 3; a++) {
-    const double e = a == 0 ? cams->eye.x : a == 1 ? cams->eye.y : cams->eye.z;
-    b[a] = 0.5 * ((double)n->lo[a] + n->hi[a]) - e, d2 += b[a] * b[a];
-    r2 += 0.25 * ((double)n->hi[a] - n->lo[a]) * ((double)n->hi[a] - n->lo[a]);
+    const double lo = n->lo[a], hi = n->hi[a];
+    b[a] = 0.5 * (lo + hi) - eye[a], d2 += b[a] * b[a];
+    r2 += 0.25 * (hi - lo) * (hi - lo);
   }
   double s2 = r2 * (1 + 1e-9) / d2;
   if (!(s2 < 0.98)) return false;
-  const double dist = sqrt(d2);
-  axis[0] = b[0] / dist, axis[1] = b[1] / dist, axis[2] = b[2] / dist;
+  const double inv = 1 / sqrt(d2);
+  axis[0] = b[0] * inv, axis[1] = b[1] * inv, axis[2] = b[2] * inv;
   *rho = sqrt(s2 / (1 - s2)) + 1e-4;
   if (sc && *rho >= sc->rho_min) {
     const double F[3] = {cams->fwd.x, cams->fwd.y, cams->fwd.z};
