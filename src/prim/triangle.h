@@ -312,12 +312,13 @@ int rr_tri_curved_chart(const camera *c, const tri_setup *ts, double rem_scale, 
  * 0 when no sample looks there, -1 when it knows no bound (another camera, rho of
  * 1.5 rad or more, a cap over a pole of the map). */
 int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int rect[4]);
-/* rr_cam_cap_rect in two steps: the sample-coordinate extents e[i] = x0, x1, y0, y1
- * of n caps' images, k[i] 1 with them or rr_cam_cap_rect's 0, -1 (AVX2 when simd;
- * the same for every camera that differs from c only in sx0, sy0), then their
- * rectangle for such a camera. */
-void rr_cam_cap_extents(const camera *c, const double (*axis)[3], const double *rho, int n, bool simd, double (*e)[4],
-                        int *k);
+/* rr_cam_cap_rect in two steps: for four caps in lanes (axis[i][l]: coordinate i
+ * of lane l's), the sample-coordinate extents of their images, e[0..3][l] = x0,
+ * x1, y0, y1, and k[l] 1 with them or rr_cam_cap_rect's 0, -1 (AVX2 when simd; the
+ * same for every camera that differs from c only in sx0, sy0); then a cap's
+ * rectangle for such a camera from its e = x0, x1, y0, y1 and k. */
+void rr_cam_cap_extents4(const camera *c, const double axis[3][4], const double rho[4], bool simd, double e[4][4],
+                         int64_t k[4]);
 int rr_cam_extent_rect(const camera *c, const double e[4], int k, int rect[4]);
 /* Before any setup: the image rectangle of the cap about triangle i's corner
  * directions from c's eye, widened by slack radians (what the caller allows for

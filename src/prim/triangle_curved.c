@@ -256,32 +256,26 @@ static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, i
 
 /* Four lanes a pass (triangle_sphere_tmp.h, cap_lanes: the argument of
  * rr_tri_curved_cap's comment). */
-void rr_cam_cap_extents(const camera *c, const double (*axis)[3], const double *rho, int n, bool simd, double (*e)[4],
-                        int *k) {
-  for (int q = 0; q < n; q += 4) {
-    const int m = n - q < 4 ? n - q : 4;
-    vd4 a[3], r, ext[4];
-    for (int l = 0; l < 4; l++) { /* padding lanes repeat the last */
-      const int i = q + (l < m ? l : m - 1);
-      a[0][l] = axis[i][0], a[1][l] = axis[i][1], a[2][l] = axis[i][2], r[l] = rho[i];
-    }
-    vl4 img;
+void rr_cam_cap_extents4(const camera *c, const double axis[3][4], const double rho[4], bool simd, double e[4][4],
+                         int64_t k[4]) {
+  vd4 a[3], r, ext[4];
+  vl4 img;
+  memcpy(a, axis, sizeof a), memcpy(&r, rho, sizeof r);
 #ifdef RR_SIMD_X86
-    if (simd && __builtin_cpu_supports("avx2")) cap_lanes_avx2(c, a, &r, ext, &img);
-    else
+  if (simd && __builtin_cpu_supports("avx2")) cap_lanes_avx2(c, a, &r, ext, &img);
+  else
 #endif
-      cap_lanes_plain(c, a, &r, ext, &img);
-    (void)simd;
-    for (int l = 0; l < m; l++) {
-      k[q + l] = (int)img[l];
-      for (int j = 0; j < 4; j++) e[q + l][j] = ext[j][l];
-    }
-  }
+    cap_lanes_plain(c, a, &r, ext, &img);
+  (void)simd;
+  memcpy(e, ext, sizeof ext), memcpy(k, &img, sizeof img);
 }
 static int cap_extent(const camera *c, const double axis[3], double rho, double e[4]) {
-  int k;
-  rr_cam_cap_extents(c, (const double(*)[3])axis, &rho, 1, true, (double(*)[4])e, &k);
-  return k;
+  double a[3][4], r[4], ext[4][4];
+  int64_t k[4];
+  for (int l = 0; l < 4; l++) a[0][l] = axis[0], a[1][l] = axis[1], a[2][l] = axis[2], r[l] = rho;
+  rr_cam_cap_extents4(c, a, r, true, ext, k);
+  for (int j = 0; j < 4; j++) e[j] = ext[j][0];
+  return (int)k[0];
 }
 
 /* The chart bound of the lat-long and fisheye (tighter than the cap's but for

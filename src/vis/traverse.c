@@ -720,8 +720,9 @@ static cap_shortcut cap_shortcut_of(const camera *c) {
  * box test of the BVH methods, the frustum cone here and rc-bvh's widened slabs,
  * drops such samples alike: they are not hits of the triangle in its box.)
  * A box that holds the eye, or a cap it cannot bound, may. box_cap: false when the
- * box may (or, with sc, is taken as showing one), else its cap's axis and rho. */
-static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *sc, double axis[3], double *rho) {
+ * box may (or, with sc, is taken as showing one), else true with its cap's axis
+ * and rho in lane l of rr_cam_cap_extents4's. */
+static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *sc, double axis[3][4], double *rho, int l) {
   const double eye[3] = {cams->eye.x, cams->eye.y, cams->eye.z};
   double b[3], d2 = 0, r2 = 0;
   for (int a = 0; a < 3; a++) {
@@ -731,31 +732,35 @@ static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *s
   }
   double s2 = r2 * (1 + 1e-9) / d2;
   if (!(s2 < 0.98)) return false;
-  const double inv = 1 / sqrt(d2);
-  axis[0] = b[0] * inv, axis[1] = b[1] * inv, axis[2] = b[2] * inv;
-  *rho = sqrt(s2 / (1 - s2)) + 1e-4;
-  if (sc && *rho >= sc->rho_min) {
+  const double inv = 1 / sqrt(d2), r = sqrt(s2 / (1 - s2)) + 1e-4;
+  for (int a = 0; a < 3; a++) axis[a][l] = b[a] * inv;
+  rho[l] = r;
+  if (sc && r >= sc->rho_min) {
     const double F[3] = {cams->fwd.x, cams->fwd.y, cams->fwd.z};
-    if (axis[0] * F[0] + axis[1] * F[1] + axis[2] * F[2] >= sc->cos_min + *rho * sc->sin_min) return false;
+    if (axis[0][l] * F[0] + axis[1][l] * F[1] + axis[2][l] * F[2] >= sc->cos_min + r * sc->sin_min) return false;
   }
   return true;
 }
 
-/* Does the cap's image (rr_cam_cap_extents' e, k) show a sample of r (of the image when NULL) at a position? */
-static bool extent_meets(const camera *cams, int ns, const double e[4], int k, const tile_rect *r) {
+/* Does the cap's image in lane l of rr_cam_cap_extents4's e, k show a sample of r
+ * (of the image when NULL) at one of the ns positions? */
+static bool extent_meets(const camera *cams, int ns, const double e[4][4], const int64_t k[4], int l,
+                         const tile_rect *r) {
+  const double el[4] = {e[0][l], e[1][l], e[2][l], e[3][l]};
   for (int p = 0; p < ns; p++) {
-    int q[4], kp = rr_cam_extent_rect(&cams[p], e, k, q);
+    int q[4], kp = rr_cam_extent_rect(&cams[p], el, (int)k[l], q);
     if (kp < 0 || (kp > 0 && (!r || meets(q, *r)))) return true;
   }
   return false;
 }
 
 static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
-  double axis[3], rho, e[4];
-  int k;
-  if (!box_cap(cams, n, NULL, axis, &rho)) return true;
-  rr_cam_cap_extents(cams, (const double(*)[3])axis, &rho, 1, true, (double(*)[4])e, &k);
-  return extent_meets(cams, ns, e, k, r);
+  double axis[3][4], rho[4], e[4][4];
+  int64_t k[4];
+  if (!box_cap(cams, n, NULL, axis, rho, 0)) return true;
+  for (int l = 1; l < 4; l++) axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
+  rr_cam_cap_extents4(cams, (const double(*)[4])axis, rho, true, e, k);
+  return extent_meets(cams, ns, (const double(*)[4])e, k, 0, r);
 }
 
 /* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
@@ -955,15 +960,20 @@ static void mark_seen(const trav *t, uint8_t *seen) {
   while (sp) { /* four nodes a step, their caps' images in lanes */
     bvh_node buf[4];
     const bvh_node *n[4];
-    double axis[4][3], rho[4], e[4][4];
-    int m = 0, test = 0, k[4], slot[4];
+    double axis[3][4], rho[4], e[4][4];
+    int64_t k[4];
+    int m = 0, test = 0, slot[4];
     for (; sp && m < 4; m++) {
       n[m] = bvh_node_at(bvh, stack[--sp], &buf[m]);
-      slot[m] = box_cap(t->cams, n[m], &sc, axis[test], &rho[test]) ? test++ : -1;
+      slot[m] = box_cap(t->cams, n[m], &sc, axis, rho, test) ? test++ : -1;
     }
-    if (test) rr_cam_cap_extents(t->c, (const double(*)[3])axis, rho, test, t->simd, e, k);
+    if (test) {
+      for (int l = test; l < 4; l++) /* padding lanes repeat the first */
+        axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
+      rr_cam_cap_extents4(t->c, (const double(*)[4])axis, rho, t->simd, e, k);
+    }
     for (int i = 0; i < m; i++) {
-      if (slot[i] >= 0 && !extent_meets(t->cams, t->ns, e[slot[i]], k[slot[i]], NULL)) continue;
+      if (slot[i] >= 0 && !extent_meets(t->cams, t->ns, (const double(*)[4])e, k, slot[i], NULL)) continue;
       if (n[i]->count) {
         for (uint32_t q = 0; q < n[i]->count; q++) seen[bvh_prim_at(bvh, n[i]->first + q)] = 1;
       } else if (sp + 2 <= sizeof stack / sizeof *stack) {
