@@ -324,6 +324,10 @@ int rr_cam_extent_rect(const camera *c, const double e[4], int k, int rect[4]);
  * directions from c's eye, widened by slack radians (what the caller allows for
  * the rounding of the setup); as rr_cam_cap_rect, -1 also for corners at infinity. */
 int rr_tri_corner_cap(const rr_scene *s, uint32_t i, const camera *c, double slack, int rect[4]);
+/* That cap's axis and radius, in lane l of rr_cam_cap_extents4's axis and rho:
+ * 1, or -1 when it bounds nothing. */
+int rr_tri_corner_cap_lane(const rr_scene *s, uint32_t i, const camera *c, double slack, double axis[3][4],
+                           double rho[4], int l);
 /* Planar cameras bound a triangle from its corners alone, before its setup: most
  * triangles of a detailed mesh fall between samples. rr_tri_corner_bounds bounds triangles
  * ids[0..n-1] (first..first+n-1 when ids is NULL), 8 at a time with AVX2 when

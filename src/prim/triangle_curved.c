@@ -112,7 +112,6 @@ static void polar_range(const dv3 nu[3], const dv3 v[3], double E, dv3 P, dv3 e1
   *plo = mn - m, *phi = mx + m;
 }
 
-static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, int r[4]);
 
 /* The spherical triangle T of a setup's edge planes (rr_tri_spheres): unit
  * normals n, vertices v (vertex i lies on edges i+1 and i+2, inside edge i; its
@@ -240,18 +239,20 @@ int rr_tri_curved_cap(const camera *c, const tri_setup *ts, double scale, int r[
   return sp.cap ? rr_cam_cap_rect(c, sp.axis, sp.rho * scale, r) : -1;
 }
 
-/* curved_cap's cap for the corners of rr_tri_corner_cap (the lanes of
- * rr_tri_spheres compute the same for set-up triangles). */
-static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, int r[4]) {
+/* The cap about unit vertices v for rr_tri_corner_cap, with widening E (the lanes
+ * of rr_tri_spheres compute the same for set-up triangles): 1 with its axis and
+ * radius in lane l, -1 when it bounds nothing. */
+static int curved_cap(const dv3 v[3], double E, double axis[3][4], double rho[4], int l) {
   dv3 m = dv(v[0].x + v[1].x + v[2].x, v[0].y + v[1].y + v[2].y, v[0].z + v[1].z + v[2].z);
   double lm = dlen(m);
   if (!(lm > 1e-3)) return -1;
   m = dscale(m, 1 / lm);
   double cr = mind(ddot(m, v[0]), mind(ddot(m, v[1]), ddot(m, v[2])));
   if (!(cr > 0.1)) return -1; /* a cap beyond 84°: the arcs bound it better */
-  double h2 = maxd(0.0, 2 - 2 * cr), rho = (sqrt(h2 / (1 - h2 / 4)) + E + 1e-9) * scale;
-  const double md[3] = {m.x, m.y, m.z};
-  return rr_cam_cap_rect(c, md, rho, r);
+  double h2 = maxd(0.0, 2 - 2 * cr);
+  rho[l] = sqrt(h2 / (1 - h2 / 4)) + E + 1e-9;
+  axis[0][l] = m.x, axis[1][l] = m.y, axis[2][l] = m.z;
+  return 1;
 }
 
 /* Four lanes a pass (triangle_sphere_tmp.h, cap_lanes: the argument of
@@ -480,17 +481,24 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_spher
   return kind;
 }
 
-int rr_tri_corner_cap(const rr_scene *s, uint32_t i, const camera *c, double slack, int r[4]) {
+int rr_tri_corner_cap_lane(const rr_scene *s, uint32_t i, const camera *c, double slack, double axis[3][4],
+                           double rho[4], int l) {
   if (scene_inf(s, i)) return -1;
   vec3 p[3];
   scene_corners(s, i, p);
   dv3 v[3], e = dvf(c->eye);
   for (int k = 0; k < 3; k++) {
     v[k] = dsub(dvf(p[k]), e);
-    double l = dlen(v[k]);
-    if (!(l > 0) || !(l < INFINITY)) return -1;
-    v[k] = dscale(v[k], 1 / l);
+    double len = dlen(v[k]);
+    if (!(len > 0) || !(len < INFINITY)) return -1;
+    v[k] = dscale(v[k], 1 / len);
   }
-  return curved_cap(c, v, slack, 1, r);
+  return curved_cap(v, slack, axis, rho, l);
 }
 
+int rr_tri_corner_cap(const rr_scene *s, uint32_t i, const camera *c, double slack, int r[4]) {
+  double axis[3][4], rho[4];
+  if (rr_tri_corner_cap_lane(s, i, c, slack, axis, rho, 0) < 0) return -1;
+  const double a[3] = {axis[0][0], axis[1][0], axis[2][0]};
+  return rr_cam_cap_rect(c, a, rho[0], r);
+}

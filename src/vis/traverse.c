@@ -379,14 +379,35 @@ static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, const
   return any;
 }
 
-/* Before its setup: may the triangle's corner cap (rr_tri_corner_cap, with the
- * slack of mark_seen) show a sample of r at some position? */
-static bool corner_cap_meets(const trav *t, uint32_t id, tile_rect r) {
-  for (int p = 0; p < t->ns; p++) {
-    int b[4], k = rr_tri_corner_cap(t->s, id, &t->cams[p], 1e-4, b);
-    if (k < 0 || (k > 0 && meets(b, r))) return true;
+static bool extent_meets(const camera *cams, int ns, const double e[4][4], const int64_t k[4], int l,
+                         const tile_rect *r);
+
+/* Before their setup: the triangles ids[0..n-1] (first..first+n-1 when ids is
+ * NULL) whose corner cap (rr_tri_corner_cap, with the slack of mark_seen) may show
+ * a sample of r at some position, into out; four caps' images a step in lanes.
+ * Returns how many. */
+static uint32_t corner_caps_meet(const trav *t, uint32_t first, const uint32_t *ids, uint32_t n, tile_rect r,
+                                 uint32_t *out) {
+  uint32_t kept = 0;
+  for (uint32_t q = 0; q < n; q += 4) {
+    const int m = n - q < 4 ? (int)(n - q) : 4;
+    double axis[3][4], rho[4], e[4][4];
+    int64_t k[4];
+    int slot[4], test = 0;
+    for (int l = 0; l < m; l++) {
+      const uint32_t id = ids ? ids[q + l] : first + q + l;
+      slot[l] = rr_tri_corner_cap_lane(t->s, id, t->c, 1e-4, axis, rho, test) > 0 ? test++ : -1;
+    }
+    if (test) {
+      for (int l = test; l < 4; l++) /* padding lanes repeat the first */
+        axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
+      rr_cam_cap_extents4(t->c, (const double(*)[4])axis, rho, t->simd, e, k);
+    }
+    for (int l = 0; l < m; l++)
+      if (slot[l] < 0 || extent_meets(t->cams, t->ns, (const double(*)[4])e, k, slot[l], &r))
+        out[kept++] = ids ? ids[q + l] : first + q + l;
   }
-  return false;
+  return kept;
 }
 
 /* Triangle setup: triangles ids[0..n-1] (first..first+n-1 when ids is NULL) into
@@ -491,7 +512,9 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
     }
     return setup_bounded(t, scratch, nb, out);
   }
-  uint32_t kept = 0;
+  uint32_t kept = 0, near[PEND_DRAW + BVH_MAX_LEAF];
+  if (r && !t->seen && n <= PEND_DRAW + BVH_MAX_LEAF) /* (a frustum's leaves: no more) */
+    n = corner_caps_meet(t, first, ids, n, *r, near), ids = near;
   for (uint32_t q = 0; q < n;) { /* eight lanes at a time, the bits of one */
     int m = 0, face[8];
     uint32_t lid[8];
@@ -499,7 +522,6 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
     for (; q < n && m < 8; q++) {
       uint32_t id = ids ? ids[q] : first + q;
       if (t->seen && !t->seen[id]) continue;
-      if (r && !t->seen && !corner_cap_meets(t, id, *r)) continue;
       lid[m++] = id;
     }
     t->st.setups += (uint64_t)m;
