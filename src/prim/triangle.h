@@ -314,7 +314,7 @@ int rr_tri_curved_chart(const camera *c, const tri_setup *ts, double rem_scale, 
 int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int rect[4]);
 /* rr_cam_cap_rect in two steps: for four caps in lanes (axis[i][l]: coordinate i
  * of lane l's), the sample-coordinate extents of their images, e[0..3][l] = x0,
- * x1, y0, y1, and k[l] 1 with them or rr_cam_cap_rect's 0, -1 (AVX2 when simd; the
+ * x1, y0, y1, and k[l] 1 with them or rr_cam_cap_rect's 0, -1 (-1 for cameras not polar; AVX2 when simd; the
  * same for every camera that differs from c only in sx0, sy0); then a cap's
  * rectangle for such a camera from its e = x0, x1, y0, y1 and k. */
 void rr_cam_cap_extents4(const camera *c, const double axis[3][4], const double rho[4], bool simd, double e[4][4],

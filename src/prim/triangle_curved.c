@@ -259,6 +259,10 @@ static int curved_cap(const dv3 v[3], double E, double axis[3][4], double rho[4]
  * rr_tri_curved_cap's comment). */
 void rr_cam_cap_extents4(const camera *c, const double axis[3][4], const double rho[4], bool simd, double e[4][4],
                          int64_t k[4]) {
+  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) {
+    for (int l = 0; l < 4; l++) k[l] = -1; /* no bound known */
+    return;
+  }
   vd4 a[3], r, ext[4];
   vl4 img;
   memcpy(a, axis, sizeof a), memcpy(&r, rho, sizeof r);
