@@ -379,14 +379,14 @@ static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, const
   return any;
 }
 
-static bool extent_meets(const camera *cams, int ns, const double e[4][4], const int64_t k[4], int l,
-                         const tile_rect *r);
+static inline __attribute__((always_inline)) bool extent_meets(const camera *cams, int ns, const double e[4][4],
+                                                               const int64_t k[4], int l, const tile_rect *r);
 
 /* Before their setup: the triangles ids[0..n-1] (first..first+n-1 when ids is
  * NULL) whose corner cap (rr_tri_corner_cap, with the slack of mark_seen) may show
  * a sample of r at some position, into out; four caps' images a step in lanes.
  * Returns how many. */
-static uint32_t corner_caps_meet(const trav *t, uint32_t first, const uint32_t *ids, uint32_t n, tile_rect r,
+static __attribute__((noinline)) uint32_t corner_caps_meet(const trav *t, uint32_t first, const uint32_t *ids, uint32_t n, tile_rect r,
                                  uint32_t *out) {
   uint32_t kept = 0;
   for (uint32_t q = 0; q < n; q += 4) {
@@ -766,8 +766,8 @@ static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *s
 
 /* Does the cap's image in lane l of rr_cam_cap_extents4's e, k show a sample of r
  * (of the image when NULL) at one of the ns positions? */
-static bool extent_meets(const camera *cams, int ns, const double e[4][4], const int64_t k[4], int l,
-                         const tile_rect *r) {
+static inline __attribute__((always_inline)) bool extent_meets(const camera *cams, int ns, const double e[4][4],
+                                                               const int64_t k[4], int l, const tile_rect *r) {
   const double el[4] = {e[0][l], e[1][l], e[2][l], e[3][l]};
   for (int p = 0; p < ns; p++) {
     int q[4], kp = rr_cam_extent_rect(&cams[p], el, (int)k[l], q);
