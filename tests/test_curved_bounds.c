@@ -52,6 +52,8 @@ static vec3 hard_dir(const rr_camera *rc, vec3 f, vec3 r, vec3 u) {
   }
 }
 
+static long flat_missed_all; /* passing samples outside chart bounds without their remainder */
+
 static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int ntri, const char *what) {
   float pos[2] = {(float)rnd(), (float)rnd()};
   camera c;
@@ -63,10 +65,19 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   for (int t = 0; t < ntri; t++) {
     vec3 centre = hard_dir(rc, c.fwd, c.right, c.up);
     double size = exp(log(1e-3) + rnd() * (log(1.5) - log(1e-3)));
+    /* a quarter are slivers: the third corner near the line through the first two
+     * (chart_extent moves a sharp corner along the sliver only) */
+    const bool sliver = rnd() < 0.25;
     for (int k = 0; k < 3; k++) {
       vec3 d = v3_norm(v3_add(centre, v3_scale(rnd_unit(), (float)size)));
       float dist = (float)(0.5 + 10 * rnd());
       vec3 q = v3_add(c.eye, v3_scale(d, dist));
+      if (sliver && k == 2) {
+        vec3 a, b;
+        memcpy(&a, p + 9 * t, 12), memcpy(&b, p + 9 * t + 3, 12);
+        float u = (float)(1.5 * rnd() - 0.25), off = (float)exp(log(1e-5) + rnd() * (log(1e-2) - log(1e-5)));
+        q = v3_add(v3_add(a, v3_scale(v3_sub(b, a), u)), v3_scale(rnd_unit(), off * v3_len(v3_sub(b, a))));
+      }
       memcpy(p + 9 * t + 3 * k, &q, 12);
     }
   }
@@ -76,6 +87,7 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
         rr_device_message(dev));
   CHECK(rr_scene_commit(s) == RR_OK, "commit");
   long missed = 0, passing = 0, area = 0, tight = 0, seen = 0, caps = 0, cap_missed = 0, half_missed = 0, corner_missed = 0;
+  long charts = 0, chart_missed = 0, flat_missed = 0;
   /* a cube's samples are those of its six perspective faces (camera/camera.h) */
   const bool cube = rc->type == RR_CAMERA_CUBE;
   for (int f = 0; f < (cube ? 6 : 1); f++) {
@@ -85,11 +97,14 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
     for (uint32_t i = 0; i < s->ntris; i++) {
       tri_setup ts;
       if (rr_tri_setup(s, i, cc, false, &ts) == SETUP_CULLED) continue;
-      int r[4], rt[4], rc[4], rh[4];
+      int r[4], rt[4], rc[4], rh[4], rg[4], rf[4];
       bool has = rr_tri_screen_bounds(s, i, cc, &ts, r);
       /* the cap bound alone, at its radius and at half of it */
       int cap = cube ? -1 : rr_tri_curved_cap(cc, &ts, 1, rc), half = cube ? -1 : rr_tri_curved_cap(cc, &ts, 0.5, rh);
       caps += cap > 0;
+      /* the chart bound alone, with its remainder and without (the linearisation alone) */
+      int chart = cube ? -1 : rr_tri_curved_chart(cc, &ts, 1, rg), flat = cube ? -1 : rr_tri_curved_chart(cc, &ts, 0, rf);
+      charts += chart >= 0;
       /* before the setup: the corner cap with the root pass's slack (vis/traverse.c, mark_seen) */
       int rk[4], corner = cube ? -1 : rr_tri_corner_cap(s, i, cc, 1e-4, rk);
       tight += cube || rr_tri_curved_rect(cc, &ts, rt) >= 0;
@@ -111,6 +126,11 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
             if (corner_missed++ < 5)
               fprintf(stderr, "%s: triangle %u passes at (%d, %d) outside its corner cap\n", what, i, x, y);
           }
+          if (chart == 0 || (chart > 0 && (x < rg[0] || x > rg[2] || y < rg[1] || y > rg[3]))) {
+            if (chart_missed++ < 5)
+              fprintf(stderr, "%s: triangle %u passes at (%d, %d) outside its chart rectangle\n", what, i, x, y);
+          }
+          flat_missed += flat == 0 || (flat > 0 && (x < rf[0] || x > rf[2] || y < rf[1] || y > rf[3]));
           half_missed += half == 0 || (half > 0 && (x < rh[0] || x > rh[2] || y < rh[1] || y > rh[3]));
           if (!has || x < r[0] || x > r[2] || y < r[1] || y > r[3]) {
             if (missed++ < 5)
@@ -164,13 +184,17 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   CHECK(missed == 0, "%s: %ld passing samples outside their triangle's rectangle", what, missed);
   CHECK(passing > 0, "%s: no triangle passes anywhere (the test would prove nothing)", what);
   CHECK(cap_missed == 0, "%s: %ld passing samples outside their triangle's cap rectangle", what, cap_missed);
+  CHECK(chart_missed == 0, "%s: %ld passing samples outside their triangle's chart rectangle", what, chart_missed);
+  const bool chart_map = rc->type == RR_CAMERA_LATLONG || rc->type == RR_CAMERA_FISHEYE;
+  CHECK(!chart_map || charts * 4 >= seen, "%s: chart bounds for only %ld of %ld triangles", what, charts, seen);
+  flat_missed_all += flat_missed; /* checked over every view (main) */
   CHECK(corner_missed == 0, "%s: %ld passing samples outside their triangle's corner cap", what, corner_missed);
   CHECK(!polar_map || tight * 10 >= seen * 9, "%s: tight bounds for only %ld of %ld triangles", what, tight, seen);
   /* the cap's radius is not loose by half: halved, it misses samples */
   CHECK(!polar_map || half_missed > 0, "%s: a cap of half the radius misses no sample", what);
   printf("%s: %ld triangles (%ld tight, %ld capped), %ld passing samples in rectangles of %ld samples (%.1f%%); "
-         "half caps miss %ld\n",
-         what, seen, tight, caps, passing, area, area ? 100.0 * passing / area : 0.0, half_missed);
+         "half caps miss %ld; %ld charts, without the remainder missing %ld\n",
+         what, seen, tight, caps, passing, area, area ? 100.0 * passing / area : 0.0, half_missed, charts, flat_missed);
   rr_scene_release(s);
   free(p), free(idx);
   rr_cam_release(&c);
@@ -297,6 +321,8 @@ int main(void) {
       snprintf(what, sizeof what, "%s, view %d", cams[k].what, view);
       check_camera(dev, &rc, cams[k].w, cams[k].h, ntri, what);
     }
+  /* the chart's remainder is needed: without it, the linearisation misses samples */
+  CHECK(flat_missed_all > 0, "the chart bounds without their remainder miss no sample");
   rr_device_release(dev);
   return test_done();
 }

@@ -279,6 +279,11 @@ struct tri_sphere {
   bool ok, cap;
   int8_t img_k;  /* the cap's image for rr_tri_spheres_cam's camera (parabolic): TRI_CAP_UNSET, */
   double img[4]; /* or rr_cam_cap_rect's 1 with its extents x0, x1, y0, y1 (sample coordinates), 0, -1 */
+  /* with the cap, computed only where prim/triangle_curved.c needs them: the
+   * triangle in the gnomonic chart about the axis m that holds every passing
+   * sample (chart_extent) and the largest length of its vertices (infinite when
+   * not computed) */
+  double gx[3][3], gt;
 };
 #define TRI_CAP_UNSET 2
 void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out);
@@ -296,15 +301,33 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_spher
  * stretch over it; scale multiplies the cap's radius (1; the tests halve it to see
  * samples missed). 1 with rect, 0 when no sample can pass, -1 when it knows no bound. */
 int rr_tri_curved_cap(const camera *c, const tri_setup *ts, double scale, int rect[4]);
+/* The chart bound rr_tri_curved_rect cuts the cap's with (lat-long and fisheye,
+ * prim/triangle_curved.c): the image of the spherical triangle's linearisation in
+ * the gnomonic chart about the cap's axis, widened by the map's second-order
+ * remainder times rem_scale (1; the tests see that 0 misses samples) and the
+ * setup's widening. 1 with rect, 0 when no sample can pass, -1 when it knows no bound. */
+int rr_tri_curved_chart(const camera *c, const tri_setup *ts, double rem_scale, int rect[4]);
 /* The image rectangle of the directions within angle rho of the unit axis for the
  * curved cameras polar about an axis (lat-long, parabolic, fisheye): 1 with rect,
  * 0 when no sample looks there, -1 when it knows no bound (another camera, rho of
  * 1.5 rad or more, a cap over a pole of the map). */
 int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int rect[4]);
+/* rr_cam_cap_rect in two steps: for four caps in lanes (axis[i][l]: coordinate i
+ * of lane l's), the sample-coordinate extents of their images, e[0..3][l] = x0,
+ * x1, y0, y1, and k[l] 1 with them or rr_cam_cap_rect's 0, -1 (-1 for cameras not polar; AVX2 when simd; the
+ * same for every camera that differs from c only in sx0, sy0); then a cap's
+ * rectangle for such a camera from its e = x0, x1, y0, y1 and k. */
+void rr_cam_cap_extents4(const camera *c, const double axis[3][4], const double rho[4], bool simd, double e[4][4],
+                         int64_t k[4]);
+int rr_cam_extent_rect(const camera *c, const double e[4], int k, int rect[4]);
 /* Before any setup: the image rectangle of the cap about triangle i's corner
  * directions from c's eye, widened by slack radians (what the caller allows for
  * the rounding of the setup); as rr_cam_cap_rect, -1 also for corners at infinity. */
 int rr_tri_corner_cap(const rr_scene *s, uint32_t i, const camera *c, double slack, int rect[4]);
+/* That cap's axis and radius, in lane l of rr_cam_cap_extents4's axis and rho:
+ * 1, or -1 when it bounds nothing. */
+int rr_tri_corner_cap_lane(const rr_scene *s, uint32_t i, const camera *c, double slack, double axis[3][4],
+                           double rho[4], int l);
 /* Planar cameras bound a triangle from its corners alone, before its setup: most
  * triangles of a detailed mesh fall between samples. rr_tri_corner_bounds bounds triangles
  * ids[0..n-1] (first..first+n-1 when ids is NULL), 8 at a time with AVX2 when

@@ -29,6 +29,8 @@
 /* A cap rectangle of at most this many samples is kept without the arcs'
  * (they cost about ten times as much, and the few samples more cost less). */
 #define CAP_ENOUGH 64
+/* A cap rectangle of more samples than this is cut by the chart's too. */
+#define CHART_FROM 16
 
 typedef struct dv3 { double x, y, z; } dv3;
 static dv3 dv(double x, double y, double z) { return (dv3){x, y, z}; }
@@ -46,12 +48,15 @@ static double mind(double a, double b) { return a < b ? a : b; }
  * octant's exact reflections. Five times cheaper than libm's, for the cap bounds,
  * which widen their ranges by ATAN_ERR. */
 #define ATAN_ERR 1e-7
+/* arctan a for a in [0, 1] (a and q = a², double or lanes of doubles) */
+#define ATAN01(a, q)                                                                                              \
+  ((a) * (1 + (q) * (-0.3333314528 + (q) * (0.1999355085 + (q) * (-0.1420889944 + (q) * (0.1065626393 +         \
+          (q) * (-0.0752896400 + (q) * (0.0429096138 + (q) * (-0.0161657367 + (q) * 0.0028662257)))))))))
 static double fast_atan2(double y, double x) {
   double ax = fabs(x), ay = fabs(y), hi = ax > ay ? ax : ay, lo = ax > ay ? ay : ax;
   if (!(hi > 0)) return 0;
   double a = lo / hi, q = a * a;
-  double r = a * (1 + q * (-0.3333314528 + q * (0.1999355085 + q * (-0.1420889944 + q * (0.1065626393 +
-                  q * (-0.0752896400 + q * (0.0429096138 + q * (-0.0161657367 + q * 0.0028662257))))))));
+  double r = ATAN01(a, q);
   if (ay > ax) r = RR_PI / 2 - r;
   if (x < 0) r = RR_PI - r;
   return y < 0 ? -r : r;
@@ -107,7 +112,6 @@ static void polar_range(const dv3 nu[3], const dv3 v[3], double E, dv3 P, dv3 e1
   *plo = mn - m, *phi = mx + m;
 }
 
-static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, int r[4]);
 
 /* The spherical triangle T of a setup's edge planes (rr_tri_spheres): unit
  * normals n, vertices v (vertex i lies on edges i+1 and i+2, inside edge i; its
@@ -136,6 +140,7 @@ typedef int64_t vl4 __attribute__((vector_size(32)));
    (o)[2] = (a)[0] * (b)[1] - (a)[1] * (b)[0])
 
 #define SPH_NAME spheres_plain
+#define SPH_CAT(x) x##_plain
 #define SPH_TARGET
 #define SPH_SQRT(x)                                                                                               \
   ({                                                                                                              \
@@ -145,23 +150,25 @@ typedef int64_t vl4 __attribute__((vector_size(32)));
   })
 #include "prim/triangle_sphere_tmp.h"
 #undef SPH_NAME
+#undef SPH_CAT
 #undef SPH_TARGET
 #undef SPH_SQRT
 #ifdef RR_SIMD_X86
 #define SPH_NAME spheres_avx2
+#define SPH_CAT(x) x##_avx2
 #define SPH_TARGET RR_TARGET_AVX2
 #define SPH_SQRT(x) ((vd4)_mm256_sqrt_pd((__m256d)(x)))
 #include "prim/triangle_sphere_tmp.h"
 #undef SPH_NAME
+#undef SPH_CAT
 #undef SPH_TARGET
 #undef SPH_SQRT
 #endif
 
-/* c (may be NULL): the camera whose cap images to compute, the parabolic's in the
- * lanes; the lat-long's and fisheye's (atan2, not yet in lanes) are left unset:
- * rr_tri_sphere_cap_rect computes them at need, for the lanes that pass the setup. */
+/* c (may be NULL): the camera whose cap images to compute in the lanes. */
 static void spheres(const tri_setup *ts, int n, const camera *c, bool simd, tri_sphere *out, double (*nv)[2][3][3]) {
-  const camera *pc = c && c->type == RR_CAMERA_PARABOLIC ? c : NULL;
+  const camera *pc =
+      c && (c->type == RR_CAMERA_PARABOLIC || c->type == RR_CAMERA_LATLONG || c->type == RR_CAMERA_FISHEYE) ? c : NULL;
   for (int k = 0; k < n; k += 4) {
     int m = n - k < 4 ? n - k : 4;
 #ifdef RR_SIMD_X86
@@ -232,63 +239,138 @@ int rr_tri_curved_cap(const camera *c, const tri_setup *ts, double scale, int r[
   return sp.cap ? rr_cam_cap_rect(c, sp.axis, sp.rho * scale, r) : -1;
 }
 
-/* curved_cap's cap for the corners of rr_tri_corner_cap (the lanes of
- * rr_tri_spheres compute the same for set-up triangles). */
-static int curved_cap(const camera *c, const dv3 v[3], double E, double scale, int r[4]) {
+/* The cap about unit vertices v for rr_tri_corner_cap, with widening E (the lanes
+ * of rr_tri_spheres compute the same for set-up triangles): 1 with its axis and
+ * radius in lane l, -1 when it bounds nothing. */
+static int curved_cap(const dv3 v[3], double E, double axis[3][4], double rho[4], int l) {
   dv3 m = dv(v[0].x + v[1].x + v[2].x, v[0].y + v[1].y + v[2].y, v[0].z + v[1].z + v[2].z);
   double lm = dlen(m);
   if (!(lm > 1e-3)) return -1;
   m = dscale(m, 1 / lm);
   double cr = mind(ddot(m, v[0]), mind(ddot(m, v[1]), ddot(m, v[2])));
   if (!(cr > 0.1)) return -1; /* a cap beyond 84°: the arcs bound it better */
-  double h2 = maxd(0.0, 2 - 2 * cr), rho = (sqrt(h2 / (1 - h2 / 4)) + E + 1e-9) * scale;
-  const double md[3] = {m.x, m.y, m.z};
-  return rr_cam_cap_rect(c, md, rho, r);
+  double h2 = maxd(0.0, 2 - 2 * cr);
+  rho[l] = sqrt(h2 / (1 - h2 / 4)) + E + 1e-9;
+  axis[0][l] = m.x, axis[1][l] = m.y, axis[2][l] = m.z;
+  return 1;
 }
 
-/* rr_cam_cap_rect's sample-coordinate extents e = x0, x1, y0, y1 of the cap's
- * image, before sample_rect: what does not depend on the sample position (the
- * lanes of spheres compute the parabolic's alike). 1 with e, 0 or -1 as rr_cam_cap_rect. */
+/* Four lanes a pass (triangle_sphere_tmp.h, cap_lanes: the argument of
+ * rr_tri_curved_cap's comment). */
+void rr_cam_cap_extents4(const camera *c, const double axis[3][4], const double rho[4], bool simd, double e[4][4],
+                         int64_t k[4]) {
+  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) {
+    for (int l = 0; l < 4; l++) k[l] = -1; /* no bound known */
+    return;
+  }
+  vd4 a[3], r, ext[4];
+  vl4 img;
+  memcpy(a, axis, sizeof a), memcpy(&r, rho, sizeof r);
+#ifdef RR_SIMD_X86
+  if (simd && __builtin_cpu_supports("avx2")) cap_lanes_avx2(c, a, &r, ext, &img);
+  else
+#endif
+    cap_lanes_plain(c, a, &r, ext, &img);
+  (void)simd;
+  memcpy(e, ext, sizeof ext), memcpy(k, &img, sizeof img);
+}
 static int cap_extent(const camera *c, const double axis[3], double rho, double e[4]) {
-  if (!(rho < 1.5)) return -1;
-  const dv3 m = dv(axis[0], axis[1], axis[2]);
-  dv3 R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
-  const double W = c->width, H = c->height;
-  double mr = ddot(m, R), mu = ddot(m, U), mf = ddot(m, F);
+  double a[3][4], r[4], ext[4][4];
+  int64_t k[4];
+  for (int l = 0; l < 4; l++) a[0][l] = axis[0], a[1][l] = axis[1], a[2][l] = axis[2], r[l] = rho;
+  rr_cam_cap_extents4(c, a, r, true, ext, k);
+  for (int j = 0; j < 4; j++) e[j] = ext[j][0];
+  return (int)k[0];
+}
+
+/* The chart bound of the lat-long and fisheye (tighter than the cap's but for
+ * round triangles: a thin one's cap is far wider than it). In the gnomonic chart
+ * about the cap's axis m, x ↦ p = (m + x) / |m + x| (x ⊥ m), great circles are
+ * straight lines: the spherical triangle T is the plane triangle of its
+ * vertices' images x_i = v_i / (v_i·m) − m. A passing sample's exact direction w
+ * has n̂_i·w >= −ε (the comment at the top) and lies in the cap (w·m >= cos ρ >=
+ * 1 − ρ²/2), so its chart point x = w / (w·m) − m has n̂_i·(m + x) >= −ε / cos ρ:
+ * T's edges shifted out by that, which meet at y_i = x_i + δ_i, δ_i ⊥ m with
+ * n̂_j·δ_i = n̂_k·δ_i = −ε / cos ρ, δ_i = −(ε / cos ρ) m × (n̂_j − n̂_k) /
+ * (m·(n̂_j × n̂_k)) (Cramer): x lies in the triangle Y of the y_i (tri_sphere.gx,
+ * in the lanes), |x| <= t = max |y_i|. (A sliver's sharp corner moves far, along
+ * the sliver only: the margin E of the cap widens it every way.) The map's image
+ * coordinates g along the ray s·x̂ from 0 (the geodesic from m, arc length
+ * σ = atan s, dσ/ds = 1 / (1 + s²) <= 1, |d²σ/ds²| <= 2s) have
+ * g(x) = g(0) + Dg·x + R, |R| <= (M2 + 2t·M1)·t²/2 per coordinate, M1 and M2
+ * bounding the first and second derivatives of g along unit-speed geodesics over
+ * the cap. Dg·x over Y spans the box of its values at the y_i (linear), so the
+ * samples' images lie in g(m) + box(Dg·y_i) ± R. M1, M2:
+ *  - lat-long, θ from up and φ = atan2(d·right, d·fwd) on the sphere's metric
+ *    dθ² + sin²θ dφ², geodesics θ'' = sin θ cos θ φ'², φ'' = −2 cot θ θ'φ' with
+ *    θ'² + sin²θ φ'² = 1: |θ'| <= 1, |φ'| <= 1 / sin θ, |θ''| <= |cos θ| / sin θ,
+ *    |φ''| <= |cos θ| / sin²θ (2|θ'||φ' sin θ| <= 1); over the cap sin θ >= slo
+ *    (cap_extent's), and Dθ·x = −x·up / sin θ_m, Dφ·x = x·(m_f right − m_r fwd) /
+ *    (m_r² + m_f²); the cap's conditions (no pole in it, φ off the seam) hold;
+ *  - fisheye, the polar plane coordinates (α / k, ψ) of the direction's angle α
+ *    from fwd: the image's acceleration along a geodesic (α'' = sin α cos α ψ'²,
+ *    ψ'' = −2 cot α α'ψ') has radial part ψ'²(α − sin α cos α) <= 2α³ / (3 sin²α)
+ *    (2α − sin 2α <= (2α)³ / 6) and tangential 2α'ψ'(1 − α cot α) <=
+ *    (sin α − α cos α) / sin²α <= α³ / (3 sin²α) (the difference grows from 0 with
+ *    derivative α(α − sin α)), so |g''| <= α³ / (k sin²α) and |g'| <= α / (k sin α),
+ *    both growing with α: at most A³ / (k s²) and A / (k s) with A >= α_m + ρ and
+ *    s <= sin(α_m + ρ) (cap_extent's). g = q(α) (d·right, d·up) / k, q = α / sin α,
+ *    so Dg·x = (q (x·right, x·up) − c₂ (x·fwd) (m_r, m_u)) / k with
+ *    c₂ = q'(α_m) / sin α_m = (sin α_m − α_m cos α_m) / sin³α_m; with α_m within
+ *    ATAN_ERR, q and c₂ are within ATAN_ERR / sin α_m and (ATAN_ERR + 1e-15) /
+ *    sin³α_m, which the margin carries (off the axis only: sin α_m > 1e-2).
+ * Rounding: the chart's vertices carry a few ulps of t, far below the 1e-9 rad added.
+ * rem_scale multiplies R (1; the tests see that 0 misses samples). 1 with the
+ * sample-coordinate extents e, -1 when it knows no bound. */
+static int chart_extent(const camera *c, const tri_sphere *sp, double rem_scale, double e[4]) {
+  const double rho = sp->rho, t = sp->gt, W = c->width, H = c->height;
+  if (!(rho < 1.5) || !(t < 1)) return -1;
+  const dv3 m = dv(sp->axis[0], sp->axis[1], sp->axis[2]), R = dvf(c->right), U = dvf(c->up), F = dvf(c->fwd);
+  const double mr = ddot(m, R), mu = ddot(m, U), mf = ddot(m, F);
+  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}; /* Dg·x_i: x, y image coordinates */
   if (c->type == RR_CAMERA_LATLONG) {
-    double ct = mu, st = sqrt(maxd(0.0, 1 - ct * ct)), theta = fast_atan2(st, ct);
-    double y0 = (theta - rho - ATAN_ERR) * H / RR_PI, y1 = (theta + rho + ATAN_ERR) * H / RR_PI;
-    double slo = st * (1 - rho * rho / 2) - fabs(ct) * rho; /* least sin θ over the cap */
-    double x0 = 0, x1 = W;
-    if (slo > 1e-6 && rho / slo < RR_PI) {
-      double phi = fast_atan2(mr, mf), dphi = rho / slo + ATAN_ERR;
-      if (phi - dphi >= -RR_PI && phi + dphi <= RR_PI)
-        x0 = (phi - dphi + RR_PI) * W / (2 * RR_PI), x1 = (phi + dphi + RR_PI) * W / (2 * RR_PI);
+    const double ct = mu, st = sqrt(maxd(0.0, 1 - ct * ct)), slo = st * (1 - rho * rho / 2) - fabs(ct) * rho;
+    const double g2 = mr * mr + mf * mf;
+    if (!(slo > 1e-6) || !(rho / slo < RR_PI) || !(g2 > 1e-12)) return -1;
+    const double phi = fast_atan2(mr, mf), dphi = rho / slo + ATAN_ERR;
+    if (phi - dphi < -RR_PI || phi + dphi > RR_PI) return -1; /* across the seam */
+    const double theta = fast_atan2(st, ct);
+    const dv3 G = dsub(dscale(R, mf), dscale(F, mr));
+    for (int i = 0; i < 3; i++) {
+      const dv3 x = dv(sp->gx[i][0], sp->gx[i][1], sp->gx[i][2]);
+      const double dp = ddot(x, G) / g2, dt = -ddot(x, U) / st;
+      lo[0] = mind(lo[0], dp), hi[0] = maxd(hi[0], dp), lo[1] = mind(lo[1], dt), hi[1] = maxd(hi[1], dt);
     }
-    e[0] = x0, e[1] = x1, e[2] = y0, e[3] = y1;
+    const double h = t * t / 2 * rem_scale;
+    const double mp = (1 / (slo * slo) + 2 * t / slo) * h + 1e-9 / slo + ATAN_ERR;
+    const double mt = (1 / slo + 2 * t) * h + 1e-9 + ATAN_ERR;
+    /* φ = 2π sx / W − π, θ = π sy / H */
+    e[0] = (phi + lo[0] - mp + RR_PI) * W / (2 * RR_PI), e[1] = (phi + hi[0] + mp + RR_PI) * W / (2 * RR_PI);
+    e[2] = (theta + lo[1] - mt) * H / RR_PI, e[3] = (theta + hi[1] + mt) * H / RR_PI;
     return 1;
   }
-  double ca = mf, sa = sqrt(maxd(0.0, 1 - ca * ca));
-  /* beyond the disk's rim (α = π/2, or the fisheye's k) by 1e-3 rad: no rays */
-  double cmax = ca * (ca >= 0 ? 1 : 1 - rho * rho / 2) + sa * rho; /* >= cos α over the cap */
-  double u, vv, rad;
-  if (c->type == RR_CAMERA_PARABOLIC) {
-    if (cmax < -1e-3) return 0;
-    double cmin = ca * (ca >= 0 ? 1 - rho * rho / 2 : 1) - sa * rho; /* <= cos α over the cap */
-    if (!(1 + cmin > 1e-3)) return -1;
-    u = mr / (1 + ca), vv = mu / (1 + ca), rad = rho / (1 + cmin);
-  } else {
-    double k = c->fov_deg * RR_PI / 360, am = fast_atan2(sa, ca);
-    if (am - ATAN_ERR - rho > k + 1e-3) return 0;
-    double s = sa * (1 - rho * rho / 2) + mind(ca, 0.0) * rho; /* <= sin(α_m + ρ) */
-    if (!(s > 1e-3)) return -1;
-    double f = sa > 1e-12 ? am / sa : 1; /* → 1 on the axis, where (mr, mu) → 0 */
-    /* am within ATAN_ERR of α_m: the centre's image within ATAN_ERR / k of (u, v) */
-    u = f * mr / k, vv = f * mu / k, rad = (am + ATAN_ERR + rho) / (k * s) * rho + ATAN_ERR / k;
+  if (c->type != RR_CAMERA_FISHEYE) return -1;
+  const double ca = mf, sa = sqrt(maxd(0.0, 1 - ca * ca)), k = c->fov_deg * RR_PI / 360;
+  const double s = sa * (1 - rho * rho / 2) + mind(ca, 0.0) * rho; /* <= sin(α_m + ρ) */
+  if (!(sa > 1e-2) || !(s > 1e-3)) return -1;
+  const double am = fast_atan2(sa, ca), A = am + ATAN_ERR + rho, M1 = A / (k * s), M2 = A * A * A / (k * s * s);
+  const double q = am / sa, c2 = (sa - am * ca) / (sa * sa * sa);
+  for (int i = 0; i < 3; i++) {
+    const dv3 x = dv(sp->gx[i][0], sp->gx[i][1], sp->gx[i][2]);
+    const double xf = ddot(x, F), du = (q * ddot(x, R) - c2 * xf * mr) / k, dv_ = (q * ddot(x, U) - c2 * xf * mu) / k;
+    lo[0] = mind(lo[0], du), hi[0] = maxd(hi[0], du), lo[1] = mind(lo[1], dv_), hi[1] = maxd(hi[1], dv_);
   }
+  const double u = q * mr / k, vv = q * mu / k;
+  const double mg = (M2 + 2 * t * M1) * t * t / 2 * rem_scale + 1e-9 * M1 +
+                    (ATAN_ERR * (1 + t / sa + 2 * t / (sa * sa)) + 1e-12) / k;
   /* u = 2 sx / W − 1, v = 1 − 2 sy / H */
-  e[0] = (u - rad + 1) * W / 2, e[1] = (u + rad + 1) * W / 2, e[2] = (1 - vv - rad) * H / 2, e[3] = (1 - vv + rad) * H / 2;
+  e[0] = (u + lo[0] - mg + 1) * W / 2, e[1] = (u + hi[0] + mg + 1) * W / 2;
+  e[2] = (1 - vv - hi[1] - mg) * H / 2, e[3] = (1 - vv - lo[1] + mg) * H / 2;
   return 1;
+}
+
+int rr_cam_extent_rect(const camera *c, const double e[4], int k, int r[4]) {
+  return k > 0 ? sample_rect(c, e[0], e[1], e[2], e[3], r) : k;
 }
 
 int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int r[4]) {
@@ -296,6 +378,20 @@ int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int r[4])
   double e[4];
   int k = cap_extent(c, axis, rho, e);
   return k > 0 ? sample_rect(c, e[0], e[1], e[2], e[3], r) : k;
+}
+
+/* chart_extent's rectangle: 1 with r, 0 when it holds no sample, -1 when unknown. */
+static int chart_rect(const camera *c, const tri_sphere *sp, double rem_scale, int r[4]) {
+  double e[4];
+  if (!sp->cap || chart_extent(c, sp, rem_scale, e) < 0) return -1;
+  return sample_rect(c, e[0], e[1], e[2], e[3], r);
+}
+
+int rr_tri_curved_chart(const camera *c, const tri_setup *ts, double rem_scale, int r[4]) {
+  tri_sphere sp;
+  double nv[1][2][3][3];
+  spheres(ts, 1, NULL, true, &sp, nv);
+  return sp.ok ? chart_rect(c, &sp, rem_scale, r) : -1;
 }
 
 int rr_tri_sphere_cap_rect(const camera *c, const tri_sphere *sp, int r[4]) {
@@ -321,14 +417,26 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_spher
    * it is not, the arcs' rectangle within it */
   int cap[4], has_cap = rr_tri_sphere_cap_rect(c, sp, cap);
   if (has_cap == 0) return 0;
+  /* the chart and the arcs need T's normals and vertices: this lane again, with them */
+  tri_sphere again;
+  double nv[1][2][3][3];
+  bool full = false;
+  if (has_cap > 0 && (cap[2] - cap[0] + 1) * (cap[3] - cap[1] + 1) > CHART_FROM &&
+      (c->type == RR_CAMERA_LATLONG || c->type == RR_CAMERA_FISHEYE)) { /* and the chart's */
+    spheres(ts, 1, NULL, true, &again, nv), full = true;
+    int g[4], kg = chart_rect(c, &again, 1, g);
+    if (kg == 0) return 0;
+    if (kg > 0) {
+      cap[0] = cap[0] > g[0] ? cap[0] : g[0], cap[1] = cap[1] > g[1] ? cap[1] : g[1];
+      cap[2] = cap[2] < g[2] ? cap[2] : g[2], cap[3] = cap[3] < g[3] ? cap[3] : g[3];
+      if (cap[0] > cap[2] || cap[1] > cap[3]) return 0;
+    }
+  }
   if (has_cap > 0 && (cap[2] - cap[0] + 1) * (cap[3] - cap[1] + 1) <= CAP_ENOUGH) {
     memcpy(r, cap, sizeof cap);
     return kind;
   }
-  /* the arcs need T's normals and vertices: this lane again, with them */
-  tri_sphere again;
-  double nv[1][2][3][3];
-  spheres(ts, 1, NULL, true, &again, nv);
+  if (!full) spheres(ts, 1, NULL, true, &again, nv);
   dv3 n[3], v[3];
   for (int i = 0; i < 3; i++)
     n[i] = dv(nv[0][0][i][0], nv[0][0][i][1], nv[0][0][i][2]), v[i] = dv(nv[0][1][i][0], nv[0][1][i][1], nv[0][1][i][2]);
@@ -377,17 +485,24 @@ int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_spher
   return kind;
 }
 
-int rr_tri_corner_cap(const rr_scene *s, uint32_t i, const camera *c, double slack, int r[4]) {
+int rr_tri_corner_cap_lane(const rr_scene *s, uint32_t i, const camera *c, double slack, double axis[3][4],
+                           double rho[4], int l) {
   if (scene_inf(s, i)) return -1;
   vec3 p[3];
   scene_corners(s, i, p);
   dv3 v[3], e = dvf(c->eye);
   for (int k = 0; k < 3; k++) {
     v[k] = dsub(dvf(p[k]), e);
-    double l = dlen(v[k]);
-    if (!(l > 0) || !(l < INFINITY)) return -1;
-    v[k] = dscale(v[k], 1 / l);
+    double len = dlen(v[k]);
+    if (!(len > 0) || !(len < INFINITY)) return -1;
+    v[k] = dscale(v[k], 1 / len);
   }
-  return curved_cap(c, v, slack, 1, r);
+  return curved_cap(v, slack, axis, rho, l);
 }
 
+int rr_tri_corner_cap(const rr_scene *s, uint32_t i, const camera *c, double slack, int r[4]) {
+  double axis[3][4], rho[4];
+  if (rr_tri_corner_cap_lane(s, i, c, slack, axis, rho, 0) < 0) return -1;
+  const double a[3] = {axis[0][0], axis[1][0], axis[2][0]};
+  return rr_cam_cap_rect(c, a, rho[0], r);
+}

@@ -1,13 +1,77 @@
 /* The spherical triangles and caps of four set-up triangles at once
- * (rr_tri_spheres, prim/triangle_curved.c includes this once per target: SPH_NAME,
- * SPH_TARGET, SPH_SQRT). Lanes of doubles (GCC vectors) with the operations, order
- * and comparisons of the one-lane argument in triangle_curved.c's comments (no FMA
- * in the build, sqrt correctly rounded at any width), so every lane holds the bits
- * a scalar evaluation would: the proofs there carry over unchanged. A lane that
- * fails a test only clears its ok or cap; its NaNs go nowhere. Four lanes, not
- * eight: a leaf's setups keep about three. nv (may be NULL): the normals and
- * vertices, for the arcs. pc (may be NULL): a parabolic camera, whose cap images
- * (cap_extent) the lanes compute too, in its order. */
+ * (rr_tri_spheres), and the images of four caps (cap_lanes); prim/triangle_curved.c
+ * includes this once per target (SPH_NAME, SPH_CAT, SPH_TARGET, SPH_SQRT). Lanes of
+ * doubles (GCC vectors) with the operations, order and comparisons of the one-lane
+ * argument in triangle_curved.c's comments (no FMA in the build, sqrt correctly
+ * rounded at any width), so every lane holds the bits a one-lane call gives (the
+ * width does not change them): the proofs there hold lane by lane. */
+/* atan2 (fast_atan2's operations, lane by lane; a macro: see vd_splat) */
+#ifndef SPH_ATAN2
+#define SPH_ATAN2(y_, x_)                                                                                         \
+  ({                                                                                                              \
+    const vd4 y = (y_), x = (x_), ax = vabs(x), ay = vabs(y);                                                     \
+    const vl4 xa = ax > ay;                                                                                       \
+    const vd4 hi = vsel(xa, ax, ay), lo = vsel(xa, ay, ax), a = lo / hi, q = a * a;                               \
+    vd4 r = ATAN01(a, q);                                                                                         \
+    r = vsel(ay > ax, RR_PI / 2 - r, r);                                                                          \
+    r = vsel(x < 0, RR_PI - r, r);                                                                                \
+    r = vsel(y < 0, -r, r);                                                                                       \
+    vsel(hi > 0, r, vd_splat(0));                                                                                 \
+  })
+#endif
+
+/* The image extents e of caps about unit axes m of radii rho for a polar camera c,
+ * in sample coordinates (x0, x1, y0, y1), what rr_tri_curved_cap's comment
+ * proves; k: each lane's 1, 0 (no sample can look into it) or -1 (no bound). */
+SPH_TARGET static void SPH_CAT(cap_lanes)(const camera *c, const vd4 m[3], const vd4 *rho_, vd4 e[4], vl4 *k_) {
+  const vd4 rho = *rho_;
+  const double W = c->width, H = c->height;
+  const vd4 mr = m[0] * (double)c->right.x + m[1] * (double)c->right.y + m[2] * (double)c->right.z;
+  const vd4 mu = m[0] * (double)c->up.x + m[1] * (double)c->up.y + m[2] * (double)c->up.z;
+  const vd4 mf = m[0] * (double)c->fwd.x + m[1] * (double)c->fwd.y + m[2] * (double)c->fwd.z;
+  const vd4 h = 1 - rho * rho / 2; /* <= cos ρ */
+  vl4 k = vl_splat(1);
+  if (c->type == RR_CAMERA_LATLONG) {
+    const vd4 ct = mu, st = SPH_SQRT(vmax(vd_splat(0), 1 - ct * ct)), theta = SPH_ATAN2(st, ct);
+    e[2] = (theta - rho - ATAN_ERR) * H / RR_PI, e[3] = (theta + rho + ATAN_ERR) * H / RR_PI;
+    const vd4 slo = st * h - vabs(ct) * rho; /* least sin θ over the cap */
+    const vd4 phi = SPH_ATAN2(mr, mf), dphi = rho / slo + ATAN_ERR;
+    /* with a pole in the cap, or across the seam: the whole width */
+    const vl4 part = (slo > 1e-6) & (rho / slo < RR_PI) & (phi - dphi >= -RR_PI) & (phi + dphi <= RR_PI);
+    e[0] = vsel(part, (phi - dphi + RR_PI) * W / (2 * RR_PI), vd_splat(0));
+    e[1] = vsel(part, (phi + dphi + RR_PI) * W / (2 * RR_PI), vd_splat(W));
+  } else {
+    const vd4 ca = mf, sa = SPH_SQRT(vmax(vd_splat(0), 1 - ca * ca));
+    const vl4 front = ca >= 0;
+    vd4 u, vv, rad;
+    if (c->type == RR_CAMERA_PARABOLIC) {
+      /* beyond the disk's rim by 1e-3 rad: no rays (cmax >= cos α over the cap) */
+      const vd4 cmax = ca * vsel(front, vd_splat(1), h) + sa * rho, cmin = ca * vsel(front, h, vd_splat(1)) - sa * rho;
+      u = mr / (1 + ca), vv = mu / (1 + ca), rad = rho / (1 + cmin);
+      k = vsel_l(1 + cmin > 1e-3, k, vl_splat(-1));
+      k = vsel_l(cmax < -1e-3, vl_splat(0), k);
+    } else {
+      const double kf = c->fov_deg * RR_PI / 360;
+      const vd4 am = SPH_ATAN2(sa, ca);
+      const vd4 s = sa * h + vmin(ca, vd_splat(0)) * rho; /* <= sin(α_m + ρ) */
+      /* → 1 on the axis, where (mr, mu) → 0; am within ATAN_ERR of α_m: the centre's
+       * image within ATAN_ERR / k of (u, v) */
+      const vd4 f = vsel(sa > 1e-12, am / sa, vd_splat(1));
+      u = f * mr / kf, vv = f * mu / kf, rad = (am + ATAN_ERR + rho) / (kf * s) * rho + ATAN_ERR / kf;
+      k = vsel_l(s > 1e-3, k, vl_splat(-1));
+      k = vsel_l(am - ATAN_ERR - rho > kf + 1e-3, vl_splat(0), k);
+    }
+    /* u = 2 sx / W − 1, v = 1 − 2 sy / H */
+    e[0] = (u - rad + 1) * W / 2, e[1] = (u + rad + 1) * W / 2;
+    e[2] = (1 - vv - rad) * H / 2, e[3] = (1 - vv + rad) * H / 2;
+  }
+  *k_ = vsel_l(rho < 1.5, k, vl_splat(-1));
+}
+
+/* A lane that fails a test only clears its ok or cap; its NaNs go nowhere. Four
+ * lanes, not eight: a leaf's setups keep about three. nv (may be NULL): the normals
+ * and vertices, for the arcs, and the chart's triangle (gx, gt; else gt infinite).
+ * pc (may be NULL): a polar camera whose cap images (cap_lanes) to compute too. */
 SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tri_sphere *out, double (*nv)[2][3][3]) {
   vd4 nrm[3][3], v[3][3]; /* [edge or vertex][axis] */
   vl4 ok = vl_splat(-1);
@@ -47,25 +111,27 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
   const vd4 cr = vmin(vdot(m, v[0]), vmin(vdot(m, v[1]), vdot(m, v[2])));
   cap &= cr > 0.1;
   const vd4 h2 = vmax(vd_splat(0), 2 - 2 * cr), rho = SPH_SQRT(h2 / (1 - h2 / 4)) + E + 1e-9;
-  /* cap_extent's parabolic image of the cap: the centre's stereographic image,
-   * the radius ρ / (1 + cmin), and 0 for a cap behind the disk's rim */
+  /* chart_extent's triangle: the vertices in the gnomonic chart about m
+   * (v·m >= cr > 0.1 with the cap), each moved to where the edges through it,
+   * shifted out by ε / cos ρ, meet (chart_extent's comment) */
+  vd4 gx[3][3], gt2 = vd_splat(0);
+  memset(gx, 0, sizeof gx);
+  const vd4 ec = eps / (1 - rho * rho / 2);
+  for (int i = 0; i < 3 && nv; i++) { /* (rarely needed: with the arcs' normals and vertices only) */
+    const vd4 *nj = nrm[(i + 1) % 3], *nk = nrm[(i + 2) % 3];
+    vd4 jk[3], mx[3], dn[3];
+    vcross(nj, nk, jk);
+    for (int k = 0; k < 3; k++) dn[k] = nj[k] - nk[k];
+    vcross(m, dn, mx);
+    const vd4 iv = 1 / vdot(v[i], m), sh = -ec / vdot(m, jk);
+    for (int k = 0; k < 3; k++) gx[i][k] = (v[i][k] * iv - m[k]) + mx[k] * sh;
+    gt2 = vmax(gt2, vdot(gx[i], gx[i]));
+  }
+  const vd4 gt = vsel(rho < 1.3, SPH_SQRT(gt2), vd_splat(INFINITY));
+  /* the cap's image for pc */
   vd4 ext[4] = {0};
   vl4 img = vl_splat(TRI_CAP_UNSET);
-  if (pc) {
-    const double W = pc->width, H = pc->height;
-    vd4 mr = m[0] * (double)pc->right.x + m[1] * (double)pc->right.y + m[2] * (double)pc->right.z;
-    vd4 mu = m[0] * (double)pc->up.x + m[1] * (double)pc->up.y + m[2] * (double)pc->up.z;
-    vd4 ca = m[0] * (double)pc->fwd.x + m[1] * (double)pc->fwd.y + m[2] * (double)pc->fwd.z;
-    vd4 sa = SPH_SQRT(vmax(vd_splat(0), 1 - ca * ca)), q = 1 - rho * rho / 2;
-    vl4 front = ca >= 0;
-    vd4 cmax = ca * vsel(front, vd_splat(1), q) + sa * rho, cmin = ca * vsel(front, q, vd_splat(1)) - sa * rho;
-    vd4 u = mr / (1 + ca), vv = mu / (1 + ca), rad = rho / (1 + cmin);
-    ext[0] = (u - rad + 1) * W / 2, ext[1] = (u + rad + 1) * W / 2;
-    ext[2] = (1 - vv - rad) * H / 2, ext[3] = (1 - vv + rad) * H / 2;
-    img = vsel_l(1 + cmin > 1e-3, vl_splat(1), vl_splat(-1));
-    img = vsel_l(cmax < -1e-3, vl_splat(0), img);
-    img = vsel_l(rho < 1.5, img, vl_splat(-1));
-  }
+  if (pc) SPH_CAT(cap_lanes)(pc, m, &rho, ext, &img);
   for (int l = 0; l < n; l++) {
     tri_sphere *o = &out[l];
     o->img_k = (int8_t)img[l];
@@ -73,6 +139,9 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
     for (int i = 0; i < 3 && nv; i++)
       for (int k = 0; k < 3; k++) nv[l][0][i][k] = nrm[i][k][l], nv[l][1][i][k] = v[i][k][l];
     for (int k = 0; k < 3; k++) o->axis[k] = m[k][l];
+    for (int i = 0; i < 3 && nv; i++)
+      for (int k = 0; k < 3; k++) o->gx[i][k] = gx[i][k][l];
+    o->gt = nv ? gt[l] : INFINITY;
     o->smin = smin[l], o->E = E[l], o->rho = rho[l];
     o->ok = ok[l] != 0, o->cap = ok[l] && cap[l];
   }

@@ -380,14 +380,35 @@ static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, const
   return any;
 }
 
-/* Before its setup: may the triangle's corner cap (rr_tri_corner_cap, with the
- * slack of mark_seen) show a sample of r at some position? */
-static bool corner_cap_meets(const trav *t, uint32_t id, tile_rect r) {
-  for (int p = 0; p < t->ns; p++) {
-    int b[4], k = rr_tri_corner_cap(t->s, id, &t->cams[p], 1e-4, b);
-    if (k < 0 || (k > 0 && meets(b, r))) return true;
+static inline __attribute__((always_inline)) bool extent_meets(const camera *cams, int ns, const double e[4][4],
+                                                               const int64_t k[4], int l, const tile_rect *r);
+
+/* Before their setup: the triangles ids[0..n-1] (first..first+n-1 when ids is
+ * NULL) whose corner cap (rr_tri_corner_cap, with the slack of mark_seen) may show
+ * a sample of r at some position, into out; four caps' images a step in lanes.
+ * Returns how many. */
+static __attribute__((noinline)) uint32_t corner_caps_meet(const trav *t, uint32_t first, const uint32_t *ids, uint32_t n, tile_rect r,
+                                 uint32_t *out) {
+  uint32_t kept = 0;
+  for (uint32_t q = 0; q < n; q += 4) {
+    const int m = n - q < 4 ? (int)(n - q) : 4;
+    double axis[3][4], rho[4], e[4][4];
+    int64_t k[4];
+    int slot[4], test = 0;
+    for (int l = 0; l < m; l++) {
+      const uint32_t id = ids ? ids[q + l] : first + q + l;
+      slot[l] = rr_tri_corner_cap_lane(t->s, id, t->c, 1e-4, axis, rho, test) > 0 ? test++ : -1;
+    }
+    if (test) {
+      for (int l = test; l < 4; l++) /* padding lanes repeat the first */
+        axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
+      rr_cam_cap_extents4(t->c, (const double(*)[4])axis, rho, t->simd, e, k);
+    }
+    for (int l = 0; l < m; l++)
+      if (slot[l] < 0 || extent_meets(t->cams, t->ns, (const double(*)[4])e, k, slot[l], &r))
+        out[kept++] = ids ? ids[q + l] : first + q + l;
   }
-  return false;
+  return kept;
 }
 
 /* Triangle setup: triangles ids[0..n-1] (first..first+n-1 when ids is NULL) into
@@ -492,7 +513,9 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
     }
     return setup_bounded(t, scratch, nb, out);
   }
-  uint32_t kept = 0;
+  uint32_t kept = 0, near[PEND_DRAW + BVH_MAX_LEAF];
+  if (r && !t->seen && n <= PEND_DRAW + BVH_MAX_LEAF) /* (a frustum's leaves: no more) */
+    n = corner_caps_meet(t, first, ids, n, *r, near), ids = near;
   for (uint32_t q = 0; q < n;) { /* eight lanes at a time, the bits of one */
     int m = 0, face[8];
     uint32_t lid[8];
@@ -500,7 +523,6 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
     for (; q < n && m < 8; q++) {
       uint32_t id = ids ? ids[q] : first + q;
       if (t->seen && !t->seen[id]) continue;
-      if (r && !t->seen && !corner_cap_meets(t, id, *r)) continue;
       lid[m++] = id;
     }
     t->st.setups += (uint64_t)m;
@@ -685,6 +707,31 @@ static bool outside_cone(int has_cone, vec3 axis, float angle, const bvh_node *b
   return phi > angle + beta + 1e-4f;
 }
 
+/* A shortcut of mark_seen's walk, where most boxes show a sample: a cap of
+ * radius rho_min or more (1.5 samples over the map's least stretch, in samples a
+ * radian) wholly inside the image (the parabolic's and fisheye's disk:
+ * cos α_m >= cos_min + rho·sin_min, above cos(α_rim − ρ)) is taken as showing
+ * one, without its rectangle (two atan2 for the lat-long and fisheye). Taking a
+ * box is always safe: this only gives up dropping the odd such box whose image
+ * falls between samples. */
+typedef struct cap_shortcut {
+  double rho_min, cos_min, sin_min; /* rho_min infinite: none */
+} cap_shortcut;
+
+static cap_shortcut cap_shortcut_of(const camera *c) {
+  cap_shortcut q = {INFINITY, 1, 0};
+  const double W = c->width, H = c->height;
+  if (c->type == RR_CAMERA_LATLONG) { /* every direction; stretch H / π along θ, >= W / 2π along φ */
+    q.rho_min = 1.5 / fmin(H / RR_PI, W / (2 * RR_PI)), q.cos_min = -2;
+  } else if (c->type == RR_CAMERA_PARABOLIC) { /* stretch 1 / (1 + cos α) >= 1/2 image half-widths */
+    q.rho_min = 1.5 / (fmin(W, H) / 4), q.cos_min = 0, q.sin_min = 1;
+  } else if (c->type == RR_CAMERA_FISHEYE) { /* radial stretch 1 / k, the least */
+    const double k = c->fov_deg * RR_PI / 360;
+    q.rho_min = 1.5 / (fmin(W, H) / (2 * k)), q.cos_min = cos(k), q.sin_min = sin(k);
+  }
+  return q;
+}
+
 /* May a sample of r (of the image when r is NULL) at one of the ns positions of
  * a curved view polar about an axis look into box n? A box lies in the ball about its centre b of its
  * half-diagonal r, which from the eye e (|b − e| > r) is the cap about b − e of
@@ -697,23 +744,48 @@ static bool outside_cone(int has_cone, vec3 axis, float angle, const bvh_node *b
  * samples farther out, as far as its setup's spherical triangle reaches; every
  * box test of the BVH methods, the frustum cone here and rc-bvh's widened slabs,
  * drops such samples alike: they are not hits of the triangle in its box.)
- * A box that holds the eye, or a cap it cannot bound, may. */
-static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
+ * A box that holds the eye, or a cap it cannot bound, may. box_cap: false when the
+ * box may (or, with sc, is taken as showing one), else true with its cap's axis
+ * and rho in lane l of rr_cam_cap_extents4's. */
+static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *sc, double axis[3][4], double *rho, int l) {
+  const double eye[3] = {cams->eye.x, cams->eye.y, cams->eye.z};
   double b[3], d2 = 0, r2 = 0;
   for (int a = 0; a < 3; a++) {
-    const double e = a == 0 ? cams->eye.x : a == 1 ? cams->eye.y : cams->eye.z;
-    b[a] = 0.5 * ((double)n->lo[a] + n->hi[a]) - e, d2 += b[a] * b[a];
-    r2 += 0.25 * ((double)n->hi[a] - n->lo[a]) * ((double)n->hi[a] - n->lo[a]);
+    const double lo = n->lo[a], hi = n->hi[a];
+    b[a] = 0.5 * (lo + hi) - eye[a], d2 += b[a] * b[a];
+    r2 += 0.25 * (hi - lo) * (hi - lo);
   }
   double s2 = r2 * (1 + 1e-9) / d2;
-  if (!(s2 < 0.98)) return true;
-  const double dist = sqrt(d2), axis[3] = {b[0] / dist, b[1] / dist, b[2] / dist};
-  const double rho = sqrt(s2 / (1 - s2)) + 1e-4;
+  if (!(s2 < 0.98)) return false;
+  const double inv = 1 / sqrt(d2), r = sqrt(s2 / (1 - s2)) + 1e-4;
+  for (int a = 0; a < 3; a++) axis[a][l] = b[a] * inv;
+  rho[l] = r;
+  if (sc && r >= sc->rho_min) {
+    const double F[3] = {cams->fwd.x, cams->fwd.y, cams->fwd.z};
+    if (axis[0][l] * F[0] + axis[1][l] * F[1] + axis[2][l] * F[2] >= sc->cos_min + r * sc->sin_min) return false;
+  }
+  return true;
+}
+
+/* Does the cap's image in lane l of rr_cam_cap_extents4's e, k show a sample of r
+ * (of the image when NULL) at one of the ns positions? */
+static inline __attribute__((always_inline)) bool extent_meets(const camera *cams, int ns, const double e[4][4],
+                                                               const int64_t k[4], int l, const tile_rect *r) {
+  const double el[4] = {e[0][l], e[1][l], e[2][l], e[3][l]};
   for (int p = 0; p < ns; p++) {
-    int q[4], k = rr_cam_cap_rect(&cams[p], axis, rho, q);
-    if (k < 0 || (k > 0 && (!r || meets(q, *r)))) return true;
+    int q[4], kp = rr_cam_extent_rect(&cams[p], el, (int)k[l], q);
+    if (kp < 0 || (kp > 0 && (!r || meets(q, *r)))) return true;
   }
   return false;
+}
+
+static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
+  double axis[3][4], rho[4], e[4][4];
+  int64_t k[4];
+  if (!box_cap(cams, n, NULL, axis, rho, 0)) return true;
+  for (int l = 1; l < 4; l++) axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
+  rr_cam_cap_extents4(cams, (const double(*)[4])axis, rho, true, e, k);
+  return extent_meets(cams, ns, (const double(*)[4])e, k, 0, r);
 }
 
 /* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
@@ -907,19 +979,34 @@ static void root_band(int b, int thread, void *arg) {
  * hemisphere, or between the samples) cost no setup. */
 static void mark_seen(const trav *t, uint8_t *seen) {
   const rr_bvh *bvh = t->s->bvh;
-  uint32_t stack[128], sp = 0;
+  uint32_t stack[512], sp = 0;
+  const cap_shortcut sc = cap_shortcut_of(t->c);
   stack[sp++] = 0;
-  while (sp) {
-    bvh_node buf;
-    const bvh_node *n = bvh_node_at(bvh, stack[--sp], &buf);
-    if (!box_cap_meets(t->cams, t->ns, n, NULL)) continue;
-    if (n->count) {
-      for (uint32_t k = 0; k < n->count; k++) seen[bvh_prim_at(bvh, n->first + k)] = 1;
-    } else if (sp + 2 <= sizeof stack / sizeof *stack) {
-      stack[sp++] = n->first + 1, stack[sp++] = n->first;
-    } else { /* (deeper than any tree built) everything */
-      memset(seen, 1, t->s->ntris);
-      return;
+  while (sp) { /* four nodes a step, their caps' images in lanes */
+    bvh_node buf[4];
+    const bvh_node *n[4];
+    double axis[3][4], rho[4], e[4][4];
+    int64_t k[4];
+    int m = 0, test = 0, slot[4];
+    for (; sp && m < 4; m++) {
+      n[m] = bvh_node_at(bvh, stack[--sp], &buf[m]);
+      slot[m] = box_cap(t->cams, n[m], &sc, axis, rho, test) ? test++ : -1;
+    }
+    if (test) {
+      for (int l = test; l < 4; l++) /* padding lanes repeat the first */
+        axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
+      rr_cam_cap_extents4(t->c, (const double(*)[4])axis, rho, t->simd, e, k);
+    }
+    for (int i = 0; i < m; i++) {
+      if (slot[i] >= 0 && !extent_meets(t->cams, t->ns, (const double(*)[4])e, k, slot[i], NULL)) continue;
+      if (n[i]->count) {
+        for (uint32_t q = 0; q < n[i]->count; q++) seen[bvh_prim_at(bvh, n[i]->first + q)] = 1;
+      } else if (sp + 2 <= sizeof stack / sizeof *stack) {
+        stack[sp++] = n[i]->first + 1, stack[sp++] = n[i]->first;
+      } else { /* (deeper than any tree built) everything */
+        memset(seen, 1, t->s->ntris);
+        return;
+      }
     }
   }
 }
