@@ -143,6 +143,7 @@ enum { W = 24, H = 18 };
 
 /* A frame of the fixture's method (with heat maps), shaded in every mode, and its AOVs. */
 static rr_error frame(const fixture *fx, uint64_t *print) {
+  rr_scratch_free(fx->dev); /* the device's kept work buffers: allocated (and failed) afresh */
   rr_render_options opt;
   rr_render_options_init(&opt);
   opt.method = fx->method, opt.width = W, opt.height = H, opt.threads = 1, opt.heat = 1;

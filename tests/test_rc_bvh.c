@@ -206,8 +206,50 @@ static void grazing_sheets(rr_device *dev) {
   rr_scene_release(s);
 }
 
+/* A device keeps its renders' large work buffers (rr_scratch_take): a frame drawn
+ * on kept buffers, grown from a smaller scene's, filled with garbage beforehand, or
+ * taken meanwhile (a fresh buffer then) has the bits of one drawn by a new device. */
+static void kept_buffers(void) {
+  rr_device *d = rr_device_new(), *fresh = rr_device_new();
+  rr_scene *small = NULL, *big = NULL;
+  if (!d || !fresh || rr_scene_load(d, "sphere:24", &small) || rr_scene_load(d, "plane:64", &big)) {
+    CHECK(0, "kept buffers: set-up failed");
+    rr_scene_release(small), rr_scene_release(big), rr_device_release(d), rr_device_release(fresh);
+    return;
+  }
+  const rr_method ms[3] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB};
+  const int uses[3] = {SCRATCH_RC_SETUPS, SCRATCH_RC_SETUPS, SCRATCH_SM_PRIMS};
+  for (int m = 0; m < 3; m++) {
+    rr_scene *seq[3] = {small, big, big};
+    rr_camera cams[2] = {test_random_view(small, 1.0f, 2.0f, 0.3f, 30, 100),
+                         test_random_view(big, 1.0f, 2.0f, 0.3f, 30, 100)};
+    for (int k = 0; k < 4; k++) {
+      rr_scene *s = seq[k < 3 ? k : 2];
+      const rr_camera *cam = &cams[s == big];
+      rr_frame *want = test_render(fresh, s, cam, ms[m], 2, 64, 48, 0);
+      rr_scratch_free(fresh);
+      rr_scratch *kept = &d->scratch[uses[m]];
+      void *before = kept->p;
+      size_t cap = kept->cap;
+      if (kept->p) memset(kept->p, 0xA5, kept->cap);
+      rr_buf taken = {0};
+      if (k == 3) taken = rr_scratch_take(d, uses[m], 1); /* the render's take gets a fresh buffer */
+      rr_frame *f = test_render(d, s, cam, ms[m], 2, 64, 48, 0);
+      if (want && f)
+        CHECK(!test_frames_differ(want, f), "%s on kept buffers, frame %d: other bits", rr_method_name(ms[m]), k);
+      CHECK(kept->p, "%s, frame %d: the device keeps its buffer", rr_method_name(ms[m]), k);
+      if (k >= 2) CHECK(kept->p == before && kept->cap == cap, "%s, frame %d: the same scene again reallocated",
+                        rr_method_name(ms[m]), k);
+      rr_scratch_give(d, taken);
+      rr_frame_release(want), rr_frame_release(f);
+    }
+  }
+  rr_scene_release(small), rr_scene_release(big), rr_device_release(d), rr_device_release(fresh);
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
+  kept_buffers();
   bound_views(dev);
   small_part(dev);
   grazing_sheets(dev);

@@ -6,12 +6,29 @@
 #include "core/vec.h"
 
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdlib.h>
 
 /* Hot kernels written once and specialised by their constant arguments. */
 #define KERNEL static inline __attribute__((always_inline))
+
+/* The per-frame work buffers a device keeps from one render to the next (see
+ * rr_scratch_take), one of each use. */
+enum {
+  SCRATCH_RC_SETUPS, /* rc-bvh / rc-packet: leaf triangles' setups */
+  SCRATCH_RC_SLOTS,  /* rc-bvh / rc-packet: their index by BVH position */
+  SCRATCH_RC_BOUNDS, /* rc-bvh / rc-packet: wide nodes' bounds */
+  SCRATCH_SM_PRIMS,  /* sort-middle: a batch's set-up primitives */
+  SCRATCH_SM_SPANS,  /* sort-middle: their blocks of rows */
+  SCRATCH_COUNT
+};
+typedef struct rr_scratch {
+  void *p;
+  size_t cap;       /* bytes at p */
+  atomic_bool busy; /* taken: another take gets a fresh buffer */
+} rr_scratch;
 
 struct rr_device {
   rr_error error;
@@ -31,6 +48,7 @@ struct rr_device {
   rr_progress_fn progress; /* rr_device_set_progress; NULL: none */
   void *progress_user;
   double progress_ms;      /* when it was last told an inner fraction */
+  rr_scratch scratch[SCRATCH_COUNT];
 };
 
 /* Records a failure in dev (when not NULL) and returns its code. */
@@ -69,6 +87,21 @@ void rr_parallel_for_progress(int njobs, int threads, rr_parallel_fn fn, void *a
 /* malloc for buffers of many megabytes: in huge pages where the system offers them
  * (fewer page faults); free() releases it. */
 void *rr_alloc_large(size_t bytes);
+/* A work buffer of at least `bytes` (64-byte aligned, uninitialised), from the
+ * device's buffer for `use` when it is free: the pages a frame touched stay mapped
+ * for the next frame (fresh pages cost a fault each: the teapot grid's rc-bvh setups
+ * are 264 MB). The buffer grows by half at least, and lives until the device is
+ * released. With dev NULL, the buffer taken (concurrent renders of one device, or
+ * nested takes) or a failed growth, a fresh allocation; NULL when out of memory. */
+typedef struct rr_buf {
+  void *p;
+  int use; /* the device's buffer it is, or -1: a fresh one */
+} rr_buf;
+rr_buf rr_scratch_take(rr_device *dev, int use, size_t bytes);
+/* Gives back rr_scratch_take's buffer (frees a fresh one); b.p NULL does nothing. */
+void rr_scratch_give(rr_device *dev, rr_buf b);
+/* Frees the device's buffers (rr_device_release). */
+void rr_scratch_free(rr_device *dev);
 /* Number of cores available. */
 int rr_cpu_count(void);
 /* Milliseconds on a monotonic clock. */

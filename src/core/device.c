@@ -4,9 +4,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-rr_device *rr_device_new(void) { return calloc(1, sizeof(rr_device)); }
+rr_device *rr_device_new(void) {
+  rr_device *dev = calloc(1, sizeof(rr_device));
+  for (int u = 0; dev && u < SCRATCH_COUNT; u++) atomic_init(&dev->scratch[u].busy, false);
+  return dev;
+}
 
-void rr_device_release(rr_device *dev) { free(dev); }
+void rr_device_release(rr_device *dev) {
+  if (dev) rr_scratch_free(dev);
+  free(dev);
+}
 
 rr_error rr_device_error(const rr_device *dev) { return dev ? dev->error : RR_ERROR_ARGUMENT; }
 

@@ -790,7 +790,8 @@ static rr_error run2d(rr_device *dev, const progress_span *progress, const rr_sc
                      .setup = setup2d,
                      .rows = rows2d,
                      .band = samples > 1 ? band_job_all : band_job,
-                     .progress = progress};
+                     .progress = progress,
+                     .dev = dev};
     /* blocks of whole tiles, the largest bins and depth blocks */
     ok = rr_sortmiddle(&sm, s->ntris, pp.height, block_size(LEVELS - 1), threads);
     for (int t = 0; t < RR_MAX_THREADS; t++) stats->setups += p->setups[t], stats->edge_evals += p->evals[t];

@@ -90,6 +90,8 @@ typedef struct {
   uint8_t *reached;  /* by wide node (perspective frames): its box may hold a sample (reach_walk) */
   wide_bounds *wb;   /* by wide node */
   thread_stats *st;  /* per thread: S */
+  rr_device *dev;    /* keeps ts, slot and wb for its next frame (rr_scratch_take) */
+  rr_buf ts_buf, slot_buf, wb_buf;
 } frame_setups;
 
 enum { SETUP_CHUNK = 1024, SEEN_CHUNK = 1024, BATCH = 2 * BVH_MAX_LEAF };
@@ -452,16 +454,21 @@ static void wide_union(frame_setups *fs, uint32_t w, float u[5]) {
   }
 }
 
-static void setups_free(frame_setups *fs) { free(fs->ts), free(fs->slot), free(fs->seen), free(fs->reached), free(fs->wb); }
+static void setups_free(frame_setups *fs) {
+  rr_scratch_give(fs->dev, fs->ts_buf), rr_scratch_give(fs->dev, fs->slot_buf), rr_scratch_give(fs->dev, fs->wb_buf);
+  free(fs->seen), free(fs->reached);
+}
 
 static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *ctx, const rr_bvh *b,
                             thread_stats *st) {
   *fs = (frame_setups){.s = ctx->scene, .b = b, .cam = ctx->cam, .cull = ctx->opt->cull_backfaces != 0,
-                        .simd = !ctx->opt->scalar, .st = st};
+                        .simd = !ctx->opt->scalar, .st = st, .dev = dev};
   atomic_init(&fs->nts, 0);
   size_t n = b->vpos;
-  fs->ts = malloc(n * sizeof *fs->ts + 1);
-  fs->slot = malloc(n * sizeof *fs->slot + 1);
+  /* The device's buffers: a frame writes what it reads, and on the teapot grid a
+   * fresh 264 MB of setups would cost a page fault per 4 KiB touched each frame. */
+  fs->ts_buf = rr_scratch_take(dev, SCRATCH_RC_SETUPS, n * sizeof *fs->ts + 1), fs->ts = fs->ts_buf.p;
+  fs->slot_buf = rr_scratch_take(dev, SCRATCH_RC_SLOTS, n * sizeof *fs->slot + 1), fs->slot = fs->slot_buf.p;
   /* Perspective views of scenes with more triangles than samples walk down to the
    * boxes that may hold a sample (reach_walk): a frame touches what its samples can
    * reach, and most triangles fall between samples or outside the view. Where
@@ -472,7 +479,7 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
                ctx->scene->ntris > (uint64_t)ctx->cam->width * (uint64_t)ctx->cam->height;
   if (reach) fs->reached = calloc(b->vwide, 1);
   else if (fs->cam->planar) fs->seen = malloc((size_t)ctx->scene->ntris + 1);
-  fs->wb = aligned_alloc(16, (size_t)b->vwide * sizeof *fs->wb);
+  fs->wb_buf = rr_scratch_take(dev, SCRATCH_RC_BOUNDS, (size_t)b->vwide * sizeof *fs->wb), fs->wb = fs->wb_buf.p;
   if (!fs->ts || !fs->slot || !fs->wb || (reach ? !fs->reached : fs->cam->planar && !fs->seen)) {
     setups_free(fs);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for %zu triangle setups", n);

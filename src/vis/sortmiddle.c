@@ -20,8 +20,9 @@ static void setup_chunk(int k, int thread, void *arg) {
 
 bool rr_sortmiddle(sortmiddle *sm, uint32_t n, int height, int align, int threads) {
   size_t cap = (size_t)sm->batch * sm->out_max;
-  sm->prims = aligned_alloc(64, (cap * sm->size + 63) / 64 * 64);
-  sm->span = malloc(cap * sizeof *sm->span);
+  rr_buf prims = rr_scratch_take(sm->dev, SCRATCH_SM_PRIMS, cap * sm->size);
+  rr_buf span = rr_scratch_take(sm->dev, SCRATCH_SM_SPANS, cap * sizeof *sm->span);
+  sm->prims = prims.p, sm->span = span.p;
   sm->kept = malloc((sm->batch + sm->chunk - 1) / sm->chunk * sizeof *sm->kept);
   bool ok = sm->prims && sm->span && sm->kept;
   /* blocks of whole z-buffer blocks and bins: long runs of a band's primitives lie
@@ -37,7 +38,7 @@ bool rr_sortmiddle(sortmiddle *sm, uint32_t n, int height, int align, int thread
                                       : (progress_span){0};
     rr_parallel_for_progress(sm->bands, threads, sm->band, sm, &part);
   }
-  free(sm->prims), free(sm->span), free(sm->kept);
+  rr_scratch_give(sm->dev, prims), rr_scratch_give(sm->dev, span), free(sm->kept);
   sm->prims = NULL, sm->span = NULL, sm->kept = NULL;
   return ok;
 }

@@ -37,6 +37,7 @@ struct sortmiddle {
   /* Draws band `job` of the batch in this struct (arg), with sm_draw_band. */
   rr_parallel_fn band;
   const progress_span *progress; /* the pass's, reported batch by batch and band by band; NULL: none */
+  rr_device *dev;       /* keeps the batch's buffers for the next pass (rr_scratch_take); NULL: fresh ones */
   /* Filled by rr_sortmiddle: the blocks, and the batch being drawn. */
   int bands, block_rows, height;
   uint32_t first, count;

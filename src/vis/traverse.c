@@ -1035,7 +1035,8 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
                    .setup = root_setup,
                    .rows = root_rows,
                    .band = root_band,
-                   .progress = &ctx->progress};
+                   .progress = &ctx->progress,
+                   .dev = dev};
   /* blocks of whole top-level bins, else of 8 z tiles */
   const oracles *o = ctx->oracles;
   int align = o->binning && o->bin_size > HIZ ? (o->bin_size + HIZ - 1) / HIZ * HIZ : 8 * HIZ;
