@@ -188,8 +188,6 @@ TARGET static inline __attribute__((always_inline)) uint64_t RR_CAT(pixels_at, W
         const int tried = VI_(bits)(in);
         if (!tried) break;
         evals += (uint64_t)__builtin_popcount((unsigned)tried);
-      }
-      if (!stepwise) {
         const VI row = VI_(trunc)((VF_(from_int)(i) + half) * inv_w);
         x = x0 + (i - row * wv), y = y0 + row;
       }

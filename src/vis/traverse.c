@@ -380,15 +380,34 @@ static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, const
   return any;
 }
 
+/* Does the cap's image in lane l of rr_cam_cap_extents4's e, k show a sample of r
+ * (of the image when NULL) at one of the ns positions? */
 static inline __attribute__((always_inline)) bool extent_meets(const camera *cams, int ns, const double e[4][4],
-                                                               const int64_t k[4], int l, const tile_rect *r);
+                                                               const int64_t k[4], int l, const tile_rect *r) {
+  const double el[4] = {e[0][l], e[1][l], e[2][l], e[3][l]};
+  for (int p = 0; p < ns; p++) {
+    int q[4], kp = rr_cam_extent_rect(&cams[p], el, (int)k[l], q);
+    if (kp < 0 || (kp > 0 && (!r || meets(q, *r)))) return true;
+  }
+  return false;
+}
+
+/* rr_cam_cap_extents4 of the caps in lanes 0..used-1 of axis and rho (used >= 1),
+ * the other lanes padded with lane 0's. */
+static void cap_extents(const camera *c, double axis[3][4], double rho[4], int used, bool simd, double e[4][4],
+                        int64_t k[4]) {
+  for (int l = used; l < 4; l++)
+    axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
+  rr_cam_cap_extents4(c, (const double(*)[4])axis, rho, simd, e, k);
+}
+
 
 /* Before their setup: the triangles ids[0..n-1] (first..first+n-1 when ids is
  * NULL) whose corner cap (rr_tri_corner_cap, with the slack of mark_seen) may show
  * a sample of r at some position, into out; four caps' images a step in lanes.
  * Returns how many. */
-static __attribute__((noinline)) uint32_t corner_caps_meet(const trav *t, uint32_t first, const uint32_t *ids, uint32_t n, tile_rect r,
-                                 uint32_t *out) {
+static __attribute__((noinline)) uint32_t corner_caps_meet(const trav *t, uint32_t first, const uint32_t *ids,
+                                                           uint32_t n, tile_rect r, uint32_t *out) {
   uint32_t kept = 0;
   for (uint32_t q = 0; q < n; q += 4) {
     const int m = n - q < 4 ? (int)(n - q) : 4;
@@ -399,11 +418,7 @@ static __attribute__((noinline)) uint32_t corner_caps_meet(const trav *t, uint32
       const uint32_t id = ids ? ids[q + l] : first + q + l;
       slot[l] = rr_tri_corner_cap_lane(t->s, id, t->c, 1e-4, axis, rho, test) > 0 ? test++ : -1;
     }
-    if (test) {
-      for (int l = test; l < 4; l++) /* padding lanes repeat the first */
-        axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
-      rr_cam_cap_extents4(t->c, (const double(*)[4])axis, rho, t->simd, e, k);
-    }
+    if (test) cap_extents(t->c, axis, rho, test, t->simd, e, k);
     for (int l = 0; l < m; l++)
       if (slot[l] < 0 || extent_meets(t->cams, t->ns, (const double(*)[4])e, k, slot[l], &r))
         out[kept++] = ids ? ids[q + l] : first + q + l;
@@ -747,7 +762,8 @@ static cap_shortcut cap_shortcut_of(const camera *c) {
  * A box that holds the eye, or a cap it cannot bound, may. box_cap: false when the
  * box may (or, with sc, is taken as showing one), else true with its cap's axis
  * and rho in lane l of rr_cam_cap_extents4's. */
-static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *sc, double axis[3][4], double *rho, int l) {
+static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *sc, double axis[3][4], double *rho,
+                    int l) {
   const double eye[3] = {cams->eye.x, cams->eye.y, cams->eye.z};
   double b[3], d2 = 0, r2 = 0;
   for (int a = 0; a < 3; a++) {
@@ -767,24 +783,11 @@ static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *s
   return true;
 }
 
-/* Does the cap's image in lane l of rr_cam_cap_extents4's e, k show a sample of r
- * (of the image when NULL) at one of the ns positions? */
-static inline __attribute__((always_inline)) bool extent_meets(const camera *cams, int ns, const double e[4][4],
-                                                               const int64_t k[4], int l, const tile_rect *r) {
-  const double el[4] = {e[0][l], e[1][l], e[2][l], e[3][l]};
-  for (int p = 0; p < ns; p++) {
-    int q[4], kp = rr_cam_extent_rect(&cams[p], el, (int)k[l], q);
-    if (kp < 0 || (kp > 0 && (!r || meets(q, *r)))) return true;
-  }
-  return false;
-}
-
 static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
   double axis[3][4], rho[4], e[4][4];
   int64_t k[4];
   if (!box_cap(cams, n, NULL, axis, rho, 0)) return true;
-  for (int l = 1; l < 4; l++) axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
-  rr_cam_cap_extents4(cams, (const double(*)[4])axis, rho, true, e, k);
+  cap_extents(cams, axis, rho, 1, true, e, k);
   return extent_meets(cams, ns, (const double(*)[4])e, k, 0, r);
 }
 
@@ -992,11 +995,7 @@ static void mark_seen(const trav *t, uint8_t *seen) {
       n[m] = bvh_node_at(bvh, stack[--sp], &buf[m]);
       slot[m] = box_cap(t->cams, n[m], &sc, axis, rho, test) ? test++ : -1;
     }
-    if (test) {
-      for (int l = test; l < 4; l++) /* padding lanes repeat the first */
-        axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
-      rr_cam_cap_extents4(t->c, (const double(*)[4])axis, rho, t->simd, e, k);
-    }
+    if (test) cap_extents(t->c, axis, rho, test, t->simd, e, k);
     for (int i = 0; i < m; i++) {
       if (slot[i] >= 0 && !extent_meets(t->cams, t->ns, (const double(*)[4])e, k, slot[i], NULL)) continue;
       if (n[i]->count) {
