@@ -334,6 +334,10 @@ typedef struct {
   double ms[NCAND], gain[NCAND];
 } timed_view;
 
+static void view_key(char key[128], const char *scene, int type, int w, int h, int cull) {
+  snprintf(key, 128, "%s %d %d %d %d", scene, type, w, h, cull);
+}
+
 static int read_times(const char *path, timed_view *t, int max) {
   FILE *f = path ? fopen(path, "r") : NULL;
   if (!f) return 0;
@@ -353,7 +357,7 @@ static int read_times(const char *path, timed_view *t, int max) {
       (c < NCAND ? t[n].ms : t[n].gain)[c % NCAND] = x;
     }
     if (!ok) continue;
-    snprintf(t[n].key, sizeof t[n].key, "%s %d %d %d %d", name, type, w, h, cull);
+    view_key(t[n].key, name, type, w, h, cull);
     n++;
   }
   fclose(f);
@@ -402,7 +406,7 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
           x->planar = planar, x->kind = kind_of(type);
           for (int c = 0; c < NCAND; c++) x->pred[c] = predicted(&p, c);
           char key[128];
-          snprintf(key, sizeof key, "%s %d %d %d %d", scenes[sc], type, w, h, cull);
+          view_key(key, scenes[sc], type, w, h, cull);
           int k = 0;
           while (k < nknown && strcmp(known[k].key, key)) k++;
           if (k < nknown) {
