@@ -443,7 +443,7 @@ static int calibrate(rr_device *dev, const char *const *scenes, int nscenes, int
          "further thread |\n|---|---|---|---|---|---|\n");
   for (int k = 0; k < RR_CAMERA_COUNT; k++)
     for (int c = 0; c < NCAND; c++)
-      if (kind_of(k) == k) fit(v, nv, k, c, rr_auto_uses(cands[c], is_planar(k)), cost[k][c]);
+      if (kind_of(k) == k) fit(v, nv, k, c, rr_auto_uses(cands[c], (rr_camera_type)k), cost[k][c]);
   for (int c = 0; c < NCAND; c++) {
     double g[MAX_VIEWS];
     int n = 0;

@@ -2,7 +2,8 @@
  * triangles (vis/auto.c) is high for a stack of layers and low for one layer of as
  * many triangles, also when it looks at only some of them, and S/D follows; the
  * setups a front-to-back pass leaves (F) are one layer's, seen from either side (the
- * pass takes the nearest first, not the first in the scene); the per-frame figure is 1. */
+ * pass takes the nearest first, not the first in the scene); the per-frame figure is 1;
+ * a cube's figures are those of its six faces' perspective views, summed. */
 #include "testutil.h"
 #include "vis/vis.h"
 
@@ -62,6 +63,44 @@ static bool predict(rr_device *dev, const rr_scene *s, bool behind, auto_predict
   return rr_auto_predict(dev, s, &cam, &opt, p) == RR_OK;
 }
 
+/* A cube camera inside a stack of layers against the six perspective views of
+ * 90° along its faces: S, A and F (and T, P) are their sums. */
+static void cube_is_six_faces(rr_device *dev) {
+  rr_scene *s = stack(dev, 4, 8);
+  const float eye[3] = {0.3f, 0.2f, -0.15f}, r[3] = {1, 0, 0}, u[3] = {0, 1, 0}, w[3] = {0, 0, -1};
+  const float *fwd[6] = {w, r, NULL, NULL, u, NULL}, *up[6] = {u, u, u, u, NULL, w};
+  const float nw[3] = {0, 0, 1}, nr[3] = {-1, 0, 0}, nu[3] = {0, -1, 0};
+  fwd[2] = nw, fwd[3] = nr, fwd[5] = nu, up[4] = nw; /* back, left, bottom; the top's up */
+  rr_camera cam;
+  rr_camera_init(&cam);
+  rr_render_options opt;
+  rr_render_options_init(&opt);
+  opt.threads = 1;
+  double sum[AUTO_NFIG] = {0};
+  auto_prediction p;
+  bool ok = s != NULL;
+  for (int f = 0; f < 6 && ok; f++) {
+    cam.type = RR_CAMERA_PERSPECTIVE, cam.fov_deg = 90;
+    for (int k = 0; k < 3; k++) cam.eye[k] = eye[k], cam.target[k] = eye[k] + fwd[f][k], cam.up[k] = up[f][k];
+    opt.width = opt.height = 64;
+    ok = rr_auto_predict(dev, s, &cam, &opt, &p) == RR_OK;
+    for (int k = 0; k < AUTO_NFIG; k++) sum[k] += p.fig[k];
+  }
+  cam.type = RR_CAMERA_CUBE;
+  for (int k = 0; k < 3; k++) cam.target[k] = eye[k] + w[k], cam.up[k] = u[k];
+  opt.width = 4 * 64, opt.height = 3 * 64;
+  ok = ok && rr_auto_predict(dev, s, &cam, &opt, &p) == RR_OK;
+  CHECK(ok, "cube: %s", rr_device_message(dev));
+  printf("cube: %s\n", p.figures);
+  const int figs[] = {AUTO_S, AUTO_A, AUTO_F, AUTO_P};
+  for (int k = 0; ok && k < 4; k++) {
+    double x = p.fig[figs[k]], y = sum[figs[k]];
+    CHECK(y > 0 && fabs(x - y) <= 0.02 * y, "cube's %s %g, six faces' %g", rr_auto_fig_names[figs[k]], x, y);
+  }
+  CHECK(!ok || p.fig[AUTO_T] == sum[AUTO_T] / 6, "cube's T %g", p.fig[AUTO_T]);
+  rr_scene_release(s);
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
   /* 8 layers of 24² cells (9216 triangles: more than the model looks at) against
@@ -114,6 +153,7 @@ int main(void) {
           "two layers seen from %s: F = %g", side ? "behind" : "the front", p.fig[AUTO_F]);
   }
   rr_scene_release(two);
+  cube_is_six_faces(dev);
   rr_device_release(dev);
   return test_done();
 }

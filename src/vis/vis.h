@@ -152,7 +152,7 @@ typedef struct auto_prediction {
 rr_error rr_auto_predict(rr_device *dev, const rr_scene *scene, const rr_camera *cam, const rr_render_options *opt,
                          auto_prediction *out);
 /* Which figures a method's cost may use (bit f for figure f), for fitting the costs. */
-unsigned rr_auto_uses(rr_method m, bool planar);
+unsigned rr_auto_uses(rr_method m, rr_camera_type type);
 /* auto's choice for a view (render.c renders it): near[0] the model's pick, near[1..
  * *close-1] the candidates it is unsure of; *repays whether a trial among them
  * (AUTO_TRIAL_ROUNDS interleaved rounds at rr_auto_trial_options' size) repays its
