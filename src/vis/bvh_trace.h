@@ -81,13 +81,15 @@ typedef int (*trace_node_fn)(void *q, const bvh_wide *w, uint32_t ref, uint64_t 
 typedef bool (*trace_leaf_fn)(void *q, uint32_t first, uint32_t count, uint64_t lanes);
 typedef float (*trace_best_fn)(const void *q);
 
-/* The non-empty slots of a wide node: what N counts for a node test. */
-KERNEL uint64_t wide_slots(const bvh_wide *w) {
-  rr_vi4 ref;
-  memcpy(&ref, w->ref, sizeof ref);
+/* The non-empty slots of a wide node's references: what N counts for a node test. */
+KERNEL uint64_t refs_slots(const uint32_t ref[4]) {
+  rr_vi4 r;
+  memcpy(&r, ref, sizeof r);
   /* one compare for the four; the count of the four bits from a table of nibbles */
-  return 0x4332322132212110ull >> (4 * rr_vi4_bits(ref != -1)) & 0xF;
+  return 0x4332322132212110ull >> (4 * rr_vi4_bits(r != -1)) & 0xF;
 }
+
+KERNEL uint64_t wide_slots(const bvh_wide *w) { return refs_slots(w->ref); }
 
 /* Front-to-back traversal of the 4-wide tree from its root with `lanes`: the
  * slots the node test enters, in order, the nearest visited and the others

@@ -71,6 +71,7 @@ typedef struct {
  * an empty slot has an empty rectangle and an infinite bound. */
 typedef struct {
   rr_vf4 x0, y0, x1, y1, tlo;
+  uint32_t slots; /* the node's non-empty slots, what N counts for its test: one load, not four compares */
 } wide_bounds;
 
 typedef struct {
@@ -441,6 +442,7 @@ static void wide_union(frame_setups *fs, uint32_t w, float u[5]) {
   uint32_t ref[4], count[4];
   bvh_wide_refs(fs->b, w, ref, count);
   wide_bounds *wb = &fs->wb[w];
+  wb->slots = (uint32_t)refs_slots(ref);
   for (int i = 0; i < 4; i++) {
     if (count[i] || ref[i] == UINT32_MAX || (fs->reached && !fs->reached[ref[i]])) continue;
     float c[5];
@@ -527,12 +529,12 @@ typedef struct {
 /* Planar cameras: the slots whose rectangle holds the sample and whose bound is
  * not above the best t, nearest bound first (rectangles only: no 3D test). */
 KERNEL int ray_node_planar(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s) {
-  (void)lanes;
+  (void)w, (void)lanes;
   primary_ray *r = q;
   const wide_bounds *wb = &r->wb[ref];
   rr_vf4 x = r->sx4, y = r->sy4;
   rr_vi4 in = (wb->x0 <= x) & (x <= wb->x1) & (wb->y0 <= y) & (y <= wb->y1);
-  r->nodes += wide_slots(w);
+  r->nodes += wb->slots;
   s->order = s->key = wb->tlo;
   return rr_vi4_bits(in & (wb->tlo <= rr_vf4_splat(r->t)));
 }
@@ -542,7 +544,7 @@ KERNEL int ray_node_planar(void *q, const bvh_wide *w, uint32_t ref, uint64_t la
 KERNEL int ray_node_curved(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s) {
   (void)lanes;
   primary_ray *r = q;
-  r->nodes += wide_slots(w);
+  r->nodes += r->wb[ref].slots;
   s->key = r->wb[ref].tlo;
   return wide_test(w, &r->q, 0, s->key, r->t, &s->order);
 }
@@ -640,6 +642,7 @@ KERNEL uint64_t rect_lanes(const packet *p, float x0, float y0, float x1, float 
 /* The slots whose bound is not above every lane's best t, each with the lanes
  * whose samples lie in its rectangle, nearest bound first. */
 KERNEL int packet_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes, trace_slots *s) {
+  (void)w;
   packet *p = q;
   const wide_bounds *wb = &p->fs->wb[ref];
   int hits = 0;
@@ -648,7 +651,7 @@ KERNEL int packet_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes,
     hits |= (s->lanes[i] != 0) << i;
   }
   s->order = s->key = wb->tlo;
-  uint64_t tested = wide_slots(w);
+  uint64_t tested = wb->slots;
   p->nodes += tested;
   if (p->heat) {
     float share = (float)tested / (float)__builtin_popcountll(lanes);
