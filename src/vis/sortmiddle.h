@@ -17,6 +17,7 @@
 /* The most set-up primitives a chunk may hold, chunk × out_max (a band lists them
  * by 16-bit index). */
 #define SM_CHUNK_MAX 16384
+#define SM_BANDS_MAX (4 * RR_MAX_THREADS)
 
 /* The blocks of rows a set-up primitive meets, first to last, and the first's band. */
 typedef struct sm_span {
@@ -28,7 +29,11 @@ typedef struct sm_batch {
   uint32_t first, count;
   char *prims;          /* chunk k's set-up primitives from prims + k × chunk × out_max × size, */
   sm_span *span;        /* their spans from the same index, */
-  uint32_t *kept;       /* and kept[k] of them */
+  uint32_t *kept;       /* and kept[k] of them; on several bands, */
+  uint16_t *order;      /* chunk k's kept primitives (indices in the chunk) from order + k × chunk ×
+                         * out_max, grouped: those meeting one block by band, then those meeting
+                         * several, each group in batch order; */
+  uint16_t *start;      /* where each group starts, bands + 2 a chunk from start + k × (bands + 2) */
 } sm_batch;
 
 typedef struct sortmiddle sortmiddle;
@@ -73,28 +78,31 @@ KERNEL void sm_draw_band(const sortmiddle *sm, int b, void *state,
       for (uint32_t q = 0; q < bt->kept[k]; q++) draw(state, bt->prims + ((size_t)k * cap + q) * sm->size, 0, sm->height);
     return;
   }
-  int rows = sm->block_rows, height = sm->height;
+  const int rows = sm->block_rows, height = sm->height, bands = sm->bands;
   for (int k = 0; k < nchunks; k++) {
     const char *prims = bt->prims + (size_t)k * cap * sm->size;
     const sm_span *span = bt->span + (size_t)k * cap;
-    /* The band's primitives are scattered through the chunk (and often in another
-     * core's cache): list them first, then fetch each a few ahead of its drawing. */
-    uint16_t mine[SM_CHUNK_MAX];
-    int16_t skip[SM_CHUNK_MAX]; /* blocks from its first to band b's first */
-    int n = 0;
-    for (uint32_t q = 0; q < bt->kept[k]; q++) {
-      int s = b - span[q].band;
-      if (s < 0) s += sm->bands;
-      if (span[q].first + s <= span[q].last) mine[n] = (uint16_t)q, skip[n++] = (int16_t)s;
-    }
-    for (int i = 0; i < n; i++) {
-      if (i + 6 < n) {
-        const char *ahead = prims + (size_t)mine[i + 6] * sm->size;
-        __builtin_prefetch(ahead), __builtin_prefetch(ahead + 64);
-      }
-      int q = mine[i];
-      for (int blk = span[q].first + skip[i]; blk <= span[q].last; blk += sm->bands)
+    /* The band's primitives of one block and those of several, two lists in batch
+     * order (sm_batch.order), merged; each fetched a few ahead of its drawing (the
+     * lists are scattered through the chunk, often in another core's cache). */
+    const uint16_t *order = bt->order + (size_t)k * cap, *start = bt->start + (size_t)k * (bands + 2);
+    const uint16_t *one = order + start[b], *one_end = order + start[b + 1];
+    const uint16_t *wide = order + start[bands], *wide_end = order + start[bands + 1];
+    while (one < one_end || wide < wide_end) {
+      if (wide == wide_end || (one < one_end && *one < *wide)) {
+        if (one + 6 < one_end) {
+          const char *ahead = prims + (size_t)one[6] * sm->size;
+          __builtin_prefetch(ahead), __builtin_prefetch(ahead + 64);
+        }
+        const int q = *one++, blk = span[q].first;
         draw(state, prims + (size_t)q * sm->size, blk * rows, (blk + 1) * rows < height ? (blk + 1) * rows : height);
+      } else {
+        const int q = *wide++;
+        int s = b - span[q].band; /* blocks from its first to band b's first */
+        if (s < 0) s += bands;
+        for (int blk = span[q].first + s; blk <= span[q].last; blk += bands)
+          draw(state, prims + (size_t)q * sm->size, blk * rows, (blk + 1) * rows < height ? (blk + 1) * rows : height);
+      }
     }
   }
 }
