@@ -145,13 +145,25 @@ TARGET __attribute__((always_inline)) static inline uint32_t RR_CAT(corner_bound
   return kept;
 }
 
+/* corner_bounds over triangles ids[0..n-1] (first..first+n-1), W a step, into out;
+ * returns how many it kept. The camera's constants are made once for the run. */
+TARGET __attribute__((always_inline)) static inline uint32_t RR_CAT(corner_bounds_run, W)(
+    const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c, int npos,
+    const float (*pos)[2], tri_bound *out, bool flat) {
+  uint32_t kept = 0;
+  for (uint32_t k = 0; k < n; k += W)
+    kept += RR_CAT(corner_bounds, W)(s, first + k, ids ? ids + k : NULL, n - k < W ? (int)(n - k) : W, c, npos, pos,
+                                     out + kept, flat);
+  return kept;
+}
+
 /* corner_bounds compiled apart for one position and for scenes without instances */
-TARGET static uint32_t RR_CAT(corner_bounds_any, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
-                                                    const camera *c, int npos, const float (*pos)[2],
+TARGET static uint32_t RR_CAT(corner_bounds_any, W)(const rr_scene *s, uint32_t first, const uint32_t *ids,
+                                                    uint32_t n, const camera *c, int npos, const float (*pos)[2],
                                                     tri_bound *out) {
   if (npos == 1)
-    return s->inst ? RR_CAT(corner_bounds, W)(s, first, ids, n, c, 1, pos, out, false)
-                   : RR_CAT(corner_bounds, W)(s, first, ids, n, c, 1, pos, out, true);
-  return s->inst ? RR_CAT(corner_bounds, W)(s, first, ids, n, c, npos, pos, out, false)
-                 : RR_CAT(corner_bounds, W)(s, first, ids, n, c, npos, pos, out, true);
+    return s->inst ? RR_CAT(corner_bounds_run, W)(s, first, ids, n, c, 1, pos, out, false)
+                   : RR_CAT(corner_bounds_run, W)(s, first, ids, n, c, 1, pos, out, true);
+  return s->inst ? RR_CAT(corner_bounds_run, W)(s, first, ids, n, c, npos, pos, out, false)
+                 : RR_CAT(corner_bounds_run, W)(s, first, ids, n, c, npos, pos, out, true);
 }
