@@ -46,10 +46,24 @@ static void batch_job(int job, int thread, void *arg) {
   else setup_chunk(job - bands, thread, sm);
 }
 
+/* One loop: the bands of sm->draw and the setup chunks of sm->set (either may be empty). */
+static void run_loop(sortmiddle *sm, uint32_t n, int threads) {
+  const sm_batch *d = &sm->draw;
+  const int draws = d->count ? sm->bands : 0, jobs = draws + nchunks(sm, &sm->set);
+  /* progress: by the batch being drawn */
+  progress_span part = sm->progress && draws ? rr_progress_part(sm->progress, (double)d->first / n,
+                                                                (double)(d->first + d->count) / n)
+                                             : (progress_span){0};
+  rr_parallel_for_progress(jobs, threads, batch_job, sm, draws ? &part : NULL);
+}
+
 bool rr_sortmiddle(sortmiddle *sm, uint32_t n, int height, int align, int threads) {
-  /* Two batches in flight, one drawn while the next is set up: the loop that draws
-   * a batch has no tail in which a thread waits for another's last band. */
-  const int nbuf = n > sm->batch ? 2 : 1;
+  /* On several threads, two batches in flight, one drawn while the next is set up:
+   * the loop that draws a batch has no tail in which a thread waits for another's
+   * last band. One thread draws each batch right after its setup, while it is in
+   * cache. */
+  const bool pipe = threads > 1 && n > sm->batch;
+  const int nbuf = pipe ? 2 : 1;
   const size_t cap = (size_t)sm->batch * sm->out_max, nk = (sm->batch + sm->chunk - 1) / sm->chunk;
   rr_buf prims = rr_scratch_take(sm->dev, SCRATCH_SM_PRIMS, nbuf * cap * sm->size);
   rr_buf span = rr_scratch_take(sm->dev, SCRATCH_SM_SPANS, nbuf * cap * sizeof(sm_span));
@@ -74,14 +88,13 @@ bool rr_sortmiddle(sortmiddle *sm, uint32_t n, int height, int align, int thread
                          .kept = kept + buf * nk,
                          .order = order ? order + buf * cap : NULL,
                          .start = start ? start + buf * nk * (bands + 2) : NULL};
-    const int draws = sm->draw.count ? sm->bands : 0, jobs = draws + nchunks(sm, &sm->set);
-    /* progress: by the batch being drawn */
-    const sm_batch *d = &sm->draw;
-    progress_span part = sm->progress && draws ? rr_progress_part(sm->progress, (double)d->first / n,
-                                                                  (double)(d->first + d->count) / n)
-                                               : (progress_span){0};
-    rr_parallel_for_progress(jobs, threads, batch_job, sm, draws ? &part : NULL);
+    run_loop(sm, n, threads);
     sm->draw = sm->set;
+    if (!pipe && sm->draw.count) { /* drawn now, from the one buffer */
+      sm->set = (sm_batch){0};
+      run_loop(sm, n, threads);
+      sm->draw = (sm_batch){0};
+    }
   }
   rr_scratch_give(sm->dev, prims), rr_scratch_give(sm->dev, span), free(kept), free(order), free(start);
   sm->draw = sm->set = (sm_batch){0};
