@@ -113,15 +113,11 @@ bool rr_tri_screen_bounds_sph(const rr_scene *s, uint32_t i, const camera *c, co
 
 uint32_t rr_tri_corner_bounds_at(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,
                                  int npos, const float (*pos)[2], bool simd, tri_bound *out) {
-  uint32_t kept = 0, k = 0;
 #ifdef RR_SIMD_X86
-  if (simd && __builtin_cpu_supports("avx2"))
-    for (; k < n; k += 8)
-      kept += corner_bounds_any8(s, first + k, ids ? ids + k : NULL, n - k < 8 ? (int)(n - k) : 8, c, npos, pos, out + kept);
+  if (simd && __builtin_cpu_supports("avx2")) return corner_bounds_any8(s, first, ids, n, c, npos, pos, out);
 #endif
   (void)simd;
-  for (; k < n; k++) kept += corner_bounds_any1(s, first + k, ids ? ids + k : NULL, 1, c, npos, pos, out + kept);
-  return kept;
+  return corner_bounds_any1(s, first, ids, n, c, npos, pos, out);
 }
 
 uint32_t rr_tri_corner_bounds(const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c,

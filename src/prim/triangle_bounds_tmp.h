@@ -17,8 +17,13 @@ TARGET __attribute__((always_inline)) static inline uint32_t RR_CAT(corner_bound
     const rr_scene *s, uint32_t first, const uint32_t *ids, int n, const camera *c, int npos, const float (*pos)[2],
     tri_bound *out, bool flat) {
   int32_t lane_id[W], lane_inf[W] = {0};
-  for (int l = 0; l < W; l++)
-    lane_id[l] = (int32_t)(ids ? ids[l < n ? l : n - 1] : first + (uint32_t)(l < n ? l : n - 1));
+  if (ids) {
+    for (int l = 0; l < W; l++) lane_id[l] = (int32_t)ids[l < n ? l : n - 1];
+  } else { /* first, first + 1, ...: the root pass's every call, in lanes */
+    const VI l = VI_(lanes)(), last = VI_(splat)(n - 1);
+    const VI v = VI_(splat)((int32_t)first) + VI_(select)(l < last, l, last);
+    memcpy(lane_id, &v, sizeof lane_id);
+  }
   if (s->inf)
     for (int l = 0; l < W; l++) lane_inf[l] = (int32_t)scene_inf(s, (uint32_t)lane_id[l]);
   const VI inf = VI_(load)(lane_inf);
@@ -140,13 +145,25 @@ TARGET __attribute__((always_inline)) static inline uint32_t RR_CAT(corner_bound
   return kept;
 }
 
+/* corner_bounds over triangles ids[0..n-1] (first..first+n-1), W a step, into out;
+ * returns how many it kept. The camera's constants are made once for the run. */
+TARGET __attribute__((always_inline)) static inline uint32_t RR_CAT(corner_bounds_run, W)(
+    const rr_scene *s, uint32_t first, const uint32_t *ids, uint32_t n, const camera *c, int npos,
+    const float (*pos)[2], tri_bound *out, bool flat) {
+  uint32_t kept = 0;
+  for (uint32_t k = 0; k < n; k += W)
+    kept += RR_CAT(corner_bounds, W)(s, first + k, ids ? ids + k : NULL, n - k < W ? (int)(n - k) : W, c, npos, pos,
+                                     out + kept, flat);
+  return kept;
+}
+
 /* corner_bounds compiled apart for one position and for scenes without instances */
-TARGET static uint32_t RR_CAT(corner_bounds_any, W)(const rr_scene *s, uint32_t first, const uint32_t *ids, int n,
-                                                    const camera *c, int npos, const float (*pos)[2],
+TARGET static uint32_t RR_CAT(corner_bounds_any, W)(const rr_scene *s, uint32_t first, const uint32_t *ids,
+                                                    uint32_t n, const camera *c, int npos, const float (*pos)[2],
                                                     tri_bound *out) {
   if (npos == 1)
-    return s->inst ? RR_CAT(corner_bounds, W)(s, first, ids, n, c, 1, pos, out, false)
-                   : RR_CAT(corner_bounds, W)(s, first, ids, n, c, 1, pos, out, true);
-  return s->inst ? RR_CAT(corner_bounds, W)(s, first, ids, n, c, npos, pos, out, false)
-                 : RR_CAT(corner_bounds, W)(s, first, ids, n, c, npos, pos, out, true);
+    return s->inst ? RR_CAT(corner_bounds_run, W)(s, first, ids, n, c, 1, pos, out, false)
+                   : RR_CAT(corner_bounds_run, W)(s, first, ids, n, c, 1, pos, out, true);
+  return s->inst ? RR_CAT(corner_bounds_run, W)(s, first, ids, n, c, npos, pos, out, false)
+                 : RR_CAT(corner_bounds_run, W)(s, first, ids, n, c, npos, pos, out, true);
 }

@@ -13,7 +13,16 @@
  * (Two entries, so the one-position frame takes no more steps than before.) */
 uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const camera *c, visbuf *vb,
                         uint64_t *covered, bool simd) {
-  uint64_t n, samples = (uint64_t)(r[2] - r[0] + 1) * (uint64_t)(r[3] - r[1] + 1);
+  uint64_t n = 0, samples = (uint64_t)(r[2] - r[0] + 1) * (uint64_t)(r[3] - r[1] + 1);
+  if (c->planar && samples <= 2) {
+    /* one or two samples (most triangles of a detailed mesh): the one sample test
+     * as rc calls it, the same bits without the loop's constants (lanes_of) */
+    for (int y = r[1]; y <= r[3]; y++)
+      for (int x = r[0]; x <= r[2]; x++) {
+        const float sx = (float)x + c->sx0, sy = (float)y + c->sy0;
+        n += shade_sample_w(ts, id, v3(1.0f, sx, sy), sx, sy, vb, (size_t)y * vb->width + (size_t)x) != 0;
+      }
+  } else
 #ifdef RR_SIMD_X86
   /* a rectangle of a few samples (most triangles of a detailed mesh) costs less
    * than the vector loop's setup; both paths give the same bits */
