@@ -320,6 +320,22 @@ int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int rect[
 void rr_cam_cap_extents4(const camera *c, const double axis[3][4], const double rho[4], bool simd, double e[4][4],
                          int64_t k[4]);
 int rr_cam_extent_rect(const camera *c, const double e[4], int k, int rect[4]);
+/* rr_cam_cap_rect for four caps in lanes at once, and for the ns positions
+ * cams[0..ns-1] (cameras that differ only in sx0, sy0): the lanes of the bit mask
+ * used whose rectangle at some position meets r (x0, y0, x1, y1, ends exclusive),
+ * or that know no bound (every lane for cameras not polar); AVX2 when simd. */
+unsigned rr_cam_caps_show4(const camera *cams, int ns, const double axis[3][4], const double rho[4], unsigned used,
+                           const int r[4], bool simd);
+/* Boxes a polar camera's samples see most of (rr_cam_cap_shortcut, for a walk
+ * over a whole image) are taken as showing one without their image. */
+typedef struct cam_cap_shortcut {
+  double rho_min, cos_min, sin_min; /* rho_min infinite: none */
+} cam_cap_shortcut;
+cam_cap_shortcut rr_cam_cap_shortcut(const camera *c);
+/* The same for four boxes (lo, hi: lanes per axis) seen from cams' eye, by their
+ * bounding balls' caps (prim/triangle_curved.c argues the slack); sc may be NULL. */
+unsigned rr_cam_boxes_show4(const camera *cams, int ns, const float lo[3][4], const float hi[3][4], unsigned used,
+                            const cam_cap_shortcut *sc, const int r[4], bool simd);
 /* Before any setup: the image rectangle of the cap about triangle i's corner
  * directions from c's eye, widened by slack radians (what the caller allows for
  * the rounding of the setup); as rr_cam_cap_rect, -1 also for corners at infinity. */

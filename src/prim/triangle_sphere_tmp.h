@@ -68,6 +68,63 @@ SPH_TARGET static void SPH_CAT(cap_lanes)(const camera *c, const vd4 m[3], const
   *k_ = vsel_l(rho < 1.5, k, vl_splat(-1));
 }
 
+/* The lanes of `used` whose cap (axis m, radius rho) may show a sample of r (x0,
+ * y0, x1, y1, ends exclusive) at one of the ns positions cams[0..ns-1] (cameras
+ * that differ only in sx0, sy0): cap_lanes knows no bound, or the rectangle
+ * sample_rect rounds its image to meets r (the same rounding in lanes: that
+ * rectangle meets r iff max(ceil(x0'), r.x0) <= min(floor(x1'), r.x1 - 1) per
+ * axis, a NaN end taken as unbounded, as ceil_in and floor_in take it). A bit a lane. */
+SPH_TARGET static unsigned SPH_CAT(caps_show)(const camera *cams, int ns, const vd4 m[3], const vd4 *rho,
+                                              unsigned used, const int r[4]) {
+  vd4 e[4];
+  vl4 k;
+  SPH_CAT(cap_lanes)(cams, m, rho, e, &k);
+  vl4 show = k < 0;
+  const vd4 rx0 = vd_splat(r[0]), ry0 = vd_splat(r[1]), rx1 = vd_splat(r[2] - 1), ry1 = vd_splat(r[3] - 1);
+  for (int p = 0; p < ns; p++) {
+    const double sx = cams[p].sx0, sy = cams[p].sy0;
+    const vd4 lx = vmax(SPH_CEIL(e[0] - sx - 1e-2), rx0), hx = vmin(SPH_FLOOR(e[1] - sx + 1e-2), rx1);
+    const vd4 ly = vmax(SPH_CEIL(e[2] - sy - 1e-2), ry0), hy = vmin(SPH_FLOOR(e[3] - sy + 1e-2), ry1);
+    show |= (k > 0) & (lx <= hx) & (ly <= hy);
+  }
+  unsigned bits = 0;
+  for (int l = 0; l < 4; l++) bits |= (unsigned)(show[l] != 0) << l;
+  return bits & used;
+}
+
+/* The lanes of `used` whose box (lo, hi: lanes per axis) may show a sample of r
+ * at one of the ns positions: rr_cam_boxes_show4's argument (triangle_curved.c),
+ * the box's ball's cap about b − eye of radius s / √(1 − s²) + 1e-4, s the ball's
+ * radius over its distance; a box too near the eye (s² >= 0.98), or one that sc
+ * takes as showing a sample, may. */
+SPH_TARGET static unsigned SPH_CAT(boxes_show)(const camera *cams, int ns, const float lo[3][4],
+                                               const float hi[3][4], unsigned used, const cam_cap_shortcut *sc,
+                                               const int r[4]) {
+  const double eye[3] = {cams->eye.x, cams->eye.y, cams->eye.z};
+  vd4 b[3], d2 = vd_splat(0), r2 = vd_splat(0);
+  for (int a = 0; a < 3; a++) {
+    vd4 l = vd_splat(0), h = vd_splat(0);
+    for (int j = 0; j < 4; j++) l[j] = lo[a][j], h[j] = hi[a][j];
+    b[a] = 0.5 * (l + h) - eye[a], d2 += b[a] * b[a];
+    r2 += 0.25 * (h - l) * (h - l);
+  }
+  const vd4 s2 = r2 * (1 + 1e-9) / d2;
+  const vl4 near = ~(s2 < 0.98);
+  const vd4 inv = 1 / SPH_SQRT(d2), rho = SPH_SQRT(s2 / (1 - s2)) + 1e-4;
+  vd4 m[3];
+  for (int a = 0; a < 3; a++) m[a] = b[a] * inv;
+  vl4 take = near;
+  if (sc) {
+    const vd4 mf = m[0] * (double)cams->fwd.x + m[1] * (double)cams->fwd.y + m[2] * (double)cams->fwd.z;
+    take |= (rho >= sc->rho_min) & (mf >= sc->cos_min + rho * sc->sin_min);
+  }
+  unsigned bits = 0;
+  for (int l = 0; l < 4; l++) bits |= (unsigned)(take[l] != 0) << l;
+  bits &= used;
+  if (bits == used) return used;
+  return bits | SPH_CAT(caps_show)(cams, ns, m, &rho, used & ~bits, r);
+}
+
 /* A lane that fails a test only clears its ok or cap; its NaNs go nowhere. Four
  * lanes, not eight: a leaf's setups keep about three. nv (may be NULL): the normals
  * and vertices, for the arcs, and the chart's triangle (gx, gt; else gt infinite).
