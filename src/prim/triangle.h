@@ -279,6 +279,11 @@ struct tri_sphere {
   bool ok, cap;
   int8_t img_k;  /* the cap's image for rr_tri_spheres_cam's camera (parabolic): TRI_CAP_UNSET, */
   double img[4]; /* or rr_cam_cap_rect's 1 with its extents x0, x1, y0, y1 (sample coordinates), 0, -1 */
+  /* rr_tri_curved_rect_sph's answer for that camera at its own position
+   * (rect_sx, rect_sy), where the cap's image gives it: TRI_CAP_UNSET, 0, or 1 with rect */
+  int8_t rect_k;
+  float rect_sx, rect_sy;
+  int rect[4];
   /* with the cap, computed only where prim/triangle_curved.c needs them: the
    * triangle in the gnomonic chart about the axis m that holds every passing
    * sample (chart_extent) and the largest length of its vertices (infinite when

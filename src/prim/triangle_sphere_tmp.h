@@ -189,10 +189,35 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
   vd4 ext[4] = {0};
   vl4 img = vl_splat(TRI_CAP_UNSET);
   if (pc) SPH_CAT(cap_lanes)(pc, m, &rho, ext, &img);
+  /* rr_tri_curved_rect_sph's answer at pc's own position where the cap alone gives
+   * it (no sample; or a round triangle's small rectangle, kept as it is), with
+   * sample_rect's rounding (caps_show's comment) */
+  vl4 dec = vl_splat(TRI_CAP_UNSET);
+  vd4 rl[4] = {0};
+  if (pc) {
+    const double sx = pc->sx0, sy = pc->sy0;
+    rl[0] = vmax(SPH_CEIL(ext[0] - sx - 1e-2), vd_splat(0));
+    rl[1] = vmax(SPH_CEIL(ext[2] - sy - 1e-2), vd_splat(0));
+    rl[2] = vmin(SPH_FLOOR(ext[1] - sx + 1e-2), vd_splat(pc->width - 1));
+    rl[3] = vmin(SPH_FLOOR(ext[3] - sy + 1e-2), vd_splat(pc->height - 1));
+    const vl4 some = (img == 1) & (rl[0] <= rl[2]) & (rl[1] <= rl[3]);
+    const vd4 area = (rl[2] - rl[0] + 1) * (rl[3] - rl[1] + 1);
+    const double most = pc->type == RR_CAMERA_PARABOLIC ? CAP_ENOUGH : CHART_FROM;
+    const vl4 known = ok & cap & ((img == 0) | ((img == 1) & ~some) | (some & (smin > 1e-3) & (area <= most)));
+    dec = vsel_l(known, some & 1, dec);
+  }
+  int32_t ri[4][4]; /* the rectangles' bounds, where decided 1 (else 0: no conversion out of range) */
+  double ex[4][4];
+  for (int k = 0; k < 4; k++) {
+    const vi4 q = __builtin_convertvector(vsel(dec == 1, rl[k], vd_splat(0)), vi4);
+    memcpy(ri[k], &q, sizeof q), memcpy(ex[k], &ext[k], sizeof ex[k]);
+  }
   for (int l = 0; l < n; l++) {
     tri_sphere *o = &out[l];
     o->img_k = (int8_t)img[l];
-    for (int k = 0; k < 4 && pc; k++) o->img[k] = ext[k][l];
+    o->rect_k = (int8_t)dec[l];
+    if (pc) o->rect_sx = pc->sx0, o->rect_sy = pc->sy0;
+    for (int k = 0; k < 4; k++) o->rect[k] = ri[k][l], o->img[k] = ex[k][l];
     for (int i = 0; i < 3 && nv; i++)
       for (int k = 0; k < 3; k++) nv[l][0][i][k] = nrm[i][k][l], nv[l][1][i][k] = v[i][k][l];
     for (int k = 0; k < 3; k++) o->axis[k] = m[k][l];

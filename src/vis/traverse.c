@@ -514,6 +514,9 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
     uint32_t lid[8];
     tri_setup ts[8];
     for (; q < n && m < 8; q++) {
+      uint64_t none = 0; /* (the root pass: eight unseen at a step) */
+      while (!ids && t->seen && q + 8 <= n && (memcpy(&none, t->seen + first + q, 8), !none)) q += 8;
+      if (q >= n) break;
       uint32_t id = ids ? ids[q] : first + q;
       if (t->seen && !t->seen[id]) continue;
       lid[m++] = id;
