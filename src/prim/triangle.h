@@ -291,6 +291,13 @@ struct tri_sphere {
   double gx[3][3], gt;
 };
 #define TRI_CAP_UNSET 2
+/* sp's rectangle as its lanes decided it for c's position (rect_k): 1 with rect, 0
+ * when no sample can pass, -1 when not decided there (rr_tri_curved_rect_sph then). */
+static inline int rr_tri_sphere_decided(const camera *c, const tri_sphere *sp, int rect[4]) {
+  if (sp->rect_k == TRI_CAP_UNSET || c->sx0 != sp->rect_sx || c->sy0 != sp->rect_sy) return -1;
+  memcpy(rect, sp->rect, sizeof sp->rect);
+  return sp->rect_k;
+}
 void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out);
 /* The same with the cap's image for camera c (NULL: none; so far the parabolic's,
  * computed in the lanes), whatever the sample position: rr_tri_sphere_cap_rect then serves every camera that differs from c

@@ -127,6 +127,7 @@ static void polar_range(const dv3 nu[3], const dv3 v[3], double E, dv3 P, dv3 e1
 typedef double vd4 __attribute__((vector_size(32)));
 typedef int64_t vl4 __attribute__((vector_size(32)));
 typedef int32_t vi4 __attribute__((vector_size(16)));
+typedef float vf4 __attribute__((vector_size(16)));
 /* macros, not functions: 32-byte vector arguments would change the ABI without AVX */
 #define vd_splat(x) ((vd4){0} + (x))
 #define vl_splat(x) ((vl4){0} + (x))
@@ -477,10 +478,8 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
 
 int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_sphere *sp, int r[4]) {
   if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
-  if (sp->rect_k != TRI_CAP_UNSET && c->sx0 == sp->rect_sx && c->sy0 == sp->rect_sy) { /* from the lanes */
-    memcpy(r, sp->rect, sizeof sp->rect);
-    return sp->rect_k;
-  }
+  const int lanes = rr_tri_sphere_decided(c, sp, r);
+  if (lanes >= 0) return lanes;
   if (!sp->ok) return -1;
   const double E = sp->E;
   const int kind = sp->smin > 1e-3 ? 1 : 2;

@@ -103,8 +103,9 @@ SPH_TARGET static unsigned SPH_CAT(boxes_show)(const camera *cams, int ns, const
   const double eye[3] = {cams->eye.x, cams->eye.y, cams->eye.z};
   vd4 b[3], d2 = vd_splat(0), r2 = vd_splat(0);
   for (int a = 0; a < 3; a++) {
-    vd4 l = vd_splat(0), h = vd_splat(0);
-    for (int j = 0; j < 4; j++) l[j] = lo[a][j], h[j] = hi[a][j];
+    vf4 lf, hf;
+    memcpy(&lf, lo[a], sizeof lf), memcpy(&hf, hi[a], sizeof hf);
+    const vd4 l = __builtin_convertvector(lf, vd4), h = __builtin_convertvector(hf, vd4);
     b[a] = 0.5 * (l + h) - eye[a], d2 += b[a] * b[a];
     r2 += 0.25 * (h - l) * (h - l);
   }
@@ -132,11 +133,12 @@ SPH_TARGET static unsigned SPH_CAT(boxes_show)(const camera *cams, int ns, const
 SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tri_sphere *out, double (*nv)[2][3][3]) {
   vd4 nrm[3][3], v[3][3]; /* [edge or vertex][axis] */
   vl4 ok = vl_splat(-1);
+  const tri_setup *t[4]; /* padding lanes repeat the last */
+  for (int l = 0; l < 4; l++) t[l] = &ts[l < n ? l : n - 1];
   for (int i = 0; i < 3; i++) {
-    for (int l = 0; l < 4; l++) {
-      const tri_setup *t = &ts[l < n ? l : n - 1]; /* padding lanes repeat the last */
-      nrm[i][0][l] = t->a[i], nrm[i][1][l] = t->b[i], nrm[i][2][l] = t->c[i];
-    }
+    nrm[i][0] = (vd4){t[0]->a[i], t[1]->a[i], t[2]->a[i], t[3]->a[i]};
+    nrm[i][1] = (vd4){t[0]->b[i], t[1]->b[i], t[2]->b[i], t[3]->b[i]};
+    nrm[i][2] = (vd4){t[0]->c[i], t[1]->c[i], t[2]->c[i], t[3]->c[i]};
     vd4 l2 = vdot(nrm[i], nrm[i]);
     ok &= l2 > 0;
     vd4 inv = 1 / SPH_SQRT(l2);
@@ -171,8 +173,7 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
   /* chart_extent's triangle: the vertices in the gnomonic chart about m
    * (v·m >= cr > 0.1 with the cap), each moved to where the edges through it,
    * shifted out by ε / cos ρ, meet (chart_extent's comment) */
-  vd4 gx[3][3], gt2 = vd_splat(0);
-  memset(gx, 0, sizeof gx);
+  vd4 gx[3][3], gt2 = vd_splat(0); /* (with nv only) */
   const vd4 ec = eps / (1 - rho * rho / 2);
   for (int i = 0; i < 3 && nv; i++) { /* (rarely needed: with the arcs' normals and vertices only) */
     const vd4 *nj = nrm[(i + 1) % 3], *nk = nrm[(i + 2) % 3];
@@ -206,25 +207,26 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
     const vl4 known = ok & cap & ((img == 0) | ((img == 1) & ~some) | (some & (smin > 1e-3) & (area <= most)));
     dec = vsel_l(known, some & 1, dec);
   }
+  /* out of the lanes through memory, a row per quantity */
   int32_t ri[4][4]; /* the rectangles' bounds, where decided 1 (else 0: no conversion out of range) */
-  double ex[4][4];
+  int64_t kk[4][4];
+  double ex[4][4], dd[7][4];
+  const vd4 drow[7] = {m[0], m[1], m[2], smin, E, rho, nv ? gt : vd_splat(INFINITY)};
+  const vl4 krow[4] = {img, dec, ok, ok & cap};
   for (int k = 0; k < 4; k++) {
     const vi4 q = __builtin_convertvector(vsel(dec == 1, rl[k], vd_splat(0)), vi4);
-    memcpy(ri[k], &q, sizeof q), memcpy(ex[k], &ext[k], sizeof ex[k]);
+    memcpy(ri[k], &q, sizeof q), memcpy(ex[k], &ext[k], sizeof ex[k]), memcpy(kk[k], &krow[k], sizeof kk[k]);
   }
+  memcpy(dd, drow, sizeof dd);
   for (int l = 0; l < n; l++) {
     tri_sphere *o = &out[l];
-    o->img_k = (int8_t)img[l];
-    o->rect_k = (int8_t)dec[l];
-    if (pc) o->rect_sx = pc->sx0, o->rect_sy = pc->sy0;
+    o->img_k = (int8_t)kk[0][l], o->rect_k = (int8_t)kk[1][l], o->ok = kk[2][l] != 0, o->cap = kk[3][l] != 0;
+    o->rect_sx = pc ? pc->sx0 : 0, o->rect_sy = pc ? pc->sy0 : 0;
     for (int k = 0; k < 4; k++) o->rect[k] = ri[k][l], o->img[k] = ex[k][l];
+    for (int k = 0; k < 3; k++) o->axis[k] = dd[k][l];
+    o->smin = dd[3][l], o->E = dd[4][l], o->rho = dd[5][l], o->gt = dd[6][l];
     for (int i = 0; i < 3 && nv; i++)
-      for (int k = 0; k < 3; k++) nv[l][0][i][k] = nrm[i][k][l], nv[l][1][i][k] = v[i][k][l];
-    for (int k = 0; k < 3; k++) o->axis[k] = m[k][l];
-    for (int i = 0; i < 3 && nv; i++)
-      for (int k = 0; k < 3; k++) o->gx[i][k] = gx[i][k][l];
-    o->gt = nv ? gt[l] : INFINITY;
-    o->smin = smin[l], o->E = E[l], o->rho = rho[l];
-    o->ok = ok[l] != 0, o->cap = ok[l] && cap[l];
+      for (int k = 0; k < 3; k++)
+        nv[l][0][i][k] = nrm[i][k][l], nv[l][1][i][k] = v[i][k][l], o->gx[i][k] = gx[i][k][l];
   }
 }

@@ -370,8 +370,8 @@ static bool meets(const int bb[4], tile_rect r) {
 static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, const tri_sphere *sp, int bb[4]) {
   bool any = false;
   for (int s = 0; s < t->ns; s++) {
-    int r[4];
-    if (!rr_tri_screen_bounds_sph(t->s, id, &t->cams[s], ts, sp, r)) continue;
+    int r[4], lanes = rr_tri_sphere_decided(&t->cams[s], sp, r); /* (the common case, at once) */
+    if (lanes == 0 || (lanes < 0 && !rr_tri_screen_bounds_sph(t->s, id, &t->cams[s], ts, sp, r))) continue;
     if (!any) memcpy(bb, r, sizeof r);
     bb[0] = r[0] < bb[0] ? r[0] : bb[0], bb[1] = r[1] < bb[1] ? r[1] : bb[1];
     bb[2] = r[2] > bb[2] ? r[2] : bb[2], bb[3] = r[3] > bb[3] ? r[3] : bb[3];
