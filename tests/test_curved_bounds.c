@@ -149,7 +149,7 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   for (uint32_t i = 0; i < s->ntris; i++)
     if (rr_tri_setup(s, i, &c, false, &all[nset]) != SETUP_CULLED) nset++;
   const bool polar_map = rc->type == RR_CAMERA_LATLONG || rc->type == RR_CAMERA_PARABOLIC || rc->type == RR_CAMERA_FISHEYE;
-  long lane_diff = 0, lane_ok = 0, lane_img = 0;
+  long lane_diff = 0, lane_ok = 0, lane_img = 0, lane_rect = 0;
   for (uint32_t q = 0; q < nset; q += 8) {
     int m = nset - q < 8 ? (int)(nset - q) : 8;
     tri_sphere wide[8], plain[8], one; /* two passes of four lanes */
@@ -168,6 +168,15 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
           lane_diff += ka != kb || (kb > 0 && memcmp(ra, rb, sizeof ra));
           lane_img += rc->type == RR_CAMERA_PARABOLIC && x[k]->img_k != TRI_CAP_UNSET;
         }
+        /* the rectangle the lanes decided at c's position is rr_tri_curved_rect_sph's without it */
+        if (x[k]->rect_k != TRI_CAP_UNSET) {
+          tri_sphere u = *x[k];
+          u.rect_k = TRI_CAP_UNSET;
+          int ra[4] = {0}, rb[4] = {0}, ka = rr_tri_curved_rect_sph(&c, &all[q + l], x[k], ra),
+              kb = rr_tri_curved_rect_sph(&c, &all[q + l], &u, rb);
+          lane_diff += ka != kb || (kb > 0 && memcmp(ra, rb, sizeof ra));
+          lane_rect++;
+        }
         lane_diff += x[k]->ok != one.ok || x[k]->cap != one.cap ||
                      (one.ok && (memcmp(&x[k]->smin, &one.smin, sizeof one.smin) ||
                                  memcmp(&x[k]->E, &one.E, sizeof one.E))) ||
@@ -181,6 +190,7 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   CHECK(lane_diff == 0, "%s: %ld lanes of rr_tri_spheres differ from one-lane calls", what, lane_diff);
   CHECK(cube || lane_ok > 0, "%s: no spherical triangle to compare lanes on", what);
   CHECK(rc->type != RR_CAMERA_PARABOLIC || lane_img > 0, "%s: no cap image computed in the lanes", what);
+  CHECK(!polar_map || lane_rect > 0, "%s: no rectangle decided in the lanes", what);
   CHECK(missed == 0, "%s: %ld passing samples outside their triangle's rectangle", what, missed);
   CHECK(passing > 0, "%s: no triangle passes anywhere (the test would prove nothing)", what);
   CHECK(cap_missed == 0, "%s: %ld passing samples outside their triangle's cap rectangle", what, cap_missed);
@@ -276,6 +286,76 @@ static void check_caps(rr_device *dev, rr_camera_type type, float fov, int w, in
   }
   CHECK(bad == 0 && inside > 0, "%s: %ld of %ld samples in a cap outside its rectangle", rr_camera_name(type), bad,
         inside);
+  /* rr_cam_caps_show4: four caps at once, over two positions and a part of the
+   * image, as rr_cam_cap_rect's rectangles say */
+  camera two[2] = {c, c};
+  two[1].sx0 = (float)rnd(), two[1].sy0 = (float)rnd();
+  long lanes_diff = 0, shown = 0;
+  for (int k = 0; k < 400; k++) {
+    double axis[3][4], rho[4];
+    for (int l = 0; l < 4; l++) {
+      vec3 a = v3_norm(hard_dir(&rc, c.fwd, c.right, c.up));
+      axis[0][l] = a.x, axis[1][l] = a.y, axis[2][l] = a.z, rho[l] = exp(log(1e-3) + rnd() * (log(1.4) - log(1e-3)));
+    }
+    const int x0 = (int)(rnd() * w), y0 = (int)(rnd() * h), part[4] = {x0, y0, x0 + 1 + (int)(rnd() * (w - x0)),
+                                                                    y0 + 1 + (int)(rnd() * (h - y0))};
+    const unsigned used = 1 + (unsigned)(rnd() * 15);
+    const int ns = 1 + (k & 1);
+    unsigned want = 0;
+    for (int l = 0; l < 4; l++)
+      for (int p = 0; p < ns && (used >> l & 1); p++) {
+        int r[4], got = rr_cam_cap_rect(&two[p], (double[3]){axis[0][l], axis[1][l], axis[2][l]}, rho[l], r);
+        if (got < 0 || (got > 0 && r[0] < part[2] && r[2] >= part[0] && r[1] < part[3] && r[3] >= part[1]))
+          want |= 1u << l;
+      }
+    for (int simd = 0; simd < 2; simd++)
+      lanes_diff += rr_cam_caps_show4(two, ns, (const double(*)[4])axis, rho, used, part, simd) != want;
+    shown += __builtin_popcount(want);
+  }
+  CHECK(lanes_diff == 0 && shown > 0, "%s: rr_cam_caps_show4 differs from rr_cam_cap_rect %ld times",
+        rr_camera_name(type), lanes_diff);
+  /* rr_cam_boxes_show4: every sample whose ray meets a random box (from the eye) is
+   * shown, with the walk's shortcut and without */
+  const cam_cap_shortcut sc = rr_cam_cap_shortcut(&c);
+  const int all[4] = {0, 0, w, h};
+  long box_missed = 0, box_hit = 0, dropped = 0;
+  for (int k = 0; k < 150; k++) {
+    float lo[3][4], hi[3][4];
+    for (int l = 0; l < 4; l++) {
+      vec3 d = v3_norm(hard_dir(&rc, c.fwd, c.right, c.up));
+      const double dist = 0.5 + 5 * rnd(), size = dist * exp(log(1e-3) + rnd() * (log(0.5) - log(1e-3)));
+      const float *e = &c.eye.x;
+      for (int a = 0; a < 3; a++) {
+        const double mid = e[a] + dist * (&d.x)[a], half = size * (0.2 + rnd());
+        lo[a][l] = (float)(mid - half), hi[a][l] = (float)(mid + half);
+      }
+    }
+    const unsigned show[2] = {rr_cam_boxes_show4(&c, 1, (const float(*)[4])lo, (const float(*)[4])hi, 15, NULL, all, true),
+                              rr_cam_boxes_show4(&c, 1, (const float(*)[4])lo, (const float(*)[4])hi, 15, &sc, all, false)};
+    dropped += 4 - __builtin_popcount(show[0]);
+    for (int l = 0; l < 4; l++)
+      for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+          vec3 d = c.dirs[(size_t)y * w + x];
+          if (!(v3_len(d) > 0)) continue;
+          double t0 = 0, t1 = INFINITY; /* the ray's slabs, in double */
+          for (int a = 0; a < 3 && t0 <= t1; a++) {
+            const double o = (&c.eye.x)[a], v = (&d.x)[a];
+            if (v == 0) {
+              if (o < lo[a][l] || o > hi[a][l]) t1 = -1;
+              continue;
+            }
+            double ta = (lo[a][l] - o) / v, tb = (hi[a][l] - o) / v;
+            t0 = fmax(t0, fmin(ta, tb)), t1 = fmin(t1, fmax(ta, tb));
+          }
+          if (!(t0 <= t1)) continue;
+          box_hit++;
+          box_missed += !(show[0] >> l & 1) + !(show[1] >> l & 1);
+        }
+  }
+  CHECK(box_missed == 0 && box_hit > 0, "%s: %ld of %ld samples in boxes not shown", rr_camera_name(type), box_missed,
+        box_hit);
+  CHECK(dropped > 0, "%s: rr_cam_boxes_show4 dropped no box", rr_camera_name(type));
   CHECK(bounded > 300, "%s: only %ld of 600 caps bounded", rr_camera_name(type), bounded);
   printf("%s %g: cap rectangles hold the %ld samples of %ld caps\n", rr_camera_name(type), (double)fov, inside,
          bounded);

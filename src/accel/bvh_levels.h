@@ -62,7 +62,10 @@ static inline const bvh_node *bvh_node_at(const rr_bvh *b, uint32_t r, bvh_node 
   const rr_bvh *o = b->obj;
   uint32_t j, k = bvh_inst_of(r, b->nnodes, o->nnodes, &j);
   const bvh_node *src = &o->nodes[j];
-  bvh_inst_box(b->inst, k, src->lo, src->hi, buf->lo, buf->hi);
+  const float *m = b->inst->xf[k];
+  if (b->inst->shift[k]) /* (bvh_inst_box's translation, inline: the common grid's) */
+    for (int a = 0; a < 3; a++) buf->lo[a] = src->lo[a] + m[4 * a + 3], buf->hi[a] = src->hi[a] + m[4 * a + 3];
+  else bvh_inst_box(b->inst, k, src->lo, src->hi, buf->lo, buf->hi);
   buf->count = src->count;
   buf->first = src->first + (src->count ? b->ntop + k * o->nprims : b->nnodes + k * o->nnodes);
   return buf;

@@ -279,6 +279,11 @@ struct tri_sphere {
   bool ok, cap;
   int8_t img_k;  /* the cap's image for rr_tri_spheres_cam's camera (parabolic): TRI_CAP_UNSET, */
   double img[4]; /* or rr_cam_cap_rect's 1 with its extents x0, x1, y0, y1 (sample coordinates), 0, -1 */
+  /* rr_tri_curved_rect_sph's answer for that camera at its own position
+   * (rect_sx, rect_sy), where the cap's image gives it: TRI_CAP_UNSET, 0, or 1 with rect */
+  int8_t rect_k;
+  float rect_sx, rect_sy;
+  int rect[4];
   /* with the cap, computed only where prim/triangle_curved.c needs them: the
    * triangle in the gnomonic chart about the axis m that holds every passing
    * sample (chart_extent) and the largest length of its vertices (infinite when
@@ -286,6 +291,13 @@ struct tri_sphere {
   double gx[3][3], gt;
 };
 #define TRI_CAP_UNSET 2
+/* sp's rectangle as its lanes decided it for c's position (rect_k): 1 with rect, 0
+ * when no sample can pass, -1 when not decided there (rr_tri_curved_rect_sph then). */
+static inline int rr_tri_sphere_decided(const camera *c, const tri_sphere *sp, int rect[4]) {
+  if (sp->rect_k == TRI_CAP_UNSET || c->sx0 != sp->rect_sx || c->sy0 != sp->rect_sy) return -1;
+  memcpy(rect, sp->rect, sizeof sp->rect);
+  return sp->rect_k;
+}
 void rr_tri_spheres(const tri_setup *ts, int n, bool simd, tri_sphere *out);
 /* The same with the cap's image for camera c (NULL: none; so far the parabolic's,
  * computed in the lanes), whatever the sample position: rr_tri_sphere_cap_rect then serves every camera that differs from c
@@ -320,6 +332,22 @@ int rr_cam_cap_rect(const camera *c, const double axis[3], double rho, int rect[
 void rr_cam_cap_extents4(const camera *c, const double axis[3][4], const double rho[4], bool simd, double e[4][4],
                          int64_t k[4]);
 int rr_cam_extent_rect(const camera *c, const double e[4], int k, int rect[4]);
+/* rr_cam_cap_rect for four caps in lanes at once, and for the ns positions
+ * cams[0..ns-1] (cameras that differ only in sx0, sy0): the lanes of the bit mask
+ * used whose rectangle at some position meets r (x0, y0, x1, y1, ends exclusive),
+ * or that know no bound (every lane for cameras not polar); AVX2 when simd. */
+unsigned rr_cam_caps_show4(const camera *cams, int ns, const double axis[3][4], const double rho[4], unsigned used,
+                           const int r[4], bool simd);
+/* Boxes a polar camera's samples see most of (rr_cam_cap_shortcut, for a walk
+ * over a whole image) are taken as showing one without their image. */
+typedef struct cam_cap_shortcut {
+  double rho_min, cos_min, sin_min; /* rho_min infinite: none */
+} cam_cap_shortcut;
+cam_cap_shortcut rr_cam_cap_shortcut(const camera *c);
+/* The same for four boxes (lo, hi: lanes per axis) seen from cams' eye, by their
+ * bounding balls' caps (prim/triangle_curved.c argues the slack); sc may be NULL. */
+unsigned rr_cam_boxes_show4(const camera *cams, int ns, const float lo[3][4], const float hi[3][4], unsigned used,
+                            const cam_cap_shortcut *sc, const int r[4], bool simd);
 /* Before any setup: the image rectangle of the cap about triangle i's corner
  * directions from c's eye, widened by slack radians (what the caller allows for
  * the rounding of the setup); as rr_cam_cap_rect, -1 also for corners at infinity. */

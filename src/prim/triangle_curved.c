@@ -126,6 +126,8 @@ static void polar_range(const dv3 nu[3], const dv3 v[3], double E, dv3 P, dv3 e1
  * would lose the digits the margins above do not cover. */
 typedef double vd4 __attribute__((vector_size(32)));
 typedef int64_t vl4 __attribute__((vector_size(32)));
+typedef int32_t vi4 __attribute__((vector_size(16)));
+typedef float vf4 __attribute__((vector_size(16)));
 /* macros, not functions: 32-byte vector arguments would change the ABI without AVX */
 #define vd_splat(x) ((vd4){0} + (x))
 #define vl_splat(x) ((vl4){0} + (x))
@@ -142,27 +144,37 @@ typedef int64_t vl4 __attribute__((vector_size(32)));
 #define SPH_NAME spheres_plain
 #define SPH_CAT(x) x##_plain
 #define SPH_TARGET
-#define SPH_SQRT(x)                                                                                               \
+/* f of each lane (plain C) */
+#define SPH_LANES(f, x)                                                                                           \
   ({                                                                                                              \
     vd4 x_ = (x), r_;                                                                                             \
-    for (int l_ = 0; l_ < 4; l_++) r_[l_] = sqrt(x_[l_]);                                                         \
+    for (int l_ = 0; l_ < 4; l_++) r_[l_] = f(x_[l_]);                                                            \
     r_;                                                                                                           \
   })
+#define SPH_SQRT(x) SPH_LANES(sqrt, x)
+#define SPH_FLOOR(x) SPH_LANES(floor, x)
+#define SPH_CEIL(x) SPH_LANES(ceil, x)
 #include "prim/triangle_sphere_tmp.h"
 #undef SPH_NAME
 #undef SPH_CAT
 #undef SPH_TARGET
 #undef SPH_SQRT
+#undef SPH_FLOOR
+#undef SPH_CEIL
 #ifdef RR_SIMD_X86
 #define SPH_NAME spheres_avx2
 #define SPH_CAT(x) x##_avx2
 #define SPH_TARGET RR_TARGET_AVX2
 #define SPH_SQRT(x) ((vd4)_mm256_sqrt_pd((__m256d)(x)))
+#define SPH_FLOOR(x) ((vd4)_mm256_floor_pd((__m256d)(x)))
+#define SPH_CEIL(x) ((vd4)_mm256_ceil_pd((__m256d)(x)))
 #include "prim/triangle_sphere_tmp.h"
 #undef SPH_NAME
 #undef SPH_CAT
 #undef SPH_TARGET
 #undef SPH_SQRT
+#undef SPH_FLOOR
+#undef SPH_CEIL
 #endif
 
 /* c (may be NULL): the camera whose cap images to compute in the lanes. */
@@ -274,6 +286,62 @@ void rr_cam_cap_extents4(const camera *c, const double axis[3][4], const double 
   (void)simd;
   memcpy(e, ext, sizeof ext), memcpy(k, &img, sizeof img);
 }
+static bool polar(const camera *c) {
+  return c->type == RR_CAMERA_LATLONG || c->type == RR_CAMERA_PARABOLIC || c->type == RR_CAMERA_FISHEYE;
+}
+
+unsigned rr_cam_caps_show4(const camera *cams, int ns, const double axis[3][4], const double rho[4], unsigned used,
+                           const int r[4], bool simd) {
+  if (!polar(cams)) return used; /* no bound known */
+  vd4 a[3], q;
+  memcpy(a, axis, sizeof a), memcpy(&q, rho, sizeof q);
+#ifdef RR_SIMD_X86
+  if (simd && __builtin_cpu_supports("avx2")) return caps_show_avx2(cams, ns, a, &q, used, r);
+#endif
+  (void)simd;
+  return caps_show_plain(cams, ns, a, &q, used, r);
+}
+
+/* The shortcut: a cap of radius rho_min or more (1.5 samples over the map's least
+ * stretch, in samples a radian) wholly inside the image (the parabolic's and
+ * fisheye's disk: cos α_m >= cos_min + rho·sin_min, above cos(α_rim − ρ)) shows
+ * one; only the odd such box whose image falls between samples is taken for nothing. */
+cam_cap_shortcut rr_cam_cap_shortcut(const camera *c) {
+  cam_cap_shortcut q = {INFINITY, 1, 0};
+  const double W = c->width, H = c->height;
+  if (c->type == RR_CAMERA_LATLONG) { /* every direction; stretch H / π along θ, >= W / 2π along φ */
+    q.rho_min = 1.5 / mind(H / RR_PI, W / (2 * RR_PI)), q.cos_min = -2;
+  } else if (c->type == RR_CAMERA_PARABOLIC) { /* stretch 1 / (1 + cos α) >= 1/2 image half-widths */
+    q.rho_min = 1.5 / (mind(W, H) / 4), q.cos_min = 0, q.sin_min = 1;
+  } else if (c->type == RR_CAMERA_FISHEYE) { /* radial stretch 1 / k, the least */
+    const double k = c->fov_deg * RR_PI / 360;
+    q.rho_min = 1.5 / (mind(W, H) / (2 * k)), q.cos_min = cos(k), q.sin_min = sin(k);
+  }
+  return q;
+}
+
+/* A box lies in the ball about its centre b of its half-diagonal r, which from the
+ * eye e (|b − e| > r) is the cap about b − e of radius asin(r / |b − e|) <=
+ * s / √(1 − s²), s = r / |b − e| (asin x <= tan asin x); a triangle's corners, in
+ * the box, look into that cap, and so do its spherical triangle (the cap is convex
+ * under 90°) and, within the slack of the frustum traversal's cone test (1e-4 rad;
+ * rays and edge values round to about 1e-6), the samples that pass its edge test.
+ * cap_lanes bounds the cap's image. (The rounded planes of a near-degenerate
+ * sliver, or of an edge seen end-on, can pass samples farther out, as far as its
+ * setup's spherical triangle reaches; every box test of the BVH methods, the
+ * frustum cone and rc-bvh's widened slabs, drops such samples alike: they are not
+ * hits of the triangle in its box.) A box that holds the eye, or a cap it cannot
+ * bound, may show a sample. */
+unsigned rr_cam_boxes_show4(const camera *cams, int ns, const float lo[3][4], const float hi[3][4], unsigned used,
+                            const cam_cap_shortcut *sc, const int r[4], bool simd) {
+  if (!polar(cams)) return used;
+#ifdef RR_SIMD_X86
+  if (simd && __builtin_cpu_supports("avx2")) return boxes_show_avx2(cams, ns, lo, hi, used, sc, r);
+#endif
+  (void)simd;
+  return boxes_show_plain(cams, ns, lo, hi, used, sc, r);
+}
+
 static int cap_extent(const camera *c, const double axis[3], double rho, double e[4]) {
   double a[3][4], r[4], ext[4][4];
   int64_t k[4];
@@ -410,6 +478,8 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
 
 int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_sphere *sp, int r[4]) {
   if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
+  const int lanes = rr_tri_sphere_decided(c, sp, r);
+  if (lanes >= 0) return lanes;
   if (!sp->ok) return -1;
   const double E = sp->E;
   const int kind = sp->smin > 1e-3 ? 1 : 2;

@@ -68,6 +68,64 @@ SPH_TARGET static void SPH_CAT(cap_lanes)(const camera *c, const vd4 m[3], const
   *k_ = vsel_l(rho < 1.5, k, vl_splat(-1));
 }
 
+/* The lanes of `used` whose cap (axis m, radius rho) may show a sample of r (x0,
+ * y0, x1, y1, ends exclusive) at one of the ns positions cams[0..ns-1] (cameras
+ * that differ only in sx0, sy0): cap_lanes knows no bound, or the rectangle
+ * sample_rect rounds its image to meets r (the same rounding in lanes: that
+ * rectangle meets r iff max(ceil(x0'), r.x0) <= min(floor(x1'), r.x1 - 1) per
+ * axis, a NaN end taken as unbounded, as ceil_in and floor_in take it). A bit a lane. */
+SPH_TARGET static unsigned SPH_CAT(caps_show)(const camera *cams, int ns, const vd4 m[3], const vd4 *rho,
+                                              unsigned used, const int r[4]) {
+  vd4 e[4];
+  vl4 k;
+  SPH_CAT(cap_lanes)(cams, m, rho, e, &k);
+  vl4 show = k < 0;
+  const vd4 rx0 = vd_splat(r[0]), ry0 = vd_splat(r[1]), rx1 = vd_splat(r[2] - 1), ry1 = vd_splat(r[3] - 1);
+  for (int p = 0; p < ns; p++) {
+    const double sx = cams[p].sx0, sy = cams[p].sy0;
+    const vd4 lx = vmax(SPH_CEIL(e[0] - sx - 1e-2), rx0), hx = vmin(SPH_FLOOR(e[1] - sx + 1e-2), rx1);
+    const vd4 ly = vmax(SPH_CEIL(e[2] - sy - 1e-2), ry0), hy = vmin(SPH_FLOOR(e[3] - sy + 1e-2), ry1);
+    show |= (k > 0) & (lx <= hx) & (ly <= hy);
+  }
+  unsigned bits = 0;
+  for (int l = 0; l < 4; l++) bits |= (unsigned)(show[l] != 0) << l;
+  return bits & used;
+}
+
+/* The lanes of `used` whose box (lo, hi: lanes per axis) may show a sample of r
+ * at one of the ns positions: rr_cam_boxes_show4's argument (triangle_curved.c),
+ * the box's ball's cap about b − eye of radius s / √(1 − s²) + 1e-4, s the ball's
+ * radius over its distance; a box too near the eye (s² >= 0.98), or one that sc
+ * takes as showing a sample, may. */
+SPH_TARGET static unsigned SPH_CAT(boxes_show)(const camera *cams, int ns, const float lo[3][4],
+                                               const float hi[3][4], unsigned used, const cam_cap_shortcut *sc,
+                                               const int r[4]) {
+  const double eye[3] = {cams->eye.x, cams->eye.y, cams->eye.z};
+  vd4 b[3], d2 = vd_splat(0), r2 = vd_splat(0);
+  for (int a = 0; a < 3; a++) {
+    vf4 lf, hf;
+    memcpy(&lf, lo[a], sizeof lf), memcpy(&hf, hi[a], sizeof hf);
+    const vd4 l = __builtin_convertvector(lf, vd4), h = __builtin_convertvector(hf, vd4);
+    b[a] = 0.5 * (l + h) - eye[a], d2 += b[a] * b[a];
+    r2 += 0.25 * (h - l) * (h - l);
+  }
+  const vd4 s2 = r2 * (1 + 1e-9) / d2;
+  const vl4 near = ~(s2 < 0.98);
+  const vd4 inv = 1 / SPH_SQRT(d2), rho = SPH_SQRT(s2 / (1 - s2)) + 1e-4;
+  vd4 m[3];
+  for (int a = 0; a < 3; a++) m[a] = b[a] * inv;
+  vl4 take = near;
+  if (sc) {
+    const vd4 mf = m[0] * (double)cams->fwd.x + m[1] * (double)cams->fwd.y + m[2] * (double)cams->fwd.z;
+    take |= (rho >= sc->rho_min) & (mf >= sc->cos_min + rho * sc->sin_min);
+  }
+  unsigned bits = 0;
+  for (int l = 0; l < 4; l++) bits |= (unsigned)(take[l] != 0) << l;
+  bits &= used;
+  if (bits == used) return used;
+  return bits | SPH_CAT(caps_show)(cams, ns, m, &rho, used & ~bits, r);
+}
+
 /* A lane that fails a test only clears its ok or cap; its NaNs go nowhere. Four
  * lanes, not eight: a leaf's setups keep about three. nv (may be NULL): the normals
  * and vertices, for the arcs, and the chart's triangle (gx, gt; else gt infinite).
@@ -75,11 +133,12 @@ SPH_TARGET static void SPH_CAT(cap_lanes)(const camera *c, const vd4 m[3], const
 SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tri_sphere *out, double (*nv)[2][3][3]) {
   vd4 nrm[3][3], v[3][3]; /* [edge or vertex][axis] */
   vl4 ok = vl_splat(-1);
+  const tri_setup *t[4]; /* padding lanes repeat the last */
+  for (int l = 0; l < 4; l++) t[l] = &ts[l < n ? l : n - 1];
   for (int i = 0; i < 3; i++) {
-    for (int l = 0; l < 4; l++) {
-      const tri_setup *t = &ts[l < n ? l : n - 1]; /* padding lanes repeat the last */
-      nrm[i][0][l] = t->a[i], nrm[i][1][l] = t->b[i], nrm[i][2][l] = t->c[i];
-    }
+    nrm[i][0] = (vd4){t[0]->a[i], t[1]->a[i], t[2]->a[i], t[3]->a[i]};
+    nrm[i][1] = (vd4){t[0]->b[i], t[1]->b[i], t[2]->b[i], t[3]->b[i]};
+    nrm[i][2] = (vd4){t[0]->c[i], t[1]->c[i], t[2]->c[i], t[3]->c[i]};
     vd4 l2 = vdot(nrm[i], nrm[i]);
     ok &= l2 > 0;
     vd4 inv = 1 / SPH_SQRT(l2);
@@ -114,8 +173,7 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
   /* chart_extent's triangle: the vertices in the gnomonic chart about m
    * (v·m >= cr > 0.1 with the cap), each moved to where the edges through it,
    * shifted out by ε / cos ρ, meet (chart_extent's comment) */
-  vd4 gx[3][3], gt2 = vd_splat(0);
-  memset(gx, 0, sizeof gx);
+  vd4 gx[3][3], gt2 = vd_splat(0); /* (with nv only) */
   const vd4 ec = eps / (1 - rho * rho / 2);
   for (int i = 0; i < 3 && nv; i++) { /* (rarely needed: with the arcs' normals and vertices only) */
     const vd4 *nj = nrm[(i + 1) % 3], *nk = nrm[(i + 2) % 3];
@@ -132,17 +190,43 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
   vd4 ext[4] = {0};
   vl4 img = vl_splat(TRI_CAP_UNSET);
   if (pc) SPH_CAT(cap_lanes)(pc, m, &rho, ext, &img);
+  /* rr_tri_curved_rect_sph's answer at pc's own position where the cap alone gives
+   * it (no sample; or a round triangle's small rectangle, kept as it is), with
+   * sample_rect's rounding (caps_show's comment) */
+  vl4 dec = vl_splat(TRI_CAP_UNSET);
+  vd4 rl[4] = {0};
+  if (pc) {
+    const double sx = pc->sx0, sy = pc->sy0;
+    rl[0] = vmax(SPH_CEIL(ext[0] - sx - 1e-2), vd_splat(0));
+    rl[1] = vmax(SPH_CEIL(ext[2] - sy - 1e-2), vd_splat(0));
+    rl[2] = vmin(SPH_FLOOR(ext[1] - sx + 1e-2), vd_splat(pc->width - 1));
+    rl[3] = vmin(SPH_FLOOR(ext[3] - sy + 1e-2), vd_splat(pc->height - 1));
+    const vl4 some = (img == 1) & (rl[0] <= rl[2]) & (rl[1] <= rl[3]);
+    const vd4 area = (rl[2] - rl[0] + 1) * (rl[3] - rl[1] + 1);
+    const double most = pc->type == RR_CAMERA_PARABOLIC ? CAP_ENOUGH : CHART_FROM;
+    const vl4 known = ok & cap & ((img == 0) | ((img == 1) & ~some) | (some & (smin > 1e-3) & (area <= most)));
+    dec = vsel_l(known, some & 1, dec);
+  }
+  /* out of the lanes through memory, a row per quantity */
+  int32_t ri[4][4]; /* the rectangles' bounds, where decided 1 (else 0: no conversion out of range) */
+  int64_t kk[4][4];
+  double ex[4][4], dd[7][4];
+  const vd4 drow[7] = {m[0], m[1], m[2], smin, E, rho, nv ? gt : vd_splat(INFINITY)};
+  const vl4 krow[4] = {img, dec, ok, ok & cap};
+  for (int k = 0; k < 4; k++) {
+    const vi4 q = __builtin_convertvector(vsel(dec == 1, rl[k], vd_splat(0)), vi4);
+    memcpy(ri[k], &q, sizeof q), memcpy(ex[k], &ext[k], sizeof ex[k]), memcpy(kk[k], &krow[k], sizeof kk[k]);
+  }
+  memcpy(dd, drow, sizeof dd);
   for (int l = 0; l < n; l++) {
     tri_sphere *o = &out[l];
-    o->img_k = (int8_t)img[l];
-    for (int k = 0; k < 4 && pc; k++) o->img[k] = ext[k][l];
+    o->img_k = (int8_t)kk[0][l], o->rect_k = (int8_t)kk[1][l], o->ok = kk[2][l] != 0, o->cap = kk[3][l] != 0;
+    o->rect_sx = pc ? pc->sx0 : 0, o->rect_sy = pc ? pc->sy0 : 0;
+    for (int k = 0; k < 4; k++) o->rect[k] = ri[k][l], o->img[k] = ex[k][l];
+    for (int k = 0; k < 3; k++) o->axis[k] = dd[k][l];
+    o->smin = dd[3][l], o->E = dd[4][l], o->rho = dd[5][l], o->gt = dd[6][l];
     for (int i = 0; i < 3 && nv; i++)
-      for (int k = 0; k < 3; k++) nv[l][0][i][k] = nrm[i][k][l], nv[l][1][i][k] = v[i][k][l];
-    for (int k = 0; k < 3; k++) o->axis[k] = m[k][l];
-    for (int i = 0; i < 3 && nv; i++)
-      for (int k = 0; k < 3; k++) o->gx[i][k] = gx[i][k][l];
-    o->gt = nv ? gt[l] : INFINITY;
-    o->smin = smin[l], o->E = E[l], o->rho = rho[l];
-    o->ok = ok[l] != 0, o->cap = ok[l] && cap[l];
+      for (int k = 0; k < 3; k++)
+        nv[l][0][i][k] = nrm[i][k][l], nv[l][1][i][k] = v[i][k][l], o->gx[i][k] = gx[i][k][l];
   }
 }

@@ -376,8 +376,8 @@ static bool meets(const int bb[4], tile_rect r) {
 static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, const tri_sphere *sp, int bb[4]) {
   bool any = false;
   for (int s = 0; s < t->ns; s++) {
-    int r[4];
-    if (!rr_tri_screen_bounds_sph(t->s, id, &t->cams[s], ts, sp, r)) continue;
+    int r[4], lanes = rr_tri_sphere_decided(&t->cams[s], sp, r); /* (the common case, at once) */
+    if (lanes == 0 || (lanes < 0 && !rr_tri_screen_bounds_sph(t->s, id, &t->cams[s], ts, sp, r))) continue;
     if (!any) memcpy(bb, r, sizeof r);
     bb[0] = r[0] < bb[0] ? r[0] : bb[0], bb[1] = r[1] < bb[1] ? r[1] : bb[1];
     bb[2] = r[2] > bb[2] ? r[2] : bb[2], bb[3] = r[3] > bb[3] ? r[3] : bb[3];
@@ -386,48 +386,26 @@ static bool curved_bounds(const trav *t, uint32_t id, const tri_setup *ts, const
   return any;
 }
 
-/* Does the cap's image in lane l of rr_cam_cap_extents4's e, k show a sample of r
- * (of the image when NULL) at one of the ns positions? */
-static inline __attribute__((always_inline)) bool extent_meets(const camera *cams, int ns, const double e[4][4],
-                                                               const int64_t k[4], int l, const tile_rect *r) {
-  const double el[4] = {e[0][l], e[1][l], e[2][l], e[3][l]};
-  for (int p = 0; p < ns; p++) {
-    int q[4], kp = rr_cam_extent_rect(&cams[p], el, (int)k[l], q);
-    if (kp < 0 || (kp > 0 && (!r || meets(q, *r)))) return true;
-  }
-  return false;
-}
-
-/* rr_cam_cap_extents4 of the caps in lanes 0..used-1 of axis and rho (used >= 1),
- * the other lanes padded with lane 0's. */
-static void cap_extents(const camera *c, double axis[3][4], double rho[4], int used, bool simd, double e[4][4],
-                        int64_t k[4]) {
-  for (int l = used; l < 4; l++)
-    axis[0][l] = axis[0][0], axis[1][l] = axis[1][0], axis[2][l] = axis[2][0], rho[l] = rho[0];
-  rr_cam_cap_extents4(c, (const double(*)[4])axis, rho, simd, e, k);
-}
-
-
 /* Before their setup: the triangles ids[0..n-1] (first..first+n-1 when ids is
  * NULL) whose corner cap (rr_tri_corner_cap, with the slack of mark_seen) may show
  * a sample of r at some position, into out; four caps' images a step in lanes.
  * Returns how many. */
 static __attribute__((noinline)) uint32_t corner_caps_meet(const trav *t, uint32_t first, const uint32_t *ids,
                                                            uint32_t n, tile_rect r, uint32_t *out) {
+  const int rr[4] = {r.x0, r.y0, r.x1, r.y1};
   uint32_t kept = 0;
   for (uint32_t q = 0; q < n; q += 4) {
     const int m = n - q < 4 ? (int)(n - q) : 4;
-    double axis[3][4], rho[4], e[4][4];
-    int64_t k[4];
-    int slot[4], test = 0;
+    double axis[3][4] = {{0}}, rho[4] = {0};
+    unsigned used = 0, show = 0;
     for (int l = 0; l < m; l++) {
       const uint32_t id = ids ? ids[q + l] : first + q + l;
-      slot[l] = rr_tri_corner_cap_lane(t->s, id, t->c, 1e-4, axis, rho, test) > 0 ? test++ : -1;
+      if (rr_tri_corner_cap_lane(t->s, id, t->c, 1e-4, axis, rho, l) > 0) used |= 1u << l;
+      else show |= 1u << l; /* no bound */
     }
-    if (test) cap_extents(t->c, axis, rho, test, t->simd, e, k);
+    if (used) show |= rr_cam_caps_show4(t->cams, t->ns, (const double(*)[4])axis, rho, used, rr, t->simd);
     for (int l = 0; l < m; l++)
-      if (slot[l] < 0 || extent_meets(t->cams, t->ns, (const double(*)[4])e, k, slot[l], &r))
-        out[kept++] = ids ? ids[q + l] : first + q + l;
+      if (show >> l & 1) out[kept++] = ids ? ids[q + l] : first + q + l;
   }
   return kept;
 }
@@ -542,6 +520,9 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
     uint32_t lid[8];
     tri_setup ts[8];
     for (; q < n && m < 8; q++) {
+      uint64_t none = 0; /* (the root pass: eight unseen at a step) */
+      while (!ids && t->seen && q + 8 <= n && (memcpy(&none, t->seen + first + q, 8), !none)) q += 8;
+      if (q >= n) break;
       uint32_t id = ids ? ids[q] : first + q;
       if (t->seen && !t->seen[id]) continue;
       lid[m++] = id;
@@ -728,73 +709,14 @@ static bool outside_cone(int has_cone, vec3 axis, float angle, const bvh_node *b
   return phi > angle + beta + 1e-4f;
 }
 
-/* A shortcut of mark_seen's walk, where most boxes show a sample: a cap of
- * radius rho_min or more (1.5 samples over the map's least stretch, in samples a
- * radian) wholly inside the image (the parabolic's and fisheye's disk:
- * cos α_m >= cos_min + rho·sin_min, above cos(α_rim − ρ)) is taken as showing
- * one, without its rectangle (two atan2 for the lat-long and fisheye). Taking a
- * box is always safe: this only gives up dropping the odd such box whose image
- * falls between samples. */
-typedef struct cap_shortcut {
-  double rho_min, cos_min, sin_min; /* rho_min infinite: none */
-} cap_shortcut;
-
-static cap_shortcut cap_shortcut_of(const camera *c) {
-  cap_shortcut q = {INFINITY, 1, 0};
-  const double W = c->width, H = c->height;
-  if (c->type == RR_CAMERA_LATLONG) { /* every direction; stretch H / π along θ, >= W / 2π along φ */
-    q.rho_min = 1.5 / fmin(H / RR_PI, W / (2 * RR_PI)), q.cos_min = -2;
-  } else if (c->type == RR_CAMERA_PARABOLIC) { /* stretch 1 / (1 + cos α) >= 1/2 image half-widths */
-    q.rho_min = 1.5 / (fmin(W, H) / 4), q.cos_min = 0, q.sin_min = 1;
-  } else if (c->type == RR_CAMERA_FISHEYE) { /* radial stretch 1 / k, the least */
-    const double k = c->fov_deg * RR_PI / 360;
-    q.rho_min = 1.5 / (fmin(W, H) / (2 * k)), q.cos_min = cos(k), q.sin_min = sin(k);
-  }
-  return q;
-}
-
-/* May a sample of r (of the image when r is NULL) at one of the ns positions of
- * a curved view polar about an axis look into box n? A box lies in the ball about its centre b of its
- * half-diagonal r, which from the eye e (|b − e| > r) is the cap about b − e of
- * radius asin(r / |b − e|) <= s / √(1 − s²), s = r / |b − e| (asin x <= tan asin x);
- * a triangle's corners, in the box, look into that cap, and so do its spherical
- * triangle (the cap is convex under 90°) and, within the slack of the frustum
- * traversal's cone test (1e-4 rad; rays and edge values round to about 1e-6), the
- * samples that pass its edge test. rr_cam_cap_rect bounds the cap's image. (The
- * rounded planes of a near-degenerate sliver, or of an edge seen end-on, can pass
- * samples farther out, as far as its setup's spherical triangle reaches; every
- * box test of the BVH methods, the frustum cone here and rc-bvh's widened slabs,
- * drops such samples alike: they are not hits of the triangle in its box.)
- * A box that holds the eye, or a cap it cannot bound, may. box_cap: false when the
- * box may (or, with sc, is taken as showing one), else true with its cap's axis
- * and rho in lane l of rr_cam_cap_extents4's. */
-static bool box_cap(const camera *cams, const bvh_node *n, const cap_shortcut *sc, double axis[3][4], double *rho,
-                    int l) {
-  const double eye[3] = {cams->eye.x, cams->eye.y, cams->eye.z};
-  double b[3], d2 = 0, r2 = 0;
-  for (int a = 0; a < 3; a++) {
-    const double lo = n->lo[a], hi = n->hi[a];
-    b[a] = 0.5 * (lo + hi) - eye[a], d2 += b[a] * b[a];
-    r2 += 0.25 * (hi - lo) * (hi - lo);
-  }
-  double s2 = r2 * (1 + 1e-9) / d2;
-  if (!(s2 < 0.98)) return false;
-  const double inv = 1 / sqrt(d2), r = sqrt(s2 / (1 - s2)) + 1e-4;
-  for (int a = 0; a < 3; a++) axis[a][l] = b[a] * inv;
-  rho[l] = r;
-  if (sc && r >= sc->rho_min) {
-    const double F[3] = {cams->fwd.x, cams->fwd.y, cams->fwd.z};
-    if (axis[0][l] * F[0] + axis[1][l] * F[1] + axis[2][l] * F[2] >= sc->cos_min + r * sc->sin_min) return false;
-  }
-  return true;
-}
-
+/* May a sample of r at one of the ns positions of a curved view polar about an
+ * axis look into box n? (rr_cam_boxes_show4: its ball's cap.) */
 static bool box_cap_meets(const camera *cams, int ns, const bvh_node *n, const tile_rect *r) {
-  double axis[3][4], rho[4], e[4][4];
-  int64_t k[4];
-  if (!box_cap(cams, n, NULL, axis, rho, 0)) return true;
-  cap_extents(cams, axis, rho, 1, true, e, k);
-  return extent_meets(cams, ns, (const double(*)[4])e, k, 0, r);
+  float lo[3][4], hi[3][4];
+  for (int a = 0; a < 3; a++)
+    for (int l = 0; l < 4; l++) lo[a][l] = n->lo[a], hi[a][l] = n->hi[a];
+  const int rr[4] = {r->x0, r->y0, r->x1, r->y1};
+  return rr_cam_boxes_show4(cams, ns, (const float(*)[4])lo, (const float(*)[4])hi, 1, NULL, rr, true) != 0;
 }
 
 /* isOutside: the box (box_tmin tmin) lies wholly outside one side plane, behind
@@ -989,21 +911,22 @@ static void root_band(int b, int thread, void *arg) {
 static void mark_seen(const trav *t, uint8_t *seen) {
   const rr_bvh *bvh = t->s->bvh;
   uint32_t stack[512], sp = 0;
-  const cap_shortcut sc = cap_shortcut_of(t->c);
+  const cam_cap_shortcut sc = rr_cam_cap_shortcut(t->c);
+  const int all[4] = {0, 0, t->c->width, t->c->height};
   stack[sp++] = 0;
-  while (sp) { /* four nodes a step, their caps' images in lanes */
+  while (sp) { /* four nodes a step, their caps in lanes */
     bvh_node buf[4];
     const bvh_node *n[4];
-    double axis[3][4], rho[4], e[4][4];
-    int64_t k[4];
-    int m = 0, test = 0, slot[4];
+    float lo[3][4] = {{0}}, hi[3][4] = {{0}};
+    int m = 0;
     for (; sp && m < 4; m++) {
       n[m] = bvh_node_at(bvh, stack[--sp], &buf[m]);
-      slot[m] = box_cap(t->cams, n[m], &sc, axis, rho, test) ? test++ : -1;
+      for (int a = 0; a < 3; a++) lo[a][m] = n[m]->lo[a], hi[a][m] = n[m]->hi[a];
     }
-    if (test) cap_extents(t->c, axis, rho, test, t->simd, e, k);
+    const unsigned show =
+        rr_cam_boxes_show4(t->cams, t->ns, (const float(*)[4])lo, (const float(*)[4])hi, (1u << m) - 1, &sc, all, t->simd);
     for (int i = 0; i < m; i++) {
-      if (slot[i] >= 0 && !extent_meets(t->cams, t->ns, (const double(*)[4])e, k, slot[i], NULL)) continue;
+      if (!(show >> i & 1)) continue;
       if (n[i]->count) {
         for (uint32_t q = 0; q < n[i]->count; q++) seen[bvh_prim_at(bvh, n[i]->first + q)] = 1;
       } else if (sp + 2 <= sizeof stack / sizeof *stack) {
