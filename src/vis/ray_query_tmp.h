@@ -91,9 +91,12 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
               stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp++].key = entry[k];
             }
           }
-          for (; rest; rest &= rest - 1) { /* any hit: the first entered, the others stacked */
-            int k = __builtin_ctz(rest);
-            stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp++].key = entry[k];
+          if (any) { /* any hit: the last entered, the others stacked */
+            i = 31 - __builtin_clz(hits), rest = hits & ~(1u << i);
+            for (; rest; rest &= rest - 1) {
+              int k = __builtin_ctz(rest);
+              stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp++].key = entry[k];
+            }
           }
         } else if (rest) { /* two (the common case): the nearer entered, the other stacked */
           int k = __builtin_ctz(rest), far = entry[i] < entry[k] ? k : i;
