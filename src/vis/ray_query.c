@@ -124,18 +124,21 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
   return false;
 }
 
-/* Prepares a valid ray against the scene's tree b (NULL: an empty scene). */
-static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const float org[3], const float dir[3],
-                       float tmin, float tmax) {
+/* Prepares a valid ray against the scene's tree b (NULL: an empty scene); the
+ * three axes written out, which the compiler does not unroll by itself. */
+static inline __attribute__((always_inline)) void query_axis(query_ray *r, int a, float org, float dir) {
+  float inv = 1.0f / dir; /* ±inf for a zero component, by its sign */
+  int lo = (int)offsetof(bvh_wide8, lo[a]), hi = (int)offsetof(bvh_wide8, hi[a]);
+  bool neg = inv < 0;
+  r->wn[a] = neg ? hi : lo, r->wf[a] = neg ? lo : hi;
+  r->org[a] = org, r->inv_n[a] = inv * (1 - RAY_MARGIN), r->inv_f[a] = inv * (1 + RAY_MARGIN);
+  r->o[a] = rr_vf4_splat(org), r->d[a] = rr_vf4_splat(dir);
+}
+static inline __attribute__((always_inline)) void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b,
+                                                             const float org[3], const float dir[3], float tmin,
+                                                             float tmax) {
   r->s = s, r->b = b, r->rc.ready = false;
-  for (int a = 0; a < 3; a++) {
-    float inv = 1.0f / dir[a]; /* ±inf for a zero component, by its sign */
-    bool neg = inv < 0;
-    r->wn[a] = (int)(neg ? offsetof(bvh_wide8, hi[a]) : offsetof(bvh_wide8, lo[a]));
-    r->wf[a] = (int)(neg ? offsetof(bvh_wide8, lo[a]) : offsetof(bvh_wide8, hi[a]));
-    r->org[a] = org[a], r->inv_n[a] = inv * (1 - RAY_MARGIN), r->inv_f[a] = inv * (1 + RAY_MARGIN);
-    r->o[a] = rr_vf4_splat(org[a]), r->d[a] = rr_vf4_splat(dir[a]);
-  }
+  query_axis(r, 0, org[0], dir[0]), query_axis(r, 1, org[1], dir[1]), query_axis(r, 2, org[2], dir[2]);
   r->tlo = tmin > 0 ? tmin : 0;
   float d0 = fabsf(dir[0]), d1 = fabsf(dir[1]), d2 = fabsf(dir[2]), d01 = d0 > d1 ? d0 : d1;
   r->dmax = d01 > d2 ? d01 : d2;
@@ -177,10 +180,17 @@ static bool query_trace(query_ray *r, bool any) {
   return any ? query_trace4_any(r) : (query_trace4_closest(r), r->id != RR_MISS);
 }
 
-/* The committed scene's tree (NULL for an empty scene) or an error in dev. */
-static rr_error query_scene(rr_device *dev, const char *fn, const rr_scene *s, const void *in, const void *out,
-                            const rr_bvh **b) {
-  if (!s || !in || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: NULL scene, ray or result", fn);
+/* The committed scene's tree (NULL for an empty scene) or an error in dev: a
+ * current tree without rr_bvh_of's call, which says what is wrong otherwise. */
+static inline __attribute__((always_inline)) rr_error query_scene(rr_device *dev, const char *fn, const rr_scene *s,
+                                                                  const void *in, const void *out,
+                                                                  const rr_bvh **b) {
+  *b = NULL;
+  if (__builtin_expect(!s || !in || !out, 0)) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: NULL scene, ray or result", fn);
+  if (__builtin_expect(s->ntris && s->bvh && s->bvh->nprims == s->ntris, 1)) {
+    *b = s->bvh;
+    return RR_OK;
+  }
   bool empty;
   *b = rr_bvh_of(dev, s, &empty);
   if (!*b && !empty) return RR_ERROR_ARGUMENT; /* a scene changed since its commit: rr_bvh_of said so */
@@ -188,13 +198,15 @@ static rr_error query_scene(rr_device *dev, const char *fn, const rr_scene *s, c
 }
 
 /* Checks a query's arguments and prepares its ray; errors go to dev only. */
-static rr_error query_begin(rr_device *dev, const char *fn, const rr_scene *s, const rr_ray *ray, const void *out,
-                            query_ray *r) {
+static inline __attribute__((always_inline)) rr_error query_begin(rr_device *dev, const char *fn, const rr_scene *s,
+                                                                  const rr_ray *ray, const void *out,
+                                                                  query_ray *r) {
   const rr_bvh *b;
   rr_error e = query_scene(dev, fn, s, ray, out, &b);
   if (e) return e;
-  const char *why = ray_problem(ray->org, ray->dir, ray->tmin, ray->tmax);
-  if (why) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray with %s", fn, why);
+  if (__builtin_expect(!ray_valid(ray), 0))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray with %s", fn,
+                   ray_problem(ray->org, ray->dir, ray->tmin, ray->tmax));
   query_init(r, s, b, ray->org, ray->dir, ray->tmin, ray->tmax);
   return RR_OK;
 }
@@ -253,12 +265,10 @@ static float stream_at(const rr_ray_stream *rs, const float *p, size_t i) {
   return *(const float *)((const char *)p + i * rs->stride);
 }
 
-/* Ray i of a stream; why it cannot be traced, or NULL. */
-static const char *stream_ray(const rr_ray_stream *rs, size_t i, float org[3], float dir[3], float *tmin,
-                              float *tmax) {
-  for (int a = 0; a < 3; a++) org[a] = stream_at(rs, rs->org[a], i), dir[a] = stream_at(rs, rs->dir[a], i);
-  *tmin = stream_at(rs, rs->tmin, i), *tmax = stream_at(rs, rs->tmax, i);
-  return ray_problem(org, dir, *tmin, *tmax);
+/* Ray i of a stream, gathered into one rr_ray. */
+static inline __attribute__((always_inline)) void stream_ray(const rr_ray_stream *rs, size_t i, rr_ray *ray) {
+  for (int a = 0; a < 3; a++) ray->org[a] = stream_at(rs, rs->org[a], i), ray->dir[a] = stream_at(rs, rs->dir[a], i);
+  ray->tmin = stream_at(rs, rs->tmin, i), ray->tmax = stream_at(rs, rs->tmax, i);
 }
 
 static void stream_chunk(int job, int thread, void *arg) {
@@ -267,11 +277,12 @@ static void stream_chunk(int job, int thread, void *arg) {
   const rr_ray_stream *rs = j->rays;
   size_t lo = (size_t)job * j->chunk, hi = lo + j->chunk < rs->count ? lo + j->chunk : rs->count;
   for (size_t i = lo; i < hi; i++) {
-    float org[3], dir[3], tmin, tmax;
-    bool valid = !stream_ray(rs, i, org, dir, &tmin, &tmax), hit = false;
+    rr_ray ray;
+    stream_ray(rs, i, &ray);
+    bool valid = ray_valid(&ray), hit = false;
     query_ray r;
     if (valid) {
-      query_init(&r, j->s, j->b, org, dir, tmin, tmax);
+      query_init(&r, j->s, j->b, ray.org, ray.dir, ray.tmin, ray.tmax);
       hit = query_trace(&r, j->occluded != NULL);
     } else {
       size_t bad = atomic_load(&j->bad);
@@ -307,9 +318,10 @@ static rr_error stream_run(rr_device *dev, const char *fn, const rr_scene *s, co
   rr_parallel_for((int)((rs->count + chunk - 1) / chunk), threads ? threads : rr_cpu_count(), stream_chunk, &j);
   size_t bad = atomic_load(&j.bad);
   if (bad != SIZE_MAX) {
-    float org[3], dir[3], tmin, tmax;
+    rr_ray ray;
+    stream_ray(rs, bad, &ray);
     return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray %zu with %s (a miss)", fn, bad,
-                   stream_ray(rs, bad, org, dir, &tmin, &tmax));
+                   ray_problem(ray.org, ray.dir, ray.tmin, ray.tmax));
   }
   return rr_ok(dev);
 }
