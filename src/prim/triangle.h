@@ -230,6 +230,7 @@ typedef struct {
 } tri4_edges;
 KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 eye[3], tri4_edges *te) {
   tri_v4 q[3];
+#pragma GCC unroll 3
   for (int k = 0; k < 3; k++)
     q[k] = (tri_v4){rr_vf4_load(v + (3 * k) * stride) - eye[0], rr_vf4_load(v + (3 * k + 1) * stride) - eye[1],
                     rr_vf4_load(v + (3 * k + 2) * stride) - eye[2]};
