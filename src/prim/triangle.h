@@ -203,7 +203,6 @@ typedef struct {
 } tri_v4;
 static inline tri_v4 tri_v4_sub(tri_v4 a, tri_v4 b) { return (tri_v4){a.x - b.x, a.y - b.y, a.z - b.z}; }
 static inline rr_vf4 tri_v4_dot(tri_v4 a, tri_v4 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static inline rr_vi4 tri_vi4_select(rr_vi4 m, rr_vi4 a, rr_vi4 b) { return (m & a) | (~m & b); }
 /* tri_edge_normal lane by lane, in fewer operations: h × (a − b), h the edge's
  * higher endpoint in the canonical order. Where a comes first, h = b and this is
  * tri_edge_normal's h × (l − h) itself; where b does, h = a and tri_edge_normal
@@ -212,7 +211,10 @@ static inline rr_vi4 tri_vi4_select(rr_vi4 m, rr_vi4 a, rr_vi4 b) { return (m & 
  * the cross product only changes sign — up to the sign of a zero, which no test
  * below tells apart. */
 KERNEL tri_v4 tri_v4_edge_normal(tri_v4 a, tri_v4 b) {
-  rr_vi4 swap = tri_vi4_select(b.x != a.x, b.x < a.x, tri_vi4_select(b.y != a.y, b.y < a.y, b.z < a.z));
+  /* b before a, lexicographically; as ands and ors of comparisons (not selects
+   * of them) the compiler knows it for a mask, and blends h in one instruction
+   * where it can (AVX) */
+  rr_vi4 swap = (b.x < a.x) | ((b.x == a.x) & ((b.y < a.y) | ((b.y == a.y) & (b.z < a.z))));
   tri_v4 h = {rr_vf4_select(swap, a.x, b.x), rr_vf4_select(swap, a.y, b.y), rr_vf4_select(swap, a.z, b.z)};
   tri_v4 e = tri_v4_sub(a, b);
   return (tri_v4){h.y * e.z - h.z * e.y, h.z * e.x - h.x * e.z, h.x * e.y - h.y * e.x};
