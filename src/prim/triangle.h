@@ -230,12 +230,18 @@ typedef struct {
   rr_vf4 vol;     /* q0·n0 */
   rr_vi4 ok;      /* the volume is not 0 and finite: the triangle is not edge-on */
 } tri4_edges;
-KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 eye[3], tri4_edges *te) {
+/* tri4_edges_setup of the corners moved by sh (NULL: not moved), each corner
+ * rounded as p + sh first, as a moved copy of the corners would hold it. */
+KERNEL void tri4_edges_setup_moved(const float *v, size_t stride, const rr_vf4 *sh, const rr_vf4 eye[3],
+                                   tri4_edges *te) {
   tri_v4 q[3];
 #pragma GCC unroll 3
-  for (int k = 0; k < 3; k++)
-    q[k] = (tri_v4){rr_vf4_load(v + (3 * k) * stride) - eye[0], rr_vf4_load(v + (3 * k + 1) * stride) - eye[1],
-                    rr_vf4_load(v + (3 * k + 2) * stride) - eye[2]};
+  for (int k = 0; k < 3; k++) {
+    rr_vf4 p[3] = {rr_vf4_load(v + (3 * k) * stride), rr_vf4_load(v + (3 * k + 1) * stride),
+                   rr_vf4_load(v + (3 * k + 2) * stride)};
+    if (sh) p[0] = p[0] + sh[0], p[1] = p[1] + sh[1], p[2] = p[2] + sh[2];
+    q[k] = (tri_v4){p[0] - eye[0], p[1] - eye[1], p[2] - eye[2]};
+  }
   te->m[0] = tri_v4_edge_normal(q[1], q[2]), te->m[1] = tri_v4_edge_normal(q[2], q[0]),
   te->m[2] = tri_v4_edge_normal(q[0], q[1]);
   rr_vf4 vol = tri_v4_dot(q[0], te->m[0]);
@@ -243,6 +249,9 @@ KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 eye[3],
   te->sgn = sigma;
   te->vol = vol;
   te->ok = (vol != 0) & (rr_vf4_abs(vol) < INFINITY);
+}
+KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 eye[3], tri4_edges *te) {
+  tri4_edges_setup_moved(v, stride, NULL, eye, te);
 }
 KERNEL int tri4_edges_test(const tri4_edges *te, const rr_vf4 d[3], rr_vf4 out[4]) {
   tri_v4 dv = {d[0], d[1], d[2]};
@@ -252,10 +261,14 @@ KERNEL int tri4_edges_test(const tri4_edges *te, const rr_vf4 d[3], rr_vf4 out[4
   out[0] = a0, out[1] = a1, out[2] = a2, out[3] = te->vol;
   return rr_vi4_bits(te->ok & (a0 >= 0) & (a1 >= 0) & (a2 >= 0));
 }
-KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3], rr_vf4 out[4]) {
+KERNEL int tri_ray_may_hit4_moved(const float *v, size_t stride, const rr_vf4 *sh, const rr_vf4 eye[3],
+                                  const rr_vf4 d[3], rr_vf4 out[4]) {
   tri4_edges te;
-  tri4_edges_setup(v, stride, eye, &te);
+  tri4_edges_setup_moved(v, stride, sh, eye, &te);
   return tri4_edges_test(&te, d, out);
+}
+KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3], rr_vf4 out[4]) {
+  return tri_ray_may_hit4_moved(v, stride, NULL, eye, d, out);
 }
 
 /* The inclusive pixel rectangle a set-up triangle's samples may lie in; false when

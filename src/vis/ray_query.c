@@ -65,18 +65,15 @@ typedef struct {
  * nearest, lower id on a tie, so the hit does not depend on the order. */
 KERNEL bool query_tris(query_ray *r, const float *leaf, const uint32_t *ids, uint32_t idbase, const bool moved,
                        const float *shift, uint32_t count, const bool any) {
+  rr_vf4 sh[3]; /* moved: the translation, added to each corner as it is loaded */
+  if (moved)
+    for (int a = 0; a < 3; a++) sh[a] = rr_vf4_splat(shift[4 * a]);
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;
     const float *v = leaf + j;
     size_t stride = count;
-    float mv[9 * 4]; /* the group's corners moved */
-    if (moved) {
-      for (int c = 0; c < 9; c++)
-        rr_vf4_store(mv + 4 * c, rr_vf4_load(v + c * count) + rr_vf4_splat(shift[4 * (c % 3)]));
-      v = mv, stride = 4;
-    }
     rr_vf4 pre[4];
-    int may = tri_ray_may_hit4(v, stride, r->o, r->d, pre) & ((1 << n) - 1);
+    int may = tri_ray_may_hit4_moved(v, stride, moved ? sh : NULL, r->o, r->d, pre) & ((1 << n) - 1);
     if (r->s->inf)
       for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, ids[j + k] + idbase) != 0) << k;
     for (; may; may &= may - 1) {
@@ -84,7 +81,7 @@ KERNEL bool query_tris(query_ray *r, const float *leaf, const uint32_t *ids, uin
       float t, l1, l2, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
       const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
       if (e[0] > 0 && e[1] > 0 && e[2] > 0 && !(r->s->inf && scene_inf(r->s, id))) {
-        const float S = ray_corner_extent(v + lane, stride, r->org);
+        const float S = ray_corner_extent_moved(v + lane, stride, moved ? shift : NULL, r->org);
         if (ray_t_outside(S, r->dmax, e, r->tmin, r->t)) continue;
         if (any && ray_t_inside(S, r->dmax, e, r->tmin, r->t)) return true; /* a proven hit: the answer */
       }
