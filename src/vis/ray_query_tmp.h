@@ -32,6 +32,7 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
     float key;
   } stack[7 * BVH_STACK]; /* a level pushes at most seven; the tree is less than BVH_STACK deep */
   RQ_VF org[3], inv_n[3], inv_f[3];
+#pragma GCC unroll 3
   for (int a = 0; a < 3; a++)
     org[a] = RQ_(splat)(r->org[a]), inv_n[a] = RQ_(splat)(r->inv_n[a]), inv_f[a] = RQ_(splat)(r->inv_f[a]);
   const RQ_VF tlo = RQ_(splat)(r->tlo);
