@@ -214,6 +214,26 @@ static void plane_rays(rr_device *dev) {
   rr_scene_release(s);
 }
 
+/* ray_valid (the queries' four-lane check) agrees with ray_problem on every
+ * component set to each special value, alone and in pairs. */
+static void valid_rays(void) {
+  const float special[] = {0, -0.0f, 1, -2, 1e30f, -1e-40f, INFINITY, -INFINITY, NAN};
+  const int ns = (int)(sizeof special / sizeof special[0]);
+  int bad = 0, valid = 0, n = 0;
+  for (int c0 = 0; c0 < 8; c0++)
+    for (int c1 = c0; c1 < 8; c1++)
+      for (int a = 0; a < ns; a++)
+        for (int b = 0; b < ns; b++) {
+          rr_ray ray = {{0.5f, 1, 2}, {0, -1, 0}, 0, INFINITY};
+          float *f[8] = {&ray.org[0], &ray.org[1], &ray.org[2], &ray.dir[0], &ray.dir[1], &ray.dir[2], &ray.tmin,
+                         &ray.tmax};
+          *f[c0] = special[a], *f[c1] = special[b];
+          bool ok = ray_problem(ray.org, ray.dir, ray.tmin, ray.tmax) == NULL;
+          bad += ray_valid(&ray) != ok, valid += ok, n++;
+        }
+  CHECK(bad == 0 && valid > 0 && valid < n, "ray_valid differs from ray_problem on %d of %d rays", bad, n);
+}
+
 /* Bad rays are misses and an error naming the lowest; bad streams are refused. */
 static void bad_input(rr_device *dev) {
   rr_scene *s;
@@ -357,6 +377,7 @@ int main(void) {
   rr_device_set_build_options(dev, &opt);
   plane_rays(dev);
   bad_input(dev);
+  valid_rays();
   bunny_rays(dev);
   rr_device_release(dev);
   return test_done();

@@ -203,7 +203,6 @@ typedef struct {
 } tri_v4;
 static inline tri_v4 tri_v4_sub(tri_v4 a, tri_v4 b) { return (tri_v4){a.x - b.x, a.y - b.y, a.z - b.z}; }
 static inline rr_vf4 tri_v4_dot(tri_v4 a, tri_v4 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static inline rr_vi4 tri_vi4_select(rr_vi4 m, rr_vi4 a, rr_vi4 b) { return (m & a) | (~m & b); }
 /* tri_edge_normal lane by lane, in fewer operations: h × (a − b), h the edge's
  * higher endpoint in the canonical order. Where a comes first, h = b and this is
  * tri_edge_normal's h × (l − h) itself; where b does, h = a and tri_edge_normal
@@ -212,7 +211,10 @@ static inline rr_vi4 tri_vi4_select(rr_vi4 m, rr_vi4 a, rr_vi4 b) { return (m & 
  * the cross product only changes sign — up to the sign of a zero, which no test
  * below tells apart. */
 KERNEL tri_v4 tri_v4_edge_normal(tri_v4 a, tri_v4 b) {
-  rr_vi4 swap = tri_vi4_select(b.x != a.x, b.x < a.x, tri_vi4_select(b.y != a.y, b.y < a.y, b.z < a.z));
+  /* b before a, lexicographically; as ands and ors of comparisons (not selects
+   * of them) the compiler knows it for a mask, and blends h in one instruction
+   * where it can (AVX) */
+  rr_vi4 swap = (b.x < a.x) | ((b.x == a.x) & ((b.y < a.y) | ((b.y == a.y) & (b.z < a.z))));
   tri_v4 h = {rr_vf4_select(swap, a.x, b.x), rr_vf4_select(swap, a.y, b.y), rr_vf4_select(swap, a.z, b.z)};
   tri_v4 e = tri_v4_sub(a, b);
   return (tri_v4){h.y * e.z - h.z * e.y, h.z * e.x - h.x * e.z, h.x * e.y - h.y * e.x};
@@ -228,11 +230,18 @@ typedef struct {
   rr_vf4 vol;     /* q0·n0 */
   rr_vi4 ok;      /* the volume is not 0 and finite: the triangle is not edge-on */
 } tri4_edges;
-KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 eye[3], tri4_edges *te) {
+/* tri4_edges_setup of the corners moved by sh (NULL: not moved), each corner
+ * rounded as p + sh first, as a moved copy of the corners would hold it. */
+KERNEL void tri4_edges_setup_moved(const float *v, size_t stride, const rr_vf4 *sh, const rr_vf4 eye[3],
+                                   tri4_edges *te) {
   tri_v4 q[3];
-  for (int k = 0; k < 3; k++)
-    q[k] = (tri_v4){rr_vf4_load(v + (3 * k) * stride) - eye[0], rr_vf4_load(v + (3 * k + 1) * stride) - eye[1],
-                    rr_vf4_load(v + (3 * k + 2) * stride) - eye[2]};
+#pragma GCC unroll 3
+  for (int k = 0; k < 3; k++) {
+    rr_vf4 p[3] = {rr_vf4_load(v + (3 * k) * stride), rr_vf4_load(v + (3 * k + 1) * stride),
+                   rr_vf4_load(v + (3 * k + 2) * stride)};
+    if (sh) p[0] = p[0] + sh[0], p[1] = p[1] + sh[1], p[2] = p[2] + sh[2];
+    q[k] = (tri_v4){p[0] - eye[0], p[1] - eye[1], p[2] - eye[2]};
+  }
   te->m[0] = tri_v4_edge_normal(q[1], q[2]), te->m[1] = tri_v4_edge_normal(q[2], q[0]),
   te->m[2] = tri_v4_edge_normal(q[0], q[1]);
   rr_vf4 vol = tri_v4_dot(q[0], te->m[0]);
@@ -240,6 +249,9 @@ KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 eye[3],
   te->sgn = sigma;
   te->vol = vol;
   te->ok = (vol != 0) & (rr_vf4_abs(vol) < INFINITY);
+}
+KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 eye[3], tri4_edges *te) {
+  tri4_edges_setup_moved(v, stride, NULL, eye, te);
 }
 KERNEL int tri4_edges_test(const tri4_edges *te, const rr_vf4 d[3], rr_vf4 out[4]) {
   tri_v4 dv = {d[0], d[1], d[2]};
@@ -249,10 +261,14 @@ KERNEL int tri4_edges_test(const tri4_edges *te, const rr_vf4 d[3], rr_vf4 out[4
   out[0] = a0, out[1] = a1, out[2] = a2, out[3] = te->vol;
   return rr_vi4_bits(te->ok & (a0 >= 0) & (a1 >= 0) & (a2 >= 0));
 }
-KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3], rr_vf4 out[4]) {
+KERNEL int tri_ray_may_hit4_moved(const float *v, size_t stride, const rr_vf4 *sh, const rr_vf4 eye[3],
+                                  const rr_vf4 d[3], rr_vf4 out[4]) {
   tri4_edges te;
-  tri4_edges_setup(v, stride, eye, &te);
+  tri4_edges_setup_moved(v, stride, sh, eye, &te);
   return tri4_edges_test(&te, d, out);
+}
+KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3], rr_vf4 out[4]) {
+  return tri_ray_may_hit4_moved(v, stride, NULL, eye, d, out);
 }
 
 /* The inclusive pixel rectangle a set-up triangle's samples may lie in; false when

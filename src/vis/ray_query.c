@@ -65,18 +65,15 @@ typedef struct {
  * nearest, lower id on a tie, so the hit does not depend on the order. */
 KERNEL bool query_tris(query_ray *r, const float *leaf, const uint32_t *ids, uint32_t idbase, const bool moved,
                        const float *shift, uint32_t count, const bool any) {
+  rr_vf4 sh[3]; /* moved: the translation, added to each corner as it is loaded */
+  if (moved)
+    for (int a = 0; a < 3; a++) sh[a] = rr_vf4_splat(shift[4 * a]);
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;
     const float *v = leaf + j;
     size_t stride = count;
-    float mv[9 * 4]; /* the group's corners moved */
-    if (moved) {
-      for (int c = 0; c < 9; c++)
-        rr_vf4_store(mv + 4 * c, rr_vf4_load(v + c * count) + rr_vf4_splat(shift[4 * (c % 3)]));
-      v = mv, stride = 4;
-    }
     rr_vf4 pre[4];
-    int may = tri_ray_may_hit4(v, stride, r->o, r->d, pre) & ((1 << n) - 1);
+    int may = tri_ray_may_hit4_moved(v, stride, moved ? sh : NULL, r->o, r->d, pre) & ((1 << n) - 1);
     if (r->s->inf)
       for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, ids[j + k] + idbase) != 0) << k;
     for (; may; may &= may - 1) {
@@ -84,7 +81,7 @@ KERNEL bool query_tris(query_ray *r, const float *leaf, const uint32_t *ids, uin
       float t, l1, l2, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
       const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
       if (e[0] > 0 && e[1] > 0 && e[2] > 0 && !(r->s->inf && scene_inf(r->s, id))) {
-        const float S = ray_corner_extent(v + lane, stride, r->org);
+        const float S = ray_corner_extent_moved(v + lane, stride, moved ? shift : NULL, r->org);
         if (ray_t_outside(S, r->dmax, e, r->tmin, r->t)) continue;
         if (any && ray_t_inside(S, r->dmax, e, r->tmin, r->t)) return true; /* a proven hit: the answer */
       }
@@ -124,18 +121,21 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
   return false;
 }
 
-/* Prepares a valid ray against the scene's tree b (NULL: an empty scene). */
-static void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b, const float org[3], const float dir[3],
-                       float tmin, float tmax) {
+/* Prepares a valid ray against the scene's tree b (NULL: an empty scene); the
+ * three axes written out, which the compiler does not unroll by itself. */
+static inline __attribute__((always_inline)) void query_axis(query_ray *r, int a, float org, float dir) {
+  float inv = 1.0f / dir; /* ±inf for a zero component, by its sign */
+  int lo = (int)offsetof(bvh_wide8, lo[a]), hi = (int)offsetof(bvh_wide8, hi[a]);
+  bool neg = inv < 0;
+  r->wn[a] = neg ? hi : lo, r->wf[a] = neg ? lo : hi;
+  r->org[a] = org, r->inv_n[a] = inv * (1 - RAY_MARGIN), r->inv_f[a] = inv * (1 + RAY_MARGIN);
+  r->o[a] = rr_vf4_splat(org), r->d[a] = rr_vf4_splat(dir);
+}
+static inline __attribute__((always_inline)) void query_init(query_ray *r, const rr_scene *s, const rr_bvh *b,
+                                                             const float org[3], const float dir[3], float tmin,
+                                                             float tmax) {
   r->s = s, r->b = b, r->rc.ready = false;
-  for (int a = 0; a < 3; a++) {
-    float inv = 1.0f / dir[a]; /* ±inf for a zero component, by its sign */
-    bool neg = inv < 0;
-    r->wn[a] = (int)(neg ? offsetof(bvh_wide8, hi[a]) : offsetof(bvh_wide8, lo[a]));
-    r->wf[a] = (int)(neg ? offsetof(bvh_wide8, lo[a]) : offsetof(bvh_wide8, hi[a]));
-    r->org[a] = org[a], r->inv_n[a] = inv * (1 - RAY_MARGIN), r->inv_f[a] = inv * (1 + RAY_MARGIN);
-    r->o[a] = rr_vf4_splat(org[a]), r->d[a] = rr_vf4_splat(dir[a]);
-  }
+  query_axis(r, 0, org[0], dir[0]), query_axis(r, 1, org[1], dir[1]), query_axis(r, 2, org[2], dir[2]);
   r->tlo = tmin > 0 ? tmin : 0;
   float d0 = fabsf(dir[0]), d1 = fabsf(dir[1]), d2 = fabsf(dir[2]), d01 = d0 > d1 ? d0 : d1;
   r->dmax = d01 > d2 ? d01 : d2;
@@ -177,10 +177,17 @@ static bool query_trace(query_ray *r, bool any) {
   return any ? query_trace4_any(r) : (query_trace4_closest(r), r->id != RR_MISS);
 }
 
-/* The committed scene's tree (NULL for an empty scene) or an error in dev. */
-static rr_error query_scene(rr_device *dev, const char *fn, const rr_scene *s, const void *in, const void *out,
-                            const rr_bvh **b) {
-  if (!s || !in || !out) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: NULL scene, ray or result", fn);
+/* The committed scene's tree (NULL for an empty scene) or an error in dev: a
+ * current tree without rr_bvh_of's call, which says what is wrong otherwise. */
+static inline __attribute__((always_inline)) rr_error query_scene(rr_device *dev, const char *fn, const rr_scene *s,
+                                                                  const void *in, const void *out,
+                                                                  const rr_bvh **b) {
+  *b = NULL;
+  if (__builtin_expect(!s || !in || !out, 0)) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: NULL scene, ray or result", fn);
+  if (__builtin_expect(s->ntris && s->bvh && s->bvh->nprims == s->ntris, 1)) {
+    *b = s->bvh;
+    return RR_OK;
+  }
   bool empty;
   *b = rr_bvh_of(dev, s, &empty);
   if (!*b && !empty) return RR_ERROR_ARGUMENT; /* a scene changed since its commit: rr_bvh_of said so */
@@ -188,13 +195,15 @@ static rr_error query_scene(rr_device *dev, const char *fn, const rr_scene *s, c
 }
 
 /* Checks a query's arguments and prepares its ray; errors go to dev only. */
-static rr_error query_begin(rr_device *dev, const char *fn, const rr_scene *s, const rr_ray *ray, const void *out,
-                            query_ray *r) {
+static inline __attribute__((always_inline)) rr_error query_begin(rr_device *dev, const char *fn, const rr_scene *s,
+                                                                  const rr_ray *ray, const void *out,
+                                                                  query_ray *r) {
   const rr_bvh *b;
   rr_error e = query_scene(dev, fn, s, ray, out, &b);
   if (e) return e;
-  const char *why = ray_problem(ray->org, ray->dir, ray->tmin, ray->tmax);
-  if (why) return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray with %s", fn, why);
+  if (__builtin_expect(!ray_valid(ray), 0))
+    return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray with %s", fn,
+                   ray_problem(ray->org, ray->dir, ray->tmin, ray->tmax));
   query_init(r, s, b, ray->org, ray->dir, ray->tmin, ray->tmax);
   return RR_OK;
 }
@@ -249,16 +258,25 @@ typedef struct {
   atomic_size_t bad; /* the lowest invalid ray, SIZE_MAX when none */
 } stream_job;
 
-static float stream_at(const rr_ray_stream *rs, const float *p, size_t i) {
-  return *(const float *)((const char *)p + i * rs->stride);
+/* A stream's eight component arrays, in rr_ray's order. */
+typedef struct {
+  const char *p[8];
+} stream_src;
+
+static stream_src stream_src_of(const rr_ray_stream *rs) {
+  return (stream_src){{(const char *)rs->org[0], (const char *)rs->org[1], (const char *)rs->org[2],
+                       (const char *)rs->dir[0], (const char *)rs->dir[1], (const char *)rs->dir[2],
+                       (const char *)rs->tmin, (const char *)rs->tmax}};
 }
 
-/* Ray i of a stream; why it cannot be traced, or NULL. */
-static const char *stream_ray(const rr_ray_stream *rs, size_t i, float org[3], float dir[3], float *tmin,
-                              float *tmax) {
-  for (int a = 0; a < 3; a++) org[a] = stream_at(rs, rs->org[a], i), dir[a] = stream_at(rs, rs->dir[a], i);
-  *tmin = stream_at(rs, rs->tmin, i), *tmax = stream_at(rs, rs->tmax, i);
-  return ray_problem(org, dir, *tmin, *tmax);
+/* Ray i of a stream, gathered into one rr_ray (eight floats in a row: ray_valid). */
+static inline __attribute__((always_inline)) void stream_ray(const stream_src *src, size_t stride, size_t i,
+                                                             rr_ray *ray) {
+  float f[8];
+  size_t at = i * stride;
+#pragma GCC unroll 8
+  for (int k = 0; k < 8; k++) memcpy(&f[k], src->p[k] + at, sizeof f[k]);
+  memcpy(ray, f, sizeof *ray);
 }
 
 static void stream_chunk(int job, int thread, void *arg) {
@@ -266,12 +284,14 @@ static void stream_chunk(int job, int thread, void *arg) {
   stream_job *j = arg;
   const rr_ray_stream *rs = j->rays;
   size_t lo = (size_t)job * j->chunk, hi = lo + j->chunk < rs->count ? lo + j->chunk : rs->count;
+  const stream_src src = stream_src_of(rs);
   for (size_t i = lo; i < hi; i++) {
-    float org[3], dir[3], tmin, tmax;
-    bool valid = !stream_ray(rs, i, org, dir, &tmin, &tmax), hit = false;
+    rr_ray ray;
+    stream_ray(&src, rs->stride, i, &ray);
+    bool valid = ray_valid(&ray), hit = false;
     query_ray r;
     if (valid) {
-      query_init(&r, j->s, j->b, org, dir, tmin, tmax);
+      query_init(&r, j->s, j->b, ray.org, ray.dir, ray.tmin, ray.tmax);
       hit = query_trace(&r, j->occluded != NULL);
     } else {
       size_t bad = atomic_load(&j->bad);
@@ -307,9 +327,11 @@ static rr_error stream_run(rr_device *dev, const char *fn, const rr_scene *s, co
   rr_parallel_for((int)((rs->count + chunk - 1) / chunk), threads ? threads : rr_cpu_count(), stream_chunk, &j);
   size_t bad = atomic_load(&j.bad);
   if (bad != SIZE_MAX) {
-    float org[3], dir[3], tmin, tmax;
+    rr_ray ray;
+    const stream_src src = stream_src_of(rs);
+    stream_ray(&src, rs->stride, bad, &ray);
     return rr_fail(dev, RR_ERROR_ARGUMENT, "%s: ray %zu with %s (a miss)", fn, bad,
-                   stream_ray(rs, bad, org, dir, &tmin, &tmax));
+                   ray_problem(ray.org, ray.dir, ray.tmin, ray.tmax));
   }
   return rr_ok(dev);
 }

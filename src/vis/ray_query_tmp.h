@@ -7,7 +7,8 @@
  * RQ_NAME_any); it clears them at the end.
  *
  * Front to back: the slots a node's test enters are taken nearest entry first
- * (closest hit; an any-hit query takes them in slot order, as any hit ends it),
+ * (closest hit; an any-hit query takes them from the far end of the slot order,
+ * as any hit ends it),
  * the others stacked with their entry, and a stacked slot is dropped on pop when
  * the best hit is already nearer (strictly: an equal t with a lower id still
  * wins). Leaves go to query_tris, the one place a leaf's triangles are tested
@@ -31,6 +32,7 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
     float key;
   } stack[7 * BVH_STACK]; /* a level pushes at most seven; the tree is less than BVH_STACK deep */
   RQ_VF org[3], inv_n[3], inv_f[3];
+#pragma GCC unroll 3
   for (int a = 0; a < 3; a++)
     org[a] = RQ_(splat)(r->org[a]), inv_n[a] = RQ_(splat)(r->inv_n[a]), inv_f[a] = RQ_(splat)(r->inv_f[a]);
   const RQ_VF tlo = RQ_(splat)(r->tlo);
@@ -77,22 +79,36 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
       if (hits) {
         int i = __builtin_ctz(hits);
         unsigned rest = hits & (hits - 1);
-        if (rest && (any || (rest & (rest - 1)))) {
-          if (!any) { /* three or more: the nearest entered, the others stacked farthest first */
-            int order[8], n = 0;
-            for (unsigned m = hits; m; m &= m - 1) {
-              int k = __builtin_ctz(m), j = n++;
-              for (; j > 0 && entry[order[j - 1]] < entry[k]; j--) order[j] = order[j - 1];
-              order[j] = k;
-            }
-            rest = 0, i = order[n - 1];
-            for (int j = 0; j < n - 1; j++) {
-              int k = order[j];
+        if (rest && any) {
+          /* Any hit: the far end first. A shadow ray leaves the surface it starts
+           * on (which tmin excludes), and its blockers lie more often away from its
+           * origin than near it. Slots keep the binary tree's order (left before
+           * right along each split), so they run roughly along or against the ray:
+           * the first and last entered slots' entries tell which, and the slots are
+           * taken from the far end without a sort. */
+          int l = 31 - __builtin_clz(hits);
+          if (entry[l] > entry[i]) { /* the last entered, the others stacked first to last */
+            for (rest = hits & ~(1u << l); rest; rest &= rest - 1) {
+              int k = __builtin_ctz(rest);
               stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp++].key = entry[k];
             }
+            i = l;
+          } else { /* the first entered, the others stacked last to first */
+            for (; rest; rest &= ~(1u << l)) {
+              l = 31 - __builtin_clz(rest);
+              stack[sp].ref = w->ref[l], stack[sp].count = w->count[l], stack[sp++].key = entry[l];
+            }
           }
-          for (; rest; rest &= rest - 1) { /* any hit: the first entered, the others stacked */
-            int k = __builtin_ctz(rest);
+        } else if (rest && (rest & (rest - 1))) { /* three or more: the nearest entered, the others stacked farthest first */
+          int order[8], n = 0;
+          for (unsigned m = hits; m; m &= m - 1) {
+            int k = __builtin_ctz(m), j = n++;
+            for (; j > 0 && entry[order[j - 1]] < entry[k]; j--) order[j] = order[j - 1];
+            order[j] = k;
+          }
+          i = order[n - 1];
+          for (int j = 0; j < n - 1; j++) {
+            int k = order[j];
             stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp++].key = entry[k];
           }
         } else if (rest) { /* two (the common case): the nearer entered, the other stacked */

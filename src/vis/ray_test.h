@@ -33,6 +33,17 @@ static inline const char *ray_problem(const float org[3], const float dir[3], fl
   return "a NaN range";
 }
 
+/* Whether ray_problem finds nothing wrong with the ray, in four lanes: org and
+ * dir finite (x − x is 0), tmin and tmax not NaN, dir not zero. */
+static inline bool ray_valid(const rr_ray *ray) {
+  _Static_assert(sizeof(rr_ray) == 8 * sizeof(float), "rr_ray: eight floats in a row");
+  rr_vf4 a, b; /* o0 o1 o2 d0, d1 d2 tmin tmax: the struct's bytes, read as such */
+  memcpy(&a, ray, sizeof a), memcpy(&b, (const char *)ray + sizeof a, sizeof b);
+  const rr_vi4 range = {0, 0, -1, -1}; /* tmin, tmax: infinite is fine, NaN is not */
+  int ok = rr_vi4_bits((a - a == 0) & ((b - b == 0) | (range & (b == b))));
+  return ok == 0xF && (ray->dir[0] != 0 || ray->dir[1] != 0 || ray->dir[2] != 0);
+}
+
 /* Whether the full test (ray_tri_test) of a triangle whose pre-test values pre
  * (tri_ray_may_hit4) are all inside, e_i > 0, surely finds its t outside [tmin,
  * tmax], from those values alone: the start triangle of a ray from a surface, or a
@@ -99,15 +110,19 @@ static inline bool ray_t_inside(float S, float dmax, const float pre[4], float t
 /* S of ray_t_outside for a triangle laid out as tri_ray_may_hit4 reads its lanes
  * (corner k's axis x at v[(3k + x)·stride]): max |q_k| over the corners and axes,
  * q_k = p_k − o rounded as the pre-test rounds it. No NaN (finite corners), so a
- * plain comparison (fmaxf is a call). */
-static inline float ray_corner_extent(const float *v, size_t stride, const float org[3]) {
+ * plain comparison (fmaxf is a call). sh: the corners moved by a translation
+ * (x, y, z at sh[0], [4], [8]), each rounded as p + sh first, or NULL. */
+static inline float ray_corner_extent_moved(const float *v, size_t stride, const float *sh, const float org[3]) {
   float S = 0;
 #pragma GCC unroll 9
   for (int m = 0; m < 9; m++, v += stride) {
-    float q = fabsf(*v - org[m % 3]);
+    float q = fabsf((sh ? *v + sh[4 * (m % 3)] : *v) - org[m % 3]);
     S = q > S ? q : S;
   }
   return S;
+}
+static inline float ray_corner_extent(const float *v, size_t stride, const float org[3]) {
+  return ray_corner_extent_moved(v, stride, NULL, org);
 }
 
 /* A ray's pseudo-camera, made when its first triangle passes the pre-test (many
