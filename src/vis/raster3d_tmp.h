@@ -37,8 +37,9 @@ TARGET static inline __attribute__((always_inline)) VI RR_CAT(edge_inside, W)(VF
  * a time, columns then rows (the terms in sx are the same on every row), for each
  * of ns sample positions in turn: the triangle's constants are loaded once. One
  * position (mv NULL): ts's own over r. Several: the k-th is position s = act[k]
- * (cams[s], layer s of vb) over its own rectangle rs[k] (inside r), with mv's four
- * setup values that move with it. A lane is
+ * (cams[s], sample s of each pixel of vb: a gather, and the winners written one at
+ * a time, as the lanes' samples lie vb->ns apart) over its own rectangle rs[k]
+ * (inside r), with mv's four setup values that move with it. A lane is
  * the sample test of prim/triangle.h (sample_test_w) and the depth test of
  * vis/vis.h (depth_wins), with the depth of TRI_DEPTH: the same operations in the same order on IEEE single
  * floats (no FMA, a true division), so every width gives their bits. Lanes past

@@ -269,7 +269,7 @@ static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_came
 }
 
 /* A method's passes over ctx: one for every position, or one per position, each
- * writing its own layer (S grows with N). */
+ * writing its own sample of every pixel (S grows with N). */
 static rr_error run_passes(rr_device *dev, rr_method m, render_ctx ctx, progress_span whole) {
   if (methods[m].all_samples) {
     ctx.progress = whole;

@@ -85,7 +85,7 @@ struct rr_frame {
   rr_stats stats;
   rr_method method;
   int samples; /* vb holds this many samples a pixel (vb.ns) */
-  float sample_pos[RR_MAX_SAMPLES][2]; /* options.sample_pos: where layer s sampled each pixel */
+  float sample_pos[RR_MAX_SAMPLES][2]; /* options.sample_pos: where sample s of each pixel lies */
   rr_aa_mode aa;                       /* how shading uses them (options.aa, aa_stored) */
   int aa_stored;
 };
@@ -109,7 +109,7 @@ typedef struct render_ctx {
   progress_span progress;        /* this pass's share of the frame's progress: for its main loop */
   /* A cube camera drawn in one pass (render.c, rr_vis_traverse): its 6 faces, else 0;
    * face f at position s is the perspective camera face_cams[f·samples + s], drawn
-   * into face_vb[f] (samples layers of F × F) and charging face_heat_e/n + f·F². */
+   * into face_vb[f] (F × F pixels of samples each) and charging face_heat_e/n + f·F². */
   int faces;
   const camera *face_cams;
   visbuf *face_vb;
@@ -179,7 +179,8 @@ rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx);
 rr_error rr_vis_2dr_bin(rr_device *dev, render_ctx *ctx);
 /* Test hook: runs the 2D pipeline (binning when `bin`) over every triangle at the
  * `samples` positions of cams[] but, instead of the z test, counts in front[k] /
- * back[k] every triangle that claims sample k (layered like the visibility buffer). */
+ * back[k] every triangle that claims sample k (a layer per position: sample s of
+ * pixel p at s·width·height + p). */
 rr_error rr_raster2d_claims(const rr_scene *s, const camera *cams, int samples, bool bin, int threads, uint8_t *front,
                             uint8_t *back);
 /* Test hook: where the 2D pipeline's vertex stage puts world point p on the screen;
