@@ -628,8 +628,8 @@ RR_API rr_error rr_frame_get_sample_pos(const rr_frame *frame, float pos[RR_MAX_
 /* Read-only views of the visibility buffer, row 0 at the top: primitive id
  * (the triangle's id as under "geometries" above, RR_MISS on a miss), ray parameter t along the unnormalised camera ray
  * (+inf on a miss) and barycentrics λ1, λ2 of the hit. With several samples per
- * pixel they hold one width × height layer per sample, sample s at offset
- * s·width·height. */
+ * pixel a pixel's samples lie side by side (height × width × samples, as the
+ * sample-* AOVs): sample s of pixel (x, y) at offset (y·width + x)·samples + s. */
 RR_API const uint32_t *rr_frame_ids(const rr_frame *frame);
 RR_API const float *rr_frame_t(const rr_frame *frame);
 RR_API const float *rr_frame_bary1(const rr_frame *frame);

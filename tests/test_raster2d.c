@@ -320,15 +320,25 @@ static void check_view_pattern(const rr_scene *s, const rr_camera *cam, const ca
     CHECK(memcmp(a->id, b->id, n * 4) == 0 && memcmp(a->t, b->t, n * 4) == 0 && memcmp(a->l1, b->l1, n * 4) == 0 &&
               memcmp(a->l2, b->l2, n * 4) == 0,
           "%s: 2dr-bin differs from 2dr-bb at %d positions", what, NPAT);
-    for (int k = 0; k < NPAT; k++) {
+    /* position k's layers, copied apart (the buffer keeps a pixel's samples side by side) */
+    uint32_t *ids = malloc(2 * npix * sizeof *ids);
+    float *fs = malloc(6 * npix * sizeof *fs);
+    CHECK(ids && fs, "out of memory");
+    for (int k = 0; ids && fs && k < NPAT; k++) {
       const visbuf *r = &f[2]->vb;
-      rr_frame la = {.vb = {w, h, a->id + k * npix, a->t + k * npix, a->l1 + k * npix, a->l2 + k * npix}};
-      rr_frame lr = {.vb = {w, h, r->id + k * npix, r->t + k * npix, r->l1 + k * npix, r->l2 + k * npix}};
+      for (size_t p = 0; p < npix; p++) {
+        size_t q = p * NPAT + k;
+        ids[p] = a->id[q], fs[p] = a->t[q], fs[npix + p] = a->l1[q], fs[2 * npix + p] = a->l2[q];
+        ids[npix + p] = r->id[q], fs[3 * npix + p] = r->t[q], fs[4 * npix + p] = r->l1[q], fs[5 * npix + p] = r->l2[q];
+      }
+      rr_frame la = {.vb = {w, h, ids, fs, fs + npix, fs + 2 * npix, 1}};
+      rr_frame lr = {.vb = {w, h, ids + npix, fs + 3 * npix, fs + 4 * npix, fs + 5 * npix, 1}};
       agreement g = compare(s, &pat[k], &la, &lr);
       char label[300];
       snprintf(label, sizeof label, "%s, position %d (%g, %g)", what, k, pat[k].sx0, pat[k].sy0);
       check_agreement(label, &g, min_id, min_hit);
     }
+    free(ids), free(fs);
   }
   for (int m = 0; m < 3; m++) rr_frame_release(f[m]);
 }

@@ -53,7 +53,7 @@ static void check_positions(rr_device *dev, const rr_scene *s, const rr_camera *
     for (int k = 0; k < 4; k++)
       for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
-          uint32_t id = a->vb.id[(size_t)k * w * h + (size_t)y * w + x];
+          uint32_t id = a->vb.id[((size_t)y * w + x) * 4 + k];
           agree += id == b->vb.id[(size_t)(2 * y + k / 2) * 2 * w + 2 * x + k % 2];
           moved += id != c->vb.id[(size_t)y * w + x];
         }

@@ -116,7 +116,7 @@ static void check_raster(const rr_scene *s, const camera *c, const char *what) {
   visbuf vb[2];
   for (int k = 0; k < 2; k++) {
     vb[k] = (visbuf){w, h, malloc(n * sizeof(uint32_t)), malloc(n * sizeof(float)), calloc(n, sizeof(float)),
-                     calloc(n, sizeof(float))};
+                     calloc(n, sizeof(float)), 1};
     CHECK(vb[k].id && vb[k].t && vb[k].l1 && vb[k].l2, "out of memory");
     if (!vb[k].id || !vb[k].t || !vb[k].l1 || !vb[k].l2) return;
   }

@@ -73,10 +73,12 @@ void test_check_layers(rr_device *dev, const rr_scene *s, const rr_camera *cam, 
     rr_render_options o1 = test_pattern(one, o->width, o->height, o->threads, 1, &o->sample_pos[k]);
     rr_frame *f = test_render_opt(dev, s, cam, &o1);
     if (!f) continue;
-    size_t off = (size_t)k * npix;
-    bool same = memcmp(f->vb.id, multi->vb.id + off, npix * 4) == 0 &&
-                memcmp(f->vb.t, multi->vb.t + off, npix * 4) == 0 &&
-                memcmp(f->vb.l1, multi->vb.l1 + off, npix * 4) == 0 && memcmp(f->vb.l2, multi->vb.l2 + off, npix * 4) == 0;
+    bool same = true; /* sample k of each pixel (a pixel's samples side by side) */
+    for (size_t p = 0; p < npix; p++) {
+      size_t m = p * (size_t)o->samples + k;
+      same &= memcmp(&f->vb.id[p], &multi->vb.id[m], 4) == 0 && memcmp(&f->vb.t[p], &multi->vb.t[m], 4) == 0 &&
+              memcmp(&f->vb.l1[p], &multi->vb.l1[m], 4) == 0 && memcmp(&f->vb.l2[p], &multi->vb.l2[m], 4) == 0;
+    }
     CHECK(same, "%s: layer %d of %d is not %s's frame of one sample at (%g, %g)", what, k, o->samples,
           rr_method_name(one), o->sample_pos[k][0], o->sample_pos[k][1]);
     rr_frame_release(f);

@@ -75,7 +75,7 @@ static hit sample_hit(const rr_scene *s, const camera *c, const visbuf *vb, size
 
 /* Sample 0 of pixel (x, y). */
 static hit hit_at(const rr_scene *s, const camera *c, const visbuf *vb, int x, int y) {
-  return sample_hit(s, c, vb, (size_t)y * vb->width + x, x, y);
+  return sample_hit(s, c, vb, ((size_t)y * vb->width + x) * vb->ns, x, y); /* vb: one layer */
 }
 
 /* The hit's ray's differentials over the sample's footprint (a camera's, scaled to
@@ -347,9 +347,8 @@ static void background(int y, int height, float o[3]) {
   o[0] = srgb_decode(g * 0.9f), o[1] = srgb_decode(g), o[2] = srgb_decode(g * 1.15f);
 }
 
-/* A run of pixels of one row, every layer copied side by side: the layers lie a
- * power of two apart, so reading a pixel's samples in place would map them all to
- * the same cache sets. */
+/* A run of pixels of one row, each sample's row of them apart (the buffer keeps a
+ * pixel's samples side by side; shading reads a sample's row). */
 enum { RUN = 64 };
 typedef struct sample_run {
   uint32_t id[RR_MAX_SAMPLES][RUN];
@@ -437,14 +436,13 @@ static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int
 /* The run of pixels x0 .. x0 + len - 1 of row y, from the visibility buffer. */
 static void run_load(const shade_pass *p, sample_run *r, int y, int x0, int len) {
   const visbuf *vb = p->vb;
-  size_t npix = (size_t)vb->width * vb->height, k0 = (size_t)y * vb->width + x0;
-  for (int i = 0; i < p->samples; i++) {
-    size_t e = i * npix + k0;
-    memcpy(r->id[i], vb->id + e, len * sizeof(uint32_t));
-    memcpy(r->l1[i], vb->l1 + e, len * sizeof(float));
-    memcpy(r->l2[i], vb->l2 + e, len * sizeof(float));
-    memcpy(r->t[i], vb->t + e, len * sizeof(float));
-  }
+  const int n = p->samples;
+  const size_t e0 = ((size_t)y * vb->width + x0) * n;
+  for (int j = 0; j < len; j++)
+    for (int i = 0; i < n; i++) {
+      const size_t e = e0 + (size_t)j * n + i;
+      r->id[i][j] = vb->id[e], r->l1[i][j] = vb->l1[e], r->l2[i][j] = vb->l2[e], r->t[i][j] = vb->t[e];
+    }
 }
 
 /* The run's coloured samples: resolved into the image (the box of each pixel's own
@@ -571,12 +569,11 @@ static void lit_frame(shade_pass *p, int wave_points, int threads) {
 /* The frame's range of eye distances over every shaded sample (the depth mode's scale). */
 static void depth_range(const shade_pass *p, float *dmin, float *dmax) {
   const visbuf *vb = p->vb;
-  size_t npix = (size_t)vb->width * vb->height;
   *dmin = INFINITY, *dmax = 0;
   for (int i = 0; i < p->samples; i++)
     for (int y = 0; y < vb->height; y++)
       for (int x = 0; x < vb->width; x++) {
-        hit h = sample_hit(p->s, &p->cams[i], vb, i * npix + (size_t)y * vb->width + x, x, y);
+        hit h = sample_hit(p->s, &p->cams[i], vb, ((size_t)y * vb->width + x) * vb->ns + i, x, y);
         if (h.valid) *dmin = fminf(*dmin, h.dist), *dmax = fmaxf(*dmax, h.dist);
       }
 }
@@ -717,8 +714,9 @@ static rr_aov per_sample_base(rr_aov aov) {
   }
 }
 
-/* Fills an AOV from the frame's layers, by the rules of several samples per pixel
- * (rastray.h): a per-sample AOV takes every layer as a channel; coverage counts the
+/* Fills an AOV from the frame's layers (a layer: one sample of every pixel), by the
+ * rules of several samples per pixel (rastray.h): a per-sample AOV takes every layer
+ * as a channel (the H × W × N order of the buffer itself); coverage counts the
  * layers' hits; depth keeps the nearest; the others read the centre's layer. */
 static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams, const rr_frame *f, rr_aov aov,
                           rr_image *out) {
@@ -756,11 +754,11 @@ static rr_error frame_aov(rr_device *dev, const rr_scene *s, const camera *cams,
       for (int x = 0; x < vb->width; x++) {
         size_t k = (size_t)y * vb->width + x;
         if (ints) {
-          ((uint32_t *)out->data)[k * ch + c0] = id_aov(s, base, layer.id[k]);
+          ((uint32_t *)out->data)[k * ch + c0] = id_aov(s, base, layer.id[k * layer.ns]);
           continue;
         }
         if (aov == RR_AOV_COVERAGE) {
-          o[k] += layer.id[k] < s->ntris ? 1.0f / f->samples : 0.0f;
+          o[k] += layer.id[k * layer.ns] < s->ntris ? 1.0f / f->samples : 0.0f;
           continue;
         }
         hit h = hit_at(s, &cams[smp], &layer, x, y);
@@ -844,8 +842,9 @@ static rr_error lit_aov(rr_device *dev, const rr_scene *s, const rr_camera *cam,
     for (size_t k = 0; ok && k < npix; k++) {
       int x = (int)(k % vb.width), y = (int)(k / vb.width);
       vec3 o, d;
-      if (vb.id[k] >= s->ntris || !rr_cam_ray(&cams[centre], x, y, &o, &d)) continue; /* 0 */
-      hit h = hit_make(s, vb.id[k], vb.l1[k], vb.l2[k], vb.t[k], o, d, &cams[centre], x, y);
+      const size_t q = k * vb.ns; /* the centre's sample of pixel k */
+      if (vb.id[q] >= s->ntris || !rr_cam_ray(&cams[centre], x, y, &o, &d)) continue; /* 0 */
+      hit h = hit_make(s, vb.id[q], vb.l1[q], vb.l2[q], vb.t[q], o, d, &cams[centre], x, y);
       surface sf;
       hit_surface(s, &h, &p->tex, &sf);
       ok = rr_lit_wave_add(wave, 0, &sf, colour + 3 * k, parts + k * LIT_PARTS, vis ? vis + k * nl : NULL);

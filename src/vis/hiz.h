@@ -16,7 +16,8 @@
 
 typedef struct hiz {
   const visbuf *vb;          /* the depths it summarises: */
-  int layers;                /* this many layers of vb (1 unless set after rr_hiz_init) */
+  int layers;                /* vb.ns: every sample of vb's pixels; 1: vb is one layer of a buffer (set
+                                after rr_hiz_init, which sets 1) */
   int shift, levels;         /* level l's blocks are 1 << (shift + 2l) samples wide */
   int w[HIZ_LEVELS_MAX], h[HIZ_LEVELS_MAX]; /* blocks a row, rows of blocks */
   float *zmax[HIZ_LEVELS_MAX];
@@ -37,13 +38,16 @@ static inline float hiz_refresh_samples(hiz *h, int i, int j) {
   int s = 1 << h->shift;
   int x1 = (i + 1) * s < vb->width ? (i + 1) * s : vb->width, y1 = (j + 1) * s < vb->height ? (j + 1) * s : vb->height;
   float m = -INFINITY;
-  for (int l = 0; l < h->layers; l++) /* a block holds every sample of its pixels */
-    for (int y = j * s; y < y1; y++) {
-      const float *t = vb->t + ((size_t)l * vb->height + y) * vb->width;
-      int x = i * s;
-      for (; x + 4 <= x1; x += 4) m = maxf(m, maxf(maxf(t[x], t[x + 1]), maxf(t[x + 2], t[x + 3])));
-      for (; x < x1; x++) m = maxf(m, t[x]);
-    }
+  const int ns = vb->ns;
+  for (int y = j * s; y < y1; y++) {
+    const float *t = vb->t + (size_t)y * vb->width * ns;
+    if (h->layers == ns) { /* a block holds every sample of its pixels: a row's lie side by side */
+      int x = i * s * ns, xe = x1 * ns;
+      for (; x + 4 <= xe; x += 4) m = maxf(m, maxf(maxf(t[x], t[x + 1]), maxf(t[x + 2], t[x + 3])));
+      for (; x < xe; x++) m = maxf(m, t[x]);
+    } else /* one layer of several */
+      for (int x = i * s; x < x1; x++) m = maxf(m, t[(size_t)x * ns]);
+  }
   size_t k = (size_t)j * h->w[0] + i;
   h->zmax[0][k] = m;
   h->dirty[0][k] = 0;

@@ -456,6 +456,7 @@ KERNEL bool shade2d(const tri2d *t, float dx, float qr, float tr, float r1, floa
   float depth = (tr + dx * t->pt[1]) * w;
   depth = depth < t->tmin ? t->tmin : depth > t->tmax ? t->tmax : depth;
   visbuf *vb = tg->vb;
+  k *= (size_t)vb->ns; /* the position's layer: pixel k's sample */
   if (!depth_wins(depth, t->id, vb->t[k], vb->id[k])) return false;
   vb->t[k] = depth;
   vb->id[k] = t->id;
@@ -756,7 +757,8 @@ static void band_job(int b, int thread, void *arg) { band_jobs(b, thread, arg, f
 static void band_job_all(int b, int thread, void *arg) { band_jobs(b, thread, arg, true); }
 
 /* A pattern of `samples` positions (cams[s] for position s) in one pass; tg's
- * buffers (the visibility buffer, or the claim counts) hold a layer per position. */
+ * buffers hold every position: the visibility buffer a pixel's samples side by side
+ * (vis.h), the claim counts a layer per position. */
 static rr_error run2d(rr_device *dev, const progress_span *progress, const rr_scene *s, const camera *cams, int samples,
                       bool cull, bool bin, int threads, target tg, rr_stats *stats) {
   pipe2d pp;
@@ -774,7 +776,7 @@ static rr_error run2d(rr_device *dev, const progress_span *progress, const rr_sc
     *p = (pass2d){.scene = s, .pp = &pp, .bin = bin, .hz = hz};
     size_t npix = (size_t)tg.vb->width * tg.vb->height;
     const visbuf *vb = tg.vb;
-    for (int k = 0; k < samples; k++) { /* layer k of each buffer the target has */
+    for (int k = 0; k < samples; k++) { /* position k's part of each buffer the target has */
       size_t o = (size_t)k * npix;
       p->layer[k] = visbuf_layer(vb, k);
       p->tg[k] = (target){&p->layer[k], tg.front ? tg.front + o : NULL, tg.back ? tg.back + o : NULL, tg.heat};
@@ -837,7 +839,7 @@ static void impostor_band(int b, int thread, void *arg) {
       visbuf vb = visbuf_layer(im->vb, s);
       for (int y = ya; y < yb; y++)
         for (int x = r[0]; x <= r[2]; x++) {
-          size_t k = (size_t)y * vb.width + x;
+          size_t k = ((size_t)y * vb.width + x) * vb.ns;
           if (im->bin && vb.t[k] < im->floor[j]) continue;
           evals++;
           ana_shade_sample(im->s, c, im->ids[j], camera_w(c, x, y), (float)x + c->sx0, (float)y + c->sy0, &vb, k);
@@ -884,7 +886,7 @@ rr_error rr_raster2d_claims(const rr_scene *s, const camera *cams, int samples, 
                             uint8_t *back) {
   size_t n = (size_t)cams->width * cams->height * samples;
   memset(front, 0, n), memset(back, 0, n);
-  visbuf vb = {.width = cams->width, .height = cams->height};
+  visbuf vb = {.width = cams->width, .height = cams->height, .ns = samples};
   target tg = {.vb = &vb, .front = front, .back = back};
   rr_stats st = {0};
   return run2d(NULL, NULL, s, cams, samples, false, bin, threads < 1 ? 1 : threads, tg, &st);

@@ -37,8 +37,9 @@ TARGET static inline __attribute__((always_inline)) VI RR_CAT(edge_inside, W)(VF
  * a time, columns then rows (the terms in sx are the same on every row), for each
  * of ns sample positions in turn: the triangle's constants are loaded once. One
  * position (mv NULL): ts's own over r. Several: the k-th is position s = act[k]
- * (cams[s], layer s of vb) over its own rectangle rs[k] (inside r), with mv's four
- * setup values that move with it. A lane is
+ * (cams[s], sample s of each pixel of vb: a gather, and the winners written one at
+ * a time, as the lanes' samples lie vb->ns apart) over its own rectangle rs[k]
+ * (inside r), with mv's four setup values that move with it. A lane is
  * the sample test of prim/triangle.h (sample_test_w) and the depth test of
  * vis/vis.h (depth_wins), with the depth of TRI_DEPTH: the same operations in the same order on IEEE single
  * floats (no FMA, a true division), so every width gives their bits. Lanes past
@@ -46,12 +47,17 @@ TARGET static inline __attribute__((always_inline)) VI RR_CAT(edge_inside, W)(VF
 
 TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_moves *mv, const uint8_t *act,
                                                      const int (*rs)[4], uint32_t id, const int r0[4],
-                                                     const camera *cams, int ns, visbuf *vb, const bool planar) {
+                                                     const camera *cams, int ns, visbuf *vb, const bool planar,
+                                                     const bool dense) {
   const RR_CAT(tri_lanes, W) L = RR_CAT(lanes_of, W)(ts);
   const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
   /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
   const VI idv = VI_(splat)((int32_t)id), bias = VI_(splat)(INT32_MIN), id_biased = idv ^ bias;
-  const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
+  const size_t width = (size_t)vb->width, stride = dense ? 1 : (size_t)vb->ns;
+  /* not dense (several samples a pixel): a row's samples of one position lie
+   * stride apart, read by gathers of 32-bit indices where they fit */
+  const bool gathered = (uint64_t)stride * width * (size_t)vb->height <= INT32_MAX;
+  const VI strides = VI_(splat)((int32_t)stride) * VI_(lanes)();
   uint64_t covered = 0;
   for (int k = 0; k < ns; k++) {
   const int s = mv ? act[k] : 0, *r = mv ? rs[k] : r0;
@@ -60,8 +66,8 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_mov
                                                mv ? mv->cx[s] : ts->cx, mv ? mv->cy[s] : ts->cy};
   const VI end = VI_(splat)(r[2] + 1);
   const VF pa = VF_(splat)(p.pa), num0 = VF_(splat)(p.num0), cx = VF_(splat)(p.cx), cy = VF_(splat)(p.cy);
-  float *best_t = vb->t + s * layer, *l1 = vb->l1 + s * layer, *l2 = vb->l2 + s * layer;
-  int32_t *best_id = (int32_t *)vb->id + s * layer;
+  float *best_t = vb->t + s, *l1 = vb->l1 + s, *l2 = vb->l2 + s; /* sample s of each pixel */
+  int32_t *best_id = (int32_t *)vb->id + s;
   for (int x = r[0]; x <= r[2]; x += W) {
     const VI xi = VI_(splat)(x) + VI_(lanes)(), valid = end > xi;
     const VF sx = VF_(from_int)(xi) + VF_(splat)(c->sx0);
@@ -93,14 +99,30 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_mov
       covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
       const VF den = planar ? px + L.pc * (sy - cy) : pa * wx + L.pb * (wy - cx) + L.pc * (wz - cy);
       const VF inv = one / sum, t = TRI_DEPTH(nx + (sy - cy) * L.num_y, den, v, inv, zero, VF_(select));
-      const VF bt = VF_(load_masked)(best_t + k, in);
-      const VI bid = VI_(load_masked)(best_id + k, in);
-      const VI wins = in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased)));
-      if (!VI_(bits)(wins)) continue;
-      VF_(store_masked)(best_t + k, wins, t);
-      VI_(store_masked)(best_id + k, wins, idv);
-      VF_(store_masked)(l1 + k, wins, ev[1] * inv);
-      VF_(store_masked)(l2 + k, wins, ev[2] * inv);
+      if (dense) {
+        const VF bt = VF_(load_masked)(best_t + k, in);
+        const VI bid = VI_(load_masked)(best_id + k, in);
+        const VI wins = in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased)));
+        if (!VI_(bits)(wins)) continue;
+        VF_(store_masked)(best_t + k, wins, t);
+        VI_(store_masked)(best_id + k, wins, idv);
+        VF_(store_masked)(l1 + k, wins, ev[1] * inv);
+        VF_(store_masked)(l2 + k, wins, ev[2] * inv);
+      } else {
+        const VF b1 = ev[1] * inv, b2 = ev[2] * inv;
+        if (gathered) {
+          const VI kv = VI_(splat)((int32_t)(k * stride)) + strides;
+          const VF bt = VF_(gather_masked)(best_t, kv, in);
+          const VI bid = VI_(gather_masked)(best_id, kv, in);
+          hit = VI_(bits)(in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased))));
+        }
+        for (; hit; hit &= hit - 1) { /* the winners' writes, one lane at a time */
+          const int l = __builtin_ctz((unsigned)hit);
+          const size_t q = (k + (size_t)l) * stride;
+          if (gathered || t[l] < best_t[q] || (t[l] == best_t[q] && (uint32_t)best_id[q] > id))
+            best_t[q] = t[l], best_id[q] = (int32_t)id, l1[q] = b1[l], l2[q] = b2[l];
+        }
+      }
     }
   }
   }
@@ -111,37 +133,72 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_mov
  * so the one-position frame pays nothing for the loop over positions. */
 TARGET static uint64_t RR_CAT(raster_one, W)(const tri_setup *ts, uint32_t id, const int r[4], const camera *c,
                                              visbuf *vb, const bool planar) {
-  return planar ? RR_CAT(raster_loop, W)(ts, NULL, NULL, NULL, id, r, c, 1, vb, true)
-                : RR_CAT(raster_loop, W)(ts, NULL, NULL, NULL, id, r, c, 1, vb, false);
+  return planar ? RR_CAT(raster_loop, W)(ts, NULL, NULL, NULL, id, r, c, 1, vb, true, true)
+                : RR_CAT(raster_loop, W)(ts, NULL, NULL, NULL, id, r, c, 1, vb, false, true);
 }
 TARGET static uint64_t RR_CAT(raster_many, W)(const tri_setup *ts, const tri_moves *mv, const uint8_t *act,
                                               const int (*rs)[4], uint32_t id, const camera *cams, int n,
                                               visbuf *vb, const bool planar) {
-  return planar ? RR_CAT(raster_loop, W)(ts, mv, act, rs, id, rs[0], cams, n, vb, true)
-                : RR_CAT(raster_loop, W)(ts, mv, act, rs, id, rs[0], cams, n, vb, false);
+  return planar ? RR_CAT(raster_loop, W)(ts, mv, act, rs, id, rs[0], cams, n, vb, true, false)
+                : RR_CAT(raster_loop, W)(ts, mv, act, rs, id, rs[0], cams, n, vb, false, false);
 }
 
 #include "prim/triangle_moved_tmp.h"
 
-/* A triangle of a few pixels at several positions (planar cameras), within r: set
- * up once for all of them, lanes over (position, pixel) pairs. A step takes P
- * positions (ns rounded up to a power of two, at most W), each at the next W / P
- * pixels of its own rectangle (within r) in row order, so a triangle of a pixel or
- * two costs one step per P positions. Each position's rectangle comes in the lanes
- * from the bounds' bits (tri_pos_rect), its moved setup values (tri_moved) at the
- * first hit: a draw costs nothing per position beyond its lanes. The same
- * operations in the same order as the loop above, lane by lane, so the same bits.
- * The lanes that pass take the depth test together (their samples are distinct:
- * a lane's position or pixel differs), reading each one's layer by a gather of
- * 32-bit indices (frames of fewer than 2^31 samples; larger ones test one lane at
- * a time), and the winners are written one at a time. Adds the samples tested to
- * *tested. */
+/* A triangle at several positions (planar cameras), within r: set up once for all
+ * of them, lanes over (position, pixel) pairs. A step takes P positions (ns rounded
+ * up to a power of two, at most W) at W / P pixels each. Each position's rectangle
+ * comes in the lanes from the bounds' bits (tri_pos_rect), its moved setup values
+ * (tri_moved) at the first hit: a draw costs nothing per position beyond its lanes.
+ * The same operations in the same order as the loop above, lane by lane, so the
+ * same bits. Two walks:
+ * - each lane over its own rectangle (within r) in row order, so a triangle of a
+ *   pixel or two costs one step per P positions. The lanes that pass take the depth
+ *   test together (their samples are distinct: a lane's position or pixel
+ *   differs), reading their samples by a gather of 32-bit indices (frames of fewer
+ *   than 2^31 samples; larger ones test one lane at a time), and the winners are
+ *   written one at a time.
+ * - together (ns a power of two; larger draws): every lane at the same W / P pixels
+ *   of the union of the rectangles, off where its own rectangle is not: the lanes'
+ *   samples lie side by side in the buffer (vis.h), so one masked load and store an
+ *   array. A few steps more than the largest rectangle (positions' rectangles
+ *   differ by a row or column), no gathers and no one-at-a-time writes.
+ * Adds the samples tested (those of the lanes' own rectangles) to *tested. */
+
+/* One step's tests at the lanes' pixels (x, y) (*in: the lanes to test, then those
+ * that hit): the edges, the hit ahead, then the depth and barycentrics. */
+TARGET static inline __attribute__((always_inline)) int RR_CAT(pixel_hits, W)(
+    const RR_CAT(tri_lanes, W) * L, const tri_setup *ts, const tri_moves *mv, const camera *c, VF ox, VF oy, VF m[4],
+    bool *moved, VI x, VI y, VI *in, VF *t, VF *l1, VF *l2) {
+  const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
+  const VF sx = VF_(from_int)(x) + ox, sy = VF_(from_int)(y) + oy;
+  VF ev[3];
+  VI inside = *in;
+#pragma GCC unroll 3
+  for (int e = 0; e < 3; e++) {
+    ev[e] = (L->a[e] * one + L->b[e] * sx) + L->cc[e] * sy;
+    inside &= RR_CAT(edge_inside, W)(ev[e], L->tie[e], L->tie2[e]);
+  }
+  if (!VI_(bits)(inside)) return 0;
+  const VF sum = ev[0] * L->w0 + ev[1] * L->w1 + ev[2] * L->w2, v = (L->vol + sx * L->vol_x) + sy * L->vol_y;
+  inside &= TRI_HIT_AHEAD(sum, v, zero);
+  const int hit = VI_(bits)(inside);
+  if (!hit) return 0;
+  if (!*moved) RR_CAT(tri_moved_lanes, W)(ts, mv->pl, c, ox, oy, m), *moved = true;
+  const VF pa = m[0], num0 = m[1], cx = m[2], cy = m[3];
+  const VF den = (pa * one + L->pb * (sx - cx)) + L->pc * (sy - cy);
+  const VF inv = one / sum;
+  *t = TRI_DEPTH((num0 + (sx - cx) * L->num_x) + (sy - cy) * L->num_y, den, v, inv, zero, VF_(select));
+  *l1 = ev[1] * inv, *l2 = ev[2] * inv, *in = inside;
+  return hit;
+}
+
 TARGET static inline __attribute__((always_inline)) uint64_t RR_CAT(pixels_at, W)(
     const tri_setup *ts, const tri_moves *mv, uint32_t id, const int r[4], const camera *c, int ns, visbuf *vb,
-    uint64_t *tested, const int lg) {
+    uint64_t *tested, const int lg, const bool together) {
   const RR_CAT(tri_lanes, W) L = RR_CAT(lanes_of, W)(ts);
-  const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
-  const size_t width = (size_t)vb->width, layer = width * (size_t)vb->height;
+  const VF one = VF_(splat)(1.0f);
+  const size_t width = (size_t)vb->width, nsv = (size_t)vb->ns, layer = width * (size_t)vb->height;
   const int P = 1 << lg, G = W / P;
   /* one pixel a lane (P = W): the next pixel is the one to the right, or the row's
    * first on the next row, without the division by the width */
@@ -149,12 +206,13 @@ TARGET static inline __attribute__((always_inline)) uint64_t RR_CAT(pixels_at, W
   const VI lane = VI_(lanes)(), one_i = VI_(splat)(1), zero_i = VI_(splat)(0);
   const VF half = VF_(splat)(0.5f);
   const tri_pos_bits *b = mv->pos;
-  const bool gathered = (uint64_t)ns * layer <= INT32_MAX;
+  const bool gathered = (uint64_t)nsv * layer <= INT32_MAX;
+  const VI nsv_i = VI_(splat)((int32_t)nsv);
   /* the buffer's arrays in locals: the compiler cannot tell that the writes leave vb alone */
   float *const buf_t = vb->t, *const buf_l1 = vb->l1, *const buf_l2 = vb->l2;
   uint32_t *const buf_id = vb->id;
   /* depth_wins compares ids unsigned: flip the sign bits for a signed compare */
-  const VI bias = VI_(splat)(INT32_MIN), id_biased = VI_(splat)((int32_t)id) ^ bias;
+  const VI bias = VI_(splat)(INT32_MIN), id_biased = VI_(splat)((int32_t)id) ^ bias, idv = VI_(splat)((int32_t)id);
   uint64_t covered = 0, evals = 0;
   for (int p0 = 0; p0 < ns; p0 += P) {
     const VI p = VI_(splat)(p0) + (lane & (P - 1)), bit = one_i << p;
@@ -170,10 +228,43 @@ TARGET static inline __attribute__((always_inline)) uint64_t RR_CAT(pixels_at, W
     if (!VI_(bits)(live)) continue;
     /* a lane without samples has none to run */
     const VI wv = VI_(select)(live, x1 - x0 + one_i, one_i), n = VI_(select)(live, wv * (y1 - y0 + one_i), zero_i);
-    const VF inv_w = one / VF_(from_int)(wv);
     const VF ox = VF_(gather)(mv->ox, p), oy = VF_(gather)(mv->oy, p);
-    VF m[4];
+    VF m[4], t, l1, l2;
     bool moved = false;
+    if (together) {
+      /* the union of the live lanes' rectangles; lane l at pixel (ux + l / P, uy) */
+      int ux0 = INT32_MAX, uy0 = INT32_MAX, ux1 = INT32_MIN, uy1 = INT32_MIN;
+      for (int l = 0; l < P; l++) /* (lanes l and l + P hold the same position) */
+        if (live[l]) {
+          ux0 = x0[l] < ux0 ? x0[l] : ux0, uy0 = y0[l] < uy0 ? y0[l] : uy0;
+          ux1 = x1[l] > ux1 ? x1[l] : ux1, uy1 = y1[l] > uy1 ? y1[l] : uy1;
+          evals += (uint64_t)n[l];
+        }
+      const VI g = lane >> lg;
+      for (int uy = uy0; uy <= uy1; uy++) {
+        const VI y = VI_(splat)(uy), in_row = live & (y >= y0) & (y <= y1);
+        if (!VI_(bits)(in_row)) continue;
+        for (int ux = ux0; ux <= ux1; ux += G) {
+          const VI x = VI_(splat)(ux) + g;
+          VI in = in_row & (x >= x0) & (x <= x1);
+          if (!VI_(bits)(in)) continue;
+          const int hit = RR_CAT(pixel_hits, W)(&L, ts, mv, c, ox, oy, m, &moved, x, y, &in, &t, &l1, &l2);
+          if (!hit) continue;
+          covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
+          const size_t k = ((size_t)uy * width + (size_t)ux) * nsv + (size_t)p0; /* lane 0's sample */
+          const VF bt = VF_(load_masked)(buf_t + k, in);
+          const VI bid = VI_(load_masked)((const int32_t *)buf_id + k, in);
+          const VI wins = in & ((t < bt) | ((t == bt) & ((bid ^ bias) > id_biased)));
+          if (!VI_(bits)(wins)) continue;
+          VF_(store_masked)(buf_t + k, wins, t);
+          VI_(store_masked)((int32_t *)buf_id + k, wins, idv);
+          VF_(store_masked)(buf_l1 + k, wins, l1);
+          VF_(store_masked)(buf_l2 + k, wins, l2);
+        }
+      }
+      continue;
+    }
+    const VF inv_w = one / VF_(from_int)(wv);
     /* each lane's pixels: the q-th of every G of its rectangle's in row order; pixel
      * i is in row (i + 1/2) / wv, rounded down (exact while i < 2^22: the quotient
      * lies 1/(2·wv) or more from an integer, far above two roundings) */
@@ -191,27 +282,11 @@ TARGET static inline __attribute__((always_inline)) uint64_t RR_CAT(pixels_at, W
         const VI row = VI_(trunc)((VF_(from_int)(i) + half) * inv_w);
         x = x0 + (i - row * wv), y = y0 + row;
       }
-      const VF sx = VF_(from_int)(x) + ox, sy = VF_(from_int)(y) + oy;
-      VF ev[3];
-#pragma GCC unroll 3
-      for (int e = 0; e < 3; e++) {
-        ev[e] = (L.a[e] * one + L.b[e] * sx) + L.cc[e] * sy;
-        in &= RR_CAT(edge_inside, W)(ev[e], L.tie[e], L.tie2[e]);
-      }
-      if (!VI_(bits)(in)) continue;
-      const VF sum = ev[0] * L.w0 + ev[1] * L.w1 + ev[2] * L.w2, v = (L.vol + sx * L.vol_x) + sy * L.vol_y;
-      in &= TRI_HIT_AHEAD(sum, v, zero);
-      int hit = VI_(bits)(in);
+      int hit = RR_CAT(pixel_hits, W)(&L, ts, mv, c, ox, oy, m, &moved, x, y, &in, &t, &l1, &l2);
       if (!hit) continue;
-      if (!moved) RR_CAT(tri_moved_lanes, W)(ts, mv->pl, c, ox, oy, m), moved = true;
-      const VF pa = m[0], num0 = m[1], cx = m[2], cy = m[3];
-      const VF den = (pa * one + L.pb * (sx - cx)) + L.pc * (sy - cy);
-      const VF inv = one / sum, t = TRI_DEPTH((num0 + (sx - cx) * L.num_x) + (sy - cy) * L.num_y, den, v, inv, zero,
-                                              VF_(select));
-      const VF l1 = ev[1] * inv, l2 = ev[2] * inv;
       covered += W == 1 ? (uint64_t)hit : (uint64_t)__builtin_popcount((unsigned)hit);
       if (gathered) {
-        const VI kv = p * VI_(splat)((int32_t)layer) + y * VI_(splat)((int32_t)width) + x;
+        const VI kv = (y * VI_(splat)((int32_t)width) + x) * nsv_i + p;
         const VF bt = VF_(gather_masked)(buf_t, kv, in);
         const VI bid = VI_(gather_masked)((const int32_t *)buf_id, kv, in);
         /* the winners' writes, one lane at a time (no scatter in AVX2) */
@@ -223,7 +298,7 @@ TARGET static inline __attribute__((always_inline)) uint64_t RR_CAT(pixels_at, W
       } else
         for (; hit; hit &= hit - 1) {
           const int l = __builtin_ctz((unsigned)hit);
-          const size_t k = (size_t)p[l] * layer + (size_t)y[l] * width + (size_t)x[l];
+          const size_t k = ((size_t)y[l] * width + (size_t)x[l]) * nsv + (size_t)p[l];
           if (t[l] < buf_t[k] || (t[l] == buf_t[k] && buf_id[k] > id))
             buf_t[k] = t[l], buf_id[k] = id, buf_l1[k] = l1[l], buf_l2[k] = l2[l];
         }
@@ -236,6 +311,13 @@ TARGET static uint64_t RR_CAT(raster_pixels, W)(const tri_setup *ts, const tri_m
                                                 const int r[4], const camera *c, int ns, visbuf *vb,
                                                 uint64_t *tested) {
   const int lg_w = __builtin_ctz(W), lg_ns = ns > 1 ? 32 - __builtin_clz((unsigned)ns - 1) : 0;
-  return lg_ns >= lg_w ? RR_CAT(pixels_at, W)(ts, mv, id, r, c, ns, vb, tested, lg_w)
-                       : RR_CAT(pixels_at, W)(ts, mv, id, r, c, ns, vb, tested, lg_ns);
+  return lg_ns >= lg_w ? RR_CAT(pixels_at, W)(ts, mv, id, r, c, ns, vb, tested, lg_w, false)
+                       : RR_CAT(pixels_at, W)(ts, mv, id, r, c, ns, vb, tested, lg_ns, false);
+}
+/* The same by the walk together (ns a power of two: a step's lanes are side by side). */
+TARGET static uint64_t RR_CAT(raster_together, W)(const tri_setup *ts, const tri_moves *mv, uint32_t id,
+                                                  const int r[4], const camera *c, int ns, visbuf *vb,
+                                                  uint64_t *tested) {
+  const int lg_w = __builtin_ctz(W), lg_ns = ns > 1 ? 32 - __builtin_clz((unsigned)ns - 1) : 0;
+  return RR_CAT(pixels_at, W)(ts, mv, id, r, c, ns, vb, tested, lg_ns >= lg_w ? lg_w : lg_ns, true);
 }

@@ -554,7 +554,7 @@ KERNEL int ray_node_curved(void *q, const bvh_wide *w, uint32_t ref, uint64_t la
 KERNEL bool ray_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
   (void)lanes;
   primary_ray *r = q;
-  visbuf one = {1, 1, &r->id, &r->t, &r->l1, &r->l2};
+  visbuf one = {1, 1, &r->id, &r->t, &r->l1, &r->l2, 1};
   const uint32_t *slot = r->fs->slot; /* in locals: the hit's stores cannot change them */
   const leaf_tri *ts = r->fs->ts;
   for (uint32_t i = first; i < first + count; i++) {
@@ -664,7 +664,7 @@ KERNEL int packet_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes,
 KERNEL bool packet_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes) {
   packet *p = q;
   const frame_setups *fs = p->fs;
-  visbuf pvb = {PK, PK, p->id, p->t, p->l1, p->l2};
+  visbuf pvb = {PK, PK, p->id, p->t, p->l1, p->l2, 1};
   for (uint32_t i = first; i < first + count; i++) {
     if (fs->slot[i] == UINT32_MAX) continue;
     const leaf_tri *lt = &fs->ts[fs->slot[i]];

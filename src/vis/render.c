@@ -156,10 +156,10 @@ static inline __attribute__((always_inline)) void visbuf_clear(visbuf *vb, size_
 RR_TARGET_AVX2 static void visbuf_clear_avx2(visbuf *vb, size_t n) { visbuf_clear(vb, n); }
 #endif
 
-/* A buffer of `samples` layers of w × h (vb->width and height are those of one layer). */
+/* A buffer of w × h pixels of `samples` samples each (vis.h: a pixel's side by side). */
 static bool visbuf_alloc(visbuf *vb, int w, int h, int samples) {
   size_t n = (size_t)w * h * samples;
-  vb->width = w, vb->height = h;
+  vb->width = w, vb->height = h, vb->ns = samples;
   vb->id = rr_alloc_large(n * sizeof *vb->id);
   vb->t = rr_alloc_large(n * sizeof *vb->t);
   vb->l1 = rr_alloc_large(n * sizeof *vb->l1);
@@ -269,7 +269,7 @@ static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_came
 }
 
 /* A method's passes over ctx: one for every position, or one per position, each
- * writing its own layer (S grows with N). */
+ * writing its own sample of every pixel (S grows with N). */
 static rr_error run_passes(rr_device *dev, rr_method m, render_ctx ctx, progress_span whole) {
   if (methods[m].all_samples) {
     ctx.progress = whole;
@@ -278,15 +278,27 @@ static rr_error run_passes(rr_device *dev, rr_method m, render_ctx ctx, progress
   const camera *cams = ctx.cams;
   visbuf *vb = ctx.vb;
   const int ns = ctx.samples;
+  if (ns == 1) return methods[m].fn(dev, &ctx);
+  /* each position into a buffer of one sample, then copied into that sample of
+   * every pixel (the methods index a buffer of one sample per pixel) */
+  visbuf one;
+  if (!visbuf_alloc(&one, vb->width, vb->height, 1))
+    return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d visibility buffer", vb->width, vb->height);
+  const size_t npix = (size_t)vb->width * vb->height;
   rr_error e = RR_OK;
   for (int s = 0; s < ns && !e; s++) {
     ctx.progress = rr_progress_part(&whole, (double)s / ns, (double)(s + 1) / ns);
-    visbuf layer = visbuf_layer(vb, s);
     ctx.cam = ctx.cams = &cams[s];
     ctx.samples = 1;
-    ctx.vb = &layer;
-    e = methods[m].fn(dev, &ctx);
+    ctx.vb = &one;
+    if (s) visbuf_clear(&one, npix);
+    if ((e = methods[m].fn(dev, &ctx))) break;
+    for (size_t k = 0; k < npix; k++) {
+      const size_t o = k * ns + s;
+      vb->id[o] = one.id[k], vb->t[o] = one.t[k], vb->l1[o] = one.l1[k], vb->l2[o] = one.l2[k];
+    }
   }
+  visbuf_free(&one);
   return e;
 }
 
@@ -305,11 +317,15 @@ static rr_error render_cube(rr_device *dev, rr_method m, render_ctx ctx, progres
     for (int s = 0; s < ns; s++) rr_cam_cube_face(&ctx.cams[s], f, &fc[f * ns + s]);
   visbuf fvb, faces[6];
   float *heat = NULL;
-  if (!visbuf_alloc(&fvb, F, F, 6 * ns) || (ctx.heat_e && !(heat = calloc(12 * FF, sizeof *heat)))) {
+  if (!visbuf_alloc(&fvb, F, 6 * F, ns) || (ctx.heat_e && !(heat = calloc(12 * FF, sizeof *heat)))) {
     visbuf_free(&fvb);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a cube camera's faces of %dx%d", F, F);
   }
-  for (int f = 0; f < 6; f++) faces[f] = visbuf_layer(&fvb, f * ns); /* face f: ns layers of F × F */
+  /* face f: F × F pixels of ns samples, after the f before it */
+  for (int f = 0; f < 6; f++) {
+    const size_t o = (size_t)f * FF * ns;
+    faces[f] = (visbuf){F, F, fvb.id + o, fvb.t + o, fvb.l1 + o, fvb.l2 + o, ns};
+  }
   rr_error e = RR_OK;
   if (methods[m].fn == rr_vis_traverse && !ctx.oracles->leaves) {
     ctx.faces = 6, ctx.face_cams = fc, ctx.face_vb = faces;
@@ -327,13 +343,11 @@ static rr_error render_cube(rr_device *dev, rr_method m, render_ctx ctx, progres
   for (int f = 0; f < 6 && !e; f++) {
     int x0, y0;
     rr_cam_cube_face_origin(cube, f, &x0, &y0);
-    for (int s = 0; s < ns; s++) {
-      visbuf to = visbuf_layer(cross, s), from = visbuf_layer(&faces[f], s);
-      for (int y = 0; y < F; y++) {
-        size_t k = (size_t)(y0 + y) * W + x0, j = (size_t)y * F;
-        memcpy(to.id + k, from.id + j, F * sizeof *to.id), memcpy(to.t + k, from.t + j, F * sizeof *to.t);
-        memcpy(to.l1 + k, from.l1 + j, F * sizeof *to.l1), memcpy(to.l2 + k, from.l2 + j, F * sizeof *to.l2);
-      }
+    const visbuf *from = &faces[f];
+    for (int y = 0; y < F; y++) { /* a row's pixels with their samples */
+      size_t k = ((size_t)(y0 + y) * W + x0) * ns, j = (size_t)y * F * ns, n = (size_t)F * ns;
+      memcpy(cross->id + k, from->id + j, n * sizeof *cross->id), memcpy(cross->t + k, from->t + j, n * sizeof *cross->t);
+      memcpy(cross->l1 + k, from->l1 + j, n * sizeof *cross->l1), memcpy(cross->l2 + k, from->l2 + j, n * sizeof *cross->l2);
     }
     for (int y = 0; heat && y < F; y++)
       for (int x = 0; x < F; x++) {

@@ -116,11 +116,11 @@ typedef struct tri_job {
 static uint64_t ana_raster(trav *t, uint32_t id, tile_rect r, uint64_t *covered) {
   for (int s = 0; s < t->ns; s++) {
     const camera *c = &t->cams[s];
-    visbuf vb = t->ns > 1 ? visbuf_layer(t->vb, s) : *t->vb;
+    visbuf vb = visbuf_layer(t->vb, s);
     for (int y = r.y0; y < r.y1; y++)
       for (int x = r.x0; x < r.x1; x++)
         *covered += ana_shade_sample(t->s, c, id, camera_w(c, x, y), (float)x + c->sx0, (float)y + c->sy0, &vb,
-                                     (size_t)y * vb.width + x) != 0;
+                                     ((size_t)y * vb.width + x) * vb.ns) != 0;
   }
   return (uint64_t)(r.x1 - r.x0) * (uint64_t)(r.y1 - r.y0) * (uint64_t)t->ns;
 }

@@ -7,20 +7,22 @@
 #include "prim/triangle.h"
 
 /* Per sample: the hit's triangle index, t and barycentrics. A buffer of several
- * samples per pixel holds one width × height layer per sample position: sample s
- * of pixel k at s·width·height + k. */
+ * samples per pixel keeps a pixel's samples side by side (ns of them): sample s of
+ * pixel k at k·ns + s, so a pixel's samples share cache lines and vectors. A layer
+ * (visbuf_layer: one sample of every pixel) is a view of the same arrays, its
+ * pixel k at k·ns. */
 typedef struct visbuf {
   int width, height;
   uint32_t *id;
   float *t, *l1, *l2;
+  int ns; /* the stride between pixels: samples per pixel of the buffer (1: one sample) */
 } visbuf;
 
-/* Layer s of a buffer of several samples: sample s of every pixel (arrays the
- * buffer lacks stay NULL). */
+/* Layer s of a buffer of several samples: sample s of every pixel, pixel k at
+ * k·ns (arrays the buffer lacks stay NULL). */
 static inline visbuf visbuf_layer(const visbuf *vb, int s) {
-  size_t o = (size_t)s * vb->width * vb->height;
-  return (visbuf){vb->width, vb->height, vb->id ? vb->id + o : NULL, vb->t ? vb->t + o : NULL,
-                  vb->l1 ? vb->l1 + o : NULL, vb->l2 ? vb->l2 + o : NULL};
+  return (visbuf){vb->width, vb->height, vb->id ? vb->id + s : NULL, vb->t ? vb->t + s : NULL,
+                  vb->l1 ? vb->l1 + s : NULL, vb->l2 ? vb->l2 + s : NULL, vb->ns};
 }
 
 /* The depth test shared by every method: nearer wins; on equal t the lower id wins,
@@ -29,8 +31,8 @@ static inline bool depth_wins(float t, uint32_t id, float best_t, uint32_t best_
   return t < best_t || (t == best_t && id < best_id);
 }
 
-/* Tests one set-up triangle at pixel k, whose sample is (sx, sy) with evaluation
- * vector w, and keeps it when it is nearer. Returns 0 when the triangle does not
+/* Tests one set-up triangle at element k of vb (a layer's pixel p: k = p·ns),
+ * whose sample is (sx, sy) with evaluation vector w, and keeps it when it is nearer. Returns 0 when the triangle does not
  * cover the sample, 1 when it covers it behind what is stored, 2 when it is kept. */
 KERNEL int shade_sample_w(const tri_setup *ts, uint32_t id, vec3 w, float sx, float sy, visbuf *vb, size_t k) {
   float e[3], t, l1, l2;
@@ -82,16 +84,17 @@ struct rr_frame {
   float *heat_e, *heat_n; /* per-pixel E and N, when options.heat was set */
   rr_stats stats;
   rr_method method;
-  int samples; /* vb holds this many layers of vb.width × vb.height */
-  float sample_pos[RR_MAX_SAMPLES][2]; /* options.sample_pos: where layer s sampled each pixel */
+  int samples; /* vb holds this many samples a pixel (vb.ns) */
+  float sample_pos[RR_MAX_SAMPLES][2]; /* options.sample_pos: where sample s of each pixel lies */
   rr_aa_mode aa;                       /* how shading uses them (options.aa, aa_stored) */
   int aa_stored;
 };
 
 /* A pass of a method: fills vb (cleared to misses) and adds to stats. A method that
  * takes every sample position in one pass (all_samples in render.c's table) gets
- * samples > 1 cameras, cams[s] resolved for position s, and writes layer s of vb;
- * any other method runs once per position with samples = 1 and vb that layer. */
+ * samples > 1 cameras, cams[s] resolved for position s, and writes sample s of each
+ * pixel of vb; any other method runs once per position with samples = 1 and a
+ * buffer of one sample (render.c copies it into that sample of vb). */
 typedef struct render_ctx {
   const rr_scene *scene;
   const camera *cam;  /* cams[0] */
@@ -106,7 +109,7 @@ typedef struct render_ctx {
   progress_span progress;        /* this pass's share of the frame's progress: for its main loop */
   /* A cube camera drawn in one pass (render.c, rr_vis_traverse): its 6 faces, else 0;
    * face f at position s is the perspective camera face_cams[f·samples + s], drawn
-   * into face_vb[f] (samples layers of F × F) and charging face_heat_e/n + f·F². */
+   * into face_vb[f] (F × F pixels of samples each) and charging face_heat_e/n + f·F². */
   int faces;
   const camera *face_cams;
   visbuf *face_vb;
@@ -176,7 +179,8 @@ rr_error rr_vis_2dr_bb(rr_device *dev, render_ctx *ctx);
 rr_error rr_vis_2dr_bin(rr_device *dev, render_ctx *ctx);
 /* Test hook: runs the 2D pipeline (binning when `bin`) over every triangle at the
  * `samples` positions of cams[] but, instead of the z test, counts in front[k] /
- * back[k] every triangle that claims sample k (layered like the visibility buffer). */
+ * back[k] every triangle that claims sample k (a layer per position: sample s of
+ * pixel p at s·width·height + p). */
 rr_error rr_raster2d_claims(const rr_scene *s, const camera *cams, int samples, bool bin, int threads, uint8_t *front,
                             uint8_t *back);
 /* Test hook: where the 2D pipeline's vertex stage puts world point p on the screen;
@@ -184,7 +188,8 @@ rr_error rr_raster2d_claims(const rr_scene *s, const camera *cams, int samples, 
 bool rr_raster2d_project(const rr_scene *s, const camera *c, vec3 p, double *sx, double *sy);
 /* Tests every sample of an inclusive rectangle against one set-up triangle and
  * returns the number of edge-function evaluations; adds the samples the
- * triangle covers to *covered. simd: use AVX2 where the processor has it. */
+ * triangle covers to *covered. simd: use AVX2 where the processor has it. vb: a
+ * buffer of one sample per pixel (ns = 1). */
 uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int rect[4], const camera *c, visbuf *vb,
                         uint64_t *covered, bool simd);
 
@@ -214,7 +219,7 @@ typedef struct tri_moves {
 /* Makes mv's per-position values for ts at the ns positions of cams (once). */
 void rr_tri_moves_ready(const tri_setup *ts, tri_moves *mv, const camera *cams, int ns, bool simd);
 /* rr_raster_rect at ns sample positions at once: each position over rect ∩ its
- * rectangle, with cams[s] and layer s of vb (of vb->width × vb->height each).
+ * rectangle, with cams[s] and sample s of each pixel of vb (vb->ns = ns).
  * Returns the evaluations, one per sample of those rectangles. */
 uint64_t rr_raster_rect_samples(const tri_setup *ts, tri_moves *mv, uint32_t id, const int rect[4],
                                 const camera *cams, int ns, visbuf *vb, uint64_t *covered, bool simd);
@@ -223,7 +228,7 @@ uint64_t rr_raster_rect_samples(const tri_setup *ts, tri_moves *mv, uint32_t id,
  * (position, pixel) pairs (planar cameras)? rr_raster_rect_samples' choice. */
 static inline bool rr_raster_few_pixels(const int r[4], int ns) {
   const int w = r[2] - r[0] + 1, area = w * (r[3] - r[1] + 1);
-  return area <= 4 * ns || (ns <= 4 && w <= 8);
+  return ns <= 4 ? area <= 4 * ns || w <= 8 : area <= 2 * ns;
 }
 /* rr_raster_rect_samples for such a draw, called straight from the traversal
  * (planar camera c = cams[0]; mv needs only ox, oy, pl, pos and bb; avx2: the
