@@ -271,14 +271,13 @@ static rr_error render_auto(rr_device *dev, const rr_scene *scene, const rr_came
 /* A method's passes over ctx: one for every position, or one per position, each
  * writing its own sample of every pixel (S grows with N). */
 static rr_error run_passes(rr_device *dev, rr_method m, render_ctx ctx, progress_span whole) {
-  if (methods[m].all_samples) {
+  const int ns = ctx.samples;
+  if (methods[m].all_samples || ns == 1) {
     ctx.progress = whole;
     return methods[m].fn(dev, &ctx);
   }
   const camera *cams = ctx.cams;
   visbuf *vb = ctx.vb;
-  const int ns = ctx.samples;
-  if (ns == 1) return methods[m].fn(dev, &ctx);
   /* each position into a buffer of one sample, then copied into that sample of
    * every pixel (the methods index a buffer of one sample per pixel) */
   visbuf one;
