@@ -149,12 +149,13 @@ int main(int argc, char **argv) {
   for (int a = 0; a < 3; a++) nf[a] = -f[a], nr[a] = -r[a], nu[a] = -u[a];
   const float *dirs[6][2] = {{f, u}, {r, u}, {nf, u}, {nr, u}, {u, nf}, {nu, f}};
   printf("\n| cube map, faces of %d² | method | one cube camera ms | six perspective renders ms | ratio | S cube | S "
-         "six |\n|---|---|---|---|---|---|---|\n",
+         "six | empty bins cube, six |\n|---|---|---|---|---|---|---|---|\n",
          face);
   for (int m = 0; m < NM; m++) {
     rr_stats st;
     double t_cube = run(&b, &cube, methods[m], 4 * face, 3 * face, "cube", &st);
-    uint64_t s_cube = st.setups, s_six = 0;
+    uint64_t s_cube = st.setups, s_six = 0, bins_six = 0, empty_six = 0;
+    const double share_cube = share(&st);
     double total = 0;
     for (int k = 0; k < 6; k++) {
       rr_camera p;
@@ -165,10 +166,11 @@ int main(int argc, char **argv) {
       char part[32];
       snprintf(part, sizeof part, "cube face %d", k);
       total += run(&b, &p, methods[m], face, face, part, &st);
-      s_six += st.setups;
+      s_six += st.setups, bins_six += st.bins, empty_six += st.bins_empty;
     }
-    printf("| %dx%d | %s | %.1f | %.1f | %.2f | %llu | %llu |\n", 4 * face, 3 * face, rr_method_name(methods[m]), t_cube,
-           total, t_cube / total, (unsigned long long)s_cube, (unsigned long long)s_six);
+    printf("| %dx%d | %s | %.1f | %.1f | %.2f | %llu | %llu | %.1f%%, %.1f%% |\n", 4 * face, 3 * face,
+           rr_method_name(methods[m]), t_cube, total, t_cube / total, (unsigned long long)s_cube,
+           (unsigned long long)s_six, share_cube, bins_six ? 100.0 * empty_six / bins_six : 0.0);
   }
   rr_scene_release(s);
   rr_device_release(dev);

@@ -302,16 +302,55 @@ static float max_pa(const trav *t, const tri_job *j) {
   return pa;
 }
 
-static void finish_binning(const trav *t, uint32_t id, tri_job *j);
+static bool finish_binning(const trav *t, uint32_t id, tri_job *j);
 
 /* Completes a set-up triangle j with what binning and early-z need (inlined: most
- * methods draw from the root without binning, where this is four stores). */
-static inline __attribute__((always_inline)) void finish_setup(const trav *t, uint32_t id, tri_job *j) {
+ * methods draw from the root without binning, where this is four stores); false
+ * when binning shows that it covers no sample. */
+static inline __attribute__((always_inline)) bool finish_setup(const trav *t, uint32_t id, tri_job *j) {
   j->id = id, j->ana = false, j->face = (uint8_t)t->face, j->face_y = t->face * t->face_rows;
-  if (t->o->binning) finish_binning(t, id, j);
+  return !t->o->binning || finish_binning(t, id, j);
 }
 
-static void finish_binning(const trav *t, uint32_t id, tri_job *j) {
+/* A planar triangle at one position with a vertex behind the eye has the whole
+ * image for rectangle (its corners bound nothing), and where its three edge lines
+ * cross far from the region they enclose, bins of every size pass the edge test
+ * with nothing to find (the cube's top and bottom faces, grazed by triangles
+ * across the eye's level, refined only such bins). The samples it may cover pass
+ * every edge test, e_i >= -slack_i (bin_raster's reject, for one sample): their
+ * region is bb clipped by the three lines, bounded here in double with twice the
+ * slack and a pixel more. False: no sample. */
+static bool clip_to_edges(const trav *t, tri_job *j) {
+  const double ox = t->span[0], oy = t->span[1]; /* a pixel's sample position, less the pixel */
+  double p[8][2] = {{j->bb[0] + ox, j->bb[1] + oy}, {j->bb[2] + ox, j->bb[1] + oy}, {j->bb[2] + ox, j->bb[3] + oy},
+                    {j->bb[0] + ox, j->bb[3] + oy}};
+  int n = 4;
+  for (int e = 0; e < 3 && n; e++) { /* Sutherland-Hodgman: at most one more vertex an edge */
+    double q[8][2], v[8];
+    int m = 0;
+    for (int k = 0; k < n; k++) v[k] = j->ts.a[e] + p[k][0] * (double)j->ts.b[e] + p[k][1] * (double)j->ts.c[e] + 2.0 * j->slack[e];
+    for (int k = 0; k < n; k++) {
+      const int l = (k + 1) % n;
+      if (v[k] >= 0) q[m][0] = p[k][0], q[m][1] = p[k][1], m++;
+      if ((v[k] >= 0) != (v[l] >= 0)) {
+        const double s = v[k] / (v[k] - v[l]);
+        q[m][0] = p[k][0] + s * (p[l][0] - p[k][0]), q[m][1] = p[k][1] + s * (p[l][1] - p[k][1]), m++;
+      }
+    }
+    memcpy(p, q, sizeof q), n = m;
+  }
+  if (!n) return false;
+  double lo[2] = {p[0][0], p[0][1]}, hi[2] = {p[0][0], p[0][1]};
+  for (int k = 1; k < n; k++)
+    for (int a = 0; a < 2; a++) lo[a] = fmin(lo[a], p[k][a]), hi[a] = fmax(hi[a], p[k][a]);
+  const int x0 = (int)floor(lo[0] - ox) - 1, y0 = (int)floor(lo[1] - oy) - 1;
+  const int x1 = (int)ceil(hi[0] - ox) + 1, y1 = (int)ceil(hi[1] - oy) + 1;
+  j->bb[0] = x0 > j->bb[0] ? x0 : j->bb[0], j->bb[1] = y0 > j->bb[1] ? y0 : j->bb[1];
+  j->bb[2] = x1 < j->bb[2] ? x1 : j->bb[2], j->bb[3] = y1 < j->bb[3] ? y1 : j->bb[3];
+  return j->bb[0] <= j->bb[2] && j->bb[1] <= j->bb[3];
+}
+
+static bool finish_binning(const trav *t, uint32_t id, tri_job *j) {
   const camera *c = t->c;
   if (c->planar) {
     float zmin = INFINITY;
@@ -328,6 +367,7 @@ static void finish_binning(const trav *t, uint32_t id, tri_job *j) {
     }
     float mag_p = (t->ns > 1 ? max_pa(t, j) : fabsf(j->ts.pa)) + W * fabsf(j->ts.pb) + H * fabsf(j->ts.pc);
     j->zmin = c->type == RR_CAMERA_PERSPECTIVE ? tri_t_floor(zmin, mag, mag_p, &j->ts) : 0;
+    if (t->ns == 1 && c->type == RR_CAMERA_PERSPECTIVE && zmin <= 0) return clip_to_edges(t, j);
   } else {
     /* the distance to the triangle's plane bounds every hit's distance from below */
     unsigned inf = scene_inf(t->s, id);
@@ -340,6 +380,7 @@ static void finish_binning(const trav *t, uint32_t id, tri_job *j) {
     float mag_p = (fabsf(j->ts.pa) + fabsf(j->ts.pb) + fabsf(j->ts.pc)) * c->dir_len_max;
     j->zmin = dist > 0 && isfinite(dist) ? tri_t_floor(dist / c->dir_len_max, mag, mag_p, &j->ts) : 0;
   }
+  return true;
 }
 
 /* Sets up the bounded triangles b[0..nb-1] of a planar camera, eight at a time,
@@ -356,11 +397,11 @@ static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job 
     rr_tri_setup_planes(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face, pl);
     for (int l = 0; l < m; l++) {
       if (face[l] == SETUP_CULLED) continue;
-      tri_job *j = out + kept++;
+      tri_job *j = out + kept;
       j->ts = ts[l];
       if (pl) j->pl = pl[l], j->pos = b[q + l].pos;
       memcpy(j->bb, b[q + l].bb, sizeof j->bb);
-      finish_setup(t, ids[l], j);
+      kept += finish_setup(t, ids[l], j);
     }
   }
   return kept;
@@ -469,12 +510,12 @@ static uint32_t setup_faces(trav *t, uint32_t first, uint32_t n, tri_job *out) {
         const int k = f * q + i;
         if (face[k] == SETUP_CULLED) continue;
         const tri_bound *tb = &b[f][slot[f][at[i]]];
-        tri_job *j = out + kept++;
+        tri_job *j = out + kept;
         use_face(t, f);
         j->ts = ts[k];
         if (pl) j->pl = pl[k], j->pos = tb->pos;
         memcpy(j->bb, tb->bb, sizeof j->bb);
-        finish_setup(t, ids[i], j);
+        kept += finish_setup(t, ids[i], j);
       }
   }
   if (t->s->kind) { /* analytic primitives: bounded in every face, S once */
@@ -536,8 +577,7 @@ static uint32_t setup_tris(trav *t, uint32_t first, const uint32_t *ids, uint32_
       if (face[l] == SETUP_CULLED || !curved_bounds(t, lid[l], &ts[l], &sp[l], j->bb) || (r && !meets(j->bb, *r)))
         continue;
       j->ts = ts[l];
-      finish_setup(t, lid[l], j);
-      kept++;
+      kept += finish_setup(t, lid[l], j);
     }
   }
   return kept;
