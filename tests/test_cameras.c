@@ -207,6 +207,11 @@ static void check_cube_setups(rr_device *dev) {
       if (!f) continue;
       CHECK(f->stats.setups == unis[ns], "%s: S = %llu, triangles that meet a face %llu", what,
             (unsigned long long)f->stats.setups, (unsigned long long)unis[ns]);
+      /* walls cross the eye plane of the faces: clipped to their edge lines, they
+       * leave few bins refined for nothing (62.7% of 1845 before, 9.1% of 758) */
+      if (m && ns == 1)
+        CHECK(f->stats.bins && f->stats.bins_empty * 4 < f->stats.bins, "%s: %llu of %llu bins refined empty", what,
+              (unsigned long long)f->stats.bins_empty, (unsigned long long)f->stats.bins);
       rr_frame_release(f);
     }
     rr_frame_release(ref);
