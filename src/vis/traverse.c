@@ -328,7 +328,10 @@ static bool clip_to_edges(const trav *t, tri_job *j) {
   for (int e = 0; e < 3 && n; e++) { /* Sutherland-Hodgman: at most one more vertex an edge */
     double q[8][2], v[8];
     int m = 0;
-    for (int k = 0; k < n; k++) v[k] = j->ts.a[e] + p[k][0] * (double)j->ts.b[e] + p[k][1] * (double)j->ts.c[e] + 2.0 * j->slack[e];
+    for (int k = 0; k < n; k++) {
+      v[k] = j->ts.a[e] + p[k][0] * (double)j->ts.b[e] + p[k][1] * (double)j->ts.c[e] + 2.0 * j->slack[e];
+      if (!isfinite(v[k])) return true; /* no bound to trust: keep the rectangle */
+    }
     for (int k = 0; k < n; k++) {
       const int l = (k + 1) % n;
       if (v[k] >= 0) q[m][0] = p[k][0], q[m][1] = p[k][1], m++;
