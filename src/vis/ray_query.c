@@ -169,7 +169,7 @@ static inline __attribute__((always_inline)) void query_init(query_ray *r, const
 #endif
 
 /* Traces a prepared ray: the nearest hit into r, or (any) whether there is one. */
-static bool query_trace(query_ray *r, bool any) {
+static inline __attribute__((always_inline)) bool query_trace(query_ray *r, bool any) {
   if (!r->b) return false;
 #ifdef RR_SIMD_X86
   if (__builtin_cpu_supports("avx2")) return any ? query_trace8_any(r) : (query_trace8_closest(r), r->id != RR_MISS);
