@@ -66,13 +66,13 @@ static size_t check_t_bound(const rr_scene *s, const rr_ray *rays, size_t n, con
       for (int m = 0; m < 9; m++)
         for (int j = 0; j < 4; j++) v[4 * m + j] = s->p[m / 3][m % 3][i];
       rr_vf4 pre[4];
-      if (!(tri_ray_may_hit4(v, 4, eye, dir, pre) & 1)) continue;
+      if (!(tri_ray_may_hit4(v, 4, NULL, eye, dir, pre) & 1)) continue;
       const float e[4] = {pre[0][0], pre[1][0], pre[2][0], pre[3][0]};
       if (!(e[0] > 0 && e[1] > 0 && e[2] > 0)) continue;
       float t, l1, l2;
       bool hit = rr_tri_ray_hit(s, i, &rc, false, 0, INFINITY, &t, &l1, &l2);
       bool in = hit && t >= rays[r].tmin && t <= rays[r].tmax;
-      float S = ray_corner_extent(v, 4, rays[r].org);
+      float S = ray_corner_extent(v, 4, NULL, rays[r].org);
       bool out = ray_t_outside(S, dmax, e, rays[r].tmin, rays[r].tmax);
       bool inside = ray_t_inside(S, dmax, e, rays[r].tmin, rays[r].tmax);
       hits += hit, cut += out, sure += inside;

@@ -230,10 +230,11 @@ typedef struct {
   rr_vf4 vol;     /* q0·n0 */
   rr_vi4 ok;      /* the volume is not 0 and finite: the triangle is not edge-on */
 } tri4_edges;
-/* tri4_edges_setup of the corners moved by sh (NULL: not moved), each corner
- * rounded as p + sh first, as a moved copy of the corners would hold it. */
-KERNEL void tri4_edges_setup_moved(const float *v, size_t stride, const rr_vf4 *sh, const rr_vf4 eye[3],
-                                   tri4_edges *te) {
+/* The part from the eye: corner k's axis x of lane j at v[(3k + x)·stride + j],
+ * moved by sh (x, y, z in sh[0..2]; NULL: not moved), each corner then rounded
+ * as p + sh first, as a moved copy of the corners would hold it. */
+KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 *sh, const rr_vf4 eye[3],
+                             tri4_edges *te) {
   tri_v4 q[3];
 #pragma GCC unroll 3
   for (int k = 0; k < 3; k++) {
@@ -250,9 +251,7 @@ KERNEL void tri4_edges_setup_moved(const float *v, size_t stride, const rr_vf4 *
   te->vol = vol;
   te->ok = (vol != 0) & (rr_vf4_abs(vol) < INFINITY);
 }
-KERNEL void tri4_edges_setup(const float *v, size_t stride, const rr_vf4 eye[3], tri4_edges *te) {
-  tri4_edges_setup_moved(v, stride, NULL, eye, te);
-}
+/* The part each direction d pays: the result and out as tri_ray_may_hit4's. */
 KERNEL int tri4_edges_test(const tri4_edges *te, const rr_vf4 d[3], rr_vf4 out[4]) {
   tri_v4 dv = {d[0], d[1], d[2]};
   rr_vf4 a0 = (rr_vf4)((rr_vi4)tri_v4_dot(te->m[0], dv) ^ te->sgn),
@@ -261,14 +260,13 @@ KERNEL int tri4_edges_test(const tri4_edges *te, const rr_vf4 d[3], rr_vf4 out[4
   out[0] = a0, out[1] = a1, out[2] = a2, out[3] = te->vol;
   return rr_vi4_bits(te->ok & (a0 >= 0) & (a1 >= 0) & (a2 >= 0));
 }
-KERNEL int tri_ray_may_hit4_moved(const float *v, size_t stride, const rr_vf4 *sh, const rr_vf4 eye[3],
-                                  const rr_vf4 d[3], rr_vf4 out[4]) {
+/* The pre-test above for the ray (eye, d), the corners moved by sh as in
+ * tri4_edges_setup (NULL: not moved). */
+KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 *sh, const rr_vf4 eye[3], const rr_vf4 d[3],
+                            rr_vf4 out[4]) {
   tri4_edges te;
-  tri4_edges_setup_moved(v, stride, sh, eye, &te);
+  tri4_edges_setup(v, stride, sh, eye, &te);
   return tri4_edges_test(&te, d, out);
-}
-KERNEL int tri_ray_may_hit4(const float *v, size_t stride, const rr_vf4 eye[3], const rr_vf4 d[3], rr_vf4 out[4]) {
-  return tri_ray_may_hit4_moved(v, stride, NULL, eye, d, out);
 }
 
 /* The inclusive pixel rectangle a set-up triangle's samples may lie in; false when

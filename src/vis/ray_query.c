@@ -55,25 +55,25 @@ typedef struct {
 
 /* Tests a leaf's count triangles, keeping the nearest hit; `any`: stops at the
  * first, which needs no full test where ray_t_inside proves it. Their corners
- * are at leaf in rr_bvh.leaf_v8's layout, their ids are ids[i] + idbase;
- * `moved`: a translated instance's leaf read in place, whose corners are leaf's
- * plus shift (x, y, z at shift[0], [4], [8]: a transform's last column), the
- * additions bvh_leaf_at's copy makes, so the same bits.
+ * are at leaf in rr_bvh.leaf_v8's layout, their ids are ids[i] + idbase; shift
+ * (NULL: none): a translated instance's leaf read in place, whose corners are
+ * leaf's plus shift (x, y, z at shift[0], [4], [8]: a transform's last column),
+ * the additions bvh_leaf_at's copy makes, so the same bits.
  * Four at a time through the edge pre-test, then the full test for the lanes
  * that pass it (and for triangles with corners at infinity, which it cannot
  * judge). The same triangles pass whatever the order, and depth_wins keeps the
  * nearest, lower id on a tie, so the hit does not depend on the order. */
-KERNEL bool query_tris(query_ray *r, const float *leaf, const uint32_t *ids, uint32_t idbase, const bool moved,
-                       const float *shift, uint32_t count, const bool any) {
-  rr_vf4 sh[3]; /* moved: the translation, added to each corner as it is loaded */
-  if (moved)
+KERNEL bool query_tris(query_ray *r, const float *leaf, const uint32_t *ids, uint32_t idbase, const float *shift,
+                       uint32_t count, const bool any) {
+  rr_vf4 sh[3]; /* the translation, added to each corner as it is loaded */
+  if (shift)
     for (int a = 0; a < 3; a++) sh[a] = rr_vf4_splat(shift[4 * a]);
   for (uint32_t j = 0; j < count; j += 4) {
     uint32_t n = count - j < 4 ? count - j : 4;
     const float *v = leaf + j;
     size_t stride = count;
     rr_vf4 pre[4];
-    int may = tri_ray_may_hit4_moved(v, stride, moved ? sh : NULL, r->o, r->d, pre) & ((1 << n) - 1);
+    int may = tri_ray_may_hit4(v, stride, shift ? sh : NULL, r->o, r->d, pre) & ((1 << n) - 1);
     if (r->s->inf)
       for (uint32_t k = 0; k < n; k++) may |= (scene_inf(r->s, ids[j + k] + idbase) != 0) << k;
     for (; may; may &= may - 1) {
@@ -81,7 +81,7 @@ KERNEL bool query_tris(query_ray *r, const float *leaf, const uint32_t *ids, uin
       float t, l1, l2, dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
       const float e[4] = {pre[0][lane], pre[1][lane], pre[2][lane], pre[3][lane]};
       if (e[0] > 0 && e[1] > 0 && e[2] > 0 && !(r->s->inf && scene_inf(r->s, id))) {
-        const float S = ray_corner_extent_moved(v + lane, stride, moved ? shift : NULL, r->org);
+        const float S = ray_corner_extent(v + lane, stride, shift, r->org);
         if (ray_t_outside(S, r->dmax, e, r->tmin, r->t)) continue;
         if (any && ray_t_inside(S, r->dmax, e, r->tmin, r->t)) return true; /* a proven hit: the answer */
       }
@@ -105,7 +105,7 @@ KERNEL bool query_leaf(query_ray *r, uint32_t first, uint32_t count, const bool 
     ids = r->b->prims + first, v = r->b->leaf_v8 + (size_t)9 * first;
   else
     v = bvh_leaf_at(r->b, true, first, count, vbuf, ibuf, &ids);
-  if (query_tris(r, v, ids, 0, false, NULL, count, any)) return true;
+  if (query_tris(r, v, ids, 0, NULL, count, any)) return true;
   if (r->s->kind) { /* analytic primitives, which the pre-test rejects as edge-on: their own test */
     const float dir[3] = {r->d[0][0], r->d[1][0], r->d[2][0]};
     ana_ray ar = ana_ray_of(r->org, dir);
@@ -169,7 +169,7 @@ static inline __attribute__((always_inline)) void query_init(query_ray *r, const
 #endif
 
 /* Traces a prepared ray: the nearest hit into r, or (any) whether there is one. */
-static bool query_trace(query_ray *r, bool any) {
+static inline __attribute__((always_inline)) bool query_trace(query_ray *r, bool any) {
   if (!r->b) return false;
 #ifdef RR_SIMD_X86
   if (__builtin_cpu_supports("avx2")) return any ? query_trace8_any(r) : (query_trace8_closest(r), r->id != RR_MISS);

@@ -48,7 +48,7 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
   uint32_t ref = root, count = 0;
   for (;;) {
     if (count) {
-      if (inst ? query_tris(r, o->leaf_v8 + (size_t)9 * ref, o->prims + ref, idbase, true, shift, count, any)
+      if (inst ? query_tris(r, o->leaf_v8 + (size_t)9 * ref, o->prims + ref, idbase, shift, count, any)
                : query_leaf(r, ref, count, any))
         return true;
     } else if (!inst && ref >= b->nwide8 && b->inst->shift[k = bvh_inst_of(ref, b->nwide8, o->nwide8, &root)]) {
@@ -77,6 +77,7 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
         hits |= (unsigned)RQ_(bits)(t0 <= t1) << h;
       }
       if (hits) {
+#define RQ_PUSH(k) (stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp++].key = entry[k])
         int i = __builtin_ctz(hits);
         unsigned rest = hits & (hits - 1);
         if (rest && any) {
@@ -88,15 +89,12 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
            * taken from the far end without a sort. */
           int l = 31 - __builtin_clz(hits);
           if (entry[l] > entry[i]) { /* the last entered, the others stacked first to last */
-            for (rest = hits & ~(1u << l); rest; rest &= rest - 1) {
-              int k = __builtin_ctz(rest);
-              stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp++].key = entry[k];
-            }
+            for (rest = hits & ~(1u << l); rest; rest &= rest - 1) RQ_PUSH(__builtin_ctz(rest));
             i = l;
           } else { /* the first entered, the others stacked last to first */
             for (; rest; rest &= ~(1u << l)) {
               l = 31 - __builtin_clz(rest);
-              stack[sp].ref = w->ref[l], stack[sp].count = w->count[l], stack[sp++].key = entry[l];
+              RQ_PUSH(l);
             }
           }
         } else if (rest && (rest & (rest - 1))) { /* three or more: the nearest entered, the others stacked farthest first */
@@ -107,15 +105,13 @@ RQ_TARGET static inline __attribute__((always_inline)) bool RR_CAT(RQ_NAME, _bod
             order[j] = k;
           }
           i = order[n - 1];
-          for (int j = 0; j < n - 1; j++) {
-            int k = order[j];
-            stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp++].key = entry[k];
-          }
+          for (int j = 0; j < n - 1; j++) RQ_PUSH(order[j]);
         } else if (rest) { /* two (the common case): the nearer entered, the other stacked */
           int k = __builtin_ctz(rest), far = entry[i] < entry[k] ? k : i;
           i ^= k ^ far;
-          stack[sp].ref = w->ref[far], stack[sp].count = w->count[far], stack[sp++].key = entry[far];
+          RQ_PUSH(far);
         }
+#undef RQ_PUSH
         ref = w->ref[i], count = w->count[i];
         continue;
       }

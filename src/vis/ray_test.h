@@ -111,8 +111,9 @@ static inline bool ray_t_inside(float S, float dmax, const float pre[4], float t
  * (corner k's axis x at v[(3k + x)·stride]): max |q_k| over the corners and axes,
  * q_k = p_k − o rounded as the pre-test rounds it. No NaN (finite corners), so a
  * plain comparison (fmaxf is a call). sh: the corners moved by a translation
- * (x, y, z at sh[0], [4], [8]), each rounded as p + sh first, or NULL. */
-static inline float ray_corner_extent_moved(const float *v, size_t stride, const float *sh, const float org[3]) {
+ * (x, y, z at sh[0], [4], [8]: a transform's last column), each rounded as p + sh
+ * first, or NULL. */
+static inline float ray_corner_extent(const float *v, size_t stride, const float *sh, const float org[3]) {
   float S = 0;
 #pragma GCC unroll 9
   for (int m = 0; m < 9; m++, v += stride) {
@@ -120,9 +121,6 @@ static inline float ray_corner_extent_moved(const float *v, size_t stride, const
     S = q > S ? q : S;
   }
   return S;
-}
-static inline float ray_corner_extent(const float *v, size_t stride, const float org[3]) {
-  return ray_corner_extent_moved(v, stride, NULL, org);
 }
 
 /* A ray's pseudo-camera, made when its first triangle passes the pre-test (many

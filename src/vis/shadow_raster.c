@@ -165,7 +165,7 @@ KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes, con
         int k = __builtin_ctzll(live);
         const rr_ray *r = &b->rays[b->idx[k]];
         rr_vf4 pre[4];
-        int may = (tri_ray_may_hit4(v + j, count, b->from[k], b->dir[k], pre) & ((1 << n) - 1)) | inf;
+        int may = (tri_ray_may_hit4(v + j, count, NULL, b->from[k], b->dir[k], pre) & ((1 << n) - 1)) | inf;
         b->st.edge_evals++;
         for (; may; may &= may - 1) {
           int lane = __builtin_ctz(may);
@@ -182,7 +182,7 @@ KERNEL bool sr_leaf(void *q, uint32_t first, uint32_t count, uint64_t lanes, con
       if (!b->live) return true;
       continue;
     }
-    tri4_edges_setup(v + j, count, b->eye, &te);
+    tri4_edges_setup(v + j, count, NULL, b->eye, &te);
     /* The bin test: an edge whose value is below -slack at the four corners is
      * negative at every sample of the bin (each direction is a positive
      * combination of the corners), where the pre-test fails. The slack covers the
