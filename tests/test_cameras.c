@@ -97,7 +97,8 @@ static void check_methods(rr_device *dev, const char *name, int views) {
     return;
   }
   uint64_t bins = 0, empty = 0;
-  for (int v = 0; v < views; v++) {
+  /* views: 0 from outside, 1 inside; the sanitizers' run skips the outside one */
+  for (int v = test_quick() ? 1 : 0; v < views; v++) {
     for (int type = 0; type < RR_CAMERA_COUNT; type++) {
       float fov = type == RR_CAMERA_FISHEYE ? 200 : 70;
       rr_camera cam = test_random_view(s, v % 2 ? 0.05f : 1.2f, v % 2 ? 0.5f : 2.5f, 0.3f, fov, fov);
@@ -171,7 +172,11 @@ static void check_cube(rr_device *dev) {
 /* The cube in one pass (3dr-bb, 3dr-bin): S is once per triangle whose corner
  * rectangle meets a face (the union over the faces, fewer than the sum when
  * triangles straddle an edge of the cube), and the frame is rc-bvh's, byte for
- * byte, on 1, 2 and 8 threads, with one sample position and with four. */
+ * byte, on 1, 2 and 8 threads, with one sample position and with four. The
+ * frustum methods (3dr-fc, 3dr-fs, 3dr-full) draw the faces one by one
+ * (vis/render.c, render_cube): the same frames, S at most the faces' sum (on this
+ * view 3dr-fc 429 and 3dr-fs, 3dr-full 965, against 367 triangles and 1023 over the
+ * faces one by one). */
 static void check_cube_setups(rr_device *dev) {
   rr_scene *s;
   if (rr_scene_load(dev, "rooms:2", &s) != RR_OK) return;
@@ -199,17 +204,24 @@ static void check_cube_setups(rr_device *dev) {
   for (int ns = 1; ns <= 4; ns += 3) {
     rr_render_options o = test_pattern(RR_METHOD_RC_BVH, 4 * F, 3 * F, 2, ns, pos);
     rr_frame *ref = test_render_opt(dev, s, &cube, &o);
-    for (int m = 0; m < 2 && ref; m++) {
+    const rr_method cms[] = {RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_METHOD_3DR_FC, RR_METHOD_3DR_FS, RR_METHOD_3DR_FULL};
+    for (int m = 0; m < 5 && ref; m++) {
       char what[64];
-      o.method = m ? RR_METHOD_3DR_BIN : RR_METHOD_3DR_BB;
+      o.method = cms[m];
       snprintf(what, sizeof what, "cube, %s, %d position(s)", rr_method_name(o.method), ns);
       rr_frame *f = test_render_threads(dev, s, &cube, &o, ref, what);
       if (!f) continue;
-      CHECK(f->stats.setups == unis[ns], "%s: S = %llu, triangles that meet a face %llu", what,
-            (unsigned long long)f->stats.setups, (unsigned long long)unis[ns]);
+      printf("%s: S = %llu; %llu triangles meet a face\n", what, (unsigned long long)f->stats.setups,
+             (unsigned long long)unis[ns]);
+      if (m < 2)
+        CHECK(f->stats.setups == unis[ns], "%s: S = %llu, triangles that meet a face %llu", what,
+              (unsigned long long)f->stats.setups, (unsigned long long)unis[ns]);
+      else if (ns == 1) /* face by face: at most once per face a triangle meets */
+        CHECK(f->stats.setups <= sum, "%s: S = %llu, more than the %llu of the faces one by one", what,
+              (unsigned long long)f->stats.setups, (unsigned long long)sum);
       /* walls cross the eye plane of the faces: clipped to their edge lines, they
        * leave few bins refined for nothing (62.7% of 1845 before, 9.1% of 758) */
-      if (m && ns == 1)
+      if (m == 1 && ns == 1)
         CHECK(f->stats.bins && f->stats.bins_empty * 4 < f->stats.bins, "%s: %llu of %llu bins refined empty", what,
               (unsigned long long)f->stats.bins_empty, (unsigned long long)f->stats.bins);
       rr_frame_release(f);
@@ -228,8 +240,8 @@ int main(void) {
   check_directions(dev);
   check_cube(dev);
   check_cube_setups(dev);
-  check_methods(dev, "demo", test_quick() ? 1 : 2);
-  check_methods(dev, "rooms:3", test_quick() ? 1 : 2);
+  check_methods(dev, "demo", 2);
+  check_methods(dev, "rooms:3", 2);
   const char *p = test_quick() ? NULL : test_model("stanford-bunny.obj");
   if (p) check_methods(dev, p, 1);
 

@@ -3,8 +3,8 @@
  * ray passes the 3D edge test lies inside the triangle's rectangle. The triangles
  * gather where the maps are singular or wrap: the lat-long's seam and poles, the
  * hemisphere's rim, the fisheye's axis and (at 360°) its antipode, the cube's
- * edges and corners (the cube: each face's perspective rectangle, from the
- * corners, against the face's own samples). */
+ * 12 edges and 8 corners (the cube: each face's perspective rectangle, from the
+ * corners, against the face's own samples); the OpenCV cameras with distortion. */
 #include "vis/vis.h"
 #include "io/io.h"
 #include "testutil.h"
@@ -41,12 +41,15 @@ static vec3 hard_dir(const rr_camera *rc, vec3 f, vec3 r, vec3 u) {
   case 2: return polar(v3_neg(u), f, r, jit, psi);          /* south pole */
   case 3: return polar(v3_neg(f), u, r, jit, psi);          /* behind: the seam, the 360° fisheye's rim */
   default: {                                               /* the rim of the disk, the axis */
-    double rim = rc->type == RR_CAMERA_FISHEYE ? rc->fov_deg * RR_PI / 360 : RR_PI / 2;
-    if (rc->type == RR_CAMERA_CUBE) { /* a corner of the cube, or the middle of an edge */
-      bool corner = rnd() < 0.5;
-      rim = corner ? atan(sqrt(2.0)) : RR_PI / 4;
-      psi = (floor(rnd() * 4) + (corner ? 0.5 : 0)) * RR_PI / 2 + jit;
+    if (rc->type == RR_CAMERA_CUBE) { /* any of the 8 corners, or a point on any of the 12 edges */
+      const int free_axis = (int)(rnd() * 3);
+      double q[3];
+      for (int a = 0; a < 3; a++) q[a] = rnd() < 0.5 ? -1 : 1;
+      if (rnd() < 0.6) q[free_axis] = rnd() < 0.5 ? 0 : 2 * rnd() - 1; /* an edge: its middle, or anywhere on it */
+      vec3 d = v3_add(v3_scale(f, (float)q[0]), v3_add(v3_scale(r, (float)q[1]), v3_scale(u, (float)q[2])));
+      return v3_add(v3_norm(d), v3_scale(rnd_unit(), (float)fabs(jit)));
     }
+    double rim = rc->type == RR_CAMERA_FISHEYE ? rc->fov_deg * RR_PI / 360 : RR_PI / 2;
     return polar(f, r, u, rnd() < 0.3 ? jit : rim + jit, psi);
   }
   }
@@ -387,6 +390,7 @@ int main(void) {
       {RR_CAMERA_FISHEYE, 360, 96, 96, "fisheye 360"},
       {RR_CAMERA_CUBE, 90, 96, 72, "cube"},
       {RR_CAMERA_OPENCV_FISHEYE, 150, 96, 80, "opencv-fisheye"},
+      {RR_CAMERA_OPENCV, 100, 96, 80, "opencv"},
   };
   for (size_t k = 0; k < sizeof cams / sizeof cams[0]; k++)
     for (int view = 0; view < 2; view++) {
@@ -397,6 +401,9 @@ int main(void) {
       vec3 up = view ? v3(0.2f, 1, 0.1f) : v3(0, 1, 0);
       memcpy(rc.eye, &eye, 12), memcpy(rc.target, &target, 12), memcpy(rc.up, &up, 12);
       if (rc.type == RR_CAMERA_OPENCV_FISHEYE) rc.dist[0] = 0.05f, rc.dist[1] = -0.01f;
+      /* Brown–Conrady: strong barrel (folding back near the corners) with tangential terms */
+      static const float brown[8] = {-0.3f, 0.08f, 0.002f, -0.001f, -0.01f};
+      if (rc.type == RR_CAMERA_OPENCV) memcpy(rc.dist, brown, sizeof brown);
       char what[64];
       snprintf(what, sizeof what, "%s, view %d", cams[k].what, view);
       check_camera(dev, &rc, cams[k].w, cams[k].h, ntri, what);

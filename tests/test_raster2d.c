@@ -324,6 +324,7 @@ static void check_view_pattern(const rr_scene *s, const rr_camera *cam, const ca
     uint32_t *ids = malloc(2 * npix * sizeof *ids);
     float *fs = malloc(6 * npix * sizeof *fs);
     CHECK(ids && fs, "out of memory");
+    double worst_id = 1, worst_hit = 1;
     for (int k = 0; ids && fs && k < NPAT; k++) {
       const visbuf *r = &f[2]->vb;
       for (size_t p = 0; p < npix; p++) {
@@ -337,7 +338,10 @@ static void check_view_pattern(const rr_scene *s, const rr_camera *cam, const ca
       char label[300];
       snprintf(label, sizeof label, "%s, position %d (%g, %g)", what, k, pat[k].sx0, pat[k].sy0);
       check_agreement(label, &g, min_id, min_hit);
+      worst_id = fmin(worst_id, g.same_id), worst_hit = fmin(worst_hit, g.same_hit);
     }
+    printf("%s, %d positions: ids agree with 3dr-bb on at least %.4f%% (asked %.4f%%), hit/miss %.4f%%\n", what, NPAT,
+           100 * worst_id, 100 * min_id, 100 * worst_hit);
     free(ids), free(fs);
   }
   for (int m = 0; m < 3; m++) rr_frame_release(f[m]);
@@ -475,6 +479,28 @@ static void check_clipping(void) {
   }
 }
 
+/* A view where even the pixel centres miss the thresholds on ids: each position of
+ * the 16-position pattern must agree with 3dr-bb at the level the centres do (at most
+ * twice their share of differing ids: a few samples each at 128²), and on hits, depths
+ * and λ as check_view asks. */
+static void check_dense_pattern(const rr_scene *s, const rr_camera *cam, int w, int h, const char *what) {
+  camera c;
+  if (rr_cam_setup(dev, cam, w, h, &c) != RR_OK) {
+    CHECK(0, "%s: camera: %s", what, rr_device_message(dev));
+    return;
+  }
+  rr_frame *a = test_render(dev, s, cam, RR_METHOD_2DR_BB, 2, w, h, 0);
+  rr_frame *b = test_render(dev, s, cam, RR_METHOD_3DR_BB, 2, w, h, 0);
+  if (a && b) {
+    agreement g = compare(s, &c, a, b);
+    printf("%s: %d hits; pixel centres vs 3dr-bb: id %.4f%%, hit/miss %.4f%%\n", what, g.hits, 100 * g.same_id,
+           100 * g.same_hit);
+    check_agreement(what, &g, 0.99, 0.9999);
+    check_view_pattern(s, cam, &c, w, h, 0, what, 1 - 2 * (1 - g.same_id), 0.9999);
+  }
+  rr_frame_release(a), rr_frame_release(b);
+}
+
 /* Real meshes at several views, one of them from inside the bounds. */
 static void check_models(void) {
   const char *meshes[] = {"stanford-bunny.obj", "ogre.obj", "nefertiti.obj", "suzanne.obj", "spot.obj"};
@@ -497,6 +523,15 @@ static void check_models(void) {
       char what[256];
       snprintf(what, sizeof what, "%s view %d", meshes[m], v);
       check_view(s, &cam, 512, 512, v == 1, what, 0.999, 0.9999);
+      if (m > 0) continue;
+      /* The bunny at 128² too, with the 16-position pattern. The sparse view 1 is held
+       * to the thresholds of the 512² pixel centres at every position; on views 0 and 2
+       * the pixel centres themselves miss 0.999 on ids at 128² (99.88%, 99.87% measured:
+       * triangles 1/16 the size, so snapping to 1/256 px moves more ids), and each
+       * position is held to the centres' own level instead. */
+      snprintf(what, sizeof what, "%s view %d at 128²", meshes[m], v);
+      if (v == 1) check_view(s, &cam, 128, 128, 1, what, 0.999, 0.9999);
+      else check_dense_pattern(s, &cam, 128, 128, what);
     }
     /* Orthographic, from outside and with the image plane through the mesh. */
     for (int v = 0; v < 2; v++) {

@@ -1,7 +1,8 @@
 /* Sample positions are data: a pattern of N positions inside the pixel gives N
  * layers of the visibility buffer, and every method and camera takes the
  * positions as they are. The 3D methods and ray casters stay bit-identical at any
- * position; a layer is the frame of one sample at that position; positions mean
+ * position (the OpenCV cameras with distortion); a layer is the frame of one
+ * sample at that position; positions mean
  * what they say (a 2x2 grid in W×H is the centre of 2W×2H); the 2D pipeline, which
  * snaps positions to 1/256 pixel like its vertices, agrees with them. */
 #include "testutil.h"
@@ -144,6 +145,12 @@ int main(void) {
       cam.target[0] = c[0] + 1, cam.target[1] = c[1], cam.target[2] = c[2];
       cam.fov_deg = type >= RR_CAMERA_OPENCV ? 120 : 200; /* the OpenCV cameras are pinholes */
     }
+    /* the OpenCV cameras with real distortion: Brown–Conrady with its rational terms
+     * (k1 k2 p1 p2 k3 k4 k5 k6), and Kannala–Brandt */
+    static const float brown[8] = {-0.25f, 0.06f, 0.0015f, -0.001f, -0.005f, 0.02f, 0.001f, 0},
+                       kb[8] = {-0.05f, 0.01f, -0.002f, 0.0005f};
+    if (type == RR_CAMERA_OPENCV) memcpy(cam.dist, brown, sizeof brown);
+    if (type == RR_CAMERA_OPENCV_FISHEYE) memcpy(cam.dist, kb, sizeof kb);
     bool curved = type >= RR_CAMERA_PARABOLIC; /* exact but slow: smaller images */
     check_methods(dev, s, &cam, curved ? 32 : 64, curved ? 24 : 48, rr_camera_name(type));
   }

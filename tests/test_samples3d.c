@@ -1,9 +1,10 @@
 /* The 3D rasterization methods take every sample position of a pattern in one
  * pass (render.c: all_samples): each triangle is set up once and moved to each
  * position (rr_tri_setup_at). Checked here: the moved setup is the setup at that
- * position, bit for bit; on a 16-position pattern every 3dr method equals rc-bvh
- * (one pass per position) for every camera, random and inside views, on one and
- * two threads, and a layer equals the one-sample frame at its position; and at
+ * position, bit for bit; on a 16-position pattern every 3dr method, rc-packet and
+ * rc (on the small scene) equal rc-bvh (one pass per position) for every camera,
+ * the OpenCV ones with distortion, random and inside views, on one and two
+ * threads, and a layer equals the one-sample frame at its position; and at
  * sample level the pipeline is watertight: positions on the vertices and edges of
  * a tessellated plane are each claimed exactly once. */
 #include "vis/vis.h"
@@ -27,25 +28,33 @@ static const rr_method methods3d[] = {RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN, RR_ME
                                       RR_METHOD_3DR_FULL};
 enum { NMETHODS3D = sizeof methods3d / sizeof methods3d[0] };
 
-/* Every 3dr method against rc-bvh on all 16 layers; with `layers`, each layer of
- * 3dr-full against a one-sample 3dr-bb frame at its position too. */
+/* rc tests every sample against every triangle: only on scenes this small */
+enum { RC_MAX_TRIS = 4096 };
+
+/* Every 3dr method, rc-packet (rc-bvh's traversal on curved cameras) and, on a small
+ * scene, rc against rc-bvh on all 16 layers; with `layers`, each layer of 3dr-full
+ * against a one-sample 3dr-bb frame at its position too. */
 static void check_view(rr_device *dev, const rr_scene *s, const rr_camera *cam, int w, int h, int threads,
                        bool layers, const char *what) {
   rr_render_options o = test_pattern(RR_METHOD_RC_BVH, w, h, threads, 16, (const float (*)[2])rg16);
   rr_frame *ref = test_render_opt(dev, s, cam, &o);
   if (!ref) return;
   rr_frame *full = NULL;
-  for (int i = 0; i < NMETHODS3D; i++) {
-    o.method = methods3d[i];
+  const rr_method others[NMETHODS3D + 2] = {RR_METHOD_RC, RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
+                                            RR_METHOD_3DR_FC, RR_METHOD_3DR_FS, RR_METHOD_3DR_FULL};
+  for (int i = 0; i < NMETHODS3D + 2; i++) {
+    o.method = others[i];
+    if (o.method == RR_METHOD_RC && s->ntris > RC_MAX_TRIS) continue;
     rr_frame *f = test_render_opt(dev, s, cam, &o);
     if (!f) continue;
     int d = test_frames_differ(ref, f);
     CHECK(d == 0, "%s, %d threads: %s differs from rc-bvh in %d of %d samples", what, threads,
-          rr_method_name(methods3d[i]), d, 16 * w * h);
+          rr_method_name(o.method), d, 16 * w * h);
     rr_stats st;
     rr_frame_get_stats(f, &st);
-    CHECK(st.edge_evals > 0 && st.setups > 0, "%s: %s reports no work", what, rr_method_name(methods3d[i]));
-    if (methods3d[i] == RR_METHOD_3DR_FULL) full = f;
+    CHECK(st.setups > 0 && (st.edge_evals > 0 || o.method == RR_METHOD_RC_PACKET), "%s: %s reports no work", what,
+          rr_method_name(o.method));
+    if (o.method == RR_METHOD_3DR_FULL) full = f;
     else rr_frame_release(f);
   }
   if (layers && full) test_check_layers(dev, s, cam, &o, RR_METHOD_3DR_BB, full, what);
@@ -210,21 +219,31 @@ int main(void) {
   }
   check_moves(dev, s);
   check_watertight(dev);
+  CHECK(light->ntris <= RC_MAX_TRIS, "sphere:32 has %u triangles: too many for rc", light->ntris);
+  /* the OpenCV cameras with real distortion: Brown–Conrady barrel with tangential terms
+   * (k1 k2 p1 p2 k3), and Kannala–Brandt */
+  static const float brown[8] = {-0.12f, 0.03f, 0.001f, -0.0015f, -0.004f}, kb[8] = {0.03f, -0.01f, 0.004f, -0.001f};
   const int views = 1;
   for (int type = 0; type < RR_CAMERA_COUNT; type++) {
     bool curved = type >= RR_CAMERA_PARABOLIC;
     int w = curved ? 32 : 48, h = curved ? 24 : 36;
-    for (int v = 0; v <= views; v++) {
-      /* v = 0: inside the bounds, looking around; then random views from outside */
-      const rr_scene *sc = curved ? light : s;
-      rr_camera cam = v == 0 ? test_random_view(sc, 0.2f, 0.2f, 1, 90, 90) : test_random_view(sc, 1.2f, 3, 0.4f, 30, 80);
-      cam.type = (rr_camera_type)type;
-      if (type == RR_CAMERA_FISHEYE && v == 0) cam.fov_deg = 200;
-      if (type == RR_CAMERA_CUBE) w = 32, h = 24;
-      char what[64];
-      snprintf(what, sizeof what, "%s, %s view %d", rr_camera_name(type), v ? "random" : "inside", v);
-      for (int threads = 1; threads <= 2; threads++) check_view(dev, sc, &cam, w, h, threads, threads == 1 && v == 1, what);
-    }
+    /* curved views on the light scene only; planar ones on both (rc runs on the light one) */
+    for (int sci = curved; sci < 2; sci++)
+      for (int v = 0; v <= views; v++) {
+        /* v = 0: inside the bounds, looking around; then random views from outside */
+        const rr_scene *sc = sci ? light : s;
+        rr_camera cam = v == 0 ? test_random_view(sc, 0.2f, 0.2f, 1, 90, 90) : test_random_view(sc, 1.2f, 3, 0.4f, 30, 80);
+        cam.type = (rr_camera_type)type;
+        if (type == RR_CAMERA_FISHEYE && v == 0) cam.fov_deg = 200;
+        if (type == RR_CAMERA_OPENCV) memcpy(cam.dist, brown, sizeof brown);
+        if (type == RR_CAMERA_OPENCV_FISHEYE) memcpy(cam.dist, kb, sizeof kb);
+        if (type == RR_CAMERA_CUBE) w = 32, h = 24;
+        char what[96];
+        snprintf(what, sizeof what, "%s, %s, %s view %d", rr_camera_name(type), sci ? "sphere:32" : "mesh",
+                 v ? "random" : "inside", v);
+        for (int threads = 1; threads <= 2; threads++)
+          check_view(dev, sc, &cam, w, h, threads, threads == 1 && v == 1, what);
+      }
   }
   rr_camera cam;
   rr_camera_init(&cam);
