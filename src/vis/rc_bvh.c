@@ -109,6 +109,7 @@ enum { REACH_FEW = 4, REACH_CAP = 8, PROBE = 4 };
 typedef struct {
   uint32_t ids[BATCH], sid[BATCH], leaves[BATCH], first[BATCH], count[BATCH]; /* per leaf: its positions */
   int n, nl, setup[BATCH];
+  int nout; /* the setups and analytic primitives: batch_finish's run in ts */
   int bb[BATCH][4];
   tri_setup ts[BATCH];
   int face[BATCH];
@@ -128,7 +129,7 @@ static void leaf_add(leaf_batch *lb, const rr_bvh *b, uint32_t leaf, uint32_t fi
  * 3dr-bb tests it over): most triangles of a detailed mesh fall between samples
  * and cost no setup. */
 static void batch_setup(frame_setups *fs, leaf_batch *lb, int thread) {
-  int ns = 0;
+  int ns = 0, nana = 0;
   /* analytic primitives (SETUP_ANALYTIC) are bounded in batch_finish, not set up */
   const rr_scene *s = fs->s;
   if (fs->cam->planar) {
@@ -140,13 +141,15 @@ static void batch_setup(frame_setups *fs, leaf_batch *lb, int thread) {
     for (int k = 0, q = 0; k < lb->n; k++) {
       bool kept = q < (int)nf && lb->found[q].id == lb->ids[k]; /* in order; ids in a tree are distinct */
       lb->setup[k] = scene_kind(s, lb->ids[k]) != RR_GEOMETRY_TRIANGLE ? SETUP_ANALYTIC : kept ? ns : -1;
+      nana += lb->setup[k] == SETUP_ANALYTIC;
       if (kept) memcpy(lb->bb[k], lb->found[q++].bb, sizeof lb->bb[k]), lb->sid[ns++] = lb->ids[k];
     }
   } else {
     for (int k = 0; k < lb->n; k++)
-      if (scene_kind(s, lb->ids[k]) != RR_GEOMETRY_TRIANGLE) lb->setup[k] = SETUP_ANALYTIC;
+      if (scene_kind(s, lb->ids[k]) != RR_GEOMETRY_TRIANGLE) lb->setup[k] = SETUP_ANALYTIC, nana++;
       else lb->setup[k] = ns, lb->sid[ns++] = lb->ids[k];
   }
+  lb->nout = ns + nana;
   rr_tri_setup_run(fs->s, lb->sid, ns, fs->cam, fs->cull, fs->simd, lb->ts, lb->face);
   fs->st[thread].setups += (uint64_t)ns;
 }
@@ -193,15 +196,12 @@ static float probe_samples(const tri_setup *ts, const camera *c, const int bb[4]
  * that rectangle; a curved camera's over the whole image. */
 static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
   const camera *c = fs->cam;
-  /* The batch's run: room for every triangle set up and seen (one whose floor
-   * finds no sample stays an unused entry). Where the run lands depends on the
+  /* The batch's run: room for every triangle set up (one culled, or whose floor
+   * finds no sample, stays an unused entry). Where the run lands depends on the
    * threads' timing; what it holds does not. */
-  int nout = 0;
-  for (int k = 0; k < lb->n; k++)
-    nout += lb->setup[k] == SETUP_ANALYTIC || (lb->setup[k] >= 0 && lb->face[lb->setup[k]] != SETUP_CULLED);
-  uint32_t base = atomic_fetch_add_explicit(&fs->nts, (unsigned)nout, memory_order_relaxed);
+  uint32_t base = atomic_fetch_add_explicit(&fs->nts, (unsigned)lb->nout, memory_order_relaxed);
   leaf_tri *out = fs->ts + base;
-  nout = 0;
+  int nout = 0;
   for (int q = 0, k = 0; q < lb->nl; q++) {
     uint32_t w = lb->leaves[q] / 4, s = lb->leaves[q] % 4, first = lb->first[q];
     float tlo = INFINITY, r[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
@@ -279,6 +279,30 @@ static void setup_leaves(int job, int thread, void *arg) {
     }
   }
   batch_setup(fs, &lb, thread), batch_finish(fs, &lb);
+}
+
+/* Fills the inner slots of wide node w from their children, bottom up, and returns
+ * the union of its slots: the least bound and the rectangle x0, y0, x1, y1. At
+ * `depth` 0 the node's subtree is already filled (reach_subtree: the subtrees in
+ * parallel), so only its union is taken; below 0 it never stops. */
+static void wide_union(frame_setups *fs, uint32_t w, int depth, float u[5]) {
+  wide_bounds *wb = &fs->wb[w];
+  if (depth != 0) {
+    uint32_t ref[4], count[4];
+    bvh_wide_refs(fs->b, w, ref, count);
+    wb->slots = (uint32_t)refs_slots(ref);
+    for (int i = 0; i < 4; i++) {
+      if (count[i] || ref[i] == UINT32_MAX || (fs->reached && !fs->reached[ref[i]])) continue;
+      float c[5];
+      wide_union(fs, ref[i], depth - 1, c);
+      wb->tlo[i] = c[0], wb->x0[i] = c[1], wb->y0[i] = c[2], wb->x1[i] = c[3], wb->y1[i] = c[4];
+    }
+  }
+  u[0] = u[1] = u[2] = INFINITY, u[3] = u[4] = -INFINITY;
+  for (int i = 0; i < 4; i++) {
+    u[0] = minf(u[0], wb->tlo[i]), u[1] = minf(u[1], wb->x0[i]), u[2] = minf(u[2], wb->y0[i]);
+    u[3] = maxf(u[3], wb->x1[i]), u[4] = maxf(u[4], wb->y1[i]);
+  }
 }
 
 /* ---- perspective frames: only the nodes whose box may hold a sample ---------- */
@@ -424,36 +448,23 @@ static void reach_subtree(int job, int thread, void *arg) {
   lb.n = lb.nl = 0;
   reach_walk(rj->fs, rj->roots.w[job], -1, false, &lb, thread, NULL);
   batch_setup(rj->fs, &lb, thread), batch_finish(rj->fs, &lb);
+  float u[5];
+  wide_union(rj->fs, rj->roots.w[job], -1, u); /* its leaves are all finished: the unions in parallel too */
 }
 
-/* The top three levels in this thread, the subtrees below them in parallel. */
+enum { REACH_TOP = 3 }; /* levels walked in one thread above the parallel subtrees */
+
+/* The top REACH_TOP levels in this thread, the subtrees below them in parallel
+ * (their walks, setups and unions), then the unions of the top levels. */
 static void reach_frame(frame_setups *fs, int threads) {
   reach_job rj = {.fs = fs};
   leaf_batch lb;
   lb.n = lb.nl = 0;
-  reach_walk(fs, 0, 3, false, &lb, 0, &rj.roots);
+  reach_walk(fs, 0, REACH_TOP, false, &lb, 0, &rj.roots);
   batch_setup(fs, &lb, 0), batch_finish(fs, &lb);
   rr_parallel_for(rj.roots.n, threads, reach_subtree, &rj);
-}
-
-/* Fills the inner slots of wide node w from their children, bottom up, and returns
- * the union of its slots: the least bound and the rectangle x0, y0, x1, y1. */
-static void wide_union(frame_setups *fs, uint32_t w, float u[5]) {
-  uint32_t ref[4], count[4];
-  bvh_wide_refs(fs->b, w, ref, count);
-  wide_bounds *wb = &fs->wb[w];
-  wb->slots = (uint32_t)refs_slots(ref);
-  for (int i = 0; i < 4; i++) {
-    if (count[i] || ref[i] == UINT32_MAX || (fs->reached && !fs->reached[ref[i]])) continue;
-    float c[5];
-    wide_union(fs, ref[i], c);
-    wb->tlo[i] = c[0], wb->x0[i] = c[1], wb->y0[i] = c[2], wb->x1[i] = c[3], wb->y1[i] = c[4];
-  }
-  u[0] = u[1] = u[2] = INFINITY, u[3] = u[4] = -INFINITY;
-  for (int i = 0; i < 4; i++) {
-    u[0] = minf(u[0], wb->tlo[i]), u[1] = minf(u[1], wb->x0[i]), u[2] = minf(u[2], wb->y0[i]);
-    u[3] = maxf(u[3], wb->x1[i]), u[4] = maxf(u[4], wb->y1[i]);
-  }
+  float root[5];
+  wide_union(fs, 0, REACH_TOP, root);
 }
 
 static void setups_free(frame_setups *fs) {
@@ -492,9 +503,9 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
     if (fs->cam->planar)
       rr_parallel_for((int)((ctx->scene->ntris + SEEN_CHUNK - 1) / SEEN_CHUNK), ctx->threads, seen_chunk, fs);
     rr_parallel_for((int)((b->vwide + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, fs);
+    float root[5];
+    wide_union(fs, 0, -1, root);
   }
-  float root[5];
-  wide_union(fs, 0, root);
   return RR_OK;
 }
 
