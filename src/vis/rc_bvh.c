@@ -196,8 +196,9 @@ static float probe_samples(const tri_setup *ts, const camera *c, const int bb[4]
  * that rectangle; a curved camera's over the whole image. */
 static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
   const camera *c = fs->cam;
-  /* The batch's run: room for every triangle set up (one culled, or whose floor
-   * finds no sample, stays an unused entry). Where the run lands depends on the
+  /* The batch's run: room for every triangle set up; those with a sample where
+   * they can pass are packed at its start (the rest, culled or never passing,
+   * leave its end unused and cost no copy). Where the run lands depends on the
    * threads' timing; what it holds does not. */
   uint32_t base = atomic_fetch_add_explicit(&fs->nts, (unsigned)lb->nout, memory_order_relaxed);
   leaf_tri *out = fs->ts + base;
@@ -209,24 +210,24 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
       int j = lb->setup[k];
       fs->slot[i] = UINT32_MAX;
       if (j != SETUP_ANALYTIC && (j < 0 || lb->face[j] == SETUP_CULLED)) continue;
-      leaf_tri *lt = &out[nout];
-      lt->id = lb->ids[k];
-      float t, *tr = lt->rect;
+      /* the bounds into out[nout], kept only when some sample can pass */
+      float t, *tr = out[nout].rect;
+      const tri_setup *ts = j == SETUP_ANALYTIC ? NULL : &lb->ts[j];
       if (j == SETUP_ANALYTIC) {
         /* its samples (rr_ana_screen_bounds) and its floor over the image (rr_ana_t_floor) */
         int bb[4] = {0, 0, -1, -1};
-        t = rr_ana_screen_bounds(fs->s, lt->id, c, bb) ? rr_ana_t_floor(fs->s, lt->id, c) : INFINITY;
+        t = rr_ana_screen_bounds(fs->s, lb->ids[k], c, bb) ? rr_ana_t_floor(fs->s, lb->ids[k], c) : INFINITY;
         tr[0] = (float)bb[0] + c->sx0, tr[1] = (float)bb[1] + c->sy0;
         tr[2] = (float)bb[2] + c->sx0, tr[3] = (float)bb[3] + c->sy0;
-      } else if (lt->ts = lb->ts[j], c->planar) {
+      } else if (c->planar) {
         /* the extreme samples, as the rays compute their coordinates */
         tr[0] = (float)lb->bb[k][0] + c->sx0, tr[1] = (float)lb->bb[k][1] + c->sy0;
         tr[2] = (float)lb->bb[k][2] + c->sx0, tr[3] = (float)lb->bb[k][3] + c->sy0;
         const int *bb = lb->bb[k];
         if ((bb[2] - bb[0] + 1) * (bb[3] - bb[1] + 1) <= PROBE) {
-          t = probe_samples(&lt->ts, c, bb, tr);
+          t = probe_samples(ts, c, bb, tr);
         } else if (bb[0] > 0 || bb[1] > 0 || bb[2] < c->width - 1 || bb[3] < c->height - 1) {
-          t = rr_tri_rect_floor(&lt->ts, c, tr);
+          t = rr_tri_rect_floor(ts, c, tr);
         } else {
           /* A corner rectangle of the whole image (mostly a triangle crossing the
            * eye's plane) would give every ancestor the whole image and a floor near
@@ -235,16 +236,17 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
            * triangle is tested only where both rectangles meet, with their floor (a NaN
            * bound leaves the corner rectangle as it is). */
           float pr[4];
-          t = rr_tri_bounds(&lt->ts, c, pr);
+          t = rr_tri_bounds(ts, c, pr);
           tr[0] = maxf(pr[0], tr[0]), tr[1] = maxf(pr[1], tr[1]), tr[2] = minf(pr[2], tr[2]), tr[3] = minf(pr[3], tr[3]);
           if (!(tr[0] <= tr[2] && tr[1] <= tr[3])) t = INFINITY;
         }
       } else {
-        t = rr_tri_bounds(&lt->ts, c, tr);
+        t = rr_tri_bounds(ts, c, tr);
       }
-      if (t != INFINITY) fs->slot[i] = base + (uint32_t)nout; /* else no sample can pass */
-      nout++;
-      if (t == INFINITY) continue;
+      if (t == INFINITY) continue; /* no sample can pass */
+      out[nout].id = lb->ids[k];
+      if (ts) out[nout].ts = *ts;
+      fs->slot[i] = base + (uint32_t)nout++;
       tlo = t < tlo ? t : tlo;
       r[0] = minf(r[0], tr[0]), r[1] = minf(r[1], tr[1]), r[2] = maxf(r[2], tr[2]), r[3] = maxf(r[3], tr[3]);
     }
