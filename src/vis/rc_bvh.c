@@ -71,6 +71,7 @@ typedef struct {
  * an empty slot has an empty rectangle and an infinite bound. */
 typedef struct {
   rr_vf4 x0, y0, x1, y1, tlo;
+  uint32_t ref[4], count[4]; /* the node's (an instance's moved to its place): what the rays descend by */
   uint32_t slots; /* the node's non-empty slots, what N counts for its test: one load, not four compares */
 } wide_bounds;
 
@@ -267,6 +268,7 @@ static void setup_leaves(int job, int thread, void *arg) {
   for (uint32_t w = w0; w < w1; w++) {
     BVH_NODE_ALIGN bvh_wide buf;
     const bvh_wide *n = bvh_wide_at(b, w, &buf);
+    memcpy(fs->wb[w].ref, n->ref, sizeof n->ref), memcpy(fs->wb[w].count, n->count, sizeof n->count);
     for (uint32_t i = 0; i < 4; i++) {
       if (n->ref[i] == UINT32_MAX) {
         wide_bounds *wb = &fs->wb[w];
@@ -290,8 +292,7 @@ static void setup_leaves(int job, int thread, void *arg) {
 static void wide_union(frame_setups *fs, uint32_t w, int depth, float u[5]) {
   wide_bounds *wb = &fs->wb[w];
   if (depth != 0) {
-    uint32_t ref[4], count[4];
-    bvh_wide_refs(fs->b, w, ref, count);
+    const uint32_t *ref = wb->ref, *count = wb->count; /* setup_leaves' or reach_walk's copy */
     wb->slots = (uint32_t)refs_slots(ref);
     for (int i = 0; i < 4; i++) {
       if (count[i] || ref[i] == UINT32_MAX || (fs->reached && !fs->reached[ref[i]])) continue;
@@ -419,6 +420,7 @@ static void reach_walk(frame_setups *fs, uint32_t w, int depth, bool all, leaf_b
   BVH_NODE_ALIGN bvh_wide buf;
   const bvh_wide *n = all ? bvh_wide_refs_at(fs->b, w, &buf) : bvh_wide_at(fs->b, w, &buf);
   wide_bounds *wb = &fs->wb[w];
+  memcpy(wb->ref, n->ref, sizeof n->ref), memcpy(wb->count, n->count, sizeof n->count);
   int few = 0, reach = all ? 15 : box_reach(fs->cam, n, &few);
   fs->reached[w] = 1;
   for (int i = 0; i < 4; i++) {
@@ -549,6 +551,7 @@ KERNEL int ray_node_planar(void *q, const bvh_wide *w, uint32_t ref, uint64_t la
   rr_vi4 in = (wb->x0 <= x) & (x <= wb->x1) & (wb->y0 <= y) & (y <= wb->y1);
   r->nodes += wb->slots;
   s->order = s->key = wb->tlo;
+  s->ref = wb->ref, s->count = wb->count;
   return rr_vi4_bits(in & (wb->tlo <= rr_vf4_splat(r->t)));
 }
 
@@ -610,7 +613,7 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
         r.w = camera_w(c, x, y);
         vec3 o, d;
         uint64_t e0 = r.evals, n0 = r.nodes;
-        if (c->planar) bvh_trace_nodes(j->b, &r, 1, ray_node_planar, ray_leaf, ray_best, false);
+        if (c->planar) bvh_trace_nodes(j->b, &r, 1, ray_node_planar, ray_leaf, ray_best, false); /* fs.wb alone */
         else if (rr_cam_ray(c, x, y, &o, &d)) { /* else a pixel without a ray: a miss */
           ray_q_init(&r.q, o, d);
           bvh_trace(j->b, &r, 1, ray_node_curved, ray_leaf, ray_best);
@@ -664,6 +667,7 @@ KERNEL int packet_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes,
     hits |= (s->lanes[i] != 0) << i;
   }
   s->order = s->key = wb->tlo;
+  s->ref = wb->ref, s->count = wb->count;
   uint64_t tested = wb->slots;
   p->nodes += tested;
   if (p->heat) {
@@ -717,7 +721,7 @@ static void rc_packet_tile(int job, int thread, void *arg) {
         p->t[k] = INFINITY, p->id[k] = RR_MISS, p->l1[k] = p->l2[k] = 0, p->heat_e[k] = p->heat_n[k] = 0;
         if (px + (k & 7) < vb->width && py + (k >> 3) < vb->height) p->valid |= 1ull << k;
       }
-      bvh_trace_nodes(j->b, p, p->valid, packet_node, packet_leaf, packet_best, false); /* rectangles only */
+      bvh_trace_nodes(j->b, p, p->valid, packet_node, packet_leaf, packet_best, false); /* fs.wb alone */
       for (int k = 0; k < PN; k++) {
         if (!((p->valid >> k) & 1)) continue;
         size_t i = (size_t)(py + (k >> 3)) * vb->width + px + (k & 7);
