@@ -712,21 +712,24 @@ static void rc_packet_tile(int job, int thread, void *arg) {
   packet pk = {.fs = &j->fs, .heat = j->ctx->heat_e != NULL}, *p = &pk;
   for (int py = ty0; py < ty0 + TILE && py < vb->height; py += PK)
     for (int px = tx0; px < tx0 + TILE && px < vb->width; px += PK) {
-      p->x0 = px, p->y0 = py, p->valid = 0, p->maxbest = INFINITY;
+      /* the lanes on the image: nx columns by ny rows */
+      int nx = vb->width - px < PK ? vb->width - px : PK, ny = vb->height - py < PK ? vb->height - py : PK;
+      uint64_t row = (1ull << nx) - 1, rows = ny == PK ? ~0ull : (1ull << 8 * ny) - 1;
+      p->x0 = px, p->y0 = py, p->valid = row * 0x0101010101010101ull & rows, p->maxbest = INFINITY;
       float cx[PK], cy[PK];
       for (int k = 0; k < PK; k++) cx[k] = (float)(px + k) + j->ctx->cam->sx0, cy[k] = (float)(py + k) + j->ctx->cam->sy0;
       p->sx[0] = rr_vf4_load(cx), p->sx[1] = rr_vf4_load(cx + 4);
       p->sy[0] = rr_vf4_load(cy), p->sy[1] = rr_vf4_load(cy + 4);
-      for (int k = 0; k < PN; k++) {
+      for (int k = 0; k < PN; k++)
         p->t[k] = INFINITY, p->id[k] = RR_MISS, p->l1[k] = p->l2[k] = 0, p->heat_e[k] = p->heat_n[k] = 0;
-        if (px + (k & 7) < vb->width && py + (k >> 3) < vb->height) p->valid |= 1ull << k;
-      }
       bvh_trace_nodes(j->b, p, p->valid, packet_node, packet_leaf, packet_best, false); /* fs.wb alone */
-      for (int k = 0; k < PN; k++) {
-        if (!((p->valid >> k) & 1)) continue;
-        size_t i = (size_t)(py + (k >> 3)) * vb->width + px + (k & 7);
-        vb->id[i] = p->id[k], vb->t[i] = p->t[k], vb->l1[i] = p->l1[k], vb->l2[i] = p->l2[k];
-        if (j->ctx->heat_e) j->ctx->heat_e[i] += p->heat_e[k], j->ctx->heat_n[i] += p->heat_n[k];
+      for (int y = 0; y < ny; y++) { /* a row of the packet: a run of the buffer */
+        size_t i = (size_t)(py + y) * vb->width + px, n = (size_t)nx;
+        memcpy(vb->id + i, p->id + PK * y, n * sizeof *vb->id), memcpy(vb->t + i, p->t + PK * y, n * sizeof *vb->t);
+        memcpy(vb->l1 + i, p->l1 + PK * y, n * sizeof *vb->l1), memcpy(vb->l2 + i, p->l2 + PK * y, n * sizeof *vb->l2);
+        if (j->ctx->heat_e)
+          for (int x = 0; x < nx; x++)
+            j->ctx->heat_e[i + x] += p->heat_e[PK * y + x], j->ctx->heat_n[i + x] += p->heat_n[PK * y + x];
       }
     }
   thread_stats *st = &j->st[thread];
