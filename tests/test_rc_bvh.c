@@ -43,7 +43,7 @@ static void check_scene(rr_device *dev, const char *path, const char *name, int 
   }
   for (int v = 0; v < views_rc + views_bb; v++) {
     rr_camera cam = test_random_view(s, v % 3 == 0 ? 0.1f : 1.0f, v % 3 == 0 ? 0.9f : 3.0f, 0.3f, 30, 100);
-    if (v < views_rc) check_view(dev, s, name, v, &cam, RR_METHOD_RC, 40, 30, v % 2);
+    if (v < views_rc) check_view(dev, s, name, v, &cam, RR_METHOD_RC, 42, 30, v % 2); /* rc-packet: partial packets both ways */
     else check_view(dev, s, name, v, &cam, RR_METHOD_3DR_BB, 200, 150, v % 2);
   }
   rr_scene_release(s);

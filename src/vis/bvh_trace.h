@@ -73,6 +73,7 @@ typedef struct {
   rr_vf4 order;      /* the nearest is entered, the others stacked farthest first */
   rr_vf4 key;        /* a stacked slot is dropped on pop when its key is above best() */
   uint64_t lanes[4]; /* the lanes that enter each slot (a single ray: left as they are) */
+  const uint32_t *ref, *count; /* the slots' references, from a node test that reads no node (bvh_trace_nodes) */
 } trace_slots;
 
 /* The policy: q is the traced ray's or packet's state, `lanes` the lanes of it
@@ -95,8 +96,10 @@ KERNEL uint64_t wide_slots(const bvh_wide *w) { return refs_slots(w->ref); }
  * slots the node test enters, in order, the nearest visited and the others
  * stacked, each dropped on pop when best() is already nearer than its key
  * (strictly: an equal t with a lower id still wins). True when leaf() ended it.
- * `boxes` false: node() reads no box, only the references (an instance's node
- * then comes without its boxes moved). */
+ * `boxes` false: the tree is not read at all; node() gets no node (w NULL) and
+ * gives the slots' references itself in s->ref, s->count (a per-frame copy next
+ * to its own bounds: one read, and an instance's references moved once a frame
+ * rather than at every visit). */
 KERNEL bool bvh_trace_nodes(const rr_bvh *b, void *q, uint64_t lanes, trace_node_fn node, trace_leaf_fn leaf,
                             trace_best_fn best, const bool boxes) {
   struct {
@@ -111,15 +114,16 @@ KERNEL bool bvh_trace_nodes(const rr_bvh *b, void *q, uint64_t lanes, trace_node
       if (leaf(q, ref, count, lanes)) return true;
     } else {
       BVH_NODE_ALIGN bvh_wide buf; /* an instance's node, moved to world space (accel/bvh_levels.h) */
-      const bvh_wide *w = boxes ? bvh_wide_at(b, ref, &buf) : bvh_wide_refs_at(b, ref, &buf);
+      const bvh_wide *w = boxes ? bvh_wide_at(b, ref, &buf) : NULL;
       trace_slots s = {.lanes = {lanes, lanes, lanes, lanes}};
       int hits = node(q, w, ref, lanes, &s);
+      const uint32_t *wref = boxes ? w->ref : s.ref, *wcount = boxes ? w->count : s.count;
       if (hits) {
         int i = __builtin_ctz(hits), rest = hits & (hits - 1);
         if (rest && !(rest & (rest - 1))) { /* two (the common case): the nearer entered, the other stacked */
           int k = __builtin_ctz(rest), far = s.order[i] < s.order[k] ? k : i;
           i ^= k ^ far;
-          stack[sp].ref = w->ref[far], stack[sp].count = w->count[far], stack[sp].key = s.key[far];
+          stack[sp].ref = wref[far], stack[sp].count = wcount[far], stack[sp].key = s.key[far];
           stack_lanes[sp++] = s.lanes[far];
         } else if (rest) { /* more: the nearest entered, the others stacked farthest first */
           int order[4], n = 0;
@@ -130,12 +134,12 @@ KERNEL bool bvh_trace_nodes(const rr_bvh *b, void *q, uint64_t lanes, trace_node
           }
           for (int j = 0; j < n - 1; j++) {
             int k = order[j];
-            stack[sp].ref = w->ref[k], stack[sp].count = w->count[k], stack[sp].key = s.key[k];
+            stack[sp].ref = wref[k], stack[sp].count = wcount[k], stack[sp].key = s.key[k];
             stack_lanes[sp++] = s.lanes[k];
           }
           i = order[n - 1];
         }
-        ref = w->ref[i], count = w->count[i], lanes = s.lanes[i];
+        ref = wref[i], count = wcount[i], lanes = s.lanes[i];
         continue;
       }
     }

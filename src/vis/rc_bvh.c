@@ -71,6 +71,7 @@ typedef struct {
  * an empty slot has an empty rectangle and an infinite bound. */
 typedef struct {
   rr_vf4 x0, y0, x1, y1, tlo;
+  uint32_t ref[4], count[4]; /* the node's (an instance's moved to its place): what the rays descend by */
   uint32_t slots; /* the node's non-empty slots, what N counts for its test: one load, not four compares */
 } wide_bounds;
 
@@ -109,6 +110,7 @@ enum { REACH_FEW = 4, REACH_CAP = 8, PROBE = 4 };
 typedef struct {
   uint32_t ids[BATCH], sid[BATCH], leaves[BATCH], first[BATCH], count[BATCH]; /* per leaf: its positions */
   int n, nl, setup[BATCH];
+  int nout; /* the setups and analytic primitives: batch_finish's run in ts */
   int bb[BATCH][4];
   tri_setup ts[BATCH];
   int face[BATCH];
@@ -128,7 +130,7 @@ static void leaf_add(leaf_batch *lb, const rr_bvh *b, uint32_t leaf, uint32_t fi
  * 3dr-bb tests it over): most triangles of a detailed mesh fall between samples
  * and cost no setup. */
 static void batch_setup(frame_setups *fs, leaf_batch *lb, int thread) {
-  int ns = 0;
+  int ns = 0, nana = 0;
   /* analytic primitives (SETUP_ANALYTIC) are bounded in batch_finish, not set up */
   const rr_scene *s = fs->s;
   if (fs->cam->planar) {
@@ -140,13 +142,15 @@ static void batch_setup(frame_setups *fs, leaf_batch *lb, int thread) {
     for (int k = 0, q = 0; k < lb->n; k++) {
       bool kept = q < (int)nf && lb->found[q].id == lb->ids[k]; /* in order; ids in a tree are distinct */
       lb->setup[k] = scene_kind(s, lb->ids[k]) != RR_GEOMETRY_TRIANGLE ? SETUP_ANALYTIC : kept ? ns : -1;
+      nana += lb->setup[k] == SETUP_ANALYTIC;
       if (kept) memcpy(lb->bb[k], lb->found[q++].bb, sizeof lb->bb[k]), lb->sid[ns++] = lb->ids[k];
     }
   } else {
     for (int k = 0; k < lb->n; k++)
-      if (scene_kind(s, lb->ids[k]) != RR_GEOMETRY_TRIANGLE) lb->setup[k] = SETUP_ANALYTIC;
+      if (scene_kind(s, lb->ids[k]) != RR_GEOMETRY_TRIANGLE) lb->setup[k] = SETUP_ANALYTIC, nana++;
       else lb->setup[k] = ns, lb->sid[ns++] = lb->ids[k];
   }
+  lb->nout = ns + nana;
   rr_tri_setup_run(fs->s, lb->sid, ns, fs->cam, fs->cull, fs->simd, lb->ts, lb->face);
   fs->st[thread].setups += (uint64_t)ns;
 }
@@ -193,15 +197,13 @@ static float probe_samples(const tri_setup *ts, const camera *c, const int bb[4]
  * that rectangle; a curved camera's over the whole image. */
 static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
   const camera *c = fs->cam;
-  /* The batch's run: room for every triangle set up and seen (one whose floor
-   * finds no sample stays an unused entry). Where the run lands depends on the
+  /* The batch's run: room for every triangle set up; those with a sample where
+   * they can pass are packed at its start (the rest, culled or never passing,
+   * leave its end unused and cost no copy). Where the run lands depends on the
    * threads' timing; what it holds does not. */
-  int nout = 0;
-  for (int k = 0; k < lb->n; k++)
-    nout += lb->setup[k] == SETUP_ANALYTIC || (lb->setup[k] >= 0 && lb->face[lb->setup[k]] != SETUP_CULLED);
-  uint32_t base = atomic_fetch_add_explicit(&fs->nts, (unsigned)nout, memory_order_relaxed);
+  uint32_t base = atomic_fetch_add_explicit(&fs->nts, (unsigned)lb->nout, memory_order_relaxed);
   leaf_tri *out = fs->ts + base;
-  nout = 0;
+  int nout = 0;
   for (int q = 0, k = 0; q < lb->nl; q++) {
     uint32_t w = lb->leaves[q] / 4, s = lb->leaves[q] % 4, first = lb->first[q];
     float tlo = INFINITY, r[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
@@ -209,24 +211,24 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
       int j = lb->setup[k];
       fs->slot[i] = UINT32_MAX;
       if (j != SETUP_ANALYTIC && (j < 0 || lb->face[j] == SETUP_CULLED)) continue;
-      leaf_tri *lt = &out[nout];
-      lt->id = lb->ids[k];
-      float t, *tr = lt->rect;
+      /* the bounds into out[nout], kept only when some sample can pass */
+      float t, *tr = out[nout].rect;
+      const tri_setup *ts = j == SETUP_ANALYTIC ? NULL : &lb->ts[j];
       if (j == SETUP_ANALYTIC) {
         /* its samples (rr_ana_screen_bounds) and its floor over the image (rr_ana_t_floor) */
         int bb[4] = {0, 0, -1, -1};
-        t = rr_ana_screen_bounds(fs->s, lt->id, c, bb) ? rr_ana_t_floor(fs->s, lt->id, c) : INFINITY;
+        t = rr_ana_screen_bounds(fs->s, lb->ids[k], c, bb) ? rr_ana_t_floor(fs->s, lb->ids[k], c) : INFINITY;
         tr[0] = (float)bb[0] + c->sx0, tr[1] = (float)bb[1] + c->sy0;
         tr[2] = (float)bb[2] + c->sx0, tr[3] = (float)bb[3] + c->sy0;
-      } else if (lt->ts = lb->ts[j], c->planar) {
+      } else if (c->planar) {
         /* the extreme samples, as the rays compute their coordinates */
         tr[0] = (float)lb->bb[k][0] + c->sx0, tr[1] = (float)lb->bb[k][1] + c->sy0;
         tr[2] = (float)lb->bb[k][2] + c->sx0, tr[3] = (float)lb->bb[k][3] + c->sy0;
         const int *bb = lb->bb[k];
         if ((bb[2] - bb[0] + 1) * (bb[3] - bb[1] + 1) <= PROBE) {
-          t = probe_samples(&lt->ts, c, bb, tr);
+          t = probe_samples(ts, c, bb, tr);
         } else if (bb[0] > 0 || bb[1] > 0 || bb[2] < c->width - 1 || bb[3] < c->height - 1) {
-          t = rr_tri_rect_floor(&lt->ts, c, tr);
+          t = rr_tri_rect_floor(ts, c, tr);
         } else {
           /* A corner rectangle of the whole image (mostly a triangle crossing the
            * eye's plane) would give every ancestor the whole image and a floor near
@@ -235,16 +237,17 @@ static void batch_finish(frame_setups *fs, const leaf_batch *lb) {
            * triangle is tested only where both rectangles meet, with their floor (a NaN
            * bound leaves the corner rectangle as it is). */
           float pr[4];
-          t = rr_tri_bounds(&lt->ts, c, pr);
+          t = rr_tri_bounds(ts, c, pr);
           tr[0] = maxf(pr[0], tr[0]), tr[1] = maxf(pr[1], tr[1]), tr[2] = minf(pr[2], tr[2]), tr[3] = minf(pr[3], tr[3]);
           if (!(tr[0] <= tr[2] && tr[1] <= tr[3])) t = INFINITY;
         }
       } else {
-        t = rr_tri_bounds(&lt->ts, c, tr);
+        t = rr_tri_bounds(ts, c, tr);
       }
-      if (t != INFINITY) fs->slot[i] = base + (uint32_t)nout; /* else no sample can pass */
-      nout++;
-      if (t == INFINITY) continue;
+      if (t == INFINITY) continue; /* no sample can pass */
+      out[nout].id = lb->ids[k];
+      if (ts) out[nout].ts = *ts;
+      fs->slot[i] = base + (uint32_t)nout++;
       tlo = t < tlo ? t : tlo;
       r[0] = minf(r[0], tr[0]), r[1] = minf(r[1], tr[1]), r[2] = maxf(r[2], tr[2]), r[3] = maxf(r[3], tr[3]);
     }
@@ -265,6 +268,7 @@ static void setup_leaves(int job, int thread, void *arg) {
   for (uint32_t w = w0; w < w1; w++) {
     BVH_NODE_ALIGN bvh_wide buf;
     const bvh_wide *n = bvh_wide_at(b, w, &buf);
+    memcpy(fs->wb[w].ref, n->ref, sizeof n->ref), memcpy(fs->wb[w].count, n->count, sizeof n->count);
     for (uint32_t i = 0; i < 4; i++) {
       if (n->ref[i] == UINT32_MAX) {
         wide_bounds *wb = &fs->wb[w];
@@ -279,6 +283,29 @@ static void setup_leaves(int job, int thread, void *arg) {
     }
   }
   batch_setup(fs, &lb, thread), batch_finish(fs, &lb);
+}
+
+/* Fills the inner slots of wide node w from their children, bottom up, and returns
+ * the union of its slots: the least bound and the rectangle x0, y0, x1, y1. At
+ * `depth` 0 the node's subtree is already filled (reach_subtree: the subtrees in
+ * parallel), so only its union is taken; below 0 it never stops. */
+static void wide_union(frame_setups *fs, uint32_t w, int depth, float u[5]) {
+  wide_bounds *wb = &fs->wb[w];
+  if (depth != 0) {
+    const uint32_t *ref = wb->ref, *count = wb->count; /* setup_leaves' or reach_walk's copy */
+    wb->slots = (uint32_t)refs_slots(ref);
+    for (int i = 0; i < 4; i++) {
+      if (count[i] || ref[i] == UINT32_MAX || (fs->reached && !fs->reached[ref[i]])) continue;
+      float c[5];
+      wide_union(fs, ref[i], depth - 1, c);
+      wb->tlo[i] = c[0], wb->x0[i] = c[1], wb->y0[i] = c[2], wb->x1[i] = c[3], wb->y1[i] = c[4];
+    }
+  }
+  u[0] = u[1] = u[2] = INFINITY, u[3] = u[4] = -INFINITY;
+  for (int i = 0; i < 4; i++) {
+    u[0] = minf(u[0], wb->tlo[i]), u[1] = minf(u[1], wb->x0[i]), u[2] = minf(u[2], wb->y0[i]);
+    u[3] = maxf(u[3], wb->x1[i]), u[4] = maxf(u[4], wb->y1[i]);
+  }
 }
 
 /* ---- perspective frames: only the nodes whose box may hold a sample ---------- */
@@ -393,6 +420,7 @@ static void reach_walk(frame_setups *fs, uint32_t w, int depth, bool all, leaf_b
   BVH_NODE_ALIGN bvh_wide buf;
   const bvh_wide *n = all ? bvh_wide_refs_at(fs->b, w, &buf) : bvh_wide_at(fs->b, w, &buf);
   wide_bounds *wb = &fs->wb[w];
+  memcpy(wb->ref, n->ref, sizeof n->ref), memcpy(wb->count, n->count, sizeof n->count);
   int few = 0, reach = all ? 15 : box_reach(fs->cam, n, &few);
   fs->reached[w] = 1;
   for (int i = 0; i < 4; i++) {
@@ -424,36 +452,23 @@ static void reach_subtree(int job, int thread, void *arg) {
   lb.n = lb.nl = 0;
   reach_walk(rj->fs, rj->roots.w[job], -1, false, &lb, thread, NULL);
   batch_setup(rj->fs, &lb, thread), batch_finish(rj->fs, &lb);
+  float u[5];
+  wide_union(rj->fs, rj->roots.w[job], -1, u); /* its leaves are all finished: the unions in parallel too */
 }
 
-/* The top three levels in this thread, the subtrees below them in parallel. */
+enum { REACH_TOP = 3 }; /* levels walked in one thread above the parallel subtrees */
+
+/* The top REACH_TOP levels in this thread, the subtrees below them in parallel
+ * (their walks, setups and unions), then the unions of the top levels. */
 static void reach_frame(frame_setups *fs, int threads) {
   reach_job rj = {.fs = fs};
   leaf_batch lb;
   lb.n = lb.nl = 0;
-  reach_walk(fs, 0, 3, false, &lb, 0, &rj.roots);
+  reach_walk(fs, 0, REACH_TOP, false, &lb, 0, &rj.roots);
   batch_setup(fs, &lb, 0), batch_finish(fs, &lb);
   rr_parallel_for(rj.roots.n, threads, reach_subtree, &rj);
-}
-
-/* Fills the inner slots of wide node w from their children, bottom up, and returns
- * the union of its slots: the least bound and the rectangle x0, y0, x1, y1. */
-static void wide_union(frame_setups *fs, uint32_t w, float u[5]) {
-  uint32_t ref[4], count[4];
-  bvh_wide_refs(fs->b, w, ref, count);
-  wide_bounds *wb = &fs->wb[w];
-  wb->slots = (uint32_t)refs_slots(ref);
-  for (int i = 0; i < 4; i++) {
-    if (count[i] || ref[i] == UINT32_MAX || (fs->reached && !fs->reached[ref[i]])) continue;
-    float c[5];
-    wide_union(fs, ref[i], c);
-    wb->tlo[i] = c[0], wb->x0[i] = c[1], wb->y0[i] = c[2], wb->x1[i] = c[3], wb->y1[i] = c[4];
-  }
-  u[0] = u[1] = u[2] = INFINITY, u[3] = u[4] = -INFINITY;
-  for (int i = 0; i < 4; i++) {
-    u[0] = minf(u[0], wb->tlo[i]), u[1] = minf(u[1], wb->x0[i]), u[2] = minf(u[2], wb->y0[i]);
-    u[3] = maxf(u[3], wb->x1[i]), u[4] = maxf(u[4], wb->y1[i]);
-  }
+  float root[5];
+  wide_union(fs, 0, REACH_TOP, root);
 }
 
 static void setups_free(frame_setups *fs) {
@@ -492,9 +507,9 @@ static rr_error setups_init(rr_device *dev, frame_setups *fs, const render_ctx *
     if (fs->cam->planar)
       rr_parallel_for((int)((ctx->scene->ntris + SEEN_CHUNK - 1) / SEEN_CHUNK), ctx->threads, seen_chunk, fs);
     rr_parallel_for((int)((b->vwide + SETUP_CHUNK - 1) / SETUP_CHUNK), ctx->threads, setup_leaves, fs);
+    float root[5];
+    wide_union(fs, 0, -1, root);
   }
-  float root[5];
-  wide_union(fs, 0, root);
   return RR_OK;
 }
 
@@ -536,6 +551,7 @@ KERNEL int ray_node_planar(void *q, const bvh_wide *w, uint32_t ref, uint64_t la
   rr_vi4 in = (wb->x0 <= x) & (x <= wb->x1) & (wb->y0 <= y) & (y <= wb->y1);
   r->nodes += wb->slots;
   s->order = s->key = wb->tlo;
+  s->ref = wb->ref, s->count = wb->count;
   return rr_vi4_bits(in & (wb->tlo <= rr_vf4_splat(r->t)));
 }
 
@@ -597,7 +613,7 @@ static void rc_bvh_tile(int job, int thread, void *arg) {
         r.w = camera_w(c, x, y);
         vec3 o, d;
         uint64_t e0 = r.evals, n0 = r.nodes;
-        if (c->planar) bvh_trace_nodes(j->b, &r, 1, ray_node_planar, ray_leaf, ray_best, false);
+        if (c->planar) bvh_trace_nodes(j->b, &r, 1, ray_node_planar, ray_leaf, ray_best, false); /* fs.wb alone */
         else if (rr_cam_ray(c, x, y, &o, &d)) { /* else a pixel without a ray: a miss */
           ray_q_init(&r.q, o, d);
           bvh_trace(j->b, &r, 1, ray_node_curved, ray_leaf, ray_best);
@@ -651,6 +667,7 @@ KERNEL int packet_node(void *q, const bvh_wide *w, uint32_t ref, uint64_t lanes,
     hits |= (s->lanes[i] != 0) << i;
   }
   s->order = s->key = wb->tlo;
+  s->ref = wb->ref, s->count = wb->count;
   uint64_t tested = wb->slots;
   p->nodes += tested;
   if (p->heat) {
@@ -695,21 +712,24 @@ static void rc_packet_tile(int job, int thread, void *arg) {
   packet pk = {.fs = &j->fs, .heat = j->ctx->heat_e != NULL}, *p = &pk;
   for (int py = ty0; py < ty0 + TILE && py < vb->height; py += PK)
     for (int px = tx0; px < tx0 + TILE && px < vb->width; px += PK) {
-      p->x0 = px, p->y0 = py, p->valid = 0, p->maxbest = INFINITY;
+      /* the lanes on the image: nx columns by ny rows */
+      int nx = vb->width - px < PK ? vb->width - px : PK, ny = vb->height - py < PK ? vb->height - py : PK;
+      uint64_t row = (1ull << nx) - 1, rows = ny == PK ? ~0ull : (1ull << 8 * ny) - 1;
+      p->x0 = px, p->y0 = py, p->valid = row * 0x0101010101010101ull & rows, p->maxbest = INFINITY;
       float cx[PK], cy[PK];
       for (int k = 0; k < PK; k++) cx[k] = (float)(px + k) + j->ctx->cam->sx0, cy[k] = (float)(py + k) + j->ctx->cam->sy0;
       p->sx[0] = rr_vf4_load(cx), p->sx[1] = rr_vf4_load(cx + 4);
       p->sy[0] = rr_vf4_load(cy), p->sy[1] = rr_vf4_load(cy + 4);
-      for (int k = 0; k < PN; k++) {
+      for (int k = 0; k < PN; k++)
         p->t[k] = INFINITY, p->id[k] = RR_MISS, p->l1[k] = p->l2[k] = 0, p->heat_e[k] = p->heat_n[k] = 0;
-        if (px + (k & 7) < vb->width && py + (k >> 3) < vb->height) p->valid |= 1ull << k;
-      }
-      bvh_trace_nodes(j->b, p, p->valid, packet_node, packet_leaf, packet_best, false); /* rectangles only */
-      for (int k = 0; k < PN; k++) {
-        if (!((p->valid >> k) & 1)) continue;
-        size_t i = (size_t)(py + (k >> 3)) * vb->width + px + (k & 7);
-        vb->id[i] = p->id[k], vb->t[i] = p->t[k], vb->l1[i] = p->l1[k], vb->l2[i] = p->l2[k];
-        if (j->ctx->heat_e) j->ctx->heat_e[i] += p->heat_e[k], j->ctx->heat_n[i] += p->heat_n[k];
+      bvh_trace_nodes(j->b, p, p->valid, packet_node, packet_leaf, packet_best, false); /* fs.wb alone */
+      for (int y = 0; y < ny; y++) { /* a row of the packet: a run of the buffer */
+        size_t i = (size_t)(py + y) * vb->width + px, n = (size_t)nx;
+        memcpy(vb->id + i, p->id + PK * y, n * sizeof *vb->id), memcpy(vb->t + i, p->t + PK * y, n * sizeof *vb->t);
+        memcpy(vb->l1 + i, p->l1 + PK * y, n * sizeof *vb->l1), memcpy(vb->l2 + i, p->l2 + PK * y, n * sizeof *vb->l2);
+        if (j->ctx->heat_e)
+          for (int x = 0; x < nx; x++)
+            j->ctx->heat_e[i + x] += p->heat_e[PK * y + x], j->ctx->heat_n[i + x] += p->heat_n[PK * y + x];
       }
     }
   thread_stats *st = &j->st[thread];
