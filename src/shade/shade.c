@@ -34,8 +34,9 @@ typedef struct hit {
 static vec3 geometric_normal(const rr_scene *s, uint32_t i, float l1, float l2) {
   if (scene_kind(s, i) != RR_GEOMETRY_TRIANGLE) return rr_ana_normal(s, i, l1, l2);
   if (scene_inf(s, i)) return v3_norm(rr_scene_tri_normal(s, i)); /* corners at infinity */
-  vec3 p0 = scene_vertex(s, 0, i);
-  return v3_norm(v3_cross(v3_sub(scene_vertex(s, 1, i), p0), v3_sub(scene_vertex(s, 2, i), p0)));
+  vec3 c[3];
+  scene_corners(s, i, c);
+  return v3_norm(v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0])));
 }
 
 /* The shading inputs of triangle `id` at barycentrics (l1, l2), seen along the ray
@@ -52,10 +53,10 @@ static hit hit_make(const rr_scene *s, uint32_t id, float l1, float l2, float t,
   h.l1 = l1, h.l2 = l2, h.l0 = 1.0f - l1 - l2;
   vec3 n = geometric_normal(s, id, l1, l2);
   if (s->n[0][0] && scene_kind(s, id) == RR_GEOMETRY_TRIANGLE) {
-    vec3 sn = v3(0, 0, 0);
+    vec3 sn = v3(0, 0, 0), c[3];
     float w[3] = {h.l0, h.l1, h.l2};
-    for (int v = 0; v < 3; v++)
-      sn = v3_add(sn, v3_scale(scene_normal(s, v, id), w[v]));
+    scene_normals(s, id, c);
+    for (int v = 0; v < 3; v++) sn = v3_add(sn, v3_scale(c[v], w[v]));
     if (v3_dot(sn, sn) > 1e-12f) {
       sn = v3_norm(sn);
       /* keep interpolated normals on the geometric normal's side */
@@ -386,13 +387,14 @@ static inline bool one_surface(const rr_scene *s, const pixel_samples *px, int n
 }
 
 /* The colour of the group of samples of pixel (x, y) that starts at stored sample i
- * and ends before `last` (those of them that saw its surface): shaded once at the
+ * and ends before `last` (those of them that saw its surface; all: every one of
+ * them, as one_surface found): shaded once at the
  * group's mean barycentrics and ray parameter along sample i's ray (a triangle's),
  * or at sample i's hit (an analytic primitive's); the background on a miss, black
  * where the camera has no ray. Lit, the point is queued in the wave instead and col
  * stays black. Returns the shading invocations (0 or 1). */
-static uint64_t shade_group(shade_pass *p, const pixel_samples *px, int i, int last, int thread, int x, int y,
-                            const float bg[3], float col[3]) {
+static uint64_t shade_group(shade_pass *p, const pixel_samples *px, int i, int last, bool all, int thread, int x,
+                            int y, const float bg[3], float col[3]) {
   const rr_scene *s = p->s;
   uint32_t id = px->id[i];
   vec3 o, d;
@@ -406,8 +408,11 @@ static uint64_t shade_group(shade_pass *p, const pixel_samples *px, int i, int l
   /* An analytic primitive's coordinates are not linear over it (a box's face in
    * l1's integer part, a sphere's u wrapping at its seam): its first sample's hit. */
   int upto = scene_kind(s, id) == RR_GEOMETRY_TRIANGLE ? last : i + 1;
-  for (int m = i; m < upto; m++)
-    if (same_surface(s, px, m, i)) l1 += px->l1[m], l2 += px->l2[m], t += px->t[m], members++;
+  if (all) /* every sample is the group's (one_surface): the same sums, without the tests */
+    for (int m = i; m < upto; m++) l1 += px->l1[m], l2 += px->l2[m], t += px->t[m], members++;
+  else
+    for (int m = i; m < upto; m++)
+      if (same_surface(s, px, m, i)) l1 += px->l1[m], l2 += px->l2[m], t += px->t[m], members++;
   if (!rr_cam_ray(&p->cams[i], x, y, &o, &d)) return 0;
   float inv = 1.0f / (float)members;
   hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, o, d, &p->cams[i], x, y);
@@ -444,7 +449,7 @@ static uint64_t shade_pixel(shade_pass *p, sample_run *r, const pixel_samples *p
     if (done[i]) continue;
     int last = grouped ? n : i + 1;
     float col[3];
-    shades += shade_group(p, px, i, last, thread, x, y, bg, col);
+    shades += shade_group(p, px, i, last, false, thread, x, y, bg, col);
     for (int m = i; m < (last < K ? last : K); m++)
       if (same_surface(s, px, m, i)) {
         memcpy(&r->rgb[m][3 * j], col, sizeof col); /* (queued: 0 until the wave is shaded) */
@@ -525,8 +530,10 @@ static void shade_run(shade_pass *p, sample_run *r, int thread, int y, int x0, i
     r->one[j] = p->out && (n == 1 || (grouped && one_surface(p->s, &px, n)));
     if (r->one[j]) {
       float col[3];
-      shades += shade_group(p, &px, 0, n, thread, x, y, bg, col);
-      resolve_one(col, !p->has_alpha || px.id[0] < p->s->ntris, ch, p->out + ch * ((size_t)y * p->vb->width + x));
+      const bool hit = px.id[0] < p->s->ntris;
+      if (!hit && p->cams[0].planar) memcpy(col, bg, sizeof col); /* shade_group's miss, inline */
+      else shades += shade_group(p, &px, 0, n, true, thread, x, y, bg, col);
+      resolve_one(col, hit || !p->has_alpha, ch, p->out + ch * ((size_t)y * p->vb->width + x));
     } else {
       shades += shade_pixel(p, r, &px, thread, j, x, y, bg);
     }
@@ -679,7 +686,9 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
   p->has_alpha = opt->alpha != 0;
   if (!e && own) { /* resolved as shading goes: no per-sample colours */
     int ch = opt->alpha ? 4 : 3;
-    *out = (rr_image){vb->width, vb->height, ch, RR_PIXEL_F32, malloc(sizeof(float) * ch * npix), RR_IMAGE_COLOR};
+    /* in huge pages where the system gives them: the image is written whole, and in
+     * small pages each 4 KiB of it is a fault in the shading loop (3072 at 1024²) */
+    *out = (rr_image){vb->width, vb->height, ch, RR_PIXEL_F32, rr_alloc_large(sizeof(float) * ch * npix), RR_IMAGE_COLOR};
     if (!(p->out = out->data)) e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d image", vb->width, vb->height);
   } else if (!e) {
     p->rgb = rr_alloc_large(nsamp * 3 * sizeof(float));
