@@ -378,8 +378,16 @@ static inline bool same_surface(const rr_scene *s, const pixel_samples *px, int 
 
 /* Whether all n samples of a pixel saw one surface (most pixels under msaa, csaa). */
 static inline bool one_surface(const rr_scene *s, const pixel_samples *px, int n) {
+  typedef uint32_t v4u __attribute__((vector_size(16)));
+  const uint32_t id0 = px->id[0];
   uint32_t diff = 0;
-  for (int m = 1; m < n; m++) diff |= px->id[m] ^ px->id[0]; /* no branch a sample: vectorised */
+  int m = 1;
+  if (n >= 4) { /* four ids a step (n is 4, 8 or 16) */
+    v4u acc = {0, 0, 0, 0}, v;
+    for (m = 0; m < n; m += 4) memcpy(&v, px->id + m, sizeof v), acc |= v ^ id0;
+    diff = acc[0] | acc[1] | acc[2] | acc[3];
+  }
+  for (; m < n; m++) diff |= px->id[m] ^ id0;
   if (diff) return false;
   for (int m = 1; m < n && s->kind && px->id[0] < s->ntris; m++)
     if (!same_surface(s, px, m, 0)) return false;
