@@ -1,6 +1,7 @@
 /* The resolve stage and the outputs of several samples per pixel: every filter keeps
  * a constant image constant (border included, with per-sample weights), the box of
- * one sample is the identity, the wide filters spread a bright sample into the
+ * one sample is the identity, and so is that of samples of one colour (resolve_one),
+ * the wide filters spread a bright sample into the
  * neighbours, alpha is the coverage with the colour straight; the per-sample AOVs
  * are the frame's layers (checked against one-sample frames at each position), the
  * per-pixel AOVs follow their rules, the resolved colour is the mean of the
@@ -79,6 +80,36 @@ static void test_box_identity(void) {
           (double)pattern[s][0], (double)pattern[s][1]);
     rr_image_free(&img);
   }
+}
+
+/* A pixel whose samples share one colour (shading's shortcut, resolve_one) resolves to
+ * resolve_own's bits: every count of samples, csaa's whole weights (coverage samples
+ * at 0), alpha or none, hit or miss, and colours of every kind (0, -0, negative,
+ * tiny, subnormal, huge, infinite, NaN). */
+static void test_one_colour(void) {
+  const float values[] = {0.0f, -0.0f, 0.5f, 0.1f, 1.0f / 3, -0.25f, 1e-30f, 1e-45f, 3e38f, 0.99999994f,
+                          INFINITY, -INFINITY, NAN};
+  const int nv = sizeof values / sizeof *values;
+  int bad = 0, cases = 0;
+  for (int n = 1; n <= 16; n *= 2)
+    for (int csaa = 0; csaa < 2; csaa++)
+      for (int channels = 3; channels <= 4; channels++)
+        for (int hit = 0; hit < 2; hit++)
+          for (int v = 0; v < nv; v++) {
+            float rgb[16][3], w[16], a[16], own[4] = {0}, one[4] = {0};
+            for (int k = 0; k < n; k++) {
+              /* csaa: the first quarter stored, weighing 1 + their votes; the rest weigh 0
+               * and carry black, as shading leaves them */
+              int stored = n / 4 > 0 ? n / 4 : 1;
+              w[k] = !csaa ? 1.0f : k < stored ? 1.0f + (float)((n - stored) / stored) : 0.0f;
+              for (int c = 0; c < 3; c++) rgb[k][c] = w[k] > 0 ? values[(v + c) % nv] : 0.0f;
+              a[k] = channels == 4 && !hit ? 0.0f : 1.0f;
+            }
+            resolve_own(n, rgb[0], 3, csaa ? w : NULL, channels == 4 ? a : NULL, 1, channels, own);
+            resolve_one(rgb[0], channels == 3 || hit, channels, one);
+            bad += memcmp(own, one, sizeof own) != 0, cases++;
+          }
+  CHECK(bad == 0, "resolve_one differs from resolve_own in %d of %d cases", bad, cases);
 }
 
 /* One bright sample: the box keeps it in its pixel, the wide filters spread it to
@@ -341,6 +372,7 @@ int main(void) {
   if (!(dev = rr_device_new())) return 1;
   test_constant();
   test_box_identity();
+  test_one_colour();
   test_spread();
   test_alpha();
   test_frame_outputs();

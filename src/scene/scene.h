@@ -241,6 +241,15 @@ static inline vec3 scene_normal(const rr_scene *s, int k, uint32_t i) {
   vec3 n = v3(s->n[k][0][j], s->n[k][1][j], s->n[k][2][j]);
   return in == RR_MISS || s->inst->shift[in] ? n : inst_dir(s->inst->nxf[in], n);
 }
+/* The three corners' shading normals of triangle i, as scene_normal gives each (one
+ * look-up for the three). */
+static inline void scene_normals(const rr_scene *s, uint32_t i, vec3 n[3]) {
+  uint32_t in, j = scene_locate(s, i, &in);
+  for (int k = 0; k < 3; k++) {
+    n[k] = v3(s->n[k][0][j], s->n[k][1][j], s->n[k][2][j]);
+    if (in != RR_MISS && !s->inst->shift[in]) n[k] = inst_dir(s->inst->nxf[in], n[k]);
+  }
+}
 /* The (unnormalised) normal of triangle i's plane, for finite and infinite corners. */
 vec3 rr_scene_tri_normal(const rr_scene *s, uint32_t i);
 

@@ -189,7 +189,7 @@ rr_error rr_resolve_image(rr_device *dev, const resolve_input *in, const rr_shad
   int channels = in->alpha ? 4 : 3;
   out->width = in->width, out->height = in->height, out->channels = channels;
   out->type = RR_PIXEL_F32, out->kind = RR_IMAGE_COLOR;
-  out->data = taps ? malloc(sizeof(float) * channels * in->width * in->height) : NULL;
+  out->data = taps ? rr_alloc_large(sizeof(float) * channels * in->width * in->height) : NULL; /* (shade.c: faults) */
   if (!out->data) {
     free(taps);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory resolving a %dx%d image", in->width, in->height);

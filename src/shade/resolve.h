@@ -58,4 +58,13 @@ static inline void resolve_own(int n, const float *rgb, size_t rgb_step, const f
   resolve_finish(sum, o, channels);
 }
 
+/* The box of a pixel whose samples all have colour rgb and alpha `hit` (1 or 0; 1
+ * without an alpha channel), whatever their weights: resolve_own's bits. Its sums
+ * are then whole multiples (at most 16) of one colour and one alpha, exact in
+ * double, so their quotient is the colour itself, clamped at 0 (NaN to 0). */
+static inline void resolve_one(const float rgb[3], bool hit, int channels, float *o) {
+  for (int c = 0; c < 3; c++) o[c] = hit && rgb[c] > 0 ? rgb[c] : 0.0f;
+  if (channels == 4) o[3] = hit ? 1.0f : 0.0f;
+}
+
 #endif

@@ -34,8 +34,9 @@ typedef struct hit {
 static vec3 geometric_normal(const rr_scene *s, uint32_t i, float l1, float l2) {
   if (scene_kind(s, i) != RR_GEOMETRY_TRIANGLE) return rr_ana_normal(s, i, l1, l2);
   if (scene_inf(s, i)) return v3_norm(rr_scene_tri_normal(s, i)); /* corners at infinity */
-  vec3 p0 = scene_vertex(s, 0, i);
-  return v3_norm(v3_cross(v3_sub(scene_vertex(s, 1, i), p0), v3_sub(scene_vertex(s, 2, i), p0)));
+  vec3 c[3];
+  scene_corners(s, i, c);
+  return v3_norm(v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0])));
 }
 
 /* The shading inputs of triangle `id` at barycentrics (l1, l2), seen along the ray
@@ -52,10 +53,10 @@ static hit hit_make(const rr_scene *s, uint32_t id, float l1, float l2, float t,
   h.l1 = l1, h.l2 = l2, h.l0 = 1.0f - l1 - l2;
   vec3 n = geometric_normal(s, id, l1, l2);
   if (s->n[0][0] && scene_kind(s, id) == RR_GEOMETRY_TRIANGLE) {
-    vec3 sn = v3(0, 0, 0);
+    vec3 sn = v3(0, 0, 0), c[3];
     float w[3] = {h.l0, h.l1, h.l2};
-    for (int v = 0; v < 3; v++)
-      sn = v3_add(sn, v3_scale(scene_normal(s, v, id), w[v]));
+    scene_normals(s, id, c);
+    for (int v = 0; v < 3; v++) sn = v3_add(sn, v3_scale(c[v], w[v]));
     if (v3_dot(sn, sn) > 1e-12f) {
       sn = v3_norm(sn);
       /* keep interpolated normals on the geometric normal's side */
@@ -347,74 +348,118 @@ static void background(int y, int height, float o[3]) {
   o[0] = srgb_decode(g * 0.9f), o[1] = srgb_decode(g), o[2] = srgb_decode(g * 1.15f);
 }
 
-/* A run of pixels of one row, each sample's row of them apart (the buffer keeps a
- * pixel's samples side by side; shading reads a sample's row). */
+/* The samples of one pixel, side by side in the visibility buffer (vis.h). */
+typedef struct pixel_samples {
+  const uint32_t *id;
+  const float *l1, *l2, *t;
+} pixel_samples;
+
+static inline pixel_samples pixel_at(const visbuf *vb, int x, int y) {
+  const size_t e = ((size_t)y * vb->width + x) * vb->ns;
+  return (pixel_samples){vb->id + e, vb->l1 + e, vb->l2 + e, vb->t + e};
+}
+
+/* A run of pixels of one row: the colours of their samples, each sample's row of
+ * them apart (as the resolve and the lit wave take them). */
 enum { RUN = 64 };
 typedef struct sample_run {
-  uint32_t id[RR_MAX_SAMPLES][RUN];
-  float l1[RR_MAX_SAMPLES][RUN], l2[RR_MAX_SAMPLES][RUN], t[RR_MAX_SAMPLES][RUN];
   float rgb[RR_MAX_SAMPLES][3 * RUN], w[RR_MAX_SAMPLES][RUN], a[RR_MAX_SAMPLES][RUN];
   signed char lead[RR_MAX_SAMPLES][RUN]; /* lit: the sample whose colour this one shares */
+  bool one[RUN]; /* the pixel is in the image already: one colour for all its samples */
 } sample_run;
 
-/* Whether samples a and b of run entry j saw the same surface: the same primitive,
- * and of a box the same face (l1's integer part), so msaa shades each face it covers. */
-static inline bool same_surface(const rr_scene *s, const sample_run *r, int a, int b, int j) {
-  uint32_t id = r->id[a][j];
-  if (r->id[b][j] != id) return false;
-  return id >= s->ntris || scene_kind(s, id) != RR_GEOMETRY_BOX || (int)r->l1[a][j] == (int)r->l1[b][j];
+/* Whether samples a and b of a pixel saw the same surface: the same primitive, and
+ * of a box the same face (l1's integer part), so msaa shades each face it covers. */
+static inline bool same_surface(const rr_scene *s, const pixel_samples *px, int a, int b) {
+  uint32_t id = px->id[a];
+  if (px->id[b] != id) return false;
+  return id >= s->ntris || scene_kind(s, id) != RR_GEOMETRY_BOX || (int)px->l1[a] == (int)px->l1[b];
+}
+
+/* Whether all n samples of a pixel saw one surface (most pixels under msaa, csaa). */
+static inline bool one_surface(const rr_scene *s, const pixel_samples *px, int n) {
+  typedef uint32_t v4u __attribute__((vector_size(16)));
+  const uint32_t id0 = px->id[0];
+  uint32_t diff = 0;
+  int m = 1;
+  if (n >= 4) { /* four ids a step (n is 4, 8 or 16) */
+    v4u acc = {0, 0, 0, 0}, v;
+    for (m = 0; m < n; m += 4) memcpy(&v, px->id + m, sizeof v), acc |= v ^ id0;
+    diff = acc[0] | acc[1] | acc[2] | acc[3];
+  }
+  for (; m < n; m++) diff |= px->id[m] ^ id0;
+  if (diff) return false;
+  for (int m = 1; m < n && s->kind && px->id[0] < s->ntris; m++)
+    if (!same_surface(s, px, m, 0)) return false;
+  return true;
+}
+
+/* The colour of the group of samples of pixel (x, y) that starts at stored sample i
+ * and ends before `last` (those of them that saw its surface; all: every one of
+ * them, as one_surface found): shaded once at the
+ * group's mean barycentrics and ray parameter along sample i's ray (a triangle's),
+ * or at sample i's hit (an analytic primitive's); the background on a miss, black
+ * where the camera has no ray. Lit, the point is queued in the wave instead and col
+ * stays black. Returns the shading invocations (0 or 1). */
+static uint64_t shade_group(shade_pass *p, const pixel_samples *px, int i, int last, bool all, int thread, int x,
+                            int y, const float bg[3], float col[3]) {
+  const rr_scene *s = p->s;
+  uint32_t id = px->id[i];
+  vec3 o, d;
+  col[0] = col[1] = col[2] = 0;
+  if (id >= s->ntris) {
+    if (p->cams[i].planar || rr_cam_ray(&p->cams[i], x, y, &o, &d)) memcpy(col, bg, 3 * sizeof *col);
+    return 0;
+  }
+  float l1 = 0, l2 = 0, t = 0;
+  int members = 0;
+  /* An analytic primitive's coordinates are not linear over it (a box's face in
+   * l1's integer part, a sphere's u wrapping at its seam): its first sample's hit. */
+  int upto = scene_kind(s, id) == RR_GEOMETRY_TRIANGLE ? last : i + 1;
+  if (all) /* every sample is the group's (one_surface): the same sums, without the tests */
+    for (int m = i; m < upto; m++) l1 += px->l1[m], l2 += px->l2[m], t += px->t[m], members++;
+  else
+    for (int m = i; m < upto; m++)
+      if (same_surface(s, px, m, i)) l1 += px->l1[m], l2 += px->l2[m], t += px->t[m], members++;
+  if (!rr_cam_ray(&p->cams[i], x, y, &o, &d)) return 0;
+  float inv = 1.0f / (float)members;
+  hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, o, d, &p->cams[i], x, y);
+  h.footprint = p->footprint;
+  if (p->lit) { /* shaded with the wave's other points; the colour arrives in the wave's arrays */
+    surface sf;
+    hit_surface(s, &h, &p->tex, &sf);
+    size_t q = (size_t)(y - p->y0) * p->vb->width + x;
+    /* the lit AOVs: the point of the centre sample (of its group in msaa, csaa) */
+    bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
+    bool centre = grouped ? same_surface(s, px, p->centre, i) : i == p->centre;
+    size_t pix = (size_t)y * p->vb->width + x;
+    float *parts = p->parts && centre ? p->parts + LIT_PARTS * pix : NULL;
+    float *vis = p->vis && centre ? p->vis + (size_t)p->lights.nlights * pix : NULL;
+    if (!rr_lit_wave_add(p->wave, thread, &sf, p->wave_rgb + 3 * (i * p->wave_pix + q), parts, vis))
+      p->failed = true;
+  } else {
+    shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
+  }
+  return 1;
 }
 
 /* Shades pixel (x, y), run entry j: see rr_aa_mode for what each mode does. */
-static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int x, int y, const float bg[3]) {
+static uint64_t shade_pixel(shade_pass *p, sample_run *r, const pixel_samples *px, int thread, int j, int x, int y,
+                            const float bg[3]) {
   const rr_scene *s = p->s;
   int n = p->samples, K = p->stored;
   bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
   bool done[RR_MAX_SAMPLES] = {false};
   uint64_t shades = 0;
   /* Each stored sample not yet coloured starts a group: the samples that saw its
-   * primitive. ssaa and none: every sample its own group. msaa, csaa: shaded once,
-   * at the group's mean barycentrics and ray parameter along its first sample's ray
-   * (a triangle's), or at its first sample's hit (an analytic primitive's). */
+   * primitive. ssaa and none: every sample its own group. msaa, csaa: shade_group. */
   for (int i = 0; i < K; i++) {
     if (done[i]) continue;
-    uint32_t id = r->id[i][j];
     int last = grouped ? n : i + 1;
-    float col[3] = {0, 0, 0};
-    vec3 o, d;
-    if (id < s->ntris) {
-      float l1 = 0, l2 = 0, t = 0;
-      int members = 0;
-      /* An analytic primitive's coordinates are not linear over it (a box's face in
-       * l1's integer part, a sphere's u wrapping at its seam): its first sample's hit. */
-      int upto = scene_kind(s, id) == RR_GEOMETRY_TRIANGLE ? last : i + 1;
-      for (int m = i; m < upto; m++)
-        if (same_surface(s, r, m, i, j)) l1 += r->l1[m][j], l2 += r->l2[m][j], t += r->t[m][j], members++;
-      if (rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
-        float inv = 1.0f / (float)members;
-        hit h = hit_make(s, id, l1 * inv, l2 * inv, t * inv, o, d, &p->cams[i], x, y);
-        h.footprint = p->footprint;
-        if (p->lit) { /* shaded with the wave's other points; the colour arrives in the wave's arrays */
-          surface sf;
-          hit_surface(s, &h, &p->tex, &sf);
-          size_t q = (size_t)(y - p->y0) * p->vb->width + x;
-          /* the lit AOVs: the point of the centre sample (of its group in msaa, csaa) */
-          bool centre = grouped ? same_surface(s, r, p->centre, i, j) : i == p->centre;
-          size_t pix = (size_t)y * p->vb->width + x;
-          float *parts = p->parts && centre ? p->parts + LIT_PARTS * pix : NULL;
-          float *vis = p->vis && centre ? p->vis + (size_t)p->lights.nlights * pix : NULL;
-          if (!rr_lit_wave_add(p->wave, thread, &sf, p->wave_rgb + 3 * (i * p->wave_pix + q), parts, vis))
-            p->failed = true;
-        } else {
-          shade_hit(s, &h, p->mode, &p->tex, p->dmin, p->dmax, col);
-        }
-        shades++;
-      }
-    } else if (p->cams[i].planar || rr_cam_ray(&p->cams[i], x, y, &o, &d)) {
-      memcpy(col, bg, sizeof col);
-    }
+    float col[3];
+    shades += shade_group(p, px, i, last, false, thread, x, y, bg, col);
     for (int m = i; m < (last < K ? last : K); m++)
-      if (same_surface(s, r, m, i, j)) {
+      if (same_surface(s, px, m, i)) {
         memcpy(&r->rgb[m][3 * j], col, sizeof col); /* (queued: 0 until the wave is shaded) */
         done[m] = true, r->w[m][j] = 1.0f, r->lead[m][j] = (signed char)i;
       }
@@ -423,7 +468,7 @@ static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int
    * its own colour counts for nothing */
   for (int c = K; c < n; c++) {
     for (int v = 0; v < K; v++)
-      if (same_surface(s, r, p->nearest[c][v], c, j)) {
+      if (same_surface(s, px, p->nearest[c][v], c)) {
         r->w[p->nearest[c][v]][j] += 1.0f;
         break;
       }
@@ -433,31 +478,23 @@ static uint64_t shade_pixel(shade_pass *p, sample_run *r, int thread, int j, int
   return shades;
 }
 
-/* The run of pixels x0 .. x0 + len - 1 of row y, from the visibility buffer. */
-static void run_load(const shade_pass *p, sample_run *r, int y, int x0, int len) {
-  const visbuf *vb = p->vb;
-  const int n = p->samples;
-  const size_t e0 = ((size_t)y * vb->width + x0) * n;
-  for (int j = 0; j < len; j++)
-    for (int i = 0; i < n; i++) {
-      const size_t e = e0 + (size_t)j * n + i;
-      r->id[i][j] = vb->id[e], r->l1[i][j] = vb->l1[e], r->l2[i][j] = vb->l2[e], r->t[i][j] = vb->t[e];
-    }
-}
-
-/* The run's coloured samples: resolved into the image (the box of each pixel's own
- * samples), or kept for the resolve. */
+/* The run's coloured samples, but for the pixels already in the image (r->one):
+ * resolved into the image (the box of each pixel's own samples), or kept for the
+ * resolve. */
 static void run_store(shade_pass *p, sample_run *r, int y, int x0, int len) {
   const visbuf *vb = p->vb;
   size_t npix = (size_t)vb->width * vb->height, k0 = (size_t)y * vb->width + x0;
   int n = p->samples;
-  for (int i = 0; p->has_alpha && i < n; i++)
-    for (int j = 0; j < len; j++) r->a[i][j] = r->id[i][j] < p->s->ntris ? 1.0f : 0.0f;
+  for (int j = 0; p->has_alpha && j < len; j++) {
+    const uint32_t *id = pixel_at(vb, x0 + j, y).id;
+    for (int i = 0; i < n; i++) r->a[i][j] = id[i] < p->s->ntris ? 1.0f : 0.0f;
+  }
   const float *w = p->aa == RR_AA_CSAA ? r->w[0] : NULL, *a = p->has_alpha ? r->a[0] : NULL;
   if (p->out) {
     int ch = p->has_alpha ? 4 : 3;
     for (int j = 0; j < len; j++)
-      resolve_own(n, &r->rgb[0][3 * j], 3 * RUN, w ? w + j : NULL, a ? a + j : NULL, RUN, ch, p->out + ch * (k0 + j));
+      if (!r->one[j])
+        resolve_own(n, &r->rgb[0][3 * j], 3 * RUN, w ? w + j : NULL, a ? a + j : NULL, RUN, ch, p->out + ch * (k0 + j));
     return;
   }
   for (int i = 0; i < n; i++) {
@@ -486,12 +523,30 @@ static void rows_by_runs(shade_pass *p, int y0, int end, int job, int thread, ru
   free(r);
 }
 
-/* The modes other than lit: each run shaded and stored. */
+/* The modes other than lit: each run shaded and stored. A pixel whose samples all
+ * share one colour (one sample; msaa and csaa where one surface covers the pixel)
+ * goes straight into the image under the box, as its resolve would give it. */
 static void shade_run(shade_pass *p, sample_run *r, int thread, int y, int x0, int len) {
   float bg[3];
   row_background(p, y, bg);
-  run_load(p, r, y, x0, len);
-  for (int j = 0; j < len; j++) p->shades[thread] += shade_pixel(p, r, thread, j, x0 + j, y, bg);
+  const int n = p->samples, ch = p->has_alpha ? 4 : 3;
+  const bool grouped = p->aa == RR_AA_MSAA || p->aa == RR_AA_CSAA;
+  uint64_t shades = 0;
+  for (int j = 0; j < len; j++) {
+    const int x = x0 + j;
+    const pixel_samples px = pixel_at(p->vb, x, y);
+    r->one[j] = p->out && (n == 1 || (grouped && one_surface(p->s, &px, n)));
+    if (r->one[j]) {
+      float col[3];
+      const bool hit = px.id[0] < p->s->ntris;
+      if (!hit && p->cams[0].planar) memcpy(col, bg, sizeof col); /* shade_group's miss, inline */
+      else shades += shade_group(p, &px, 0, n, true, thread, x, y, bg, col);
+      resolve_one(col, hit || !p->has_alpha, ch, p->out + ch * ((size_t)y * p->vb->width + x));
+    } else {
+      shades += shade_pixel(p, r, &px, thread, j, x, y, bg);
+    }
+  }
+  p->shades[thread] += shades;
   run_store(p, r, y, x0, len);
 }
 static void shade_rows(int job, int thread, void *arg) {
@@ -503,8 +558,10 @@ static void shade_rows(int job, int thread, void *arg) {
 static void lit_gather_run(shade_pass *p, sample_run *r, int thread, int y, int x0, int len) {
   float bg[3];
   row_background(p, y, bg);
-  run_load(p, r, y, x0, len);
-  for (int j = 0; j < len; j++) p->shades[thread] += shade_pixel(p, r, thread, j, x0 + j, y, bg);
+  for (int j = 0; j < len; j++) {
+    const pixel_samples px = pixel_at(p->vb, x0 + j, y);
+    p->shades[thread] += shade_pixel(p, r, &px, thread, j, x0 + j, y, bg);
+  }
   size_t q0 = (size_t)(y - p->y0) * p->vb->width + x0;
   for (int i = 0; i < p->samples; i++) {
     size_t e = i * p->wave_pix + q0;
@@ -521,7 +578,7 @@ static void lit_gather_rows(int job, int thread, void *arg) {
 /* Lit, last: the shaded colours given to the samples that share them, then stored. */
 static void lit_finish_run(shade_pass *p, sample_run *r, int thread, int y, int x0, int len) {
   (void)thread;
-  if (p->has_alpha) run_load(p, r, y, x0, len); /* the ids give alpha */
+  memset(r->one, 0, sizeof r->one);
   size_t q0 = (size_t)(y - p->y0) * p->vb->width + x0;
   for (int i = 0; i < p->samples; i++) {
     size_t e = i * p->wave_pix + q0;
@@ -637,7 +694,9 @@ static rr_error shade_samples(rr_device *dev, const rr_scene *s, const camera *c
   p->has_alpha = opt->alpha != 0;
   if (!e && own) { /* resolved as shading goes: no per-sample colours */
     int ch = opt->alpha ? 4 : 3;
-    *out = (rr_image){vb->width, vb->height, ch, RR_PIXEL_F32, malloc(sizeof(float) * ch * npix), RR_IMAGE_COLOR};
+    /* in huge pages where the system gives them: the image is written whole, and in
+     * small pages each 4 KiB of it is a fault in the shading loop (3072 at 1024²) */
+    *out = (rr_image){vb->width, vb->height, ch, RR_PIXEL_F32, rr_alloc_large(sizeof(float) * ch * npix), RR_IMAGE_COLOR};
     if (!(p->out = out->data)) e = rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a %dx%d image", vb->width, vb->height);
   } else if (!e) {
     p->rgb = rr_alloc_large(nsamp * 3 * sizeof(float));
