@@ -10,7 +10,9 @@
  * WxH METHOD", "cube METHOD" and "cube face K METHOD", which repeat from run to
  * run where times on a shared machine do not.
  *
- *   bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [SCENE EYE TARGET] */
+ * --cube runs the cube map's table alone.
+ *
+ *   bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [--cube] [SCENE EYE TARGET] */
 #include "benchutil.h"
 
 #include <math.h>
@@ -60,9 +62,48 @@ static double row(const bench *b, const rr_camera *cam, int w, int h, double ms[
   return best;
 }
 
+/* Every camera beside a perspective camera of the same view and pixel count. */
+static void cameras_table(const bench *b, const float eye[3], const float target[3], int size) {
+  printf("Each camera beside a perspective camera (fov 70°) of the same view and pixel count; ms, and the fastest\n"
+         "3D method against rc-bvh on the same camera and against the fastest 3D method on the perspective one.\n\n");
+  printf("| camera | size | rc-bvh ms | 3dr-bb ms | 3dr-bin ms | 3dr-full ms | fastest 3D / rc-bvh | fastest 3D / "
+         "perspective's | S (3dr-bb) | empty bins 3dr-bin, 3dr-full |\n");
+  printf("|---|---|---|---|---|---|---|---|---|---|\n");
+  /* the perspective view at each size a camera uses: square, 2:1 (lat-long), 4:3 (cube) */
+  int sizes[3][2] = {{size, size}, {size, size / 2}, {size, size / 4 * 3}};
+  double persp_best[3];
+  for (int k = 0; k < 3; k++) {
+    rr_camera cam;
+    rr_camera_init(&cam);
+    memcpy(cam.eye, eye, 3 * sizeof *eye), memcpy(cam.target, target, 3 * sizeof *target);
+    cam.fov_deg = 70;
+    double ms[NM];
+    rr_stats st[NM];
+    persp_best[k] = row(b, &cam, sizes[k][0], sizes[k][1], ms, st);
+    printf("| perspective | %dx%d | %.1f | %.1f | %.1f | %.1f | %.2f× | 1 | %llu | %.1f%%, %.1f%% |\n", sizes[k][0],
+           sizes[k][1], ms[0], ms[1], ms[2], ms[3], persp_best[k] / ms[0], (unsigned long long)st[1].setups,
+           share(&st[2]), share(&st[3]));
+  }
+  for (int type = 0; type < RR_CAMERA_COUNT; type++) {
+    if (type == RR_CAMERA_PERSPECTIVE) continue;
+    rr_camera cam;
+    rr_camera_init(&cam);
+    cam.type = (rr_camera_type)type;
+    memcpy(cam.eye, eye, 3 * sizeof *eye), memcpy(cam.target, target, 3 * sizeof *target);
+    cam.fov_deg = type == RR_CAMERA_FISHEYE ? 180 : 70;
+    int k = type == RR_CAMERA_LATLONG ? 1 : type == RR_CAMERA_CUBE ? 2 : 0;
+    double ms[NM];
+    rr_stats st[NM];
+    double best = row(b, &cam, sizes[k][0], sizes[k][1], ms, st);
+    printf("| %s | %dx%d | %.1f | %.1f | %.1f | %.1f | %.2f× | %.2f× | %llu | %.1f%%, %.1f%% |\n", rr_camera_name(type),
+           sizes[k][0], sizes[k][1], ms[0], ms[1], ms[2], ms[3], best / ms[0], best / persp_best[k],
+           (unsigned long long)st[1].setups, share(&st[2]), share(&st[3]));
+  }
+}
+
 int main(int argc, char **argv) {
   int threads = 1, reps = 5, size = 512;
-  bool count = false;
+  bool count = false, cube_only = false;
   const char *scene = "grid:teapot.obj:7";
   float eye[3] = {20.6f, 2.4f, 13.2f}, target[3] = {30, 1.2f, 20};
   int pos = 0;
@@ -75,6 +116,8 @@ int main(int argc, char **argv) {
       if (!bench_arg_int("bench_cameras", "--size", argv[++i], 48, 8192, &size)) return 2;
     } else if (strcmp(argv[i], "--instructions") == 0) {
       count = true;
+    } else if (strcmp(argv[i], "--cube") == 0) {
+      cube_only = true;
     } else if (pos == 0 && argv[i][0] != '-') {
       scene = argv[i], pos++;
     } else if (pos == 1 && parse3(argv[i], eye)) {
@@ -82,7 +125,8 @@ int main(int argc, char **argv) {
     } else if (pos == 2 && parse3(argv[i], target)) {
       pos++;
     } else {
-      fprintf(stderr, "usage: bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [SCENE EYE TARGET]\n");
+      fprintf(stderr, "usage: bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [--cube] "
+                      "[SCENE EYE TARGET]\n");
       return 2;
     }
   }
@@ -94,41 +138,7 @@ int main(int argc, char **argv) {
   bench b = {dev, s, threads, reps, count};
   printf("%s, %llu triangles, eye (%g,%g,%g), target (%g,%g,%g), %d thread(s), median of %d\n\n", scene,
          (unsigned long long)in.triangles, eye[0], eye[1], eye[2], target[0], target[1], target[2], threads, reps);
-  printf("Each camera beside a perspective camera (fov 70°) of the same view and pixel count; ms, and the fastest\n"
-         "3D method against rc-bvh on the same camera and against the fastest 3D method on the perspective one.\n\n");
-  printf("| camera | size | rc-bvh ms | 3dr-bb ms | 3dr-bin ms | 3dr-full ms | fastest 3D / rc-bvh | fastest 3D / "
-         "perspective's | S (3dr-bb) | empty bins 3dr-bin, 3dr-full |\n");
-  printf("|---|---|---|---|---|---|---|---|---|---|\n");
-  /* the perspective view at each size a camera uses: square, 2:1 (lat-long), 4:3 (cube) */
-  int sizes[3][2] = {{size, size}, {size, size / 2}, {size, size / 4 * 3}};
-  double persp_best[3];
-  for (int k = 0; k < 3; k++) {
-    rr_camera cam;
-    rr_camera_init(&cam);
-    memcpy(cam.eye, eye, sizeof eye), memcpy(cam.target, target, sizeof target);
-    cam.fov_deg = 70;
-    double ms[NM];
-    rr_stats st[NM];
-    persp_best[k] = row(&b, &cam, sizes[k][0], sizes[k][1], ms, st);
-    printf("| perspective | %dx%d | %.1f | %.1f | %.1f | %.1f | %.2f× | 1 | %llu | %.1f%%, %.1f%% |\n", sizes[k][0],
-           sizes[k][1], ms[0], ms[1], ms[2], ms[3], persp_best[k] / ms[0], (unsigned long long)st[1].setups,
-           share(&st[2]), share(&st[3]));
-  }
-  for (int type = 0; type < RR_CAMERA_COUNT; type++) {
-    if (type == RR_CAMERA_PERSPECTIVE) continue;
-    rr_camera cam;
-    rr_camera_init(&cam);
-    cam.type = (rr_camera_type)type;
-    memcpy(cam.eye, eye, sizeof eye), memcpy(cam.target, target, sizeof target);
-    cam.fov_deg = type == RR_CAMERA_FISHEYE ? 180 : 70;
-    int k = type == RR_CAMERA_LATLONG ? 1 : type == RR_CAMERA_CUBE ? 2 : 0;
-    double ms[NM];
-    rr_stats st[NM];
-    double best = row(&b, &cam, sizes[k][0], sizes[k][1], ms, st);
-    printf("| %s | %dx%d | %.1f | %.1f | %.1f | %.1f | %.2f× | %.2f× | %llu | %.1f%%, %.1f%% |\n", rr_camera_name(type),
-           sizes[k][0], sizes[k][1], ms[0], ms[1], ms[2], ms[3], best / ms[0], best / persp_best[k],
-           (unsigned long long)st[1].setups, share(&st[2]), share(&st[3]));
-  }
+  if (!cube_only) cameras_table(&b, eye, target, size);
 
   /* Cube map: one render of the cross against six 90° perspective renders of the
    * faces, from the cube's own basis. */
