@@ -261,7 +261,8 @@ static void check_shared_setup(rr_device *dev) {
     idx[k] = (uint32_t)k;
   }
   for (int i = 0; i < 3; i++) /* two translations and a turn about z */
-    for (int a = 0; a < 12; a++) xf[i][a] = a % 5 == 0 ? 1.0f : a == 3 ? 0.5f * (float)i : a == 7 ? -0.25f * (float)i : 0;
+    for (int a = 0; a < 12; a++)
+      xf[i][a] = a % 5 == 0 ? 1.0f : a == 3 ? 0.5f * (float)i : a == 7 ? -0.25f * (float)i : 0;
   xf[2][0] = xf[2][5] = 0.8f, xf[2][1] = -0.6f, xf[2][4] = 0.6f;
   long compared = 0, bad = 0;
   for (int sc = 0; sc < 2; sc++) {

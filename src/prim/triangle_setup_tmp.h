@@ -258,11 +258,10 @@ TARGET static void RR_CAT(setup_one, W)(const rr_scene *s, const uint32_t *ids, 
  * stored by field (rec), then, for each camera, the triangles it asks for gathered
  * W to a step and set up for it. Stored and gathered floats keep their bits, and
  * view_lanes computes what it computes for the triangles in any lanes. */
-enum { RR_CAT(REC_, W) = 25 }; /* fields: p1, p2, pf, n (3 each), vol; at_inf, inf1, inf2 */
-TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_shared_lanes, W)(const rr_scene *s, const uint32_t *ids, int n, const camera *cams,
-                                                 int ncams, const int32_t *sel, const int *nsel, bool cull,
-                                                 tri_setup *out, size_t ostride, int *face, tri_plane *pl,
-                                                 size_t pstride, bool flat) {
+enum { RR_CAT(REC_, W) = 24 }; /* fields: p1, p2, pf, n (3 each), vol; at_inf (3), inf1, inf2 */
+TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_shared_lanes, W)(
+    const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams, const int32_t *sel, const int *nsel,
+    bool cull, tri_setup *out, size_t ostride, int *face, tri_plane *pl, size_t pstride, bool flat) {
   float rec[RR_CAT(REC_, W)][TRI_SHARED_MAX + W]; /* (W lanes past the last triangle: its stores) */
 #define STORE_F(f, v) memcpy(&rec[f][k], &(v), W * sizeof(float))
 #define STORE3(f, v) (STORE_F(f, (v).x), STORE_F((f) + 1, (v).y), STORE_F((f) + 2, (v).z))
