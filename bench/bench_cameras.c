@@ -10,9 +10,10 @@
  * WxH METHOD", "cube METHOD" and "cube face K METHOD", which repeat from run to
  * run where times on a shared machine do not.
  *
- * --cube runs the cube map's table alone.
+ * --cube runs the cube map's table alone; --cpu reports the median processor time
+ * of the frames (all threads) instead of wall time, steadier on a loaded machine.
  *
- *   bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [--cube] [SCENE EYE TARGET] */
+ *   bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [--cube] [--cpu] [SCENE EYE TARGET] */
 #include "benchutil.h"
 
 #include <math.h>
@@ -30,7 +31,27 @@ typedef struct bench {
   const rr_scene *s;
   int threads, reps;
   bool count; /* under callgrind: one counted frame per part */
+  bool cpu;   /* processor time (all threads) instead of wall time: on a loaded machine */
 } bench;
+
+/* bench_render with the median of the frames' processor time (rr_stats.cpu_ms). */
+static double render_cpu(const bench *b, const rr_camera *cam, const rr_render_options *opt, rr_frame **out) {
+  double t[64];
+  const int reps = b->reps < 64 ? b->reps : 64;
+  rr_frame *f = NULL;
+  for (int r = 0; r < reps; r++) {
+    rr_frame_release(f);
+    if (rr_render(b->dev, b->s, cam, opt, &f) != RR_OK) {
+      fprintf(stderr, "bench_cameras: %s\n", rr_device_message(b->dev));
+      exit(1);
+    }
+    rr_stats st;
+    rr_frame_get_stats(f, &st);
+    t[r] = st.cpu_ms;
+  }
+  *out = f;
+  return bench_median(t, reps);
+}
 
 /* Milliseconds of method m on camera cam at w×h, and its stats (under callgrind:
  * one frame counted as the part "`part` METHOD"). */
@@ -42,6 +63,7 @@ static double run(const bench *b, const rr_camera *cam, rr_method m, int w, int 
   char name[128];
   snprintf(name, sizeof name, "%s %s", part, rr_method_name(m));
   double ms = b->count ? bench_count_frame(b->dev, b->s, cam, &opt, name, &f)
+             : b->cpu  ? render_cpu(b, cam, &opt, &f)
                        : bench_render(b->dev, b->s, cam, &opt, b->reps, &f);
   rr_frame_get_stats(f, st);
   rr_frame_release(f);
@@ -103,7 +125,7 @@ static void cameras_table(const bench *b, const float eye[3], const float target
 
 int main(int argc, char **argv) {
   int threads = 1, reps = 5, size = 512;
-  bool count = false, cube_only = false;
+  bool count = false, cube_only = false, cpu = false;
   const char *scene = "grid:teapot.obj:7";
   float eye[3] = {20.6f, 2.4f, 13.2f}, target[3] = {30, 1.2f, 20};
   int pos = 0;
@@ -118,6 +140,8 @@ int main(int argc, char **argv) {
       count = true;
     } else if (strcmp(argv[i], "--cube") == 0) {
       cube_only = true;
+    } else if (strcmp(argv[i], "--cpu") == 0) {
+      cpu = true;
     } else if (pos == 0 && argv[i][0] != '-') {
       scene = argv[i], pos++;
     } else if (pos == 1 && parse3(argv[i], eye)) {
@@ -125,7 +149,7 @@ int main(int argc, char **argv) {
     } else if (pos == 2 && parse3(argv[i], target)) {
       pos++;
     } else {
-      fprintf(stderr, "usage: bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [--cube] "
+      fprintf(stderr, "usage: bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [--cube] [--cpu] "
                       "[SCENE EYE TARGET]\n");
       return 2;
     }
@@ -135,9 +159,10 @@ int main(int argc, char **argv) {
   rr_scene *s = bench_load(dev, scene, NULL);
   rr_scene_info in;
   rr_scene_get_info(s, &in);
-  bench b = {dev, s, threads, reps, count};
-  printf("%s, %llu triangles, eye (%g,%g,%g), target (%g,%g,%g), %d thread(s), median of %d\n\n", scene,
-         (unsigned long long)in.triangles, eye[0], eye[1], eye[2], target[0], target[1], target[2], threads, reps);
+  bench b = {dev, s, threads, reps, count, cpu};
+  printf("%s, %llu triangles, eye (%g,%g,%g), target (%g,%g,%g), %d thread(s), median of %d%s\n\n", scene,
+         (unsigned long long)in.triangles, eye[0], eye[1], eye[2], target[0], target[1], target[2], threads, reps,
+         cpu ? " (processor ms, all threads)" : "");
   if (!cube_only) cameras_table(&b, eye, target, size);
 
   /* Cube map: one render of the cross against six 90° perspective renders of the
