@@ -256,8 +256,9 @@ TARGET static void RR_CAT(setup_one, W)(const rr_scene *s, const uint32_t *ids, 
 
 /* The shared setup (triangle.h, rr_tri_setup_shared): EYE of every triangle once,
  * stored by field (rec), then, for each camera, the triangles it asks for gathered
- * W to a step and set up for it. Stored and gathered floats keep their bits, and
- * view_lanes computes what it computes for the triangles in any lanes. */
+ * W to a step (loaded when they are W in a row) and set up for it. Stored and
+ * gathered floats keep their bits, and view_lanes computes what it computes for
+ * the triangles in any lanes. */
 enum { RR_CAT(REC_, W) = 24 }; /* fields: p1, p2, pf, n (3 each), vol; at_inf (3), inf1, inf2 */
 TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_shared_lanes, W)(
     const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams, const int32_t *sel, const int *nsel,
@@ -279,15 +280,18 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_shared_lan
 #undef STORE3
 #undef STORE_F
   const VI all = VI_(splat)(-1);
-#define GATHER_F(f) VF_(gather)(rec[f], idx)
+#define GATHER_F(f) (run ? VF_(load)(rec[f] + lane[0]) : VF_(gather)(rec[f], idx))
 #define GATHER3(f) ((V3){GATHER_F(f), GATHER_F((f) + 1), GATHER_F((f) + 2)})
-#define GATHER_I(f) VI_(gather_masked)((const int32_t *)rec[f], idx, all)
+#define GATHER_I(f) \
+  (run ? VI_(load)((const int32_t *)rec[f] + lane[0]) : VI_(gather_masked)((const int32_t *)rec[f], idx, all))
   for (int view = 0, at = 0; view < ncams; at += nsel[view++])
     for (int j = 0; j < nsel[view]; j += W) {
       const int m = nsel[view] - j < W ? nsel[view] - j : W;
       int32_t lane[W];
       for (int l = 0; l < W; l++) lane[l] = sel[at + j + (l < m ? l : m - 1)];
       const VI idx = VI_(load)(lane);
+      /* W of a face's triangles in a row (the common case): loads, cheaper than gathers */
+      const bool run = m == W && VI_(bits)(idx == VI_(splat)(lane[0]) + VI_(lanes)()) == (1 << W) - 1;
       EYE e; /* what view_lanes reads for a camera that is not orthographic */
       e.p1 = GATHER3(0), e.p2 = GATHER3(3), e.pf = GATHER3(6);
       for (int i = 0; i < 3; i++) e.n[i] = GATHER3(9 + 3 * i);
