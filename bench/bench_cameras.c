@@ -10,7 +10,10 @@
  * WxH METHOD", "cube METHOD" and "cube face K METHOD", which repeat from run to
  * run where times on a shared machine do not.
  *
- *   bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [SCENE EYE TARGET] */
+ * --cube runs the cube map's table alone; --cpu reports the median processor time
+ * of the frames (all threads) instead of wall time, steadier on a loaded machine.
+ *
+ *   bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [--cube] [--cpu] [SCENE EYE TARGET] */
 #include "benchutil.h"
 
 #include <math.h>
@@ -28,7 +31,27 @@ typedef struct bench {
   const rr_scene *s;
   int threads, reps;
   bool count; /* under callgrind: one counted frame per part */
+  bool cpu;   /* processor time (all threads) instead of wall time: on a loaded machine */
 } bench;
+
+/* bench_render with the median of the frames' processor time (rr_stats.cpu_ms). */
+static double render_cpu(const bench *b, const rr_camera *cam, const rr_render_options *opt, rr_frame **out) {
+  double t[64];
+  const int reps = b->reps < 64 ? b->reps : 64;
+  rr_frame *f = NULL;
+  for (int r = 0; r < reps; r++) {
+    rr_frame_release(f);
+    if (rr_render(b->dev, b->s, cam, opt, &f) != RR_OK) {
+      fprintf(stderr, "bench_cameras: %s\n", rr_device_message(b->dev));
+      exit(1);
+    }
+    rr_stats st;
+    rr_frame_get_stats(f, &st);
+    t[r] = st.cpu_ms;
+  }
+  *out = f;
+  return bench_median(t, reps);
+}
 
 /* Milliseconds of method m on camera cam at w×h, and its stats (under callgrind:
  * one frame counted as the part "`part` METHOD"). */
@@ -40,6 +63,7 @@ static double run(const bench *b, const rr_camera *cam, rr_method m, int w, int 
   char name[128];
   snprintf(name, sizeof name, "%s %s", part, rr_method_name(m));
   double ms = b->count ? bench_count_frame(b->dev, b->s, cam, &opt, name, &f)
+             : b->cpu  ? render_cpu(b, cam, &opt, &f)
                        : bench_render(b->dev, b->s, cam, &opt, b->reps, &f);
   rr_frame_get_stats(f, st);
   rr_frame_release(f);
@@ -60,9 +84,48 @@ static double row(const bench *b, const rr_camera *cam, int w, int h, double ms[
   return best;
 }
 
+/* Every camera beside a perspective camera of the same view and pixel count. */
+static void cameras_table(const bench *b, const float eye[3], const float target[3], int size) {
+  printf("Each camera beside a perspective camera (fov 70°) of the same view and pixel count; ms, and the fastest\n"
+         "3D method against rc-bvh on the same camera and against the fastest 3D method on the perspective one.\n\n");
+  printf("| camera | size | rc-bvh ms | 3dr-bb ms | 3dr-bin ms | 3dr-full ms | fastest 3D / rc-bvh | fastest 3D / "
+         "perspective's | S (3dr-bb) | empty bins 3dr-bin, 3dr-full |\n");
+  printf("|---|---|---|---|---|---|---|---|---|---|\n");
+  /* the perspective view at each size a camera uses: square, 2:1 (lat-long), 4:3 (cube) */
+  int sizes[3][2] = {{size, size}, {size, size / 2}, {size, size / 4 * 3}};
+  double persp_best[3];
+  for (int k = 0; k < 3; k++) {
+    rr_camera cam;
+    rr_camera_init(&cam);
+    memcpy(cam.eye, eye, 3 * sizeof *eye), memcpy(cam.target, target, 3 * sizeof *target);
+    cam.fov_deg = 70;
+    double ms[NM];
+    rr_stats st[NM];
+    persp_best[k] = row(b, &cam, sizes[k][0], sizes[k][1], ms, st);
+    printf("| perspective | %dx%d | %.1f | %.1f | %.1f | %.1f | %.2f× | 1 | %llu | %.1f%%, %.1f%% |\n", sizes[k][0],
+           sizes[k][1], ms[0], ms[1], ms[2], ms[3], persp_best[k] / ms[0], (unsigned long long)st[1].setups,
+           share(&st[2]), share(&st[3]));
+  }
+  for (int type = 0; type < RR_CAMERA_COUNT; type++) {
+    if (type == RR_CAMERA_PERSPECTIVE) continue;
+    rr_camera cam;
+    rr_camera_init(&cam);
+    cam.type = (rr_camera_type)type;
+    memcpy(cam.eye, eye, 3 * sizeof *eye), memcpy(cam.target, target, 3 * sizeof *target);
+    cam.fov_deg = type == RR_CAMERA_FISHEYE ? 180 : 70;
+    int k = type == RR_CAMERA_LATLONG ? 1 : type == RR_CAMERA_CUBE ? 2 : 0;
+    double ms[NM];
+    rr_stats st[NM];
+    double best = row(b, &cam, sizes[k][0], sizes[k][1], ms, st);
+    printf("| %s | %dx%d | %.1f | %.1f | %.1f | %.1f | %.2f× | %.2f× | %llu | %.1f%%, %.1f%% |\n", rr_camera_name(type),
+           sizes[k][0], sizes[k][1], ms[0], ms[1], ms[2], ms[3], best / ms[0], best / persp_best[k],
+           (unsigned long long)st[1].setups, share(&st[2]), share(&st[3]));
+  }
+}
+
 int main(int argc, char **argv) {
   int threads = 1, reps = 5, size = 512;
-  bool count = false;
+  bool count = false, cube_only = false, cpu = false;
   const char *scene = "grid:teapot.obj:7";
   float eye[3] = {20.6f, 2.4f, 13.2f}, target[3] = {30, 1.2f, 20};
   int pos = 0;
@@ -75,6 +138,10 @@ int main(int argc, char **argv) {
       if (!bench_arg_int("bench_cameras", "--size", argv[++i], 48, 8192, &size)) return 2;
     } else if (strcmp(argv[i], "--instructions") == 0) {
       count = true;
+    } else if (strcmp(argv[i], "--cube") == 0) {
+      cube_only = true;
+    } else if (strcmp(argv[i], "--cpu") == 0) {
+      cpu = true;
     } else if (pos == 0 && argv[i][0] != '-') {
       scene = argv[i], pos++;
     } else if (pos == 1 && parse3(argv[i], eye)) {
@@ -82,7 +149,8 @@ int main(int argc, char **argv) {
     } else if (pos == 2 && parse3(argv[i], target)) {
       pos++;
     } else {
-      fprintf(stderr, "usage: bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [SCENE EYE TARGET]\n");
+      fprintf(stderr, "usage: bench_cameras [--threads N] [--reps N] [--size N] [--instructions] [--cube] [--cpu] "
+                      "[SCENE EYE TARGET]\n");
       return 2;
     }
   }
@@ -91,44 +159,11 @@ int main(int argc, char **argv) {
   rr_scene *s = bench_load(dev, scene, NULL);
   rr_scene_info in;
   rr_scene_get_info(s, &in);
-  bench b = {dev, s, threads, reps, count};
-  printf("%s, %llu triangles, eye (%g,%g,%g), target (%g,%g,%g), %d thread(s), median of %d\n\n", scene,
-         (unsigned long long)in.triangles, eye[0], eye[1], eye[2], target[0], target[1], target[2], threads, reps);
-  printf("Each camera beside a perspective camera (fov 70°) of the same view and pixel count; ms, and the fastest\n"
-         "3D method against rc-bvh on the same camera and against the fastest 3D method on the perspective one.\n\n");
-  printf("| camera | size | rc-bvh ms | 3dr-bb ms | 3dr-bin ms | 3dr-full ms | fastest 3D / rc-bvh | fastest 3D / "
-         "perspective's | S (3dr-bb) | empty bins 3dr-bin, 3dr-full |\n");
-  printf("|---|---|---|---|---|---|---|---|---|---|\n");
-  /* the perspective view at each size a camera uses: square, 2:1 (lat-long), 4:3 (cube) */
-  int sizes[3][2] = {{size, size}, {size, size / 2}, {size, size / 4 * 3}};
-  double persp_best[3];
-  for (int k = 0; k < 3; k++) {
-    rr_camera cam;
-    rr_camera_init(&cam);
-    memcpy(cam.eye, eye, sizeof eye), memcpy(cam.target, target, sizeof target);
-    cam.fov_deg = 70;
-    double ms[NM];
-    rr_stats st[NM];
-    persp_best[k] = row(&b, &cam, sizes[k][0], sizes[k][1], ms, st);
-    printf("| perspective | %dx%d | %.1f | %.1f | %.1f | %.1f | %.2f× | 1 | %llu | %.1f%%, %.1f%% |\n", sizes[k][0],
-           sizes[k][1], ms[0], ms[1], ms[2], ms[3], persp_best[k] / ms[0], (unsigned long long)st[1].setups,
-           share(&st[2]), share(&st[3]));
-  }
-  for (int type = 0; type < RR_CAMERA_COUNT; type++) {
-    if (type == RR_CAMERA_PERSPECTIVE) continue;
-    rr_camera cam;
-    rr_camera_init(&cam);
-    cam.type = (rr_camera_type)type;
-    memcpy(cam.eye, eye, sizeof eye), memcpy(cam.target, target, sizeof target);
-    cam.fov_deg = type == RR_CAMERA_FISHEYE ? 180 : 70;
-    int k = type == RR_CAMERA_LATLONG ? 1 : type == RR_CAMERA_CUBE ? 2 : 0;
-    double ms[NM];
-    rr_stats st[NM];
-    double best = row(&b, &cam, sizes[k][0], sizes[k][1], ms, st);
-    printf("| %s | %dx%d | %.1f | %.1f | %.1f | %.1f | %.2f× | %.2f× | %llu | %.1f%%, %.1f%% |\n", rr_camera_name(type),
-           sizes[k][0], sizes[k][1], ms[0], ms[1], ms[2], ms[3], best / ms[0], best / persp_best[k],
-           (unsigned long long)st[1].setups, share(&st[2]), share(&st[3]));
-  }
+  bench b = {dev, s, threads, reps, count, cpu};
+  printf("%s, %llu triangles, eye (%g,%g,%g), target (%g,%g,%g), %d thread(s), median of %d%s\n\n", scene,
+         (unsigned long long)in.triangles, eye[0], eye[1], eye[2], target[0], target[1], target[2], threads, reps,
+         cpu ? " (processor ms, all threads)" : "");
+  if (!cube_only) cameras_table(&b, eye, target, size);
 
   /* Cube map: one render of the cross against six 90° perspective renders of the
    * faces, from the cube's own basis. */

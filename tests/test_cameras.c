@@ -2,7 +2,7 @@
  * double-precision reference; every 3D method bit-identical to rc for every
  * camera, on 1, 2 or 8 threads (curved binning and culling are conservative);
  * the cube's faces are six 90° perspective renders, and its one-pass drawing sets
- * each triangle up once; 2D methods refuse
+ * each triangle up once (its shared setups, bit for bit the faces' own); 2D methods refuse
  * curved cameras. */
 #include "vis/vis.h"
 #include "io/io.h"
@@ -235,10 +235,92 @@ static void check_cube_setups(rr_device *dev) {
   rr_scene_release(s);
 }
 
+/* The cube's shared setup (rr_tri_setup_shared): each face's setups, bit for bit,
+ * those of the face alone (rr_tri_setup_planes), for random selections of random
+ * triangles about the eye, with corners at infinity, and of translated and turned
+ * instances, in lanes and in plain code; and the cube's rays (rr_cam_ray) the
+ * faces' own, bit for bit. */
+static void check_shared_setup(rr_device *dev) {
+  enum { NT = 96 };
+  const vec3 eye = v3(0.3f, -0.2f, 0.4f);
+  rr_camera cube = test_camera(RR_CAMERA_CUBE, eye, v3(1.1f, 0.1f, -0.3f), 90);
+  camera c, fc[6];
+  const float pos[2] = {0.25f, 0.625f};
+  CHECK(rr_cam_setup_at(dev, &cube, 4 * 24, 3 * 24, pos, &c) == RR_OK, "cube camera");
+  for (int f = 0; f < 6; f++) rr_cam_cube_face(&c, f, &fc[f]);
+  long rays = 0, ray_bad = 0;
+  for (int y = 0; y < c.height; y++)
+    for (int x = 0; x < c.width; x++) {
+      vec3 o, d;
+      const int f = rr_cam_cube_face_at(&c, x, y);
+      const bool has = rr_cam_ray(&c, x, y, &o, &d);
+      if (f < 0) {
+        ray_bad += has;
+        continue;
+      }
+      const vec3 e = camera_dir(&fc[f], (float)(x % c.face) + c.sx0, (float)(y % c.face) + c.sy0);
+      rays++, ray_bad += !has || memcmp(&d, &e, sizeof d) != 0 || memcmp(&o, &eye, sizeof o) != 0;
+    }
+  CHECK(ray_bad == 0, "cube: %ld of %ld rays differ from their face's", ray_bad, rays);
+  float v4[NT * 3][4], v3s[NT * 3][3], xf[3][12];
+  uint32_t idx[NT * 3];
+  for (int k = 0; k < NT * 3; k++) {
+    const vec3 d = v3(test_randf(-1, 1), test_randf(-1, 1), test_randf(-1, 1));
+    const float r = test_randf(0.2f, 4.0f), w = test_rand() % 9 == 0 && k % 3 != 0 ? 0.0f : 1.0f;
+    v4[k][0] = w ? eye.x + r * d.x : d.x, v4[k][1] = w ? eye.y + r * d.y : d.y, v4[k][2] = w ? eye.z + r * d.z : d.z;
+    v4[k][3] = w;
+    v3s[k][0] = eye.x + r * d.x, v3s[k][1] = eye.y + r * d.y, v3s[k][2] = eye.z + r * d.z;
+    idx[k] = (uint32_t)k;
+  }
+  for (int i = 0; i < 3; i++) /* two translations and a turn about z */
+    for (int a = 0; a < 12; a++)
+      xf[i][a] = a % 5 == 0 ? 1.0f : a == 3 ? 0.5f * (float)i : a == 7 ? -0.25f * (float)i : 0;
+  xf[2][0] = xf[2][5] = 0.8f, xf[2][1] = -0.6f, xf[2][4] = 0.6f;
+  long compared = 0, bad = 0;
+  for (int sc = 0; sc < 2; sc++) {
+    rr_scene *s = NULL;
+    CHECK(rr_scene_new(dev, &s) == RR_OK, "scene");
+    rr_error e = sc == 0 ? rr_scene_add_mesh4(s, &v4[0][0], NT * 3, idx, NT, NULL)
+                         : rr_scene_add_instances(s, &v3s[0][0], NT * 3, idx, NT, NULL, &xf[0][0], 3);
+    CHECK(e == RR_OK && rr_scene_commit(s) == RR_OK, "scene %d: %s", sc, rr_device_message(dev));
+    const int n = (int)s->ntris < TRI_SHARED_MAX ? (int)s->ntris : TRI_SHARED_MAX;
+    uint32_t ids[TRI_SHARED_MAX];
+    for (int i = 0; i < n; i++) ids[i] = (uint32_t)i;
+    for (int trial = 0; trial < 8; trial++) {
+      int32_t sel[6 * TRI_SHARED_MAX];
+      int nsel[6], a = 0;
+      for (int f = 0; f < 6; f++) { /* a random subset, in order (trial 0: every triangle) */
+        nsel[f] = 0;
+        for (int i = 0; i < n; i++)
+          if (trial == 0 || test_rand() % 3 == 0) sel[a++] = i, nsel[f]++;
+      }
+      const bool simd = trial & 1, cull = trial & 2;
+      static tri_setup got[6 * TRI_SHARED_MAX], want;
+      static tri_plane gpl[6 * TRI_SHARED_MAX], wpl;
+      static int face[6 * TRI_SHARED_MAX];
+      rr_tri_setup_shared(s, ids, n, fc, 6, sel, nsel, cull, simd, got, sizeof *got, face, gpl, sizeof *gpl);
+      for (int f = 0, k = 0; f < 6; f++)
+        for (int j = 0; j < nsel[f]; j++, k++) {
+          int wface;
+          memset(&want, 0, sizeof want), memset(&wpl, 0, sizeof wpl);
+          rr_tri_setup_planes(s, &ids[sel[k]], 1, &fc[f], cull, !simd, &want, &wface, &wpl);
+          compared++;
+          bad += face[k] != wface ||
+                 (wface != SETUP_CULLED && (memcmp(&got[k], &want, sizeof want) || memcmp(&gpl[k], &wpl, sizeof wpl)));
+        }
+    }
+    rr_scene_release(s);
+  }
+  printf("cube: shared setups of %ld (triangle, face) pairs, %ld differ from the faces' own\n", compared, bad);
+  CHECK(compared > 1000 && bad == 0, "cube: %ld of %ld shared setups differ from the faces' own", bad, compared);
+  rr_cam_release(&c);
+}
+
 int main(void) {
   rr_device *dev = rr_device_new();
   check_directions(dev);
   check_cube(dev);
+  check_shared_setup(dev);
   check_cube_setups(dev);
   check_methods(dev, "demo", 2);
   check_methods(dev, "rooms:3", 2);

@@ -74,12 +74,18 @@ rr_error rr_camera_check(rr_device *dev, const rr_camera *c) {
   return rr_ok(dev);
 }
 
+/* A perspective camera's rays from its basis and image size:
+ * d(sx, sy) = fwd + (2 sx / W - 1) tw right + (1 - 2 sy / H) th up. */
+static void perspective_rays(vec3 fwd, vec3 right, vec3 up, float tw, float th, int width, int height, vec3 *d0,
+                             vec3 *dx, vec3 *dy) {
+  *d0 = v3_add(fwd, v3_sub(v3_scale(up, th), v3_scale(right, tw)));
+  *dx = v3_scale(right, 2.0f * tw / (float)width);
+  *dy = v3_scale(up, -2.0f * th / (float)height);
+}
+
 /* A perspective camera's rays and side planes from its basis and image size. */
 static void perspective_basis(camera *c) {
-  /* d(sx, sy) = fwd + (2 sx / W - 1) tw right + (1 - 2 sy / H) th up */
-  c->d0 = v3_add(c->fwd, v3_sub(v3_scale(c->up, c->tan_half_h), v3_scale(c->right, c->tan_half_w)));
-  c->dx = v3_scale(c->right, 2.0f * c->tan_half_w / (float)c->width);
-  c->dy = v3_scale(c->up, -2.0f * c->tan_half_h / (float)c->height);
+  perspective_rays(c->fwd, c->right, c->up, c->tan_half_w, c->tan_half_h, c->width, c->height, &c->d0, &c->dx, &c->dy);
   /* the planes through the eye and a column x (a row y) of the image have normals
    * linear in x (y); the sign makes them face increasing x (y) */
   float s = v3_dot(v3_cross(c->dx, c->dy), c->d0) > 0 ? 1.0f : -1.0f;
@@ -102,21 +108,39 @@ void rr_cam_cube_face_origin(const camera *c, int f, int *x0, int *y0) {
   *x0 = cube_cols[f] * c->face, *y0 = cube_rows[f] * c->face;
 }
 
-void rr_cam_cube_face(const camera *c, int f, camera *out) {
-  /* forward and right of each face in the cube's basis; up = right × forward */
+/* Face f's forward, right and up in the cube's basis (up = right × forward). */
+static void cube_face_basis(const camera *c, int f, vec3 *fwd, vec3 *right, vec3 *up) {
   const vec3 r = c->right, u = c->up, w = c->fwd;
-  const vec3 fwd[6] = {w, r, v3_neg(w), v3_neg(r), u, v3_neg(u)};
-  const vec3 right[6] = {r, v3_neg(w), v3_neg(r), w, r, r};
-  const vec3 up[6] = {u, u, u, u, v3_neg(w), w};
+  const vec3 fw[6] = {w, r, v3_neg(w), v3_neg(r), u, v3_neg(u)};
+  const vec3 ri[6] = {r, v3_neg(w), v3_neg(r), w, r, r};
+  const vec3 uu[6] = {u, u, u, u, v3_neg(w), w};
+  *fwd = fw[f], *right = ri[f], *up = uu[f];
+}
+
+void rr_cam_cube_face(const camera *c, int f, camera *out) {
+  vec3 fwd, right, up;
+  cube_face_basis(c, f, &fwd, &right, &up);
   memset(out, 0, sizeof *out);
   out->type = RR_CAMERA_PERSPECTIVE, out->planar = true;
   out->width = out->height = c->face;
   out->sx0 = c->sx0, out->sy0 = c->sy0;
-  out->eye = c->eye, out->fwd = fwd[f], out->right = right[f], out->up = up[f];
+  out->eye = c->eye, out->fwd = fwd, out->right = right, out->up = up;
   out->tan_half_h = out->tan_half_w = 1.0f; /* 90° exactly */
   out->fov_deg = 90.0f;
   out->dir_len_max = 1;
   perspective_basis(out);
+}
+
+/* The ray of pixel (x, y) of a cube camera: its face's (rr_cam_cube_face's d0, dx,
+ * dy, without the rest of the face camera), zero in the cross's gaps. */
+static vec3 cube_dir(const camera *c, int x, int y) {
+  const int f = rr_cam_cube_face_at(c, x, y);
+  if (f < 0) return v3(0, 0, 0);
+  vec3 fwd, right, up, d0, dx, dy;
+  cube_face_basis(c, f, &fwd, &right, &up);
+  perspective_rays(fwd, right, up, 1.0f, 1.0f, c->face, c->face, &d0, &dx, &dy);
+  const float sx = (float)(x - cube_cols[f] * c->face) + c->sx0, sy = (float)(y - cube_rows[f] * c->face) + c->sy0;
+  return v3_add(d0, v3_add(v3_scale(dx, sx), v3_scale(dy, sy))); /* camera_dir's operations */
 }
 
 /* The direction of pixel (x, y) of a curved camera; zero where it has no ray.
@@ -168,10 +192,12 @@ static vec3 curved_dir(const camera *c, int x, int y, vec3 *dd) {
     /* the ray of the face's own perspective camera (rr_cam_cube_face), in camera_dir's operations */
     int f = rr_cam_cube_face_at(c, x, y);
     if (f < 0) return v3(0, 0, 0);
-    camera fc;
-    rr_cam_cube_face(c, f, &fc);
-    if (dd) dd[0] = fc.dx, dd[1] = fc.dy;
-    return camera_dir(&fc, (float)(x - cube_cols[f] * c->face) + c->sx0, (float)(y - cube_rows[f] * c->face) + c->sy0);
+    if (dd) {
+      camera fc;
+      rr_cam_cube_face(c, f, &fc);
+      dd[0] = fc.dx, dd[1] = fc.dy;
+    }
+    return cube_dir(c, x, y);
   }
   case RR_CAMERA_OPENCV:
   case RR_CAMERA_OPENCV_FISHEYE: {
@@ -283,6 +309,12 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     c->tan_half_h = h / 2, c->tan_half_w = w / 2; /* half extents of the view */
     return rr_ok(dev);
   }
+  if (in->type == RR_CAMERA_CUBE) { /* its faces are perspective cameras: no table of rays, no cells */
+    c->face = height / 3;
+    c->lipschitz = 2.0f / (float)c->face * 1.001f; /* a 90° face, atan' <= 1 on its [-1, 1] image plane */
+    c->dir_len_max = sqrtf(3.0f);
+    return rr_ok(dev);
+  }
   /* Curved: one direction per sample, computed once, and the largest angle between
    * directions of samples one pixel apart (the map's Lipschitz constant). */
   c->dirs = malloc((size_t)width * height * sizeof *c->dirs);
@@ -295,20 +327,8 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
       c->lens.cx = 0.5f * (float)width - 0.5f, c->lens.cy = 0.5f * (float)height - 0.5f;
     }
   }
-  if (in->type == RR_CAMERA_CUBE) { /* the faces' rays; the cross's gaps have none */
-    memset(c->dirs, 0, (size_t)width * height * sizeof *c->dirs);
-    for (int f = 0; f < 6; f++) {
-      camera fc;
-      rr_cam_cube_face(c, f, &fc);
-      for (int y = 0; y < c->face; y++)
-        for (int x = 0; x < c->face; x++)
-          c->dirs[(size_t)(cube_rows[f] * c->face + y) * width + cube_cols[f] * c->face + x] =
-              camera_dir(&fc, (float)x + c->sx0, (float)y + c->sy0);
-    }
-  } else {
-    for (int y = 0; y < height; y++)
-      for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);
-  }
+  for (int y = 0; y < height; y++)
+    for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);
   switch (in->type) {
   case RR_CAMERA_PARABOLIC: /* conformal, angle = 2 atan(r): at most 2 radians per unit of u */
     c->lipschitz = 2.0f * 2.0f / (float)(width < height ? width : height);
@@ -323,9 +343,7 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
   case RR_CAMERA_OPENCV_FISHEYE:
     c->lipschitz = measured_lipschitz(c);
     break;
-  default: /* cube: a 90° face, atan' <= 1 on its [-1, 1] image plane */
-    c->lipschitz = 2.0f / (float)c->face;
-    c->dir_len_max = sqrtf(3.0f);
+  default:
     break;
   }
   c->lipschitz *= 1.001f;
@@ -389,6 +407,9 @@ bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
     *origin = v3_add(c->eye, v3_add(c->o0, v3_add(v3_scale(c->ox, sx), v3_scale(c->oy, sy))));
     *dir = c->fwd;
     return true;
+  case RR_CAMERA_CUBE:
+    *dir = cube_dir(c, x, y);
+    return dir->x != 0 || dir->y != 0 || dir->z != 0;
   default:
     *dir = c->dirs[(size_t)y * c->width + x];
     return dir->x != 0 || dir->y != 0 || dir->z != 0;

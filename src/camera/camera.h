@@ -11,10 +11,11 @@
  * cameras, one layer of the visibility buffer each. Planar cameras (perspective, orthographic)
  * have edge functions linear in (sx, sy): a perspective ray leaves the eye along
  * d0 + sx·dx + sy·dy; an orthographic ray leaves eye + o0 + sx·ox + sy·oy along fwd.
- * Curved cameras (parabolic, lat-long, fisheye, cube, the OpenCV lenses) keep one direction per
+ * Curved cameras (parabolic, lat-long, fisheye, the OpenCV lenses) keep one direction per
  * sample in `dirs` (zero where the image has no ray), and bound the directions of
  * a rectangle of samples by a cone whose half-angle grows by `lipschitz` radians
- * per pixel of distance. */
+ * per pixel of distance. The cube keeps neither: every method draws its faces,
+ * perspective cameras (rr_cam_cube_face), and rr_cam_ray gives its rays. */
 typedef struct camera {
   rr_camera_type type;
   int width, height;
@@ -76,7 +77,8 @@ bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir);
  * a cube's within the pixel's face). Zero where the pixel has no ray (false). */
 bool rr_cam_ray_diff(const camera *c, int x, int y, vec3 *origin, vec3 *dir, vec3 do_dxy[2], vec3 dd_dxy[2]);
 /* What a triangle's edge functions are evaluated against at pixel (x, y):
- * (1, sx, sy) for planar cameras, the ray direction for curved ones. */
+ * (1, sx, sy) for planar cameras, the ray direction for curved ones (not the
+ * cube: its faces'). */
 static inline vec3 camera_w(const camera *c, int x, int y) {
   return c->planar ? v3(1.0f, (float)x + c->sx0, (float)y + c->sy0) : c->dirs[(size_t)y * c->width + x];
 }
@@ -90,7 +92,7 @@ bool rr_cam_dir_at(const camera *c, double sx, double sy, double d[3]);
 bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy);
 /* A cone (unit axis, half-angle) holding the directions of the samples
  * [x0, x1) × [y0, y1) of a curved camera: 1 when found, 0 when none is known,
- * -1 when none of the samples has a ray. */
+ * -1 when none of the samples has a ray (not for the cube, which has no rays of its own). */
 int rr_cam_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle);
 
 /* A pseudo-camera for one arbitrary ray: eye = origin, d0 = direction and dx, dy

@@ -22,6 +22,7 @@ enum {
   SCRATCH_RC_BOUNDS, /* rc-bvh / rc-packet: wide nodes' bounds */
   SCRATCH_SM_PRIMS,  /* sort-middle: a batch's set-up primitives */
   SCRATCH_SM_SPANS,  /* sort-middle: their blocks of rows */
+  SCRATCH_CUBE,      /* the cube camera: its faces' visibility buffers */
   SCRATCH_COUNT
 };
 typedef struct rr_scratch {

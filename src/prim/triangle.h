@@ -52,13 +52,16 @@ typedef struct tri_plane {
 void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces,
                          bool simd, tri_setup *out, int *face, tri_plane *pl);
 /* rr_tri_setup_planes for cameras cams[0..ncams-1] that share one eye (a cube's
- * faces): what depends on the eye alone is computed once per triangle, the rest per
- * camera, with the bits each camera alone gives. Camera k's setup of triangle i goes
- * to out[k·n + i], face[k·n + i] (pl likewise when not NULL), for the triangles whose
- * bit k of views[i] is set (every one when views is NULL); face is SETUP_CULLED for
- * the others. */
-void rr_tri_setup_views(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
-                        const uint8_t *views, bool cull_backfaces, bool simd, tri_setup *out, int *face, tri_plane *pl);
+ * faces), each for some of the triangles ids[0..n-1] (n <= TRI_SHARED_MAX): what
+ * depends on the eye alone is computed once per triangle, the rest per camera for
+ * the triangles it asks for, W to a step, with the bits each camera alone gives.
+ * Camera k asks for ids[sel[a_k + j]], j < nsel[k] (a_k = nsel[0] + .. + nsel[k-1]);
+ * its setup of it goes to entry a_k + j of out, face and pl (when not NULL), the
+ * entries of out ostride bytes apart, of pl pstride (a caller's records). */
+#define TRI_SHARED_MAX 256
+void rr_tri_setup_shared(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
+                         const int32_t *sel, const int *nsel, bool cull_backfaces, bool simd, tri_setup *out,
+                         size_t ostride, int *face, tri_plane *pl, size_t pstride);
 /* The setup ts (from rr_tri_setup_planes with a camera that differs from c only in
  * its sample position) for camera c: the bits rr_tri_setup gives for c. */
 void rr_tri_setup_at(const tri_setup *ts, const tri_plane *pl, const camera *c, tri_setup *out);

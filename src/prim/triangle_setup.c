@@ -56,22 +56,28 @@ int rr_tri_setup(const rr_scene *s, uint32_t i, const camera *c, bool cull_backf
   return face;
 }
 
-void rr_tri_setup_views(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
-                        const uint8_t *views, bool cull_backfaces, bool simd, tri_setup *out, int *face, tri_plane *pl) {
-  int k = 0;
+void rr_tri_setup_shared(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
+                         const int32_t *sel, const int *nsel, bool cull_backfaces, bool simd, tri_setup *out,
+                         size_t ostride, int *face, tri_plane *pl, size_t pstride) {
+  bool ortho = false;
+  for (int k = 0; k < ncams; k++) ortho |= cams[k].type == RR_CAMERA_ORTHOGRAPHIC;
+  if (ortho) { /* (no caller: the shared EYE leaves out what the eye at infinity reads) */
+    for (int k = 0, at = 0; k < ncams; at += nsel[k++])
+      for (int j = at; j < at + nsel[k]; j++)
+        setup_one1(s, &ids[sel[j]], 1, &cams[k], cull_backfaces, (tri_setup *)((char *)out + j * ostride), &face[j],
+                   pl ? (tri_plane *)((char *)pl + j * pstride) : NULL);
+    return;
+  }
 #ifdef RR_SIMD_X86
-  if (simd && __builtin_cpu_supports("avx2"))
-    for (; k < n; k += 8)
-      setup_views8(s, ids + k, n - k < 8 ? n - k : 8, cams, ncams, views ? views + k : NULL, cull_backfaces, out + k,
-                   face + k, pl ? pl + k : NULL, (size_t)n);
+  if (simd && __builtin_cpu_supports("avx2")) {
+    setup_shared8(s, ids, n, cams, ncams, sel, nsel, cull_backfaces, out, ostride, face, pl, pstride);
+    return;
+  }
 #endif
   (void)simd;
-  for (; k < n; k++)
-    setup_views1(s, ids + k, 1, cams, ncams, views ? views + k : NULL, cull_backfaces, out + k, face + k,
-                 pl ? pl + k : NULL, (size_t)n);
+  setup_shared1(s, ids, n, cams, ncams, sel, nsel, cull_backfaces, out, ostride, face, pl, pstride);
 }
 
-/* One camera: the template without its loop over cameras (setup_one). */
 void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces,
                          bool simd, tri_setup *out, int *face, tri_plane *pl) {
   int k = 0;

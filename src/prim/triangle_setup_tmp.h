@@ -44,18 +44,21 @@ typedef struct {
 #define LEX_POSITIVE(g1, g2, g3) \
   (((g1) > zero) | (((g1) == zero) & (((g2) > zero) | (((g2) == zero) & ((g3) > zero)))))
 
-/* Cameras cams[0..ncams-1] that share the eye (a cube camera's faces; one camera
- * otherwise): the part of the setup that depends on the eye alone (the corners
- * relative to it, the edge normals, the volume, the plane's normal) is computed
- * once, the rest (a few dot products) per camera, for the lanes l whose bit k of
- * views[l] asks for camera k (every lane when views is NULL). Camera k's setup of
- * lane l goes to out[k·stride + l], face[k·stride + l] (SETUP_CULLED when not
- * asked for), pl likewise. The same operations in the same order as for each
- * camera alone, so the same bits. flat: a constant, true when the scene has no
- * instances (lane_corners). */
-TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(
-    const rr_scene *s, const uint32_t *ids, int count, const camera *cams, int ncams, const uint8_t *views, bool cull,
-    tri_setup *out, int *face, tri_plane *pl, size_t stride, bool flat) {
+#define EYE RR_CAT(setup_eye_, W)
+/* The part of W triangles' setup that depends on the eye alone (and is the same
+ * for every camera there): the corners relative to it (q; p as given), the edge
+ * normals n and their canonical order (swap), the volume, the plane's corners
+ * (pf, p1, p2, the two others' infinity inf1, inf2) and the corners at infinity. */
+typedef struct {
+  V3 q[3], p[3], n[3], pf, p1, p2;
+  VI at_inf[3], swap[3], inf1, inf2;
+  VF vol;
+} EYE;
+
+/* EYE of triangles ids[0..count-1] (count <= W) seen from eye. flat: a constant,
+ * true when the scene has no instances (lane_corners). */
+TARGET __attribute__((always_inline)) static inline void RR_CAT(eye_lanes, W)(const rr_scene *s, const uint32_t *ids,
+                                                                            int count, vec3 eye, bool flat, EYE *e) {
   int32_t lane_id[W], lane_inf[W] = {0};
   for (int l = 0; l < W; l++) lane_id[l] = (int32_t)ids[l < count ? l : count - 1];
   if (s->inf)
@@ -65,199 +68,255 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(
   VF corner[3][3];
   RR_CAT(lane_corners, W)(s, lane_id, consecutive, corner, flat);
   const VI inf = VI_(load)(lane_inf);
-  const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
-  const V3 zero3 = {zero, zero, zero};
-  const vec3 eye = cams[0].eye;
   /* q: the corner relative to the eye, or its direction when it is at infinity */
-  V3 q[3], p[3];
-  VI at_inf[3] = {VI_(splat)(0), VI_(splat)(0), VI_(splat)(0)};
 #pragma GCC unroll 3
   for (int k = 0; k < 3; k++) {
-    p[k] = (V3){corner[k][0], corner[k][1], corner[k][2]};
-    q[k] = SUB3(p[k], SPLAT3(eye));
+    e->p[k] = (V3){corner[k][0], corner[k][1], corner[k][2]};
+    e->q[k] = SUB3(e->p[k], SPLAT3(eye));
+    e->at_inf[k] = VI_(splat)(0);
     if (s->inf) {
-      at_inf[k] = -((inf >> k) & 1);
-      q[k] = SELECT3(at_inf[k], p[k], q[k]);
+      e->at_inf[k] = -((inf >> k) & 1);
+      e->q[k] = SELECT3(e->at_inf[k], e->p[k], e->q[k]);
     }
   }
-  /* edge e runs from q[e+1] to q[e+2]: n_e = h × (l − h) in the canonical order (l, h) */
-  V3 n[3];
-  VI swap[3];
+  /* edge i runs from q[i+1] to q[i+2]: n_i = h × (l − h) in the canonical order (l, h) */
 #pragma GCC unroll 3
-  for (int e = 0; e < 3; e++) {
-    V3 a = q[(e + 1) % 3], b = q[(e + 2) % 3];
-    swap[e] = LEX_LESS3(b, a);
-    V3 l = SELECT3(swap[e], b, a), h = SELECT3(swap[e], a, b);
+  for (int i = 0; i < 3; i++) {
+    V3 a = e->q[(i + 1) % 3], b = e->q[(i + 2) % 3];
+    e->swap[i] = LEX_LESS3(b, a);
+    V3 l = SELECT3(e->swap[i], b, a), h = SELECT3(e->swap[i], a, b);
     V3 m = CROSS3(h, SUB3(l, h));
-    n[e] = SELECT3(swap[e], NEG3(m), m);
+    e->n[i] = SELECT3(e->swap[i], NEG3(m), m);
   }
-  const VF vol_eye = DOT3(q[0], n[0]);
+  e->vol = DOT3(e->q[0], e->n[0]);
   /* The plane (prim/triangle_setup.c) in double, rounded once to float:
    * N = r_{f+2} × r_{f+1}, r_k = p_k − w_k·p_f for a finite corner f (0 unless it
    * lies at infinity). Float corners subtract and multiply exactly in double. */
-  V3 pf = p[0], p1 = p[1], p2 = p[2];
-  VI inf1 = at_inf[1], inf2 = at_inf[2];
+  e->pf = e->p[0], e->p1 = e->p[1], e->p2 = e->p[2];
+  e->inf1 = e->at_inf[1], e->inf2 = e->at_inf[2];
   if (s->inf) {
-    const VI f1 = at_inf[0] & ~at_inf[1], f2 = at_inf[0] & at_inf[1]; /* f = 1, f = 2 */
-    pf = SELECT3(f1, p[1], SELECT3(f2, p[2], p[0]));
-    p1 = SELECT3(f1, p[2], SELECT3(f2, p[0], p[1]));
-    p2 = SELECT3(f1, p[0], SELECT3(f2, p[1], p[2]));
-    inf1 = VI_(select)(f1, at_inf[2], VI_(select)(f2, at_inf[0], at_inf[1]));
-    inf2 = VI_(select)(f1, at_inf[0], VI_(select)(f2, at_inf[1], at_inf[2]));
+    const VI f1 = e->at_inf[0] & ~e->at_inf[1], f2 = e->at_inf[0] & e->at_inf[1]; /* f = 1, f = 2 */
+    e->pf = SELECT3(f1, e->p[1], SELECT3(f2, e->p[2], e->p[0]));
+    e->p1 = SELECT3(f1, e->p[2], SELECT3(f2, e->p[0], e->p[1]));
+    e->p2 = SELECT3(f1, e->p[0], SELECT3(f2, e->p[1], e->p[2]));
+    e->inf1 = VI_(select)(f1, e->at_inf[2], VI_(select)(f2, e->at_inf[0], e->at_inf[1]));
+    e->inf2 = VI_(select)(f1, e->at_inf[0], VI_(select)(f2, e->at_inf[1], e->at_inf[2]));
   }
-  /* computed at the first camera that keeps a lane, after its edges: live across
-   * them, its doubles would take registers the edges need */
-  D3 nrm_eye, qf;
-  bool have_plane = false;
-  VF w[3];
-  for (int k = 0; k < 3; k++) w[k] = VF_(select)(at_inf[k], zero, one);
+}
+
+/* The rest of the setup of the lanes of e for camera c (whose eye is e's): the
+ * lanes l < count whose bit is set in asked go to out[l], face[l] and pl[l] (when
+ * not NULL), each entry ostride (pstride) bytes after the one before; face is
+ * SETUP_CULLED for the others, whose out and pl are not written. may_ortho (a
+ * constant): c may be orthographic, which reads e's q and swap. */
+TARGET __attribute__((always_inline)) static inline void RR_CAT(view_lanes, W)(const EYE *e, int count, int asked,
+                                                                             const camera *c, bool cull, tri_setup *out,
+                                                                             size_t ostride, int *face, tri_plane *pl,
+                                                                             size_t pstride, bool may_ortho) {
+  const VF zero = VF_(splat)(0.0f), one = VF_(splat)(1.0f);
+  const V3 zero3 = {zero, zero, zero};
   const int lanes = (1 << count) - 1;
-  for (int view = 0; view < ncams; view++) {
-    const camera *c = &cams[view];
-    int asked = lanes;
-    if (views) {
-      asked = 0;
-      for (int l = 0; l < count; l++) asked |= (views[l] >> view & 1) << l;
-    }
-    tri_setup *vout = out + view * stride;
-    int *vface = face + view * stride;
-    tri_plane *vpl = pl ? pl + view * stride : NULL;
-    VF vol = vol_eye, vol_x = zero, vol_y = zero, orient = vol;
-    const bool ortho = c->type == RR_CAMERA_ORTHOGRAPHIC;
-    const V3 fwd = SPLAT3(c->fwd);
-    if (ortho) {
-      /* Σ w_i n_i */
-      V3 sum = ADD3(ADD3(SELECT3(at_inf[0], zero3, n[0]), SELECT3(at_inf[1], zero3, n[1])),
-                    SELECT3(at_inf[2], zero3, n[2]));
-      const V3 o0 = SPLAT3(c->o0), ox = SPLAT3(c->ox), oy = SPLAT3(c->oy);
-      vol = vol - DOT3(o0, sum);
-      vol_x = -DOT3(ox, sum);
-      vol_y = -DOT3(oy, sum);
-      orient = DOT3(fwd, sum);
-    }
-    /* seen unless edge-on (or not finite); front faces have orient > 0 */
-    const VI seen = (orient != zero) & (VF_(abs)(vol) < VF_(splat)(INFINITY)), front = orient > zero;
-    const int front_m = VI_(bits)(front) & lanes,
-              kept = VI_(bits)(seen & (cull ? front : VI_(splat)(-1))) & asked;
-    if (!kept) {
-      for (int l = 0; l < count; l++) vface[l] = SETUP_CULLED;
-      continue;
-    }
-    const VF sign = VF_(select)(front, one, VF_(splat)(-1.0f));
-    const V3 d0 = SPLAT3(c->d0), dx = SPLAT3(c->dx), dy = SPLAT3(c->dy);
-    VF ea[3], eb[3], ec[3];
-    VI tie = VI_(splat)(0);
+  VF vol = e->vol, vol_x = zero, vol_y = zero, orient = vol;
+  const bool ortho = may_ortho && c->type == RR_CAMERA_ORTHOGRAPHIC;
+  const V3 fwd = SPLAT3(c->fwd);
+  if (ortho) {
+    /* Σ w_i n_i */
+    V3 sum = ADD3(ADD3(SELECT3(e->at_inf[0], zero3, e->n[0]), SELECT3(e->at_inf[1], zero3, e->n[1])),
+                  SELECT3(e->at_inf[2], zero3, e->n[2]));
+    const V3 o0 = SPLAT3(c->o0), ox = SPLAT3(c->ox), oy = SPLAT3(c->oy);
+    vol = vol - DOT3(o0, sum);
+    vol_x = -DOT3(ox, sum);
+    vol_y = -DOT3(oy, sum);
+    orient = DOT3(fwd, sum);
+  }
+  /* seen unless edge-on (or not finite); front faces have orient > 0 */
+  const VI seen = (orient != zero) & (VF_(abs)(vol) < VF_(splat)(INFINITY)), front = orient > zero;
+  const int front_m = VI_(bits)(front) & lanes,
+            kept = VI_(bits)(seen & (cull ? front : VI_(splat)(-1))) & asked & lanes;
+  if (!kept) {
+    for (int l = 0; l < count; l++) face[l] = SETUP_CULLED;
+    return;
+  }
+  const VF sign = VF_(select)(front, one, VF_(splat)(-1.0f));
+  const V3 d0 = SPLAT3(c->d0), dx = SPLAT3(c->dx), dy = SPLAT3(c->dy);
+  VF ea[3], eb[3], ec[3];
+  VI tie = VI_(splat)(0);
 #pragma GCC unroll 3
-    for (int e = 0; e < 3; e++) {
-      V3 ne = SCALE3(n[e], sign);
-      VF g1, g2;
-      if (c->type == RR_CAMERA_PERSPECTIVE) {
-        ea[e] = DOT3(ne, d0), eb[e] = DOT3(ne, dx), ec[e] = DOT3(ne, dy);
-        g1 = eb[e], g2 = ec[e];
-      } else if (ortho) {
-        /* the eye at infinity: m_e = d × (w_h·l − w_l·h) in the edge's canonical order */
-        int ia = (e + 1) % 3, ib = (e + 2) % 3;
-        V3 l = SELECT3(swap[e], q[ib], q[ia]), h = SELECT3(swap[e], q[ia], q[ib]);
-        VI l_inf = VI_(select)(swap[e], at_inf[ib], at_inf[ia]), h_inf = VI_(select)(swap[e], at_inf[ia], at_inf[ib]);
-        V3 diff = SELECT3(l_inf, SELECT3(h_inf, zero3, l), SELECT3(h_inf, NEG3(h), SUB3(l, h)));
-        V3 m = CROSS3(fwd, diff);
-        V3 me = SCALE3(SELECT3(swap[e], NEG3(m), m), sign);
-        ea[e] = DOT3(ne, fwd) + DOT3(me, SPLAT3(c->o0));
-        eb[e] = DOT3(me, SPLAT3(c->ox)), ec[e] = DOT3(me, SPLAT3(c->oy));
-        g1 = eb[e], g2 = ec[e];
-      } else {
-        ea[e] = ne.x, eb[e] = ne.y, ec[e] = ne.z;
-        g1 = DOT3(ne, SPLAT3(c->right)), g2 = -DOT3(ne, SPLAT3(c->up));
-      }
-      /* the top-left rule's tie bit */
-      tie |= LEX_POSITIVE(g1, g2, DOT3(ne, fwd)) & (1 << e);
-    }
-    vol = vol * sign, vol_x = vol_x * sign, vol_y = vol_y * sign;
-    if (!have_plane) {
-      const V3 base1 = SELECT3(inf1, zero3, pf), base2 = SELECT3(inf2, zero3, pf); /* w_k·p_f */
-      const D3 r1 = SUB3_T(D3, TO_D3(p1), TO_D3(base1)), r2 = SUB3_T(D3, TO_D3(p2), TO_D3(base2));
-      nrm_eye = CROSS3_T(D3, r2, r1), qf = SUB3_T(D3, TO_D3(pf), DSPLAT3(eye));
-      have_plane = true;
-    }
-    const D3 nrm = SCALE3_T(D3, nrm_eye, TO_D(sign));
-    /* (cx, cy): the sample nearest to where p_f projects, within the image; the
-     * coordinates of q_f in the basis of the camera's (d0, dx, dy) or, orthographic,
-     * of q_f − o0 in (ox, oy, fwd), by the dual basis (the rows of its inverse). */
-    VF cx = zero, cy = zero;
-    if (c->planar) {
-      vec3 u = ortho ? c->ox : c->dx, v = ortho ? c->oy : c->dy, w0 = ortho ? c->fwd : c->d0;
-      V3 qp = SUB3(pf, SPLAT3(c->eye));
-      if (ortho) qp = SUB3(qp, SPLAT3(c->o0));
-      /* perspective: q = λ·(d0 + sx·dx + sy·dy), sx = q·(dy × d0) / q·(dx × dy);
-       * orthographic: q = sx·ox + sy·oy + t·fwd, sx = q·(oy × fwd) / fwd·(ox × oy) */
-      const vec3 uv = v3_cross(u, v);
-      const VF depth = ortho ? VF_(splat)(v3_dot(w0, uv)) : DOT3(qp, SPLAT3(uv));
-      const VF lo_x = VF_(splat)(c->sx0), hi_x = VF_(splat)((float)(c->width - 1) + c->sx0);
-      const VF lo_y = VF_(splat)(c->sy0), hi_y = VF_(splat)((float)(c->height - 1) + c->sy0);
-      cx = DOT3(qp, SPLAT3(v3_cross(v, w0))) / depth, cy = DOT3(qp, SPLAT3(v3_cross(w0, u))) / depth;
-      if (vpl)
-        for (int l = 0; l < count; l++) vpl[l].px = cx[l], vpl[l].py = cy[l];
-      /* NaN (a corner in the eye's plane) clamps to the far side: any sample is exact
-       * (tri_setup_at repeats these operations for another position) */
-      cx = VF_(max)(VF_(min)(cx, hi_x), lo_x), cy = VF_(max)(VF_(min)(cy, hi_y), lo_y);
-      cx = VF_(floor)(cx - lo_x) + lo_x, cy = VF_(floor)(cy - lo_y) + lo_y;
-    }
-    const VD dcx = TO_D(cx), dcy = TO_D(cy);
-    VD pa, pb, pc, num0, num_x = TO_D(zero), num_y = num_x, base;
+  for (int i = 0; i < 3; i++) {
+    V3 ne = SCALE3(e->n[i], sign);
+    VF g1, g2;
     if (c->type == RR_CAMERA_PERSPECTIVE) {
-      pb = DOT3(nrm, DSPLAT3(c->dx)), pc = DOT3(nrm, DSPLAT3(c->dy));
-      base = DOT3(nrm, DSPLAT3(c->d0));
-      pa = base + dcx * pb + dcy * pc;
-      num0 = DOT3(nrm, qf);
-      if (vpl)
-        for (int l = 0; l < count; l++) vpl[l].base = base[l], vpl[l].u = pb[l], vpl[l].v = pc[l];
+      ea[i] = DOT3(ne, d0), eb[i] = DOT3(ne, dx), ec[i] = DOT3(ne, dy);
+      g1 = eb[i], g2 = ec[i];
     } else if (ortho) {
-      /* rays from eye + o0 + sx·ox + sy·oy along fwd */
-      pa = DOT3(nrm, DSPLAT3(c->fwd)), pb = num_x, pc = num_x;
-      num_x = -DOT3(nrm, DSPLAT3(c->ox)), num_y = -DOT3(nrm, DSPLAT3(c->oy));
-      base = DOT3(nrm, SUB3_T(D3, qf, DSPLAT3(c->o0)));
-      num0 = base + dcx * num_x + dcy * num_y;
-      if (vpl)
-        for (int l = 0; l < count; l++) vpl[l].base = base[l], vpl[l].u = num_x[l], vpl[l].v = num_y[l];
+      /* the eye at infinity: m_i = d × (w_h·l − w_l·h) in the edge's canonical order */
+      int ia = (i + 1) % 3, ib = (i + 2) % 3;
+      V3 l = SELECT3(e->swap[i], e->q[ib], e->q[ia]), h = SELECT3(e->swap[i], e->q[ia], e->q[ib]);
+      VI l_inf = VI_(select)(e->swap[i], e->at_inf[ib], e->at_inf[ia]),
+         h_inf = VI_(select)(e->swap[i], e->at_inf[ia], e->at_inf[ib]);
+      V3 diff = SELECT3(l_inf, SELECT3(h_inf, zero3, l), SELECT3(h_inf, NEG3(h), SUB3(l, h)));
+      V3 m = CROSS3(fwd, diff);
+      V3 me = SCALE3(SELECT3(e->swap[i], NEG3(m), m), sign);
+      ea[i] = DOT3(ne, fwd) + DOT3(me, SPLAT3(c->o0));
+      eb[i] = DOT3(me, SPLAT3(c->ox)), ec[i] = DOT3(me, SPLAT3(c->oy));
+      g1 = eb[i], g2 = ec[i];
     } else {
-      pa = nrm.x, pb = nrm.y, pc = nrm.z;
-      num0 = DOT3(nrm, qf);
+      ea[i] = ne.x, eb[i] = ne.y, ec[i] = ne.z;
+      g1 = DOT3(ne, SPLAT3(c->right)), g2 = -DOT3(ne, SPLAT3(c->up));
     }
-    const VF fpa = TO_F(pa), fpb = TO_F(pb), fpc = TO_F(pc), fn0 = TO_F(num0), fnx = TO_F(num_x), fny = TO_F(num_y);
-    for (int l = 0; l < count; l++) {
-      vface[l] = !(kept >> l & 1) ? SETUP_CULLED : front_m >> l & 1 ? SETUP_FRONT : SETUP_BACK;
-      if (vface[l] == SETUP_CULLED) continue;
-      tri_setup *o = &vout[l];
-      for (int e = 0; e < 3; e++) o->a[e] = ea[e][l], o->b[e] = eb[e][l], o->c[e] = ec[e][l];
-      o->vol = vol[l], o->vol_x = vol_x[l], o->vol_y = vol_y[l];
-      o->tie = (uint32_t)tie[l];
-      for (int k = 0; k < 3; k++) o->w[k] = w[k][l];
-      o->pa = fpa[l], o->pb = fpb[l], o->pc = fpc[l];
-      o->num0 = fn0[l], o->num_x = fnx[l], o->num_y = fny[l];
-      o->cx = cx[l], o->cy = cy[l];
-    }
+    /* the top-left rule's tie bit */
+    tie |= LEX_POSITIVE(g1, g2, DOT3(ne, fwd)) & (1 << i);
+  }
+  vol = vol * sign, vol_x = vol_x * sign, vol_y = vol_y * sign;
+  /* after the edges: live across them, its doubles would take registers the edges need */
+  const V3 base1 = SELECT3(e->inf1, zero3, e->pf), base2 = SELECT3(e->inf2, zero3, e->pf); /* w_k·p_f */
+  const D3 r1 = SUB3_T(D3, TO_D3(e->p1), TO_D3(base1)), r2 = SUB3_T(D3, TO_D3(e->p2), TO_D3(base2));
+  const D3 nrm_eye = CROSS3_T(D3, r2, r1), qf = SUB3_T(D3, TO_D3(e->pf), DSPLAT3(c->eye));
+  const D3 nrm = SCALE3_T(D3, nrm_eye, TO_D(sign));
+#define PL(l) ((tri_plane *)((char *)pl + (size_t)(l) * pstride))
+  /* (cx, cy): the sample nearest to where p_f projects, within the image; the
+   * coordinates of q_f in the basis of the camera's (d0, dx, dy) or, orthographic,
+   * of q_f − o0 in (ox, oy, fwd), by the dual basis (the rows of its inverse). */
+  VF cx = zero, cy = zero;
+  if (c->planar) {
+    vec3 u = ortho ? c->ox : c->dx, v = ortho ? c->oy : c->dy, w0 = ortho ? c->fwd : c->d0;
+    V3 qp = SUB3(e->pf, SPLAT3(c->eye));
+    if (ortho) qp = SUB3(qp, SPLAT3(c->o0));
+    /* perspective: q = λ·(d0 + sx·dx + sy·dy), sx = q·(dy × d0) / q·(dx × dy);
+     * orthographic: q = sx·ox + sy·oy + t·fwd, sx = q·(oy × fwd) / fwd·(ox × oy) */
+    const vec3 uv = v3_cross(u, v);
+    const VF depth = ortho ? VF_(splat)(v3_dot(w0, uv)) : DOT3(qp, SPLAT3(uv));
+    const VF lo_x = VF_(splat)(c->sx0), hi_x = VF_(splat)((float)(c->width - 1) + c->sx0);
+    const VF lo_y = VF_(splat)(c->sy0), hi_y = VF_(splat)((float)(c->height - 1) + c->sy0);
+    cx = DOT3(qp, SPLAT3(v3_cross(v, w0))) / depth, cy = DOT3(qp, SPLAT3(v3_cross(w0, u))) / depth;
+    if (pl)
+      for (int l = 0; l < count; l++) PL(l)->px = cx[l], PL(l)->py = cy[l];
+    /* NaN (a corner in the eye's plane) clamps to the far side: any sample is exact
+     * (tri_setup_at repeats these operations for another position) */
+    cx = VF_(max)(VF_(min)(cx, hi_x), lo_x), cy = VF_(max)(VF_(min)(cy, hi_y), lo_y);
+    cx = VF_(floor)(cx - lo_x) + lo_x, cy = VF_(floor)(cy - lo_y) + lo_y;
+  }
+  const VD dcx = TO_D(cx), dcy = TO_D(cy);
+  VD pa, pb, pc, num0, num_x = TO_D(zero), num_y = num_x, base;
+  if (c->type == RR_CAMERA_PERSPECTIVE) {
+    pb = DOT3(nrm, DSPLAT3(c->dx)), pc = DOT3(nrm, DSPLAT3(c->dy));
+    base = DOT3(nrm, DSPLAT3(c->d0));
+    pa = base + dcx * pb + dcy * pc;
+    num0 = DOT3(nrm, qf);
+    if (pl)
+      for (int l = 0; l < count; l++) PL(l)->base = base[l], PL(l)->u = pb[l], PL(l)->v = pc[l];
+  } else if (ortho) {
+    /* rays from eye + o0 + sx·ox + sy·oy along fwd */
+    pa = DOT3(nrm, DSPLAT3(c->fwd)), pb = num_x, pc = num_x;
+    num_x = -DOT3(nrm, DSPLAT3(c->ox)), num_y = -DOT3(nrm, DSPLAT3(c->oy));
+    base = DOT3(nrm, SUB3_T(D3, qf, DSPLAT3(c->o0)));
+    num0 = base + dcx * num_x + dcy * num_y;
+    if (pl)
+      for (int l = 0; l < count; l++) PL(l)->base = base[l], PL(l)->u = num_x[l], PL(l)->v = num_y[l];
+  } else {
+    pa = nrm.x, pb = nrm.y, pc = nrm.z;
+    num0 = DOT3(nrm, qf);
+  }
+#undef PL
+  VF w[3];
+  for (int k = 0; k < 3; k++) w[k] = VF_(select)(e->at_inf[k], zero, one);
+  const VF fpa = TO_F(pa), fpb = TO_F(pb), fpc = TO_F(pc), fn0 = TO_F(num0), fnx = TO_F(num_x), fny = TO_F(num_y);
+  for (int l = 0; l < count; l++) {
+    face[l] = !(kept >> l & 1) ? SETUP_CULLED : front_m >> l & 1 ? SETUP_FRONT : SETUP_BACK;
+    if (face[l] == SETUP_CULLED) continue;
+    tri_setup *o = (tri_setup *)((char *)out + (size_t)l * ostride);
+    for (int i = 0; i < 3; i++) o->a[i] = ea[i][l], o->b[i] = eb[i][l], o->c[i] = ec[i][l];
+    o->vol = vol[l], o->vol_x = vol_x[l], o->vol_y = vol_y[l];
+    o->tie = (uint32_t)tie[l];
+    for (int k = 0; k < 3; k++) o->w[k] = w[k][l];
+    o->pa = fpa[l], o->pb = fpb[l], o->pc = fpc[l];
+    o->num0 = fn0[l], o->num_x = fnx[l], o->num_y = fny[l];
+    o->cx = cx[l], o->cy = cy[l];
   }
 }
 
-/* setup_lanes for several cameras (it is always inlined: a call of its own here),
- * compiled apart for scenes with and without instances. */
-TARGET static void RR_CAT(setup_views, W)(const rr_scene *s, const uint32_t *ids, int count, const camera *cams,
-                                          int ncams, const uint8_t *views, bool cull, tri_setup *out, int *face,
-                                          tri_plane *pl, size_t stride) {
-  if (s->inst)
-    RR_CAT(setup_lanes, W)(s, ids, count, cams, ncams, views, cull, out, face, pl, stride, false);
-  else
-    RR_CAT(setup_lanes, W)(s, ids, count, cams, ncams, views, cull, out, face, pl, stride, true);
+/* Triangles ids[0..count-1] for camera c: out[l], face[l], pl[l] (when not NULL). */
+TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_lanes, W)(const rr_scene *s, const uint32_t *ids,
+                                                                              int count, const camera *c, bool cull,
+                                                                              tri_setup *out, int *face, tri_plane *pl,
+                                                                              bool flat) {
+  EYE e;
+  RR_CAT(eye_lanes, W)(s, ids, count, c->eye, flat, &e);
+  RR_CAT(view_lanes, W)(&e, count, (1 << count) - 1, c, cull, out, sizeof *out, face, pl, sizeof *pl, true);
 }
 
-/* setup_lanes for one camera and every lane, compiled without the loop over
- * cameras, and apart for scenes with and without instances. */
+/* setup_lanes compiled apart for scenes with and without instances. */
 TARGET static void RR_CAT(setup_one, W)(const rr_scene *s, const uint32_t *ids, int count, const camera *c, bool cull,
                                         tri_setup *out, int *face, tri_plane *pl) {
   if (s->inst)
-    RR_CAT(setup_lanes, W)(s, ids, count, c, 1, NULL, cull, out, face, pl, 0, false);
+    RR_CAT(setup_lanes, W)(s, ids, count, c, cull, out, face, pl, false);
   else
-    RR_CAT(setup_lanes, W)(s, ids, count, c, 1, NULL, cull, out, face, pl, 0, true);
+    RR_CAT(setup_lanes, W)(s, ids, count, c, cull, out, face, pl, true);
+}
+
+/* The shared setup (triangle.h, rr_tri_setup_shared): EYE of every triangle once,
+ * stored by field (rec), then, for each camera, the triangles it asks for gathered
+ * W to a step (loaded when they are W in a row) and set up for it. Stored and
+ * gathered floats keep their bits, and view_lanes computes what it computes for
+ * the triangles in any lanes. */
+enum { RR_CAT(REC_, W) = 24 }; /* fields: p1, p2, pf, n (3 each), vol; at_inf (3), inf1, inf2 */
+TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_shared_lanes, W)(
+    const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams, const int32_t *sel, const int *nsel,
+    bool cull, tri_setup *out, size_t ostride, int *face, tri_plane *pl, size_t pstride, bool flat) {
+  float rec[RR_CAT(REC_, W)][TRI_SHARED_MAX + W]; /* (W lanes past the last triangle: its stores) */
+#define STORE_F(f, v) memcpy(&rec[f][k], &(v), W * sizeof(float))
+#define STORE3(f, v) (STORE_F(f, (v).x), STORE_F((f) + 1, (v).y), STORE_F((f) + 2, (v).z))
+  for (int k = 0; k < n; k += W) {
+    EYE e;
+    RR_CAT(eye_lanes, W)(s, ids + k, n - k < W ? n - k : W, cams[0].eye, flat, &e);
+    STORE3(0, e.p1), STORE3(3, e.p2), STORE3(6, e.pf);
+    for (int i = 0; i < 3; i++) STORE3(9 + 3 * i, e.n[i]);
+    STORE_F(18, e.vol);
+    if (s->inf) {
+      for (int i = 0; i < 3; i++) STORE_F(19 + i, e.at_inf[i]);
+      STORE_F(22, e.inf1), STORE_F(23, e.inf2);
+    }
+  }
+#undef STORE3
+#undef STORE_F
+  const VI all = VI_(splat)(-1);
+#define GATHER_F(f) (run ? VF_(load)(rec[f] + lane[0]) : VF_(gather)(rec[f], idx))
+#define GATHER3(f) ((V3){GATHER_F(f), GATHER_F((f) + 1), GATHER_F((f) + 2)})
+#define GATHER_I(f) \
+  (run ? VI_(load)((const int32_t *)rec[f] + lane[0]) : VI_(gather_masked)((const int32_t *)rec[f], idx, all))
+  for (int view = 0, at = 0; view < ncams; at += nsel[view++])
+    for (int j = 0; j < nsel[view]; j += W) {
+      const int m = nsel[view] - j < W ? nsel[view] - j : W;
+      int32_t lane[W];
+      for (int l = 0; l < W; l++) lane[l] = sel[at + j + (l < m ? l : m - 1)];
+      const VI idx = VI_(load)(lane);
+      /* W of a face's triangles in a row (the common case): loads, cheaper than gathers */
+      const bool run = m == W && VI_(bits)(idx == VI_(splat)(lane[0]) + VI_(lanes)()) == (1 << W) - 1;
+      EYE e; /* what view_lanes reads for a camera that is not orthographic */
+      e.p1 = GATHER3(0), e.p2 = GATHER3(3), e.pf = GATHER3(6);
+      for (int i = 0; i < 3; i++) e.n[i] = GATHER3(9 + 3 * i);
+      e.vol = GATHER_F(18);
+      e.at_inf[0] = e.at_inf[1] = e.at_inf[2] = e.inf1 = e.inf2 = VI_(splat)(0);
+      if (s->inf) {
+        for (int i = 0; i < 3; i++) e.at_inf[i] = GATHER_I(19 + i);
+        e.inf1 = GATHER_I(22), e.inf2 = GATHER_I(23);
+      }
+      RR_CAT(view_lanes, W)(&e, m, (1 << m) - 1, &cams[view], cull, (tri_setup *)((char *)out + (at + j) * ostride),
+                            ostride, face + at + j, pl ? (tri_plane *)((char *)pl + (at + j) * pstride) : NULL,
+                            pstride, false);
+    }
+#undef GATHER_I
+#undef GATHER3
+#undef GATHER_F
+}
+
+TARGET static void RR_CAT(setup_shared, W)(const rr_scene *s, const uint32_t *ids, int n, const camera *cams,
+                                           int ncams, const int32_t *sel, const int *nsel, bool cull, tri_setup *out,
+                                           size_t ostride, int *face, tri_plane *pl, size_t pstride) {
+  if (s->inst)
+    RR_CAT(setup_shared_lanes, W)(s, ids, n, cams, ncams, sel, nsel, cull, out, ostride, face, pl, pstride, false);
+  else
+    RR_CAT(setup_shared_lanes, W)(s, ids, n, cams, ncams, sel, nsel, cull, out, ostride, face, pl, pstride, true);
 }
 
 #include "prim/triangle_moved_tmp.h"
@@ -291,3 +350,4 @@ TARGET static void RR_CAT(moved_lanes, W)(const tri_setup *ts, const tri_plane *
 #undef TO_F
 #undef TO_D3
 #undef DSPLAT3
+#undef EYE

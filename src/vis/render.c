@@ -156,6 +156,17 @@ static inline __attribute__((always_inline)) void visbuf_clear(visbuf *vb, size_
 RR_TARGET_AVX2 static void visbuf_clear_avx2(visbuf *vb, size_t n) { visbuf_clear(vb, n); }
 #endif
 
+/* visbuf_clear with AVX2 where the processor has it. */
+static void visbuf_clear_any(visbuf *vb, size_t n) {
+#ifdef RR_SIMD_X86
+  if (__builtin_cpu_supports("avx2")) {
+    visbuf_clear_avx2(vb, n);
+    return;
+  }
+#endif
+  visbuf_clear(vb, n);
+}
+
 /* A buffer of w × h pixels of `samples` samples each (vis.h: a pixel's side by side). */
 static bool visbuf_alloc(visbuf *vb, int w, int h, int samples) {
   size_t n = (size_t)w * h * samples;
@@ -168,13 +179,7 @@ static bool visbuf_alloc(visbuf *vb, int w, int h, int samples) {
     visbuf_free(vb);
     return false;
   }
-#ifdef RR_SIMD_X86
-  if (__builtin_cpu_supports("avx2")) {
-    visbuf_clear_avx2(vb, n);
-    return true;
-  }
-#endif
-  visbuf_clear(vb, n);
+  visbuf_clear_any(vb, n);
   return true;
 }
 
@@ -314,12 +319,20 @@ static rr_error render_cube(rr_device *dev, rr_method m, render_ctx ctx, progres
   camera fc[6 * RR_MAX_SAMPLES];
   for (int f = 0; f < 6; f++)
     for (int s = 0; s < ns; s++) rr_cam_cube_face(&ctx.cams[s], f, &fc[f * ns + s]);
-  visbuf fvb, faces[6];
+  /* the faces' buffers from the device's scratch, kept from frame to frame: no
+   * fresh pages to fault in and zero every frame (six separate renders' buffers
+   * are small enough to come back from the heap) */
+  const size_t nf = 6 * FF * ns, part = (nf * sizeof(float) + 63) / 64 * 64;
+  rr_buf fbuf = rr_scratch_take(dev, SCRATCH_CUBE, 4 * part);
   float *heat = NULL;
-  if (!visbuf_alloc(&fvb, F, 6 * F, ns) || (ctx.heat_e && !(heat = calloc(12 * FF, sizeof *heat)))) {
-    visbuf_free(&fvb);
+  if (!fbuf.p || (ctx.heat_e && !(heat = calloc(12 * FF, sizeof *heat)))) {
+    rr_scratch_give(dev, fbuf);
     return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for a cube camera's faces of %dx%d", F, F);
   }
+  char *fp = fbuf.p;
+  visbuf fvb = {F, 6 * F, (uint32_t *)fp, (float *)(fp + part), (float *)(fp + 2 * part), (float *)(fp + 3 * part), ns},
+         faces[6];
+  visbuf_clear_any(&fvb, nf);
   /* face f: F × F pixels of ns samples, after the f before it */
   for (int f = 0; f < 6; f++) {
     const size_t o = (size_t)f * FF * ns;
@@ -354,7 +367,7 @@ static rr_error render_cube(rr_device *dev, rr_method m, render_ctx ctx, progres
         ctx.heat_e[k] += heat[j], ctx.heat_n[k] += heat[6 * FF + j];
       }
   }
-  visbuf_free(&fvb);
+  rr_scratch_give(dev, fbuf);
   free(heat);
   return e;
 }

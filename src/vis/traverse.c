@@ -484,41 +484,49 @@ static uint32_t setup_analytic(trav *t, uint32_t first, const uint32_t *ids, uin
 
 /* A cube camera's triangles first..first+n-1 (trav.faces): each one's rectangle in
  * every face from its corners, then, for those that meet a face, the part of the
- * setup that depends on the eye once and the rest for each face met
- * (rr_tri_setup_views): one job per triangle and face, S once per triangle. */
+ * setup that depends on the eye once and the rest for each face met, a face's
+ * triangles together in the lanes (rr_tri_setup_shared): one job per triangle and
+ * face, S once per triangle. The setups go straight into the jobs, which are then
+ * finished in place (a dropped one leaves no gap). */
 static uint32_t setup_faces(trav *t, uint32_t first, uint32_t n, tri_job *out) {
-  enum { GROUP = 64 };
+  enum { GROUP = TRI_SHARED_MAX };
   uint32_t kept = 0;
   for (uint32_t g = first; g < first + n; g += GROUP) {
     const uint32_t m = first + n - g < GROUP ? first + n - g : GROUP;
     tri_bound b[6][GROUP];
-    uint8_t views[GROUP] = {0}, slot[6][GROUP];
+    int nb[6];
+    int16_t at[GROUP]; /* triangle g + i's place in ids, -1 when it meets no face */
+    memset(at, 0xFF, sizeof at);
     for (int f = 0; f < 6; f++) {
-      uint32_t nb = rr_tri_corner_bounds_at(t->s, g, NULL, m, &t->face_cams[f * t->ns], t->ns, t->pos, t->simd, b[f]);
-      for (uint32_t k = 0; k < nb; k++) views[b[f][k].id - g] |= (uint8_t)(1u << f), slot[f][b[f][k].id - g] = (uint8_t)k;
+      nb[f] = (int)rr_tri_corner_bounds_at(t->s, g, NULL, m, &t->face_cams[f * t->ns], t->ns, t->pos, t->simd, b[f]);
+      for (int k = 0; k < nb[f]; k++) at[b[f][k].id - g] = 0;
     }
     uint32_t ids[GROUP];
-    uint8_t v[GROUP], at[GROUP];
     int q = 0;
     for (uint32_t i = 0; i < m; i++)
-      if (views[i]) ids[q] = g + i, v[q] = views[i], at[q++] = (uint8_t)i;
+      if (!at[i]) at[i] = (int16_t)q, ids[q++] = g + i;
     if (!q) continue;
     t->st.setups += (uint64_t)q;
-    tri_setup ts[6 * GROUP];
-    int face[6 * GROUP];
-    tri_plane pls[6 * GROUP], *pl = t->ns > 1 ? pls : NULL;
-    rr_tri_setup_views(t->s, ids, q, t->face_cams0, 6, v, t->cull_back, t->simd, ts, face, pl);
+    int32_t sel[6 * GROUP];
+    int face[6 * GROUP], pairs = 0;
     for (int f = 0; f < 6; f++)
-      for (int i = 0; i < q; i++) {
-        const int k = f * q + i;
-        if (face[k] == SETUP_CULLED) continue;
-        const tri_bound *tb = &b[f][slot[f][at[i]]];
+      for (int k = 0; k < nb[f]; k++) sel[pairs++] = at[b[f][k].id - g];
+    tri_job *jobs = out + kept; /* room for 6 a triangle: kept + pairs <= 6 (g + m - first) */
+    const bool several = t->ns > 1;
+    rr_tri_setup_shared(t->s, ids, q, t->face_cams0, 6, sel, nb, t->cull_back, t->simd, &jobs->ts, sizeof *jobs, face,
+                        several ? &jobs->pl : NULL, sizeof *jobs);
+    for (int f = 0, p = 0; f < 6; f++)
+      for (int k = 0; k < nb[f]; k++, p++) {
+        if (face[p] == SETUP_CULLED) continue;
         tri_job *j = out + kept;
         use_face(t, f);
-        j->ts = ts[k];
-        if (pl) j->pl = pl[k], j->pos = tb->pos;
-        memcpy(j->bb, tb->bb, sizeof j->bb);
-        kept += finish_setup(t, ids[i], j);
+        if (j != &jobs[p]) {
+          j->ts = jobs[p].ts;
+          if (several) j->pl = jobs[p].pl;
+        }
+        if (several) j->pos = b[f][k].pos;
+        memcpy(j->bb, b[f][k].bb, sizeof j->bb);
+        kept += finish_setup(t, ids[sel[p]], j);
       }
   }
   if (t->s->kind) { /* analytic primitives: bounded in every face, S once */
