@@ -21,6 +21,7 @@
  * image in the bounding box of that annular sector (or of the whole disk, or the
  * whole width for the lat-long, near the axis or across the seam). */
 #include "prim/triangle.h"
+#include "camera/lens.h"
 #include "core/simd.h"
 
 #include <math.h>
@@ -469,14 +470,30 @@ int rr_tri_sphere_cap_rect(const camera *c, const tri_sphere *sp, int r[4]) {
 }
 
 
+static bool lens(const camera *c) { return c->type == RR_CAMERA_OPENCV || c->type == RR_CAMERA_OPENCV_FISHEYE; }
+
+/* The OpenCV lenses: the cap holds every passing sample's exact direction (the
+ * comment at the top); its image through the lens (rr_lens_cap_extent). */
+static int lens_rect(const camera *c, const tri_sphere *sp, int r[4]) {
+  if (!sp->ok || !sp->cap) return -1;
+  const dv3 m = dv(sp->axis[0], sp->axis[1], sp->axis[2]);
+  const double axis[3] = {ddot(m, dvf(c->right)), -ddot(m, dvf(c->up)), ddot(m, dvf(c->fwd))}; /* x right, y down */
+  double e[4];
+  int k = rr_lens_cap_extent(&c->lens, c->lens_fold, axis, sp->rho, e);
+  if (k <= 0) return k;
+  return sample_rect(c, e[0], e[1], e[2], e[3], r) ? (sp->smin > 1e-3 ? 1 : 2) : 0;
+}
+
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
-  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
+  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE && !lens(c))
+    return -1;
   tri_sphere sp;
   rr_tri_spheres_cam(ts, 1, c, true, &sp);
   return rr_tri_curved_rect_sph(c, ts, &sp, r);
 }
 
 int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_sphere *sp, int r[4]) {
+  if (lens(c)) return lens_rect(c, sp, r);
   if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
   const int lanes = rr_tri_sphere_decided(c, sp, r);
   if (lanes >= 0) return lanes;
