@@ -57,7 +57,9 @@ static vec3 hard_dir(const rr_camera *rc, vec3 f, vec3 r, vec3 u) {
 
 static long flat_missed_all; /* passing samples outside chart bounds without their remainder */
 
-static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int ntri, const char *what) {
+/* front: small triangles (1e-2 to 0.25 rad) within 30° of the axis, where every
+ * camera's bound must be tight, instead of the hard directions' triangles. */
+static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int ntri, bool front, const char *what) {
   float pos[2] = {(float)rnd(), (float)rnd()};
   camera c;
   CHECK(rr_cam_setup_at(dev, rc, w, h, pos, &c) == RR_OK, "%s: camera", what);
@@ -66,8 +68,8 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   uint32_t *idx = malloc((size_t)ntri * 3 * sizeof *idx);
   for (int k = 0; k < 3 * ntri; k++) idx[k] = (uint32_t)k;
   for (int t = 0; t < ntri; t++) {
-    vec3 centre = hard_dir(rc, c.fwd, c.right, c.up);
-    double size = exp(log(1e-3) + rnd() * (log(1.5) - log(1e-3)));
+    vec3 centre = front ? polar(c.fwd, c.right, c.up, 0.52 * rnd(), 2 * RR_PI * rnd()) : hard_dir(rc, c.fwd, c.right, c.up);
+    double size = exp((front ? log(1e-2) : log(1e-3)) + rnd() * (front ? log(0.25) - log(1e-2) : log(1.5) - log(1e-3)));
     /* a quarter are slivers: the third corner near the line through the first two
      * (chart_extent moves a sharp corner along the sliver only) */
     const bool sliver = rnd() < 0.25;
@@ -203,6 +205,11 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   flat_missed_all += flat_missed; /* checked over every view (main) */
   CHECK(corner_missed == 0, "%s: %ld passing samples outside their triangle's corner cap", what, corner_missed);
   CHECK(!polar_map || tight * 10 >= seen * 9, "%s: tight bounds for only %ld of %ld triangles", what, tight, seen);
+  /* the lenses' small triangles ahead: tight rectangles, on average under 5% of the image */
+  const bool lens = rc->type == RR_CAMERA_OPENCV || rc->type == RR_CAMERA_OPENCV_FISHEYE;
+  CHECK(!lens || !front || tight * 10 >= seen * 9, "%s: tight bounds for only %ld of %ld triangles", what, tight, seen);
+  CHECK(!lens || !front || area * 20 < seen * (long)w * h, "%s: rectangles of %.1f%% of the image on average", what,
+        seen ? 100.0 * area / ((double)seen * w * h) : 0.0);
   /* the cap's radius is not loose by half: halved, it misses samples */
   CHECK(!polar_map || half_missed > 0, "%s: a cap of half the radius misses no sample", what);
   printf("%s: %ld triangles (%ld tight, %ld capped), %ld passing samples in rectangles of %ld samples (%.1f%%); "
@@ -406,7 +413,11 @@ int main(void) {
       if (rc.type == RR_CAMERA_OPENCV) memcpy(rc.dist, brown, sizeof brown);
       char what[64];
       snprintf(what, sizeof what, "%s, view %d", cams[k].what, view);
-      check_camera(dev, &rc, cams[k].w, cams[k].h, ntri, what);
+      check_camera(dev, &rc, cams[k].w, cams[k].h, ntri, false, what);
+      if (rc.type == RR_CAMERA_OPENCV || rc.type == RR_CAMERA_OPENCV_FISHEYE) { /* and small triangles ahead */
+        snprintf(what, sizeof what, "%s ahead, view %d", cams[k].what, view);
+        check_camera(dev, &rc, cams[k].w, cams[k].h, ntri, true, what);
+      }
     }
   /* the chart's remainder is needed: without it, the linearisation misses samples */
   CHECK(flat_missed_all > 0, "the chart bounds without their remainder miss no sample");
