@@ -197,6 +197,8 @@ int rr_lens_cap_extent(const rr_camera *cam, double fold, const double axis[3], 
   a = iv(a.lo - 1e-12 * (1 + fabs(a.lo)), a.hi + 1e-12 * (1 + fabs(a.hi)));
   b = iv(b.lo - 1e-12 * (1 + fabs(b.lo)), b.hi + 1e-12 * (1 + fabs(b.hi)));
   ival r2 = iadd(isq(a), isq(b));
+  double big = 1, ksum = 1; /* the sums' largest terms, for the rounding: (1 + Σ|k|)(1 + x)³ / den */
+  for (int i = 0; i < 8; i++) ksum += fabs(k[i]);
   if (cam->type == RR_CAMERA_OPENCV_FISHEYE) {
     /* a pixel's m = θd(θ)/tan θ·(a, b), θ = atan |(a, b)| < fold: θd(θ)/θ a polynomial in
      * θ², θ/tan θ decreasing from 1 at 0 */
@@ -205,6 +207,7 @@ int rr_lens_cap_extent(const rr_camera *cam, double fold, const double axis[3], 
     const double c[4] = {k[0], k[1], k[2], k[3]};
     ival q = imul(ipoly1(isq(th), c, 4), iv(th.hi > 0 ? th.hi / tan(th.hi) : 1, th.lo > 0 ? th.lo / tan(th.lo) : 1));
     m[0] = imul(a, q), m[1] = imul(b, q);
+    big = pow(1 + th.hi * th.hi, 3);
   } else {
     /* distort() in intervals, r² < fold² (undistort's condition for a ray) */
     if (!(r2.lo < fold * fold)) return 0;
@@ -215,13 +218,16 @@ int rr_lens_cap_extent(const rr_camera *cam, double fold, const double axis[3], 
     ival q = imul(num, iv(1 / den.hi, 1 / den.lo)), ab = iscale(imul(a, b), 2);
     m[0] = iadd(iadd(imul(a, q), iscale(ab, k[2])), iscale(iadd(r2, iscale(isq(a), 2)), k[3]));
     m[1] = iadd(iadd(imul(b, q), iscale(iadd(r2, iscale(isq(b), 2)), k[2])), iscale(ab, k[3]));
+    big = pow(1 + r2.hi, 3) / den.lo;
   }
+  big *= 1e-14 * ksum * (1 + fmax(fabs(a.lo), fabs(a.hi)) + fmax(fabs(b.lo), fabs(b.hi)));
   /* sample coordinates: the image point plus 0.5 (rr_lens_unproject's pixel centres
-   * at integers); the margin covers the rounding and undistort's residual */
+   * at integers); the margin covers the rounding (relative to the products, and
+   * `big` for the sums' cancellation) and undistort's residual (1e-13 of m) */
   const double f[2] = {cam->fx, cam->fy}, cc[2] = {cam->cx + 0.5, cam->cy + 0.5};
   for (int j = 0; j < 2; j++) {
     ival p = iscale(m[j], f[j]);
-    double mg = 1e-9 * (fabs(p.lo) + fabs(p.hi) + f[j]);
+    double mg = 1e-9 * (fabs(p.lo) + fabs(p.hi) + f[j]) + big * f[j];
     e[2 * j] = p.lo + cc[j] - mg, e[2 * j + 1] = p.hi + cc[j] + mg;
     if (!isfinite(e[2 * j]) || !isfinite(e[2 * j + 1])) return -1;
   }

@@ -279,9 +279,10 @@ bool rr_tri_screen_bounds_sph(const rr_scene *s, uint32_t i, const camera *c, co
                               const tri_sphere *sp, int rect[4]);
 /* The tight rectangle of the curved views polar about an axis (lat-long, parabolic,
  * fisheye), from the spherical triangle of the setup's edge planes
- * (prim/triangle_curved.c): 1 with rect, 2 with a rect whose margin is wide (a
- * sliver: the cells may bound it better), 0 when no sample can pass, -1 when it
- * knows no bound (another camera, a degenerate setup). */
+ * (prim/triangle_curved.c), and of the OpenCV lenses, from the cap that holds it
+ * (wholly ahead: camera/lens.c, rr_lens_cap_extent): 1 with rect, 2 with a rect
+ * whose margin is wide (a sliver: the cells may bound it better), 0 when no sample
+ * can pass, -1 when it knows no bound (another camera, a degenerate setup). */
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
 /* What the curved bounds take from a setup, whatever the camera's position: its
  * spherical triangle (sin of half the least interior angle smin, the widening E;
