@@ -191,6 +191,9 @@ static ival cone_range(double a, double g, double s) {
 int rr_lens_cap_extent(const rr_camera *cam, double fold, const double axis[3], double rho, double e[4]) {
   const float *k = cam->dist;
   rho += 1e-6; /* the float basis the rays are made in is orthonormal to a few 1e-8 */
+  /* every ray lies within the field's angle from the axis: atan(fold), or the fisheye's fold */
+  const double field = cam->type == RR_CAMERA_OPENCV_FISHEYE ? fold : atan(fold);
+  if (field < RR_PI && acos(fmax(-1.0, fmin(1.0, axis[2]))) - rho > field + 1e-6) return 0;
   const double s = sin(rho);
   if (!(rho < 1.5) || !(axis[2] > s + 1e-3)) return -1; /* not wholly in front */
   ival a = cone_range(axis[0], axis[2], s), b = cone_range(axis[1], axis[2], s), m[2];
