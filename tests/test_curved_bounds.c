@@ -422,6 +422,9 @@ int main(void) {
       {RR_CAMERA_CUBE, 90, 96, 72, "cube"},
       {RR_CAMERA_OPENCV_FISHEYE, 150, 96, 80, "opencv-fisheye"},
       {RR_CAMERA_OPENCV, 100, 96, 80, "opencv"},
+      /* narrower: the field ends at the image's corners, not at the fold (rr_lens_field) */
+      {RR_CAMERA_OPENCV_FISHEYE, 90, 96, 80, "opencv-fisheye 90"},
+      {RR_CAMERA_OPENCV, 80, 96, 80, "opencv radial"},
   };
   for (size_t k = 0; k < sizeof cams / sizeof cams[0]; k++)
     for (int view = 0; view < 2; view++) {
@@ -435,6 +438,7 @@ int main(void) {
       /* Brown–Conrady: strong barrel (folding back near the corners) with tangential terms */
       static const float brown[8] = {-0.3f, 0.08f, 0.002f, -0.001f, -0.01f};
       if (rc.type == RR_CAMERA_OPENCV) memcpy(rc.dist, brown, sizeof brown);
+      if (strstr(cams[k].what, "radial")) rc.dist[2] = rc.dist[3] = 0; /* no tangential terms */
       char what[64];
       snprintf(what, sizeof what, "%s, view %d", cams[k].what, view);
       check_camera(dev, &rc, cams[k].w, cams[k].h, ntri, false, what);

@@ -188,11 +188,26 @@ static ival cone_range(double a, double g, double s) {
   return iv((a * g - root) / den, (a * g + root) / den);
 }
 
-int rr_lens_cap_extent(const rr_camera *cam, double fold, const double axis[3], double rho, double e[4]) {
+double rr_lens_field(const rr_camera *cam, double fold, int width, int height) {
+  const float *k = cam->dist;
+  double rd = 0, d; /* the image's farthest point from the centre: samples in [-0.5, W - 0.5] × [-0.5, H - 0.5] */
+  for (int i = 0; i < 4; i++) {
+    double u = (i & 1 ? width - 0.5 : -0.5) - cam->cx, v = (i & 2 ? height - 0.5 : -0.5) - cam->cy;
+    rd = fmax(rd, sqrt(u * u / ((double)cam->fx * cam->fx) + v * v / ((double)cam->fy * cam->fy)));
+  }
+  rd *= 1 + 1e-9;
+  if (cam->type == RR_CAMERA_OPENCV_FISHEYE) /* θ solves θd(θ) = |m| on the monotone [0, fold) */
+    return theta_d(k, fold, NULL) > rd ? fmin(fold, solve_increasing(theta_d, k, rd, fold) * (1 + 1e-9) + 1e-9) : fold;
+  /* without tangential terms undistort's |p| solves r q(r²) = |m| (its Newton steps start at the answer) */
+  if (k[2] == 0 && k[3] == 0 && radial_r(k, fold, &d) > rd)
+    return atan(fmin(fold, solve_increasing(radial_r, k, rd, fold) * (1 + 1e-9) + 1e-9));
+  return atan(fold);
+}
+
+int rr_lens_cap_extent(const rr_camera *cam, double fold, double field, const double axis[3], double rho,
+                       double e[4]) {
   const float *k = cam->dist;
   rho += 1e-6; /* the float basis the rays are made in is orthonormal to a few 1e-8 */
-  /* every ray lies within the field's angle from the axis: atan(fold), or the fisheye's fold */
-  const double field = cam->type == RR_CAMERA_OPENCV_FISHEYE ? fold : atan(fold);
   if (field < RR_PI && acos(fmax(-1.0, fmin(1.0, axis[2]))) - rho > field + 1e-6) return 0;
   const double s = sin(rho);
   if (!(rho < 1.5) || !(axis[2] > s + 1e-3)) return -1; /* not wholly in front */

@@ -303,7 +303,7 @@ static unsigned lens_caps_show(const camera *cams, int ns, const double axis[3][
       const dv3 m = dv(axis[0][l], axis[1][l], axis[2][l]);
       const double ax[3] = {ddot(m, dvf(c->right)), -ddot(m, dvf(c->up)), ddot(m, dvf(c->fwd))}; /* x right, y down */
       double e[4];
-      int q[4], k = rr_lens_cap_extent(&c->lens, c->lens_fold, ax, rho[l], e);
+      int q[4], k = rr_lens_cap_extent(&c->lens, c->lens_fold, c->lens_field, ax, rho[l], e);
       if (k < 0 || (k > 0 && sample_rect(c, e[0], e[1], e[2], e[3], q) && q[0] < r[2] && q[2] >= r[0] &&
                     q[1] < r[3] && q[3] >= r[1]))
         shown |= 1u << l;
@@ -515,7 +515,7 @@ static int lens_rect(const camera *c, const tri_sphere *sp, int r[4]) {
   const dv3 m = dv(sp->axis[0], sp->axis[1], sp->axis[2]);
   const double axis[3] = {ddot(m, dvf(c->right)), -ddot(m, dvf(c->up)), ddot(m, dvf(c->fwd))}; /* x right, y down */
   double e[4];
-  int k = rr_lens_cap_extent(&c->lens, c->lens_fold, axis, sp->rho, e);
+  int k = rr_lens_cap_extent(&c->lens, c->lens_fold, c->lens_field, axis, sp->rho, e);
   if (k <= 0) return k;
   return sample_rect(c, e[0], e[1], e[2], e[3], r) ? (sp->smin > 1e-3 ? 1 : 2) : 0;
 }
