@@ -350,7 +350,8 @@ int rr_cam_extent_rect(const camera *c, const double e[4], int k, int rect[4]);
 /* rr_cam_cap_rect for four caps in lanes at once, and for the ns positions
  * cams[0..ns-1] (cameras that differ only in sx0, sy0): the lanes of the bit mask
  * used whose rectangle at some position meets r (x0, y0, x1, y1, ends exclusive),
- * or that know no bound (every lane for cameras not polar); AVX2 when simd. */
+ * or that know no bound (every lane for cameras neither polar nor an OpenCV lens,
+ * whose caps go through the lens, rr_lens_cap_extent, a lane at a time); AVX2 when simd. */
 unsigned rr_cam_caps_show4(const camera *cams, int ns, const double axis[3][4], const double rho[4], unsigned used,
                            const int r[4], bool simd);
 /* Boxes a polar camera's samples see most of (rr_cam_cap_shortcut, for a walk
