@@ -57,7 +57,9 @@ static vec3 hard_dir(const rr_camera *rc, vec3 f, vec3 r, vec3 u) {
 
 static long flat_missed_all; /* passing samples outside chart bounds without their remainder */
 
-static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int ntri, const char *what) {
+/* front: small triangles (1e-2 to 0.25 rad) within 30° of the axis, where every
+ * camera's bound must be tight, instead of the hard directions' triangles. */
+static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int ntri, bool front, const char *what) {
   float pos[2] = {(float)rnd(), (float)rnd()};
   camera c;
   CHECK(rr_cam_setup_at(dev, rc, w, h, pos, &c) == RR_OK, "%s: camera", what);
@@ -66,8 +68,8 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   uint32_t *idx = malloc((size_t)ntri * 3 * sizeof *idx);
   for (int k = 0; k < 3 * ntri; k++) idx[k] = (uint32_t)k;
   for (int t = 0; t < ntri; t++) {
-    vec3 centre = hard_dir(rc, c.fwd, c.right, c.up);
-    double size = exp(log(1e-3) + rnd() * (log(1.5) - log(1e-3)));
+    vec3 centre = front ? polar(c.fwd, c.right, c.up, 0.52 * rnd(), 2 * RR_PI * rnd()) : hard_dir(rc, c.fwd, c.right, c.up);
+    double size = exp((front ? log(1e-2) : log(1e-3)) + rnd() * (front ? log(0.25) - log(1e-2) : log(1.5) - log(1e-3)));
     /* a quarter are slivers: the third corner near the line through the first two
      * (chart_extent moves a sharp corner along the sliver only) */
     const bool sliver = rnd() < 0.25;
@@ -203,6 +205,12 @@ static void check_camera(rr_device *dev, const rr_camera *rc, int w, int h, int 
   flat_missed_all += flat_missed; /* checked over every view (main) */
   CHECK(corner_missed == 0, "%s: %ld passing samples outside their triangle's corner cap", what, corner_missed);
   CHECK(!polar_map || tight * 10 >= seen * 9, "%s: tight bounds for only %ld of %ld triangles", what, tight, seen);
+  /* the lenses' small triangles ahead: tight rectangles, on average under 10% of the image (one
+   * cell of the cones, the bound without, is 13% of it) */
+  const bool lens = rc->type == RR_CAMERA_OPENCV || rc->type == RR_CAMERA_OPENCV_FISHEYE;
+  CHECK(!lens || !front || tight * 10 >= seen * 9, "%s: tight bounds for only %ld of %ld triangles", what, tight, seen);
+  CHECK(!lens || !front || area * 10 < seen * (long)w * h, "%s: rectangles of %.1f%% of the image on average", what,
+        seen ? 100.0 * area / ((double)seen * w * h) : 0.0);
   /* the cap's radius is not loose by half: halved, it misses samples */
   CHECK(!polar_map || half_missed > 0, "%s: a cap of half the radius misses no sample", what);
   printf("%s: %ld triangles (%ld tight, %ld capped), %ld passing samples in rectangles of %ld samples (%.1f%%); "
@@ -262,6 +270,8 @@ static void check_bend(rr_device *dev, rr_camera_type type, float fov, int w, in
   rr_cam_release(&c);
 }
 
+static void check_boxes(const rr_camera *rc, const camera *c);
+
 /* rr_cam_cap_rect: every sample whose ray lies within the cap (short of the rays'
  * rounding) lies in the cap's rectangle; random caps of 1e-3 to 1.4 rad about
  * the maps' hard directions. */
@@ -317,15 +327,26 @@ static void check_caps(rr_device *dev, rr_camera_type type, float fov, int w, in
   }
   CHECK(lanes_diff == 0 && shown > 0, "%s: rr_cam_caps_show4 differs from rr_cam_cap_rect %ld times",
         rr_camera_name(type), lanes_diff);
-  /* rr_cam_boxes_show4: every sample whose ray meets a random box (from the eye) is
-   * shown, with the walk's shortcut and without */
+  check_boxes(&rc, &c);
+  CHECK(bounded > 300, "%s: only %ld of 600 caps bounded", rr_camera_name(type), bounded);
+  printf("%s %g: cap rectangles hold the %ld samples of %ld caps\n", rr_camera_name(type), (double)fov, inside,
+         bounded);
+  rr_cam_release(&c);
+}
+
+/* rr_cam_boxes_show4: every sample whose ray meets a random box (from the eye) is
+ * shown, with the walk's shortcut and without; some boxes are dropped. */
+static void check_boxes(const rr_camera *rc, const camera *cp) {
+  const camera c = *cp;
+  const int w = c.width, h = c.height;
+  const rr_camera_type type = rc->type;
   const cam_cap_shortcut sc = rr_cam_cap_shortcut(&c);
   const int all[4] = {0, 0, w, h};
   long box_missed = 0, box_hit = 0, dropped = 0;
   for (int k = 0; k < 150; k++) {
     float lo[3][4], hi[3][4];
     for (int l = 0; l < 4; l++) {
-      vec3 d = v3_norm(hard_dir(&rc, c.fwd, c.right, c.up));
+      vec3 d = v3_norm(hard_dir(rc, c.fwd, c.right, c.up));
       const double dist = 0.5 + 5 * rnd(), size = dist * exp(log(1e-3) + rnd() * (log(0.5) - log(1e-3)));
       const float *e = &c.eye.x;
       for (int a = 0; a < 3; a++) {
@@ -359,10 +380,8 @@ static void check_caps(rr_device *dev, rr_camera_type type, float fov, int w, in
   CHECK(box_missed == 0 && box_hit > 0, "%s: %ld of %ld samples in boxes not shown", rr_camera_name(type), box_missed,
         box_hit);
   CHECK(dropped > 0, "%s: rr_cam_boxes_show4 dropped no box", rr_camera_name(type));
-  CHECK(bounded > 300, "%s: only %ld of 600 caps bounded", rr_camera_name(type), bounded);
-  printf("%s %g: cap rectangles hold the %ld samples of %ld caps\n", rr_camera_name(type), (double)fov, inside,
-         bounded);
-  rr_cam_release(&c);
+  printf("%s: boxes hold the %ld samples whose rays meet them, %ld of 600 dropped\n", rr_camera_name(type), box_hit,
+         dropped);
 }
 
 int main(void) {
@@ -373,6 +392,18 @@ int main(void) {
   check_caps(dev, RR_CAMERA_FISHEYE, 180, 96, 96);
   check_caps(dev, RR_CAMERA_FISHEYE, 100, 80, 96);
   check_caps(dev, RR_CAMERA_FISHEYE, 360, 80, 64);
+  for (int k = 0; k < 2; k++) { /* the OpenCV lenses' boxes, distorted as below */
+    rr_camera rc;
+    camera c;
+    rr_camera_init(&rc);
+    rc.type = k ? RR_CAMERA_OPENCV_FISHEYE : RR_CAMERA_OPENCV, rc.fov_deg = k ? 150 : 100;
+    static const float brown[8] = {-0.3f, 0.08f, 0.002f, -0.001f, -0.01f}, kb[8] = {0.05f, -0.01f};
+    memcpy(rc.dist, k ? kb : brown, sizeof brown);
+    const float pos[2] = {(float)rnd(), (float)rnd()};
+    CHECK(rr_cam_setup_at(dev, &rc, 96, 80, pos, &c) == RR_OK, "camera");
+    check_boxes(&rc, &c);
+    rr_cam_release(&c);
+  }
   check_bend(dev, RR_CAMERA_PARABOLIC, 90, 96, 80);
   check_bend(dev, RR_CAMERA_LATLONG, 90, 128, 64);
   check_bend(dev, RR_CAMERA_FISHEYE, 180, 96, 96);
@@ -391,6 +422,9 @@ int main(void) {
       {RR_CAMERA_CUBE, 90, 96, 72, "cube"},
       {RR_CAMERA_OPENCV_FISHEYE, 150, 96, 80, "opencv-fisheye"},
       {RR_CAMERA_OPENCV, 100, 96, 80, "opencv"},
+      /* narrower: the field ends at the image's corners, not at the fold (rr_lens_field) */
+      {RR_CAMERA_OPENCV_FISHEYE, 90, 96, 80, "opencv-fisheye 90"},
+      {RR_CAMERA_OPENCV, 80, 96, 80, "opencv radial"},
   };
   for (size_t k = 0; k < sizeof cams / sizeof cams[0]; k++)
     for (int view = 0; view < 2; view++) {
@@ -404,9 +438,14 @@ int main(void) {
       /* Brown–Conrady: strong barrel (folding back near the corners) with tangential terms */
       static const float brown[8] = {-0.3f, 0.08f, 0.002f, -0.001f, -0.01f};
       if (rc.type == RR_CAMERA_OPENCV) memcpy(rc.dist, brown, sizeof brown);
+      if (strstr(cams[k].what, "radial")) rc.dist[2] = rc.dist[3] = 0; /* no tangential terms */
       char what[64];
       snprintf(what, sizeof what, "%s, view %d", cams[k].what, view);
-      check_camera(dev, &rc, cams[k].w, cams[k].h, ntri, what);
+      check_camera(dev, &rc, cams[k].w, cams[k].h, ntri, false, what);
+      if (rc.type == RR_CAMERA_OPENCV || rc.type == RR_CAMERA_OPENCV_FISHEYE) { /* and small triangles ahead */
+        snprintf(what, sizeof what, "%s ahead, view %d", cams[k].what, view);
+        check_camera(dev, &rc, cams[k].w, cams[k].h, ntri, true, what);
+      }
     }
   /* the chart's remainder is needed: without it, the linearisation misses samples */
   CHECK(flat_missed_all > 0, "the chart bounds without their remainder miss no sample");

@@ -326,6 +326,7 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
       c->lens.fx = c->lens.fy = 0.5f * (float)height / c->tan_half_h;
       c->lens.cx = 0.5f * (float)width - 0.5f, c->lens.cy = 0.5f * (float)height - 0.5f;
     }
+    c->lens_field = rr_lens_field(&c->lens, c->lens_fold, width, height);
   }
   for (int y = 0; y < height; y++)
     for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);

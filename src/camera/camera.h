@@ -37,7 +37,8 @@ typedef struct camera {
   int cells_x, cells_y; /* curved: cones of CAMERA_CELL² cells of samples, 4 floats each: */
   float *cells;         /* unit axis and half-angle; no bound when >= CAMERA_NO_CONE, no rays when < 0 */
   rr_camera lens;       /* the OpenCV cameras: intrinsics and distortion as given */
-  double lens_fold;     /* and the edge of their field (rr_lens_fold) */
+  double lens_fold;     /* and the edge of their field (rr_lens_fold), */
+  double lens_field;    /* the largest angle of the image's rays from fwd (rr_lens_field) */
 } camera;
 
 #define CAMERA_CELL 32

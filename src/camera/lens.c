@@ -154,3 +154,100 @@ bool rr_lens_project(const rr_camera *cam, const double p[3], double *u, double 
   *u = cam->fx * m[0] + cam->cx, *v = cam->fy * m[1] + cam->cy;
   return true;
 }
+
+/* Intervals, for the distortion over a box of undistorted points (outward
+ * rounding is left to the caller's margin: a few ulps of the largest term). */
+typedef struct ival {
+  double lo, hi;
+} ival;
+static ival iv(double lo, double hi) { return (ival){lo, hi}; }
+static ival iadd(ival a, ival b) { return iv(a.lo + b.lo, a.hi + b.hi); }
+static ival iscale(ival a, double s) { return s >= 0 ? iv(a.lo * s, a.hi * s) : iv(a.hi * s, a.lo * s); }
+static ival imul(ival a, ival b) {
+  double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi}, lo = p[0], hi = p[0];
+  for (int i = 1; i < 4; i++) lo = fmin(lo, p[i]), hi = fmax(hi, p[i]);
+  return iv(lo, hi);
+}
+static ival isq(ival a) {
+  double l = a.lo * a.lo, h = a.hi * a.hi;
+  return iv(a.lo > 0 ? l : a.hi < 0 ? h : 0, fmax(l, h));
+}
+/* 1 + x (c[0] + x (c[1] + ... + x c[n-1])), Horner's scheme in intervals */
+static ival ipoly1(ival x, const double *c, int n) {
+  ival p = iv(c[n - 1], c[n - 1]);
+  for (int i = n - 2; i >= 0; i--) p = iadd(imul(p, x), iv(c[i], c[i]));
+  return iadd(imul(p, x), iv(1, 1));
+}
+
+/* The range of x/z over the directions within angle ρ of the unit axis (a, ·, g),
+ * all in front (g > sin ρ): the planes x = t·z through the y axis that touch the
+ * cone have normals (1, 0, −t)/√(1 + t²) at ρ from a right angle to the axis,
+ * (a − t g)² = sin²ρ (1 + t²), t = (a g ± s √(a² + g² − s²)) / (g² − s²), s = sin ρ. */
+static ival cone_range(double a, double g, double s) {
+  double den = g * g - s * s, root = s * sqrt(fmax(0.0, a * a + den));
+  return iv((a * g - root) / den, (a * g + root) / den);
+}
+
+double rr_lens_field(const rr_camera *cam, double fold, int width, int height) {
+  const float *k = cam->dist;
+  double rd = 0, d; /* the image's farthest point from the centre: samples in [-0.5, W - 0.5] × [-0.5, H - 0.5] */
+  for (int i = 0; i < 4; i++) {
+    double u = (i & 1 ? width - 0.5 : -0.5) - cam->cx, v = (i & 2 ? height - 0.5 : -0.5) - cam->cy;
+    rd = fmax(rd, sqrt(u * u / ((double)cam->fx * cam->fx) + v * v / ((double)cam->fy * cam->fy)));
+  }
+  rd *= 1 + 1e-9;
+  if (cam->type == RR_CAMERA_OPENCV_FISHEYE) /* θ solves θd(θ) = |m| on the monotone [0, fold) */
+    return theta_d(k, fold, NULL) > rd ? fmin(fold, solve_increasing(theta_d, k, rd, fold) * (1 + 1e-9) + 1e-9) : fold;
+  /* without tangential terms undistort's |p| solves r q(r²) = |m| (its Newton steps start at the answer) */
+  if (k[2] == 0 && k[3] == 0 && radial_r(k, fold, &d) > rd)
+    return atan(fmin(fold, solve_increasing(radial_r, k, rd, fold) * (1 + 1e-9) + 1e-9));
+  return atan(fold);
+}
+
+int rr_lens_cap_extent(const rr_camera *cam, double fold, double field, const double axis[3], double rho,
+                       double e[4]) {
+  const float *k = cam->dist;
+  rho += 1e-6; /* the float basis the rays are made in is orthonormal to a few 1e-8 */
+  if (field < RR_PI && acos(fmax(-1.0, fmin(1.0, axis[2]))) - rho > field + 1e-6) return 0;
+  const double s = sin(rho);
+  if (!(rho < 1.5) || !(axis[2] > s + 1e-3)) return -1; /* not wholly in front */
+  ival a = cone_range(axis[0], axis[2], s), b = cone_range(axis[1], axis[2], s), m[2];
+  a = iv(a.lo - 1e-12 * (1 + fabs(a.lo)), a.hi + 1e-12 * (1 + fabs(a.hi)));
+  b = iv(b.lo - 1e-12 * (1 + fabs(b.lo)), b.hi + 1e-12 * (1 + fabs(b.hi)));
+  ival r2 = iadd(isq(a), isq(b));
+  double big = 1, ksum = 1; /* the sums' largest terms, for the rounding: (1 + Σ|k|)(1 + x)³ / den */
+  for (int i = 0; i < 8; i++) ksum += fabs(k[i]);
+  if (cam->type == RR_CAMERA_OPENCV_FISHEYE) {
+    /* a pixel's m = θd(θ)/tan θ·(a, b), θ = atan |(a, b)| < fold: θd(θ)/θ a polynomial in
+     * θ², θ/tan θ decreasing from 1 at 0 */
+    ival th = iv(atan(sqrt(r2.lo)) * (1 - 1e-15), fmin(atan(sqrt(r2.hi)) * (1 + 1e-15), fold));
+    if (!(th.lo < fold)) return 0;
+    const double c[4] = {k[0], k[1], k[2], k[3]};
+    ival q = imul(ipoly1(isq(th), c, 4), iv(th.hi > 0 ? th.hi / tan(th.hi) : 1, th.lo > 0 ? th.lo / tan(th.lo) : 1));
+    m[0] = imul(a, q), m[1] = imul(b, q);
+    big = pow(1 + th.hi * th.hi, 3);
+  } else {
+    /* distort() in intervals, r² < fold² (undistort's condition for a ray) */
+    if (!(r2.lo < fold * fold)) return 0;
+    r2.hi = fmin(r2.hi, fold * fold);
+    const double cn[3] = {k[0], k[1], k[4]}, cd[3] = {k[5], k[6], k[7]};
+    ival num = ipoly1(r2, cn, 3), den = ipoly1(r2, cd, 3);
+    if (!(den.lo > 0)) return -1;
+    ival q = imul(num, iv(1 / den.hi, 1 / den.lo)), ab = iscale(imul(a, b), 2);
+    m[0] = iadd(iadd(imul(a, q), iscale(ab, k[2])), iscale(iadd(r2, iscale(isq(a), 2)), k[3]));
+    m[1] = iadd(iadd(imul(b, q), iscale(iadd(r2, iscale(isq(b), 2)), k[2])), iscale(ab, k[3]));
+    big = pow(1 + r2.hi, 3) / den.lo;
+  }
+  big *= 1e-14 * ksum * (1 + fmax(fabs(a.lo), fabs(a.hi)) + fmax(fabs(b.lo), fabs(b.hi)));
+  /* sample coordinates: the image point plus 0.5 (rr_lens_unproject's pixel centres
+   * at integers); the margin covers the rounding (relative to the products, and
+   * `big` for the sums' cancellation) and undistort's residual (1e-13 of m) */
+  const double f[2] = {cam->fx, cam->fy}, cc[2] = {cam->cx + 0.5, cam->cy + 0.5};
+  for (int j = 0; j < 2; j++) {
+    ival p = iscale(m[j], f[j]);
+    double mg = 1e-9 * (fabs(p.lo) + fabs(p.hi) + f[j]) + big * f[j];
+    e[2 * j] = p.lo + cc[j] - mg, e[2 * j + 1] = p.hi + cc[j] + mg;
+    if (!isfinite(e[2 * j]) || !isfinite(e[2 * j + 1])) return -1;
+  }
+  return 1;
+}

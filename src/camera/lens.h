@@ -19,4 +19,15 @@ bool rr_lens_unproject(const rr_camera *cam, double fold, double u, double v, do
  * cv::fisheye::projectPoints): false when p is not in front (z <= 0). */
 bool rr_lens_project(const rr_camera *cam, const double p[3], double *u, double *v);
 
+/* The largest angle from the axis of the rays of a width × height image (at most
+ * atan(fold), or the fisheye's fold; the Brown–Conrady's with tangential terms is that). */
+double rr_lens_field(const rr_camera *cam, double fold, int width, int height);
+/* The sample-coordinate extents x0, x1, y0, y1 of every pixel whose ray lies
+ * within angle rho of the unit axis (camera axes), the cap wholly in front: the
+ * cap's box in the undistorted plane, mapped through the distortion in interval
+ * arithmetic. 1 with e, 0 when no pixel's ray can lie there (beyond the field,
+ * rr_lens_field), -1 when unknown. */
+int rr_lens_cap_extent(const rr_camera *cam, double fold, double field, const double axis[3], double rho,
+                       double e[4]);
+
 #endif

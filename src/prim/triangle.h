@@ -282,9 +282,10 @@ bool rr_tri_screen_bounds_sph(const rr_scene *s, uint32_t i, const camera *c, co
                               const tri_sphere *sp, int rect[4]);
 /* The tight rectangle of the curved views polar about an axis (lat-long, parabolic,
  * fisheye), from the spherical triangle of the setup's edge planes
- * (prim/triangle_curved.c): 1 with rect, 2 with a rect whose margin is wide (a
- * sliver: the cells may bound it better), 0 when no sample can pass, -1 when it
- * knows no bound (another camera, a degenerate setup). */
+ * (prim/triangle_curved.c), and of the OpenCV lenses, from the cap that holds it
+ * (wholly ahead: camera/lens.c, rr_lens_cap_extent): 1 with rect, 2 with a rect
+ * whose margin is wide (a sliver: the cells may bound it better), 0 when no sample
+ * can pass, -1 when it knows no bound (another camera, a degenerate setup). */
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int rect[4]);
 /* What the curved bounds take from a setup, whatever the camera's position: its
  * spherical triangle (sin of half the least interior angle smin, the widening E;
@@ -352,7 +353,8 @@ int rr_cam_extent_rect(const camera *c, const double e[4], int k, int rect[4]);
 /* rr_cam_cap_rect for four caps in lanes at once, and for the ns positions
  * cams[0..ns-1] (cameras that differ only in sx0, sy0): the lanes of the bit mask
  * used whose rectangle at some position meets r (x0, y0, x1, y1, ends exclusive),
- * or that know no bound (every lane for cameras not polar); AVX2 when simd. */
+ * or that know no bound (every lane for cameras neither polar nor an OpenCV lens,
+ * whose caps go through the lens, rr_lens_cap_extent, a lane at a time); AVX2 when simd. */
 unsigned rr_cam_caps_show4(const camera *cams, int ns, const double axis[3][4], const double rho[4], unsigned used,
                            const int r[4], bool simd);
 /* Boxes a polar camera's samples see most of (rr_cam_cap_shortcut, for a walk

@@ -21,6 +21,7 @@
  * image in the bounding box of that annular sector (or of the whole disk, or the
  * whole width for the lat-long, near the axis or across the seam). */
 #include "prim/triangle.h"
+#include "camera/lens.h"
 #include "core/simd.h"
 
 #include <math.h>
@@ -289,9 +290,30 @@ void rr_cam_cap_extents4(const camera *c, const double axis[3][4], const double 
 static bool polar(const camera *c) {
   return c->type == RR_CAMERA_LATLONG || c->type == RR_CAMERA_PARABOLIC || c->type == RR_CAMERA_FISHEYE;
 }
+static bool lens(const camera *c) { return c->type == RR_CAMERA_OPENCV || c->type == RR_CAMERA_OPENCV_FISHEYE; }
+
+/* The OpenCV lenses' rr_cam_caps_show4, a lane at a time: the caps' images
+ * through the lens (rr_lens_cap_extent; a cap it cannot bound shows). */
+static unsigned lens_caps_show(const camera *cams, int ns, const double axis[3][4], const double rho[4], unsigned used,
+                               const int r[4]) {
+  unsigned shown = 0;
+  for (int l = 0; l < 4; l++)
+    for (int p = 0; p < ns && (used >> l & 1) && !(shown >> l & 1); p++) {
+      const camera *c = &cams[p];
+      const dv3 m = dv(axis[0][l], axis[1][l], axis[2][l]);
+      const double ax[3] = {ddot(m, dvf(c->right)), -ddot(m, dvf(c->up)), ddot(m, dvf(c->fwd))}; /* x right, y down */
+      double e[4];
+      int q[4], k = rr_lens_cap_extent(&c->lens, c->lens_fold, c->lens_field, ax, rho[l], e);
+      if (k < 0 || (k > 0 && sample_rect(c, e[0], e[1], e[2], e[3], q) && q[0] < r[2] && q[2] >= r[0] &&
+                    q[1] < r[3] && q[3] >= r[1]))
+        shown |= 1u << l;
+    }
+  return shown;
+}
 
 unsigned rr_cam_caps_show4(const camera *cams, int ns, const double axis[3][4], const double rho[4], unsigned used,
                            const int r[4], bool simd) {
+  if (lens(cams)) return lens_caps_show(cams, ns, axis, rho, used, r);
   if (!polar(cams)) return used; /* no bound known */
   vd4 a[3], q;
   memcpy(a, axis, sizeof a), memcpy(&q, rho, sizeof q);
@@ -334,6 +356,23 @@ cam_cap_shortcut rr_cam_cap_shortcut(const camera *c) {
  * bound, may show a sample. */
 unsigned rr_cam_boxes_show4(const camera *cams, int ns, const float lo[3][4], const float hi[3][4], unsigned used,
                             const cam_cap_shortcut *sc, const int r[4], bool simd) {
+  if (lens(cams)) { /* boxes_show's ball and cap, scalar, through the lens */
+    double axis[3][4] = {{0}}, rho[4] = {0};
+    unsigned near = 0;
+    for (int l = 0; l < 4; l++) {
+      double b[3], d2 = 0, r2 = 0;
+      for (int a = 0; a < 3; a++) {
+        b[a] = 0.5 * ((double)lo[a][l] + hi[a][l]) - (&cams->eye.x)[a], d2 += b[a] * b[a];
+        r2 += 0.25 * ((double)hi[a][l] - lo[a][l]) * ((double)hi[a][l] - lo[a][l]);
+      }
+      const double s2 = r2 * (1 + 1e-9) / d2, inv = 1 / sqrt(d2);
+      near |= (unsigned)!(s2 < 0.98) << l;
+      rho[l] = s2 < 0.98 ? sqrt(s2 / (1 - s2)) + 1e-4 : 0;
+      for (int a = 0; a < 3; a++) axis[a][l] = b[a] * inv;
+    }
+    near &= used;
+    return near | (near == used ? 0 : lens_caps_show(cams, ns, (const double(*)[4])axis, rho, used & ~near, r));
+  }
   if (!polar(cams)) return used;
 #ifdef RR_SIMD_X86
   if (simd && __builtin_cpu_supports("avx2")) return boxes_show_avx2(cams, ns, lo, hi, used, sc, r);
@@ -469,14 +508,28 @@ int rr_tri_sphere_cap_rect(const camera *c, const tri_sphere *sp, int r[4]) {
 }
 
 
+/* The OpenCV lenses: the cap holds every passing sample's exact direction (the
+ * comment at the top); its image through the lens (rr_lens_cap_extent). */
+static int lens_rect(const camera *c, const tri_sphere *sp, int r[4]) {
+  if (!sp->ok || !sp->cap) return -1;
+  const dv3 m = dv(sp->axis[0], sp->axis[1], sp->axis[2]);
+  const double axis[3] = {ddot(m, dvf(c->right)), -ddot(m, dvf(c->up)), ddot(m, dvf(c->fwd))}; /* x right, y down */
+  double e[4];
+  int k = rr_lens_cap_extent(&c->lens, c->lens_fold, c->lens_field, axis, sp->rho, e);
+  if (k <= 0) return k;
+  return sample_rect(c, e[0], e[1], e[2], e[3], r) ? (sp->smin > 1e-3 ? 1 : 2) : 0;
+}
+
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
-  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
+  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE && !lens(c))
+    return -1;
   tri_sphere sp;
   rr_tri_spheres_cam(ts, 1, c, true, &sp);
   return rr_tri_curved_rect_sph(c, ts, &sp, r);
 }
 
 int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_sphere *sp, int r[4]) {
+  if (lens(c)) return lens_rect(c, sp, r);
   if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
   const int lanes = rr_tri_sphere_decided(c, sp, r);
   if (lanes >= 0) return lanes;

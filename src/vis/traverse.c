@@ -955,7 +955,7 @@ static void root_band(int b, int thread, void *arg) {
   add_stats(&rp->st[thread], &t.st);
 }
 
-/* A curved view polar about an axis, drawn from the root: the triangles of the
+/* A curved view polar about an axis (or an OpenCV lens), drawn from the root: the triangles of the
  * BVH leaves whose box may show a sample (box_cap_meets), marked in seen (1)
  * before any setup, so that most of a detailed mesh's triangles (behind a
  * hemisphere, or between the samples) cost no setup. */
@@ -997,7 +997,8 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
   uint8_t *seen = NULL;
   const rr_camera_type type = proto->c->type;
   if (!proto->faces && ctx->scene->bvh && ctx->scene->bvh->nprims == ctx->scene->ntris &&
-      (type == RR_CAMERA_PARABOLIC || type == RR_CAMERA_LATLONG || type == RR_CAMERA_FISHEYE)) {
+      (type == RR_CAMERA_PARABOLIC || type == RR_CAMERA_LATLONG || type == RR_CAMERA_FISHEYE ||
+       type == RR_CAMERA_OPENCV || type == RR_CAMERA_OPENCV_FISHEYE)) {
     seen = calloc(ctx->scene->ntris, 1);
     if (!seen) {
       free(rp);
