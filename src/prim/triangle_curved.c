@@ -356,20 +356,14 @@ cam_cap_shortcut rr_cam_cap_shortcut(const camera *c) {
  * bound, may show a sample. */
 unsigned rr_cam_boxes_show4(const camera *cams, int ns, const float lo[3][4], const float hi[3][4], unsigned used,
                             const cam_cap_shortcut *sc, const int r[4], bool simd) {
-  if (lens(cams)) { /* boxes_show's ball and cap, scalar, through the lens */
-    double axis[3][4] = {{0}}, rho[4] = {0};
+  if (lens(cams)) { /* boxes_show's caps, through the lens */
+    vd4 m[3], q;
+    vl4 nl;
+    box_caps_plain(cams, lo, hi, m, &q, &nl);
+    double axis[3][4], rho[4];
+    memcpy(axis, m, sizeof axis), memcpy(rho, &q, sizeof rho);
     unsigned near = 0;
-    for (int l = 0; l < 4; l++) {
-      double b[3], d2 = 0, r2 = 0;
-      for (int a = 0; a < 3; a++) {
-        b[a] = 0.5 * ((double)lo[a][l] + hi[a][l]) - (&cams->eye.x)[a], d2 += b[a] * b[a];
-        r2 += 0.25 * ((double)hi[a][l] - lo[a][l]) * ((double)hi[a][l] - lo[a][l]);
-      }
-      const double s2 = r2 * (1 + 1e-9) / d2, inv = 1 / sqrt(d2);
-      near |= (unsigned)!(s2 < 0.98) << l;
-      rho[l] = s2 < 0.98 ? sqrt(s2 / (1 - s2)) + 1e-4 : 0;
-      for (int a = 0; a < 3; a++) axis[a][l] = b[a] * inv;
-    }
+    for (int l = 0; l < 4; l++) near |= (unsigned)(nl[l] != 0) << l;
     near &= used;
     return near | (near == used ? 0 : lens_caps_show(cams, ns, (const double(*)[4])axis, rho, used & ~near, r));
   }
@@ -521,8 +515,7 @@ static int lens_rect(const camera *c, const tri_sphere *sp, int r[4]) {
 }
 
 int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
-  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE && !lens(c))
-    return -1;
+  if (!polar(c) && !lens(c)) return -1;
   tri_sphere sp;
   rr_tri_spheres_cam(ts, 1, c, true, &sp);
   return rr_tri_curved_rect_sph(c, ts, &sp, r);
@@ -530,7 +523,7 @@ int rr_tri_curved_rect(const camera *c, const tri_setup *ts, int r[4]) {
 
 int rr_tri_curved_rect_sph(const camera *c, const tri_setup *ts, const tri_sphere *sp, int r[4]) {
   if (lens(c)) return lens_rect(c, sp, r);
-  if (c->type != RR_CAMERA_LATLONG && c->type != RR_CAMERA_PARABOLIC && c->type != RR_CAMERA_FISHEYE) return -1;
+  if (!polar(c)) return -1;
   const int lanes = rr_tri_sphere_decided(c, sp, r);
   if (lanes >= 0) return lanes;
   if (!sp->ok) return -1;

@@ -68,6 +68,16 @@ SPH_TARGET static void SPH_CAT(cap_lanes)(const camera *c, const vd4 m[3], const
   *k_ = vsel_l(rho < 1.5, k, vl_splat(-1));
 }
 
+/* A cap image e (x0, x1, y0, y1) as the sample rectangle sample_rect rounds it to,
+ * at the position (sx, sy) and clipped to [lo.x, hi.x] × [lo.y, hi.y] (o: x0, y0,
+ * x1, y1 in lanes; empty where x0 > x1 or y0 > y1; a NaN end taken as unbounded,
+ * as ceil_in and floor_in take it). */
+SPH_TARGET static inline void SPH_CAT(rect_lanes)(const vd4 e[4], double sx, double sy, const int lo[2],
+                                                  const int hi[2], vd4 o[4]) {
+  o[0] = vmax(SPH_CEIL(e[0] - sx - 1e-2), vd_splat(lo[0])), o[1] = vmax(SPH_CEIL(e[2] - sy - 1e-2), vd_splat(lo[1]));
+  o[2] = vmin(SPH_FLOOR(e[1] - sx + 1e-2), vd_splat(hi[0])), o[3] = vmin(SPH_FLOOR(e[3] - sy + 1e-2), vd_splat(hi[1]));
+}
+
 /* The lanes of `used` whose cap (axis m, radius rho) may show a sample of r (x0,
  * y0, x1, y1, ends exclusive) at one of the ns positions cams[0..ns-1] (cameras
  * that differ only in sx0, sy0): cap_lanes knows no bound, or the rectangle
@@ -80,12 +90,11 @@ SPH_TARGET static unsigned SPH_CAT(caps_show)(const camera *cams, int ns, const 
   vl4 k;
   SPH_CAT(cap_lanes)(cams, m, rho, e, &k);
   vl4 show = k < 0;
-  const vd4 rx0 = vd_splat(r[0]), ry0 = vd_splat(r[1]), rx1 = vd_splat(r[2] - 1), ry1 = vd_splat(r[3] - 1);
+  const int lo[2] = {r[0], r[1]}, hi[2] = {r[2] - 1, r[3] - 1};
   for (int p = 0; p < ns; p++) {
-    const double sx = cams[p].sx0, sy = cams[p].sy0;
-    const vd4 lx = vmax(SPH_CEIL(e[0] - sx - 1e-2), rx0), hx = vmin(SPH_FLOOR(e[1] - sx + 1e-2), rx1);
-    const vd4 ly = vmax(SPH_CEIL(e[2] - sy - 1e-2), ry0), hy = vmin(SPH_FLOOR(e[3] - sy + 1e-2), ry1);
-    show |= (k > 0) & (lx <= hx) & (ly <= hy);
+    vd4 q[4];
+    SPH_CAT(rect_lanes)(e, cams[p].sx0, cams[p].sy0, lo, hi, q);
+    show |= (k > 0) & (q[0] <= q[2]) & (q[1] <= q[3]);
   }
   unsigned bits = 0;
   for (int l = 0; l < 4; l++) bits |= (unsigned)(show[l] != 0) << l;
@@ -97,10 +106,11 @@ SPH_TARGET static unsigned SPH_CAT(caps_show)(const camera *cams, int ns, const 
  * the box's ball's cap about b − eye of radius s / √(1 − s²) + 1e-4, s the ball's
  * radius over its distance; a box too near the eye (s² >= 0.98), or one that sc
  * takes as showing a sample, may. */
-SPH_TARGET static unsigned SPH_CAT(boxes_show)(const camera *cams, int ns, const float lo[3][4],
-                                               const float hi[3][4], unsigned used, const cam_cap_shortcut *sc,
-                                               const int r[4]) {
-  const double eye[3] = {cams->eye.x, cams->eye.y, cams->eye.z};
+/* boxes_show's caps: each box's ball seen from the eye as a cap (axis m, radius
+ * *rho); *near: the lanes whose box is too near the eye for one (s² >= 0.98). */
+SPH_TARGET static inline void SPH_CAT(box_caps)(const camera *c, const float lo[3][4], const float hi[3][4], vd4 m[3],
+                                                vd4 *rho, vl4 *near) {
+  const double eye[3] = {c->eye.x, c->eye.y, c->eye.z};
   vd4 b[3], d2 = vd_splat(0), r2 = vd_splat(0);
   for (int a = 0; a < 3; a++) {
     vf4 lf, hf;
@@ -110,11 +120,18 @@ SPH_TARGET static unsigned SPH_CAT(boxes_show)(const camera *cams, int ns, const
     r2 += 0.25 * (h - l) * (h - l);
   }
   const vd4 s2 = r2 * (1 + 1e-9) / d2;
-  const vl4 near = ~(s2 < 0.98);
-  const vd4 inv = 1 / SPH_SQRT(d2), rho = SPH_SQRT(s2 / (1 - s2)) + 1e-4;
-  vd4 m[3];
+  const vd4 inv = 1 / SPH_SQRT(d2);
+  *rho = SPH_SQRT(s2 / (1 - s2)) + 1e-4;
   for (int a = 0; a < 3; a++) m[a] = b[a] * inv;
-  vl4 take = near;
+  *near = ~(s2 < 0.98);
+}
+
+SPH_TARGET static unsigned SPH_CAT(boxes_show)(const camera *cams, int ns, const float lo[3][4],
+                                               const float hi[3][4], unsigned used, const cam_cap_shortcut *sc,
+                                               const int r[4]) {
+  vd4 m[3], rho;
+  vl4 take;
+  SPH_CAT(box_caps)(cams, lo, hi, m, &rho, &take);
   if (sc) {
     const vd4 mf = m[0] * (double)cams->fwd.x + m[1] * (double)cams->fwd.y + m[2] * (double)cams->fwd.z;
     take |= (rho >= sc->rho_min) & (mf >= sc->cos_min + rho * sc->sin_min);
@@ -196,11 +213,8 @@ SPH_TARGET static void SPH_NAME(const tri_setup *ts, int n, const camera *pc, tr
   vl4 dec = vl_splat(TRI_CAP_UNSET);
   vd4 rl[4] = {0};
   if (pc) {
-    const double sx = pc->sx0, sy = pc->sy0;
-    rl[0] = vmax(SPH_CEIL(ext[0] - sx - 1e-2), vd_splat(0));
-    rl[1] = vmax(SPH_CEIL(ext[2] - sy - 1e-2), vd_splat(0));
-    rl[2] = vmin(SPH_FLOOR(ext[1] - sx + 1e-2), vd_splat(pc->width - 1));
-    rl[3] = vmin(SPH_FLOOR(ext[3] - sy + 1e-2), vd_splat(pc->height - 1));
+    const int lo[2] = {0, 0}, hi[2] = {pc->width - 1, pc->height - 1};
+    SPH_CAT(rect_lanes)(ext, pc->sx0, pc->sy0, lo, hi, rl);
     const vl4 some = (img == 1) & (rl[0] <= rl[2]) & (rl[1] <= rl[3]);
     const vd4 area = (rl[2] - rl[0] + 1) * (rl[3] - rl[1] + 1);
     const double most = pc->type == RR_CAMERA_PARABOLIC ? CAP_ENOUGH : CHART_FROM;
