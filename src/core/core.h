@@ -23,6 +23,7 @@ enum {
   SCRATCH_SM_PRIMS,  /* sort-middle: a batch's set-up primitives */
   SCRATCH_SM_SPANS,  /* sort-middle: their blocks of rows */
   SCRATCH_CUBE,      /* the cube camera: its faces' visibility buffers */
+  SCRATCH_EYES,      /* the cube camera drawn by frusta: its triangles' eye parts (tri_eyes) */
   SCRATCH_COUNT
 };
 typedef struct rr_scratch {

@@ -8,6 +8,8 @@
 #include "prim/triangle.h"
 #include "core/simd.h"
 
+#include <sched.h>
+
 /* Homogeneous vertices (paper appendix, eqs. 5–11). A corner at infinity
  * (w = 0) is stored as its direction D and enters as q = D instead of p − eye:
  * the edge normals n_i = q[i+2] × q[i+1] are still the planes through the eye
@@ -56,9 +58,9 @@ int rr_tri_setup(const rr_scene *s, uint32_t i, const camera *c, bool cull_backf
   return face;
 }
 
-void rr_tri_setup_shared(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
-                         const int32_t *sel, const int *nsel, bool cull_backfaces, bool simd, tri_setup *out,
-                         size_t ostride, int *face, tri_plane *pl, size_t pstride) {
+int rr_tri_setup_shared(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
+                        const int32_t *sel, const int *nsel, bool cull_backfaces, bool simd, tri_setup *out,
+                        size_t ostride, int *face, tri_plane *pl, size_t pstride, tri_eyes *keep) {
   bool ortho = false;
   for (int k = 0; k < ncams; k++) ortho |= cams[k].type == RR_CAMERA_ORTHOGRAPHIC;
   if (ortho) { /* (no caller: the shared EYE leaves out what the eye at infinity reads) */
@@ -66,16 +68,14 @@ void rr_tri_setup_shared(const rr_scene *s, const uint32_t *ids, int n, const ca
       for (int j = at; j < at + nsel[k]; j++)
         setup_one1(s, &ids[sel[j]], 1, &cams[k], cull_backfaces, (tri_setup *)((char *)out + j * ostride), &face[j],
                    pl ? (tri_plane *)((char *)pl + j * pstride) : NULL);
-    return;
+    return n;
   }
 #ifdef RR_SIMD_X86
-  if (simd && __builtin_cpu_supports("avx2")) {
-    setup_shared8(s, ids, n, cams, ncams, sel, nsel, cull_backfaces, out, ostride, face, pl, pstride);
-    return;
-  }
+  if (simd && __builtin_cpu_supports("avx2"))
+    return setup_shared8(s, ids, n, cams, ncams, sel, nsel, cull_backfaces, out, ostride, face, pl, pstride, keep);
 #endif
   (void)simd;
-  setup_shared1(s, ids, n, cams, ncams, sel, nsel, cull_backfaces, out, ostride, face, pl, pstride);
+  return setup_shared1(s, ids, n, cams, ncams, sel, nsel, cull_backfaces, out, ostride, face, pl, pstride, keep);
 }
 
 void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces,

@@ -258,40 +258,94 @@ TARGET static void RR_CAT(setup_one, W)(const rr_scene *s, const uint32_t *ids, 
  * stored by field (rec), then, for each camera, the triangles it asks for gathered
  * W to a step (loaded when they are W in a row) and set up for it. Stored and
  * gathered floats keep their bits, and view_lanes computes what it computes for
- * the triangles in any lanes. */
-enum { RR_CAT(REC_, W) = 24 }; /* fields: p1, p2, pf, n (3 each), vol; at_inf (3), inf1, inf2 */
-TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_shared_lanes, W)(
-    const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams, const int32_t *sel, const int *nsel,
-    bool cull, tri_setup *out, size_t ostride, int *face, tri_plane *pl, size_t pstride, bool flat) {
-  float rec[RR_CAT(REC_, W)][TRI_SHARED_MAX + W]; /* (W lanes past the last triangle: its stores) */
-#define STORE_F(f, v) memcpy(&rec[f][k], &(v), W * sizeof(float))
+ * the triangles in any lanes. With keep, EYE comes from its record where one is
+ * ready; the others are computed and recorded. Returns how many were computed. */
+/* EYE's fields (TRI_EYE_REC: p1, p2, pf, n, vol; at_inf, inf1, inf2 only when inf)
+ * into field f, lane l at at[f·fstride + l] */
+TARGET __attribute__((always_inline)) static inline void RR_CAT(eye_store, W)(const EYE *e, bool inf, float *at,
+                                                                            size_t fstride) {
+#define STORE_F(f, v) memcpy(at + (f) * fstride, &(v), W * sizeof(float))
 #define STORE3(f, v) (STORE_F(f, (v).x), STORE_F((f) + 1, (v).y), STORE_F((f) + 2, (v).z))
-  for (int k = 0; k < n; k += W) {
-    EYE e;
-    RR_CAT(eye_lanes, W)(s, ids + k, n - k < W ? n - k : W, cams[0].eye, flat, &e);
-    STORE3(0, e.p1), STORE3(3, e.p2), STORE3(6, e.pf);
-    for (int i = 0; i < 3; i++) STORE3(9 + 3 * i, e.n[i]);
-    STORE_F(18, e.vol);
-    if (s->inf) {
-      for (int i = 0; i < 3; i++) STORE_F(19 + i, e.at_inf[i]);
-      STORE_F(22, e.inf1), STORE_F(23, e.inf2);
-    }
+  STORE3(0, e->p1), STORE3(3, e->p2), STORE3(6, e->pf);
+  for (int i = 0; i < 3; i++) STORE3(9 + 3 * i, e->n[i]);
+  STORE_F(18, e->vol);
+  if (inf) {
+    for (int i = 0; i < 3; i++) STORE_F(19 + i, e->at_inf[i]);
+    STORE_F(22, e->inf1), STORE_F(23, e->inf2);
   }
 #undef STORE3
 #undef STORE_F
+}
+
+TARGET __attribute__((always_inline)) static inline int RR_CAT(setup_shared_lanes, W)(
+    const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams, const int32_t *sel, const int *nsel,
+    bool cull, tri_setup *out, size_t ostride, int *face, tri_plane *pl, size_t pstride, tri_eyes *keep, bool flat) {
+  /* Field f of triangle k at from[f·fstride + where[k]]: without keep, rec by
+   * field (W lanes past the last triangle for its stores; few triangles keep to
+   * few cache lines), with keep its record. */
+  float rec[TRI_EYE_REC * (TRI_SHARED_MAX + W)];
+  int32_t where[TRI_SHARED_MAX];
+  const float *from = rec;
+  int fstride = (n + W - 1) / W * W + W, fresh = n;
+  if (!keep) {
+    for (int k = 0; k < n; k += W) {
+      EYE e;
+      RR_CAT(eye_lanes, W)(s, ids + k, n - k < W ? n - k : W, cams[0].eye, flat, &e);
+      RR_CAT(eye_store, W)(&e, s->inf, rec + k, fstride);
+    }
+    for (int k = 0; k < n; k++) where[k] = k;
+  } else {
+    /* Each eye part is computed once: a setup claims the absent ones (BUSY),
+     * records them, then waits for those another thread claimed first, which it
+     * records without waiting on anything: S does not depend on the threads. */
+    const int fields = s->inf ? TRI_EYE_REC : 19;
+    uint32_t mine[TRI_SHARED_MAX];
+    int at[TRI_SHARED_MAX], theirs[TRI_SHARED_MAX], nt = 0;
+    from = keep->rec[0], fstride = 1, fresh = 0;
+    for (int k = 0; k < n; k++) {
+      uint32_t v = atomic_load_explicit(&keep->slot[ids[k]], memory_order_acquire);
+      if (v == TRI_EYE_NONE && atomic_compare_exchange_strong_explicit(&keep->slot[ids[k]], &v, TRI_EYE_BUSY,
+                                                                       memory_order_acquire, memory_order_acquire))
+        mine[fresh] = ids[k], at[fresh++] = k;
+      else if (v >= TRI_EYE_AT)
+        where[k] = (int32_t)(v - TRI_EYE_AT) * TRI_EYE_REC;
+      else
+        theirs[nt++] = k;
+    }
+    const uint32_t base = fresh ? atomic_fetch_add_explicit(&keep->used, (unsigned)fresh, memory_order_relaxed) : 0;
+    for (int k = 0; k < fresh; k += W) {
+      const int m = fresh - k < W ? fresh - k : W;
+      EYE e;
+      float lanes[TRI_EYE_REC][W];
+      RR_CAT(eye_lanes, W)(s, mine + k, m, cams[0].eye, flat, &e);
+      RR_CAT(eye_store, W)(&e, s->inf, &lanes[0][0], W);
+      for (int l = 0; l < m; l++) {
+        const uint32_t r = base + (uint32_t)(k + l);
+        for (int f = 0; f < fields; f++) keep->rec[r][f] = lanes[f][l];
+        atomic_store_explicit(&keep->slot[mine[k + l]], TRI_EYE_AT + r, memory_order_release);
+        where[at[k + l]] = (int32_t)r * TRI_EYE_REC;
+      }
+    }
+    for (int i = 0; i < nt; i++) {
+      uint32_t v;
+      while ((v = atomic_load_explicit(&keep->slot[ids[theirs[i]]], memory_order_acquire)) < TRI_EYE_AT) sched_yield();
+      where[theirs[i]] = (int32_t)(v - TRI_EYE_AT) * TRI_EYE_REC;
+    }
+  }
   const VI all = VI_(splat)(-1);
-#define GATHER_F(f) (run ? VF_(load)(rec[f] + lane[0]) : VF_(gather)(rec[f], idx))
+#define GATHER_F(f) (run ? VF_(load)(from + (f) * fstride + lane[0]) : VF_(gather)(from + (f) * fstride, idx))
 #define GATHER3(f) ((V3){GATHER_F(f), GATHER_F((f) + 1), GATHER_F((f) + 2)})
 #define GATHER_I(f) \
-  (run ? VI_(load)((const int32_t *)rec[f] + lane[0]) : VI_(gather_masked)((const int32_t *)rec[f], idx, all))
+  (run ? VI_(load)((const int32_t *)from + (f) * fstride + lane[0]) \
+       : VI_(gather_masked)((const int32_t *)from + (f) * fstride, idx, all))
   for (int view = 0, at = 0; view < ncams; at += nsel[view++])
     for (int j = 0; j < nsel[view]; j += W) {
       const int m = nsel[view] - j < W ? nsel[view] - j : W;
       int32_t lane[W];
-      for (int l = 0; l < W; l++) lane[l] = sel[at + j + (l < m ? l : m - 1)];
+      for (int l = 0; l < W; l++) lane[l] = where[sel[at + j + (l < m ? l : m - 1)]];
       const VI idx = VI_(load)(lane);
       /* W of a face's triangles in a row (the common case): loads, cheaper than gathers */
-      const bool run = m == W && VI_(bits)(idx == VI_(splat)(lane[0]) + VI_(lanes)()) == (1 << W) - 1;
+      const bool run = !keep && m == W && VI_(bits)(idx == VI_(splat)(lane[0]) + VI_(lanes)()) == (1 << W) - 1;
       EYE e; /* what view_lanes reads for a camera that is not orthographic */
       e.p1 = GATHER3(0), e.p2 = GATHER3(3), e.pf = GATHER3(6);
       for (int i = 0; i < 3; i++) e.n[i] = GATHER3(9 + 3 * i);
@@ -308,15 +362,17 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_shared_lan
 #undef GATHER_I
 #undef GATHER3
 #undef GATHER_F
+  return fresh;
 }
 
-TARGET static void RR_CAT(setup_shared, W)(const rr_scene *s, const uint32_t *ids, int n, const camera *cams,
-                                           int ncams, const int32_t *sel, const int *nsel, bool cull, tri_setup *out,
-                                           size_t ostride, int *face, tri_plane *pl, size_t pstride) {
+TARGET static int RR_CAT(setup_shared, W)(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
+                                          const int32_t *sel, const int *nsel, bool cull, tri_setup *out,
+                                          size_t ostride, int *face, tri_plane *pl, size_t pstride, tri_eyes *keep) {
   if (s->inst)
-    RR_CAT(setup_shared_lanes, W)(s, ids, n, cams, ncams, sel, nsel, cull, out, ostride, face, pl, pstride, false);
-  else
-    RR_CAT(setup_shared_lanes, W)(s, ids, n, cams, ncams, sel, nsel, cull, out, ostride, face, pl, pstride, true);
+    return RR_CAT(setup_shared_lanes, W)(s, ids, n, cams, ncams, sel, nsel, cull, out, ostride, face, pl, pstride,
+                                         keep, false);
+  return RR_CAT(setup_shared_lanes, W)(s, ids, n, cams, ncams, sel, nsel, cull, out, ostride, face, pl, pstride, keep,
+                                       true);
 }
 
 #include "prim/triangle_moved_tmp.h"

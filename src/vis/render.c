@@ -307,10 +307,9 @@ static rr_error run_passes(rr_device *dev, rr_method m, render_ctx ctx, progress
 }
 
 /* The cube camera: its six faces are perspective cameras (camera/camera.h), each
- * drawn into a buffer of its own and copied into the cross. The rasterizing
- * methods that draw from the root (3dr-bb, 3dr-bin) draw the six in one pass,
- * which sets each triangle up once for the eye (vis/traverse.c); the others run
- * once per face. */
+ * drawn into a buffer of its own and copied into the cross. The 3D rasterizing
+ * methods draw the six in one pass, which sets each triangle up once for the eye
+ * (vis/traverse.c); the ray casters run once per face. */
 static rr_error render_cube(rr_device *dev, rr_method m, render_ctx ctx, progress_span whole) {
   const camera *cube = ctx.cam;
   visbuf *cross = ctx.vb;
@@ -339,7 +338,7 @@ static rr_error render_cube(rr_device *dev, rr_method m, render_ctx ctx, progres
     faces[f] = (visbuf){F, F, fvb.id + o, fvb.t + o, fvb.l1 + o, fvb.l2 + o, ns};
   }
   rr_error e = RR_OK;
-  if (methods[m].fn == rr_vis_traverse && !ctx.oracles->leaves) {
+  if (methods[m].fn == rr_vis_traverse) {
     ctx.faces = 6, ctx.face_cams = fc, ctx.face_vb = faces;
     ctx.face_heat_e = heat, ctx.face_heat_n = heat ? heat + 6 * FF : NULL;
     ctx.cam = ctx.cams = fc, ctx.vb = &faces[0];

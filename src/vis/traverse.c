@@ -73,6 +73,7 @@ typedef struct trav {
   hiz *face_hz;
   float *face_heat_e, *face_heat_n;
   int face_rows; /* rows of the stack of faces the root pass sorts into bands, per face */
+  tri_eyes *eyes; /* drawn by frusta: the eye parts of the setups, which the faces share */
   const uint8_t *seen; /* a curved view's root pass: 0 for triangles no sample can see (mark_seen) */
 } trav;
 
@@ -390,14 +391,20 @@ static bool finish_binning(const trav *t, uint32_t id, tri_job *j) {
  * into out; returns how many can be seen. */
 static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job *out) {
   uint32_t kept = 0;
-  t->st.setups += nb;
   for (uint32_t q = 0; q < nb; q += 8) {
     int m = nb - q < 8 ? (int)(nb - q) : 8, face[8];
     uint32_t ids[8];
     tri_setup ts[8];
     tri_plane pls[8], *pl = t->ns > 1 ? pls : NULL;
     for (int l = 0; l < m; l++) ids[l] = b[q + l].id;
-    rr_tri_setup_planes(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face, pl);
+    if (t->eyes) { /* a cube's face: S counts the eye parts no face had set up */
+      static const int32_t lane[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+      t->st.setups += (uint64_t)rr_tri_setup_shared(t->s, ids, m, t->c, 1, lane, &m, t->cull_back, t->simd, ts,
+                                                    sizeof *ts, face, pl, sizeof *pl, t->eyes);
+    } else {
+      t->st.setups += (uint64_t)m;
+      rr_tri_setup_planes(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face, pl);
+    }
     for (int l = 0; l < m; l++) {
       if (face[l] == SETUP_CULLED) continue;
       tri_job *j = out + kept;
@@ -514,7 +521,7 @@ static uint32_t setup_faces(trav *t, uint32_t first, uint32_t n, tri_job *out) {
     tri_job *jobs = out + kept; /* room for 6 a triangle: kept + pairs <= 6 (g + m - first) */
     const bool several = t->ns > 1;
     rr_tri_setup_shared(t->s, ids, q, t->face_cams0, 6, sel, nb, t->cull_back, t->simd, &jobs->ts, sizeof *jobs, face,
-                        several ? &jobs->pl : NULL, sizeof *jobs);
+                        several ? &jobs->pl : NULL, sizeof *jobs, NULL);
     for (int f = 0, p = 0; f < 6; f++)
       for (int k = 0; k < nb[f]; k++, p++) {
         if (face[p] == SETUP_CULLED) continue;
@@ -548,7 +555,7 @@ static uint32_t setup_faces(trav *t, uint32_t first, uint32_t n, tri_job *out) {
 
 static uint32_t setup_triangles(trav *t, uint32_t first, const uint32_t *ids, uint32_t n, const tile_rect *r,
                                 tri_bound *scratch, tri_job *out) {
-  if (t->faces) return setup_faces(t, first, n, out);
+  if (t->faces && !ids) return setup_faces(t, first, n, out); /* (the root pass; frusta draw a face at a time) */
   uint32_t kept = setup_tris(t, first, ids, n, r, scratch, out);
   return t->s->kind ? kept + setup_analytic(t, first, ids, n, r, out + kept) : kept;
 }
@@ -1032,14 +1039,16 @@ static rr_error rasterize_root(rr_device *dev, render_ctx *ctx, const trav *prot
 
 typedef struct trav_job {
   trav proto;
-  int tile, tiles_x, frustum;
+  int tile, tiles_x, tiles_y, frustum;
   rr_stats st[RR_MAX_THREADS];
 } trav_job;
 
-/* One job: a tile of the image, cut into the initial frusta. */
+/* One job: a tile of the image (of a cube's face), cut into the initial frusta. */
 static void run_tile(int job, int thread, void *arg) {
   trav_job *tj = arg;
   trav t = tj->proto;
+  use_face(&t, job / (tj->tiles_x * tj->tiles_y));
+  job %= tj->tiles_x * tj->tiles_y;
   int tx = job % tj->tiles_x, ty = job / tj->tiles_x;
   tile_rect r = {tx * tj->tile, ty * tj->tile, (tx + 1) * tj->tile, (ty + 1) * tj->tile};
   if (r.x1 > t.vb->width) r.x1 = t.vb->width;
@@ -1061,8 +1070,7 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
   if (ctx->scene->ntris == 0) return RR_OK; /* nothing to see: the cleared buffer is the image */
   if (!ctx->scene->bvh && o->leaves)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "this method needs the scene's BVH (call rr_scene_commit)");
-  if (ctx->faces && (o->leaves || ctx->faces != 6))
-    return rr_fail(dev, RR_ERROR_UNSUPPORTED, "a cube's faces in one pass are drawn from the root only");
+  if (ctx->faces && ctx->faces != 6) return rr_fail(dev, RR_ERROR_UNSUPPORTED, "a cube has six faces, not %d", ctx->faces);
   /* z tiles: one set per face of a cube drawn in one pass */
   hiz hz[6];
   const int nhz = ctx->faces ? 6 : 1;
@@ -1118,9 +1126,23 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
     /* Initial frusta: the whole image on one thread (the paper's set-up), else
      * tiles aligned to the z tiles dealt out to the threads (no z tile has two
      * writers); frustum_size forces a tile size. */
+    /* A cube's faces, frustum by frustum: each triangle's eye part recorded by the
+     * first face that sets it up, for the others (tri_eyes; records found by
+     * 32-bit offsets) */
+    const size_t ntris = ctx->scene->ntris, recs = (ntris * sizeof(float[TRI_EYE_REC]) + 63) / 64 * 64;
+    const bool keep = ctx->faces && ntris < INT32_MAX / TRI_EYE_REC;
+    rr_buf eb = keep ? rr_scratch_take(dev, SCRATCH_EYES, recs + ntris * sizeof(uint32_t)) : (rr_buf){0};
+    tri_eyes eyes = {0};
+    if (eb.p) {
+      eyes.rec = eb.p, eyes.slot = (_Atomic uint32_t *)((char *)eb.p + recs);
+      memset((void *)eyes.slot, 0, ntris * sizeof *eyes.slot);
+      atomic_init(&eyes.used, 0);
+      proto.eyes = &eyes;
+    }
     trav_job *tj = calloc(1, sizeof *tj);
-    if (!tj) {
-      rr_hiz_free(&hz[0]);
+    if (!tj || (keep && !eb.p)) {
+      free(tj), rr_scratch_give(dev, eb);
+      for (int f = 0; f < nhz; f++) rr_hiz_free(&hz[f]);
       return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the traversal");
     }
     int whole = vb->width > vb->height ? vb->width : vb->height;
@@ -1131,11 +1153,11 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
     int tile = ctx->threads > 1 ? (frustum < 128 ? 128 : frustum > 256 ? 256 : frustum)
                                 : (frustum < whole ? frustum : whole);
     tile = (tile + HIZ - 1) / HIZ * HIZ;
-    tj->proto = proto, tj->tile = tile, tj->frustum = frustum, tj->tiles_x = (vb->width + tile - 1) / tile;
-    rr_parallel_for_progress(tj->tiles_x * ((vb->height + tile - 1) / tile), ctx->threads, run_tile, tj,
-                             &ctx->progress);
+    tj->proto = proto, tj->tile = tile, tj->frustum = frustum;
+    tj->tiles_x = (vb->width + tile - 1) / tile, tj->tiles_y = (vb->height + tile - 1) / tile;
+    rr_parallel_for_progress(tj->tiles_x * tj->tiles_y * nhz, ctx->threads, run_tile, tj, &ctx->progress);
     for (int i = 0; i < RR_MAX_THREADS; i++) add_stats(ctx->stats, &tj->st[i]);
-    free(tj);
+    free(tj), rr_scratch_give(dev, eb);
   }
   for (int f = 0; f < nhz; f++) rr_hiz_free(&hz[f]);
   return err;
