@@ -283,7 +283,7 @@ static void check_shared_setup(rr_device *dev) {
     const int n = (int)s->ntris < TRI_SHARED_MAX ? (int)s->ntris : TRI_SHARED_MAX;
     static float rec[TRI_SHARED_MAX][TRI_EYE_REC];
     static _Atomic uint32_t slot[TRI_SHARED_MAX];
-    tri_eyes keep = {rec, slot, 0};
+    tri_eyes keep = {rec, slot, 0}; /* filled over the trials */
     memset((void *)slot, TRI_EYE_NONE, sizeof slot);
     uint32_t ids[TRI_SHARED_MAX];
     for (int i = 0; i < n; i++) ids[i] = (uint32_t)i;
@@ -299,21 +299,23 @@ static void check_shared_setup(rr_device *dev) {
       static tri_setup got[6 * TRI_SHARED_MAX], want;
       static tri_plane gpl[6 * TRI_SHARED_MAX], wpl;
       static int face[6 * TRI_SHARED_MAX];
-      /* from trial 4 on through a table of eye parts, half of it filled first */
-      tri_eyes *k = trial >= 4 ? &keep : NULL;
-      int fresh = n;
-      if (k) {
-        uint32_t odd[TRI_SHARED_MAX];
-        int no = 0, none = 0, absent = 0;
-        for (int i = 1; i < n; i += 2) odd[no++] = ids[i], absent += slot[i] < TRI_EYE_AT;
-        const int got_odd = rr_tri_setup_shared(s, odd, no, fc, 1, sel, &none, cull, simd, got, sizeof *got, face,
-                                                NULL, 0, k);
-        eyes_bad += got_odd != absent;
-        fresh = 0;
-        for (int i = 0; i < n; i++) fresh += slot[i] < TRI_EYE_AT;
+      rr_tri_setup_shared(s, ids, n, fc, 6, sel, nsel, cull, simd, got, sizeof *got, face, gpl, sizeof *gpl);
+      /* from trial 4 on, the faces one by one through a table of eye parts
+       * (rr_tri_setup_kept), in its order; each call makes those it lacks */
+      for (int f = 0, k = 0; f < 6 && trial >= 4; k += nsel[f++]) {
+        uint32_t fid[TRI_SHARED_MAX];
+        int order[TRI_SHARED_MAX], absent = 0;
+        for (int j = 0; j < nsel[f]; j++) fid[j] = ids[sel[k + j]], absent += slot[sel[k + j]] < TRI_EYE_AT;
+        static tri_setup kts[TRI_SHARED_MAX];
+        static tri_plane kpl[TRI_SHARED_MAX];
+        int kface[TRI_SHARED_MAX];
+        eyes_bad += rr_tri_setup_kept(s, &keep, fid, nsel[f], &fc[f], cull, simd, kts, kface, kpl, order) != absent;
+        for (int j = 0; j < nsel[f]; j++) { /* back in the order asked */
+          const int o = k + order[j];
+          eyes_bad += order[j] < 0 || order[j] >= nsel[f] || kface[j] != face[o] ||
+                      (face[o] != SETUP_CULLED && (memcmp(&kts[j], &got[o], sizeof *got) || memcmp(&kpl[j], &gpl[o], sizeof *gpl)));
+        }
       }
-      eyes_bad += rr_tri_setup_shared(s, ids, n, fc, 6, sel, nsel, cull, simd, got, sizeof *got, face, gpl,
-                                      sizeof *gpl, k) != fresh;
       for (int f = 0, k = 0; f < 6; f++)
         for (int j = 0; j < nsel[f]; j++, k++) {
           int wface;
@@ -328,7 +330,8 @@ static void check_shared_setup(rr_device *dev) {
   }
   printf("cube: shared setups of %ld (triangle, face) pairs, %ld differ from the faces' own\n", compared, bad);
   CHECK(compared > 1000 && bad == 0, "cube: %ld of %ld shared setups differ from the faces' own", bad, compared);
-  CHECK(eyes_bad == 0, "cube: %ld calls computed another number of eye parts than the table lacked", eyes_bad);
+  CHECK(eyes_bad == 0, "cube: %ld setups through a table of eye parts differ from the faces' own, or made another "
+        "number of eye parts than it lacked", eyes_bad);
   rr_cam_release(&c);
 }
 

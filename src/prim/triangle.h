@@ -53,31 +53,37 @@ typedef struct tri_plane {
 /* rr_tri_setup_run that also writes each kept triangle's tri_plane to pl[k]. */
 void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces,
                          bool simd, tri_setup *out, int *face, tri_plane *pl);
-/* Setups at one eye kept for a frame (rr_tri_setup_shared's keep): each
- * triangle's eye part, what its setup depends on the eye alone, computed by the
- * first setup that needs it and read by every later one, on any thread, so that
- * cameras sharing the eye (a cube's faces drawn frustum by frustum) set each
- * triangle up once. The records are packed in the order they are made, so that
- * a frame touches only as many as it needs. The caller zeroes slot and used. */
+/* rr_tri_setup_planes for cameras cams[0..ncams-1] that share one eye (a cube's
+ * faces), each for some of the triangles ids[0..n-1] (n <= TRI_SHARED_MAX): what
+ * depends on the eye alone is computed once per triangle, the rest per camera for
+ * the triangles it asks for, W to a step, with the bits each camera alone gives.
+ * Camera k asks for ids[sel[a_k + j]], j < nsel[k] (a_k = nsel[0] + .. + nsel[k-1]);
+ * its setup of it goes to entry a_k + j of out, face and pl (when not NULL), the
+ * entries of out ostride bytes apart, of pl pstride (a caller's records). */
+#define TRI_SHARED_MAX 256
+void rr_tri_setup_shared(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
+                         const int32_t *sel, const int *nsel, bool cull_backfaces, bool simd, tri_setup *out,
+                         size_t ostride, int *face, tri_plane *pl, size_t pstride);
+/* Eye parts kept for a frame (rr_tri_setup_kept): each triangle's, what its setup
+ * depends on the eye alone, made by the first setup that needs it and read by
+ * every later one, on any thread, so that cameras sharing the eye (a cube's faces
+ * drawn frustum by frustum) set each triangle up once. The records are packed in
+ * the order they are made: a frame touches only those it needs. The caller zeroes
+ * slot and used for a frame. */
 enum { TRI_EYE_REC = 24, TRI_EYE_NONE = 0, TRI_EYE_BUSY = 1, TRI_EYE_AT = 2 };
 typedef struct tri_eyes {
   float (*rec)[TRI_EYE_REC]; /* room for every triangle */
   _Atomic uint32_t *slot;    /* by triangle id: TRI_EYE_NONE, _BUSY (being recorded) or _AT + its record */
   atomic_uint used;          /* records made */
 } tri_eyes;
-/* rr_tri_setup_planes for cameras cams[0..ncams-1] that share one eye (a cube's
- * faces), each for some of the triangles ids[0..n-1] (n <= TRI_SHARED_MAX): what
- * depends on the eye alone is computed once per triangle (not at all where keep,
- * when not NULL, holds it), the rest per camera for the triangles it asks for, W
- * to a step, with the bits each camera alone gives. Camera k asks for
- * ids[sel[a_k + j]], j < nsel[k] (a_k = nsel[0] + .. + nsel[k-1]); its setup of it
- * goes to entry a_k + j of out, face and pl (when not NULL), the entries of out
- * ostride bytes apart, of pl pstride (a caller's records). Returns how many eye
- * parts it computed: the setups S counts. */
-#define TRI_SHARED_MAX 256
-int rr_tri_setup_shared(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
-                        const int32_t *sel, const int *nsel, bool cull_backfaces, bool simd, tri_setup *out,
-                        size_t ostride, int *face, tri_plane *pl, size_t pstride, tri_eyes *keep);
+/* rr_tri_setup_planes of triangles ids[0..n-1] (n <= TRI_SHARED_MAX, fewer than
+ * INT32_MAX / TRI_EYE_REC in the scene) for a perspective or curved camera c at
+ * keep's eye: a triangle whose eye part keep holds costs only the rest. Entry k
+ * of out, face and pl (when not NULL) is the setup of ids[order[k]]: first those
+ * whose eye part this call made, then the others. Returns how many it made (the
+ * setups S counts). */
+int rr_tri_setup_kept(const rr_scene *s, tri_eyes *keep, const uint32_t *ids, int n, const camera *c,
+                      bool cull_backfaces, bool simd, tri_setup *out, int *face, tri_plane *pl, int *order);
 /* The setup ts (from rr_tri_setup_planes with a camera that differs from c only in
  * its sample position) for camera c: the bits rr_tri_setup gives for c. */
 void rr_tri_setup_at(const tri_setup *ts, const tri_plane *pl, const camera *c, tri_setup *out);

@@ -58,9 +58,9 @@ int rr_tri_setup(const rr_scene *s, uint32_t i, const camera *c, bool cull_backf
   return face;
 }
 
-int rr_tri_setup_shared(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
-                        const int32_t *sel, const int *nsel, bool cull_backfaces, bool simd, tri_setup *out,
-                        size_t ostride, int *face, tri_plane *pl, size_t pstride, tri_eyes *keep) {
+void rr_tri_setup_shared(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
+                         const int32_t *sel, const int *nsel, bool cull_backfaces, bool simd, tri_setup *out,
+                         size_t ostride, int *face, tri_plane *pl, size_t pstride) {
   bool ortho = false;
   for (int k = 0; k < ncams; k++) ortho |= cams[k].type == RR_CAMERA_ORTHOGRAPHIC;
   if (ortho) { /* (no caller: the shared EYE leaves out what the eye at infinity reads) */
@@ -68,14 +68,31 @@ int rr_tri_setup_shared(const rr_scene *s, const uint32_t *ids, int n, const cam
       for (int j = at; j < at + nsel[k]; j++)
         setup_one1(s, &ids[sel[j]], 1, &cams[k], cull_backfaces, (tri_setup *)((char *)out + j * ostride), &face[j],
                    pl ? (tri_plane *)((char *)pl + j * pstride) : NULL);
+    return;
+  }
+#ifdef RR_SIMD_X86
+  if (simd && __builtin_cpu_supports("avx2")) {
+    setup_shared8(s, ids, n, cams, ncams, sel, nsel, cull_backfaces, out, ostride, face, pl, pstride);
+    return;
+  }
+#endif
+  (void)simd;
+  setup_shared1(s, ids, n, cams, ncams, sel, nsel, cull_backfaces, out, ostride, face, pl, pstride);
+}
+
+int rr_tri_setup_kept(const rr_scene *s, tri_eyes *keep, const uint32_t *ids, int n, const camera *c,
+                      bool cull_backfaces, bool simd, tri_setup *out, int *face, tri_plane *pl, int *order) {
+  if (c->type == RR_CAMERA_ORTHOGRAPHIC) { /* (no caller: the eye at infinity keeps no EYE) */
+    for (int k = 0; k < n; k++) order[k] = k;
+    rr_tri_setup_planes(s, ids, n, c, cull_backfaces, simd, out, face, pl);
     return n;
   }
 #ifdef RR_SIMD_X86
   if (simd && __builtin_cpu_supports("avx2"))
-    return setup_shared8(s, ids, n, cams, ncams, sel, nsel, cull_backfaces, out, ostride, face, pl, pstride, keep);
+    return setup_kept8(s, keep, ids, n, c, cull_backfaces, out, face, pl, order);
 #endif
   (void)simd;
-  return setup_shared1(s, ids, n, cams, ncams, sel, nsel, cull_backfaces, out, ostride, face, pl, pstride, keep);
+  return setup_kept1(s, keep, ids, n, c, cull_backfaces, out, face, pl, order);
 }
 
 void rr_tri_setup_planes(const rr_scene *s, const uint32_t *ids, int n, const camera *c, bool cull_backfaces,

@@ -277,102 +277,124 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(eye_store, W)(co
 #undef STORE_F
 }
 
-TARGET __attribute__((always_inline)) static inline int RR_CAT(setup_shared_lanes, W)(
-    const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams, const int32_t *sel, const int *nsel,
-    bool cull, tri_setup *out, size_t ostride, int *face, tri_plane *pl, size_t pstride, tri_eyes *keep, bool flat) {
-  /* Field f of triangle k at from[f·fstride + where[k]]: without keep, rec by
-   * field (W lanes past the last triangle for its stores; few triangles keep to
-   * few cache lines), with keep its record. */
-  float rec[TRI_EYE_REC * (TRI_SHARED_MAX + W)];
-  int32_t where[TRI_SHARED_MAX];
-  const float *from = rec;
-  int fstride = (n + W - 1) / W * W + W, fresh = n;
-  if (!keep) {
-    for (int k = 0; k < n; k += W) {
-      EYE e;
-      RR_CAT(eye_lanes, W)(s, ids + k, n - k < W ? n - k : W, cams[0].eye, flat, &e);
-      RR_CAT(eye_store, W)(&e, s->inf, rec + k, fstride);
-    }
-    for (int k = 0; k < n; k++) where[k] = k;
-  } else {
-    /* Each eye part is computed once: a setup claims the absent ones (BUSY),
-     * records them, then waits for those another thread claimed first, which it
-     * records without waiting on anything: S does not depend on the threads. */
-    const int fields = s->inf ? TRI_EYE_REC : 19;
-    uint32_t mine[TRI_SHARED_MAX];
-    int at[TRI_SHARED_MAX], theirs[TRI_SHARED_MAX], nt = 0;
-    from = keep->rec[0], fstride = 1, fresh = 0;
-    for (int k = 0; k < n; k++) {
-      uint32_t v = atomic_load_explicit(&keep->slot[ids[k]], memory_order_acquire);
-      if (v == TRI_EYE_NONE && atomic_compare_exchange_strong_explicit(&keep->slot[ids[k]], &v, TRI_EYE_BUSY,
-                                                                       memory_order_acquire, memory_order_acquire))
-        mine[fresh] = ids[k], at[fresh++] = k;
-      else if (v >= TRI_EYE_AT)
-        where[k] = (int32_t)(v - TRI_EYE_AT) * TRI_EYE_REC;
-      else
-        theirs[nt++] = k;
-    }
-    const uint32_t base = fresh ? atomic_fetch_add_explicit(&keep->used, (unsigned)fresh, memory_order_relaxed) : 0;
-    for (int k = 0; k < fresh; k += W) {
-      const int m = fresh - k < W ? fresh - k : W;
-      EYE e;
-      float lanes[TRI_EYE_REC][W];
-      RR_CAT(eye_lanes, W)(s, mine + k, m, cams[0].eye, flat, &e);
-      RR_CAT(eye_store, W)(&e, s->inf, &lanes[0][0], W);
-      for (int l = 0; l < m; l++) {
-        const uint32_t r = base + (uint32_t)(k + l);
-        for (int f = 0; f < fields; f++) keep->rec[r][f] = lanes[f][l];
-        atomic_store_explicit(&keep->slot[mine[k + l]], TRI_EYE_AT + r, memory_order_release);
-        where[at[k + l]] = (int32_t)r * TRI_EYE_REC;
-      }
-    }
-    for (int i = 0; i < nt; i++) {
-      uint32_t v;
-      while ((v = atomic_load_explicit(&keep->slot[ids[theirs[i]]], memory_order_acquire)) < TRI_EYE_AT) sched_yield();
-      where[theirs[i]] = (int32_t)(v - TRI_EYE_AT) * TRI_EYE_REC;
-    }
-  }
-  const VI all = VI_(splat)(-1);
+/* EYE (what view_lanes reads for a camera that is not orthographic) of W lanes
+ * from stored fields: field f of lane l at from[f·fstride + lane[l]], loaded
+ * when run (the lanes in a row, fstride apart), else gathered. */
+TARGET __attribute__((always_inline)) static inline void RR_CAT(eye_load, W)(const float *from, int fstride,
+                                                                           const int32_t *lane, bool run, bool inf,
+                                                                           EYE *e) {
+  const VI idx = VI_(load)(lane), all = VI_(splat)(-1);
 #define GATHER_F(f) (run ? VF_(load)(from + (f) * fstride + lane[0]) : VF_(gather)(from + (f) * fstride, idx))
 #define GATHER3(f) ((V3){GATHER_F(f), GATHER_F((f) + 1), GATHER_F((f) + 2)})
 #define GATHER_I(f) \
   (run ? VI_(load)((const int32_t *)from + (f) * fstride + lane[0]) \
        : VI_(gather_masked)((const int32_t *)from + (f) * fstride, idx, all))
+  e->p1 = GATHER3(0), e->p2 = GATHER3(3), e->pf = GATHER3(6);
+  for (int i = 0; i < 3; i++) e->n[i] = GATHER3(9 + 3 * i);
+  e->vol = GATHER_F(18);
+  e->at_inf[0] = e->at_inf[1] = e->at_inf[2] = e->inf1 = e->inf2 = VI_(splat)(0);
+  if (inf) {
+    for (int i = 0; i < 3; i++) e->at_inf[i] = GATHER_I(19 + i);
+    e->inf1 = GATHER_I(22), e->inf2 = GATHER_I(23);
+  }
+#undef GATHER_I
+#undef GATHER3
+#undef GATHER_F
+}
+
+TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_shared_lanes, W)(
+    const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams, const int32_t *sel, const int *nsel,
+    bool cull, tri_setup *out, size_t ostride, int *face, tri_plane *pl, size_t pstride, bool flat) {
+  /* field f of triangle k at rec[f·stride + k], W lanes past the last triangle
+   * for its stores; few triangles keep to few cache lines */
+  float rec[TRI_EYE_REC * (TRI_SHARED_MAX + W)];
+  const int stride = (n + W - 1) / W * W + W;
+  for (int k = 0; k < n; k += W) {
+    EYE e;
+    RR_CAT(eye_lanes, W)(s, ids + k, n - k < W ? n - k : W, cams[0].eye, flat, &e);
+    RR_CAT(eye_store, W)(&e, s->inf, rec + k, stride);
+  }
   for (int view = 0, at = 0; view < ncams; at += nsel[view++])
     for (int j = 0; j < nsel[view]; j += W) {
       const int m = nsel[view] - j < W ? nsel[view] - j : W;
       int32_t lane[W];
-      for (int l = 0; l < W; l++) lane[l] = where[sel[at + j + (l < m ? l : m - 1)]];
-      const VI idx = VI_(load)(lane);
+      for (int l = 0; l < W; l++) lane[l] = sel[at + j + (l < m ? l : m - 1)];
       /* W of a face's triangles in a row (the common case): loads, cheaper than gathers */
-      const bool run = !keep && m == W && VI_(bits)(idx == VI_(splat)(lane[0]) + VI_(lanes)()) == (1 << W) - 1;
-      EYE e; /* what view_lanes reads for a camera that is not orthographic */
-      e.p1 = GATHER3(0), e.p2 = GATHER3(3), e.pf = GATHER3(6);
-      for (int i = 0; i < 3; i++) e.n[i] = GATHER3(9 + 3 * i);
-      e.vol = GATHER_F(18);
-      e.at_inf[0] = e.at_inf[1] = e.at_inf[2] = e.inf1 = e.inf2 = VI_(splat)(0);
-      if (s->inf) {
-        for (int i = 0; i < 3; i++) e.at_inf[i] = GATHER_I(19 + i);
-        e.inf1 = GATHER_I(22), e.inf2 = GATHER_I(23);
-      }
+      bool run = m == W;
+      for (int l = 1; l < W && run; l++) run = lane[l] == lane[0] + l;
+      EYE e;
+      RR_CAT(eye_load, W)(rec, stride, lane, run, s->inf, &e);
       RR_CAT(view_lanes, W)(&e, m, (1 << m) - 1, &cams[view], cull, (tri_setup *)((char *)out + (at + j) * ostride),
                             ostride, face + at + j, pl ? (tri_plane *)((char *)pl + (at + j) * pstride) : NULL,
                             pstride, false);
     }
-#undef GATHER_I
-#undef GATHER3
-#undef GATHER_F
+}
+
+TARGET static void RR_CAT(setup_shared, W)(const rr_scene *s, const uint32_t *ids, int n, const camera *cams,
+                                           int ncams, const int32_t *sel, const int *nsel, bool cull, tri_setup *out,
+                                           size_t ostride, int *face, tri_plane *pl, size_t pstride) {
+  if (s->inst)
+    RR_CAT(setup_shared_lanes, W)(s, ids, n, cams, ncams, sel, nsel, cull, out, ostride, face, pl, pstride, false);
+  else
+    RR_CAT(setup_shared_lanes, W)(s, ids, n, cams, ncams, sel, nsel, cull, out, ostride, face, pl, pstride, true);
+}
+
+/* The setup through a table of eye parts (triangle.h, rr_tri_setup_kept): the
+ * triangles whose eye part no setup has made are claimed, set up straight from
+ * their EYE and recorded; then those of others, from their records (a claim of
+ * another thread waited for: it records without waiting on anything, so each eye
+ * part is made once whatever the threads). */
+TARGET __attribute__((always_inline)) static inline int RR_CAT(setup_kept_lanes, W)(
+    const rr_scene *s, tri_eyes *keep, const uint32_t *ids, int n, const camera *c, bool cull, tri_setup *out,
+    int *face, tri_plane *pl, int *order, bool flat) {
+  const int fields = s->inf ? TRI_EYE_REC : 19;
+  uint32_t mine[TRI_SHARED_MAX];
+  int32_t where[TRI_SHARED_MAX + W]; /* the others' records (float offsets), from entry `fresh` on */
+  int fresh = 0, rest = n;
+  for (int k = 0; k < n; k++) { /* mine from the front of order, the others from its back */
+    uint32_t v = atomic_load_explicit(&keep->slot[ids[k]], memory_order_acquire);
+    if (v == TRI_EYE_NONE && atomic_compare_exchange_strong_explicit(&keep->slot[ids[k]], &v, TRI_EYE_BUSY,
+                                                                     memory_order_acquire, memory_order_acquire))
+      mine[fresh] = ids[k], order[fresh++] = k;
+    else
+      order[--rest] = k;
+  }
+  const uint32_t base = fresh ? atomic_fetch_add_explicit(&keep->used, (unsigned)fresh, memory_order_relaxed) : 0;
+  for (int k = 0; k < fresh; k += W) {
+    const int m = fresh - k < W ? fresh - k : W;
+    EYE e;
+    float lanes[TRI_EYE_REC][W];
+    RR_CAT(eye_lanes, W)(s, mine + k, m, c->eye, flat, &e);
+    RR_CAT(view_lanes, W)(&e, m, (1 << m) - 1, c, cull, out + k, sizeof *out, face + k, pl ? pl + k : NULL,
+                          sizeof *pl, false);
+    RR_CAT(eye_store, W)(&e, s->inf, &lanes[0][0], W);
+    for (int l = 0; l < m; l++) {
+      const uint32_t r = base + (uint32_t)(k + l);
+      for (int f = 0; f < fields; f++) keep->rec[r][f] = lanes[f][l];
+      atomic_store_explicit(&keep->slot[mine[k + l]], TRI_EYE_AT + r, memory_order_release);
+    }
+  }
+  for (int k = fresh; k < n; k++) {
+    uint32_t v;
+    while ((v = atomic_load_explicit(&keep->slot[ids[order[k]]], memory_order_acquire)) < TRI_EYE_AT) sched_yield();
+    where[k] = (int32_t)(v - TRI_EYE_AT) * TRI_EYE_REC;
+  }
+  for (int k = fresh; k < n; k += W) {
+    const int m = n - k < W ? n - k : W;
+    for (int l = m; l < W; l++) where[k + l] = where[k];
+    EYE e;
+    RR_CAT(eye_load, W)(keep->rec[0], 1, where + k, false, s->inf, &e);
+    RR_CAT(view_lanes, W)(&e, m, (1 << m) - 1, c, cull, out + k, sizeof *out, face + k, pl ? pl + k : NULL,
+                          sizeof *pl, false);
+  }
   return fresh;
 }
 
-TARGET static int RR_CAT(setup_shared, W)(const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams,
-                                          const int32_t *sel, const int *nsel, bool cull, tri_setup *out,
-                                          size_t ostride, int *face, tri_plane *pl, size_t pstride, tri_eyes *keep) {
-  if (s->inst)
-    return RR_CAT(setup_shared_lanes, W)(s, ids, n, cams, ncams, sel, nsel, cull, out, ostride, face, pl, pstride,
-                                         keep, false);
-  return RR_CAT(setup_shared_lanes, W)(s, ids, n, cams, ncams, sel, nsel, cull, out, ostride, face, pl, pstride, keep,
-                                       true);
+TARGET static int RR_CAT(setup_kept, W)(const rr_scene *s, tri_eyes *keep, const uint32_t *ids, int n,
+                                        const camera *c, bool cull, tri_setup *out, int *face, tri_plane *pl,
+                                        int *order) {
+  if (s->inst) return RR_CAT(setup_kept_lanes, W)(s, keep, ids, n, c, cull, out, face, pl, order, false);
+  return RR_CAT(setup_kept_lanes, W)(s, keep, ids, n, c, cull, out, face, pl, order, true);
 }
 
 #include "prim/triangle_moved_tmp.h"

@@ -390,28 +390,29 @@ static bool finish_binning(const trav *t, uint32_t id, tri_job *j) {
 /* Sets up the bounded triangles b[0..nb-1] of a planar camera, eight at a time,
  * into out; returns how many can be seen. */
 static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job *out) {
+  enum { STEP = 8 };
   uint32_t kept = 0;
-  for (uint32_t q = 0; q < nb; q += 8) {
-    int m = nb - q < 8 ? (int)(nb - q) : 8, face[8];
-    uint32_t ids[8];
-    tri_setup ts[8];
-    tri_plane pls[8], *pl = t->ns > 1 ? pls : NULL;
-    for (int l = 0; l < m; l++) ids[l] = b[q + l].id;
-    if (t->eyes) { /* a cube's face: S counts the eye parts no face had set up */
-      static const int32_t lane[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-      t->st.setups += (uint64_t)rr_tri_setup_shared(t->s, ids, m, t->c, 1, lane, &m, t->cull_back, t->simd, ts,
-                                                    sizeof *ts, face, pl, sizeof *pl, t->eyes);
+  for (uint32_t q = 0; q < nb; q += STEP) {
+    int m = nb - q < STEP ? (int)(nb - q) : STEP, face[STEP], order[STEP];
+    uint32_t ids[STEP];
+    tri_setup ts[STEP];
+    tri_plane pls[STEP], *pl = t->ns > 1 ? pls : NULL;
+    for (int l = 0; l < m; l++) ids[l] = b[q + l].id, order[l] = l;
+    if (t->eyes) { /* a cube's face: S counts the eye parts no face had made (setups in `order`) */
+      t->st.setups += (uint64_t)rr_tri_setup_kept(t->s, t->eyes, ids, m, t->c, t->cull_back, t->simd, ts, face, pl,
+                                                  order);
     } else {
       t->st.setups += (uint64_t)m;
       rr_tri_setup_planes(t->s, ids, m, t->c, t->cull_back, t->simd, ts, face, pl);
     }
     for (int l = 0; l < m; l++) {
       if (face[l] == SETUP_CULLED) continue;
+      const tri_bound *bl = &b[q + order[l]];
       tri_job *j = out + kept;
       j->ts = ts[l];
-      if (pl) j->pl = pl[l], j->pos = b[q + l].pos;
-      memcpy(j->bb, b[q + l].bb, sizeof j->bb);
-      kept += finish_setup(t, ids[l], j);
+      if (pl) j->pl = pl[l], j->pos = bl->pos;
+      memcpy(j->bb, bl->bb, sizeof j->bb);
+      kept += finish_setup(t, bl->id, j);
     }
   }
   return kept;
@@ -521,7 +522,7 @@ static uint32_t setup_faces(trav *t, uint32_t first, uint32_t n, tri_job *out) {
     tri_job *jobs = out + kept; /* room for 6 a triangle: kept + pairs <= 6 (g + m - first) */
     const bool several = t->ns > 1;
     rr_tri_setup_shared(t->s, ids, q, t->face_cams0, 6, sel, nb, t->cull_back, t->simd, &jobs->ts, sizeof *jobs, face,
-                        several ? &jobs->pl : NULL, sizeof *jobs, NULL);
+                        several ? &jobs->pl : NULL, sizeof *jobs);
     for (int f = 0, p = 0; f < 6; f++)
       for (int k = 0; k < nb[f]; k++, p++) {
         if (face[p] == SETUP_CULLED) continue;
