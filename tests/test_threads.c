@@ -38,8 +38,10 @@ static rr_error fail(device_work *w, rr_device *dev, rr_error e) {
   return e;
 }
 
-/* Loads the scene, renders it with every method on two threads from a planar and a
- * curved camera, and shades every frame in every mode. */
+/* Loads the scene, renders it with every method on two threads from a planar, a
+ * curved and a cube camera (whose faces the frustum methods draw at once, sharing
+ * each triangle's eye part across the threads), and shades every frame in every
+ * mode. */
 static uint64_t render_all(device_work *w, rr_device *dev) {
   uint64_t h = 0xcbf29ce484222325ull;
   rr_scene *s;
@@ -47,10 +49,10 @@ static uint64_t render_all(device_work *w, rr_device *dev) {
   rr_camera cam;
   rr_camera_init(&cam);
   if (fail(w, dev, rr_camera_frame(dev, s, W, H, &cam))) goto done;
-  for (int curved = 0; curved < 2; curved++) {
-    if (curved) cam.type = RR_CAMERA_FISHEYE, cam.fov_deg = 180;
+  for (int kind = 0; kind < 3; kind++) {
+    if (kind) cam.type = kind == 1 ? RR_CAMERA_FISHEYE : RR_CAMERA_CUBE, cam.fov_deg = kind == 1 ? 180 : 90;
     for (int m = 0; m < NMETHODS; m++) {
-      if (methods[m] == RR_METHOD_2DR_BIN && (curved || s->inf)) continue; /* planar, finite only */
+      if (methods[m] == RR_METHOD_2DR_BIN && (kind || s->inf)) continue; /* planar, finite only */
       rr_render_options opt;
       rr_render_options_init(&opt);
       opt.method = methods[m], opt.width = W, opt.height = H, opt.threads = 2, opt.heat = 1;
