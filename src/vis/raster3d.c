@@ -25,8 +25,10 @@ uint64_t rr_raster_rect(const tri_setup *ts, uint32_t id, const int r[4], const 
   } else
 #ifdef RR_SIMD_X86
   /* a rectangle of a few samples (most triangles of a detailed mesh) costs less
-   * than the vector loop's setup; both paths give the same bits */
-  if (simd && c->planar && samples > 2 && __builtin_cpu_supports("avx2")) n = raster_one8(ts, id, r, c, vb, true);
+   * than the vector loop's setup, and a curved one's rows of fewer than four
+   * than the gathers of their rays; both paths give the same bits */
+  if (simd && samples > 2 && (c->planar || r[2] - r[0] >= 3) && __builtin_cpu_supports("avx2"))
+    n = raster_one8(ts, id, r, c, vb, c->planar);
   else
 #endif
     n = raster_one1(ts, id, r, c, vb, c->planar);

@@ -66,6 +66,8 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_mov
                                                mv ? mv->cx[s] : ts->cx, mv ? mv->cy[s] : ts->cy};
   const VI end = VI_(splat)(r[2] + 1);
   const VF pa = VF_(splat)(p.pa), num0 = VF_(splat)(p.num0), cx = VF_(splat)(p.cx), cy = VF_(splat)(p.cy);
+  /* curved: the rays' directions by gathers of 32-bit float offsets where they fit */
+  const bool dirs_gathered = !planar && (uint64_t)3 * width * (size_t)vb->height <= INT32_MAX;
   float *best_t = vb->t + s, *l1 = vb->l1 + s, *l2 = vb->l2 + s; /* sample s of each pixel */
   int32_t *best_id = (int32_t *)vb->id + s;
   for (int x = r[0]; x <= r[2]; x += W) {
@@ -79,11 +81,15 @@ TARGET KERNEL uint64_t RR_CAT(raster_loop, W)(const tri_setup *ts, const tri_mov
       const VF sy = VF_(splat)((float)y + c->sy0);
       const size_t k = (size_t)y * width + (size_t)x;
       VF wx = zero, wy = zero, wz = zero; /* curved: the camera's ray direction per sample */
-      if (!planar)
-        for (int l = 0; l < W; l++) { /* (lanes past r[2] read the first one's) */
+      if (!planar && dirs_gathered) { /* (lanes past r[2] read the first one's) */
+        const VI at = (VI_(splat)((int32_t)k) + VI_(select)(valid, VI_(lanes)(), VI_(splat)(0))) * VI_(splat)(3);
+        wx = VF_(gather)(&c->dirs->x, at), wy = VF_(gather)(&c->dirs->y, at), wz = VF_(gather)(&c->dirs->z, at);
+      } else if (!planar) {
+        for (int l = 0; l < W; l++) {
           vec3 d = c->dirs[k + (size_t)(x + l <= r[2] ? l : 0)];
           wx[l] = d.x, wy[l] = d.y, wz[l] = d.z;
         }
+      }
       VF ev[3];
       VI in = valid;
 #pragma GCC unroll 3
