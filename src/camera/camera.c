@@ -143,6 +143,18 @@ static vec3 cube_dir(const camera *c, int x, int y) {
   return v3_add(d0, v3_add(v3_scale(dx, sx), v3_scale(dy, sy))); /* camera_dir's operations */
 }
 
+/* The lat-long map's angles of column x and row y, and its direction from the
+ * horizontal one of the column and the row's sine and cosine: written once for
+ * curved_dir and the table (rr_cam_setup_at, which takes the sines a column and
+ * a row at a time), so both give the same bits. */
+static double latlong_phi(const camera *c, int x) {
+  return 2 * RR_PI * (x + (double)c->sx0) / c->width - RR_PI;
+}
+static double latlong_theta(const camera *c, int y) { return RR_PI * (y + (double)c->sy0) / c->height; }
+static vec3 latlong_dir(vec3 horiz, vec3 up, float sin_theta, float cos_theta) {
+  return v3_add(v3_scale(horiz, sin_theta), v3_scale(up, cos_theta));
+}
+
 /* The direction of pixel (x, y) of a curved camera; zero where it has no ray.
  * With dd, also its derivatives with respect to the sample position, per pixel
  * step in x (dd[0]) and y (dd[1]): each mapping differentiated in closed form. */
@@ -161,7 +173,7 @@ static vec3 curved_dir(const camera *c, int x, int y, vec3 *dd) {
     return v3_add(v3_add(v3_scale(r, (float)u), v3_scale(up, (float)v)), v3_scale(f, (float)(0.5 - 0.5 * rr)));
   }
   case RR_CAMERA_LATLONG: {
-    double phi = 2 * RR_PI * sx / W - RR_PI, theta = RR_PI * sy / H;
+    double phi = latlong_phi(c, x), theta = latlong_theta(c, y);
     vec3 horiz = v3_add(v3_scale(r, (float)sin(phi)), v3_scale(f, (float)cos(phi)));
     if (dd) { /* ∂d/∂φ = sin θ (cos φ right − sin φ fwd), ∂d/∂θ = cos θ horiz − sin θ up */
       vec3 dphi = v3_sub(v3_scale(r, (float)cos(phi)), v3_scale(f, (float)sin(phi)));
@@ -169,7 +181,7 @@ static vec3 curved_dir(const camera *c, int x, int y, vec3 *dd) {
       dd[1] = v3_scale(v3_sub(v3_scale(horiz, (float)cos(theta)), v3_scale(up, (float)sin(theta))),
                        (float)(RR_PI / H));
     }
-    return v3_add(v3_scale(horiz, (float)sin(theta)), v3_scale(up, (float)cos(theta)));
+    return latlong_dir(horiz, up, (float)sin(theta), (float)cos(theta));
   }
   case RR_CAMERA_FISHEYE: {
     double rad = sqrt(u * u + v * v);
@@ -328,8 +340,26 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     }
     c->lens_field = rr_lens_field(&c->lens, c->lens_fold, width, height);
   }
-  for (int y = 0; y < height; y++)
-    for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);
+  if (in->type == RR_CAMERA_LATLONG) { /* (curved_dir's, with a sine a column and a row) */
+    vec3 *horiz = malloc((size_t)width * sizeof *horiz);
+    if (!horiz) {
+      rr_cam_release(c);
+      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
+    }
+    for (int x = 0; x < width; x++) {
+      const double phi = latlong_phi(c, x);
+      horiz[x] = v3_add(v3_scale(c->right, (float)sin(phi)), v3_scale(c->fwd, (float)cos(phi)));
+    }
+    for (int y = 0; y < height; y++) {
+      const double theta = latlong_theta(c, y);
+      const float st = (float)sin(theta), ct = (float)cos(theta);
+      for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = latlong_dir(horiz[x], c->up, st, ct);
+    }
+    free(horiz);
+  } else {
+    for (int y = 0; y < height; y++)
+      for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);
+  }
   switch (in->type) {
   case RR_CAMERA_PARABOLIC: /* conformal, angle = 2 atan(r): at most 2 radians per unit of u */
     c->lipschitz = 2.0f * 2.0f / (float)(width < height ? width : height);
