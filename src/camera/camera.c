@@ -151,8 +151,21 @@ static double latlong_phi(const camera *c, int x) {
   return 2 * RR_PI * (x + (double)c->sx0) / c->width - RR_PI;
 }
 static double latlong_theta(const camera *c, int y) { return RR_PI * (y + (double)c->sy0) / c->height; }
+static vec3 latlong_horiz(const camera *c, int x) {
+  const double phi = latlong_phi(c, x);
+  return v3_add(v3_scale(c->right, (float)sin(phi)), v3_scale(c->fwd, (float)cos(phi)));
+}
 static vec3 latlong_dir(vec3 horiz, vec3 up, float sin_theta, float cos_theta) {
   return v3_add(v3_scale(horiz, sin_theta), v3_scale(up, cos_theta));
+}
+/* The image's coordinates in [-1, 1] of column x and row y (up positive). */
+static double image_u(const camera *c, int x) { return 2 * (x + (double)c->sx0) / c->width - 1; }
+static double image_v(const camera *c, int y) { return 1 - 2 * (y + (double)c->sy0) / c->height; }
+
+/* The parabolic map's direction from the column's part right·u, the row's up·v
+ * and u² + v² (inside the disk): written once, like latlong_dir. */
+static vec3 parabolic_dir(vec3 right_u, vec3 up_v, vec3 fwd, double rr) {
+  return v3_add(v3_add(right_u, up_v), v3_scale(fwd, (float)(0.5 - 0.5 * rr)));
 }
 
 /* The direction of pixel (x, y) of a curved camera; zero where it has no ray.
@@ -160,7 +173,7 @@ static vec3 latlong_dir(vec3 horiz, vec3 up, float sin_theta, float cos_theta) {
  * step in x (dd[0]) and y (dd[1]): each mapping differentiated in closed form. */
 static vec3 curved_dir(const camera *c, int x, int y, vec3 *dd) {
   double W = c->width, H = c->height, sx = x + (double)c->sx0, sy = y + (double)c->sy0;
-  double u = 2 * sx / W - 1, v = 1 - 2 * sy / H, du = 2 / W, dv = -2 / H; /* du/dsx, dv/dsy */
+  double u = image_u(c, x), v = image_v(c, y), du = 2 / W, dv = -2 / H; /* du/dsx, dv/dsy */
   vec3 r = c->right, up = c->up, f = c->fwd;
   switch (c->type) {
   case RR_CAMERA_PARABOLIC: {
@@ -170,11 +183,11 @@ static vec3 curved_dir(const camera *c, int x, int y, vec3 *dd) {
       dd[0] = v3_scale(v3_sub(r, v3_scale(f, (float)u)), (float)du);
       dd[1] = v3_scale(v3_sub(up, v3_scale(f, (float)v)), (float)dv);
     }
-    return v3_add(v3_add(v3_scale(r, (float)u), v3_scale(up, (float)v)), v3_scale(f, (float)(0.5 - 0.5 * rr)));
+    return parabolic_dir(v3_scale(r, (float)u), v3_scale(up, (float)v), f, rr);
   }
   case RR_CAMERA_LATLONG: {
     double phi = latlong_phi(c, x), theta = latlong_theta(c, y);
-    vec3 horiz = v3_add(v3_scale(r, (float)sin(phi)), v3_scale(f, (float)cos(phi)));
+    vec3 horiz = latlong_horiz(c, x);
     if (dd) { /* ∂d/∂φ = sin θ (cos φ right − sin φ fwd), ∂d/∂θ = cos θ horiz − sin θ up */
       vec3 dphi = v3_sub(v3_scale(r, (float)cos(phi)), v3_scale(f, (float)sin(phi)));
       dd[0] = v3_scale(dphi, (float)(sin(theta) * 2 * RR_PI / W));
@@ -340,22 +353,31 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     }
     c->lens_field = rr_lens_field(&c->lens, c->lens_fold, width, height);
   }
-  if (in->type == RR_CAMERA_LATLONG) { /* (curved_dir's, with a sine a column and a row) */
-    vec3 *horiz = malloc((size_t)width * sizeof *horiz);
-    if (!horiz) {
+  if (in->type == RR_CAMERA_LATLONG || in->type == RR_CAMERA_PARABOLIC) {
+    /* curved_dir's, with what depends on the column alone computed once a column */
+    vec3 *col = malloc((size_t)width * sizeof *col);
+    if (!col) {
       rr_cam_release(c);
       return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
     }
-    for (int x = 0; x < width; x++) {
-      const double phi = latlong_phi(c, x);
-      horiz[x] = v3_add(v3_scale(c->right, (float)sin(phi)), v3_scale(c->fwd, (float)cos(phi)));
-    }
+    for (int x = 0; x < width; x++)
+      col[x] = in->type == RR_CAMERA_LATLONG ? latlong_horiz(c, x) : v3_scale(c->right, (float)image_u(c, x));
     for (int y = 0; y < height; y++) {
-      const double theta = latlong_theta(c, y);
-      const float st = (float)sin(theta), ct = (float)cos(theta);
-      for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = latlong_dir(horiz[x], c->up, st, ct);
+      vec3 *row = c->dirs + (size_t)y * width;
+      if (in->type == RR_CAMERA_LATLONG) {
+        const double theta = latlong_theta(c, y);
+        const float st = (float)sin(theta), ct = (float)cos(theta);
+        for (int x = 0; x < width; x++) row[x] = latlong_dir(col[x], c->up, st, ct);
+        continue;
+      }
+      const double v = image_v(c, y);
+      const vec3 up_v = v3_scale(c->up, (float)v);
+      for (int x = 0; x < width; x++) {
+        const double u = image_u(c, x), rr = u * u + v * v;
+        row[x] = rr > 1 ? v3(0, 0, 0) : parabolic_dir(col[x], up_v, c->fwd, rr);
+      }
     }
-    free(horiz);
+    free(col);
   } else {
     for (int y = 0; y < height; y++)
       for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);
