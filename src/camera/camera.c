@@ -288,6 +288,38 @@ static float measured_lipschitz(const camera *c) {
   return 2.0f * asinf(fminf(1.0f, 0.5f * worst)) * sqrtf(2.0f);
 }
 
+/* A curved camera's table of rays, RAY_ROWS rows a job: curved_dir's, with the
+ * columns' parts of the lat-long and parabolic maps (col) computed once. */
+enum { RAY_ROWS = 16 };
+typedef struct ray_table {
+  camera *c;
+  const vec3 *col;
+} ray_table;
+
+static void ray_rows(int job, int thread, void *arg) {
+  (void)thread;
+  const ray_table *rt = arg;
+  camera *c = rt->c;
+  const int y1 = (job + 1) * RAY_ROWS < c->height ? (job + 1) * RAY_ROWS : c->height;
+  for (int y = job * RAY_ROWS; y < y1; y++) {
+    vec3 *row = c->dirs + (size_t)y * c->width;
+    if (c->type == RR_CAMERA_LATLONG) {
+      const double theta = latlong_theta(c, y);
+      const float st = (float)sin(theta), ct = (float)cos(theta);
+      for (int x = 0; x < c->width; x++) row[x] = latlong_dir(rt->col[x], c->up, st, ct);
+    } else if (c->type == RR_CAMERA_PARABOLIC) {
+      const double v = image_v(c, y);
+      const vec3 up_v = v3_scale(c->up, (float)v);
+      for (int x = 0; x < c->width; x++) {
+        const double u = image_u(c, x), rr = u * u + v * v;
+        row[x] = rr > 1 ? v3(0, 0, 0) : parabolic_dir(rt->col[x], up_v, c->fwd, rr);
+      }
+    } else {
+      for (int x = 0; x < c->width; x++) row[x] = curved_dir(c, x, y, NULL);
+    }
+  }
+}
+
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
   static const float centre[2] = {0.5f, 0.5f};
   return rr_cam_setup_at(dev, in, width, height, centre, c);
@@ -295,6 +327,11 @@ rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height
 
 rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int height, const float sample[2],
                          camera *c) {
+  return rr_cam_setup_threads(dev, in, width, height, sample, 1, c);
+}
+
+rr_error rr_cam_setup_threads(rr_device *dev, const rr_camera *in, int width, int height, const float sample[2],
+                              int threads, camera *c) {
   memset(c, 0, sizeof *c);
   rr_error e = rr_camera_check(dev, in);
   if (e) return e;
@@ -353,8 +390,10 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     }
     c->lens_field = rr_lens_field(&c->lens, c->lens_fold, width, height);
   }
+  /* curved_dir's rays, with what depends on the column alone computed once a
+   * column, in bands of rows on the threads */
+  ray_table rt = {c, NULL};
   if (in->type == RR_CAMERA_LATLONG || in->type == RR_CAMERA_PARABOLIC) {
-    /* curved_dir's, with what depends on the column alone computed once a column */
     vec3 *col = malloc((size_t)width * sizeof *col);
     if (!col) {
       rr_cam_release(c);
@@ -362,26 +401,10 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     }
     for (int x = 0; x < width; x++)
       col[x] = in->type == RR_CAMERA_LATLONG ? latlong_horiz(c, x) : v3_scale(c->right, (float)image_u(c, x));
-    for (int y = 0; y < height; y++) {
-      vec3 *row = c->dirs + (size_t)y * width;
-      if (in->type == RR_CAMERA_LATLONG) {
-        const double theta = latlong_theta(c, y);
-        const float st = (float)sin(theta), ct = (float)cos(theta);
-        for (int x = 0; x < width; x++) row[x] = latlong_dir(col[x], c->up, st, ct);
-        continue;
-      }
-      const double v = image_v(c, y);
-      const vec3 up_v = v3_scale(c->up, (float)v);
-      for (int x = 0; x < width; x++) {
-        const double u = image_u(c, x), rr = u * u + v * v;
-        row[x] = rr > 1 ? v3(0, 0, 0) : parabolic_dir(col[x], up_v, c->fwd, rr);
-      }
-    }
-    free(col);
-  } else {
-    for (int y = 0; y < height; y++)
-      for (int x = 0; x < width; x++) c->dirs[(size_t)y * width + x] = curved_dir(c, x, y, NULL);
+    rt.col = col;
   }
+  rr_parallel_for((height + RAY_ROWS - 1) / RAY_ROWS, threads, ray_rows, &rt);
+  free((void *)rt.col);
   switch (in->type) {
   case RR_CAMERA_PARABOLIC: /* conformal, angle = 2 atan(r): at most 2 radians per unit of u */
     c->lipschitz = 2.0f * 2.0f / (float)(width < height ? width : height);

@@ -64,6 +64,10 @@ rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height
 /* The same for the sample at `sample` (x, y in [0, 1)) inside every pixel. */
 rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int height, const float sample[2],
                          camera *out);
+/* The same on `threads` threads (1..RR_MAX_THREADS): a curved camera's table of
+ * rays in bands of rows, with the same bits. */
+rr_error rr_cam_setup_threads(rr_device *dev, const rr_camera *in, int width, int height, const float sample[2],
+                              int threads, camera *out);
 void rr_cam_release(camera *c);
 /* The ray of sample (sx, sy) of a planar perspective camera (unnormalised). */
 static inline vec3 camera_dir(const camera *c, float sx, float sy) {

@@ -414,8 +414,9 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
   camera cams[RR_MAX_SAMPLES];
   int ncams = 0;
   rr_error e = RR_OK;
+  const int threads = opt->threads ? opt->threads : rr_cpu_count();
   for (; ncams < opt->samples && !e; ncams++)
-    e = rr_cam_setup_at(dev, cam, opt->width, opt->height, opt->sample_pos[ncams], &cams[ncams]);
+    e = rr_cam_setup_threads(dev, cam, opt->width, opt->height, opt->sample_pos[ncams], threads, &cams[ncams]);
   if (e) ncams--;
   rr_frame *f = e ? NULL : calloc(1, sizeof *f);
   size_t npix = (size_t)opt->width * opt->height;
@@ -436,7 +437,7 @@ rr_error rr_render(rr_device *dev, const rr_scene *scene, const rr_camera *cam,
                     .cams = cams,
                     .samples = opt->samples,
                     .opt = opt,
-                    .threads = opt->threads ? opt->threads : rr_cpu_count(),
+                    .threads = threads,
                     .vb = &f->vb,
                     .stats = &f->stats,
                     .heat_e = f->heat_e,
