@@ -242,12 +242,17 @@ bool rr_cam_dir_at(const camera *c, double sx, double sy, double d[3]) {
 }
 
 /* The largest angle between the rays of two samples one pixel apart (in x or y) of
- * a curved camera, over the whole image: along a staircase path of such steps the
- * angle between any two samples is at most that times their L1 distance, so √2
- * times it bounds the angle per pixel of Euclidean distance. For the maps without a
- * closed-form bound (the OpenCV lenses). */
-static float measured_lipschitz(const camera *c) {
-  float worst = 0; /* the longest chord between unit rays */
+ * a curved camera, over each CAMERA_LIP_CELL² cell of samples (a step counts in the
+ * cells of both its samples), into c->lips: along a staircase path of such steps
+ * within a rectangle, the angle between two of its samples is at most the largest
+ * over the cells the rectangle meets times their L1 distance, so √2 times it bounds
+ * the angle per pixel of Euclidean distance. For the maps without a closed-form
+ * bound (the OpenCV lenses), whose stretch varies most: a strong barrel's grows
+ * without bound towards the fold, where a constant for the whole image would widen
+ * every frustum's cone and make every box look small. Returns the largest. */
+static float measure_lipschitz(camera *c) {
+  const int n = CAMERA_LIP_CELL;
+  for (size_t i = 0; i < (size_t)c->lips_x * ((c->height + n - 1) / n); i++) c->lips[i] = 0; /* longest chords */
   for (int y = 0; y < c->height; y++)
     for (int x = 0; x < c->width; x++) {
       vec3 d = c->dirs[(size_t)y * c->width + x];
@@ -257,10 +262,24 @@ static float measured_lipschitz(const camera *c) {
         if (nx >= c->width || ny >= c->height) continue;
         vec3 e = c->dirs[(size_t)ny * c->width + nx];
         if (e.x == 0 && e.y == 0 && e.z == 0) continue;
-        worst = fmaxf(worst, v3_len(v3_sub(d, e)));
+        float chord = v3_len(v3_sub(d, e)), *a = &c->lips[(size_t)(y / n) * c->lips_x + x / n];
+        float *b = &c->lips[(size_t)(ny / n) * c->lips_x + nx / n];
+        *a = fmaxf(*a, chord), *b = fmaxf(*b, chord);
       }
     }
-  return 2.0f * asinf(fminf(1.0f, 0.5f * worst)) * sqrtf(2.0f);
+  float worst = 0;
+  for (size_t i = 0; i < (size_t)c->lips_x * ((c->height + n - 1) / n); i++)
+    worst = fmaxf(worst, c->lips[i] = 2.0f * asinf(fminf(1.0f, 0.5f * c->lips[i])) * sqrtf(2.0f));
+  return worst;
+}
+
+float rr_cam_rect_lipschitz(const camera *c, int x0, int y0, int x1, int y1) {
+  if (!c->lips) return c->lipschitz;
+  const int n = CAMERA_LIP_CELL;
+  float l = 0;
+  for (int y = y0 / n; y <= (y1 - 1) / n; y++)
+    for (int x = x0 / n; x <= (x1 - 1) / n; x++) l = fmaxf(l, c->lips[(size_t)y * c->lips_x + x]);
+  return l * 1.001f; /* as c->lipschitz */
 }
 
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
@@ -342,7 +361,13 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     break;
   case RR_CAMERA_OPENCV:
   case RR_CAMERA_OPENCV_FISHEYE:
-    c->lipschitz = measured_lipschitz(c);
+    c->lips_x = (width + CAMERA_LIP_CELL - 1) / CAMERA_LIP_CELL;
+    c->lips = malloc((size_t)c->lips_x * ((height + CAMERA_LIP_CELL - 1) / CAMERA_LIP_CELL) * sizeof *c->lips);
+    if (!c->lips) {
+      rr_cam_release(c);
+      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
+    }
+    c->lipschitz = measure_lipschitz(c);
     break;
   default:
     break;
@@ -393,8 +418,8 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
 }
 
 void rr_cam_release(camera *c) {
-  free(c->dirs), free(c->cells);
-  c->dirs = NULL, c->cells = NULL;
+  free(c->dirs), free(c->cells), free(c->lips);
+  c->dirs = NULL, c->cells = NULL, c->lips = NULL;
 }
 
 bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
@@ -467,7 +492,7 @@ int rr_cam_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis
     hx *= 2, hy *= 2;
   }
   *axis = v3_norm(d);
-  *angle = c->lipschitz * sqrtf(hx * hx + hy * hy) + 1e-5f;
+  *angle = rr_cam_rect_lipschitz(c, x0, y0, x1, y1) * sqrtf(hx * hx + hy * hy) + 1e-5f;
   return 1;
 }
 

@@ -30,6 +30,8 @@ typedef struct camera {
   float fov_deg; /* as given: the fisheye's angle */
   vec3 *dirs;
   float lipschitz;
+  float *lips;       /* measured maps (the OpenCV lenses): lipschitz for the samples of each */
+  int lips_x;        /* CAMERA_LIP_CELL² cell, lips_x a row (rr_cam_rect_lipschitz); NULL otherwise */
   double bend_x, bend_y; /* polar curved maps: bounds on |∂²d/∂sx²|, |∂²d/∂sy²| over the */
                          /* image (rr_cam_dir_at's d); 0 when none is known */
   float dir_len_max; /* longest |d| of the camera's rays */
@@ -42,6 +44,8 @@ typedef struct camera {
 } camera;
 
 #define CAMERA_CELL 32
+/* The cells of camera.lips: as small as the traversal's frusta split (vis/traverse.c). */
+#define CAMERA_LIP_CELL 8
 /* Cones (and caps) of directions this wide or wider bound nothing: the cone tests
  * hold for half-angles under 90° only (a little more than 1.5 radians). A cell
  * without a useful cone stores this half-angle. */
@@ -95,6 +99,10 @@ bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy);
  * [x0, x1) × [y0, y1) of a curved camera: 1 when found, 0 when none is known,
  * -1 when none of the samples has a ray (not for the cube, which has no rays of its own). */
 int rr_cam_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle);
+/* The radians per pixel of distance that bound how the rays of a curved camera turn
+ * within the samples [x0, x1) × [y0, y1) (inside the image): camera.lipschitz, or
+ * the largest of the cells the rectangle meets where it is measured per cell. */
+float rr_cam_rect_lipschitz(const camera *c, int x0, int y0, int x1, int y1);
 
 /* A pseudo-camera for one arbitrary ray: eye = origin, d0 = direction and dx, dy
  * two fixed directions perpendicular to it, so rr_tri_setup() sets a triangle
