@@ -273,6 +273,38 @@ static float measure_lipschitz(camera *c) {
   return worst;
 }
 
+/* The angle between unit a and d (not zero), in double: exact to about 1e-15
+ * where acos of the cosine would lose half the digits. */
+static double angle_to(const double a[3], vec3 d) {
+  const double x = d.x, y = d.y, z = d.z, cx = a[1] * z - a[2] * y, cy = a[2] * x - a[0] * z, cz = a[0] * y - a[1] * x;
+  return atan2(sqrt(cx * cx + cy * cy + cz * cz), a[0] * x + a[1] * y + a[2] * z);
+}
+
+/* c->fine: each CAMERA_LIP_CELL² cell's cone, about its centre sample's ray (or
+ * its first ray), as wide as its farthest ray: exact where the map's stretch
+ * varies within the cell (a step's angle near the fold can be many times its
+ * neighbours'), which a Lipschitz constant over the cell's width is not. */
+static void measure_cones(camera *c) {
+  const int n = CAMERA_LIP_CELL;
+  for (int cy = 0; cy * n < c->height; cy++)
+    for (int cx = 0; cx * n < c->width; cx++) {
+      const int x0 = cx * n, y0 = cy * n, x1 = x0 + n < c->width ? x0 + n : c->width;
+      const int y1 = y0 + n < c->height ? y0 + n : c->height;
+      float *cell = c->fine + 4 * ((size_t)cy * c->lips_x + cx);
+      vec3 d = c->dirs[(size_t)((y0 + y1 - 1) / 2) * c->width + (x0 + x1 - 1) / 2];
+      for (int y = y0; y < y1 && v3_len(d) == 0; y++)
+        for (int x = x0; x < x1 && v3_len(d) == 0; x++) d = c->dirs[(size_t)y * c->width + x];
+      const double len = v3_len(d), a[3] = {d.x / len, d.y / len, d.z / len};
+      double worst = -1;
+      for (int y = y0; y < y1 && len > 0; y++)
+        for (int x = x0; x < x1; x++) {
+          vec3 e = c->dirs[(size_t)y * c->width + x];
+          if (e.x != 0 || e.y != 0 || e.z != 0) worst = fmax(worst, angle_to(a, e));
+        }
+      cell[0] = (float)a[0], cell[1] = (float)a[1], cell[2] = (float)a[2], cell[3] = (float)worst;
+    }
+}
+
 float rr_cam_rect_lipschitz(const camera *c, int x0, int y0, int x1, int y1) {
   if (!c->lips) return c->lipschitz;
   const int n = CAMERA_LIP_CELL;
@@ -362,12 +394,14 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
   case RR_CAMERA_OPENCV:
   case RR_CAMERA_OPENCV_FISHEYE:
     c->lips_x = (width + CAMERA_LIP_CELL - 1) / CAMERA_LIP_CELL;
-    c->lips = malloc((size_t)c->lips_x * ((height + CAMERA_LIP_CELL - 1) / CAMERA_LIP_CELL) * sizeof *c->lips);
-    if (!c->lips) {
+    const size_t cells = (size_t)c->lips_x * ((height + CAMERA_LIP_CELL - 1) / CAMERA_LIP_CELL);
+    c->lips = malloc(cells * sizeof *c->lips), c->fine = malloc(cells * 4 * sizeof *c->fine);
+    if (!c->lips || !c->fine) {
       rr_cam_release(c);
       return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
     }
     c->lipschitz = measure_lipschitz(c);
+    measure_cones(c);
     break;
   default:
     break;
@@ -418,8 +452,8 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
 }
 
 void rr_cam_release(camera *c) {
-  free(c->dirs), free(c->cells), free(c->lips);
-  c->dirs = NULL, c->cells = NULL, c->lips = NULL;
+  free(c->dirs), free(c->cells), free(c->lips), free(c->fine);
+  c->dirs = NULL, c->cells = NULL, c->lips = NULL, c->fine = NULL;
 }
 
 bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
@@ -492,6 +526,18 @@ int rr_cam_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis
     hx *= 2, hy *= 2;
   }
   *axis = v3_norm(d);
+  if (c->fine) { /* the cells' cones, each within the angle of its axis from ours */
+    const double len = v3_len(d), a[3] = {d.x / len, d.y / len, d.z / len};
+    const int n = CAMERA_LIP_CELL;
+    double worst = 0;
+    for (int y = y0 / n; y <= (y1 - 1) / n; y++)
+      for (int x = x0 / n; x <= (x1 - 1) / n; x++) {
+        const float *cell = c->fine + 4 * ((size_t)y * c->lips_x + x);
+        if (cell[3] >= 0) worst = fmax(worst, angle_to(a, v3(cell[0], cell[1], cell[2])) + cell[3]);
+      }
+    *angle = (float)worst + 1e-5f;
+    return 1;
+  }
   *angle = rr_cam_rect_lipschitz(c, x0, y0, x1, y1) * sqrtf(hx * hx + hy * hy) + 1e-5f;
   return 1;
 }

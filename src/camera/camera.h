@@ -31,7 +31,9 @@ typedef struct camera {
   vec3 *dirs;
   float lipschitz;
   float *lips;       /* measured maps (the OpenCV lenses): lipschitz for the samples of each */
-  int lips_x;        /* CAMERA_LIP_CELL² cell, lips_x a row (rr_cam_rect_lipschitz); NULL otherwise */
+  int lips_x;        /* CAMERA_LIP_CELL² cell, lips_x a row (rr_cam_rect_lipschitz); NULL otherwise; */
+  float *fine;       /* and the least cone about its centre's ray that holds its rays: unit axis, */
+                     /* half-angle, 4 floats a cell (half-angle < 0: no rays; rr_cam_rect_cone) */
   double bend_x, bend_y; /* polar curved maps: bounds on |∂²d/∂sx²|, |∂²d/∂sy²| over the */
                          /* image (rr_cam_dir_at's d); 0 when none is known */
   float dir_len_max; /* longest |d| of the camera's rays */
