@@ -242,17 +242,12 @@ bool rr_cam_dir_at(const camera *c, double sx, double sy, double d[3]) {
 }
 
 /* The largest angle between the rays of two samples one pixel apart (in x or y) of
- * a curved camera, over each CAMERA_LIP_CELL² cell of samples (a step counts in the
- * cells of both its samples), into c->lips: along a staircase path of such steps
- * within a rectangle, the angle between two of its samples is at most the largest
- * over the cells the rectangle meets times their L1 distance, so √2 times it bounds
- * the angle per pixel of Euclidean distance. For the maps without a closed-form
- * bound (the OpenCV lenses), whose stretch varies most: a strong barrel's grows
- * without bound towards the fold, where a constant for the whole image would widen
- * every frustum's cone and make every box look small. Returns the largest. */
-static float measure_lipschitz(camera *c) {
-  const int n = CAMERA_LIP_CELL;
-  for (size_t i = 0; i < (size_t)c->lips_x * ((c->height + n - 1) / n); i++) c->lips[i] = 0; /* longest chords */
+ * a curved camera, over the whole image: along a staircase path of such steps the
+ * angle between any two samples is at most that times their L1 distance, so √2
+ * times it bounds the angle per pixel of Euclidean distance. For the maps without a
+ * closed-form bound (the OpenCV lenses). */
+static float measured_lipschitz(const camera *c) {
+  float worst = 0; /* the longest chord between unit rays */
   for (int y = 0; y < c->height; y++)
     for (int x = 0; x < c->width; x++) {
       vec3 d = c->dirs[(size_t)y * c->width + x];
@@ -262,56 +257,49 @@ static float measure_lipschitz(camera *c) {
         if (nx >= c->width || ny >= c->height) continue;
         vec3 e = c->dirs[(size_t)ny * c->width + nx];
         if (e.x == 0 && e.y == 0 && e.z == 0) continue;
-        float chord = v3_len(v3_sub(d, e)), *a = &c->lips[(size_t)(y / n) * c->lips_x + x / n];
-        float *b = &c->lips[(size_t)(ny / n) * c->lips_x + nx / n];
-        *a = fmaxf(*a, chord), *b = fmaxf(*b, chord);
+        worst = fmaxf(worst, v3_len(v3_sub(d, e)));
       }
     }
-  float worst = 0;
-  for (size_t i = 0; i < (size_t)c->lips_x * ((c->height + n - 1) / n); i++)
-    worst = fmaxf(worst, c->lips[i] = 2.0f * asinf(fminf(1.0f, 0.5f * c->lips[i])) * sqrtf(2.0f));
-  return worst;
+  return 2.0f * asinf(fminf(1.0f, 0.5f * worst)) * sqrtf(2.0f);
 }
 
-/* The angle between unit a and d (not zero), in double: exact to about 1e-15
- * where acos of the cosine would lose half the digits. */
+/* The angle between unit a and d (not zero), in double: accurate where acos of
+ * the cosine would lose half the digits (small angles). */
 static double angle_to(const double a[3], vec3 d) {
   const double x = d.x, y = d.y, z = d.z, cx = a[1] * z - a[2] * y, cy = a[2] * x - a[0] * z, cz = a[0] * y - a[1] * x;
   return atan2(sqrt(cx * cx + cy * cy + cz * cz), a[0] * x + a[1] * y + a[2] * z);
 }
 
-/* c->fine: each CAMERA_LIP_CELL² cell's cone, about its centre sample's ray (or
- * its first ray), as wide as its farthest ray: exact where the map's stretch
- * varies within the cell (a step's angle near the fold can be many times its
- * neighbours'), which a Lipschitz constant over the cell's width is not. */
+static bool has_ray(vec3 d) { return d.x != 0 || d.y != 0 || d.z != 0; }
+
+/* c->fine: each CAMERA_FINE² cell's cone, about its centre sample's ray (else
+ * its first ray), as wide as its farthest ray. A lens's stretch varies over the
+ * image, without bound towards a fold inside it (a square root's slope): a cone
+ * grown from the centre ray by one Lipschitz constant would be wide everywhere,
+ * and one per cell still wide at the fold, where a cell's last step turns many
+ * times more than its others. */
 static void measure_cones(camera *c) {
-  const int n = CAMERA_LIP_CELL;
+  const int n = CAMERA_FINE;
   for (int cy = 0; cy * n < c->height; cy++)
     for (int cx = 0; cx * n < c->width; cx++) {
       const int x0 = cx * n, y0 = cy * n, x1 = x0 + n < c->width ? x0 + n : c->width;
       const int y1 = y0 + n < c->height ? y0 + n : c->height;
-      float *cell = c->fine + 4 * ((size_t)cy * c->lips_x + cx);
+      float *cell = c->fine + 4 * ((size_t)cy * c->fine_x + cx);
       vec3 d = c->dirs[(size_t)((y0 + y1 - 1) / 2) * c->width + (x0 + x1 - 1) / 2];
-      for (int y = y0; y < y1 && v3_len(d) == 0; y++)
-        for (int x = x0; x < x1 && v3_len(d) == 0; x++) d = c->dirs[(size_t)y * c->width + x];
+      for (int i = 0; i < (x1 - x0) * (y1 - y0) && !has_ray(d); i++)
+        d = c->dirs[(size_t)(y0 + i / (x1 - x0)) * c->width + x0 + i % (x1 - x0)];
+      cell[0] = cell[1] = cell[2] = 0, cell[3] = -1;
+      if (!has_ray(d)) continue;
       const double len = v3_len(d), a[3] = {d.x / len, d.y / len, d.z / len};
-      double worst = -1;
-      for (int y = y0; y < y1 && len > 0; y++)
+      double worst = 0;
+      for (int y = y0; y < y1; y++)
         for (int x = x0; x < x1; x++) {
           vec3 e = c->dirs[(size_t)y * c->width + x];
-          if (e.x != 0 || e.y != 0 || e.z != 0) worst = fmax(worst, angle_to(a, e));
+          if (has_ray(e)) worst = fmax(worst, angle_to(a, e));
         }
+      /* (float rounding of the axis and angle: rr_cam_rect_cone's 1e-5 holds it) */
       cell[0] = (float)a[0], cell[1] = (float)a[1], cell[2] = (float)a[2], cell[3] = (float)worst;
     }
-}
-
-float rr_cam_rect_lipschitz(const camera *c, int x0, int y0, int x1, int y1) {
-  if (!c->lips) return c->lipschitz;
-  const int n = CAMERA_LIP_CELL;
-  float l = 0;
-  for (int y = y0 / n; y <= (y1 - 1) / n; y++)
-    for (int x = x0 / n; x <= (x1 - 1) / n; x++) l = fmaxf(l, c->lips[(size_t)y * c->lips_x + x]);
-  return l * 1.001f; /* as c->lipschitz */
 }
 
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
@@ -393,14 +381,13 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
     break;
   case RR_CAMERA_OPENCV:
   case RR_CAMERA_OPENCV_FISHEYE:
-    c->lips_x = (width + CAMERA_LIP_CELL - 1) / CAMERA_LIP_CELL;
-    const size_t cells = (size_t)c->lips_x * ((height + CAMERA_LIP_CELL - 1) / CAMERA_LIP_CELL);
-    c->lips = malloc(cells * sizeof *c->lips), c->fine = malloc(cells * 4 * sizeof *c->fine);
-    if (!c->lips || !c->fine) {
+    c->lipschitz = measured_lipschitz(c);
+    c->fine_x = (width + CAMERA_FINE - 1) / CAMERA_FINE;
+    c->fine = malloc((size_t)c->fine_x * ((height + CAMERA_FINE - 1) / CAMERA_FINE) * 4 * sizeof *c->fine);
+    if (!c->fine) {
       rr_cam_release(c);
       return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
     }
-    c->lipschitz = measure_lipschitz(c);
     measure_cones(c);
     break;
   default:
@@ -452,8 +439,8 @@ rr_error rr_cam_setup_at(rr_device *dev, const rr_camera *in, int width, int hei
 }
 
 void rr_cam_release(camera *c) {
-  free(c->dirs), free(c->cells), free(c->lips), free(c->fine);
-  c->dirs = NULL, c->cells = NULL, c->lips = NULL, c->fine = NULL;
+  free(c->dirs), free(c->cells), free(c->fine);
+  c->dirs = NULL, c->cells = NULL, c->fine = NULL;
 }
 
 bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
@@ -504,8 +491,39 @@ bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy) {
   return true;
 }
 
+/* rr_cam_rect_cone from camera.fine: about the centre sample's ray (else a cell's
+ * axis), the cones of the cells the rectangle meets, each within the angle
+ * between the axes of ours. */
+static int fine_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle) {
+  const int n = CAMERA_FINE;
+  vec3 d = c->dirs[(size_t)((y0 + y1 - 1) / 2) * c->width + (x0 + x1 - 1) / 2];
+  double a[3] = {0}, worst = -1;
+  for (int pass = has_ray(d); pass < 2; pass++) /* (pass 0: find an axis) */
+    for (int y = y0 / n; y <= (y1 - 1) / n; y++)
+      for (int x = x0 / n; x <= (x1 - 1) / n; x++) {
+        const float *cell = c->fine + 4 * ((size_t)y * c->fine_x + x);
+        if (cell[3] < 0) continue;
+        if (!has_ray(d)) d = v3(cell[0], cell[1], cell[2]);
+        if (worst < 0) {
+          const double len = v3_len(d);
+          a[0] = d.x / len, a[1] = d.y / len, a[2] = d.z / len, worst = 0;
+        }
+        if (pass) worst = fmax(worst, angle_to(a, v3(cell[0], cell[1], cell[2])) + cell[3]);
+      }
+  if (worst < 0) return -1;
+  *axis = v3_norm(d);
+  *angle = (float)worst + 1e-5f;
+  return 1;
+}
+
+float rr_cam_rect_pixel_angle(const camera *c, int x0, int y0, int x1, int y1, int cone, float angle) {
+  const float hx = (float)(x1 - x0) * 0.5f + 0.5f, hy = (float)(y1 - y0) * 0.5f + 0.5f;
+  return c->fine && cone > 0 ? angle / sqrtf(hx * hx + hy * hy) : c->lipschitz;
+}
+
 int rr_cam_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle) {
   if (c->planar) return 0;
+  if (c->fine) return fine_cone(c, x0, y0, x1, y1, axis, angle);
   if (c->type == RR_CAMERA_CUBE && (x0 / c->face != (x1 - 1) / c->face || y0 / c->face != (y1 - 1) / c->face))
     return 0; /* the cross is discontinuous between faces */
   /* The centre sample's direction and the Lipschitz bound over the half-diagonal
@@ -526,19 +544,7 @@ int rr_cam_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis
     hx *= 2, hy *= 2;
   }
   *axis = v3_norm(d);
-  if (c->fine) { /* the cells' cones, each within the angle of its axis from ours */
-    const double len = v3_len(d), a[3] = {d.x / len, d.y / len, d.z / len};
-    const int n = CAMERA_LIP_CELL;
-    double worst = 0;
-    for (int y = y0 / n; y <= (y1 - 1) / n; y++)
-      for (int x = x0 / n; x <= (x1 - 1) / n; x++) {
-        const float *cell = c->fine + 4 * ((size_t)y * c->lips_x + x);
-        if (cell[3] >= 0) worst = fmax(worst, angle_to(a, v3(cell[0], cell[1], cell[2])) + cell[3]);
-      }
-    *angle = (float)worst + 1e-5f;
-    return 1;
-  }
-  *angle = rr_cam_rect_lipschitz(c, x0, y0, x1, y1) * sqrtf(hx * hx + hy * hy) + 1e-5f;
+  *angle = c->lipschitz * sqrtf(hx * hx + hy * hy) + 1e-5f;
   return 1;
 }
 

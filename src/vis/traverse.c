@@ -649,7 +649,7 @@ typedef struct frustum {
   int has_cone;      /* curved cameras: 1 with a cone of the frustum's directions, -1 without rays */
   vec3 axis;
   float angle;
-  float lip;         /* curved cameras: rr_cam_rect_lipschitz of r */
+  float pixel;       /* curved cameras: rr_cam_rect_pixel_angle of r */
   bool has_ray;      /* the centre sample's ray, and 1 / its direction (0 where it is 0) */
   bool one_ray;      /* one sample: the frustum is that ray */
   rr_vf4 origin, dir, inv;
@@ -688,7 +688,7 @@ static frustum make_frustum(const camera *c, int ns, tile_rect r) {
     set_plane(&f, 2, c->up, hi), set_plane(&f, 3, v3_neg(c->up), lo);
   } else {
     f.has_cone = rr_cam_rect_cone(c, r.x0, r.y0, r.x1, r.y1, &f.axis, &f.angle);
-    f.lip = rr_cam_rect_lipschitz(c, r.x0, r.y0, r.x1, r.y1);
+    f.pixel = rr_cam_rect_pixel_angle(c, r.x0, r.y0, r.x1, r.y1, f.has_cone, f.angle);
   }
   return f;
 }
@@ -795,8 +795,8 @@ static bool is_outside(const frustum *f, const bvh_node *b, const camera *cams, 
 static float frustum_area(const frustum *f) { return (float)(f->r.x1 - f->r.x0) * (float)(f->r.y1 - f->r.y0); }
 
 /* Does box b (box_tmin z) look small in frustum f? Its size in pixels (curved
- * cameras: at the rays' turn over f, which varies over a lens's image), squared,
- * against split_ratio times f's area. */
+ * cameras: f's, which vary over a lens's image), squared, against split_ratio
+ * times f's area. */
 static bool looks_small(const trav *t, const frustum *f, const bvh_node *b, float z) {
   const camera *c = t->c;
   float diag = v3_len(v3(b->hi[0] - b->lo[0], b->hi[1] - b->lo[1], b->hi[2] - b->lo[2])), px;
@@ -804,7 +804,7 @@ static bool looks_small(const trav *t, const frustum *f, const bvh_node *b, floa
     px = diag / (2.0f * c->tan_half_h / (float)c->height);
   } else {
     if (!(z > 0)) return false;
-    px = c->planar ? diag / (z * 2.0f * c->tan_half_h / (float)c->height) : diag / (z * f->lip);
+    px = c->planar ? diag / (z * 2.0f * c->tan_half_h / (float)c->height) : diag / (z * f->pixel);
   }
   return px * px < t->o->split_ratio * frustum_area(f);
 }
