@@ -53,8 +53,8 @@ static int round_trip(const rr_camera *c, int W, int H, const char *what) {
   return rays;
 }
 
-/* Every 3D method against rc on a lens that folds inside the image: the measured
- * Lipschitz bound must keep the cones of curved binning and culling conservative. */
+/* Every 3D method against rc on a lens that folds inside the image: the cells'
+ * measured cones must keep the cones of curved binning and culling conservative. */
 static void methods_agree(rr_device *dev, const rr_camera *cam, const char *what) {
   static const rr_method methods[] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
                                       RR_METHOD_3DR_FC, RR_METHOD_3DR_FS,    RR_METHOD_3DR_FULL};
