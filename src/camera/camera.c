@@ -491,26 +491,25 @@ bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy) {
   return true;
 }
 
-/* rr_cam_rect_cone from camera.fine: about the centre sample's ray (else a cell's
- * axis), the cones of the cells the rectangle meets, each within the angle
- * between the axes of ours. */
+/* rr_cam_rect_cone from camera.fine: about the centre sample's ray (else the
+ * first cell's axis), the cones of the cells the rectangle meets, each within
+ * the angle between its axis and ours. */
 static int fine_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle) {
   const int n = CAMERA_FINE;
   vec3 d = c->dirs[(size_t)((y0 + y1 - 1) / 2) * c->width + (x0 + x1 - 1) / 2];
-  double a[3] = {0}, worst = -1;
-  for (int pass = has_ray(d); pass < 2; pass++) /* (pass 0: find an axis) */
-    for (int y = y0 / n; y <= (y1 - 1) / n; y++)
-      for (int x = x0 / n; x <= (x1 - 1) / n; x++) {
-        const float *cell = c->fine + 4 * ((size_t)y * c->fine_x + x);
-        if (cell[3] < 0) continue;
-        if (!has_ray(d)) d = v3(cell[0], cell[1], cell[2]);
-        if (worst < 0) {
-          const double len = v3_len(d);
-          a[0] = d.x / len, a[1] = d.y / len, a[2] = d.z / len, worst = 0;
-        }
-        if (pass) worst = fmax(worst, angle_to(a, v3(cell[0], cell[1], cell[2])) + cell[3]);
-      }
-  if (worst < 0) return -1;
+  for (int y = y0 / n; y <= (y1 - 1) / n && !has_ray(d); y++)
+    for (int x = x0 / n; x <= (x1 - 1) / n && !has_ray(d); x++) {
+      const float *cell = c->fine + 4 * ((size_t)y * c->fine_x + x);
+      if (cell[3] >= 0) d = v3(cell[0], cell[1], cell[2]);
+    }
+  if (!has_ray(d)) return -1;
+  const double len = v3_len(d), a[3] = {d.x / len, d.y / len, d.z / len};
+  double worst = 0;
+  for (int y = y0 / n; y <= (y1 - 1) / n; y++)
+    for (int x = x0 / n; x <= (x1 - 1) / n; x++) {
+      const float *cell = c->fine + 4 * ((size_t)y * c->fine_x + x);
+      if (cell[3] >= 0) worst = fmax(worst, angle_to(a, v3(cell[0], cell[1], cell[2])) + cell[3]);
+    }
   *axis = v3_norm(d);
   *angle = (float)worst + 1e-5f;
   return 1;

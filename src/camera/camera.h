@@ -14,8 +14,9 @@
  * Curved cameras (parabolic, lat-long, fisheye, the OpenCV lenses) keep one direction per
  * sample in `dirs` (zero where the image has no ray), and bound the directions of
  * a rectangle of samples by a cone whose half-angle grows by `lipschitz` radians
- * per pixel of distance (the lenses: by the exact cones of small cells, `fine`). The cube keeps neither: every method draws its faces,
- * perspective cameras (rr_cam_cube_face), and rr_cam_ray gives its rays. */
+ * per pixel of distance (the lenses: by the exact cones of small cells, `fine`).
+ * The cube keeps neither: every method draws its faces, perspective cameras
+ * (rr_cam_cube_face), and rr_cam_ray gives its rays. */
 typedef struct camera {
   rr_camera_type type;
   int width, height;
