@@ -263,14 +263,22 @@ static float measured_lipschitz(const camera *c) {
   return 2.0f * asinf(fminf(1.0f, 0.5f * worst)) * sqrtf(2.0f);
 }
 
-/* The angle between unit a and d (not zero), in double: accurate where acos of
- * the cosine would lose half the digits (small angles). */
-static double angle_to(const double a[3], vec3 d) {
-  const double x = d.x, y = d.y, z = d.z, cx = a[1] * z - a[2] * y, cy = a[2] * x - a[0] * z, cz = a[0] * y - a[1] * x;
-  return atan2(sqrt(cx * cx + cy * cy + cz * cz), a[0] * x + a[1] * y + a[2] * z);
+/* At least the angle between unit a and d, about unit itself (within 1e-7 of
+ * length, as the stored rays and axes): the chord c, and asin(c/2) <= tan asin(c/2),
+ * so the angle 2 asin(c/2) <= c / √(1 − c²/4), tight for the small angles of
+ * cells (c²/8 relative) and with no library call; π beyond the range. */
+static double angle_over(const double a[3], vec3 d) {
+  const double x = a[0] - d.x, y = a[1] - d.y, z = a[2] - d.z, c2 = x * x + y * y + z * z;
+  return c2 < 3.9 ? sqrt(c2 / (1 - c2 / 4)) + 2e-7 : RR_PI;
 }
 
 static bool has_ray(vec3 d) { return d.x != 0 || d.y != 0 || d.z != 0; }
+
+/* d over its length, in double (d not zero). */
+static void unit_of(vec3 d, double a[3]) {
+  const double x = d.x, y = d.y, z = d.z, len = sqrt(x * x + y * y + z * z);
+  a[0] = x / len, a[1] = y / len, a[2] = z / len;
+}
 
 /* c->fine: each CAMERA_FINE² cell's cone, about its centre sample's ray (else
  * its first ray), as wide as its farthest ray. A lens's stretch varies over the
@@ -290,15 +298,17 @@ static void measure_cones(camera *c) {
         d = c->dirs[(size_t)(y0 + i / (x1 - x0)) * c->width + x0 + i % (x1 - x0)];
       cell[0] = cell[1] = cell[2] = 0, cell[3] = -1;
       if (!has_ray(d)) continue;
-      const double len = v3_len(d), a[3] = {d.x / len, d.y / len, d.z / len};
-      double worst = 0;
+      double a[3], e[3], least = 1; /* the cosine: its acos is within 3e-8 of the angle */
+      unit_of(d, a);
       for (int y = y0; y < y1; y++)
-        for (int x = x0; x < x1; x++) {
-          vec3 e = c->dirs[(size_t)y * c->width + x];
-          if (has_ray(e)) worst = fmax(worst, angle_to(a, e));
-        }
+        for (int x = x0; x < x1; x++)
+          if (has_ray(c->dirs[(size_t)y * c->width + x])) {
+            unit_of(c->dirs[(size_t)y * c->width + x], e);
+            least = fmin(least, a[0] * e[0] + a[1] * e[1] + a[2] * e[2]);
+          }
       /* (float rounding of the axis and angle: rr_cam_rect_cone's 1e-5 holds it) */
-      cell[0] = (float)a[0], cell[1] = (float)a[1], cell[2] = (float)a[2], cell[3] = (float)worst;
+      cell[0] = (float)a[0], cell[1] = (float)a[1], cell[2] = (float)a[2];
+      cell[3] = (float)(acos(fmax(-1.0, least)) + 1e-7);
     }
 }
 
@@ -503,12 +513,12 @@ static int fine_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis
       if (cell[3] >= 0) d = v3(cell[0], cell[1], cell[2]);
     }
   if (!has_ray(d)) return -1;
-  const double len = v3_len(d), a[3] = {d.x / len, d.y / len, d.z / len};
-  double worst = 0;
+  double a[3], worst = 0;
+  unit_of(d, a);
   for (int y = y0 / n; y <= (y1 - 1) / n; y++)
     for (int x = x0 / n; x <= (x1 - 1) / n; x++) {
       const float *cell = c->fine + 4 * ((size_t)y * c->fine_x + x);
-      if (cell[3] >= 0) worst = fmax(worst, angle_to(a, v3(cell[0], cell[1], cell[2])) + cell[3]);
+      if (cell[3] >= 0) worst = fmax(worst, angle_over(a, v3(cell[0], cell[1], cell[2])) + cell[3]);
     }
   *axis = v3_norm(d);
   *angle = (float)worst + 1e-5f;
