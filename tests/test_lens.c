@@ -4,7 +4,9 @@
  * derivatives match central differences; the defaults (fx = fy = 0) give the
  * perspective camera's rays; rr_camera_set_extrinsics recovers OpenCV's pose;
  * every 3D method renders strongly distorted views (folding inside the image) bit
- * for bit as rc does; bad intrinsics and poses are refused. */
+ * for bit as rc does; the cones of frusta and bins hold their rays and stay tight,
+ * so the traversal's work does not grow with the distortion; bad intrinsics and
+ * poses are refused. */
 #include "camera/camera.h"
 #include "camera/lens.h"
 #include "testutil.h"
@@ -51,8 +53,8 @@ static int round_trip(const rr_camera *c, int W, int H, const char *what) {
   return rays;
 }
 
-/* Every 3D method against rc on a lens that folds inside the image: the measured
- * Lipschitz bound must keep the cones of curved binning and culling conservative. */
+/* Every 3D method against rc on a lens that folds inside the image: the cells'
+ * measured cones must keep the cones of curved binning and culling conservative. */
 static void methods_agree(rr_device *dev, const rr_camera *cam, const char *what) {
   static const rr_method methods[] = {RR_METHOD_RC_BVH, RR_METHOD_RC_PACKET, RR_METHOD_3DR_BB, RR_METHOD_3DR_BIN,
                                       RR_METHOD_3DR_FC, RR_METHOD_3DR_FS,    RR_METHOD_3DR_FULL};
@@ -73,6 +75,113 @@ static void methods_agree(rr_device *dev, const rr_camera *cam, const char *what
       rr_frame_release(f);
     }
   rr_frame_release(ref);
+  rr_scene_release(s);
+}
+
+/* The angle between unit a and d (not zero), in double. */
+static double angle_between(const double a[3], vec3 d) {
+  const double x = d.x, y = d.y, z = d.z, cx = a[1] * z - a[2] * y, cy = a[2] * x - a[0] * z, cz = a[0] * y - a[1] * x;
+  return atan2(sqrt(cx * cx + cy * cy + cz * cz), a[0] * x + a[1] * y + a[2] * z);
+}
+
+/* rr_cam_rect_cone's largest angle from its axis to a ray of [x0, x1) × [y0, y1),
+ * brute force; -1 when the cone is absent (0 or -1: checked against the rays). */
+static double cone_slack(const camera *cc, int x0, int y0, int x1, int y1, float *angle, const char *what) {
+  vec3 axis = v3(0, 0, 0);
+  *angle = 0;
+  int k = rr_cam_rect_cone(cc, x0, y0, x1, y1, &axis, angle), rays = 0;
+  const double a[3] = {axis.x, axis.y, axis.z};
+  double worst = 0;
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++) {
+      vec3 d = cc->dirs[(size_t)y * cc->width + x];
+      if (d.x == 0 && d.y == 0 && d.z == 0) continue;
+      rays++;
+      if (k > 0) worst = fmax(worst, angle_between(a, d));
+    }
+  CHECK(k != 0 && (rays == 0 || k > 0), "%s: rect %d,%d..%d,%d with %d rays has cone %d", what, x0, y0, x1, y1, rays, k);
+  CHECK(k <= 0 || worst <= *angle, "%s: rect %d,%d..%d,%d: a ray %g rad from the axis, cone %g", what, x0, y0, x1,
+        y1, worst, (double)*angle);
+  return k > 0 && rays ? worst : -1;
+}
+
+/* The cones of a lens camera's rectangles of samples (frusta, bins): every ray of
+ * the rectangle inside (random rectangles, the whole image), a cell's cone its
+ * rays' own (the frusta's smallest), and the pixel a frustum at the centre judges
+ * sizes by as the lens's there. A cone grown by one Lipschitz constant for the whole
+ * image, wide where a strong barrel nears its fold, made every frustum's cone
+ * wide and every box look small: 3dr-fs drew whole subtrees into each frustum. */
+static void cones_hold(const rr_camera *in, int W, int H, const char *what) {
+  rr_device *dev = rr_device_new();
+  camera cc;
+  if (rr_cam_setup(dev, in, W, H, &cc) != RR_OK) {
+    CHECK(0, "%s: setup: %s", what, rr_device_message(dev));
+    rr_device_release(dev);
+    return;
+  }
+  float angle;
+  double loose = 0;
+  for (int y = 0; y < H; y += CAMERA_FINE)
+    for (int x = 0; x < W; x += CAMERA_FINE) {
+      const int x1 = x + CAMERA_FINE < W ? x + CAMERA_FINE : W, y1 = y + CAMERA_FINE < H ? y + CAMERA_FINE : H;
+      double exact = cone_slack(&cc, x, y, x1, y1, &angle, what);
+      if (exact >= 0) loose = fmax(loose, angle - exact);
+    }
+  CHECK(loose < 1e-4, "%s: a cell's cone %g rad wider than its rays'", what, loose);
+  cone_slack(&cc, 0, 0, W, H, &angle, what);
+  for (int i = 0; i < 400; i++) {
+    int w = 1 + (int)(test_rand() % (unsigned)(i % 4 == 0 ? W : 24)), h = 1 + (int)(test_rand() % (unsigned)(i % 4 == 0 ? H : 24));
+    w = w < W ? w : W, h = h < H ? h : H;
+    int x0 = (int)(test_rand() % (unsigned)(W - w + 1)), y0 = (int)(test_rand() % (unsigned)(H - h + 1));
+    cone_slack(&cc, x0, y0, x0 + w, y0 + h, &angle, what);
+  }
+  /* the pixel angle of the frustum at the principal point against the lens's there, 1/fx */
+  const int x0 = (int)in->cx / CAMERA_FINE * CAMERA_FINE, y0 = (int)in->cy / CAMERA_FINE * CAMERA_FINE;
+  vec3 axis;
+  int k = rr_cam_rect_cone(&cc, x0, y0, x0 + CAMERA_FINE, y0 + CAMERA_FINE, &axis, &angle);
+  float px = rr_cam_rect_pixel_angle(&cc, x0, y0, x0 + CAMERA_FINE, y0 + CAMERA_FINE, k, angle);
+  CHECK(px < 1.5f / in->fx, "%s: a pixel at the centre judged %g rad, the lens's is %g", what, (double)px,
+        1.0 / in->fx);
+  printf("%s: cones hold their rays; cells within %.2g rad; centre pixel %.3g rad (lens %.3g)\n", what, loose,
+         (double)px, 1.0 / in->fx);
+  rr_cam_release(&cc);
+  rr_device_release(dev);
+}
+
+/* The frustum traversal's work on a strongly distorted view against the same lens
+ * undistorted (not timed: E and the bins refined, which wide cones inflate; one
+ * thread, so the frusta are the same). */
+static void traversal_work(rr_device *dev) {
+  rr_scene *s;
+  if (rr_scene_load(dev, "demo", &s) != RR_OK) {
+    CHECK(0, "load: %s", rr_device_message(dev));
+    return;
+  }
+  const int W = 256, H = 200;
+  const float plain[] = {0, 0, 0, 0}, barrel[] = {-0.45f, 0.1f, 0, 0}, folding[] = {-0.5f, 0, 0, 0};
+  const float *dists[] = {plain, barrel, folding};
+  rr_stats st[3][2];
+  for (int d = 0; d < 3; d++)
+    for (int m = 0; m < 2; m++) {
+      rr_camera c = lens_camera(RR_CAMERA_OPENCV, 150, 150, 127.5f, 99.5f, dists[d], 4);
+      CHECK(rr_camera_frame(dev, s, W, H, &c) == RR_OK, "frame: %s", rr_device_message(dev));
+      rr_frame *f = test_render(dev, s, &c, m ? RR_METHOD_3DR_BIN : RR_METHOD_3DR_FULL, 1, W, H, 0);
+      memset(&st[d][m], 0, sizeof st[d][m]);
+      if (f) rr_frame_get_stats(f, &st[d][m]);
+      rr_frame_release(f);
+    }
+  for (int d = 1; d < 3; d++)
+    for (int m = 0; m < 2; m++) {
+      const rr_stats *a = &st[d][m], *b = &st[0][m];
+      const char *name = m ? "3dr-bin" : "3dr-full";
+      CHECK(a->edge_evals < 1.25 * b->edge_evals, "k1 %g, %s: E %llu, undistorted %llu", (double)dists[d][0], name,
+            (unsigned long long)a->edge_evals, (unsigned long long)b->edge_evals);
+      CHECK(a->bins < 1.5 * b->bins, "k1 %g, %s: %llu bins refined, undistorted %llu", (double)dists[d][0], name,
+            (unsigned long long)a->bins, (unsigned long long)b->bins);
+      printf("k1 %g, %s: E %llu, bins %llu (undistorted %llu, %llu)\n", (double)dists[d][0], name,
+             (unsigned long long)a->edge_evals, (unsigned long long)a->bins, (unsigned long long)b->edge_evals,
+             (unsigned long long)b->bins);
+    }
   rr_scene_release(s);
 }
 
@@ -105,6 +214,18 @@ int main(void) {
   c = lens_camera(RR_CAMERA_OPENCV_FISHEYE, 45, 45, 39.5f, 29.5f, fish_strong, 4);
   rr_camera_set_extrinsics(dev, &c, pose_R, pose_t);
   methods_agree(dev, &c, "fisheye strong");
+
+  /* The cones of frusta and bins through the strong lenses, and the work they save. */
+  const float barrel[] = {-0.45f, 0.1f, 0, 0, 0};
+  c = lens_camera(RR_CAMERA_OPENCV, 300, 300, 160, 120, barrel, 5);
+  cones_hold(&c, W, H, "brown-conrady barrel");
+  c = lens_camera(RR_CAMERA_OPENCV, 300, 300, 160, 120, strong, 5);
+  cones_hold(&c, W, H, "brown-conrady strong");
+  c = lens_camera(RR_CAMERA_OPENCV_FISHEYE, 120, 120, 160, 120, fish_strong, 4);
+  cones_hold(&c, W, H, "fisheye strong");
+  c = lens_camera(RR_CAMERA_OPENCV, 280, 275, 161.3f, 118.7f, mild, 5);
+  cones_hold(&c, W, H, "brown-conrady mild");
+  traversal_work(dev);
 
   /* No distortion and the perspective intrinsics: the perspective camera's rays. */
   rr_camera persp, cv;

@@ -320,6 +320,55 @@ static void ray_rows(int job, int thread, void *arg) {
   }
 }
 
+/* At least the angle between unit a and d, about unit itself (within 1e-7 of
+ * length, as the stored rays and axes): the chord c, and asin(c/2) <= tan asin(c/2),
+ * so the angle 2 asin(c/2) <= c / √(1 − c²/4), tight for the small angles of
+ * cells (c²/8 relative) and with no library call; π beyond the range. */
+static double angle_over(const double a[3], vec3 d) {
+  const double x = a[0] - d.x, y = a[1] - d.y, z = a[2] - d.z, c2 = x * x + y * y + z * z;
+  return c2 < 3.9 ? sqrt(c2 / (1 - c2 / 4)) + 2e-7 : RR_PI;
+}
+
+static bool has_ray(vec3 d) { return d.x != 0 || d.y != 0 || d.z != 0; }
+
+/* d over its length, in double (d not zero). */
+static void unit_of(vec3 d, double a[3]) {
+  const double x = d.x, y = d.y, z = d.z, len = sqrt(x * x + y * y + z * z);
+  a[0] = x / len, a[1] = y / len, a[2] = z / len;
+}
+
+/* c->fine: each CAMERA_FINE² cell's cone, about its centre sample's ray (else
+ * its first ray), as wide as its farthest ray. A lens's stretch varies over the
+ * image, without bound towards a fold inside it (a square root's slope): a cone
+ * grown from the centre ray by one Lipschitz constant would be wide everywhere,
+ * and one per cell still wide at the fold, where a cell's last step turns many
+ * times more than its others. */
+static void measure_cones(camera *c) {
+  const int n = CAMERA_FINE;
+  for (int cy = 0; cy * n < c->height; cy++)
+    for (int cx = 0; cx * n < c->width; cx++) {
+      const int x0 = cx * n, y0 = cy * n, x1 = x0 + n < c->width ? x0 + n : c->width;
+      const int y1 = y0 + n < c->height ? y0 + n : c->height;
+      float *cell = c->fine + 4 * ((size_t)cy * c->fine_x + cx);
+      vec3 d = c->dirs[(size_t)((y0 + y1 - 1) / 2) * c->width + (x0 + x1 - 1) / 2];
+      for (int i = 0; i < (x1 - x0) * (y1 - y0) && !has_ray(d); i++)
+        d = c->dirs[(size_t)(y0 + i / (x1 - x0)) * c->width + x0 + i % (x1 - x0)];
+      cell[0] = cell[1] = cell[2] = 0, cell[3] = -1;
+      if (!has_ray(d)) continue;
+      double a[3], e[3], least = 1; /* the cosine: its acos is within 3e-8 of the angle */
+      unit_of(d, a);
+      for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++)
+          if (has_ray(c->dirs[(size_t)y * c->width + x])) {
+            unit_of(c->dirs[(size_t)y * c->width + x], e);
+            least = fmin(least, a[0] * e[0] + a[1] * e[1] + a[2] * e[2]);
+          }
+      /* (float rounding of the axis and angle: rr_cam_rect_cone's 1e-5 holds it) */
+      cell[0] = (float)a[0], cell[1] = (float)a[1], cell[2] = (float)a[2];
+      cell[3] = (float)(acos(fmax(-1.0, least)) + 1e-7);
+    }
+}
+
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
   static const float centre[2] = {0.5f, 0.5f};
   return rr_cam_setup_at(dev, in, width, height, centre, c);
@@ -418,6 +467,13 @@ rr_error rr_cam_setup_threads(rr_device *dev, const rr_camera *in, int width, in
   case RR_CAMERA_OPENCV:
   case RR_CAMERA_OPENCV_FISHEYE:
     c->lipschitz = measured_lipschitz(c);
+    c->fine_x = (width + CAMERA_FINE - 1) / CAMERA_FINE;
+    c->fine = malloc((size_t)c->fine_x * ((height + CAMERA_FINE - 1) / CAMERA_FINE) * 4 * sizeof *c->fine);
+    if (!c->fine) {
+      rr_cam_release(c);
+      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
+    }
+    measure_cones(c);
     break;
   default:
     break;
@@ -468,8 +524,8 @@ rr_error rr_cam_setup_threads(rr_device *dev, const rr_camera *in, int width, in
 }
 
 void rr_cam_release(camera *c) {
-  free(c->dirs), free(c->cells);
-  c->dirs = NULL, c->cells = NULL;
+  free(c->dirs), free(c->cells), free(c->fine);
+  c->dirs = NULL, c->cells = NULL, c->fine = NULL;
 }
 
 bool rr_cam_ray(const camera *c, int x, int y, vec3 *origin, vec3 *dir) {
@@ -520,8 +576,38 @@ bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy) {
   return true;
 }
 
+/* rr_cam_rect_cone from camera.fine: about the centre sample's ray (else the
+ * first cell's axis), the cones of the cells the rectangle meets, each within
+ * the angle between its axis and ours. */
+static int fine_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle) {
+  const int n = CAMERA_FINE;
+  vec3 d = c->dirs[(size_t)((y0 + y1 - 1) / 2) * c->width + (x0 + x1 - 1) / 2];
+  for (int y = y0 / n; y <= (y1 - 1) / n && !has_ray(d); y++)
+    for (int x = x0 / n; x <= (x1 - 1) / n && !has_ray(d); x++) {
+      const float *cell = c->fine + 4 * ((size_t)y * c->fine_x + x);
+      if (cell[3] >= 0) d = v3(cell[0], cell[1], cell[2]);
+    }
+  if (!has_ray(d)) return -1;
+  double a[3], worst = 0;
+  unit_of(d, a);
+  for (int y = y0 / n; y <= (y1 - 1) / n; y++)
+    for (int x = x0 / n; x <= (x1 - 1) / n; x++) {
+      const float *cell = c->fine + 4 * ((size_t)y * c->fine_x + x);
+      if (cell[3] >= 0) worst = fmax(worst, angle_over(a, v3(cell[0], cell[1], cell[2])) + cell[3]);
+    }
+  *axis = v3_norm(d);
+  *angle = (float)worst + 1e-5f;
+  return 1;
+}
+
+float rr_cam_rect_pixel_angle(const camera *c, int x0, int y0, int x1, int y1, int cone, float angle) {
+  const float hx = (float)(x1 - x0) * 0.5f + 0.5f, hy = (float)(y1 - y0) * 0.5f + 0.5f;
+  return c->fine && cone > 0 ? angle / sqrtf(hx * hx + hy * hy) : c->lipschitz;
+}
+
 int rr_cam_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle) {
   if (c->planar) return 0;
+  if (c->fine) return fine_cone(c, x0, y0, x1, y1, axis, angle);
   if (c->type == RR_CAMERA_CUBE && (x0 / c->face != (x1 - 1) / c->face || y0 / c->face != (y1 - 1) / c->face))
     return 0; /* the cross is discontinuous between faces */
   /* The centre sample's direction and the Lipschitz bound over the half-diagonal

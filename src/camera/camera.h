@@ -14,8 +14,9 @@
  * Curved cameras (parabolic, lat-long, fisheye, the OpenCV lenses) keep one direction per
  * sample in `dirs` (zero where the image has no ray), and bound the directions of
  * a rectangle of samples by a cone whose half-angle grows by `lipschitz` radians
- * per pixel of distance. The cube keeps neither: every method draws its faces,
- * perspective cameras (rr_cam_cube_face), and rr_cam_ray gives its rays. */
+ * per pixel of distance (the lenses: by the exact cones of small cells, `fine`).
+ * The cube keeps neither: every method draws its faces, perspective cameras
+ * (rr_cam_cube_face), and rr_cam_ray gives its rays. */
 typedef struct camera {
   rr_camera_type type;
   int width, height;
@@ -30,6 +31,9 @@ typedef struct camera {
   float fov_deg; /* as given: the fisheye's angle */
   vec3 *dirs;
   float lipschitz;
+  float *fine;       /* measured maps (the OpenCV lenses): per CAMERA_FINE² cell of samples, the */
+  int fine_x;        /* least cone about its centre's ray that holds its rays: unit axis, half-angle */
+                     /* (< 0: no rays), 4 floats a cell, fine_x cells a row; NULL otherwise */
   double bend_x, bend_y; /* polar curved maps: bounds on |∂²d/∂sx²|, |∂²d/∂sy²| over the */
                          /* image (rr_cam_dir_at's d); 0 when none is known */
   float dir_len_max; /* longest |d| of the camera's rays */
@@ -42,6 +46,8 @@ typedef struct camera {
 } camera;
 
 #define CAMERA_CELL 32
+/* camera.fine's cells: as small as the traversal's frusta split (vis/traverse.c). */
+#define CAMERA_FINE 8
 /* Cones (and caps) of directions this wide or wider bound nothing: the cone tests
  * hold for half-angles under 90° only (a little more than 1.5 radians). A cell
  * without a useful cone stores this half-angle. */
@@ -99,6 +105,11 @@ bool rr_cam_project(const camera *c, vec3 p, float *sx, float *sy);
  * [x0, x1) × [y0, y1) of a curved camera: 1 when found, 0 when none is known,
  * -1 when none of the samples has a ray (not for the cube, which has no rays of its own). */
 int rr_cam_rect_cone(const camera *c, int x0, int y0, int x1, int y1, vec3 *axis, float *angle);
+/* The angle a pixel of the samples [x0, x1) × [y0, y1) of a curved camera spans,
+ * to judge sizes by (not a bound), from their rr_cam_rect_cone (cone, angle):
+ * camera.lipschitz, or for the lenses, whose stretch varies, the cone's
+ * half-angle over the rectangle's half-diagonal. */
+float rr_cam_rect_pixel_angle(const camera *c, int x0, int y0, int x1, int y1, int cone, float angle);
 
 /* A pseudo-camera for one arbitrary ray: eye = origin, d0 = direction and dx, dy
  * two fixed directions perpendicular to it, so rr_tri_setup() sets a triangle

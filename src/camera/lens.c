@@ -163,9 +163,12 @@ typedef struct ival {
 static ival iv(double lo, double hi) { return (ival){lo, hi}; }
 static ival iadd(ival a, ival b) { return iv(a.lo + b.lo, a.hi + b.hi); }
 static ival iscale(ival a, double s) { return s >= 0 ? iv(a.lo * s, a.hi * s) : iv(a.hi * s, a.lo * s); }
+/* (comparisons, not fmin/fmax, which are library calls here: a NaN product, 0·∞,
+ * in p[0] stays and makes the bound unusable, as it should; later ones are skipped
+ * as fmin would) */
 static ival imul(ival a, ival b) {
   double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi}, lo = p[0], hi = p[0];
-  for (int i = 1; i < 4; i++) lo = fmin(lo, p[i]), hi = fmax(hi, p[i]);
+  for (int i = 1; i < 4; i++) lo = p[i] < lo ? p[i] : lo, hi = p[i] > hi ? p[i] : hi;
   return iv(lo, hi);
 }
 static ival isq(ival a) {

@@ -657,6 +657,7 @@ typedef struct frustum {
   int has_cone;      /* curved cameras: 1 with a cone of the frustum's directions, -1 without rays */
   vec3 axis;
   float angle;
+  float pixel;       /* curved cameras: rr_cam_rect_pixel_angle of r */
   bool has_ray;      /* the centre sample's ray, and 1 / its direction (0 where it is 0) */
   bool one_ray;      /* one sample: the frustum is that ray */
   rr_vf4 origin, dir, inv;
@@ -695,6 +696,7 @@ static frustum make_frustum(const camera *c, int ns, tile_rect r) {
     set_plane(&f, 2, c->up, hi), set_plane(&f, 3, v3_neg(c->up), lo);
   } else {
     f.has_cone = rr_cam_rect_cone(c, r.x0, r.y0, r.x1, r.y1, &f.axis, &f.angle);
+    f.pixel = rr_cam_rect_pixel_angle(c, r.x0, r.y0, r.x1, r.y1, f.has_cone, f.angle);
   }
   return f;
 }
@@ -798,18 +800,21 @@ static bool is_outside(const frustum *f, const bvh_node *b, const camera *cams, 
   return true;
 }
 
-/* Does box b (box_tmin z) look small in a frustum of `area` samples? Its size in
- * pixels, squared, against split_ratio times the area. */
-static bool looks_small(const trav *t, const bvh_node *b, float z, float area) {
+static float frustum_area(const frustum *f) { return (float)(f->r.x1 - f->r.x0) * (float)(f->r.y1 - f->r.y0); }
+
+/* Does box b (box_tmin z) look small in frustum f? Its size in pixels (curved
+ * cameras: f's, which vary over a lens's image), squared, against split_ratio
+ * times f's area. */
+static bool looks_small(const trav *t, const frustum *f, const bvh_node *b, float z) {
   const camera *c = t->c;
   float diag = v3_len(v3(b->hi[0] - b->lo[0], b->hi[1] - b->lo[1], b->hi[2] - b->lo[2])), px;
   if (c->type == RR_CAMERA_ORTHOGRAPHIC) {
     px = diag / (2.0f * c->tan_half_h / (float)c->height);
   } else {
     if (!(z > 0)) return false;
-    px = c->planar ? diag / (z * 2.0f * c->tan_half_h / (float)c->height) : diag / (z * c->lipschitz);
+    px = c->planar ? diag / (z * 2.0f * c->tan_half_h / (float)c->height) : diag / (z * f->pixel);
   }
-  return px * px < t->o->split_ratio * area;
+  return px * px < t->o->split_ratio * frustum_area(f);
 }
 
 /* Is f as small as splitting makes it? */
@@ -818,12 +823,10 @@ static bool at_split_min(const trav *t, const frustum *f) {
   return m && f->r.x1 - f->r.x0 <= m && f->r.y1 - f->r.y0 <= m;
 }
 
-static float frustum_area(const frustum *f) { return (float)(f->r.x1 - f->r.x0) * (float)(f->r.y1 - f->r.y0); }
-
 /* splitFrustum: the centre ray misses the node, or the node looks small in F. */
 static bool should_split(const trav *t, const frustum *f, const bvh_node *b, float z) {
   if (!t->o->split_min || at_split_min(t, f)) return false;
-  return !centre_hits(f, b) || looks_small(t, b, z, frustum_area(f));
+  return !centre_hits(f, b) || looks_small(t, f, b, z);
 }
 
 /* The depth in front of which a hit inside a box of box_tmin z may lie (0: anywhere). */
@@ -900,7 +903,7 @@ static void traverse(trav *t, const frustum *f, uint32_t node, float tmin) {
   /* generateSamples for a whole inner node too when it looks small in a frustum
    * that cannot split any more: testing its descendants against F would cost more
    * than bounding their triangles, which drops those beside F or between samples. */
-  if (n->count || (at_split_min(t, f) && looks_small(t, n, tmin, frustum_area(f)))) {
+  if (n->count || (at_split_min(t, f) && looks_small(t, f, n, tmin))) {
     generate(t, f, node);
     return;
   }
