@@ -387,8 +387,9 @@ static bool finish_binning(const trav *t, uint32_t id, tri_job *j) {
   return true;
 }
 
-/* Sets up the bounded triangles b[0..nb-1] of a planar camera, eight at a time,
- * into out; returns how many can be seen. */
+/* Sets up the bounded triangles b[0..nb-1] of a planar camera, eight at a time
+ * (a cube's faces drawn by frusta: through their eye parts, t->eyes), into out;
+ * returns how many can be seen. */
 static uint32_t setup_bounded(trav *t, const tri_bound *b, uint32_t nb, tri_job *out) {
   enum { STEP = 8 };
   uint32_t kept = 0;
@@ -1074,7 +1075,8 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
   if (ctx->scene->ntris == 0) return RR_OK; /* nothing to see: the cleared buffer is the image */
   if (!ctx->scene->bvh && o->leaves)
     return rr_fail(dev, RR_ERROR_ARGUMENT, "this method needs the scene's BVH (call rr_scene_commit)");
-  if (ctx->faces && ctx->faces != 6) return rr_fail(dev, RR_ERROR_UNSUPPORTED, "a cube has six faces, not %d", ctx->faces);
+  if (ctx->faces && ctx->faces != 6)
+    return rr_fail(dev, RR_ERROR_UNSUPPORTED, "a cube has six faces, not %d", ctx->faces);
   /* z tiles: one set per face of a cube drawn in one pass */
   hiz hz[6];
   const int nhz = ctx->faces ? 6 : 1;
@@ -1127,9 +1129,6 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
   if (!o->leaves) {
     err = rasterize_root(dev, ctx, &proto);
   } else {
-    /* Initial frusta: the whole image on one thread (the paper's set-up), else
-     * tiles aligned to the z tiles dealt out to the threads (no z tile has two
-     * writers); frustum_size forces a tile size. */
     /* A cube's faces, frustum by frustum: each triangle's eye part recorded by the
      * first face that sets it up, for the others (tri_eyes; records found by
      * 32-bit offsets) */
@@ -1149,6 +1148,9 @@ rr_error rr_vis_traverse(rr_device *dev, render_ctx *ctx) {
       for (int f = 0; f < nhz; f++) rr_hiz_free(&hz[f]);
       return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the traversal");
     }
+    /* Initial frusta: the whole image (each face's) on one thread (the paper's
+     * set-up), else tiles aligned to the z tiles dealt out to the threads (no z
+     * tile has two writers); frustum_size forces a tile size. */
     int whole = vb->width > vb->height ? vb->width : vb->height;
     int frustum = o->frustum_size > 0 ? o->frustum_size : whole;
     /* On several threads a job is a tile of 128..256 samples: whole-image frusta
