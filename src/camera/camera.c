@@ -271,9 +271,11 @@ bool rr_cam_dir_at(const camera *c, double sx, double sy, double d[3]) {
  * angle between any two samples is at most that times their L1 distance, so √2
  * times it bounds the angle per pixel of Euclidean distance. For the maps without a
  * closed-form bound (the OpenCV lenses). */
-static float measured_lipschitz(const camera *c) {
-  float worst = 0; /* the longest chord between unit rays */
-  for (int y = 0; y < c->height; y++)
+/* The longest chord between the unit rays of neighbouring samples in rows
+ * [y0, y1) and from them to the next row. */
+static float longest_chord(const camera *c, int y0, int y1) {
+  float worst = 0;
+  for (int y = y0; y < y1; y++)
     for (int x = 0; x < c->width; x++) {
       vec3 d = c->dirs[(size_t)y * c->width + x];
       if (d.x == 0 && d.y == 0 && d.z == 0) continue;
@@ -285,16 +287,80 @@ static float measured_lipschitz(const camera *c) {
         worst = fmaxf(worst, v3_len(v3_sub(d, e)));
       }
     }
-  return 2.0f * asinf(fminf(1.0f, 0.5f * worst)) * sqrtf(2.0f);
+  return worst;
+}
+
+/* At least the angle between unit a and d, about unit itself (within 1e-7 of
+ * length, as the stored rays and axes): the chord c, and asin(c/2) <= tan asin(c/2),
+ * so the angle 2 asin(c/2) <= c / √(1 − c²/4), tight for the small angles of
+ * cells (c²/8 relative) and with no library call; π beyond the range. */
+static double angle_over(const double a[3], vec3 d) {
+  const double x = a[0] - d.x, y = a[1] - d.y, z = a[2] - d.z, c2 = x * x + y * y + z * z;
+  return c2 < 3.9 ? sqrt(c2 / (1 - c2 / 4)) + 2e-7 : RR_PI;
+}
+
+static bool has_ray(vec3 d) { return d.x != 0 || d.y != 0 || d.z != 0; }
+
+/* d over its length, in double (d not zero). */
+static void unit_of(vec3 d, double a[3]) {
+  const double x = d.x, y = d.y, z = d.z, len = sqrt(x * x + y * y + z * z);
+  a[0] = x / len, a[1] = y / len, a[2] = z / len;
+}
+
+/* c->fine, cell rows [cy0, cy1): each CAMERA_FINE² cell's cone, about its centre sample's ray (else
+ * its first ray), as wide as its farthest ray. A lens's stretch varies over the
+ * image, without bound towards a fold inside it (a square root's slope): a cone
+ * grown from the centre ray by one Lipschitz constant would be wide everywhere,
+ * and one per cell still wide at the fold, where a cell's last step turns many
+ * times more than its others. */
+static void measure_cells(camera *c, int cy0, int cy1) {
+  const int n = CAMERA_FINE;
+  for (int cy = cy0; cy < cy1 && cy * n < c->height; cy++)
+    for (int cx = 0; cx * n < c->width; cx++) {
+      const int x0 = cx * n, y0 = cy * n, x1 = x0 + n < c->width ? x0 + n : c->width;
+      const int y1 = y0 + n < c->height ? y0 + n : c->height;
+      float *cell = c->fine + 4 * ((size_t)cy * c->fine_x + cx);
+      vec3 d = c->dirs[(size_t)((y0 + y1 - 1) / 2) * c->width + (x0 + x1 - 1) / 2];
+      for (int i = 0; i < (x1 - x0) * (y1 - y0) && !has_ray(d); i++)
+        d = c->dirs[(size_t)(y0 + i / (x1 - x0)) * c->width + x0 + i % (x1 - x0)];
+      cell[0] = cell[1] = cell[2] = 0, cell[3] = -1;
+      if (!has_ray(d)) continue;
+      double a[3], e[3], least = 1; /* the cosine: its acos is within 3e-8 of the angle */
+      unit_of(d, a);
+      for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++)
+          if (has_ray(c->dirs[(size_t)y * c->width + x])) {
+            unit_of(c->dirs[(size_t)y * c->width + x], e);
+            least = fmin(least, a[0] * e[0] + a[1] * e[1] + a[2] * e[2]);
+          }
+      /* (float rounding of the axis and angle: rr_cam_rect_cone's 1e-5 holds it) */
+      cell[0] = (float)a[0], cell[1] = (float)a[1], cell[2] = (float)a[2];
+      cell[3] = (float)(acos(fmax(-1.0, least)) + 1e-7);
+    }
 }
 
 /* A curved camera's table of rays, RAY_ROWS rows a job: curved_dir's, with the
- * columns' parts of the lat-long and parabolic maps (col) computed once. */
+ * columns' parts of the lat-long and parabolic maps (col) computed once; and a
+ * lens's cones of the cells in those rows. */
 enum { RAY_ROWS = 16 };
 typedef struct ray_table {
   camera *c;
   const vec3 *col;
 } ray_table;
+
+/* A band's longest chord (longest_chord), once the table is whole: the lenses'
+ * Lipschitz constant, measured. */
+typedef struct chord_rows {
+  const camera *c;
+  float *worst; /* per band */
+} chord_rows;
+
+static void chords_of_rows(int job, int thread, void *arg) {
+  (void)thread;
+  const chord_rows *cr = arg;
+  const int y1 = (job + 1) * RAY_ROWS < cr->c->height ? (job + 1) * RAY_ROWS : cr->c->height;
+  cr->worst[job] = longest_chord(cr->c, job * RAY_ROWS, y1);
+}
 
 static void ray_rows(int job, int thread, void *arg) {
   (void)thread;
@@ -318,55 +384,9 @@ static void ray_rows(int job, int thread, void *arg) {
       for (int x = 0; x < c->width; x++) row[x] = curved_dir(c, x, y, NULL);
     }
   }
-}
-
-/* At least the angle between unit a and d, about unit itself (within 1e-7 of
- * length, as the stored rays and axes): the chord c, and asin(c/2) <= tan asin(c/2),
- * so the angle 2 asin(c/2) <= c / √(1 − c²/4), tight for the small angles of
- * cells (c²/8 relative) and with no library call; π beyond the range. */
-static double angle_over(const double a[3], vec3 d) {
-  const double x = a[0] - d.x, y = a[1] - d.y, z = a[2] - d.z, c2 = x * x + y * y + z * z;
-  return c2 < 3.9 ? sqrt(c2 / (1 - c2 / 4)) + 2e-7 : RR_PI;
-}
-
-static bool has_ray(vec3 d) { return d.x != 0 || d.y != 0 || d.z != 0; }
-
-/* d over its length, in double (d not zero). */
-static void unit_of(vec3 d, double a[3]) {
-  const double x = d.x, y = d.y, z = d.z, len = sqrt(x * x + y * y + z * z);
-  a[0] = x / len, a[1] = y / len, a[2] = z / len;
-}
-
-/* c->fine: each CAMERA_FINE² cell's cone, about its centre sample's ray (else
- * its first ray), as wide as its farthest ray. A lens's stretch varies over the
- * image, without bound towards a fold inside it (a square root's slope): a cone
- * grown from the centre ray by one Lipschitz constant would be wide everywhere,
- * and one per cell still wide at the fold, where a cell's last step turns many
- * times more than its others. */
-static void measure_cones(camera *c) {
-  const int n = CAMERA_FINE;
-  for (int cy = 0; cy * n < c->height; cy++)
-    for (int cx = 0; cx * n < c->width; cx++) {
-      const int x0 = cx * n, y0 = cy * n, x1 = x0 + n < c->width ? x0 + n : c->width;
-      const int y1 = y0 + n < c->height ? y0 + n : c->height;
-      float *cell = c->fine + 4 * ((size_t)cy * c->fine_x + cx);
-      vec3 d = c->dirs[(size_t)((y0 + y1 - 1) / 2) * c->width + (x0 + x1 - 1) / 2];
-      for (int i = 0; i < (x1 - x0) * (y1 - y0) && !has_ray(d); i++)
-        d = c->dirs[(size_t)(y0 + i / (x1 - x0)) * c->width + x0 + i % (x1 - x0)];
-      cell[0] = cell[1] = cell[2] = 0, cell[3] = -1;
-      if (!has_ray(d)) continue;
-      double a[3], e[3], least = 1; /* the cosine: its acos is within 3e-8 of the angle */
-      unit_of(d, a);
-      for (int y = y0; y < y1; y++)
-        for (int x = x0; x < x1; x++)
-          if (has_ray(c->dirs[(size_t)y * c->width + x])) {
-            unit_of(c->dirs[(size_t)y * c->width + x], e);
-            least = fmin(least, a[0] * e[0] + a[1] * e[1] + a[2] * e[2]);
-          }
-      /* (float rounding of the axis and angle: rr_cam_rect_cone's 1e-5 holds it) */
-      cell[0] = (float)a[0], cell[1] = (float)a[1], cell[2] = (float)a[2];
-      cell[3] = (float)(acos(fmax(-1.0, least)) + 1e-7);
-    }
+  /* a lens's cells of these rows, which hold whole cells */
+  _Static_assert(RAY_ROWS % CAMERA_FINE == 0, "a band of rays holds whole cells");
+  if (c->fine) measure_cells(c, job * (RAY_ROWS / CAMERA_FINE), (job + 1) * (RAY_ROWS / CAMERA_FINE));
 }
 
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
@@ -438,6 +458,12 @@ rr_error rr_cam_setup_threads(rr_device *dev, const rr_camera *in, int width, in
       c->lens.cx = 0.5f * (float)width - 0.5f, c->lens.cy = 0.5f * (float)height - 0.5f;
     }
     c->lens_field = rr_lens_field(&c->lens, c->lens_fold, width, height);
+    c->fine_x = (width + CAMERA_FINE - 1) / CAMERA_FINE; /* (measured with the rays) */
+    c->fine = malloc((size_t)c->fine_x * ((height + CAMERA_FINE - 1) / CAMERA_FINE) * 4 * sizeof *c->fine);
+    if (!c->fine) {
+      rr_cam_release(c);
+      return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
+    }
   }
   /* curved_dir's rays, with what depends on the column alone computed once a
    * column, in bands of rows on the threads */
@@ -465,16 +491,19 @@ rr_error rr_cam_setup_threads(rr_device *dev, const rr_camera *in, int width, in
     c->lipschitz = in->fov_deg * (float)RR_PI / 360.0f * 2.0f / (float)(width < height ? width : height);
     break;
   case RR_CAMERA_OPENCV:
-  case RR_CAMERA_OPENCV_FISHEYE:
-    c->lipschitz = measured_lipschitz(c);
-    c->fine_x = (width + CAMERA_FINE - 1) / CAMERA_FINE;
-    c->fine = malloc((size_t)c->fine_x * ((height + CAMERA_FINE - 1) / CAMERA_FINE) * 4 * sizeof *c->fine);
-    if (!c->fine) {
+  case RR_CAMERA_OPENCV_FISHEYE: { /* the longest chord between neighbouring rays, band by band on the threads */
+    const int bands = (height + RAY_ROWS - 1) / RAY_ROWS;
+    float *worst = malloc((size_t)bands * sizeof *worst), most = 0;
+    if (!worst) {
       rr_cam_release(c);
       return rr_fail(dev, RR_ERROR_MEMORY, "out of memory for the camera's %dx%d rays", width, height);
     }
-    measure_cones(c);
+    rr_parallel_for(bands, threads, chords_of_rows, &(chord_rows){c, worst});
+    for (int b = 0; b < bands; b++) most = fmaxf(most, worst[b]);
+    free(worst);
+    c->lipschitz = 2.0f * asinf(fminf(1.0f, 0.5f * most)) * sqrtf(2.0f);
     break;
+  }
   default:
     break;
   }
