@@ -145,8 +145,8 @@ static vec3 cube_dir(const camera *c, int x, int y) {
 
 /* The lat-long map's angles of column x and row y, and its direction from the
  * horizontal one of the column and the row's sine and cosine: written once for
- * curved_dir and the table (rr_cam_setup_at, which takes the sines a column and
- * a row at a time), so both give the same bits. */
+ * curved_dir and the table (ray_rows, which takes the sines a column and a row at
+ * a time), so both give the same bits. */
 static double latlong_phi(const camera *c, int x) {
   return 2 * RR_PI * (x + (double)c->sx0) / c->width - RR_PI;
 }
@@ -266,13 +266,12 @@ bool rr_cam_dir_at(const camera *c, double sx, double sy, double d[3]) {
   return true;
 }
 
-/* The largest angle between the rays of two samples one pixel apart (in x or y) of
- * a curved camera, over the whole image: along a staircase path of such steps the
- * angle between any two samples is at most that times their L1 distance, so √2
- * times it bounds the angle per pixel of Euclidean distance. For the maps without a
- * closed-form bound (the OpenCV lenses). */
-/* The longest chord between the unit rays of neighbouring samples in rows
- * [y0, y1) and from them to the next row. */
+/* The longest chord between the unit rays of samples one pixel apart (in x or y)
+ * of a curved camera, from rows [y0, y1): its angle, over the whole image, is the
+ * measured Lipschitz constant of the maps without a closed-form bound (the OpenCV
+ * lenses). Along a staircase path of such steps the angle between any two samples
+ * is at most that times their L1 distance, so √2 times it bounds the angle per
+ * pixel of Euclidean distance. */
 static float longest_chord(const camera *c, int y0, int y1) {
   float worst = 0;
   for (int y = y0; y < y1; y++)
@@ -307,8 +306,8 @@ static void unit_of(vec3 d, double a[3]) {
   a[0] = x / len, a[1] = y / len, a[2] = z / len;
 }
 
-/* c->fine, cell rows [cy0, cy1): each CAMERA_FINE² cell's cone, about its centre sample's ray (else
- * its first ray), as wide as its farthest ray. A lens's stretch varies over the
+/* c->fine, cell rows [cy0, cy1): each CAMERA_FINE² cell's cone, about its centre
+ * sample's ray (else its first ray), as wide as its farthest ray. A lens's stretch varies over the
  * image, without bound towards a fold inside it (a square root's slope): a cone
  * grown from the centre ray by one Lipschitz constant would be wide everywhere,
  * and one per cell still wide at the fold, where a cell's last step turns many
@@ -348,20 +347,6 @@ typedef struct ray_table {
   const vec3 *col;
 } ray_table;
 
-/* A band's longest chord (longest_chord), once the table is whole: the lenses'
- * Lipschitz constant, measured. */
-typedef struct chord_rows {
-  const camera *c;
-  float *worst; /* per band */
-} chord_rows;
-
-static void chords_of_rows(int job, int thread, void *arg) {
-  (void)thread;
-  const chord_rows *cr = arg;
-  const int y1 = (job + 1) * RAY_ROWS < cr->c->height ? (job + 1) * RAY_ROWS : cr->c->height;
-  cr->worst[job] = longest_chord(cr->c, job * RAY_ROWS, y1);
-}
-
 static void ray_rows(int job, int thread, void *arg) {
   (void)thread;
   const ray_table *rt = arg;
@@ -387,6 +372,20 @@ static void ray_rows(int job, int thread, void *arg) {
   /* a lens's cells of these rows, which hold whole cells */
   _Static_assert(RAY_ROWS % CAMERA_FINE == 0, "a band of rays holds whole cells");
   if (c->fine) measure_cells(c, job * (RAY_ROWS / CAMERA_FINE), (job + 1) * (RAY_ROWS / CAMERA_FINE));
+}
+
+/* A band's longest chord (longest_chord), once the table is whole: the lenses'
+ * Lipschitz constant, measured. */
+typedef struct chord_rows {
+  const camera *c;
+  float *worst; /* per band */
+} chord_rows;
+
+static void chords_of_rows(int job, int thread, void *arg) {
+  (void)thread;
+  const chord_rows *cr = arg;
+  const int y1 = (job + 1) * RAY_ROWS < cr->c->height ? (job + 1) * RAY_ROWS : cr->c->height;
+  cr->worst[job] = longest_chord(cr->c, job * RAY_ROWS, y1);
 }
 
 rr_error rr_cam_setup(rr_device *dev, const rr_camera *in, int width, int height, camera *c) {
@@ -491,7 +490,7 @@ rr_error rr_cam_setup_threads(rr_device *dev, const rr_camera *in, int width, in
     c->lipschitz = in->fov_deg * (float)RR_PI / 360.0f * 2.0f / (float)(width < height ? width : height);
     break;
   case RR_CAMERA_OPENCV:
-  case RR_CAMERA_OPENCV_FISHEYE: { /* the longest chord between neighbouring rays, band by band on the threads */
+  case RR_CAMERA_OPENCV_FISHEYE: { /* the longest chord, band by band on the threads */
     const int bands = (height + RAY_ROWS - 1) / RAY_ROWS;
     float *worst = malloc((size_t)bands * sizeof *worst), most = 0;
     if (!worst) {
