@@ -254,14 +254,10 @@ TARGET static void RR_CAT(setup_one, W)(const rr_scene *s, const uint32_t *ids, 
     RR_CAT(setup_lanes, W)(s, ids, count, c, cull, out, face, pl, true);
 }
 
-/* The shared setup (triangle.h, rr_tri_setup_shared): EYE of every triangle once,
- * stored by field (rec), then, for each camera, the triangles it asks for gathered
- * W to a step (loaded when they are W in a row) and set up for it. Stored and
- * gathered floats keep their bits, and view_lanes computes what it computes for
- * the triangles in any lanes. With keep, EYE comes from its record where one is
- * ready; the others are computed and recorded. Returns how many were computed. */
-/* EYE's fields (TRI_EYE_REC: p1, p2, pf, n, vol; at_inf, inf1, inf2 only when inf)
- * into field f, lane l at at[f·fstride + l] */
+/* EYE's fields (TRI_EYE_REC: p1, p2, pf, n, vol, the 19 every scene needs; at_inf,
+ * inf1, inf2 only when inf) into field f, lane l at at[f·fstride + l]. Stored and
+ * loaded floats keep their bits, and view_lanes computes what it computes for the
+ * triangles in any lanes. */
 TARGET __attribute__((always_inline)) static inline void RR_CAT(eye_store, W)(const EYE *e, bool inf, float *at,
                                                                             size_t fstride) {
 #define STORE_F(f, v) memcpy(at + (f) * fstride, &(v), W * sizeof(float))
@@ -302,6 +298,9 @@ TARGET __attribute__((always_inline)) static inline void RR_CAT(eye_load, W)(con
 #undef GATHER_F
 }
 
+/* The shared setup (triangle.h, rr_tri_setup_shared): EYE of every triangle once,
+ * stored by field (rec), then, for each camera, the triangles it asks for gathered
+ * W to a step (loaded when they are W in a row) and set up for it. */
 TARGET __attribute__((always_inline)) static inline void RR_CAT(setup_shared_lanes, W)(
     const rr_scene *s, const uint32_t *ids, int n, const camera *cams, int ncams, const int32_t *sel, const int *nsel,
     bool cull, tri_setup *out, size_t ostride, int *face, tri_plane *pl, size_t pstride, bool flat) {
